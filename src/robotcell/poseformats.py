@@ -1,0 +1,169 @@
+"""Vendor pose formats, both ways, through :class:`scipy.spatial.transform.Rotation`.
+
+Robot controllers write a pose as a position in millimetres and an orientation as three Euler
+angles in degrees (KUKA, Fanuc, Yaskawa, Staubli), a scalar-first quaternion (ABB) or, in SI
+units, a rotation vector (Universal Robots). The table of conventions with their sources is in
+``docs/conventions.md``. Inside robotcell a pose is a 4x4 matrix in metres.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.errors import InputError
+from robotcell.transforms import validate_pose
+
+__all__ = ["FORMATS", "PoseFormat", "pose_from_vendor", "pose_to_vendor"]
+
+#: Largest deviation of a quaternion's norm from 1 that is renormalised rather than refused.
+QUAT_NORM_TOL = 1e-4
+
+
+@dataclass(frozen=True)
+class PoseFormat:
+    """How one vendor writes a pose.
+
+    Attributes
+    ----------
+    name : str
+        Format name used by the API and the CLI (``kuka``, ``abb``, ...).
+    fields : tuple of str
+        Names of the values in the order the vendor writes them.
+    units : str
+        Units of the values, for humans.
+    euler : str or None
+        scipy Euler sequence whose angles are the vendor's angles in the order of ``angle_order``,
+        or None for quaternion / rotation-vector formats.
+    angle_order : tuple of int
+        Index into the vendor's three angles giving the order scipy's ``euler`` sequence expects.
+    length_scale : float
+        Metres per vendor length unit.
+    """
+
+    name: str
+    fields: tuple[str, ...]
+    units: str
+    euler: str | None = None
+    angle_order: tuple[int, int, int] = (0, 1, 2)
+    length_scale: float = 1e-3
+
+    @property
+    def size(self) -> int:
+        """Number of values in one pose."""
+        return len(self.fields)
+
+
+FORMATS: dict[str, PoseFormat] = {
+    f.name: f
+    for f in (
+        # R = Rz(A) Ry(B) Rx(C): intrinsic Z-Y'-X'' with angles (A, B, C).
+        PoseFormat("kuka", ("X", "Y", "Z", "A", "B", "C"), "mm, deg", "ZYX"),
+        # R = Rz(R) Ry(P) Rx(W): intrinsic Z-Y'-X'' with angles (R, P, W).
+        PoseFormat("fanuc", ("X", "Y", "Z", "W", "P", "R"), "mm, deg", "ZYX", (2, 1, 0)),
+        PoseFormat("yaskawa", ("X", "Y", "Z", "Rx", "Ry", "Rz"), "mm, deg", "ZYX", (2, 1, 0)),
+        # R = Rx(Rx) Ry(Ry) Rz(Rz): intrinsic X-Y'-Z''.
+        PoseFormat("staubli", ("X", "Y", "Z", "Rx", "Ry", "Rz"), "mm, deg", "XYZ"),
+        PoseFormat("abb", ("x", "y", "z", "q1", "q2", "q3", "q4"), "mm, unit quaternion"),
+        PoseFormat("ur", ("x", "y", "z", "rx", "ry", "rz"), "m, rad (rotation vector)",
+                   length_scale=1.0),
+    )
+}
+
+
+def _format(fmt: str) -> PoseFormat:
+    try:
+        return FORMATS[fmt.lower()]
+    except KeyError:
+        raise InputError(
+            f"unknown pose format {fmt!r}; choose one of: {', '.join(FORMATS)}"
+        ) from None
+
+
+def pose_from_vendor(values: ArrayLike, fmt: str) -> NDArray[np.float64]:
+    """Convert poses written in a vendor format to 4x4 matrices.
+
+    Parameters
+    ----------
+    values : array_like, shape (..., k)
+        Poses as the vendor writes them: ``k = 6`` (``k = 7`` for ``abb``), in the vendor's units
+        (millimetres and degrees; metres and radians for ``ur``).
+    fmt : str
+        One of ``kuka``, ``fanuc``, ``yaskawa``, ``staubli``, ``abb``, ``ur``.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+        Poses with translation in metres.
+
+    Examples
+    --------
+    >>> T = pose_from_vendor([100, 0, 50, 30, 20, 10], "kuka")
+    >>> pose_to_vendor(T, "fanuc").round(6).tolist()
+    [100.0, 0.0, 50.0, 10.0, 20.0, 30.0]
+    """
+    f = _format(fmt)
+    v = np.asarray(values, dtype=float)
+    if v.ndim < 1 or v.shape[-1] != f.size:
+        raise InputError(
+            f"a {f.name} pose has {f.size} values ({', '.join(f.fields)}), got shape {v.shape}"
+        )
+    if not np.all(np.isfinite(v)):
+        raise InputError(f"{f.name} pose contains NaN or infinite values")
+    batch = v.shape[:-1]
+    flat = v.reshape(-1, f.size)
+    if f.name == "abb":
+        q = flat[:, 3:]
+        norm = np.linalg.norm(q, axis=1)
+        bad = np.abs(norm - 1.0) > QUAT_NORM_TOL
+        if np.any(bad):
+            raise InputError(
+                f"ABB quaternion q1..q4 must be normalised (|q| = 1); got |q| = {norm[bad][0]:.6g}"
+            )
+        rot = Rotation.from_quat(q, scalar_first=True)
+    elif f.name == "ur":
+        rot = Rotation.from_rotvec(flat[:, 3:])
+    else:
+        rot = Rotation.from_euler(f.euler, flat[:, 3:][:, list(f.angle_order)], degrees=True)
+    T = np.zeros((flat.shape[0], 4, 4))
+    T[:, :3, :3] = rot.as_matrix()
+    T[:, :3, 3] = flat[:, :3] * f.length_scale
+    T[:, 3, 3] = 1.0
+    return T.reshape(batch + (4, 4))
+
+
+def pose_to_vendor(T: ArrayLike, fmt: str) -> NDArray[np.float64]:
+    """Convert 4x4 poses to a vendor format.
+
+    Parameters
+    ----------
+    T : array_like, shape (..., 4, 4)
+        Poses with translation in metres; must be proper rigid transforms.
+    fmt : str
+        One of ``kuka``, ``fanuc``, ``yaskawa``, ``staubli``, ``abb``, ``ur``.
+
+    Returns
+    -------
+    ndarray, shape (..., k)
+        ``k = 6`` (``7`` for ``abb``) values in the vendor's units. Euler formats return the middle
+        angle in ``[-90, 90]`` degrees; ABB quaternions have ``q1 >= 0``.
+    """
+    f = _format(fmt)
+    arr = validate_pose(T)
+    batch = arr.shape[:-2]
+    flat = arr.reshape(-1, 4, 4)
+    rot = Rotation.from_matrix(flat[:, :3, :3])
+    if f.name == "abb":
+        q = rot.as_quat(scalar_first=True, canonical=True)
+        ang = q / np.linalg.norm(q, axis=1, keepdims=True)
+    elif f.name == "ur":
+        ang = rot.as_rotvec()
+    else:
+        e = rot.as_euler(f.euler, degrees=True)
+        ang = np.empty_like(e)
+        ang[:, list(f.angle_order)] = e
+    out = np.concatenate([flat[:, :3, 3] / f.length_scale, ang], axis=1)
+    return out.reshape(batch + (f.size,))

@@ -1,0 +1,304 @@
+"""A serial robot arm described by Denavit-Hartenberg parameters.
+
+``T_R_TCP(q) = T_R_0 · T_0_1(q_1) ··· T_{n-1,n}(q_n) · T_n_F · T_F_TCP`` with the base transform
+``T_R_0``, the DH chain, the flange transform ``T_n_F`` and the tool ``T_F_TCP``. Joint values are
+controller axis values (see ``docs/conventions.md``): the DH variable is ``sign * q + offset``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.dh import Chain, Convention
+from robotcell.errors import InputError
+from robotcell.transforms import validate_pose
+
+__all__ = ["Joint", "Robot"]
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One joint of a DH chain, in SI units.
+
+    Attributes
+    ----------
+    type : {"revolute", "prismatic"}
+    a : float
+        Link length (m); Craig's ``a_{i-1}`` in the modified convention.
+    alpha : float
+        Link twist (rad); Craig's ``alpha_{i-1}`` in the modified convention.
+    d : float
+        Joint distance (m); for a prismatic joint the constant added to ``sign * q``.
+    theta : float
+        Joint angle (rad); for a revolute joint the constant added to ``sign * q``.
+    sign : float
+        +1 or -1, direction of the controller axis relative to the DH variable.
+    lower, upper : float
+        Limits of the controller axis value ``q`` (rad or m); infinite when unlimited.
+    name : str
+        Axis name as the controller shows it (``A1``, ``J1``, ...).
+    """
+
+    type: Literal["revolute", "prismatic"]
+    a: float = 0.0
+    alpha: float = 0.0
+    d: float = 0.0
+    theta: float = 0.0
+    sign: float = 1.0
+    lower: float = -math.inf
+    upper: float = math.inf
+    name: str = ""
+
+    @property
+    def prismatic(self) -> bool:
+        """True for a prismatic (sliding) joint."""
+        return self.type == "prismatic"
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """A serial arm: DH joints, base, flange and tool transforms, provenance.
+
+    Build one with :func:`robotcell.load_robot` (library name or model file) or directly.
+
+    Attributes
+    ----------
+    name : str
+    joints : tuple of Joint
+    convention : {"standard", "modified"}
+    base : ndarray, shape (4, 4)
+        ``T_R_0``, pose of DH frame 0 in the robot base frame R (metres).
+    flange : ndarray, shape (4, 4)
+        ``T_n_F``, pose of the flange frame in the last DH frame (metres).
+    tool : ndarray, shape (4, 4)
+        ``T_F_TCP``, the default tool: pose of the TCP in the flange frame (metres).
+    home : ndarray, shape (n,) or None
+        A typical home configuration (rad, m).
+    title, source, verification : str
+        Human name, citation of the parameters, and how they were checked.
+    verified : bool
+        True when the model was checked against an independent published value.
+    """
+
+    name: str
+    joints: tuple[Joint, ...]
+    convention: Convention = "standard"
+    base: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    flange: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    tool: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    home: NDArray[np.float64] | None = None
+    title: str = ""
+    source: str = ""
+    verified: bool = False
+    verification: str = ""
+
+    def __post_init__(self) -> None:
+        if self.convention not in ("standard", "modified"):
+            raise InputError(f"convention must be 'standard' or 'modified', got {self.convention!r}")
+        if not self.joints:
+            raise InputError("a robot needs at least one joint")
+        for i, j in enumerate(self.joints, start=1):
+            if j.type not in ("revolute", "prismatic"):
+                raise InputError(f"joint {i}: type must be 'revolute' or 'prismatic', got {j.type!r}")
+            if j.sign not in (1.0, -1.0):
+                raise InputError(f"joint {i}: sign must be +1 or -1, got {j.sign}")
+            if not j.lower < j.upper:
+                raise InputError(f"joint {i}: lower limit {j.lower} is not below upper limit {j.upper}")
+        for key in ("base", "flange", "tool"):
+            object.__setattr__(self, key, validate_pose(getattr(self, key), key).copy())
+        if self.home is not None:
+            object.__setattr__(self, "home", self._joints(self.home, "home"))
+        js = self.joints
+        chain = Chain(self.convention, [j.a for j in js], [j.alpha for j in js], [j.d for j in js],
+                      [j.theta for j in js], [j.prismatic for j in js], [j.sign for j in js])
+        object.__setattr__(self, "_chain", chain)
+        self._set_tail()
+
+    def _set_tail(self) -> None:
+        tail = self.flange @ self.tool
+        object.__setattr__(self, "_tail", tail)
+        # Start pose of the single-pose kernel, as columns; the tail is applied afterwards.
+        object.__setattr__(self, "_start_cols", [self.base[:3, k].tolist() for k in range(4)])
+        object.__setattr__(self, "_tail_cols", tail[:3, :].tolist())
+        object.__setattr__(self, "_tail_is_identity", bool(np.array_equal(tail, np.eye(4))))
+
+    # -- properties -----------------------------------------------------------------------------
+    @property
+    def n_joints(self) -> int:
+        """Number of joints ``n``."""
+        return len(self.joints)
+
+    @property
+    def lower(self) -> NDArray[np.float64]:
+        """Lower joint limits, shape ``(n,)`` (rad or m)."""
+        return np.array([j.lower for j in self.joints])
+
+    @property
+    def upper(self) -> NDArray[np.float64]:
+        """Upper joint limits, shape ``(n,)`` (rad or m)."""
+        return np.array([j.upper for j in self.joints])
+
+    @property
+    def prismatic(self) -> NDArray[np.bool_]:
+        """Mask of prismatic joints, shape ``(n,)``."""
+        return np.array([j.prismatic for j in self.joints])
+
+    def with_tool(self, tool: ArrayLike) -> Robot:
+        """Return a copy whose default tool is ``tool`` (``T_F_TCP``, shape (4, 4), metres)."""
+        return replace(self, tool=np.asarray(tool, dtype=float))
+
+    def with_base(self, base: ArrayLike) -> Robot:
+        """Return a copy whose base transform is ``base`` (``T_R_0``, shape (4, 4), metres)."""
+        return replace(self, base=np.asarray(base, dtype=float))
+
+    # -- validation -----------------------------------------------------------------------------
+    def _joints(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
+        try:
+            arr = np.asarray(q, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{name} must be numeric: {exc}") from None
+        if arr.ndim == 0 or arr.shape[-1] != self.n_joints:
+            raise InputError(
+                f"{self.name} has {self.n_joints} joints; {name} must have shape (..., "
+                f"{self.n_joints}), got {arr.shape}"
+            )
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"{name} contains NaN or infinite values")
+        return arr
+
+    def within_limits(self, q: ArrayLike, tol: float = 0.0) -> NDArray[np.bool_]:
+        """Whether joint values respect the limits.
+
+        Parameters
+        ----------
+        q : array_like, shape (..., n)
+            Joint values (rad, m).
+        tol : float
+            Allowed excess beyond a limit (rad or m).
+
+        Returns
+        -------
+        ndarray of bool, shape (...)
+        """
+        arr = self._joints(q)
+        return np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
+
+    def dh_variables(self, q: ArrayLike) -> NDArray[np.float64]:
+        """DH variables ``sign * q + offset`` (theta for revolute, d for prismatic), ``(..., n)``."""
+        arr = self._joints(q)
+        sign = np.array([j.sign for j in self.joints])
+        off = np.array([j.d if j.prismatic else j.theta for j in self.joints])
+        return sign * arr + off
+
+    # -- kinematics -----------------------------------------------------------------------------
+    def fk(self, q: ArrayLike, tool: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Forward kinematics: the arm matrix ``T_R_TCP``.
+
+        Parameters
+        ----------
+        q : array_like, shape (..., n)
+            Joint values (controller axis values; rad for revolute, m for prismatic joints).
+        tool : array_like, shape (4, 4), optional
+            ``T_F_TCP`` to use instead of the robot's default tool (metres).
+
+        Returns
+        -------
+        ndarray, shape (..., 4, 4)
+            Pose of the TCP in the robot base frame (metres).
+        """
+        if tool is None:
+            tail = self._tail
+        else:
+            tail = self.flange @ validate_pose(tool, "tool")
+        # One pose: evaluate with Python floats, much cheaper than numpy calls on tiny arrays.
+        if isinstance(q, (list, tuple)) or (isinstance(q, np.ndarray) and q.ndim == 1):
+            vals = q.tolist() if isinstance(q, np.ndarray) else [float(v) for v in q]
+            if len(vals) != self.n_joints or not math.isfinite(sum(vals)):
+                self._joints(vals)  # raises the precise error
+            m = self._chain.apply_one(self._start_cols, vals)
+            if tool is None and self._tail_is_identity:
+                a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
+                return np.array(
+                    (a0, b0, c0, p0, a1, b1, c1, p1, a2, b2, c2, p2, 0.0, 0.0, 0.0, 1.0)
+                ).reshape(4, 4)
+            tc = self._tail_cols if tool is None else tail[:3, :].tolist()
+            return _compose_cols(m, tc)
+        arr = self._joints(q)
+        batch = arr.shape[:-1]
+        T = self._chain.apply(self.base, arr.reshape(-1, self.n_joints))
+        if tool is not None or not self._tail_is_identity:
+            T = T @ tail
+        return T.reshape(batch + (4, 4))
+
+    def frames(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Every DH frame in the robot base frame: ``T_R_i`` for ``i = 0..n``.
+
+        Parameters
+        ----------
+        q : array_like, shape (..., n)
+            Joint values (rad, m).
+
+        Returns
+        -------
+        ndarray, shape (..., n + 1, 4, 4)
+            ``frames[..., 0]`` is the base transform ``T_R_0``; ``frames[..., i]`` is ``T_R_i``.
+            The flange is ``frames[..., n] @ robot.flange``.
+        """
+        arr = self._joints(q)
+        batch = arr.shape[:-1]
+        F = self._chain.apply(self.base, arr.reshape(-1, self.n_joints), frames=True)
+        return F.reshape(batch + (self.n_joints + 1, 4, 4))
+
+    def jacobian(self, q: ArrayLike, tool: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Geometric Jacobian in the robot base frame, for the TCP.
+
+        Parameters
+        ----------
+        q : array_like, shape (..., n)
+            Joint values (rad, m).
+        tool : array_like, shape (4, 4), optional
+            ``T_F_TCP`` to use instead of the default tool (metres).
+
+        Returns
+        -------
+        ndarray, shape (..., 6, n)
+            Rows ``(vx, vy, vz, wx, wy, wz)``: the TCP's linear velocity (m/s) and the angular
+            velocity (rad/s) per unit velocity of each controller axis (rad/s or m/s).
+        """
+        F = self.frames(q)
+        tail = self._tail if tool is None else self.flange @ validate_pose(tool, "tool")
+        p_e = (F[..., -1, :, :] @ tail)[..., :3, 3]
+        # Joint i moves about Z_{i-1} (standard DH) or Z_i (modified DH).
+        axes = F[..., :-1, :, :] if self.convention == "standard" else F[..., 1:, :, :]
+        z = axes[..., :3, 2]
+        o = axes[..., :3, 3]
+        sign = np.array([j.sign for j in self.joints])[:, None]
+        pris = self.prismatic[:, None]
+        v = np.where(pris, z, np.cross(z, p_e[..., None, :] - o))
+        w = np.where(pris, 0.0, z)
+        J = np.concatenate([v * sign, w * sign], axis=-1)  # (..., n, 6)
+        return np.swapaxes(J, -1, -2)
+
+
+def _compose_cols(m: list[float], tail: list[list[float]]) -> NDArray[np.float64]:
+    """``[[R, p], [0, 1]] @ tail`` for a chain result given as columns and a 3x4 tail."""
+    a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
+    out = []
+    for row in range(4):
+        if row == 3:
+            out.extend((0.0, 0.0, 0.0, 1.0))
+            break
+        r0, r1, r2, pr = ((a0, b0, c0, p0), (a1, b1, c1, p1), (a2, b2, c2, p2))[row]
+        t = tail
+        out.extend((
+            r0 * t[0][0] + r1 * t[1][0] + r2 * t[2][0],
+            r0 * t[0][1] + r1 * t[1][1] + r2 * t[2][1],
+            r0 * t[0][2] + r1 * t[1][2] + r2 * t[2][2],
+            r0 * t[0][3] + r1 * t[1][3] + r2 * t[2][3] + pr,
+        ))
+    return np.array(out).reshape(4, 4)
