@@ -1,0 +1,77 @@
+"""The ``robotcell`` command line.
+
+Subcommands live in their own modules and are imported only when used, so that
+``robotcell --help`` and every command start fast.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+
+import click
+
+from robotcell import __version__
+from robotcell.errors import RobotcellError
+
+#: command name -> "module:attribute" of its click command
+COMMANDS = {
+    "robots": "robotcell.cli.robots:robots",
+    "fk": "robotcell.cli.fk:fk",
+    "ik": "robotcell.cli.ik:ik",
+    "calibrate": "robotcell.cli.calibrate:calibrate",
+    "dh": "robotcell.cli.dh:dh",
+    "export": "robotcell.cli.export:export",
+    "simulate": "robotcell.cli.simulate:simulate",
+    "plan": "robotcell.cli.plan:plan",
+    "report": "robotcell.cli.report:report",
+    "demo": "robotcell.cli.demo:demo",
+}
+
+
+class LazyGroup(click.Group):
+    """A click group whose subcommands are imported on first use."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(
+            name for name, target in COMMANDS.items()
+            if importlib.util.find_spec(target.split(":")[0]) is not None
+        )
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in self.list_commands(ctx):
+            return None
+        module, attr = COMMANDS[name].split(":")
+        return getattr(importlib.import_module(module), attr)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="robotcell")
+def cli() -> None:
+    """Kinematics and calibration of industrial robot cells.
+
+    Files and terminal output use millimetres and degrees; see docs/conventions.md.
+
+    \b
+    Example:
+      robotcell robots
+      robotcell fk kuka_kr16 --joints 0,-90,90,0,0,0 --format kuka
+    """
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point: run the CLI; refused input exits with status 2 and the reason on stderr."""
+    try:
+        cli.main(args=argv, prog_name="robotcell", standalone_mode=False)
+    except click.exceptions.Abort:
+        click.echo("aborted", err=True)
+        sys.exit(1)
+    except click.ClickException as exc:
+        exc.show()
+        sys.exit(exc.exit_code)
+    except RobotcellError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
+    except click.exceptions.Exit as exc:
+        sys.exit(exc.exit_code)
