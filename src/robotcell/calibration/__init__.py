@@ -1,0 +1,34 @@
+"""Calibration of a robot cell from touch-up measurements.
+
+Every procedure is a maximum-likelihood fit under isotropic Gaussian noise on the measured points
+and returns a :class:`CalibrationResult` (SI units inside; mm and degrees in its JSON and text
+report). Shared pieces: :mod:`.result` (the result), :mod:`.fitting` (least squares, covariance,
+conditioning, outliers, rotation parameterisation), :mod:`.measurements` (CSV columns to SI).
+See ``docs/calibration.md``.
+"""
+
+from robotcell.calibration.fitting import (
+    Fit,
+    fit,
+    kabsch,
+    nearest_rotation,
+    outlier_warnings,
+    perturb_pose,
+    perturb_rotation,
+    pose_sigma,
+)
+from robotcell.calibration.result import CalibrationResult, pose_fields, to_jsonable
+
+__all__ = [
+    "CalibrationResult",
+    "Fit",
+    "fit",
+    "kabsch",
+    "nearest_rotation",
+    "outlier_warnings",
+    "perturb_pose",
+    "perturb_rotation",
+    "pose_fields",
+    "pose_sigma",
+    "to_jsonable",
+]

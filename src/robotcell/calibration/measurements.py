@@ -1,0 +1,288 @@
+"""Measurement tables (CSV columns, vendor units) to SI arrays for the calibration procedures.
+
+The CSV contract (see ``docs/calibration.md``): a header line; lengths in millimetres, angles in
+degrees. Column names are case-insensitive.
+
+- TCP positions in the robot base frame: ``x, y, z`` (mm), or joint values ``a1..an`` (deg; mm
+  for prismatic joints) together with a robot model and the tool that was active.
+- Flange poses (tool calibration): ``x, y, z, a, b, c`` (KUKA: ``R = Rz(A) Ry(B) Rx(C)``) or
+  ``a1..an`` with a robot model (the flange pose is computed with no tool).
+- ``e1``: external axis value, mm for a linear track, deg for a turntable.
+- ``point``: the role of a touch in a 3-point frame (``origin``, ``x``, ``xy``).
+- ``nominal_x, nominal_y, nominal_z``: known coordinates of a touched point in the frame being
+  calibrated (mm), for N-point frames.
+
+Columns come from :func:`robotcell.cli.common.read_csv` (lower-cased names; numeric columns as
+float arrays, others as lists of strings).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from robotcell.errors import InputError
+from robotcell.poseformats import pose_from_vendor
+from robotcell.robot import Robot
+
+__all__ = [
+    "MM_LOOKS_LIKE_M",
+    "check_count",
+    "check_no_repeats",
+    "external_axis",
+    "flange_poses",
+    "joint_columns",
+    "nominal_points",
+    "point_roles",
+    "tcp_positions",
+]
+
+#: When every length in a column set stays below this many millimetres, the file is taken to be
+#: in metres by mistake: a robot workspace written in mm spans hundreds of millimetres.
+MM_LOOKS_LIKE_M = 5.0
+
+Columns = Mapping[str, Any]
+
+
+def _numeric(cols: Columns, names: Sequence[str], source: str) -> NDArray[np.float64]:
+    missing = [n for n in names if n not in cols]
+    if missing:
+        raise InputError(f"{source}: missing column(s) {', '.join(missing)} "
+                         f"(have: {', '.join(cols) or 'none'})")
+    out = []
+    for n in names:
+        v = cols[n]
+        if not isinstance(v, np.ndarray):
+            bad = next((c for c in v if not _is_number(c)), v[0] if v else "")
+            raise InputError(f"{source}: column '{n}' must be numeric, found {bad!r}")
+        if not np.all(np.isfinite(v)):
+            raise InputError(f"{source}: column '{n}' contains NaN or infinite values; "
+                             "re-record or delete that touch")
+        out.append(np.asarray(v, dtype=float))
+    return np.stack(out, axis=1)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_mm(values: NDArray[np.float64], what: str, source: str) -> None:
+    if values.size and np.max(np.abs(values)) < MM_LOOKS_LIKE_M:
+        raise InputError(
+            f"{source}: every {what} value is below {MM_LOOKS_LIKE_M:g} in magnitude, which looks "
+            "like metres; the CSV must be in millimetres (multiply by 1000)"
+        )
+
+
+def check_count(n: int, minimum: int, what: str, source: str) -> None:
+    """Refuse fewer than ``minimum`` measurements.
+
+    Parameters
+    ----------
+    n : int
+        Number of measurements given.
+    minimum : int
+        Smallest number the procedure can use.
+    what : str
+        What one measurement is, for the message (e.g. ``"touches of the reference point"``).
+    source : str
+        File name or description, prefixed to the message.
+    """
+    if n < minimum:
+        raise InputError(f"{source}: {n} {what} given, at least {minimum} needed "
+                         f"(more than {minimum} give a redundancy check and uncertainties)")
+
+
+def check_no_repeats(rows: NDArray[np.float64], source: str, labels: Sequence[str] | None = None) -> None:
+    """Refuse identical measurement rows (a copied line, or a touch recorded twice unchanged).
+
+    Parameters
+    ----------
+    rows : ndarray, shape (N, k)
+        The raw values of each measurement (vendor units).
+    source : str
+        File name or description.
+    labels : sequence of str, optional
+        Name of each row for the message; defaults to CSV line numbers (header is line 1).
+    """
+    names = labels if labels is not None else [f"line {i + 2}" for i in range(len(rows))]
+    seen: dict[bytes, int] = {}
+    for i, r in enumerate(np.asarray(rows, dtype=float)):
+        key = np.round(r, 9).tobytes()
+        if key in seen:
+            raise InputError(
+                f"{source}: {names[seen[key]]} and {names[i]} are identical; every touch must be a "
+                "separate approach to the point (a copied line adds no information)"
+            )
+        seen[key] = i
+
+
+def joint_columns(cols: Columns, robot: Robot, source: str) -> NDArray[np.float64]:
+    """Joint values from columns ``a1..an`` in controller units, converted to SI.
+
+    Parameters
+    ----------
+    cols : mapping
+        CSV columns.
+    robot : Robot
+        Model whose ``n_joints`` and joint types set the columns and units.
+    source : str
+
+    Returns
+    -------
+    ndarray, shape (N, n)
+        Radians for revolute joints, metres for prismatic joints.
+    """
+    names = [f"a{i + 1}" for i in range(robot.n_joints)]
+    q = _numeric(cols, names, source)
+    return np.where(robot.prismatic, q * 1e-3, np.radians(q))
+
+
+def _has(cols: Columns, names: Sequence[str]) -> bool:
+    return all(n in cols for n in names)
+
+
+def tcp_positions(cols: Columns, source: str, robot: Robot | None = None,
+                  tool: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+    """TCP positions in the robot base frame from ``x,y,z`` or from ``a1..an`` through FK.
+
+    Parameters
+    ----------
+    cols : mapping
+        CSV columns.
+    source : str
+        File name, for messages.
+    robot : Robot, optional
+        Needed for joint-value input.
+    tool : ndarray, shape (4, 4), optional
+        ``T_F_TCP`` of the tool that touched (metres); the robot's own tool when omitted.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Positions in metres.
+    """
+    if _has(cols, ("x", "y", "z")):
+        p = _numeric(cols, ("x", "y", "z"), source)
+        _check_mm(p, "x, y, z", source)
+        return p * 1e-3
+    if "a1" in cols:
+        if robot is None:
+            raise InputError(f"{source}: joint values a1..a6 need a robot model "
+                             "(--robot NAME_OR_FILE) and the tool that was used (--tool X,Y,Z,A,B,C)")
+        q = joint_columns(cols, robot, source)
+        return robot.fk(q, tool)[:, :3, 3]
+    raise InputError(f"{source}: needs TCP positions as columns x, y, z (mm) or joint values "
+                     f"a1..a6 (deg) (have: {', '.join(cols) or 'none'})")
+
+
+def flange_poses(cols: Columns, source: str, robot: Robot | None = None) -> NDArray[np.float64]:
+    """Flange poses ``T_R_F`` from ``x,y,z,a,b,c`` (KUKA) or from ``a1..an`` through FK.
+
+    Parameters
+    ----------
+    cols : mapping
+        CSV columns.
+    source : str
+    robot : Robot, optional
+        Needed for joint-value input; FK is evaluated with no tool.
+
+    Returns
+    -------
+    ndarray, shape (N, 4, 4)
+        Flange poses in the robot base frame (metres).
+    """
+    if _has(cols, ("x", "y", "z", "a", "b", "c")):
+        v = _numeric(cols, ("x", "y", "z", "a", "b", "c"), source)
+        _check_mm(v[:, :3], "flange x, y, z", source)
+        return pose_from_vendor(v, "kuka")
+    if "a1" in cols:
+        if robot is None:
+            raise InputError(f"{source}: joint values a1..a6 need a robot model (--robot NAME_OR_FILE)")
+        return robot.fk(joint_columns(cols, robot, source), np.eye(4))
+    raise InputError(f"{source}: needs flange poses as columns x, y, z, a, b, c (KUKA, mm and deg) "
+                     f"or joint values a1..a6 (deg) (have: {', '.join(cols) or 'none'})")
+
+
+def external_axis(cols: Columns, source: str, kind: str) -> NDArray[np.float64]:
+    """External axis values from column ``e1``.
+
+    Parameters
+    ----------
+    cols : mapping
+    source : str
+    kind : {"track", "table"}
+        ``"track"``: millimetres, refused when every value is below
+        :data:`MM_LOOKS_LIKE_M` (metres by mistake). ``"table"``: degrees, refused when every
+        value lies within one radian-sized turn (|e1| <= 2 pi, radians by mistake, or touches too
+        close together to use either way).
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        Metres (track) or radians (table).
+    """
+    e = _numeric(cols, ("e1",), source)[:, 0]
+    if kind == "track":
+        _check_mm(e, "e1 (track position)", source)
+        return e * 1e-3
+    if kind == "table":
+        if np.max(np.abs(e)) <= 2 * np.pi:
+            raise InputError(
+                f"{source}: every e1 (table angle) value is within +-6.28, which looks like radians; "
+                "the CSV must be in degrees. If these are degrees, the touches are too close "
+                "together: spread them over at least 90 degrees of table rotation"
+            )
+        return np.radians(e)
+    raise InputError(f"external axis kind must be 'track' or 'table', got {kind!r}")
+
+
+def point_roles(cols: Columns, source: str) -> list[str]:
+    """Roles of the touches of a 3-point frame from column ``point``.
+
+    Parameters
+    ----------
+    cols : mapping
+    source : str
+
+    Returns
+    -------
+    list of str
+        One of ``"origin"``, ``"x"``, ``"xy"`` per row (lower case). Each role must occur at least
+        once; repeated roles are averaged by the procedure.
+    """
+    if "point" not in cols:
+        raise InputError(f"{source}: missing column 'point' (origin, x or xy for each touch)")
+    roles = [str(v).strip().lower() for v in cols["point"]]
+    bad = sorted({r for r in roles if r not in ("origin", "x", "xy")})
+    if bad:
+        raise InputError(f"{source}: column 'point' must hold origin, x or xy; found {', '.join(bad)}")
+    missing = [r for r in ("origin", "x", "xy") if r not in roles]
+    if missing:
+        raise InputError(f"{source}: no touch of point(s) {', '.join(missing)}; a 3-point frame needs "
+                         "the origin, a point on +X and a point in the XY plane with positive Y")
+    return roles
+
+
+def nominal_points(cols: Columns, source: str) -> NDArray[np.float64]:
+    """Known coordinates of the touched points in the frame being calibrated.
+
+    Parameters
+    ----------
+    cols : mapping
+        Columns ``nominal_x, nominal_y, nominal_z`` (mm).
+    source : str
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Metres.
+    """
+    return _numeric(cols, ("nominal_x", "nominal_y", "nominal_z"), source) * 1e-3
+

@@ -1,0 +1,287 @@
+"""The result every calibration procedure returns: estimate, uncertainty, residuals, advice.
+
+Everything inside :class:`CalibrationResult` is in SI units (metres, radians). Millimetres and
+degrees appear only in :meth:`CalibrationResult.to_json` (keys ending in ``_mm`` / ``_deg``, plus
+the vendor fields a procedure adds) and in :meth:`CalibrationResult.summary`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from robotcell.cli.common import format_table
+from robotcell.poseformats import pose_to_vendor
+
+__all__ = ["CalibrationResult", "pose_fields", "to_jsonable"]
+
+#: Conditioning figure above which a result is flagged: Schroer's threshold of about 100 for
+#: a trustworthy identification, as cited by Nahvi and Hollerbach (ICRA 1996).
+CONDITION_LIMIT = 100.0
+
+
+def to_jsonable(value: Any) -> Any:
+    """Convert numpy values (recursively) to plain Python for :func:`json.dumps`.
+
+    Parameters
+    ----------
+    value : Any
+        Scalar, array, list, tuple or dict. NaN and infinity become None (JSON null).
+
+    Returns
+    -------
+    Any
+        Lists, dicts, floats, ints, strings, booleans and None only.
+    """
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_jsonable(value.tolist())
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    return value
+
+
+def pose_fields(T: NDArray[np.float64]) -> dict[str, Any]:
+    """Vendor fields of a pose for JSON: ``matrix`` (4x4, translation in mm) and ``xyzabc`` (KUKA).
+
+    Parameters
+    ----------
+    T : ndarray, shape (4, 4)
+        Pose (metres).
+
+    Returns
+    -------
+    dict
+        ``{"matrix": 4x4 nested list, translation in mm, "xyzabc": [X, Y, Z, A, B, C] mm/deg}``.
+    """
+    M = np.array(T, dtype=float)
+    M[:3, 3] *= 1000.0
+    return {"matrix": M.tolist(), "xyzabc": pose_to_vendor(T, "kuka").tolist()}
+
+
+@dataclass
+class CalibrationResult:
+    """Outcome of one calibration procedure.
+
+    Attributes
+    ----------
+    procedure : str
+        Procedure name, e.g. ``"tcp"``, ``"frame-3point"``, ``"turntable"``.
+    values : dict of str to Any
+        Estimated quantities in SI units: poses as ``(4, 4)`` arrays (metres), points as ``(3,)``
+        arrays (metres), lengths as floats (metres), angles (radians), unitless numbers.
+    sigma : dict of str to Any
+        1-sigma uncertainty of the estimated quantities, SI. For a pose ``values[key]``
+        (= ``T_a_b``) it holds ``key + "_position"``: shape (3,), metres, standard deviation of
+        the origin of b along the axes of a; and ``key + "_rotation"``: shape (3,), radians,
+        standard deviation of the small rotation vector ``d`` with
+        ``R_true = exp([d]x) R_estimated``, i.e. rotation about the axes of frame a. For any other
+        quantity ``sigma[key]`` has the shape of ``values[key]``. A quantity fixed by the
+        procedure (not estimated) has no sigma. NaN when no noise level is available.
+    residuals : ndarray, shape (N, 3)
+        Per measurement: measured point minus the point the fitted model predicts (metres, robot
+        base axes unless the procedure says otherwise).
+    condition : float
+        Conditioning figure: the 2-norm condition number of the Jacobian of the maximum-likelihood
+        problem after scaling each column to unit length (see :func:`robotcell.calibration.fit`).
+        Below about 100 the measurement design is good; large values mean some combination of the
+        estimated quantities is poorly determined by where the touches were taken.
+    dof : int
+        Redundancy: number of scalar measurements minus number of estimated parameters.
+    noise_sigma : float
+        Measurement noise (metres, per coordinate) behind ``sigma``: estimated from the residuals
+        (``noise_source == "residuals"``) or the prior the user gave (``"prior"``); NaN
+        (``"none"``) when there is no redundancy and no prior.
+    noise_source : {"residuals", "prior", "none"}
+    labels : list of str
+        Name of each measurement for reports (e.g. ``"row 3 (xy)"``); length N.
+    undetermined : list of str
+        Quantities the measurements do not determine (and which the result therefore omits or
+        fixes by a stated convention).
+    warnings : list of str
+    next_step : str
+        What the technician should do next.
+    kinds : dict of str to str
+        How :meth:`summary` prints a value: ``"pose"``, ``"length"`` (m, printed in mm),
+        ``"angle"`` (rad, printed in deg) or ``"number"``. Missing keys: ``"pose"`` for 4x4 arrays,
+        else ``"length"``.
+    json_fields : dict of str to Any
+        Procedure-specific fields merged into :meth:`to_json` (vendor units, e.g. ``tcp_mm``,
+        ``matrix``, ``xyzabc``).
+    covariance : ndarray, shape (p, p) or None
+        Covariance of the fitted parameter vector (SI) for propagation, with names in
+        ``parameter_names``.
+    parameter_names : list of str
+    """
+
+    procedure: str
+    values: dict[str, Any]
+    sigma: dict[str, Any]
+    residuals: NDArray[np.float64]
+    condition: float
+    dof: int
+    noise_sigma: float
+    noise_source: str
+    labels: list[str] = field(default_factory=list)
+    undetermined: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    next_step: str = ""
+    kinds: dict[str, str] = field(default_factory=dict)
+    json_fields: dict[str, Any] = field(default_factory=dict)
+    covariance: NDArray[np.float64] | None = None
+    parameter_names: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.residuals = np.asarray(self.residuals, dtype=float).reshape(-1, 3)
+        if not self.labels:
+            self.labels = [f"{i + 1}" for i in range(len(self.residuals))]
+
+    @property
+    def residual_norms(self) -> NDArray[np.float64]:
+        """Length of each residual, shape (N,), metres."""
+        return np.linalg.norm(self.residuals, axis=1)
+
+    @property
+    def rms(self) -> float:
+        """Root mean square of the residual lengths (metres)."""
+        n = self.residual_norms
+        return float(np.sqrt(np.mean(n**2))) if n.size else 0.0
+
+    @property
+    def max(self) -> float:
+        """Largest residual length (metres)."""
+        n = self.residual_norms
+        return float(n.max()) if n.size else 0.0
+
+    def _kind(self, key: str) -> str:
+        if key in self.kinds:
+            return self.kinds[key]
+        v = np.asarray(self.values[key])
+        return "pose" if v.shape == (4, 4) else "length"
+
+    def _sigma_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for key in self.values:
+            kind = self._kind(key)
+            if kind == "pose":
+                if key + "_position" in self.sigma:
+                    out[key + "_position_mm"] = np.asarray(self.sigma[key + "_position"]) * 1e3
+                if key + "_rotation" in self.sigma:
+                    out[key + "_rotation_deg"] = np.degrees(self.sigma[key + "_rotation"])
+            elif key in self.sigma:
+                s = np.asarray(self.sigma[key], dtype=float)
+                if kind == "length":
+                    out[key + "_mm"] = s * 1e3
+                elif kind == "angle":
+                    out[key + "_deg"] = np.degrees(s)
+                else:
+                    out[key] = s
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict in vendor units (mm, deg).
+
+        Returns
+        -------
+        dict
+            ``procedure``, ``residuals_mm`` (length of each residual), ``residuals_xyz_mm``
+            (N x 3), ``labels``, ``rms_mm``, ``max_mm``, ``condition``, ``dof``,
+            ``noise_sigma_mm`` and ``noise_source``, ``sigma`` (1-sigma of each estimated
+            quantity, keys with units), ``undetermined``, ``warnings``, ``next_step``, then the
+            procedure's own fields (``json_fields``).
+        """
+        out: dict[str, Any] = {
+            "procedure": self.procedure,
+            "residuals_mm": self.residual_norms * 1e3,
+            "residuals_xyz_mm": self.residuals * 1e3,
+            "labels": list(self.labels),
+            "rms_mm": self.rms * 1e3,
+            "max_mm": self.max * 1e3,
+            "condition": self.condition,
+            "dof": self.dof,
+            "noise_sigma_mm": self.noise_sigma * 1e3,
+            "noise_source": self.noise_source,
+            "sigma": self._sigma_json(),
+            "undetermined": list(self.undetermined),
+            "warnings": list(self.warnings),
+            "next_step": self.next_step,
+        }
+        out.update(self.json_fields)
+        return to_jsonable(out)
+
+    def _value_lines(self) -> list[str]:
+        lines = []
+        for key, v in self.values.items():
+            kind = self._kind(key)
+            if kind == "pose":
+                xyzabc = pose_to_vendor(v, "kuka")
+                lines.append(f"  {key} (KUKA X,Y,Z mm, A,B,C deg): "
+                             + ", ".join(f"{c:.3f}" for c in xyzabc))
+                sp = self.sigma.get(key + "_position")
+                sr = self.sigma.get(key + "_rotation")
+                if sp is not None:
+                    lines.append("    1-sigma position (mm):      "
+                                 + ", ".join(f"{c:.3f}" for c in np.asarray(sp) * 1e3))
+                if sr is not None:
+                    lines.append("    1-sigma rotation (deg):     "
+                                 + ", ".join(f"{c:.4f}" for c in np.degrees(sr)))
+                continue
+            scale, unit, fmt = {"length": (1e3, " mm", ".3f"), "angle": (180 / math.pi, " deg", ".4f"),
+                                "number": (1.0, "", ".6g")}[kind]
+            arr = np.atleast_1d(np.asarray(v, dtype=float)) * scale
+            text = ", ".join(f"{c:{fmt}}" for c in arr)
+            s = self.sigma.get(key)
+            if s is not None:
+                sarr = np.atleast_1d(np.asarray(s, dtype=float)) * scale
+                text += "  (1-sigma " + ", ".join(f"{c:{fmt}}" for c in sarr) + ")"
+            lines.append(f"  {key}{unit and ' (' + unit.strip() + ')'}: {text}")
+        return lines
+
+    def summary(self) -> str:
+        """Readable report for the terminal, in millimetres and degrees.
+
+        Returns
+        -------
+        str
+            The estimate with 1-sigma uncertainties, a table of residuals per measurement, RMS,
+            max, conditioning, undetermined quantities, warnings and the next step.
+        """
+        r = self.residuals * 1e3
+        rows = [[lab, float(a), float(b), float(c), float(n)]
+                for lab, (a, b, c), n in zip(self.labels, r, self.residual_norms * 1e3)]
+        if self.noise_source == "residuals":
+            noise = f"{self.noise_sigma * 1e3:.3f} mm per coordinate, estimated from the residuals"
+        elif self.noise_source == "prior":
+            noise = f"{self.noise_sigma * 1e3:.3f} mm per coordinate, as given (--sigma)"
+        else:
+            noise = "unknown (no redundant measurements and no --sigma given)"
+        cond = "good" if self.condition <= CONDITION_LIMIT else "poor"
+        lines = [f"calibration: {self.procedure}", "", "result:"]
+        lines += self._value_lines()
+        lines += ["", "residuals (measured - model, mm):",
+                  format_table(["touch", "dx", "dy", "dz", "|r|"], rows), "",
+                  f"RMS {self.rms * 1e3:.3f} mm, max {self.max * 1e3:.3f} mm "
+                  f"over {len(r)} measurements, redundancy {self.dof}",
+                  f"measurement noise: {noise}",
+                  f"condition number: {self.condition:.1f} ({cond}; below {CONDITION_LIMIT:.0f} is good)"]
+        if self.undetermined:
+            lines += ["", "not determined by these measurements:"]
+            lines += [f"  - {u}" for u in self.undetermined]
+        if self.warnings:
+            lines += ["", "warnings:"]
+            lines += [f"  - {w}" for w in self.warnings]
+        if self.next_step:
+            lines += ["", f"next step: {self.next_step}"]
+        return "\n".join(lines)
