@@ -8,6 +8,7 @@ units, a rotation vector (Universal Robots). The table of conventions with their
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -162,8 +163,13 @@ def pose_to_vendor(T: ArrayLike, fmt: str) -> NDArray[np.float64]:
     elif f.name == "ur":
         ang = rot.as_rotvec()
     else:
-        e = rot.as_euler(f.euler, degrees=True)
+        with warnings.catch_warnings():
+            # At gimbal lock scipy sets the third angle to zero and warns; the rotation is still
+            # exact and the convention is documented in docs/conventions.md.
+            warnings.simplefilter("ignore", UserWarning)
+            e = rot.as_euler(f.euler, degrees=True)
         ang = np.empty_like(e)
         ang[:, list(f.angle_order)] = e
     out = np.concatenate([flat[:, :3, 3] / f.length_scale, ang], axis=1)
+    out[np.abs(out) < 1e-12] = 0.0  # no "-0.0" in printed values
     return out.reshape(batch + (f.size,))

@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 import math
 from pathlib import Path
-from typing import Sequence
+from typing import Sequence, TextIO
 
 import numpy as np
 
@@ -84,13 +84,21 @@ def require_columns(cols: dict, names: Sequence[str], path: str | Path) -> np.nd
     return np.stack([cols[n] for n in names], axis=1)
 
 
-def write_csv(path: str | Path, header: Sequence[str], rows: np.ndarray, decimals: int = 6) -> None:
-    """Write an ``(N, len(header))`` array as CSV with fixed decimals."""
+def write_csv(path: str | Path | TextIO, header: Sequence[str], rows: np.ndarray,
+              decimals: int = 6) -> None:
+    """Write an ``(N, len(header))`` array as CSV with fixed decimals to a path or open stream."""
+    if hasattr(path, "write"):
+        _write_rows(path, header, rows, decimals)
+        return
     with Path(path).open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        for r in np.atleast_2d(rows):
-            w.writerow([f"{v:.{decimals}f}" for v in r])
+        _write_rows(fh, header, rows, decimals)
+
+
+def _write_rows(fh: TextIO, header: Sequence[str], rows: np.ndarray, decimals: int) -> None:
+    w = csv.writer(fh, lineterminator="\n")
+    w.writerow(header)
+    for r in np.atleast_2d(rows):
+        w.writerow([f"{v:.{decimals}f}" for v in r])
 
 
 def format_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:

@@ -1,0 +1,70 @@
+"""``robotcell robots``: list the robot library and show a model's DH table."""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from robotcell.cli.common import format_table
+from robotcell.modelfile import list_robots, load_robot
+from robotcell.poseformats import pose_to_vendor
+
+
+@click.group(invoke_without_command=True)
+@click.pass_context
+def robots(ctx: click.Context) -> None:
+    """List the built-in robot library.
+
+    \b
+    Examples:
+      robotcell robots
+      robotcell robots show kuka_kr16
+    """
+    if ctx.invoked_subcommand is not None:
+        return
+    rows = []
+    for name in list_robots():
+        r = load_robot(name)
+        kinds = "".join("P" if j.prismatic else "R" for j in r.joints)
+        rows.append((name, r.title, kinds, r.convention, "yes" if r.verified else "no"))
+    click.echo(format_table(("name", "robot", "joints", "DH", "verified"), rows))
+
+
+@robots.command()
+@click.argument("name")
+def show(name: str) -> None:
+    """Print the DH table of a library robot or model file (mm, deg).
+
+    \b
+    Example:
+      robotcell robots show ur5e
+    """
+    r = load_robot(name)
+    click.echo(f"{r.title} ({r.name}), {r.convention} DH, {r.n_joints} joints")
+    if r.convention == "standard":
+        click.echo("T_{i-1,i} = Trans(z, d) Rot(z, theta) Trans(x, a) Rot(x, alpha)")
+        heads = ("joint", "type", "a [mm]", "alpha [deg]", "d [mm]", "theta [deg]")
+    else:
+        click.echo("T_{i-1,i} = Rot(x, alpha_{i-1}) Trans(x, a_{i-1}) Rot(z, theta) Trans(z, d)")
+        heads = ("joint", "type", "a_{i-1} [mm]", "alpha_{i-1} [deg]", "d [mm]", "theta [deg]")
+    click.echo("DH variable = sign * q + offset (theta for revolute, d for prismatic joints)")
+    rows = []
+    for j in r.joints:
+        unit = 1e3 if j.prismatic else 180 / math.pi
+        lo = f"{j.lower * unit:.1f}" if math.isfinite(j.lower) else "-inf"
+        hi = f"{j.upper * unit:.1f}" if math.isfinite(j.upper) else "inf"
+        rows.append((j.name, j.type, j.a * 1e3, math.degrees(j.alpha), j.d * 1e3,
+                     math.degrees(j.theta), f"{j.sign:+.0f}", f"{lo} .. {hi}",
+                     "mm" if j.prismatic else "deg"))
+    click.echo(format_table(heads + ("sign", "limits", "unit"), rows))
+    for key, label in (("base", "base   T_R_0"), ("flange", "flange T_n_F"), ("tool", "tool   T_F_TCP")):
+        v = pose_to_vendor(getattr(r, key), "kuka")
+        click.echo(f"{label}: X {v[0]:.3f} Y {v[1]:.3f} Z {v[2]:.3f} mm, "
+                   f"A {v[3]:.3f} B {v[4]:.3f} C {v[5]:.3f} deg")
+    if r.home is not None:
+        home = [v * (1e3 if j.prismatic else 180 / math.pi) for v, j in zip(r.home, r.joints)]
+        click.echo("home: " + ", ".join(f"{v:g}" for v in home))
+    click.echo(f"source: {r.source or 'not given'}")
+    click.echo(f"verified: {'yes' if r.verified else 'no'}"
+               + (f" ({r.verification})" if r.verification else ""))
