@@ -138,9 +138,9 @@ class Chain:
         return _Op(kind, float(value), quarter=q)
 
     # -- batched ------------------------------------------------------------------------------
-    def apply(self, start: NDArray[np.float64], q: NDArray[np.float64],
-              frames: bool = False) -> NDArray[np.float64]:
-        """Evaluate ``start @ T_0_n(q)`` for a batch.
+    def apply(self, start: NDArray[np.float64], q: NDArray[np.float64], frames: bool = False,
+              tail: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """Evaluate ``start @ T_0_n(q) @ tail`` for a batch.
 
         Parameters
         ----------
@@ -149,7 +149,9 @@ class Chain:
         q : ndarray, shape (N, n)
             Joint values (rad or m), already validated.
         frames : bool
-            If True return every frame ``start @ T_0_i`` for ``i = 0..n``.
+            If True return every frame ``start @ T_0_i`` for ``i = 0..n`` (``tail`` is ignored).
+        tail : ndarray, shape (4, 4), optional
+            Constant pose appended after the last link (e.g. flange and tool).
 
         Returns
         -------
@@ -159,10 +161,10 @@ class Chain:
         out = np.empty((N, self.n + 1, 4, 4) if frames else (N, 4, 4))
         for lo in range(0, N, _BLOCK):
             hi = min(lo + _BLOCK, N)
-            self._block(start, q[lo:hi].T, out[lo:hi], frames)
+            self._block(start, q[lo:hi].T, out[lo:hi], frames, None if frames else tail)
         return out
 
-    def _block(self, start, qT, out, frames) -> None:
+    def _block(self, start, qT, out, frames, tail) -> None:
         # cos and sin of every variable angle at once, from the half-angle tangent: np.tan is
         # vectorised with SIMD where np.cos and np.sin are not, and the identities
         # c = (1 - t^2) / (1 + t^2), s = 2 t / (1 + t^2) are exact to rounding for every angle
@@ -209,6 +211,10 @@ class Chain:
                 dst = out[:, self.frame_ends.index(k) + 1]
                 for m in range(4):
                     dst[:, :3, m] = cols[m].T
+        if tail is not None:
+            # cols @ tail, skipping zero coefficients (vendor flanges are signed permutations).
+            rot = [_lincomb(tail[:3, k], cols[:3]) for k in range(3)]
+            cols = rot + [_lincomb(tail[:3, 3], cols[:3], cols[3])]
         if not frames:
             for m in range(4):
                 out[:, :3, m] = cols[m].T
@@ -259,3 +265,13 @@ class Chain:
             else:
                 p0, p1, p2 = p0 + v * a0, p1 + v * a1, p2 + v * a2
         return [a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2]
+
+
+def _lincomb(coeffs, vecs, acc=None):
+    """``acc + sum(c * v)`` over the nonzero coefficients, without multiplying by +-1."""
+    for c, v in zip(coeffs, vecs):
+        if c == 0.0:
+            continue
+        term = v if c == 1.0 else -v if c == -1.0 else c * v
+        acc = term if acc is None else acc + term
+    return np.zeros((3, 1)) if acc is None else acc

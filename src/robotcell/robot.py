@@ -230,9 +230,7 @@ class Robot:
             return _compose_cols(m, tc)
         arr = self._joints(q)
         batch = arr.shape[:-1]
-        T = self._chain.apply(self.base, arr.reshape(-1, self.n_joints))
-        if tool is not None or not self._tail_is_identity:
-            T = T @ tail
+        T = self._chain.apply(self.base, arr.reshape(-1, self.n_joints), tail=tail)
         return T.reshape(batch + (4, 4))
 
     def frames(self, q: ArrayLike) -> NDArray[np.float64]:
@@ -288,17 +286,13 @@ class Robot:
 def _compose_cols(m: list[float], tail: list[list[float]]) -> NDArray[np.float64]:
     """``[[R, p], [0, 1]] @ tail`` for a chain result given as columns and a 3x4 tail."""
     a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
-    out = []
-    for row in range(4):
-        if row == 3:
-            out.extend((0.0, 0.0, 0.0, 1.0))
-            break
-        r0, r1, r2, pr = ((a0, b0, c0, p0), (a1, b1, c1, p1), (a2, b2, c2, p2))[row]
-        t = tail
-        out.extend((
-            r0 * t[0][0] + r1 * t[1][0] + r2 * t[2][0],
-            r0 * t[0][1] + r1 * t[1][1] + r2 * t[2][1],
-            r0 * t[0][2] + r1 * t[1][2] + r2 * t[2][2],
-            r0 * t[0][3] + r1 * t[1][3] + r2 * t[2][3] + pr,
-        ))
-    return np.array(out).reshape(4, 4)
+    (t00, t01, t02, t03), (t10, t11, t12, t13), (t20, t21, t22, t23) = tail
+    return np.array((
+        a0 * t00 + b0 * t10 + c0 * t20, a0 * t01 + b0 * t11 + c0 * t21,
+        a0 * t02 + b0 * t12 + c0 * t22, a0 * t03 + b0 * t13 + c0 * t23 + p0,
+        a1 * t00 + b1 * t10 + c1 * t20, a1 * t01 + b1 * t11 + c1 * t21,
+        a1 * t02 + b1 * t12 + c1 * t22, a1 * t03 + b1 * t13 + c1 * t23 + p1,
+        a2 * t00 + b2 * t10 + c2 * t20, a2 * t01 + b2 * t11 + c2 * t21,
+        a2 * t02 + b2 * t12 + c2 * t22, a2 * t03 + b2 * t13 + c2 * t23 + p2,
+        0.0, 0.0, 0.0, 1.0,
+    )).reshape(4, 4)
