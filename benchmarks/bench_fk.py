@@ -19,10 +19,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from machine import describe  # noqa: E402
+from machine import describe
 
-from robotcell import load_robot  # noqa: E402
-from robotcell.dh import link_transform  # noqa: E402
+from robotcell import load_robot
+from robotcell.dh import link_transform
 
 
 def plain_numpy_chain(robot, q):

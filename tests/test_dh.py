@@ -7,7 +7,6 @@ import pytest
 
 from robotcell import InputError, Joint, Robot, make_pose, rot_x
 from robotcell.dh import link_transform
-from robotcell.transforms import compose
 
 
 def test_link_transform_matches_lecture_matrix():

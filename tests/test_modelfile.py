@@ -77,8 +77,8 @@ def test_library_names_follow_the_rule():
      r"robot.yaml: joint 1: missing key 'theta'"),
     ("joints:\n  - {type: revolute, a: 0, alpha: 0, d: 0, theta: 0}\n",
      r"robot.yaml: missing key 'name'"),
-    ("name: x\njoints:\n  - {type: revolute, a: 0, alpha: 0, d: 0, theta: 0}\n"
-     "  - {type: slider, a: 0, alpha: 0, d: 0, theta: 0}\n",
+    (("name: x\njoints:\n  - {type: revolute, a: 0, alpha: 0, d: 0, theta: 0}\n"
+     "  - {type: slider, a: 0, alpha: 0, d: 0, theta: 0}\n"),
      r"joint 2: key 'type' must be 'revolute' or 'prismatic', got 'slider'"),
     ("name: x\njoints:\n  - {type: revolute, a: ten, alpha: 0, d: 0, theta: 0}\n",
      r"joint 1: key 'a' must be a number, got 'ten'"),

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from robotcell import InputError, check_pose, compose, invert, make_pose, rot_x, rot_y, rot_z
 from robotcell.transforms import transform_points, validate_pose
-from scipy.spatial.transform import Rotation
 
 
 def random_poses(rng, n):
