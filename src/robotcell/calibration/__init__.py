@@ -4,6 +4,8 @@ Every procedure is a maximum-likelihood fit under isotropic Gaussian noise on th
 and returns a :class:`CalibrationResult` (SI units inside; mm and degrees in its JSON and text
 report). Shared pieces: :mod:`.result` (the result), :mod:`.fitting` (least squares, covariance,
 conditioning, outliers, rotation parameterisation), :mod:`.measurements` (CSV columns to SI).
+Procedures: :func:`calibrate_tool` (TCP, ABC 2-point, ABC World), :func:`frame_3point`,
+:func:`frame_npoint`, :func:`external_tcp`.
 See ``docs/calibration.md``.
 """
 
@@ -17,10 +19,16 @@ from robotcell.calibration.fitting import (
     perturb_rotation,
     pose_sigma,
 )
+from robotcell.calibration.frame import external_tcp, frame_3point, frame_npoint
 from robotcell.calibration.result import CalibrationResult, pose_fields, to_jsonable
+from robotcell.calibration.tcp import calibrate_tool
 
 __all__ = [
     "CalibrationResult",
+    "calibrate_tool",
+    "external_tcp",
+    "frame_3point",
+    "frame_npoint",
     "Fit",
     "fit",
     "kabsch",

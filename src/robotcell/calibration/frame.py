@@ -1,0 +1,313 @@
+"""Frames from touched points: 3-point (origin, +X, XY plane), N-point best fit, external TCP.
+
+A frame ``T_R_W`` (pose of frame W in the robot base R) is what KUKA calls a BASE, ABB a work
+object user frame, Fanuc a user frame. Every estimate is the maximum-likelihood fit under
+isotropic Gaussian noise on the touched points (see ``docs/calibration.md``).
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.calibration.fitting import (
+    fit,
+    kabsch,
+    outlier_warnings,
+    perturb_rotation,
+    pose_sigma,
+)
+from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.errors import IllPosedError, InputError
+from robotcell.transforms import as_points
+
+__all__ = ["external_tcp", "frame_3point", "frame_npoint"]
+
+#: Smallest distance (m) from the origin touch to the +X touch that defines a direction at all.
+MIN_X_DISTANCE = 0.010
+#: Below this distance (m) from origin to the +X touch a warning recommends spreading further.
+GOOD_X_DISTANCE = 0.100
+#: Sine of the angle between the +X line and the XY-plane touch below which the points count as
+#: collinear (about 1 degree) ...
+COLLINEAR_SIN = 0.02
+#: ... and below which they count as nearly collinear (about 10 degrees), with a warning.
+NEAR_COLLINEAR_SIN = 0.17
+
+
+def _labels(n: int, labels: Sequence[str] | None, roles: Sequence[str] | None = None) -> list[str]:
+    if labels is not None:
+        if len(labels) != n:
+            raise InputError(f"labels has {len(labels)} entries for {n} measurements")
+        return list(labels)
+    if roles is None:
+        return [f"{i + 1}" for i in range(n)]
+    return [f"{i + 1} ({r})" for i, r in enumerate(roles)]
+
+
+def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    return v / np.linalg.norm(v)
+
+
+def _check_roles(p: NDArray[np.float64], roles: list[str]) -> None:
+    """Refuse a 3-point layout that does not define a frame; name what to touch instead."""
+    r = np.array(roles)
+    o = p[r == "origin"].mean(axis=0)
+    x = p[r == "x"].mean(axis=0) - o
+    lx = np.linalg.norm(x)
+    if lx < MIN_X_DISTANCE:
+        raise IllPosedError(
+            f"the +X touch is {lx * 1e3:.1f} mm from the origin touch, too close to define a "
+            f"direction; touch a point on +X at least {GOOD_X_DISTANCE * 1e3:.0f} mm from the origin")
+    xy = p[r == "xy"].mean(axis=0) - o
+    sin = np.linalg.norm(np.cross(x / lx, xy)) / max(np.linalg.norm(xy), 1e-12)
+    if sin < COLLINEAR_SIN:
+        raise IllPosedError(
+            f"the origin, +X and XY-plane touches are collinear (the XY touch is "
+            f"{np.degrees(np.arcsin(min(sin, 1.0))):.2f} deg off the X line), so the rotation about "
+            "X is not determined; touch the XY-plane point well away from the X axis, ideally near +Y")
+
+
+def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | None):
+    """ML fit of origin, rotation and the free coordinates of each +X / XY-plane touch."""
+    r = np.array(roles)
+    io, ix, ixy = (np.flatnonzero(r == k) for k in ("origin", "x", "xy"))
+    o0 = p[io].mean(axis=0)
+    X0 = _unit(p[ix].mean(axis=0) - o0)
+    Y0 = _unit((w := p[ixy].mean(axis=0) - o0) - (w @ X0) * X0)
+    R0 = np.column_stack([X0, Y0, np.cross(X0, Y0)])
+    a0 = (p[ix] - o0) @ X0
+    bc0 = (p[ixy] - o0) @ R0[:, :2]
+    x0 = np.concatenate([o0, np.zeros(3), a0, bc0.ravel()])
+    nx, nxy = len(ix), len(ixy)
+
+    def model(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        R = perturb_rotation(R0, x[3:6])
+        a = x[6:6 + nx]
+        bc = x[6 + nx:].reshape(nxy, 2)
+        m = np.empty_like(p)
+        m[io] = x[:3]
+        m[ix] = x[:3] + a[:, None] * R[:, 0]
+        m[ixy] = x[:3] + bc @ R[:, :2].T
+        return m
+
+    names = (["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
+              "rotation about z"] + [f"distance of touch {i + 1} along X" for i in ix]
+             + [f"{c} of touch {i + 1} in the XY plane" for i in ixy for c in ("x", "y")])
+    res = fit(lambda x: p - model(x), x0, names, prior_sigma)
+    T = np.eye(4)
+    T[:3, :3] = perturb_rotation(R0, res.x[3:6])
+    T[:3, 3] = res.x[:3]
+    return res, T
+
+
+def _common(procedure: str, key: str, T: NDArray[np.float64], res, labels: list[str],
+            warnings: list[str], next_step: str, undetermined: list[str] | None = None,
+            names: list[str] | None = None) -> CalibrationResult:
+    sp, sr = pose_sigma(res.covariance[:6, :6])
+    warnings = list(warnings) + outlier_warnings(res, labels)
+    if res.noise_source == "none":
+        warnings.append("no redundant touches and no measurement sigma given: uncertainties are "
+                        "unknown; touch each point twice or give the touch-up accuracy (--sigma)")
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: the "
+                        "touches are poorly spread; spread them further apart")
+    return CalibrationResult(
+        procedure=procedure, values={key: T}, sigma={key + "_position": sp, key + "_rotation": sr},
+        residuals=res.residuals, condition=res.condition, dof=res.dof,
+        noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
+        undetermined=undetermined or [], warnings=warnings, next_step=next_step,
+        json_fields=pose_fields(T), covariance=res.covariance[:6, :6],
+        parameter_names=names or ["x", "y", "z", "rx", "ry", "rz"],
+    )
+
+
+def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,
+                 labels: Sequence[str] | None = None) -> CalibrationResult:
+    """Frame from touches of its origin, a point on +X, and a point in the XY plane with Y > 0.
+
+    KUKA's BASE 3-point method (also Fanuc's and Yaskawa's three-point user frame), generalised
+    to any number of touches per role: every touch of the origin, of a point on the +X axis and
+    of a point in the XY plane (positive Y) enters one maximum-likelihood fit whose unknowns are
+    the frame and each touch's free coordinates (distance along X; x and y in the plane).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        Touched TCP positions in the robot base frame (metres).
+    roles : sequence of str, length N
+        ``"origin"``, ``"x"`` or ``"xy"`` for each touch; each role at least once.
+    prior_sigma : float, optional
+        Touch-up accuracy (metres, 1-sigma per coordinate); used for the uncertainties instead of
+        the residuals. Needed for uncertainties with exactly 3 touches.
+    labels : sequence of str, optional
+        Name of each touch for the report.
+
+    Returns
+    -------
+    CalibrationResult
+        ``values["T_R_W"]``: the frame (4x4, metres); sigma of its origin and rotation; JSON
+        fields ``matrix`` and ``xyzabc``.
+
+    Raises
+    ------
+    IllPosedError
+        +X touch too close to the origin, or origin, +X and XY touches collinear.
+    """
+    p = as_points(points, "points").reshape(-1, 3)
+    roles = [str(r).lower() for r in roles]
+    if len(roles) != len(p):
+        raise InputError(f"{len(roles)} roles given for {len(p)} points")
+    missing = [k for k in ("origin", "x", "xy") if k not in roles]
+    if missing or set(roles) - {"origin", "x", "xy"}:
+        raise InputError("a 3-point frame needs roles origin, x and xy only, each at least once"
+                         + (f"; missing {', '.join(missing)}" if missing else ""))
+    _check_roles(p, roles)
+    labs = _labels(len(p), labels, roles)
+    res, T = _role_fit(p, roles, prior_sigma)
+    warnings = []
+    r = np.array(roles)
+    lx = np.linalg.norm(p[r == "x"].mean(axis=0) - p[r == "origin"].mean(axis=0))
+    if lx < GOOD_X_DISTANCE:
+        warnings.append(f"the +X touch is only {lx * 1e3:.0f} mm from the origin: the direction of X "
+                        f"is sensitive to touch errors; touch at least {GOOD_X_DISTANCE * 1e3:.0f} mm away")
+    y = (p[r == "xy"] - T[:3, 3]) @ T[:3, 1]
+    if np.any(y <= 0):
+        raise IllPosedError("an XY-plane touch lies on the negative-Y side of the fitted frame; the XY "
+                            "touches must all have positive Y (same side of the X axis)")
+    sin = np.linalg.norm(np.cross(T[:3, 0], p[r == "xy"].mean(axis=0) - T[:3, 3])) / np.linalg.norm(
+        p[r == "xy"].mean(axis=0) - T[:3, 3])
+    if sin < NEAR_COLLINEAR_SIN:
+        warnings.append(f"the XY-plane touch is only {np.degrees(np.arcsin(sin)):.1f} deg off the X axis "
+                        "(nearly collinear): the rotation about X is poorly determined; touch it near +Y")
+    return _common("frame-3point", "T_R_W", T, res, labs, warnings,
+                   "enter matrix/xyzabc as the base (user frame) in the controller, then check it by "
+                   "jogging along the new X and Y axes over the workpiece")
+
+
+def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | None = None,
+                 labels: Sequence[str] | None = None) -> CalibrationResult:
+    """Best-fit frame to touched points whose coordinates in the frame are known.
+
+    Maximum likelihood under isotropic Gaussian noise on the touched points: minimises
+    ``sum |p_i - T_R_W q_i|^2`` over rigid ``T_R_W`` (Kabsch/Umeyama start, then the same
+    least-squares refinement and covariance as every procedure).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        Touched TCP positions in the robot base frame (metres), N >= 3.
+    nominal : array_like, shape (N, 3)
+        Coordinates of the same points in the frame W, e.g. from the drawing (metres).
+    prior_sigma : float, optional
+        Touch-up accuracy (metres); needed for uncertainties with exactly 3 points.
+    labels : sequence of str, optional
+
+    Returns
+    -------
+    CalibrationResult
+        ``values["T_R_W"]`` with sigma, JSON fields ``matrix`` and ``xyzabc``.
+
+    Raises
+    ------
+    IllPosedError
+        Fewer than 3 points, or nominal points (nearly) collinear.
+    """
+    p = as_points(points, "points").reshape(-1, 3)
+    q = as_points(nominal, "nominal points").reshape(-1, 3)
+    if q.shape != p.shape:
+        raise InputError(f"{len(q)} nominal points for {len(p)} touched points")
+    if len(p) < 3:
+        raise IllPosedError(f"{len(p)} points given; a best-fit frame needs at least 3 points that "
+                            "are not on one line (4 or more give a check of the fit)")
+    s = np.linalg.svd(q - q.mean(axis=0), compute_uv=False)
+    if s[0] == 0 or s[1] / s[0] < COLLINEAR_SIN:
+        raise IllPosedError("the nominal points are collinear, so the rotation about their line is not "
+                            "determined; add points well away from that line")
+    labs = _labels(len(p), labels)
+    T0 = kabsch(q, p)
+    R0 = T0[:3, :3]
+
+    def resid(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return p - (q @ perturb_rotation(R0, x[3:6]).T + x[:3])
+
+    names = ["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
+             "rotation about z"]
+    res = fit(resid, np.concatenate([T0[:3, 3], np.zeros(3)]), names, prior_sigma)
+    T = np.eye(4)
+    T[:3, :3] = perturb_rotation(R0, res.x[3:6])
+    T[:3, 3] = res.x[:3]
+    warnings = []
+    if s[1] / s[0] < NEAR_COLLINEAR_SIN:
+        warnings.append("the nominal points are nearly collinear: the rotation about their line is "
+                        "poorly determined; add points away from that line")
+    return _common("frame-npoint", "T_R_W", T, res, labs, warnings,
+                   "enter matrix/xyzabc as the base (user frame); touch one more known point and check "
+                   "that transform_points(T_R_W, nominal) matches it within the residual RMS")
+
+
+def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,
+                 labels: Sequence[str] | None = None) -> CalibrationResult:
+    """Pose of a fixed (external) tool in the robot base frame, touched with a reference tool.
+
+    The robot carries a reference tool of known TCP; the recorded TCP positions (robot base
+    frame) are touches of the fixed tool's TCP (role ``"tcp"``, at least 3 from different
+    directions), optionally of points on the fixed tool's +X axis (its tool direction, role
+    ``"x"``) and of points in its XY plane with positive Y (role ``"xy"``). With axis and plane
+    touches the full pose is the 3-point frame fit; with TCP touches only, the position is their
+    maximum-likelihood mean and the orientation is reported as not determined (the identity is
+    returned in ``T_R_TCP``).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        Reference-tool TCP positions in the robot base frame (metres).
+    roles : sequence of str, length N
+        ``"tcp"``, ``"x"`` or ``"xy"``.
+    prior_sigma : float, optional
+        Touch-up accuracy (metres).
+    labels : sequence of str, optional
+
+    Returns
+    -------
+    CalibrationResult
+        ``values["T_R_TCP"]`` (4x4, metres), JSON ``matrix``, ``xyzabc`` and ``tcp_mm``.
+    """
+    p = as_points(points, "points").reshape(-1, 3)
+    roles = [str(r).lower() for r in roles]
+    if len(roles) != len(p):
+        raise InputError(f"{len(roles)} roles given for {len(p)} points")
+    bad = sorted(set(roles) - {"tcp", "x", "xy"})
+    if bad:
+        raise InputError(f"external TCP touches must have role tcp, x or xy; found {', '.join(bad)}")
+    n_tcp = roles.count("tcp")
+    if n_tcp < 3:
+        raise IllPosedError(f"{n_tcp} touches of the fixed TCP given; touch it at least 3 times "
+                            "(4 recommended) with the reference tool from different directions")
+    labs = _labels(len(p), labels, roles)
+    next_step = ("enter matrix/xyzabc as the external tool (KUKA: fixed tool as BASE, ABB: stationary "
+                 "tool) and check by moving a workpiece point to the fixed TCP in two orientations")
+    if "x" not in roles and "xy" not in roles:
+        pt = p[np.array(roles) == "tcp"]
+        res = fit(lambda x: pt - x, pt.mean(axis=0), ["x", "y", "z"], prior_sigma)
+        T = np.eye(4)
+        T[:3, 3] = res.x
+        out = _common("external-tcp", "T_R_TCP", T, res, labs, [], next_step,
+                      ["orientation of the fixed tool (touch points on its +X axis and in its XY plane)"],
+                      ["x", "y", "z"])
+        del out.sigma["T_R_TCP_rotation"]
+        out.json_fields.update({"tcp_mm": T[:3, 3] * 1e3, "rotation_determined": False})
+        return out
+    if "x" not in roles or "xy" not in roles:
+        raise IllPosedError("the fixed tool's orientation needs touches of both a point on its +X axis "
+                            "(role x) and a point in its XY plane with positive Y (role xy)")
+    out = frame_3point(p, ["origin" if r == "tcp" else r for r in roles], prior_sigma, labs)
+    T = out.values.pop("T_R_W")
+    out.procedure = "external-tcp"
+    out.values["T_R_TCP"] = T
+    out.sigma = {"T_R_TCP_position": out.sigma["T_R_W_position"],
+                 "T_R_TCP_rotation": out.sigma["T_R_W_rotation"]}
+    out.next_step = next_step
+    out.json_fields.update({"tcp_mm": T[:3, 3] * 1e3, "rotation_determined": True})
+    return out

@@ -1,0 +1,260 @@
+"""Tool calibration: TCP position (XYZ 4-point / N-point) and tool orientation (ABC 2-point,
+ABC World), from flange poses recorded while the tool touches one fixed reference point.
+
+Model (all in the robot base frame R, metres): with ``T_R_F_i = [R_i, p_i]`` the flange pose of
+touch i, ``t`` the TCP in the flange frame and ``c`` the reference point ("pivot"),
+``R_i t + p_i = c`` for every touch of the reference point with the TCP. The orientation
+``R_F_TCP`` comes from extra touches in which the reference point lies on the tool's negative X
+axis (``c = T_R_F_k (t + R_F_TCP (-d_k, 0, 0))``, d_k > 0) and in the tool's XY plane with positive Y
+(``c = T_R_F_k (t + R_F_TCP (x_k, y_k, 0))``, y_k > 0): KUKA's ABC 2-point method. All touches enter
+one maximum-likelihood fit under isotropic Gaussian noise on the touched point. ABC World
+instead aligns the tool with the world axes (5D: tool +X along world -Z; 6D: additionally tool
++Y along world +Y, so tool +Z along world +X).
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.calibration.fitting import fit, nearest_rotation, outlier_warnings, perturb_rotation
+from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.errors import IllPosedError, InputError
+from robotcell.transforms import validate_pose
+
+__all__ = ["ABC_WORLD_5D", "ABC_WORLD_6D", "calibrate_tool"]
+
+#: Tool axes in the world frame when aligned for ABC World 6D (columns: tool X, Y, Z).
+ABC_WORLD_6D = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
+#: Tool +X in the world frame when aligned for ABC World 5D.
+ABC_WORLD_5D = np.array([0.0, 0.0, -1.0])
+
+#: Orientation spread (rad) about the least-varied direction below which the TCP is refused ...
+MIN_SPREAD = np.radians(2.0)
+#: ... and below which a warning asks for more varied orientations.
+GOOD_SPREAD = np.radians(15.0)
+#: Smallest distance (m) of the reference point from the TCP in an ABC 2-point touch.
+MIN_AXIS_DISTANCE = 0.010
+#: Sine of the angle between the -X touch and the XY touch below which they are collinear.
+COLLINEAR_SIN = 0.02
+
+ADVICE = "touch with orientations differing by at least 30-60 degrees about different axes"
+
+
+def _poses(T: ArrayLike | None, name: str) -> NDArray[np.float64]:
+    if T is None:
+        return np.zeros((0, 4, 4))
+    return validate_pose(np.asarray(T, dtype=float).reshape(-1, 4, 4), name)
+
+
+def orientation_spread(R: NDArray[np.float64]) -> float:
+    """How much a set of flange rotations varies about its least-varied direction.
+
+    Parameters
+    ----------
+    R : ndarray, shape (N, 3, 3)
+
+    Returns
+    -------
+    float
+        ``sqrt(lambda_min(M) / N)`` with ``M = sum_i (R_i - mean R)^T (R_i - mean R)``: about the
+        rotation angle (radians) by which the touches differ in the direction in which they differ
+        least. The TCP component along a direction the rotations do not vary is not determined.
+    """
+    D = R - R.mean(axis=0)
+    M = np.einsum("nji,njk->ik", D, D)
+    return float(np.sqrt(max(np.linalg.eigvalsh(M)[0], 0.0) / len(R)))
+
+
+def _world_orientation(R_RF: NDArray[np.float64], mode: str):
+    """ABC World: mean tool rotation in the flange and its 1-sigma, from aligned flange poses."""
+    if mode == "6d":
+        Ri = np.swapaxes(R_RF, 1, 2) @ ABC_WORLD_6D
+    else:
+        Ri = []
+        for x in np.swapaxes(R_RF, 1, 2) @ ABC_WORLD_5D:
+            axis = np.cross([1.0, 0.0, 0.0], x)
+            s, c = np.linalg.norm(axis), x[0]
+            rv = axis / s * np.arctan2(s, c) if s > 1e-12 else np.array([0.0, 0.0, np.pi * (c < 0)])
+            Ri.append(Rotation.from_rotvec(rv).as_matrix())
+        Ri = np.array(Ri)
+    Rm = nearest_rotation(Ri.sum(axis=0))
+    if len(Ri) < 2:
+        return Rm, np.full(3, np.nan)
+    d = Rotation.from_matrix(Ri @ Rm.T).as_rotvec()
+    return Rm, d.std(axis=0, ddof=1) / np.sqrt(len(Ri))
+
+
+def calibrate_tool(
+    touches: ArrayLike,
+    axis_touches: ArrayLike | None = None,
+    plane_touches: ArrayLike | None = None,
+    world_touches: ArrayLike | None = None,
+    world_mode: str = "6d",
+    prior_sigma: float | None = None,
+    labels: Sequence[str] | None = None,
+) -> CalibrationResult:
+    """Calibrate a robot-held tool: TCP in the flange frame, reference point, optional orientation.
+
+    Parameters
+    ----------
+    touches : array_like, shape (N, 4, 4)
+        Flange poses ``T_R_F`` (metres) with the TCP on the reference point, N >= 3 (4 is KUKA's
+        XYZ 4-point; more are used in full).
+    axis_touches : array_like, shape (Na, 4, 4), optional
+        ABC 2-point: flange poses with the reference point on the tool's negative X axis.
+    plane_touches : array_like, shape (Np, 4, 4), optional
+        ABC 2-point: flange poses with the reference point in the tool's XY plane, Y > 0.
+    world_touches : array_like, shape (Nw, 4, 4), optional
+        ABC World: flange poses with the tool aligned to the world axes (see ``world_mode``);
+        several alignments are averaged and their spread gives the rotation sigma.
+    world_mode : {"6d", "5d"}
+        ``"6d"``: tool +X along world -Z, +Y along world +Y, +Z along world +X.
+        ``"5d"``: only tool +X along world -Z; the rotation about the tool axis is fixed by the
+        convention "smallest rotation from the flange X axis" and reported as undetermined.
+    prior_sigma : float, optional
+        Touch-up accuracy (metres, 1-sigma per coordinate).
+    labels : sequence of str, optional
+        Names of the touches in the order touches, axis_touches, plane_touches.
+
+    Returns
+    -------
+    CalibrationResult
+        ``values["tcp"]`` (3,) TCP in the flange frame, ``values["pivot"]`` (3,) reference point
+        in the base frame, and with an orientation method ``values["T_F_TCP"]`` (4x4). JSON
+        fields ``tcp_mm``, ``pivot_mm``, ``mean_mm``/``min_mm`` (as ABB reports) and, with an
+        orientation, ``matrix``/``xyzabc`` of ``T_F_TCP``.
+
+    Raises
+    ------
+    IllPosedError
+        Fewer than 3 touches, orientations too similar, or ABC 2-point touches that do not define
+        a direction/plane.
+    """
+    T = _poses(touches, "touch flange poses")
+    Ta = _poses(axis_touches, "ABC 2-point -X flange poses")
+    Tp = _poses(plane_touches, "ABC 2-point XY flange poses")
+    Tw = _poses(world_touches, "ABC World flange poses")
+    if world_mode not in ("6d", "5d"):
+        raise InputError(f"world_mode must be '6d' or '5d', got {world_mode!r}")
+    if len(T) < 3:
+        raise IllPosedError(f"{len(T)} touches of the reference point given; the TCP needs at least 3 "
+                            f"(4 recommended, more are better): {ADVICE}")
+    if (len(Ta) > 0) != (len(Tp) > 0):
+        raise IllPosedError("ABC 2-point needs both a touch with the reference point on the tool's -X "
+                            "axis and one with it in the tool's XY plane (positive Y)")
+    if len(Ta) and len(Tw):
+        raise InputError("give either ABC 2-point touches or ABC World alignments, not both")
+    spread = orientation_spread(T[:, :3, :3])
+    if spread < MIN_SPREAD:
+        raise IllPosedError(f"the flange orientations of the touches are too similar (they differ by "
+                            f"{np.degrees(spread):.1f} deg in their least-varied direction), so the TCP "
+                            f"is not determined: {ADVICE}")
+    n, na, nq = len(T), len(Ta), len(Tp)
+    if labels is None:
+        labels = ([f"{i + 1}" for i in range(n)] + [f"{n + i + 1} (-x)" for i in range(na)]
+                  + [f"{n + na + i + 1} (xy)" for i in range(nq)])
+    elif len(labels) != n + na + nq:
+        raise InputError(f"labels has {len(labels)} entries for {n + na + nq} touches")
+    # Linear start: [R_i, -I] [t; c] = -p_i.
+    A = np.concatenate([T[:, :3, :3], np.broadcast_to(-np.eye(3), (n, 3, 3))], axis=2).reshape(-1, 6)
+    t0, c0 = np.split(np.linalg.lstsq(A, -T[:, :3, 3].ravel(), rcond=None)[0], 2)
+    x0 = [t0, c0]
+    R0 = np.eye(3)
+    if na:
+        f_a = np.einsum("nji,nj->ni", Ta[:, :3, :3], c0 - Ta[:, :3, 3]) - t0
+        f_p = np.einsum("nji,nj->ni", Tp[:, :3, :3], c0 - Tp[:, :3, 3]) - t0
+        da = np.linalg.norm(f_a, axis=1)
+        if np.any(da < MIN_AXIS_DISTANCE):
+            raise IllPosedError(f"in a -X touch the reference point is only {da.min() * 1e3:.1f} mm from "
+                                "the TCP; move the tool back along its axis by at least 50 mm")
+        X = -(f_a / da[:, None]).mean(axis=0)
+        X /= np.linalg.norm(X)
+        w = f_p.mean(axis=0) - (f_p.mean(axis=0) @ X) * X
+        if np.linalg.norm(w) < COLLINEAR_SIN * np.linalg.norm(f_p.mean(axis=0)):
+            raise IllPosedError("the XY-plane touch lies on the tool's X axis (collinear with the -X "
+                                "touch): move the tool sideways so the reference point is off its axis "
+                                "on the tool's +Y side")
+        Y = w / np.linalg.norm(w)
+        R0 = np.column_stack([X, Y, np.cross(X, Y)])
+        x0 += [np.zeros(3), da, (f_p @ R0[:, :2]).ravel()]
+    x0 = np.concatenate(x0)
+
+    def resid(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        t, c = x[:3], x[3:6]
+        out = [c - (T[:, :3, :3] @ t + T[:, :3, 3])]
+        if na:
+            R = perturb_rotation(R0, x[6:9])
+            d = x[9:9 + na]
+            xy = x[9 + na:].reshape(nq, 2)
+            ta = t - d[:, None] * R[:, 0]
+            tp = t + xy @ R[:, :2].T
+            out.append(c - (np.einsum("nij,nj->ni", Ta[:, :3, :3], ta) + Ta[:, :3, 3]))
+            out.append(c - (np.einsum("nij,nj->ni", Tp[:, :3, :3], tp) + Tp[:, :3, 3]))
+        return np.concatenate(out)
+
+    names = ["tcp x", "tcp y", "tcp z", "pivot x", "pivot y", "pivot z"]
+    if na:
+        names += ["tool rotation about flange x", "tool rotation about flange y",
+                  "tool rotation about flange z"]
+        names += [f"distance of touch {labels[n + i]} along -X" for i in range(na)]
+        names += [f"{k} of touch {labels[n + na + i]}" for i in range(nq) for k in ("x", "y")]
+    res = fit(resid, x0, names, prior_sigma)
+    t, c = res.x[:3], res.x[3:6]
+    values: dict = {"tcp": t, "pivot": c}
+    sigma: dict = {"tcp": res.sigma[:3], "pivot": res.sigma[3:6]}
+    warnings = outlier_warnings(res, labels)
+    undetermined: list[str] = []
+    if spread < GOOD_SPREAD:
+        warnings.append(f"the touch orientations differ by only {np.degrees(spread):.1f} deg in their "
+                        f"least-varied direction: the TCP is poorly determined; {ADVICE}")
+    R_tool = None
+    if na:
+        R_tool = perturb_rotation(R0, res.x[6:9])
+        sigma_rot = res.sigma[6:9]
+        if np.any(res.x[9:9 + na] <= 0):
+            raise IllPosedError("in a -X touch the reference point lies on the tool's positive X side; "
+                                "the -X touch must move the tool back, against its tool direction")
+        if np.any(res.x[9 + na:].reshape(nq, 2)[:, 1] <= 0):
+            raise IllPosedError("the XY-plane touches lie on both sides of the tool's X axis; keep them "
+                                "all on the tool's positive Y side")
+    elif len(Tw):
+        R_tool, sigma_rot = _world_orientation(Tw[:, :3, :3], world_mode)
+        if len(Tw) < 2:
+            warnings.append("one ABC World alignment: its accuracy is unknown; align 2-3 times to get "
+                            "the orientation uncertainty")
+        if world_mode == "5d":
+            undetermined.append("rotation of the tool about its own X axis (ABC World 5D; the smallest "
+                                "rotation from the flange X axis is used)")
+    else:
+        undetermined.append("tool orientation (add ABC 2-point touches or ABC World alignments)")
+    if res.noise_source == "none":
+        warnings.append("no redundant touches and no measurement sigma given: uncertainties are unknown; "
+                        "touch more than the minimum or give the touch-up accuracy (--sigma)")
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: {ADVICE}")
+    norms = np.linalg.norm(res.residuals, axis=1)
+    extra = {"tcp_mm": t * 1e3, "pivot_mm": c * 1e3, "mean_mm": norms.mean() * 1e3,
+             "min_mm": norms.min() * 1e3}
+    if R_tool is not None:
+        Tft = np.eye(4)
+        Tft[:3, :3], Tft[:3, 3] = R_tool, t
+        values["T_F_TCP"] = Tft
+        sigma["T_F_TCP_position"] = sigma["tcp"]
+        sigma["T_F_TCP_rotation"] = sigma_rot
+        extra.update(pose_fields(Tft))
+        next_step = ("enter xyzabc as the tool data (KUKA TOOL_DATA X,Y,Z,A,B,C), then jog A/B/C in the "
+                     "TOOL frame at the reference point: the tip must stay on it")
+    else:
+        next_step = ("enter tcp_mm as the tool's X,Y,Z, then calibrate its orientation (ABC 2-point or "
+                     "ABC World) if the process needs the tool direction")
+    return CalibrationResult(
+        procedure="tcp", values=values, sigma=sigma, residuals=res.residuals,
+        condition=res.condition, dof=res.dof, noise_sigma=res.noise_sigma,
+        noise_source=res.noise_source, labels=list(labels), undetermined=undetermined,
+        warnings=warnings, next_step=next_step, json_fields=extra, covariance=res.covariance,
+        parameter_names=names,
+    )
