@@ -1,0 +1,214 @@
+"""The DH procedure: geometry -> DH table -> FK reproduces the geometry, case by case."""
+
+import math
+
+import numpy as np
+import pytest
+
+import robotcell as rc
+from robotcell.dhprocedure import AxisChain, dh_from_axes
+from robotcell.errors import IllPosedError, InputError
+from robotcell.transforms import make_pose
+
+TOL = 1e-9
+
+
+def pose_error(A, B):
+    """Largest position error (m) and rotation error (rad) between two batches of poses."""
+    dp = np.linalg.norm(A[..., :3, 3] - B[..., :3, 3], axis=-1).max()
+    R = np.swapaxes(A[..., :3, :3], -1, -2) @ B[..., :3, :3]
+    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1) / 2, -1, 1)
+    s = np.linalg.norm(np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                                 R[..., 1, 0] - R[..., 0, 1]], -1), axis=-1) / 2
+    return dp, np.arctan2(s, c).max()
+
+
+def unit(v):
+    return v / np.linalg.norm(v)
+
+
+def perp(rng, z):
+    v = rng.normal(size=3)
+    return unit(v - v @ z * z)
+
+
+def random_chain(rng, n):
+    """A chain whose consecutive axes are skew, intersecting, parallel or coincident at random."""
+    pts, dirs, types, cases = [rng.normal(size=3) * 0.3], [unit(rng.normal(size=3))], [], []
+    types.append(rng.choice(["revolute", "prismatic"]))
+    for _ in range(1, n):
+        p, z = pts[-1], dirs[-1]
+        case = rng.choice(["skew", "intersecting", "parallel", "coincident", "coincident-ish"])
+        if case == "skew":
+            q, w = rng.normal(size=3) * 0.3, unit(rng.normal(size=3))
+        elif case == "intersecting":
+            q, w = p + rng.normal() * 0.3 * z, unit(rng.normal(size=3))
+        elif case == "parallel":
+            q, w = p + perp(rng, z) * rng.uniform(0.05, 0.5), z * rng.choice([1, -1])
+        elif case == "coincident":
+            q, w = p + rng.normal() * z, z * rng.choice([1, -1])
+        else:  # within 1e-13 of coincident: treated as coincident at tol 1e-9
+            q, w = p + rng.normal() * z + 1e-13 * perp(rng, z), unit(z + 1e-13 * perp(rng, z))
+        t = rng.choice(["revolute", "prismatic"])
+        if t == types[-1] == "prismatic" and case in ("parallel", "coincident", "coincident-ish"):
+            t = "revolute"
+        pts.append(q)
+        dirs.append(w)
+        types.append(t)
+        cases.append(case)
+    flange_kind = rng.choice(["free", "on last axis"])
+    zf = dirs[-1] if flange_kind == "on last axis" else unit(rng.normal(size=3))
+    origin = pts[-1] + rng.normal() * dirs[-1] if flange_kind == "on last axis" else rng.normal(size=3)
+    xf = perp(rng, zf)
+    flange = make_pose(np.column_stack([xf, np.cross(zf, xf), zf]), origin)
+    return AxisChain(np.array(pts), np.array(dirs), tuple(types), flange), cases
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_library_robots_round_trip_through_their_axes(convention):
+    rng = np.random.default_rng(1)
+    names = rc.list_robots()
+    assert names
+    for name in names:
+        robot = rc.load_robot(name)
+        chain = AxisChain.from_robot(robot)
+        q = rng.uniform(-math.pi, math.pi, (200, robot.n_joints))
+        # The reference (product of screw motions) is independent of the DH table...
+        dp, dr = pose_error(chain.fk(q), robot.fk(q, tool=np.eye(4)))
+        assert dp < TOL and dr < TOL, name
+        # ...and the derived model reproduces it.
+        derived = dh_from_axes(chain, convention).robot
+        dp, dr = pose_error(derived.fk(q), chain.fk(q))
+        assert dp < TOL and dr < TOL, name
+        assert derived.convention == convention
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_random_chains_all_cases(convention):
+    rng = np.random.default_rng(7)
+    seen_cases, seen_types = set(), set()
+    for _ in range(150):
+        n = int(rng.integers(1, 8))
+        chain, _ = random_chain(rng, n)
+        signs = rng.choice([1.0, -1.0], n)
+        der = dh_from_axes(chain, convention, signs=signs)
+        q = rng.uniform(-math.pi, math.pi, (20, n))
+        dp, dr = pose_error(der.robot.fk(q), chain.fk(q))
+        assert dp < TOL and dr < TOL
+        assert [j.sign for j in der.robot.joints] == list(signs)
+        seen_cases |= {note.case for note in der.notes}
+        seen_types |= set(chain.types)
+    assert seen_cases == {"base", "skew", "intersecting", "parallel", "coincident"}
+    assert seen_types == {"revolute", "prismatic"}
+
+
+def test_frames_satisfy_the_procedure():
+    """Each Z along its joint axis, X perpendicular to and meeting both Z axes (standard)."""
+    rng = np.random.default_rng(3)
+    for _ in range(30):
+        chain, _ = random_chain(rng, 6)
+        der = dh_from_axes(chain)
+        F = der.frames
+        for i in range(6):
+            z = F[i, :3, 2]
+            assert np.linalg.norm(np.cross(z, chain.directions[i])) < 1e-9
+            # the joint axis passes through O_i
+            r = F[i, :3, 3] - chain.points[i]
+            assert np.linalg.norm(r - r @ chain.directions[i] * chain.directions[i]) < 1e-9
+            x = F[i + 1, :3, 0]
+            assert abs(x @ z) < 1e-9
+        assert np.allclose(der.robot.base, F[0])
+
+
+def test_standard_and_modified_share_theta_and_d():
+    rng = np.random.default_rng(4)
+    chain, _ = random_chain(rng, 6)
+    std, mod = dh_from_axes(chain, "standard").robot, dh_from_axes(chain, "modified").robot
+    for js, jm in zip(std.joints, mod.joints):
+        assert js.theta == pytest.approx(jm.theta, abs=1e-12)
+        assert js.d == pytest.approx(jm.d, abs=1e-12)
+    # Craig's row i holds a_{i-1}, alpha_{i-1}: the standard a, alpha moved down one row.
+    assert [j.a for j in mod.joints[1:]] == pytest.approx([j.a for j in std.joints[:-1]])
+    assert [j.alpha for j in mod.joints[1:]] == pytest.approx([j.alpha for j in std.joints[:-1]])
+    assert mod.joints[0].a == 0 and mod.joints[0].alpha == 0
+
+
+def test_parallel_axes_keep_d_zero_and_x_toward_next_axis():
+    # Planar 3R arm: parallel Z axes 0.4 m and 0.3 m apart along +X.
+    chain = AxisChain(points=[[0, 0, 0.1], [0.4, 0, 0], [0.7, 0, 0.2]], directions=[[0, 0, 1]] * 3,
+                      types=("revolute",) * 3, flange=make_pose(p=[0.9, 0, 0.5]))
+    der = dh_from_axes(chain)
+    a = [j.a for j in der.robot.joints]
+    d = [j.d for j in der.robot.joints]
+    assert a[:2] == pytest.approx([0.4, 0.3])
+    assert d[:2] == pytest.approx([0.0, 0.0])
+    assert [n.case for n in der.notes] == ["base", "parallel", "parallel", "parallel"]
+    assert "not unique" in der.notes[1].text and "d = 0" in der.notes[1].text
+    assert np.allclose(der.frames[1, :3, 0], [1, 0, 0])
+
+
+def test_intersecting_x_points_toward_end_effector():
+    chain = AxisChain(points=[[0, 0, 0], [0, 0, 0.5]], directions=[[0, 0, 1], [0, 1, 0]],
+                      types=("revolute", "revolute"), flange=make_pose(p=[-0.3, 0.2, 0.5]))
+    der = dh_from_axes(chain)
+    assert der.notes[1].case == "intersecting"
+    assert np.allclose(der.frames[1, :3, 0], [-1, 0, 0])  # toward the flange at x < 0
+    assert "toward the end effector" in der.notes[1].text
+
+
+def test_flange_on_last_axis_becomes_frame_n():
+    robot = rc.Robot("r", (rc.Joint("revolute", d=0.3, alpha=math.pi / 2),
+                           rc.Joint("revolute", d=0.1)), flange=make_pose(p=[0, 0, 0.05]))
+    der = dh_from_axes(AxisChain.from_robot(robot))
+    assert der.notes[-1].case == "coincident"
+    assert np.allclose(der.robot.flange, np.eye(4))
+    assert der.robot.joints[-1].d == pytest.approx(0.15)
+
+
+def test_sign_corrections_flip_z_and_the_sign():
+    robot = rc.load_robot("kuka_kr6_r700_sixx") if "kuka_kr6_r700_sixx" in rc.list_robots() else None
+    if robot is None:
+        pytest.skip("kuka_kr6_r700_sixx not in the library")
+    chain = AxisChain.from_robot(robot)
+    plain = dh_from_axes(chain).robot
+    corrected = dh_from_axes(chain, signs=[j.sign for j in robot.joints]).robot
+    # A1 turns about -Z of ROBROOT; with Z_0 along +Z the base height d1 comes out positive.
+    assert plain.joints[0].d == pytest.approx(-0.4)
+    assert corrected.joints[0].d == pytest.approx(0.4)
+    assert corrected.joints[0].sign == -1
+
+
+def test_zero_direction_names_the_joint():
+    with pytest.raises(InputError, match="joint elbow: axis direction has zero length"):
+        AxisChain(points=np.zeros((2, 3)), directions=[[0, 0, 1], [0, 0, 0]],
+                  types=("revolute", "revolute"), names=("base", "elbow"))
+
+
+def test_coincident_prismatic_axes_name_both_joints():
+    chain = AxisChain(points=[[0, 0, 0], [0, 0, 1]], directions=[[0, 0, 1], [0, 0, -2]],
+                      types=("prismatic", "prismatic"), names=("Z1", "Z2"))
+    with pytest.raises(IllPosedError, match="joints Z1 and Z2 are both prismatic along parallel"):
+        dh_from_axes(chain)
+
+
+def test_bad_arguments():
+    chain = AxisChain(points=[[0, 0, 0]], directions=[[0, 0, 1]], types=("revolute",))
+    with pytest.raises(InputError, match="convention must be"):
+        dh_from_axes(chain, "craig")
+    with pytest.raises(InputError, match="signs must be 1 values, each"):
+        dh_from_axes(chain, signs=[0.5])
+    with pytest.raises(InputError, match="joint J1: type must be"):
+        AxisChain(points=[[0, 0, 0]], directions=[[0, 0, 1]], types=("planar",))
+    with pytest.raises(InputError, match=r"q must have shape \(\.\.\., 1\)"):
+        chain.fk([0.0, 1.0])
+
+
+def test_screw_fk_is_batched_and_moves_as_expected():
+    chain = AxisChain(points=[[1, 0, 0], [0, 0, 0]], directions=[[0, 0, 1], [1, 0, 0]],
+                      types=("revolute", "prismatic"))
+    T = chain.fk(np.array([[[math.pi / 2, 0.2]] * 3]))
+    assert T.shape == (1, 3, 4, 4)
+    # The slide of 0.2 along +X (in the zero pose) moves the flange origin to (0.2, 0, 0); the
+    # quarter turn about the vertical line x = 1 then carries it to (1, -0.8, 0).
+    assert np.allclose(T[0, 0, :3, 3], [1, -0.8, 0])
+    assert np.allclose(T[0, 0, :3, :3], rc.rot_z(math.pi / 2))
