@@ -144,10 +144,6 @@ def joint_columns(cols: Columns, robot: Robot, source: str) -> NDArray[np.float6
     return np.where(robot.prismatic, q * 1e-3, np.radians(q))
 
 
-def _has(cols: Columns, names: Sequence[str]) -> bool:
-    return all(n in cols for n in names)
-
-
 def tcp_positions(cols: Columns, source: str, robot: Robot | None = None,
                   tool: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
     """TCP positions in the robot base frame from ``x,y,z`` or from ``a1..an`` through FK.
@@ -168,7 +164,7 @@ def tcp_positions(cols: Columns, source: str, robot: Robot | None = None,
     ndarray, shape (N, 3)
         Positions in metres.
     """
-    if _has(cols, ("x", "y", "z")):
+    if "x" in cols or "a1" not in cols and ("y" in cols or "z" in cols):
         p = _numeric(cols, ("x", "y", "z"), source)
         _check_mm(p, "x, y, z", source)
         return p * 1e-3
@@ -198,7 +194,7 @@ def flange_poses(cols: Columns, source: str, robot: Robot | None = None) -> NDAr
     ndarray, shape (N, 4, 4)
         Flange poses in the robot base frame (metres).
     """
-    if _has(cols, ("x", "y", "z", "a", "b", "c")):
+    if "x" in cols or "a1" not in cols and any(k in cols for k in "yzabc"):
         v = _numeric(cols, ("x", "y", "z", "a", "b", "c"), source)
         _check_mm(v[:, :3], "flange x, y, z", source)
         return pose_from_vendor(v, "kuka")

@@ -1,0 +1,185 @@
+"""Shared calibration pieces: ML fit and covariance, outliers, rotations, result, CSV columns."""
+
+import json
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from robotcell import IllPosedError, InputError, Joint, Robot, pose_from_vendor
+from robotcell.calibration import (
+    CalibrationResult,
+    fit,
+    kabsch,
+    nearest_rotation,
+    outlier_warnings,
+    perturb_pose,
+    pose_fields,
+)
+from robotcell.calibration.measurements import (
+    check_count,
+    check_no_repeats,
+    external_axis,
+    flange_poses,
+    nominal_points,
+    point_roles,
+    tcp_positions,
+)
+
+
+def line_model(t):
+    """Points on a line p(s) = a + s b, s known; parameters a (3), b (3)."""
+    return lambda x: x[:3] + t[:, None] * x[3:]
+
+
+def test_fit_sigma_matches_monte_carlo_spread():
+    rng = np.random.default_rng(1)
+    s = np.linspace(-1.0, 1.0, 8)
+    truth = np.array([0.5, -0.2, 1.0, 0.1, 0.3, -0.2])
+    noise = 2e-4
+    errors, sigmas, noise_est = [], [], []
+    for _ in range(400):
+        meas = line_model(s)(truth) + rng.normal(scale=noise, size=(8, 3))
+        res = fit(lambda x: meas - line_model(s)(x), np.zeros(6), list("abcdef"))
+        errors.append(res.x - truth)
+        sigmas.append(res.sigma)
+        noise_est.append(res.noise_sigma)
+    spread = np.sqrt(np.mean(np.square(errors), axis=0))
+    assert np.all(np.abs(spread / np.mean(sigmas, axis=0) - 1) < 0.25)
+    # analytic: intercept sigma = noise / sqrt(N) (s has zero mean)
+    np.testing.assert_allclose(np.mean(sigmas, axis=0)[:3], noise / np.sqrt(8), rtol=0.1)
+    assert abs(np.mean(noise_est) / noise - 1) < 0.05
+
+
+def test_fit_prior_and_no_redundancy():
+    rng = np.random.default_rng(2)
+    meas = rng.normal(size=(1, 3))
+    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"])
+    assert res.dof == 0 and res.noise_source == "none" and np.all(np.isnan(res.sigma))
+    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-3)
+    assert res.noise_source == "prior"
+    np.testing.assert_allclose(res.sigma, 1e-3)
+    with pytest.raises(InputError, match="positive"):
+        fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=-1.0)
+
+
+def test_fit_refuses_unobservable_parameter_and_names_it():
+    meas = np.ones((4, 3))
+    with pytest.raises(IllPosedError, match="do not determine .*phantom"):
+        fit(lambda x: meas - x[:3], np.zeros(4), ["x", "y", "z", "phantom"])
+
+
+def test_outlier_is_named_and_clean_data_rarely_flagged():
+    rng = np.random.default_rng(3)
+    flagged = 0
+    for _ in range(200):
+        meas = rng.normal(scale=1e-4, size=(10, 3))
+        res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"])
+        flagged += len(outlier_warnings(res, [str(i) for i in range(10)]))
+    assert flagged / 2000 < 0.01
+    meas = rng.normal(scale=1e-4, size=(10, 3))
+    meas[6] += [1.5e-3, 0, 0]
+    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"])
+    warnings = outlier_warnings(res, [f"row {i}" for i in range(10)])
+    assert len(warnings) == 1 and "row 6" in warnings[0] and "3 sigma" in warnings[0]
+
+
+def test_kabsch_recovers_pose_and_rotations_are_proper():
+    rng = np.random.default_rng(4)
+    R = Rotation.random(random_state=5).as_matrix()
+    q = rng.normal(size=(6, 3))
+    p = q @ R.T + [1.0, 2.0, 3.0]
+    T = kabsch(q, p)
+    np.testing.assert_allclose(T[:3, :3], R, atol=1e-12)
+    np.testing.assert_allclose(T[:3, 3], [1, 2, 3], atol=1e-12)
+    # mirrored data: the best proper rotation, never a reflection
+    T = kabsch(q, q * [1, 1, -1])
+    assert np.linalg.det(T[:3, :3]) == pytest.approx(1.0)
+    assert np.linalg.det(nearest_rotation(np.diag([1.0, 1.0, -1.0]))) == pytest.approx(1.0)
+    T0 = np.eye(4)
+    T = perturb_pose(T0, [0.1, 0.2, 0.3, 0.0, 0.0, np.pi / 2])
+    np.testing.assert_allclose(T[:3, :3] @ [1, 0, 0], [0, 1, 0], atol=1e-12)
+
+
+def make_result():
+    res = np.array([[1e-4, 0, 0], [0, -2e-4, 0], [0, 0, 3e-4]])
+    T = pose_from_vendor([100, 200, 300, 30, 20, 10], "kuka")
+    return CalibrationResult(
+        procedure="demo", values={"T_R_W": T, "radius": 0.5},
+        sigma={"T_R_W_position": np.full(3, 1e-4), "T_R_W_rotation": np.full(3, 1e-3),
+               "radius": 2e-4},
+        residuals=res, condition=3.0, dof=3, noise_sigma=float("nan"), noise_source="none",
+        warnings=["w1"], next_step="do it", json_fields=pose_fields(T))
+
+
+def test_result_statistics_json_and_summary():
+    r = make_result()
+    np.testing.assert_allclose(r.residual_norms, [1e-4, 2e-4, 3e-4])
+    assert r.max == pytest.approx(3e-4)
+    assert r.rms == pytest.approx(np.sqrt((1 + 4 + 9) / 3) * 1e-4)
+    j = r.to_json()
+    text = json.dumps(j)  # NaN must not leak into JSON
+    assert "NaN" not in text and j["noise_sigma_mm"] is None
+    np.testing.assert_allclose(j["residuals_mm"], [0.1, 0.2, 0.3])
+    assert j["rms_mm"] == pytest.approx(r.rms * 1e3)
+    np.testing.assert_allclose(j["xyzabc"], [100, 200, 300, 30, 20, 10], atol=1e-9)
+    assert j["matrix"][0][3] == pytest.approx(100.0)
+    assert j["sigma"]["T_R_W_position_mm"] == pytest.approx([0.1] * 3)
+    assert j["sigma"]["radius_mm"] == pytest.approx(0.2)
+    for key in ("procedure", "warnings", "condition", "undetermined", "next_step", "max_mm"):
+        assert key in j
+    s = r.summary()
+    assert "100.000, 200.000, 300.000, 30.000, 20.000, 10.000" in s
+    assert "radius (mm): 500.000" in s and "next step: do it" in s and "w1" in s
+
+
+def test_tcp_positions_from_xyz_and_from_joints():
+    cols = {"x": np.array([1000.0, 1100.0]), "y": np.array([0.0, 50.0]), "z": np.array([500.0, 400.0])}
+    np.testing.assert_allclose(tcp_positions(cols, "m.csv"), [[1, 0, 0.5], [1.1, 0.05, 0.4]])
+    robot = Robot("rr", (Joint("revolute", a=0.5), Joint("revolute", a=0.4)))
+    tool = pose_from_vendor([100, 0, 0, 0, 0, 0], "kuka")
+    cols = {"a1": np.array([0.0, 90.0]), "a2": np.array([0.0, -90.0])}
+    p = tcp_positions(cols, "m.csv", robot, tool)
+    np.testing.assert_allclose(p, [[1.0, 0, 0], [0.5, 0.5, 0]], atol=1e-12)
+    with pytest.raises(InputError, match="need a robot model"):
+        tcp_positions(cols, "m.csv")
+
+
+def test_measurement_refusals():
+    with pytest.raises(InputError, match="looks like metres.*millimetres"):
+        tcp_positions({"x": np.array([1.0, 1.1]), "y": np.zeros(2), "z": np.full(2, 0.5)}, "m.csv")
+    with pytest.raises(InputError, match="missing column.*z"):
+        flange_poses({"x": np.ones(2), "y": np.ones(2), "a": np.ones(2), "b": np.ones(2),
+                      "c": np.ones(2), "zz": np.ones(2)}, "m.csv")
+    with pytest.raises(InputError, match="needs TCP positions"):
+        tcp_positions({"u": np.ones(2)}, "m.csv")
+    with pytest.raises(InputError, match="NaN"):
+        tcp_positions({"x": np.array([np.nan, 900.0]), "y": np.ones(2), "z": np.ones(2)}, "m.csv")
+    with pytest.raises(InputError, match="line 2 and line 4 are identical"):
+        check_no_repeats(np.array([[1.0, 2.0], [3.0, 4.0], [1.0, 2.0]]), "m.csv")
+    with pytest.raises(InputError, match="2 points given, at least 3 needed"):
+        check_count(2, 3, "points", "m.csv")
+    with pytest.raises(InputError, match="looks like metres"):
+        external_axis({"e1": np.array([0.0, 0.5, 1.0])}, "m.csv", "track")
+    with pytest.raises(InputError, match="looks like radians"):
+        external_axis({"e1": np.array([0.0, 1.5, 3.1])}, "m.csv", "table")
+    np.testing.assert_allclose(external_axis({"e1": np.array([0.0, 90.0])}, "m.csv", "table"),
+                               [0, np.pi / 2])
+    np.testing.assert_allclose(external_axis({"e1": np.array([0.0, 900.0])}, "m.csv", "track"),
+                               [0, 0.9])
+    with pytest.raises(InputError, match="must hold origin, x or xy; found yy"):
+        point_roles({"point": ["origin", "x", "yy"]}, "m.csv")
+    with pytest.raises(InputError, match="no touch of point.*xy"):
+        point_roles({"point": ["origin", "x"]}, "m.csv")
+    with pytest.raises(InputError, match="must be numeric"):
+        nominal_points({"nominal_x": ["a"], "nominal_y": np.ones(1), "nominal_z": np.ones(1)}, "m.csv")
+
+
+def test_flange_poses_kuka_and_joints():
+    cols = {k: np.array([v]) for k, v in zip("xyzabc", [1000, 0, 800, 0, 90, 0])}
+    np.testing.assert_allclose(flange_poses(cols, "m.csv"),
+                               pose_from_vendor([[1000, 0, 800, 0, 90, 0]], "kuka"), atol=1e-12)
+    robot = Robot("rr", (Joint("revolute", a=0.5), Joint("revolute", a=0.4)),
+                  tool=pose_from_vendor([50, 0, 0, 0, 0, 0], "kuka"))
+    T = flange_poses({"a1": np.array([30.0]), "a2": np.array([10.0])}, "m.csv", robot)
+    np.testing.assert_allclose(T, robot.fk(np.radians([[30.0, 10.0]]), np.eye(4)))
