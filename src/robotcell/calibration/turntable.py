@@ -1,0 +1,240 @@
+"""Turntable (rotary external axis) root point calibration from touches of one point on the table.
+
+Frame B (``docs/conventions.md``): ``Z_B`` along the rotation axis, oriented so that a positive
+table angle turns the table counter-clockwise about ``Z_B``; ``X_B`` points from the axis to the
+reference point at table angle 0; the origin lies on the axis in the plane of the reference point,
+optionally shifted by a known ``height`` along ``Z_B``. A reference point at radius ``r`` touched at
+table angle ``theta_i`` has TCP position (in R)
+
+    f_i = b + R_R_B Rz(theta_i) [r, 0, -height]^T,
+
+i.e. with ``u = r X_B`` and ``v = r Y_B``, ``f_i = b' + u cos(theta_i) + v sin(theta_i)``: linear in
+``(b', u, v)``. That linear least-squares solution (3 or more distinct angles) starts a nonlinear
+maximum-likelihood fit of the 7 parameters ``b`` (3), the rotation ``R_R_B`` (3: axis direction and
+phase) and ``r``, which keeps ``X_B``, ``Y_B`` orthonormal and the radius common to both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.calibration.fitting import fit, outlier_warnings, perturb_rotation
+from robotcell.calibration.propagate import propagate
+from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.errors import IllPosedError, InputError
+from robotcell.transforms import as_points, make_pose, rot_z
+
+__all__ = ["angular_spread", "calibrate_turntable"]
+
+#: Angular spread of the touches below which a warning is given (radians).
+SPREAD_WARN = np.radians(90.0)
+
+
+def angular_spread(theta: ArrayLike) -> float:
+    """Arc of the table circle covered by the touches.
+
+    Parameters
+    ----------
+    theta : array_like, shape (N,)
+        Table angles (radians).
+
+    Returns
+    -------
+    float
+        ``2 pi`` minus the largest gap between neighbouring angles on the circle (radians); 0 for
+        a single angle.
+    """
+    t = np.sort(np.mod(np.asarray(theta, dtype=float), 2.0 * np.pi))
+    gaps = np.diff(np.concatenate([t, [t[0] + 2.0 * np.pi]]))
+    return float(2.0 * np.pi - gaps.max())
+
+
+def _check_angles(theta: NDArray[np.float64], labels: Sequence[str], min_step: float,
+                  min_spread: float) -> float:
+    t = np.mod(theta, 2.0 * np.pi)
+    order = np.argsort(t)
+    gaps = np.diff(np.concatenate([t[order], [t[order[0]] + 2.0 * np.pi]]))
+    j = int(np.argmin(gaps))
+    if gaps[j] < min_step:
+        i1, i2 = order[j], order[(j + 1) % len(order)]
+        raise IllPosedError(
+            f"touches {labels[i1]} and {labels[i2]} are at the same or too close table angles "
+            f"({np.degrees(theta[i1]):.3f} and {np.degrees(theta[i2]):.3f} deg, modulo 360); turn "
+            f"the table by at least {np.degrees(min_step):.0f} deg between touches"
+        )
+    spread = angular_spread(theta)
+    if spread < min_spread:
+        raise IllPosedError(
+            f"the touches span only {np.degrees(spread):.1f} deg of table rotation, too little to "
+            "separate the axis from the radius; spread them over at least "
+            f"{np.degrees(min_spread):.0f} deg (better 90 deg or more, ideally around the full turn)"
+        )
+    return spread
+
+
+def _linear_start(theta: NDArray[np.float64], f: NDArray[np.float64], min_radius: float):
+    """Linear LS for ``f = b' + u cos + v sin``; returns ``(b', R0, r0)``."""
+    A = np.stack([np.ones_like(theta), np.cos(theta), np.sin(theta)], axis=1)
+    (b, u, v), *_ = np.linalg.lstsq(A, f, rcond=None)
+    r0 = 0.5 * (np.linalg.norm(u) + np.linalg.norm(v))
+    if r0 < min_radius:
+        raise IllPosedError(
+            f"the reference point is only {r0 * 1e3:.1f} mm from the table axis, so the axis "
+            "direction and the angle zero are not determined; touch a point at least "
+            f"{min_radius * 1e3:.0f} mm from the axis, ideally near the rim"
+        )
+    x = u / np.linalg.norm(u)
+    z = np.cross(u, v)
+    z /= np.linalg.norm(z)
+    R0 = np.stack([x, np.cross(z, x), z], axis=1)
+    return b, R0, r0
+
+
+def calibrate_turntable(
+    theta: ArrayLike,
+    f: ArrayLike,
+    *,
+    height: float = 0.0,
+    labels: Sequence[str] | None = None,
+    prior_sigma: float | None = None,
+    min_step: float = np.radians(1.0),
+    min_spread: float = np.radians(20.0),
+    min_radius: float = 0.01,
+) -> CalibrationResult:
+    """Calibrate the root frame B of a turntable from touches of one point on the table.
+
+    Maximum-likelihood fit under isotropic Gaussian noise on the touched positions; the table
+    angles are taken as exact.
+
+    Parameters
+    ----------
+    theta : array_like, shape (N,)
+        Table angle at each touch (radians), N >= 3 distinct angles.
+    f : array_like, shape (N, 3)
+        TCP position at each touch in the robot base frame R (metres).
+    height : float
+        Position of the origin of B along ``Z_B`` relative to the plane of the reference point
+        (metres): e.g. ``-0.02`` puts it on the table top when the touched point is 20 mm above it.
+    labels : sequence of str, optional
+        Name of each touch (default ``"1".."N"``).
+    prior_sigma : float, optional
+        Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
+        the residuals.
+    min_step : float
+        Smallest angle between two touches, modulo a full turn (radians).
+    min_spread : float
+        Smallest arc covered by the touches (radians); below 90 deg a warning is given.
+    min_radius : float
+        Smallest distance of the reference point from the axis (metres).
+
+    Returns
+    -------
+    CalibrationResult
+        ``values``: ``T_R_B`` (4, 4), ``radius`` (m), ``axis`` (3,) ``Z_B`` in R, ``tilt`` (rad,
+        angle between ``Z_B`` and the robot base Z), ``spread`` (rad, not estimated). ``sigma``:
+        ``T_R_B_position`` (m), ``T_R_B_rotation`` (rad, about the axes of R), ``radius``,
+        ``axis``, ``tilt`` (first-order; when the tilt is within 3 sigma of zero, where that
+        linearisation fails, the angular 1-sigma of the axis direction instead). ``covariance``
+        over ``parameter_names`` (position m, rotation vector rad, radius m). ``json_fields``:
+        ``matrix``, ``xyzabc``, ``radius_mm``, ``tilt_deg``, ``spread_deg``, ``axis``,
+        ``axis_sigma_deg``, ``height_mm``, ``T_R_B_covariance_mm_rad`` (6x6 over position mm and
+        rotation vector rad, for the workpiece calibration).
+
+    Raises
+    ------
+    InputError
+        Wrong shapes, NaN, fewer than 3 touches.
+    IllPosedError
+        Repeated or too close angles, too small a spread, a reference point on the axis.
+    """
+    f = as_points(f, "TCP positions")
+    theta = np.asarray(theta, dtype=float)
+    if f.ndim != 2 or theta.shape != (len(f),):
+        raise InputError(f"table angles must have shape (N,) matching TCP positions (N, 3); "
+                         f"got {theta.shape} and {f.shape}")
+    if not np.all(np.isfinite(theta)) or not np.isfinite(height):
+        raise InputError("table angles or height contain NaN or infinite values")
+    n = len(f)
+    if n < 3:
+        raise InputError(f"{n} touches given, at least 3 needed at different table angles (4 or "
+                         "more give a check on every touch)")
+    labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
+    spread = _check_angles(theta, labels, min_step, min_spread)
+    b_plane, R0, r0 = _linear_start(theta, f, min_radius)
+    rot_theta = rot_z(theta)
+
+    def unpack(x: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+        return make_pose(perturb_rotation(R0, x[3:6]), x[:3]), float(x[6])
+
+    def residuals(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        T, r = unpack(x)
+        p = rot_theta @ np.array([r, 0.0, -height])
+        return f - (p @ T[:3, :3].T + T[:3, 3])
+
+    names = ["origin x", "origin y", "origin z", "rotation about R x", "rotation about R y",
+             "rotation about R z", "radius"]
+    x0 = np.concatenate([b_plane + height * R0[:, 2], np.zeros(3), [r0]])
+    res = fit(residuals, x0, names, prior_sigma)
+    T, radius = unpack(res.x)
+    axis = T[:3, 2]
+    tilt = float(np.arccos(np.clip(axis[2], -1.0, 1.0)))
+
+    def axis_of(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return unpack(x)[0][:3, 2]
+
+    axis_cov = propagate(axis_of, res.x, res.covariance)
+    axis_sigma = float(np.sqrt(np.abs(np.trace(axis_cov))))
+    if tilt > 3.0 * axis_sigma and np.pi - tilt > 3.0 * axis_sigma:
+        tilt_sigma = float(np.sqrt(np.abs(propagate(
+            lambda x: np.arccos(np.clip(axis_of(x)[2], -1.0, 1.0)), res.x, res.covariance)[0, 0])))
+    else:
+        tilt_sigma = axis_sigma
+
+    warnings = []
+    if spread < SPREAD_WARN:
+        warnings.append(f"the touches span only {np.degrees(spread):.0f} deg of table rotation; "
+                        "spread them over at least 90 deg (ideally around the full turn) for a "
+                        "well-determined axis")
+    if n < 4:
+        warnings.append("only 3 touches: no touch can be checked against the others; take 4 or "
+                        "more (ABB's RobotAxisRot asks for at least 4)")
+    if tilt > np.pi / 2:
+        warnings.append("Z_B points downward in the robot base: positive table angles turn the "
+                        "table clockwise seen from above; check the axis sign in the controller's "
+                        "machine data if that is unexpected")
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: "
+                        "spread the touches around the full turn and use a point near the rim")
+    warnings += outlier_warnings(res, labels)
+    to_mm_rad = np.array([1e3, 1e3, 1e3, 1.0, 1.0, 1.0])
+    cov6_mm = res.covariance[:6, :6] * np.outer(to_mm_rad, to_mm_rad)
+    json_fields = {
+        **pose_fields(T),
+        "radius_mm": radius * 1e3,
+        "height_mm": height * 1e3,
+        "axis": axis,
+        "axis_sigma_deg": np.degrees(axis_sigma),
+        "tilt_deg": np.degrees(tilt),
+        "spread_deg": np.degrees(spread),
+        "T_R_B_covariance_mm_rad": cov6_mm,
+    }
+    return CalibrationResult(
+        procedure="turntable",
+        values={"T_R_B": T, "radius": radius, "axis": axis, "tilt": tilt, "spread": spread},
+        sigma={"T_R_B_position": res.sigma[:3], "T_R_B_rotation": res.sigma[3:6],
+               "radius": float(res.sigma[6]), "axis": np.sqrt(np.abs(np.diag(axis_cov))),
+               "tilt": tilt_sigma},
+        residuals=res.residuals, condition=res.condition, dof=res.dof,
+        noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
+        warnings=warnings,
+        next_step=("enter T_R_B as the turntable's root frame in the controller (KUKA: ROOT of "
+                   "the external kinematics; ABB: base frame of the mechanical unit), then "
+                   "calibrate the workpiece frame on the table (robotcell calibrate workpiece)"),
+        kinds={"radius": "length", "axis": "number", "tilt": "angle", "spread": "angle"},
+        json_fields=json_fields, covariance=res.covariance,
+        parameter_names=["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z",
+                         "radius"],
+    )
