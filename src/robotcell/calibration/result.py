@@ -71,6 +71,12 @@ def pose_fields(T: NDArray[np.float64]) -> dict[str, Any]:
     return {"matrix": M.tolist(), "xyzabc": pose_to_vendor(T, "kuka").tolist()}
 
 
+def _fmt(values: Any, decimals: int) -> str:
+    """Comma-separated fixed-decimal numbers, without a minus sign on values that round to zero."""
+    arr = np.round(np.atleast_1d(np.asarray(values, dtype=float)), decimals) + 0.0
+    return ", ".join(f"{c:.{decimals}f}" for c in arr)
+
+
 @dataclass
 class CalibrationResult:
     """Outcome of one calibration procedure.
@@ -227,25 +233,20 @@ class CalibrationResult:
             kind = self._kind(key)
             if kind == "pose":
                 xyzabc = pose_to_vendor(v, "kuka")
-                lines.append(f"  {key} (KUKA X,Y,Z mm, A,B,C deg): "
-                             + ", ".join(f"{c:.3f}" for c in xyzabc))
+                lines.append(f"  {key} (KUKA X,Y,Z mm, A,B,C deg): {_fmt(xyzabc, 3)}")
                 sp = self.sigma.get(key + "_position")
                 sr = self.sigma.get(key + "_rotation")
                 if sp is not None:
-                    lines.append("    1-sigma position (mm):      "
-                                 + ", ".join(f"{c:.3f}" for c in np.asarray(sp) * 1e3))
+                    lines.append(f"    1-sigma position (mm):      {_fmt(np.asarray(sp) * 1e3, 3)}")
                 if sr is not None:
-                    lines.append("    1-sigma rotation (deg):     "
-                                 + ", ".join(f"{c:.4f}" for c in np.degrees(sr)))
+                    lines.append(f"    1-sigma rotation (deg):     {_fmt(np.degrees(sr), 4)}")
                 continue
-            scale, unit, fmt = {"length": (1e3, " mm", ".3f"), "angle": (180 / math.pi, " deg", ".4f"),
-                                "number": (1.0, "", ".6g")}[kind]
-            arr = np.atleast_1d(np.asarray(v, dtype=float)) * scale
-            text = ", ".join(f"{c:{fmt}}" for c in arr)
+            scale, unit, dec = {"length": (1e3, " mm", 3), "angle": (180 / math.pi, " deg", 4),
+                                "number": (1.0, "", 6)}[kind]
+            text = _fmt(np.asarray(v, dtype=float) * scale, dec)
             s = self.sigma.get(key)
             if s is not None:
-                sarr = np.atleast_1d(np.asarray(s, dtype=float)) * scale
-                text += "  (1-sigma " + ", ".join(f"{c:{fmt}}" for c in sarr) + ")"
+                text += f"  (1-sigma {_fmt(np.asarray(s, dtype=float) * scale, dec)})"
             lines.append(f"  {key}{unit and ' (' + unit.strip() + ')'}: {text}")
         return lines
 

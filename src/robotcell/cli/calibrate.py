@@ -133,6 +133,7 @@ def tcp(measurements: str, world_mode: str, robot: str | None, tool: str | None,
     if tool is not None:
         raise InputError("--tool is not used by 'calibrate tcp': the flange poses are computed "
                          "without a tool; give only --robot")
+    prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None)
     cols = read_csv(measurements)
     T = flange_poses(cols, measurements, model)
@@ -147,7 +148,7 @@ def tcp(measurements: str, world_mode: str, robot: str | None, tool: str | None,
     labels = _line_labels(roles)
     order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
-                            world_mode=world_mode, prior_sigma=sigma_m(sigma),
+                            world_mode=world_mode, prior_sigma=prior,
                             labels=[labels[i] for i in order])
     emit(result, as_json)
 
@@ -167,6 +168,7 @@ def frame(measurements: str, robot: str | None, tool: str | None, sigma: float |
     """
     from robotcell.calibration.frame import frame_3point, frame_npoint
 
+    prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
     cols = read_csv(measurements)
     p = tcp_positions(cols, measurements, model, T_tool)
@@ -175,10 +177,10 @@ def frame(measurements: str, robot: str | None, tool: str | None, sigma: float |
     if "nominal_x" in cols:
         check_count(len(p), 3, "points", measurements)
         q = nominal_points(cols, measurements)
-        result = frame_npoint(p, q, sigma_m(sigma), [f"line {i + 2}" for i in range(len(p))])
+        result = frame_npoint(p, q, prior, [f"line {i + 2}" for i in range(len(p))])
     else:
         roles = point_roles(cols, measurements)
-        result = frame_3point(p, roles, sigma_m(sigma), _line_labels(roles))
+        result = frame_3point(p, roles, prior, _line_labels(roles))
     emit(result, as_json)
 
 
@@ -197,6 +199,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     """
     from robotcell.calibration.frame import external_tcp
 
+    prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
     cols = read_csv(measurements)
     p = tcp_positions(cols, measurements, model, T_tool)
@@ -205,7 +208,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     else:
         roles = ["tcp"] * len(p)
     check_no_repeats(raw_rows(cols, POSE_COLUMNS), measurements)
-    result = external_tcp(p, roles, sigma_m(sigma), _line_labels(roles))
+    result = external_tcp(p, roles, prior, _line_labels(roles))
     emit(result, as_json)
 
 
