@@ -40,7 +40,7 @@ def test_fit_sigma_matches_monte_carlo_spread():
     errors, sigmas, noise_est = [], [], []
     for _ in range(400):
         meas = line_model(s)(truth) + rng.normal(scale=noise, size=(8, 3))
-        res = fit(lambda x: meas - line_model(s)(x), np.zeros(6), list("abcdef"))
+        res = fit(lambda x, m=meas: m - line_model(s)(x), np.zeros(6), list("abcdef"))
         errors.append(res.x - truth)
         sigmas.append(res.sigma)
         noise_est.append(res.noise_sigma)
@@ -74,7 +74,7 @@ def test_outlier_is_named_and_clean_data_rarely_flagged():
     flagged = 0
     for _ in range(200):
         meas = rng.normal(scale=1e-4, size=(10, 3))
-        res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"])
+        res = fit(lambda x, m=meas: m - x, np.zeros(3), ["x", "y", "z"])
         flagged += len(outlier_warnings(res, [str(i) for i in range(10)]))
     assert flagged / 2000 < 0.01
     meas = rng.normal(scale=1e-4, size=(10, 3))

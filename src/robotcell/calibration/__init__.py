@@ -25,12 +25,12 @@ from robotcell.calibration.tcp import calibrate_tool
 
 __all__ = [
     "CalibrationResult",
+    "Fit",
     "calibrate_tool",
     "external_tcp",
+    "fit",
     "frame_3point",
     "frame_npoint",
-    "Fit",
-    "fit",
     "kabsch",
     "nearest_rotation",
     "outlier_warnings",

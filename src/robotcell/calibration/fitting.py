@@ -10,8 +10,8 @@ rotation (:func:`perturb_rotation`), so that an estimate is always a proper rota
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

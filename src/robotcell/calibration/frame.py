@@ -7,7 +7,7 @@ isotropic Gaussian noise on the touched points (see ``docs/calibration.md``).
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

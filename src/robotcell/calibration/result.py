@@ -273,8 +273,8 @@ class CalibrationResult:
         lines += self._value_lines()
         lines += ["", "residuals (measured - model, mm):",
                   format_table(["touch", "dx", "dy", "dz", "|r|"], rows), "",
-                  f"RMS {self.rms * 1e3:.3f} mm, max {self.max * 1e3:.3f} mm "
-                  f"over {len(r)} measurements, redundancy {self.dof}",
+                  (f"RMS {self.rms * 1e3:.3f} mm, max {self.max * 1e3:.3f} mm "
+                   f"over {len(r)} measurements, redundancy {self.dof}"),
                   f"measurement noise: {noise}",
                   f"condition number: {self.condition:.1f} ({cond}; below {CONDITION_LIMIT:.0f} is good)"]
         if self.undetermined:

@@ -14,7 +14,7 @@ instead aligns the tool with the world axes (5D: tool +X along world -Z; 6D: add
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

@@ -11,7 +11,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import json
-from typing import Callable
+from collections.abc import Callable
 
 import click
 import numpy as np
