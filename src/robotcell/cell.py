@@ -1,0 +1,839 @@
+"""The robot cell: robot, linear track, turntable, tools and frames, and its YAML file.
+
+A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the schema); a
+:class:`Cell` holds the same content in SI units. Poses in the file are mappings
+``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention, as in robot model
+files). Every calibrated quantity carries its :class:`Provenance`.
+
+:meth:`Cell.save` writes atomically: a temporary file in the same directory, flushed and
+fsynced, then ``os.replace``; the previous file is kept as ``<name>.bak``. A process that dies
+during a save leaves either the old or the new file, never a partial one.
+
+Coupled kinematics (TCP pose in any frame given the arm joints, the track position and the table
+angle) are in :mod:`robotcell.coupled`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call them.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import os
+import re
+import shutil
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import yaml
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell import coupled
+from robotcell.coupled import RESERVED_FRAMES
+from robotcell.errors import InputError
+from robotcell.modelfile import load_robot
+from robotcell.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.robot import Robot
+from robotcell.transforms import validate_pose
+
+__all__ = ["Cell", "Frame", "Provenance", "Tool", "Track", "Turntable", "RESERVED_FRAMES"]
+
+#: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
+#: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
+NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,23}$")
+
+_POSE_KEYS = ("x", "y", "z", "a", "b", "c")
+
+
+# -- provenance -----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Provenance:
+    """Where a calibrated value comes from.
+
+    Attributes
+    ----------
+    source : str
+        ``"nominal"`` (design value), ``"manual"`` (typed in) or the calibration procedure that
+        produced the value (``"tcp"``, ``"frame"``, ``"track"``, ``"turntable"``,
+        ``"workpiece"``, ...).
+    time : str or None
+        When it was produced, ISO 8601 (``2025-03-14T09:30:00+01:00``).
+    rms_mm : float or None
+        Residual RMS of the calibration (mm).
+    note : str
+        Free text (operator, number of points, instrument).
+    """
+
+    source: str = "nominal"
+    time: str | None = None
+    rms_mm: float | None = None
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.source, str) or not self.source.strip():
+            raise InputError("provenance source must be a non-empty string")
+        if self.time is not None:
+            _iso_time(self.time, "provenance time")
+        if self.rms_mm is not None and not (math.isfinite(self.rms_mm) and self.rms_mm >= 0):
+            raise InputError(f"provenance rms_mm must be a finite number >= 0, got {self.rms_mm}")
+
+    @classmethod
+    def now(cls, source: str, rms_mm: float | None = None, note: str = "") -> Provenance:
+        """Provenance stamped with the current local time (ISO 8601, seconds, with UTC offset)."""
+        stamp = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
+        return cls(source=source, time=stamp, rms_mm=rms_mm, note=note)
+
+
+def _iso_time(value: str, where: str) -> str:
+    try:
+        _dt.datetime.fromisoformat(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{where} must be an ISO 8601 time like 2025-03-14T09:30:00+01:00, "
+                         f"got {value!r}") from None
+    return value
+
+
+# -- components -----------------------------------------------------------------------------------
+def _pose(T: ArrayLike, name: str) -> NDArray[np.float64]:
+    arr = validate_pose(T, name)
+    if arr.shape != (4, 4):
+        raise InputError(f"{name} must be a single pose of shape (4, 4), got {arr.shape}")
+    return arr.copy()
+
+
+def _limits(lower: float, upper: float, what: str) -> None:
+    if not (isinstance(lower, (int, float)) and isinstance(upper, (int, float))):
+        raise InputError(f"{what} limits must be numbers")
+    if not lower < upper:
+        raise InputError(f"{what}: lower limit {lower} must be below upper limit {upper}")
+
+
+@dataclass
+class Track:
+    """A linear track carrying the robot.
+
+    ``T_L_R(e) = T_L_R0`` with its translation moved by ``e * scale * axis``: the lecture's
+    ``p = x + L_Q_R f`` with ``x = e * scale * axis`` and ``L_Q_R`` the rotation of ``T_L_R0``.
+
+    Attributes
+    ----------
+    T_world_L : ndarray, shape (4, 4)
+        Pose of the track frame L in the world (metres).
+    T_L_R0 : ndarray, shape (4, 4)
+        Pose of the robot base R in L at track position 0 (metres); its rotation is the
+        lecture's alignment error ``L_Q_R``, its translation the mounting offset.
+    axis : {"x", "y", "z"}
+        Axis of L the robot moves along (``x`` in the lecture; KUKA's linear units use ``z``).
+    scale : float
+        Displacement per unit of the controller's track value (1 for a true encoder).
+    lower, upper : float
+        Limits of the controller's track value (metres).
+    name : str
+        Name of the mechanical unit (used by controller exports, e.g. ABB ``TRACK_1``).
+    provenance : Provenance
+    """
+
+    T_world_L: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    T_L_R0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    axis: Literal["x", "y", "z"] = "x"
+    scale: float = 1.0
+    lower: float = -math.inf
+    upper: float = math.inf
+    name: str = "track"
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_world_L = _pose(self.T_world_L, "track T_world_L")
+        self.T_L_R0 = _pose(self.T_L_R0, "track T_L_R0")
+        if self.axis not in ("x", "y", "z"):
+            raise InputError(f"track axis must be 'x', 'y' or 'z', got {self.axis!r}")
+        if not (math.isfinite(self.scale) and self.scale > 0):
+            raise InputError(f"track scale must be a finite number > 0, got {self.scale}")
+        _limits(self.lower, self.upper, "track")
+
+    @property
+    def direction(self) -> NDArray[np.float64]:
+        """Unit vector of the motion in L, shape ``(3,)``."""
+        return np.eye(3)["xyz".index(self.axis)]
+
+    def T_L_R(self, e: ArrayLike) -> NDArray[np.float64]:
+        """Pose of the robot base in L at track positions ``e`` (shape ``(...)``, metres)."""
+        return coupled.track_pose(self.T_L_R0, self.direction * self.scale, e)
+
+    def within_limits(self, e: ArrayLike) -> NDArray[np.bool_]:
+        """Whether track positions ``e`` (shape ``(...)``, metres) are within the limits."""
+        arr = np.asarray(e, dtype=float)
+        return (arr >= self.lower) & (arr <= self.upper)
+
+
+@dataclass
+class Turntable:
+    """A one-axis turntable (rotary positioner).
+
+    ``T_parent_W(theta) = T_parent_B Rz(theta) T_B_W`` for a frame W carried by the table: the
+    lecture's ``R_T_W(theta) = R_T_B Rz(theta) B_T_W``. Positive table values turn about +Z_B.
+
+    Attributes
+    ----------
+    T_parent_B : ndarray, shape (4, 4)
+        Pose of the table root frame B (origin on the axis, Z along it) in its parent (metres).
+    parent : {"world", "robot"}
+        ``world``: fixed in the cell; ``robot``: fixed to the robot base R (moves with a track).
+    lower, upper : float
+        Limits of the table angle (radians).
+    name : str
+        Name of the mechanical unit (KUKA ``MACHINE_DEF`` name, ABB ``ufmec``).
+    provenance : Provenance
+    """
+
+    T_parent_B: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    parent: Literal["world", "robot"] = "world"
+    lower: float = -math.inf
+    upper: float = math.inf
+    name: str = "turntable"
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_parent_B = _pose(self.T_parent_B, "turntable T_parent_B")
+        if self.parent not in ("world", "robot"):
+            raise InputError(f"turntable parent must be 'world' or 'robot', got {self.parent!r}")
+        _limits(self.lower, self.upper, "turntable")
+
+    def within_limits(self, theta: ArrayLike) -> NDArray[np.bool_]:
+        """Whether table angles ``theta`` (shape ``(...)``, radians) are within the limits."""
+        arr = np.asarray(theta, dtype=float)
+        return (arr >= self.lower) & (arr <= self.upper)
+
+
+@dataclass
+class Tool:
+    """A tool on the robot flange.
+
+    Attributes
+    ----------
+    T_F_TCP : ndarray, shape (4, 4)
+        Pose of the TCP in the flange frame F of the cell's robot model (metres).
+    number : int or None
+        Controller slot (KUKA ``TOOL_DATA[n]``, Fanuc ``UTOOL[n]``); None: numbered in file order.
+    mass : float or None
+        Mass of the tool (kg), for controllers that need load data (ABB ``tload``).
+    cog : ndarray, shape (3,), or None
+        Centre of gravity in the flange frame (metres).
+    provenance : Provenance
+    """
+
+    T_F_TCP: NDArray[np.float64]
+    number: int | None = None
+    mass: float | None = None
+    cog: NDArray[np.float64] | None = None
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_F_TCP = _pose(self.T_F_TCP, "tool T_F_TCP")
+        _check_number(self.number, "tool number")
+        if self.mass is not None and not (math.isfinite(self.mass) and self.mass > 0):
+            raise InputError(f"tool mass must be a finite number > 0 (kg), got {self.mass}")
+        if self.cog is not None:
+            cog = np.asarray(self.cog, dtype=float)
+            if cog.shape != (3,) or not np.all(np.isfinite(cog)):
+                raise InputError(f"tool cog must be 3 finite numbers, got {self.cog!r}")
+            self.cog = cog
+
+
+@dataclass
+class Frame:
+    """A named frame of the cell: a fixture, a base, a workpiece.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (4, 4)
+        Pose of the frame in its parent (metres): ``T_world_X``, ``T_R_X`` or ``T_B_X`` (for a
+        frame on the turntable, at table angle 0).
+    parent : {"world", "robot", "turntable"}
+        What carries the frame: nothing (fixed in the world), the robot base (moves with the
+        track), or the turntable (turns with it).
+    number : int or None
+        Controller slot (KUKA ``BASE_DATA[n]``, Fanuc ``UFRAME[n]``); None: numbered in order.
+    provenance : Provenance
+    """
+
+    pose: NDArray[np.float64]
+    parent: Literal["world", "robot", "turntable"] = "world"
+    number: int | None = None
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.pose = _pose(self.pose, "frame pose")
+        if self.parent not in ("world", "robot", "turntable"):
+            raise InputError(f"frame parent must be 'world', 'robot' or 'turntable', "
+                             f"got {self.parent!r}")
+        _check_number(self.number, "frame number")
+
+
+def _check_number(n: Any, what: str) -> None:
+    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
+        raise InputError(f"{what} must be an integer >= 1, got {n!r}")
+
+
+# -- the cell -------------------------------------------------------------------------------------
+@dataclass
+class Cell:
+    """A robot cell in SI units.
+
+    Attributes
+    ----------
+    robot : Robot
+        The arm. Its default tool applies when :meth:`fk` gets no tool.
+    robot_model : str
+        How the cell file names the robot: a library name, or the path of a model file (absolute,
+        or relative to the working directory).
+    T_world_R : ndarray, shape (4, 4)
+        Pose of the robot base in the world for a cell without track (metres).
+    track : Track or None
+    turntable : Turntable or None
+    tools : dict of str to Tool
+    frames : dict of str to Frame
+    name : str
+    """
+
+    robot: Robot
+    robot_model: str
+    T_world_R: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    track: Track | None = None
+    turntable: Turntable | None = None
+    tools: dict[str, Tool] = field(default_factory=dict)
+    frames: dict[str, Frame] = field(default_factory=dict)
+    name: str = "cell"
+
+    def __post_init__(self) -> None:
+        self.T_world_R = _pose(self.T_world_R, "robot T_world_R")
+        if self.track is not None and not np.allclose(self.T_world_R, np.eye(4), atol=0):
+            raise InputError("a robot on a track is placed by the track (track frame and "
+                             "robot_at_zero); do not give the robot a frame as well")
+        for name in self.tools:
+            _check_name(name, "tool")
+        for name, fr in self.frames.items():
+            _check_name(name, "frame")
+            self._check_parent(name, fr)
+        _unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
+        _unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
+
+    def _check_parent(self, name: str, fr: Frame) -> None:
+        if fr.parent == "turntable" and self.turntable is None:
+            raise InputError(f"frame {name!r} is carried by the turntable, but the cell has none")
+
+    # -- editing (used by calibration commands) -------------------------------------------------
+    def set_tool(self, name: str, T_F_TCP: ArrayLike, provenance: Provenance,
+                 number: int | None = None, mass: float | None = None,
+                 cog: ArrayLike | None = None) -> Tool:
+        """Add or replace a tool; an existing tool keeps its number and load unless given.
+
+        Parameters
+        ----------
+        name : str
+            Tool name (letter, then letters, digits, ``_``; at most 24 characters).
+        T_F_TCP : array_like, shape (4, 4)
+            Pose of the TCP in the flange frame (metres).
+        provenance : Provenance
+        number : int, optional
+            Controller slot.
+        mass : float, optional
+            Tool mass (kg).
+        cog : array_like, shape (3,), optional
+            Centre of gravity in the flange frame (metres).
+
+        Returns
+        -------
+        Tool
+        """
+        _check_name(name, "tool")
+        old = self.tools.get(name)
+        tool = Tool(
+            T_F_TCP=np.asarray(T_F_TCP, dtype=float),
+            number=number if number is not None else (old.number if old else None),
+            mass=mass if mass is not None else (old.mass if old else None),
+            cog=np.asarray(cog, dtype=float) if cog is not None else (old.cog if old else None),
+            provenance=provenance,
+        )
+        _unique_numbers({**{k: t.number for k, t in self.tools.items()}, name: tool.number}, "tool")
+        self.tools[name] = tool
+        return tool
+
+    def update_frame(self, name: str, pose: ArrayLike, provenance: Provenance,
+                     parent: Literal["world", "robot", "turntable"] | None = None,
+                     number: int | None = None) -> Frame:
+        """Add or replace a frame; an existing frame keeps its parent and number unless given.
+
+        Parameters
+        ----------
+        name : str
+            Frame name (not one of ``world``, ``track``, ``L``, ``robot``, ``R``,
+            ``turntable``, ``B``).
+        pose : array_like, shape (4, 4)
+            Pose of the frame in its parent (metres); in B at table angle 0 for a frame on the
+            turntable.
+        provenance : Provenance
+        parent : {"world", "robot", "turntable"}, optional
+            Default: the existing frame's parent, else ``world``.
+        number : int, optional
+            Controller slot.
+
+        Returns
+        -------
+        Frame
+        """
+        _check_name(name, "frame")
+        old = self.frames.get(name)
+        fr = Frame(
+            pose=np.asarray(pose, dtype=float),
+            parent=parent or (old.parent if old else "world"),
+            number=number if number is not None else (old.number if old else None),
+            provenance=provenance,
+        )
+        self._check_parent(name, fr)
+        _unique_numbers({**{k: f.number for k, f in self.frames.items()}, name: fr.number}, "frame")
+        self.frames[name] = fr
+        return fr
+
+    def update_track(self, provenance: Provenance, **changes: Any) -> Track:
+        """Replace fields of the track (``T_world_L``, ``T_L_R0``, ``axis``, ``scale``, ...).
+
+        Parameters
+        ----------
+        provenance : Provenance
+            Provenance of the new track calibration.
+        **changes
+            :class:`Track` attributes to change (SI units).
+
+        Returns
+        -------
+        Track
+        """
+        if self.track is None:
+            raise InputError("the cell has no track to update")
+        self.track = replace(self.track, provenance=provenance, **changes)
+        return self.track
+
+    def update_turntable(self, provenance: Provenance, **changes: Any) -> Turntable:
+        """Replace fields of the turntable (``T_parent_B``, ``parent``, limits, ``name``).
+
+        Parameters
+        ----------
+        provenance : Provenance
+            Provenance of the new turntable calibration.
+        **changes
+            :class:`Turntable` attributes to change (SI units).
+
+        Returns
+        -------
+        Turntable
+        """
+        if self.turntable is None:
+            raise InputError("the cell has no turntable to update")
+        self.turntable = replace(self.turntable, provenance=provenance, **changes)
+        return self.turntable
+
+    # -- kinematics -----------------------------------------------------------------------------
+    def frame_pose(self, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
+                   ) -> NDArray[np.float64]:
+        """Pose of a frame of the cell in the world; see :func:`robotcell.coupled.frame_pose`."""
+        return coupled.frame_pose(self, name, track, table)
+
+    def fk(self, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
+           tool: str | ArrayLike | None = None, frame: str = "world") -> NDArray[np.float64]:
+        """TCP pose in a frame of the cell; see :func:`robotcell.coupled.fk`."""
+        return coupled.fk(self, q, track, table, tool, frame)
+
+    # -- files ------------------------------------------------------------------------------------
+    @classmethod
+    def load(cls, path: str | Path) -> Cell:
+        """Read a cell file.
+
+        Parameters
+        ----------
+        path : str or Path
+            YAML cell file (millimetres, degrees). A robot model path inside it is resolved
+            against the file's directory.
+
+        Returns
+        -------
+        Cell
+
+        Raises
+        ------
+        InputError
+            Missing or unreadable file, invalid YAML, or invalid content; the message names the
+            file and the key.
+        """
+        p = Path(path)
+        if not p.is_file():
+            raise InputError(f"cell file {str(path)!r} does not exist")
+        try:
+            data = yaml.safe_load(p.read_text(encoding="utf-8"))
+        except yaml.YAMLError as exc:
+            raise InputError(f"{path}: not valid YAML: {exc}") from None
+        except UnicodeDecodeError:
+            raise InputError(f"{path}: not a text file (expected UTF-8 YAML)") from None
+        return cell_from_dict(data, str(path), p.resolve().parent)
+
+    def save(self, path: str | Path) -> None:
+        """Write the cell file atomically, keeping the previous version as ``<path>.bak``.
+
+        The text is written to a temporary file in the same directory, flushed and fsynced, then
+        moved over ``path`` with ``os.replace``; the old file is first copied (the same way) to
+        ``<path>.bak``. If the process dies at any point, ``path`` holds either the old or the new
+        content in full.
+
+        Parameters
+        ----------
+        path : str or Path
+            Destination. A robot model file is written relative to its directory.
+        """
+        p = Path(path)
+        text = _HEADER + yaml.safe_dump(cell_to_dict(self, p.resolve().parent), sort_keys=False,
+                                        default_flow_style=None, width=100)
+        if p.exists():
+            _atomic_copy(p, p.with_name(p.name + ".bak"))
+        _atomic_write(p, text)
+
+
+_HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z, a, b, c} with\n"
+           "# R = Rz(a) Ry(b) Rx(c). Schema: docs/cell.md\n")
+
+
+def _check_name(name: Any, what: str) -> None:
+    if not isinstance(name, str) or not NAME_RE.match(name):
+        raise InputError(f"{what} name {name!r} is invalid: use a letter, then letters, digits "
+                         "or '_', at most 24 characters")
+    if what == "frame" and name in RESERVED_FRAMES:
+        raise InputError(f"frame name {name!r} is reserved (reserved: "
+                         f"{', '.join(sorted(RESERVED_FRAMES))})")
+
+
+def _unique_numbers(numbers: dict[str, int | None], what: str) -> None:
+    seen: dict[int, str] = {}
+    for name, n in numbers.items():
+        if n is None:
+            continue
+        if n in seen:
+            raise InputError(f"{what}s {seen[n]!r} and {name!r} have the same number {n}")
+        seen[n] = name
+
+
+# -- atomic writes --------------------------------------------------------------------------------
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:  # platforms without directory handles
+        return
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    _fsync_dir(path.parent)
+
+
+def _atomic_copy(src: Path, dst: Path) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
+    try:
+        with os.fdopen(fd, "wb") as out, src.open("rb") as inp:
+            shutil.copyfileobj(inp, out)
+            out.flush()
+            os.fsync(out.fileno())
+        os.replace(tmp, dst)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+# -- file content <-> Cell ------------------------------------------------------------------------
+class _Reader:
+    """Typed access to the parsed YAML with errors naming the file and the key."""
+
+    def __init__(self, origin: str):
+        self.origin = origin
+
+    def fail(self, key: str, msg: str) -> InputError:
+        return InputError(f"{self.origin}: key '{key}' {msg}")
+
+    def mapping(self, value: Any, key: str, allowed: set[str], required: tuple[str, ...] = ()
+                ) -> dict:
+        if not isinstance(value, dict):
+            raise self.fail(key, f"must be a mapping, got {type(value).__name__}")
+        unknown = set(value) - allowed
+        if unknown:
+            raise self.fail(key, f"has unknown key(s) {sorted(map(str, unknown))}; "
+                            f"allowed: {sorted(allowed)}")
+        for r in required:
+            if r not in value:
+                raise self.fail(f"{key}.{r}" if key else r, "is missing")
+        return value
+
+    def number(self, value: Any, key: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(key, f"must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise self.fail(key, f"must be finite, got {value!r}")
+        return float(value)
+
+    def string(self, value: Any, key: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(key, f"must be a non-empty string, got {value!r}")
+        return value
+
+    def pose(self, value: Any, key: str) -> NDArray[np.float64]:
+        m = self.mapping(value, key, set(_POSE_KEYS))
+        v = [self.number(m.get(k, 0), f"{key}.{k}") for k in _POSE_KEYS]
+        return pose_from_vendor(v, "kuka")
+
+    def provenance(self, value: Any, key: str) -> Provenance:
+        if value is None:
+            return Provenance()
+        m = self.mapping(value, key, {"source", "time", "rms_mm", "note"}, ("source",))
+        time = m.get("time")
+        if isinstance(time, (_dt.datetime, _dt.date)):  # YAML reads unquoted timestamps
+            time = time.isoformat()
+        try:
+            return Provenance(
+                source=self.string(m["source"], f"{key}.source"),
+                time=time,
+                rms_mm=None if m.get("rms_mm") is None else self.number(m["rms_mm"], f"{key}.rms_mm"),
+                note=str(m.get("note", "")),
+            )
+        except InputError as exc:
+            raise self.fail(key, f"is invalid: {str(exc).lstrip()}") from None
+
+    def limits(self, m: dict, key: str, scale: float) -> tuple[float, float]:
+        lo = self.number(m["min"], f"{key}.min") * scale if "min" in m else -math.inf
+        hi = self.number(m["max"], f"{key}.max") * scale if "max" in m else math.inf
+        if not lo < hi:
+            raise self.fail(f"{key}.min", f"({m.get('min')}) must be below {key}.max ({m.get('max')})")
+        return lo, hi
+
+    def integer(self, value: Any, key: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise self.fail(key, f"must be an integer >= 1, got {value!r}")
+        return value
+
+
+def _is_model_path(text: str) -> bool:
+    return text.lower().endswith((".yaml", ".yml")) or "/" in text or os.sep in text
+
+
+def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> Cell:
+    """Build a cell from the parsed content of a cell file.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed YAML (millimetres, degrees).
+    origin : str
+        What to call the source in error messages (a file name).
+    base_dir : str or Path
+        Directory against which a relative robot model path is resolved.
+
+    Returns
+    -------
+    Cell
+    """
+    rd = _Reader(origin)
+    top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "tools", "frames"},
+                     ("robot",)) if isinstance(data, dict) else None
+    if top is None:
+        raise InputError(f"{origin}: a cell file must be a YAML mapping with keys robot, tools, "
+                         "frames, ...")
+    rob = rd.mapping(top["robot"], "robot", {"model", "frame"}, ("model",))
+    model = rd.string(rob["model"], "robot.model")
+    if _is_model_path(model):
+        model_path = Path(model) if Path(model).is_absolute() else Path(base_dir) / model
+        if not model_path.is_file():
+            raise rd.fail("robot.model", f"names model file {str(model_path)!r}, which does not exist")
+        model = str(model_path)
+    try:
+        robot = load_robot(model)
+    except InputError as exc:
+        raise rd.fail("robot.model", f"is invalid: {exc}") from None
+    kwargs: dict[str, Any] = {"robot": robot, "robot_model": model}
+    if "frame" in rob:
+        kwargs["T_world_R"] = rd.pose(rob["frame"], "robot.frame")
+    if "name" in top:
+        kwargs["name"] = rd.string(top["name"], "name")
+    if top.get("track") is not None:
+        t = rd.mapping(top["track"], "track", {"name", "frame", "robot_at_zero", "axis", "scale",
+                                               "min", "max", "provenance"})
+        if "frame" in rob:
+            raise rd.fail("robot.frame", "must be omitted when the cell has a track: the track "
+                          "places the robot (track.frame and track.robot_at_zero)")
+        axis = t.get("axis", "x")
+        if axis not in ("x", "y", "z"):
+            raise rd.fail("track.axis", f"must be x, y or z, got {axis!r}")
+        lo, hi = rd.limits(t, "track", 1e-3)
+        scale = rd.number(t.get("scale", 1.0), "track.scale")
+        if scale <= 0:
+            raise rd.fail("track.scale", f"must be > 0, got {scale}")
+        kwargs["track"] = Track(
+            T_world_L=rd.pose(t.get("frame", {}), "track.frame"),
+            T_L_R0=rd.pose(t.get("robot_at_zero", {}), "track.robot_at_zero"),
+            axis=axis, scale=scale, lower=lo, upper=hi,
+            name=rd.string(t.get("name", "track"), "track.name"),
+            provenance=rd.provenance(t.get("provenance"), "track.provenance"),
+        )
+    if top.get("turntable") is not None:
+        t = rd.mapping(top["turntable"], "turntable", {"name", "frame", "parent", "min", "max",
+                                                       "provenance"})
+        parent = t.get("parent", "world")
+        if parent not in ("world", "robot"):
+            raise rd.fail("turntable.parent", f"must be world or robot, got {parent!r}")
+        lo, hi = rd.limits(t, "turntable", math.pi / 180)
+        kwargs["turntable"] = Turntable(
+            T_parent_B=rd.pose(t.get("frame", {}), "turntable.frame"), parent=parent,
+            lower=lo, upper=hi, name=rd.string(t.get("name", "turntable"), "turntable.name"),
+            provenance=rd.provenance(t.get("provenance"), "turntable.provenance"),
+        )
+    tools: dict[str, Tool] = {}
+    for name, td in rd.mapping(top.get("tools") or {}, "tools", set(top.get("tools") or {})).items():
+        key = f"tools.{name}"
+        _named(rd, name, key, "tool")
+        td = rd.mapping(td, key, {"number", "frame", "mass", "cog", "provenance"}, ("frame",))
+        cog = td.get("cog")
+        if cog is not None and (not isinstance(cog, list) or len(cog) != 3):
+            raise rd.fail(f"{key}.cog", f"must be a list [x, y, z] in mm, got {cog!r}")
+        mass = rd.number(td["mass"], f"{key}.mass") if "mass" in td else None
+        if mass is not None and mass <= 0:
+            raise rd.fail(f"{key}.mass", f"must be > 0 kg, got {td['mass']}")
+        tools[name] = Tool(
+            T_F_TCP=rd.pose(td["frame"], f"{key}.frame"),
+            number=rd.integer(td["number"], f"{key}.number") if "number" in td else None,
+            mass=mass,
+            cog=None if cog is None else np.array(
+                [rd.number(v, f"{key}.cog[{i}]") for i, v in enumerate(cog)]) * 1e-3,
+            provenance=rd.provenance(td.get("provenance"), f"{key}.provenance"),
+        )
+    frames: dict[str, Frame] = {}
+    for name, fd in rd.mapping(top.get("frames") or {}, "frames", set(top.get("frames") or {})).items():
+        key = f"frames.{name}"
+        _named(rd, name, key, "frame")
+        fd = rd.mapping(fd, key, {"number", "parent", "frame", "provenance"}, ("frame",))
+        parent = fd.get("parent", "world")
+        if parent not in ("world", "robot", "turntable"):
+            raise rd.fail(f"{key}.parent", f"must be world, robot or turntable, got {parent!r}")
+        if parent == "turntable" and "turntable" not in kwargs:
+            raise rd.fail(f"{key}.parent", "is turntable, but the cell has no turntable")
+        frames[name] = Frame(
+            pose=rd.pose(fd["frame"], f"{key}.frame"), parent=parent,
+            number=rd.integer(fd["number"], f"{key}.number") if "number" in fd else None,
+            provenance=rd.provenance(fd.get("provenance"), f"{key}.provenance"),
+        )
+    try:
+        return Cell(tools=tools, frames=frames, **kwargs)
+    except InputError as exc:
+        raise InputError(f"{origin}: {exc}") from None
+
+
+def _named(rd: _Reader, name: Any, key: str, what: str) -> None:
+    try:
+        _check_name(name, what)
+    except InputError as exc:
+        raise rd.fail(key, f"is not a valid name: {exc}") from None
+
+
+def _clean(v: float) -> float | int:
+    # 10 decimals of mm or deg: 1e-10 mm, or 2e-12 rad (1e-11 mm at 6 m), far below any
+    # measurement, and a file a person can read (90 rather than 89.99999999999999).
+    r = round(float(v), 10) + 0.0
+    return int(r) if r == int(r) and abs(r) < 1e15 else r
+
+
+def _pose_dict(T: NDArray[np.float64]) -> dict[str, float | int]:
+    return {k: _clean(v) for k, v in zip(_POSE_KEYS, pose_to_vendor(T, "kuka"))}
+
+
+def _prov_dict(p: Provenance) -> dict[str, Any]:
+    out: dict[str, Any] = {"source": p.source}
+    if p.time is not None:
+        out["time"] = p.time
+    if p.rms_mm is not None:
+        out["rms_mm"] = p.rms_mm
+    if p.note:
+        out["note"] = p.note
+    return out
+
+
+def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
+    """The cell-file content of ``cell`` (millimetres, degrees).
+
+    Parameters
+    ----------
+    cell : Cell
+    base_dir : str or Path
+        Directory of the file to be written; a robot model path is written relative to it.
+
+    Returns
+    -------
+    dict
+    """
+    model = cell.robot_model
+    if _is_model_path(model):
+        model = os.path.relpath(Path(model).resolve(), Path(base_dir).resolve())
+    rob: dict[str, Any] = {"model": model}
+    if not np.allclose(cell.T_world_R, np.eye(4), atol=0):
+        rob["frame"] = _pose_dict(cell.T_world_R)
+    data: dict[str, Any] = {"name": cell.name, "robot": rob}
+    if cell.track is not None:
+        t = cell.track
+        td: dict[str, Any] = {"name": t.name, "frame": _pose_dict(t.T_world_L),
+                              "robot_at_zero": _pose_dict(t.T_L_R0), "axis": t.axis,
+                              "scale": _clean(t.scale)}
+        if math.isfinite(t.lower):
+            td["min"] = _clean(t.lower * 1e3)
+        if math.isfinite(t.upper):
+            td["max"] = _clean(t.upper * 1e3)
+        td["provenance"] = _prov_dict(t.provenance)
+        data["track"] = td
+    if cell.turntable is not None:
+        b = cell.turntable
+        bd: dict[str, Any] = {"name": b.name, "parent": b.parent, "frame": _pose_dict(b.T_parent_B)}
+        if math.isfinite(b.lower):
+            bd["min"] = _clean(math.degrees(b.lower))
+        if math.isfinite(b.upper):
+            bd["max"] = _clean(math.degrees(b.upper))
+        bd["provenance"] = _prov_dict(b.provenance)
+        data["turntable"] = bd
+    tools: dict[str, Any] = {}
+    for name, tool in cell.tools.items():
+        entry: dict[str, Any] = {}
+        if tool.number is not None:
+            entry["number"] = tool.number
+        entry["frame"] = _pose_dict(tool.T_F_TCP)
+        if tool.mass is not None:
+            entry["mass"] = _clean(tool.mass)
+        if tool.cog is not None:
+            entry["cog"] = [_clean(v * 1e3) for v in tool.cog]
+        entry["provenance"] = _prov_dict(tool.provenance)
+        tools[name] = entry
+    data["tools"] = tools
+    frames: dict[str, Any] = {}
+    for name, fr in cell.frames.items():
+        entry = {}
+        if fr.number is not None:
+            entry["number"] = fr.number
+        entry["parent"] = fr.parent
+        entry["frame"] = _pose_dict(fr.pose)
+        entry["provenance"] = _prov_dict(fr.provenance)
+        frames[name] = entry
+    data["frames"] = frames
+    return data
