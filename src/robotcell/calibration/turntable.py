@@ -59,7 +59,7 @@ def _check_angles(theta: NDArray[np.float64], labels: Sequence[str], min_step: f
     gaps = np.diff(np.concatenate([t[order], [t[order[0]] + 2.0 * np.pi]]))
     j = int(np.argmin(gaps))
     if gaps[j] < min_step:
-        i1, i2 = order[j], order[(j + 1) % len(order)]
+        i1, i2 = sorted((order[j], order[(j + 1) % len(order)]))
         raise IllPosedError(
             f"touches {labels[i1]} and {labels[i2]} are at the same or too close table angles "
             f"({np.degrees(theta[i1]):.3f} and {np.degrees(theta[i2]):.3f} deg, modulo 360); turn "
