@@ -1,0 +1,92 @@
+"""The dh command group, in process through the CLI entry point."""
+
+from importlib import resources
+
+import numpy as np
+import pytest
+
+import robotcell as rc
+from robotcell.cli import main
+
+URDF = str(resources.files("robotcell") / "robots" / "urdf" / "ur5e.urdf")
+
+
+def run(capsys, *args):
+    with pytest.raises(SystemExit) as exc:
+        main(list(args))
+        raise SystemExit(0)
+    out = capsys.readouterr()
+    return exc.value.code or 0, out.out, out.err
+
+
+def test_from_urdf_writes_a_model_that_moves_like_the_urdf(capsys, tmp_path):
+    from robotcell.dhprocedure import read_urdf
+
+    target = tmp_path / "ur5e_mdh.yaml"
+    code, out, _ = run(capsys, "dh", "from-urdf", URDF, "--convention", "modified", "-o", str(target))
+    assert code == 0
+    assert "modified DH" in out and "[parallel]" in out and "model written to" in out
+    model = rc.load_robot(target)
+    assert model.convention == "modified"
+    q = np.random.default_rng(1).uniform(-3, 3, (50, 6))
+    assert np.abs(model.fk(q) - read_urdf(URDF).fk(q)).max() < 1e-9
+
+
+def test_from_urdf_signs_and_tip(capsys):
+    code, out, _ = run(capsys, "dh", "from-urdf", URDF, "--tip-link", "wrist_3_link",
+                       "--signs=-1,1,1,1,1,-1")
+    assert code == 0
+    assert "pointing against its positive direction (sign -1)" in out
+
+
+def test_from_urdf_refusals(capsys, tmp_path):
+    code, _, err = run(capsys, "dh", "from-urdf", str(tmp_path / "missing.urdf"))
+    assert code == 2 and "does not exist" in err
+    code, _, err = run(capsys, "dh", "from-urdf", URDF, "--signs", "1,1")
+    assert code == 2 and "signs must be 6 values" in err
+    branch = tmp_path / "branch.urdf"
+    branch.write_text(
+        '<robot name="b"><link name="base"/><link name="a"/><link name="c"/>'
+        '<joint name="arm" type="revolute"><parent link="base"/><child link="a"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        '<joint name="cam" type="fixed"><parent link="base"/><child link="c"/></joint></robot>')
+    code, _, err = run(capsys, "dh", "from-urdf", str(branch))
+    assert code == 2 and "link 'base' branches into joints arm, cam" in err
+
+
+def test_convert_round_trip_through_files(capsys, tmp_path):
+    target = tmp_path / "kr16_mdh.yaml"
+    code, out, _ = run(capsys, "dh", "convert", "kuka_kr16", "--to", "modified", "-o", str(target))
+    assert code == 0 and "a_{i-1} [mm]" in out
+    q = np.random.default_rng(2).uniform(-3, 3, (50, 6))
+    assert np.abs(rc.load_robot(target).fk(q) - rc.load_robot("kuka_kr16").fk(q)).max() < 1e-9
+
+
+def test_explain_library_model_and_urdf(capsys):
+    code, out, _ = run(capsys, "dh", "explain", "puma560")
+    assert code == 0
+    assert "0 [base]" in out and "[intersecting]" in out and "table of puma560" in out
+    code, out, _ = run(capsys, "dh", "explain", URDF, "--convention", "modified")
+    assert code == 0 and "modified DH" in out and "6 [coincident]" in out
+
+
+def test_explain_recognises_its_own_table(capsys, tmp_path):
+    from robotcell.dhprocedure import AxisChain, dh_from_axes
+
+    own = dh_from_axes(AxisChain.from_robot(rc.load_robot("stanford_arm"))).robot
+    rc.save_robot(own, tmp_path / "own.yaml")
+    code, out, _ = run(capsys, "dh", "explain", str(tmp_path / "own.yaml"))
+    assert code == 0 and "The derived table equals the table of derived" in out
+
+
+def test_symbolic_text_latex_numeric(capsys):
+    code, out, _ = run(capsys, "dh", "symbolic", "stanford_arm")
+    assert code == 0 and "T_0_1 =" in out and "pz = d_1 + d_3*cos(theta_2)" in out
+    code, out, _ = run(capsys, "dh", "symbolic", "stanford_arm", "--numeric", "--latex")
+    assert code == 0 and r"\begin{align*}" in out and "412.0" in out
+
+
+@pytest.mark.parametrize("sub", ["from-urdf", "convert", "explain", "symbolic"])
+def test_help_has_an_example(capsys, sub):
+    code, out, _ = run(capsys, "dh", sub, "--help")
+    assert code == 0 and "Example" in out and f"robotcell dh {sub}" in out
