@@ -163,8 +163,8 @@ def _table(robot: Robot) -> str:
         lines = ["standard DH: T_{i-1,i} = Trans(z, d) Rot(z, theta) Trans(x, a) Rot(x, alpha)"]
         heads = ("i", "joint", "type", "a [mm]", "alpha [deg]", "d [mm]", "theta [deg]", "sign")
     else:
-        lines = ["modified DH: T_{i-1,i} = Rot(x, alpha_{i-1}) Trans(x, a_{i-1}) Rot(z, theta) "
-                 "Trans(z, d)"]
+        lines = [("modified DH: T_{i-1,i} = Rot(x, alpha_{i-1}) Trans(x, a_{i-1}) Rot(z, theta) "
+                  "Trans(z, d)")]
         heads = ("i", "joint", "type", "a_{i-1} [mm]", "alpha_{i-1} [deg]", "d [mm]",
                  "theta [deg]", "sign")
     rows = [(i, j.name, j.type, _z(j.a * 1e3), _z(math.degrees(j.alpha)), _z(j.d * 1e3),

@@ -104,11 +104,13 @@ class SymbolicArm:
         out = [f"{self.robot.name}: {conv} DH, lengths in {self.unit}, angles in rad"]
         out += [f"  {sym} = {rel}" for sym, rel in self.variables]
         if self.constants:
-            out.append("constants: " + ", ".join(f"{k} = {_fmt(v)}" for k, v in self.constants.items()))
+            consts = ", ".join(f"{k} = {_fmt(v)}" for k, v in self.constants.items())
+            out.append(f"constants: {consts}")
         for i, T in enumerate(self.links, start=1):
-            out += ["", f"T_{i - 1}_{i} =", sp.pretty(T, use_unicode=False, wrap_line=False, full_prec=False)]
-        out += ["", f"arm matrix T_0_{len(self.links)} = [[r11 r12 r13 px] [r21 r22 r23 py] "
-                "[r31 r32 r33 pz] [0 0 0 1]]:"]
+            pretty = sp.pretty(T, use_unicode=False, wrap_line=False, full_prec=False)
+            out += ["", f"T_{i - 1}_{i} =", pretty]
+        n = len(self.links)
+        out += ["", f"arm matrix T_0_{n} = [[r11 r12 r13 px] [r21 r22 r23 py] [r31 r32 r33 pz] [0 0 0 1]]:"]
         names = [["r11", "r12", "r13", "px"], ["r21", "r22", "r23", "py"],
                  ["r31", "r32", "r33", "pz"]]
         for r in range(3):
@@ -160,7 +162,7 @@ def symbolic_arm(robot: Robot, numeric: bool = False, unit: str = "m",
         if is_angle:
             deg = math.degrees(value)
             if abs(deg / 90 - round(deg / 90)) < 1e-9:
-                return sp.pi * int(round(deg / 90)) / 2
+                return sp.pi * round(deg / 90) / 2
             if numeric:
                 return sp.pi * sp.Float(round(deg, 9)) / 180
         else:

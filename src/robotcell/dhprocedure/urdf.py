@@ -171,12 +171,13 @@ def read_urdf(
     """
     try:
         from urdf_parser_py.urdf import URDF
+        from urdf_parser_py.xml_reflection.core import ParseError
     except ImportError:
         raise RobotcellError(INSTALL_HINT) from None
     text, origin = _text(source)
     try:
         model = URDF.from_xml_string(text.encode("utf-8"))
-    except Exception as exc:  # the parser raises lxml, assertion and plain exceptions alike
+    except (ParseError, SyntaxError, ValueError, AssertionError) as exc:
         raise InputError(f"{origin}: not a readable URDF: {exc}") from None
     links = set(model.link_map)
     for label, link in (("base_link", base_link), ("tip_link", tip_link)):
