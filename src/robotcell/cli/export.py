@@ -1,0 +1,40 @@
+"""``robotcell export``: controller data for the tools and frames of a cell."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from robotcell.cell import Cell
+from robotcell.export import EXPORT_FORMATS, export_cell
+
+
+@click.command()
+@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file (YAML, mm/deg).")
+@click.option("--format", "fmt", required=True, type=click.Choice(list(EXPORT_FORMATS)),
+              help="Controller format.")
+@click.option("-o", "--output", "output", type=click.Path(dir_okay=False),
+              help="File to write (default: standard output).")
+def export(cell_path: str, fmt: str, output: str | None) -> None:
+    """Write what to paste into the controller: tools, bases/work objects/user frames and the
+    placement of the robot, the track and the turntable (mm, deg; see docs/export.md).
+
+    \b
+    kuka     $config.dat TOOL_DATA/BASE_DATA/MACHINE_DEF and $machine.dat $ROBROOT/$ERSYSROOT
+    abb      RAPID module: tooldata, wobjdata, base frames as pose
+    fanuc    UTOOL/UFRAME values for Direct Entry (X Y Z W P R)
+    yaskawa  TOOL/UFRAME values for the pendant (X Y Z Rx Ry Rz)
+
+    \b
+    Examples:
+      robotcell export --cell cell.yaml --format kuka
+      robotcell export --cell cell.yaml --format abb -o cell_frames.mod
+    """
+    text = export_cell(Cell.load(cell_path), fmt)
+    if output is None:
+        click.echo(text, nl=False)
+    else:
+        Path(output).write_text(text, encoding="utf-8")
+        click.echo(f"wrote {output}", err=True)
