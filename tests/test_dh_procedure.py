@@ -212,3 +212,18 @@ def test_screw_fk_is_batched_and_moves_as_expected():
     # quarter turn about the vertical line x = 1 then carries it to (1, -0.8, 0).
     assert np.allclose(T[0, 0, :3, 3], [1, -0.8, 0])
     assert np.allclose(T[0, 0, :3, :3], rc.rot_z(math.pi / 2))
+
+
+def test_procedure_reproduces_textbook_tables():
+    """PUMA 560 (Corke): every row; KR 6 R700 with its sign corrections: rows 1-5 (frame 6 is
+    put on the flange approach axis here, the library puts it elsewhere)."""
+    cases = {"puma560": 6, "kuka_kr6_r700_sixx": 5}
+    present = [name for name in cases if name in rc.list_robots()]
+    if not present:
+        pytest.skip("neither robot in the library")
+    for name in present:
+        robot = rc.load_robot(name)
+        der = dh_from_axes(AxisChain.from_robot(robot), signs=[j.sign for j in robot.joints])
+        for mine, theirs in list(zip(der.robot.joints, robot.joints))[:cases[name]]:
+            assert (mine.a, mine.d, mine.alpha, mine.theta, mine.sign) == pytest.approx(
+                (theirs.a, theirs.d, theirs.alpha, theirs.theta, theirs.sign), abs=1e-12), name

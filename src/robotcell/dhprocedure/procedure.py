@@ -9,7 +9,8 @@ cases applies:
 * **skew**: the common normal is unique; ``x_k`` points from ``L_k`` to ``L_{k+1}``, so ``a > 0``.
 * **intersecting**: ``A_k = B_k`` is the intersection, ``x_k = ±z_k × z_{k+1}``; the sign makes
   ``x_k`` point toward the flange origin (the lecture's "toward the end effector"); when the flange
-  origin lies in the plane of both axes, ``x_k = z_k × z_{k+1}``. For the last pair, the flange's
+  origin lies in the plane of both axes, the sign that keeps ``x_k`` closest to ``x_{k-1}``
+  (smallest theta offset), else ``x_k = z_k × z_{k+1}``. For the last pair, the flange's
   own X axis is used when it is one of the two candidates (frame n is then the flange frame).
 * **parallel**: every normal is a common normal; the one through ``B_{k-1}`` (the point where the
   previous normal met ``L_k``) is chosen, which makes ``d = 0``. ``x_k`` points from ``L_k`` to
@@ -241,9 +242,13 @@ def _common_normal(
             return _Normal("intersecting", A, B, x * math.copysign(1.0, toward), (
                 f"{where}; X = +-(Z x Z') with the sign that makes X point toward the end "
                 "effector (the flange origin)."))
-        return _Normal("intersecting", A, B, x, (
-            f"{where}; X = Z x Z' / |Z x Z'| (the flange origin lies in the plane of both axes, "
-            "so 'toward the end effector' does not decide the sign)."))
+        undecided = ("the flange origin lies in the plane of both axes, so 'toward the end "
+                     "effector' does not decide the sign")
+        if prev_x is not None and abs(float(np.dot(x, prev_x))) > tol:
+            return _Normal("intersecting", A, B, x * np.sign(np.dot(x, prev_x)), (
+                f"{where}; X = +-(Z x Z'): {undecided}; the sign that keeps X closest to the "
+                "previous X is taken (smallest theta offset)."))
+        return _Normal("intersecting", A, B, x, f"{where}; X = Z x Z' / |Z x Z'| ({undecided}).")
     r_perp = r - np.dot(r, z) * z
     dist = float(np.linalg.norm(r_perp))
     if dist > tol:
