@@ -104,7 +104,8 @@ def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | Non
 
 def _common(procedure: str, key: str, T: NDArray[np.float64], res, labels: list[str],
             warnings: list[str], next_step: str, undetermined: list[str] | None = None,
-            names: list[str] | None = None) -> CalibrationResult:
+            names: list[str] | None = None,
+            points: NDArray[np.float64] | None = None) -> CalibrationResult:
     sp, sr = pose_sigma(res.covariance[:6, :6])
     warnings = list(warnings) + outlier_warnings(res, labels)
     if res.noise_source == "none":
@@ -119,7 +120,7 @@ def _common(procedure: str, key: str, T: NDArray[np.float64], res, labels: list[
         noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
         undetermined=undetermined or [], warnings=warnings, next_step=next_step,
         json_fields=pose_fields(T), covariance=res.covariance[:6, :6],
-        parameter_names=names or ["x", "y", "z", "rx", "ry", "rz"],
+        parameter_names=names or ["x", "y", "z", "rx", "ry", "rz"], points=points,
     )
 
 
@@ -183,7 +184,7 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
                         "(nearly collinear): the rotation about X is poorly determined; touch it near +Y")
     return _common("frame-3point", "T_R_W", T, res, labs, warnings,
                    "enter matrix/xyzabc as the base (user frame) in the controller, then check it by "
-                   "jogging along the new X and Y axes over the workpiece")
+                   "jogging along the new X and Y axes over the workpiece", points=p)
 
 
 def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | None = None,
@@ -244,7 +245,8 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
                         "poorly determined; add points away from that line")
     return _common("frame-npoint", "T_R_W", T, res, labs, warnings,
                    "enter matrix/xyzabc as the base (user frame); touch one more known point and check "
-                   "that transform_points(T_R_W, nominal) matches it within the residual RMS")
+                   "that transform_points(T_R_W, nominal) matches it within the residual RMS",
+                   points=p)
 
 
 def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,

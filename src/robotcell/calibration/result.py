@@ -130,6 +130,9 @@ class CalibrationResult:
         Covariance of the fitted parameter vector (SI) for propagation, with names in
         ``parameter_names``.
     parameter_names : list of str
+    points : ndarray, shape (N, 3) or None
+        The measured points behind ``residuals`` (metres, same axes), for reports; None when the
+        procedure has no single point per measurement.
     """
 
     procedure: str
@@ -148,6 +151,7 @@ class CalibrationResult:
     json_fields: dict[str, Any] = field(default_factory=dict)
     covariance: NDArray[np.float64] | None = None
     parameter_names: list[str] = field(default_factory=list)
+    points: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         self.residuals = np.asarray(self.residuals, dtype=float).reshape(-1, 3)
@@ -205,7 +209,8 @@ class CalibrationResult:
             ``procedure``, ``residuals_mm`` (length of each residual), ``residuals_xyz_mm``
             (N x 3), ``labels``, ``rms_mm``, ``max_mm``, ``condition``, ``dof``,
             ``noise_sigma_mm`` and ``noise_source``, ``sigma`` (1-sigma of each estimated
-            quantity, keys with units), ``undetermined``, ``warnings``, ``next_step``, then the
+            quantity, keys with units), ``undetermined``, ``warnings``, ``next_step``,
+            ``points_mm`` (N x 3, when the procedure records its measured points), then the
             procedure's own fields (``json_fields``).
         """
         out: dict[str, Any] = {
@@ -224,6 +229,8 @@ class CalibrationResult:
             "warnings": list(self.warnings),
             "next_step": self.next_step,
         }
+        if self.points is not None:
+            out["points_mm"] = np.asarray(self.points, dtype=float).reshape(-1, 3) * 1e3
         out.update(self.json_fields)
         return to_jsonable(out)
 

@@ -1,0 +1,29 @@
+"""``robotcell report``: an HTML report with figures from a calibration result."""
+
+from __future__ import annotations
+
+import click
+
+from robotcell.report import load_result, verdict, write_report
+
+
+@click.command()
+@click.argument("result", type=click.Path())
+@click.option("-o", "--output", default="report.html", show_default=True, type=click.Path(),
+              help="HTML file to write; PNG figures go beside it.")
+def report(result: str, output: str) -> None:
+    """Write an HTML report (and PNG figures) for a calibration result.
+
+    RESULT is the JSON written by 'robotcell calibrate ... --json'.
+
+    \b
+    Example:
+      robotcell calibrate frame base.csv --json > base.json
+      robotcell report base.json -o base.html
+    """
+    data = load_result(result)
+    files = write_report(data, output)
+    grade, reasons = verdict(data)
+    click.echo(f"{grade.upper()}: {'; '.join(reasons)}")
+    for f in files:
+        click.echo(f"wrote {f}")
