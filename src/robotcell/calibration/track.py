@@ -397,7 +397,7 @@ def calibrate_track(
         warnings=warnings, next_step=next_step,
         kinds={"direction": "number", "scale": "number", "point": "length"},
         json_fields=json_fields, covariance=res.covariance,
-        parameter_names=_names(refs),
+        parameter_names=_names(refs), points=f,
     )
 
 

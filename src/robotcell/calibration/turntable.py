@@ -229,7 +229,7 @@ def calibrate_turntable(
                "tilt": tilt_sigma},
         residuals=res.residuals, condition=res.condition, dof=res.dof,
         noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
-        warnings=warnings,
+        warnings=warnings, points=f,
         next_step=("enter T_R_B as the turntable's root frame in the controller (KUKA: ROOT of "
                    "the external kinematics; ABB: base frame of the mechanical unit), then "
                    "calibrate the workpiece frame on the table (robotcell calibrate workpiece)"),
