@@ -306,4 +306,4 @@ def _mm(v: float) -> str:
 
 
 def _mm_vec(v: NDArray) -> str:
-    return ", ".join(f"{c * 1e3:.3f}" for c in v)
+    return ", ".join(f"{round(c * 1e3, 3) + 0.0:.3f}" for c in v)
