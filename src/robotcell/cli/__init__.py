@@ -23,6 +23,7 @@ COMMANDS = {
     "calibrate": "robotcell.cli.calibrate:calibrate",
     "dh": "robotcell.cli.dh:dh",
     "export": "robotcell.cli.export:export",
+    "cell": "robotcell.cli.cell:cell",
     "simulate": "robotcell.cli.simulate:simulate",
     "plan": "robotcell.cli.plan:plan",
     "report": "robotcell.cli.report:report",

@@ -1,0 +1,63 @@
+"""``robotcell cell``: inspect a cell file (mm, deg)."""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from robotcell.cell import Cell, Provenance
+from robotcell.cli.common import format_table
+from robotcell.poseformats import pose_to_vendor
+
+
+def _prov(p: Provenance) -> str:
+    parts = [p.source]
+    if p.rms_mm is not None:
+        parts.append(f"rms {p.rms_mm:.3f} mm")
+    if p.time:
+        parts.append(p.time)
+    return ", ".join(parts)
+
+
+def _row(name: str, kind: str, number: object, T, p: Provenance) -> list[object]:
+    return [name, kind, "" if number is None else number,
+            *(float(v) for v in pose_to_vendor(T, "kuka")), _prov(p)]
+
+
+@click.group()
+def cell() -> None:
+    """Inspect cell files."""
+
+
+@cell.command()
+@click.argument("path", type=click.Path(dir_okay=False))
+def show(path: str) -> None:
+    """Print the robot, track, turntable, tools and frames of a cell with their provenance.
+
+    Poses are X, Y, Z (mm), A, B, C (deg) with R = Rz(A) Ry(B) Rx(C), each in its parent.
+
+    \b
+    Example:
+      robotcell cell show examples/cell_kr16_track_turntable.yaml
+    """
+    c = Cell.load(path)
+    click.echo(f"cell {c.name}: robot {c.robot.name} ({c.robot_model})")
+    head = ["name", "what (in parent)", "no.", "X", "Y", "Z", "A", "B", "C", "provenance"]
+    rows: list[list[object]] = []
+    if c.track is not None:
+        t = c.track
+        rows.append(_row(t.name, "track L (world)", None, t.T_world_L, t.provenance))
+        rows.append(_row("", f"robot at 0 (L), axis {t.axis}", None, t.T_L_R0, t.provenance))
+        click.echo(f"track {t.name}: {t.lower * 1e3:g} .. {t.upper * 1e3:g} mm, scale {t.scale:g}")
+    else:
+        rows.append(_row("robot", "robot R (world)", None, c.T_world_R, Provenance("nominal")))
+    if c.turntable is not None:
+        b = c.turntable
+        rows.append(_row(b.name, f"turntable B ({b.parent})", None, b.T_parent_B, b.provenance))
+        click.echo(f"turntable {b.name}: {math.degrees(b.lower):g} .. {math.degrees(b.upper):g} deg")
+    for name, tool in c.tools.items():
+        rows.append(_row(name, "tool (flange)", tool.number, tool.T_F_TCP, tool.provenance))
+    for name, fr in c.frames.items():
+        rows.append(_row(name, f"frame ({fr.parent})", fr.number, fr.pose, fr.provenance))
+    click.echo(format_table(head, rows))
