@@ -183,10 +183,10 @@ BASE = {"robot": {"model": "kuka_kr16"}}
     ("robot: {model: kuka_kr16}\nframes: {robot: {frame: {}}}\n", r"frame name 'robot' is reserved"),
     ("robot: {model: kuka_kr16}\nframes: {f: {frame: {}, provenance: {rms_mm: 1}}}\n",
      r"key 'frames.f.provenance.source' is missing"),
-    ("robot: {model: kuka_kr16}\nframes: {f: {frame: {}, provenance: {source: frame, "
-     "time: yesterday}}}\n", r"key 'frames.f.provenance' is invalid: .*ISO 8601"),
-    ("robot: {model: kuka_kr16}\nframes: {f: {frame: {}, provenance: {source: frame, "
-     "rms_mm: -2}}}\n", r"key 'frames.f.provenance' is invalid: .*rms_mm"),
+    (("robot: {model: kuka_kr16}\nframes: {f: {frame: {}, provenance: {source: frame, "
+     "time: yesterday}}}\n"), r"key 'frames.f.provenance' is invalid: .*ISO 8601"),
+    (("robot: {model: kuka_kr16}\nframes: {f: {frame: {}, provenance: {source: frame, "
+     "rms_mm: -2}}}\n"), r"key 'frames.f.provenance' is invalid: .*rms_mm"),
 ])
 def test_bad_files_name_file_and_key(tmp_path, content, match):
     p = tmp_path / "bad_cell.yaml"
@@ -210,7 +210,7 @@ def test_unquoted_yaml_timestamp_is_kept_as_iso_text(tmp_path):
     p.write_text("robot: {model: kuka_kr16}\n"
                  "tools: {t: {frame: {}, provenance: {source: tcp, time: 2025-03-14T10:05:00Z}}}\n")
     time = Cell.load(p).tools["t"].provenance.time
-    assert dt.datetime.fromisoformat(time) == dt.datetime(2025, 3, 14, 10, 5, tzinfo=dt.timezone.utc)
+    assert dt.datetime.fromisoformat(time) == dt.datetime(2025, 3, 14, 10, 5, tzinfo=dt.UTC)
 
 
 def test_editing_api_keeps_numbers_and_checks():

@@ -264,8 +264,8 @@ def test_unnumbered_slots_take_the_lowest_free_numbers():
     ("kuka", "TOOL_DATA[1]={X 1,Y 2,Z 3,A 0,B 0}", r"line 1: frame lacks C"),
     ("kuka", "BASE_DATA[3]={X 1,Y 2,Z 3,A 0,B 0,C zero}", r"line 1: 'zero' is not a number"),
     ("kuka", "TOOL_DATA[1]={X 1,Y 2,Z 3,A 0,B 0,Q 1}", r"cannot read 'Q 1'"),
-    ("kuka", 'MACHINE_DEF[3]={NAME[] "KL",COOP_KRC_INDEX 1,PARENT[] "WORLD",ROOT {X 0,Y 0,Z 0,'
-             'A 0,B 0,C 0},MECH_TYPE #ERSYS,GEOMETRY[] " "}', r"#ERSYS is not a turntable"),
+    ("kuka", ('MACHINE_DEF[3]={NAME[] "KL",COOP_KRC_INDEX 1,PARENT[] "WORLD",ROOT {X 0,Y 0,Z 0,'
+             'A 0,B 0,C 0},MECH_TYPE #ERSYS,GEOMETRY[] " "}'), r"#ERSYS is not a turntable"),
     ("abb", "PERS tooldata t:=[TRUE,[[1,2,3],[0.5,0.5,0.5,0.4]],[1,[0,0,0],[1,0,0,0],0,0,0]];",
      r"quaternion q1..q4 must be normalised"),
     ("fanuc", "UFRAME[1]  X 1  Y 2  Z 3  W 0  P 0", r"line 1: expected the fields X Y Z W P R"),

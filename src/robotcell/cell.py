@@ -37,7 +37,7 @@ from robotcell.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.robot import Robot
 from robotcell.transforms import validate_pose
 
-__all__ = ["Cell", "Frame", "Provenance", "Tool", "Track", "Turntable", "RESERVED_FRAMES"]
+__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "Provenance", "Tool", "Track", "Turntable"]
 
 #: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
 #: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
