@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,6 +17,9 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.dh import Chain, Convention
 from robotcell.errors import InputError
 from robotcell.transforms import validate_pose
+
+if TYPE_CHECKING:
+    from robotcell.ik.result import IKSolutions
 
 __all__ = ["Joint", "Robot"]
 
@@ -281,6 +284,26 @@ class Robot:
         w = np.where(pris, 0.0, z)
         J = np.concatenate([v * sign, w * sign], axis=-1)  # (..., n, 6)
         return np.swapaxes(J, -1, -2)
+
+    def ik(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
+        """Analytic inverse kinematics: every solution, see :func:`robotcell.ik.solve`.
+
+        Parameters
+        ----------
+        T : array_like, shape (..., 4, 4)
+            ``T_R_TCP``, target poses of the TCP in the robot base frame (metres).
+        tool : array_like, shape (4, 4), optional
+            ``T_F_TCP`` to use instead of the default tool (metres).
+
+        Returns
+        -------
+        IKSolutions
+            ``q`` of shape ``(..., 8, 6)`` (rad, NaN for unreachable branches) and ``valid``
+            ``(..., 8)`` (reachable and within the joint limits).
+        """
+        from robotcell.ik import solve  # imported here: robotcell.ik depends on this module
+
+        return solve(self, T, tool)
 
 
 def _compose_cols(m: list[float], tail: list[list[float]]) -> NDArray[np.float64]:

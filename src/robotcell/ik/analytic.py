@@ -1,0 +1,137 @@
+"""Batched analytic inverse kinematics of a :class:`~robotcell.robot.Robot`.
+
+:func:`solve` recognises the structure of the model once (cached per robot object) and returns
+all 8 solutions of every pose: ortho-parallel arms with a spherical wrist through
+:mod:`robotcell.ik.opw`, Universal-Robots-type arms through :mod:`robotcell.ik.ur`.
+"""
+
+from __future__ import annotations
+
+import weakref
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.errors import InputError
+from robotcell.ik.limits import fold_into_limits, wrap_to_pi
+from robotcell.ik.opw import OPWParameters, opw_kernel, opw_parameters, opw_problems
+from robotcell.ik.result import IKSolutions
+from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
+from robotcell.robot import Robot
+from robotcell.transforms import invert, validate_pose
+
+__all__ = ["AnalyticSolver", "analytic_solver", "solve"]
+
+#: Poses per block: keeps the kernel's temporaries in cache.
+_BLOCK = 4096
+
+Kernel = Callable[..., NDArray[np.bool_]]
+
+
+class AnalyticSolver:
+    """Analytic IK of one robot: structure parameters plus the batched kernel.
+
+    Parameters
+    ----------
+    robot : Robot
+        A model with one of the supported structures.
+
+    Raises
+    ------
+    InputError
+        When the model has neither structure; the message says which conditions fail.
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        opw = opw_problems(robot)
+        if not opw:
+            self.method = "opw"
+            self.params: OPWParameters | URParameters = opw_parameters(robot)
+            self._kernel: Kernel = opw_kernel
+        else:
+            ur = ur_problems(robot)
+            if ur:
+                raise InputError(
+                    f"no analytic inverse kinematics for {robot.name}: not an ortho-parallel arm "
+                    f"with a spherical wrist ({'; '.join(opw)}), nor a Universal-Robots-type arm "
+                    f"({'; '.join(ur)}). Use robotcell.ik.solve_numeric for this model."
+                )
+            self.method = "ur"
+            self.params = ur_parameters(robot)
+            self._kernel = ur_kernel
+        self.robot = robot
+        self._T_O_R = invert(self.params.T_R_O)
+        self._lower = robot.lower
+        self._upper = robot.upper
+
+    def solve(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
+        """All 8 solutions for poses of the TCP.
+
+        Parameters
+        ----------
+        T : array_like, shape (..., 4, 4)
+            ``T_R_TCP``: target poses of the TCP in the robot base frame (m).
+        tool : array_like, shape (4, 4), optional
+            ``T_F_TCP`` instead of the robot's default tool (m).
+
+        Returns
+        -------
+        IKSolutions
+            ``q`` of shape ``(..., 8, 6)`` (rad).
+        """
+        arr = validate_pose(T, "target pose")
+        tool_T = self.robot.tool if tool is None else validate_pose(tool, "tool")
+        # T_O_end = T_O_R @ T_R_TCP @ T_TCP_end, with T_TCP_end = inv(T_end_n @ flange @ tool).
+        T_tcp_end = invert(self.params.T_e_n @ self.robot.flange @ tool_T)
+        batch = arr.shape[:-2]
+        flat = arr.reshape(-1, 4, 4)
+        N = flat.shape[0]
+        q = np.empty((N, 8, 6))
+        reach = np.empty((N, 8), dtype=bool)
+        A = self._T_O_R[:3, :3]
+        a = self._T_O_R[:3, 3]
+        B = T_tcp_end[:3, :3]
+        bvec = T_tcp_end[:3, 3]
+        for s in range(0, N, _BLOCK):
+            blk = flat[s:s + _BLOCK]
+            Rt = blk[:, :3, :3]
+            R = A @ (Rt @ B)
+            P = (Rt @ bvec + blk[:, :3, 3]) @ A.T + a
+            reach[s:s + _BLOCK] = self._kernel(self.params, R, P, q[s:s + _BLOCK])
+        p = self.params
+        q = wrap_to_pi((q - p.offsets) * p.signs)
+        q, inside = fold_into_limits(q, self._lower, self._upper)
+        valid = reach & np.all(inside, axis=-1)
+        return IKSolutions(q.reshape(batch + (8, 6)), valid.reshape(batch + (8,)),
+                           reach.reshape(batch + (8,)), self.method)
+
+
+_CACHE: weakref.WeakKeyDictionary[Robot, AnalyticSolver] = weakref.WeakKeyDictionary()
+
+
+def analytic_solver(robot: Robot) -> AnalyticSolver:
+    """The (cached) analytic solver of ``robot``; raises :class:`InputError` if it has none."""
+    solver = _CACHE.get(robot)
+    if solver is None:
+        solver = AnalyticSolver(robot)
+        _CACHE[robot] = solver
+    return solver
+
+
+def solve(robot: Robot, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
+    """All analytic IK solutions of ``robot`` for TCP poses ``T`` (see :meth:`AnalyticSolver.solve`).
+
+    Parameters
+    ----------
+    robot : Robot
+    T : array_like, shape (..., 4, 4)
+        ``T_R_TCP`` (m), including the robot's base, flange and tool transforms.
+    tool : array_like, shape (4, 4), optional
+        ``T_F_TCP`` instead of the robot's default tool (m).
+
+    Returns
+    -------
+    IKSolutions
+    """
+    return analytic_solver(robot).solve(T, tool)

@@ -1,0 +1,67 @@
+"""Result types of inverse kinematics: all analytic branches, or one numeric solution."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["IKSolutions", "NumericIKResult"]
+
+
+@dataclass(frozen=True)
+class IKSolutions:
+    """Every analytic solution of a batch of poses, as a fixed-shape batch.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 8, n)
+        Joint values (rad, m) of the 8 branches; NaN where the branch does not reach the pose.
+        Revolute values are the 2*pi-equivalents chosen by :func:`robotcell.ik.limits.fold_into_limits`.
+    valid : ndarray of bool, shape (..., 8)
+        Branch reaches the pose and its joint values are within the joint limits.
+    reachable : ndarray of bool, shape (..., 8)
+        Branch reaches the pose (limits not considered); ``valid`` implies ``reachable``.
+    method : str
+        ``"opw"`` (ortho-parallel arm with a spherical wrist) or ``"ur"`` (three parallel axes).
+        Branch ``k`` has ``k = 4 * shoulder + 2 * elbow + wrist`` (see docs/ik.md).
+    """
+
+    q: NDArray[np.float64]
+    valid: NDArray[np.bool_]
+    reachable: NDArray[np.bool_]
+    method: str
+
+    @property
+    def count(self) -> NDArray[np.int_]:
+        """Number of valid branches per pose, shape ``(...)``."""
+        return np.count_nonzero(self.valid, axis=-1)
+
+
+@dataclass(frozen=True)
+class NumericIKResult:
+    """Outcome of numeric inverse kinematics for a batch of poses.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., n)
+        Best joint values found (rad, m), within the joint limits.
+    success : ndarray of bool, shape (...)
+        True only where both errors are within the tolerances that were asked for.
+    position_error : ndarray, shape (...)
+        Distance between the reached and the target TCP position (m).
+    orientation_error : ndarray, shape (...)
+        Angle of the rotation between the reached and the target orientation (rad).
+    iterations : ndarray of int, shape (...)
+        Iterations spent, summed over restarts.
+    restarts : ndarray of int, shape (...)
+        Restarts from random configurations that were needed.
+    """
+
+    q: NDArray[np.float64]
+    success: NDArray[np.bool_]
+    position_error: NDArray[np.float64]
+    orientation_error: NDArray[np.float64]
+    iterations: NDArray[np.int_]
+    restarts: NDArray[np.int_]
