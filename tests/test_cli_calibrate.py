@@ -3,23 +3,16 @@
 import json
 
 import numpy as np
-import pytest
+from cli_helpers import run
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from robotcell import load_robot, pose_from_vendor, pose_to_vendor
-from robotcell.cli import main
 from robotcell.transforms import transform_points
 
 T_TRUE = pose_from_vendor([1100, -250, 420, 35, 4, -2], "kuka")
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-        raise SystemExit(0)
-    out = capsys.readouterr()
-    return exc.value.code or 0, out.out, out.err
 
 
 def write(path, header, rows):

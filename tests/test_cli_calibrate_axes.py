@@ -4,10 +4,10 @@ import json
 
 import numpy as np
 import pytest
+from cli_helpers import run
 from scipy.spatial.transform import Rotation
 
 from robotcell.calibration.workpiece import workpiece_pose
-from robotcell.cli import main
 from robotcell.transforms import make_pose, rot_z
 
 Q = Rotation.from_rotvec([0.01, -0.02, 0.03]).as_matrix()
@@ -18,12 +18,6 @@ T_B_W = make_pose(Rotation.from_euler("zyx", [0.5, 0.02, -0.03]).as_matrix(), [0
 THETA = np.radians([0.0, 60.0, 130.0, 200.0, 270.0, 320.0])
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main([str(a) for a in args])
-        raise SystemExit(0)
-    out = capsys.readouterr()
-    return exc.value.code or 0, out.out, out.err
 
 
 def write(path, header, rows):

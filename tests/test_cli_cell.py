@@ -2,19 +2,11 @@
 
 from pathlib import Path
 
-import pytest
-
-from robotcell.cli import main
+from cli_helpers import run
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-        raise SystemExit(0)
-    out = capsys.readouterr()
-    return exc.value.code or 0, out.out, out.err
 
 
 def test_show_lists_every_item_with_values_and_provenance(capsys):

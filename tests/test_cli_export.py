@@ -3,21 +3,15 @@
 from pathlib import Path
 
 import pytest
+from cli_helpers import run
 
 from robotcell.cell import Cell
-from robotcell.cli import main
 from robotcell.export import export_cell, parse_export
 from robotcell.export.common import collect
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-        raise SystemExit(0)
-    out = capsys.readouterr()
-    return exc.value.code or 0, out.out, out.err
 
 
 @pytest.mark.parametrize("fmt", ["kuka", "abb", "fanuc", "yaskawa"])

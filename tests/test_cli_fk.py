@@ -2,17 +2,9 @@
 
 import numpy as np
 import pytest
+from cli_helpers import run
 
 from robotcell import load_robot, pose_from_vendor
-from robotcell.cli import main
-
-
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-        raise SystemExit(0)
-    out = capsys.readouterr()
-    return exc.value.code or 0, out.out, out.err
 
 
 def test_robots_lists_library(capsys):
