@@ -129,3 +129,12 @@ def test_refusals():
         calibrate_workpiece(theta, f, roles, T_R_B, T_R_B_covariance=np.eye(7))
     with pytest.raises(InputError, match="matching TCP positions"):
         calibrate_workpiece(theta[:2], f, roles, T_R_B)
+
+
+def test_three_points_borrow_the_turntable_noise_and_say_so():
+    roles = ["origin", "x", "xy"]
+    theta = np.radians([15.0, 140.0, 250.0])
+    r = calibrate_workpiece(theta, touch(roles, theta), roles, T_R_B, noise_sigma=2e-4)
+    assert r.noise_source == "turntable" and r.noise_sigma == pytest.approx(2e-4)
+    assert "taken from the turntable calibration" in r.summary()
+    assert "as given (--sigma)" not in r.summary()

@@ -110,7 +110,9 @@ class CalibrationResult:
         Measurement noise (metres, per coordinate) behind ``sigma``: estimated from the residuals
         (``noise_source == "residuals"``) or the prior the user gave (``"prior"``); NaN
         (``"none"``) when there is no redundancy and no prior.
-    noise_source : {"residuals", "prior", "none"}
+    noise_source : {"residuals", "prior", "turntable", "none"}
+        ``"turntable"``: no redundancy here, so the noise level estimated by the turntable
+        calibration is used (workpiece on the turntable).
     labels : list of str
         Name of each measurement for reports (e.g. ``"row 3 (xy)"``); length N.
     undetermined : list of str
@@ -273,6 +275,9 @@ class CalibrationResult:
             noise = f"{self.noise_sigma * 1e3:.3f} mm per coordinate, estimated from the residuals"
         elif self.noise_source == "prior":
             noise = f"{self.noise_sigma * 1e3:.3f} mm per coordinate, as given (--sigma)"
+        elif self.noise_source == "turntable":
+            noise = (f"{self.noise_sigma * 1e3:.3f} mm per coordinate, taken from the turntable "
+                     "calibration (no redundant touches here)")
         else:
             noise = "unknown (no redundant measurements and no --sigma given)"
         cond = "good" if self.condition <= CONDITION_LIMIT else "poor"

@@ -221,7 +221,8 @@ def calibrate_workpiece(
     names += [f"position of touch {labels[i]} along X" for i in np.flatnonzero(roles == "x")]
     names += [f"position of touch {labels[i]} in the XY plane ({c})"
               for i in np.flatnonzero(roles == "xy") for c in "xy"]
-    if prior_sigma is None and 3 * n == len(x0):
+    borrowed = prior_sigma is None and 3 * n == len(x0)
+    if borrowed:
         prior_sigma = noise_sigma
     res = fit(residuals, x0, names, prior_sigma=prior_sigma)
     cov = res.covariance
@@ -250,7 +251,9 @@ def calibrate_workpiece(
         procedure="workpiece", values={"T_B_W": T},
         sigma={"T_B_W_position": sd[:3], "T_B_W_rotation": sd[3:6]},
         residuals=res.residuals, condition=res.condition, dof=res.dof,
-        noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
+        noise_sigma=res.noise_sigma,
+        noise_source="turntable" if borrowed and res.noise_source == "prior" else res.noise_source,
+        labels=labels,
         undetermined=undetermined, warnings=warnings,
         next_step=("enter T_B_W as the workpiece (base) frame on the turntable's kinematics in the "
                    "controller, then check it by touching the origin at two other table angles"),
