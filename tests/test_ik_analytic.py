@@ -9,7 +9,7 @@ import pytest
 
 from robotcell.errors import InputError
 from robotcell.ik import opw_parameters, solve, ur_parameters
-from robotcell.ik.limits import fold_into_limits, wrap_to_pi
+from robotcell.ik.limits import JointFolder, wrap_to_pi
 from robotcell.ik.opw import opw_fk
 from robotcell.ik.ur import ur_fk
 from robotcell.modelfile import list_robots, load_robot
@@ -266,13 +266,20 @@ def test_batch_shape_and_input_errors():
         robot.ik(skewed)
 
 
-def test_fold_into_limits_rule():
-    lower = np.radians([-350, 100, -90, -np.inf])
-    upper = np.radians([350, 400, 90, np.inf])
-    q = np.radians([[170, -90, 170, 179], [-179, 90, -100, -179]])
-    out, inside = fold_into_limits(q, lower, upper)
-    np.testing.assert_allclose(np.degrees(out), [[170, 270, 170, 179], [-179, 450 - 360, -100, -179]])
-    np.testing.assert_array_equal(inside, [[True, True, False, True], [True, False, False, True]])
+def test_joint_folder_rule():
+    lower = np.radians([-350, 100, -90, -np.inf, -190])
+    upper = np.radians([350, 400, 90, np.inf, 45])
+    q = np.radians([[170, -90, 170, 179, 175], [-179, 90, -100, -179, 100]])
+    inside = JointFolder(lower, upper)(q)
+    np.testing.assert_allclose(np.degrees(q), [[170, 270, 170, 179, -185], [-179, 90, -100, -179, 100]])
+    np.testing.assert_array_equal(inside, [False, False])
+    q = np.radians([[180, 180, 0, 180, 0]])
+    assert JointFolder(lower, upper)(q)[0]
+
+
+def test_wrap_to_pi():
+    np.testing.assert_allclose(wrap_to_pi(np.array([math.pi, -math.pi, 3 * math.pi, 0.5 - 4 * math.pi])),
+                               [math.pi, math.pi, math.pi, 0.5])
 
 
 def test_two_pi_equivalent_chosen_inside_limits():

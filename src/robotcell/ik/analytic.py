@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
-from robotcell.ik.limits import fold_into_limits, wrap_to_pi
+from robotcell.ik.limits import JointFolder
 from robotcell.ik.opw import OPWParameters, opw_kernel, opw_parameters, opw_problems
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
@@ -24,7 +24,7 @@ from robotcell.transforms import invert, validate_pose
 __all__ = ["AnalyticSolver", "analytic_solver", "solve"]
 
 #: Poses per block: keeps the kernel's temporaries in cache.
-_BLOCK = 4096
+_BLOCK = 512
 
 Kernel = Callable[..., NDArray[np.bool_]]
 
@@ -62,8 +62,7 @@ class AnalyticSolver:
             self._kernel = ur_kernel
         self.robot = robot
         self._T_O_R = invert(self.params.T_R_O)
-        self._lower = robot.lower
-        self._upper = robot.upper
+        self._fold = JointFolder(robot.lower, robot.upper)
 
     def solve(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
         """All 8 solutions for poses of the TCP.
@@ -89,6 +88,7 @@ class AnalyticSolver:
         N = flat.shape[0]
         q = np.empty((N, 8, 6))
         reach = np.empty((N, 8), dtype=bool)
+        valid = np.empty((N, 8), dtype=bool)
         A = self._T_O_R[:3, :3]
         a = self._T_O_R[:3, 3]
         B = T_tcp_end[:3, :3]
@@ -98,11 +98,10 @@ class AnalyticSolver:
             Rt = blk[:, :3, :3]
             R = A @ (Rt @ B)
             P = (Rt @ bvec + blk[:, :3, 3]) @ A.T + a
-            reach[s:s + _BLOCK] = self._kernel(self.params, R, P, q[s:s + _BLOCK])
-        p = self.params
-        q = wrap_to_pi((q - p.offsets) * p.signs)
-        q, inside = fold_into_limits(q, self._lower, self._upper)
-        valid = reach & np.all(inside, axis=-1)
+            qb = q[s:s + _BLOCK]
+            rb = self._kernel(self.params, R, P, qb)
+            valid[s:s + _BLOCK] = rb & self._fold(qb)  # 2*pi rule and limits, in cache
+            reach[s:s + _BLOCK] = rb
         return IKSolutions(q.reshape(batch + (8, 6)), valid.reshape(batch + (8,)),
                            reach.reshape(batch + (8,)), self.method)
 

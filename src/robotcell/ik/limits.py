@@ -2,7 +2,7 @@
 
 A revolute joint that turns more than one revolution (KUKA A6 +-350 deg, ABB axis 6 +-400 deg,
 UR joints +-360 deg) reaches the same pose at ``q`` and ``q +- 2*pi``. The analytic solvers first
-produce the principal value in ``[-pi, pi)`` and then apply the rule of :func:`fold_into_limits`.
+produce the principal value in ``(-pi, pi]`` and then apply the rule of :class:`JointFolder`.
 """
 
 from __future__ import annotations
@@ -10,16 +10,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["TWO_PI", "fold_into_limits", "shift_into_interval", "wrap_to_pi"]
+__all__ = ["TWO_PI", "JointFolder", "shift_into_interval", "wrap_to_pi"]
 
 TWO_PI = 2.0 * math.pi
 
 
-def wrap_to_pi(angle: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Equivalent angles in ``[-pi, pi)`` (rad), same shape as ``angle``."""
-    return angle - TWO_PI * np.floor((angle + math.pi) * (1.0 / TWO_PI))
+def wrap_to_pi(angle: ArrayLike) -> NDArray[np.float64]:
+    """Equivalent angles in ``(-pi, pi]`` (rad), same shape as ``angle``."""
+    a = np.asarray(angle, dtype=float)
+    return a - TWO_PI * np.ceil((a - math.pi) * (1.0 / TWO_PI))
 
 
 def shift_into_interval(q: NDArray[np.float64], lo: NDArray[np.float64] | float,
@@ -42,33 +43,50 @@ def shift_into_interval(q: NDArray[np.float64], lo: NDArray[np.float64] | float,
     return np.where(out <= hi, out, np.nan)
 
 
-def fold_into_limits(q: NDArray[np.float64], lower: NDArray[np.float64],
-                     upper: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Choose, per revolute joint, the 2*pi-equivalent inside the limits.
+class JointFolder:
+    """Choose, per revolute joint, the 2*pi-equivalent of a principal value inside the limits.
 
-    The rule: keep ``q`` if it is within ``[lower, upper]``; otherwise take the equivalent
-    ``q + 2*pi*k`` inside the limits with the smallest ``|k|`` (the one nearest to ``q``). When no
-    equivalent is inside, ``q`` is kept and marked outside.
+    The rule: keep the principal value ``q`` (in ``(-pi, pi]``) if it is within
+    ``[lower, upper]``; otherwise take ``q - 2*pi`` or ``q + 2*pi`` if that is inside (the nearest
+    equivalents); if neither is, the principal value stays and is reported outside. For limits up
+    to +-540 deg this finds an equivalent whenever one exists.
 
     Parameters
     ----------
-    q : ndarray, shape (..., n)
-        Principal joint values (rad), e.g. in ``[-pi, pi)``.
-    lower, upper : ndarray, shape (n,)
+    lower, upper : array_like, shape (n,)
         Joint limits (rad), possibly infinite.
-
-    Returns
-    -------
-    q : ndarray, shape (..., n)
-        Chosen equivalents.
-    inside : ndarray of bool, shape (..., n)
-        Whether the chosen value is within the limits.
     """
-    below = q < lower
-    above = q > upper
-    # Smallest equivalent above the lower limit, and largest one below the upper limit.
-    up = q + TWO_PI * np.ceil((lower - q) * (1.0 / TWO_PI))
-    down = q - TWO_PI * np.ceil((q - upper) * (1.0 / TWO_PI))
-    out = np.where(below, up, np.where(above, down, q))
-    inside = (out >= lower) & (out <= upper)
-    return np.where(inside, out, q), inside
+
+    def __init__(self, lower: ArrayLike, upper: ArrayLike) -> None:
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+        # Joints whose limits contain all of (-pi, pi] need no work at all.
+        self._checked = [j for j in range(self.lower.size)
+                         if not (self.lower[j] <= -math.pi and self.upper[j] >= math.pi)]
+
+    def __call__(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Fold ``q`` in place.
+
+        Parameters
+        ----------
+        q : ndarray, shape (..., n)
+            Principal values (rad) in ``(-pi, pi]``, NaN allowed; replaced by the chosen values.
+
+        Returns
+        -------
+        ndarray of bool, shape (...)
+            Whether every joint value is inside its limits (False where ``q`` has NaN).
+        """
+        inside = ~np.isnan(q[..., 0]) if not self._checked else None
+        for j in self._checked:
+            lo, hi = self.lower[j], self.upper[j]
+            col = q[..., j]
+            if lo < -math.pi:
+                down = col - TWO_PI
+                col[...] = np.where((col > hi) & (down >= lo), down, col)
+            elif hi > math.pi:
+                up = col + TWO_PI
+                col[...] = np.where((col < lo) & (up <= hi), up, col)
+            ok = (col >= lo) & (col <= hi)
+            inside = ok if inside is None else inside & ok
+        return inside

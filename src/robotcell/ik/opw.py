@@ -228,9 +228,26 @@ def opw_fk(params: OPWParameters, theta: NDArray[np.float64]) -> NDArray[np.floa
     return T
 
 
+def _controller_angle(signs: NDArray[np.float64], offsets: NDArray[np.float64]):
+    """``f(j, y, x) = sign_j * (atan2(y, x) - offset_j)`` wrapped to ``(-pi, pi]``, by one atan2.
+
+    The pair ``(y, x)`` (any positive scale) is turned by ``-offset_j`` and mirrored for a negative
+    sign, so no wrapping pass over the solutions is needed.
+    """
+    rot = [(math.cos(o), math.sin(o)) if o != 0.0 else None for o in offsets]
+
+    def f(j: int, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64]:
+        if rot[j] is not None:
+            c, s = rot[j]
+            y, x = y * c - x * s, x * c + y * s
+        return np.arctan2(-y if signs[j] < 0 else y, x)
+
+    return f
+
+
 def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.float64],
                out: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """All 8 solutions in the paper's angles for poses already expressed in O.
+    """All 8 solutions, as controller axis values, for poses already expressed in O.
 
     Parameters
     ----------
@@ -240,7 +257,8 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
     P : ndarray, shape (N, 3)
         Positions ``p_O_e`` (m).
     out : ndarray, shape (N, 8, 6)
-        Receives the angles (rad, not wrapped); branch ``k = 4 * shoulder + 2 * elbow + wrist``:
+        Receives the controller values ``q = sign * (theta - offset)`` in ``(-pi, pi]`` (rad);
+        branch ``k = 4 * shoulder + 2 * elbow + wrist``:
         shoulder 1 = wrist centre behind axis 1, elbow 1 = wrist centre behind the line of axes 2
         and 3, wrist 1 = negative paper angle ``t5``. Unreachable branches are NaN.
 
@@ -269,6 +287,7 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
     denom = 1.0 / (2.0 * pa.c2 * kappa)
     base = pa.c2 * pa.c2 + kappa * kappa
     reach = np.empty((P.shape[0], 8), dtype=bool)
+    ang = _controller_angle(pa.signs, pa.offsets)
     for sh in (0, 1):
         if sh == 0:
             c1 = np.where(axial, 1.0, (cx * n + cy * b) * inv)
@@ -278,7 +297,6 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
             c1 = np.where(axial, -1.0, -(cx * n - cy * b) * inv)
             s1 = np.where(axial, 0.0, -(cy * n + cx * b) * inv)
             X = -(n + pa.a1)
-        t1 = np.arctan2(s1, c1)
         s_2 = X * X + Z * Z
         K = (s_2 - base) * denom
         ok = ok_shoulder & (np.abs(K) <= 1.0 + COS_TOL)
@@ -291,6 +309,7 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
         M11 = c1 * R11 - s1 * R01
         M12 = c1 * R12 - s1 * R02
         wz = pa.c2 + kappa * K
+        t1q = ang(0, s1, c1)
         for el in (0, 1):
             sphi = S if el == 0 else -S
             c3 = K * cpsi + sphi * spsi
@@ -314,20 +333,16 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
             inv_h = 1.0 / np.where(straight, 1.0, h)
             c4 = np.where(straight, 1.0, r02 * inv_h)
             s4 = M12 * inv_h
-            t4 = np.arctan2(s4, c4)
-            t5 = np.arctan2(h, r22)
-            t6 = np.arctan2(c4 * M10 - s4 * r00, c4 * M11 - s4 * r01)
-            t2 = np.arctan2(s2, c2)
-            t3 = np.arctan2(s3, c3)
             k = 4 * sh + 2 * el
-            for col, val in enumerate((t1, t2, t3, t4, t5, t6)):
+            t2q = ang(1, s2, c2)
+            t3q = ang(2, s3, c3)
+            n6, d6 = c4 * M10 - s4 * r00, c4 * M11 - s4 * r01
+            for col, val in enumerate((t1q, t2q, t3q, ang(3, s4, c4), ang(4, h, r22), ang(5, n6, d6))):
                 out[:, k, col] = val
-            out[:, k + 1, 0] = t1
-            out[:, k + 1, 1] = t2
-            out[:, k + 1, 2] = t3
-            out[:, k + 1, 3] = t4 + math.pi
-            out[:, k + 1, 4] = -t5
-            out[:, k + 1, 5] = t6 + math.pi
+            # The flipped wrist: t4 + pi, -t5, t6 + pi.
+            for col, val in enumerate((t1q, t2q, t3q, ang(3, -s4, -c4), ang(4, -h, r22),
+                                       ang(5, -n6, -d6))):
+                out[:, k + 1, col] = val
             reach[:, k] = ok
             reach[:, k + 1] = ok
     out[~reach] = np.nan

@@ -18,7 +18,7 @@ class IKSolutions:
     ----------
     q : ndarray, shape (..., 8, n)
         Joint values (rad, m) of the 8 branches; NaN where the branch does not reach the pose.
-        Revolute values are the 2*pi-equivalents chosen by :func:`robotcell.ik.limits.fold_into_limits`.
+        Revolute values are the 2*pi-equivalents chosen by :class:`robotcell.ik.limits.JointFolder`.
     valid : ndarray of bool, shape (..., 8)
         Branch reaches the pose and its joint values are within the joint limits.
     reachable : ndarray of bool, shape (..., 8)

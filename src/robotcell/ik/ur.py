@@ -33,6 +33,8 @@ from numpy.typing import NDArray
 from robotcell.dh import link_transform
 from robotcell.errors import InputError
 from robotcell.ik.axes import AXIS_TOL, angle_deg, closest_point, joint_axes, line_distance
+from robotcell.ik.limits import wrap_to_pi
+from robotcell.ik.opw import _controller_angle
 from robotcell.robot import Robot
 from robotcell.transforms import invert
 
@@ -191,7 +193,7 @@ def ur_fk_frames(params: URParameters, theta: NDArray[np.float64]) -> NDArray[np
 
 def ur_kernel(params: URParameters, R: NDArray[np.float64], P: NDArray[np.float64],
               out: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """All 8 solutions in canonical angles for poses of frame 6 expressed in O.
+    """All 8 solutions, as controller axis values, for poses of frame 6 expressed in O.
 
     Parameters
     ----------
@@ -201,7 +203,8 @@ def ur_kernel(params: URParameters, R: NDArray[np.float64], P: NDArray[np.float6
     P : ndarray, shape (N, 3)
         Positions ``p_O_6`` (m).
     out : ndarray, shape (N, 8, 6)
-        Receives the angles (rad, not wrapped); branch ``k = 4 * shoulder + 2 * elbow + wrist``:
+        Receives the controller values ``q = sign * (theta - offset)`` in ``(-pi, pi]`` (rad);
+        branch ``k = 4 * shoulder + 2 * elbow + wrist``:
         shoulder 1 = second solution of axis 1, wrist 1 = negative canonical ``t5``, elbow 1 =
         negative canonical ``t3``. Unreachable branches are NaN.
 
@@ -225,24 +228,26 @@ def ur_kernel(params: URParameters, R: NDArray[np.float64], P: NDArray[np.float6
     a2, a3 = pa.a2, pa.a3
     den3 = 1.0 / (2.0 * a2 * a3)
     reach = np.empty((P.shape[0], 8), dtype=bool)
+    ang = _controller_angle(pa.signs, pa.offsets)
     for sh in (0, 1):
         kk = k if sh == 0 else -k
         c1 = (p5x * kk - p5y * t) * inv_r
         s1 = (p5y * kk + p5x * t) * inv_r
-        t1 = np.arctan2(s1, c1)
+        t1q = ang(0, s1, c1)
         vx = X0 * s1 - X1 * c1
         vy = Y0 * s1 - Y1 * c1
         vz = Z0 * s1 - Z1 * c1
         h = np.sqrt(vx * vx + vy * vy)
-        t5p = np.arctan2(h, vz)
         t6p = np.where(h < SINGULAR_TOL, 0.0, np.arctan2(-vy, vx))
         for wr in (0, 1):
-            t5 = t5p if wr == 0 else -t5p
             t6 = t6p if wr == 0 else t6p + math.pi
-            s5, c5 = (h, vz) if wr == 0 else (-h, vz)
+            s5 = h if wr == 0 else -h
+            c5 = vz
             s6, c6 = np.sin(t6), np.cos(t6)
+            q5 = ang(4, s5, c5)
+            q6 = ang(5, s6, c6)
             z4x, z4y, z4z = -s6 * X0 - c6 * Y0, -s6 * X1 - c6 * Y1, -s6 * X2 - c6 * Y2
-            # x4 = c5 c6 X6 - c5 s6 Y6 - s5 Z6 (c5, s5 unnormalised by the unit length of v)
+            # x4 = c5 c6 X6 - c5 s6 Y6 - s5 Z6 (c5, s5 scaled alike by the unit length of v)
             x4x = c5 * (c6 * X0 - s6 * Y0) - s5 * Z0
             x4y = c5 * (c6 * X1 - s6 * Y1) - s5 * Z1
             x4z = c5 * (c6 * X2 - s6 * Y2) - s5 * Z2
@@ -263,12 +268,12 @@ def ur_kernel(params: URParameters, R: NDArray[np.float64], P: NDArray[np.float6
                 t2 = np.arctan2(py * wx - px * wy, px * wx + py * wy)
                 t3 = np.arctan2(s3, D)
                 kidx = 4 * sh + 2 * el + wr
-                out[:, kidx, 0] = t1
-                out[:, kidx, 1] = t2
-                out[:, kidx, 2] = t3
-                out[:, kidx, 3] = t234 - t2 - t3
-                out[:, kidx, 4] = t5
-                out[:, kidx, 5] = t6
+                out[:, kidx, 0] = t1q
+                out[:, kidx, 1] = wrap_to_pi((t2 - pa.offsets[1]) * pa.signs[1])
+                out[:, kidx, 2] = wrap_to_pi((t3 - pa.offsets[2]) * pa.signs[2])
+                out[:, kidx, 3] = wrap_to_pi((t234 - t2 - t3 - pa.offsets[3]) * pa.signs[3])
+                out[:, kidx, 4] = q5
+                out[:, kidx, 5] = q6
                 reach[:, kidx] = ok
     out[~reach] = np.nan
     return reach
