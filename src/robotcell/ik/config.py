@@ -18,7 +18,7 @@ KUKA robot axis positions to configuration (RST)"):
 * Status bit 0 = 1: overhead area (wrist centre x < 0 in the A1 coordinate system);
 * Status bit 1 = 1: A3 >= phi (wrist centre in front of the line A2-A3);
 * Status bit 2 = 1: A5 <= 0 (0 for A5 > 0);
-* Turn bit i (i = 0..5) = 1 when axis A(i+1) < 0.
+* Turn bit i (i = 0..5) = 1 when axis A(i+1) < 0 (values within 1e-12 rad of 0 count as 0).
 
 (Some third-party controllers emulating KUKA count status bit 2 the other way; KUKA's own
 tables, as above, set it for A5 <= 0.)
@@ -44,6 +44,14 @@ from robotcell.robot import Robot
 __all__ = ["abb_confdata", "arm_sides", "kuka_status_turn"]
 
 _QUARTER = math.pi / 2
+#: Joint values closer to 0 than this (rad) count as 0 for signs and quadrants: solvers return
+#: rounding noise such as -1e-17 for an exact 0.
+ZERO_TOL = 1e-12
+
+
+def _joint_values(q: ArrayLike) -> NDArray[np.float64]:
+    arr = np.asarray(q, dtype=float)
+    return np.where(np.abs(arr) < ZERO_TOL, 0.0, arr)
 
 
 def _opw(robot: Robot) -> OPWParameters:
@@ -102,7 +110,7 @@ def kuka_status_turn(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.int_], NDAr
     -------
     status, turn : ndarray of int, shape (...)
     """
-    arr = np.asarray(q, dtype=float)
+    arr = _joint_values(q)
     front, elbow = arm_sides(robot, arr)
     status = (~front).astype(int) + 2 * elbow.astype(int) + 4 * (arr[..., 4] <= 0).astype(int)
     turn = np.sum((arr < 0).astype(int) << np.arange(6), axis=-1)
@@ -122,7 +130,7 @@ def abb_confdata(robot: Robot, q: ArrayLike) -> NDArray[np.int_]:
     -------
     ndarray of int, shape (..., 4)
     """
-    arr = np.asarray(q, dtype=float)
+    arr = _joint_values(q)
     front, elbow = arm_sides(robot, arr)
     quad = np.floor(arr[..., [0, 3, 5]] / _QUARTER).astype(int)
     cfx = 4 * (~front).astype(int) + 2 * (~elbow).astype(int) + (arr[..., 4] < 0).astype(int)
