@@ -59,7 +59,7 @@ def solve_numeric(
     tol_position: float = 1e-9,
     tol_orientation: float = 1e-9,
     max_iterations: int = 30,
-    restarts: int = 60,
+    restarts: int = 150,
     seed: int = 0,
     tool: ArrayLike | None = None,
 ) -> NumericIKResult:
