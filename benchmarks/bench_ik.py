@@ -53,7 +53,7 @@ def main() -> None:
         lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
         T = robot.fk(rng.uniform(lo, hi, (N_POSES, 6)))
         solve(robot, T[:10])  # derive and cache the parameters
-        t = median_time(lambda: solve(robot, T))
+        t = median_time(lambda robot=robot, T=T: solve(robot, T))
         us = t / N_POSES * 1e6
         print(f"  {name:20s} {us:6.2f} us/pose   EAIK/robotcell = {EAIK_US_PER_POSE / us:4.2f}x"
               f"   (target >= 2x)")

@@ -180,9 +180,9 @@ def test_ur_modified_dh_with_signs():
 
 
 @pytest.mark.parametrize("change, match", [
-    (lambda j: {1: dict(alpha=j[1].alpha + 1e-3)}, r"axes 2 and 3 are not parallel \(0\.05729"),
-    (lambda j: {4: dict(d=0.01)}, r"axes 4 and 6 do not intersect \(they are 10 mm apart\)"),
-    (lambda j: {0: dict(alpha=D(-80))}, r"axes 1 and 2 are not perpendicular \(100 deg\)"),
+    (lambda j: {1: {"alpha": j[1].alpha + 1e-3}}, r"axes 2 and 3 are not parallel \(0\.05729"),
+    (lambda j: {4: {"d": 0.01}}, r"axes 4 and 6 do not intersect \(they are 10 mm apart\)"),
+    (lambda j: {0: {"alpha": D(-80)}}, r"axes 1 and 2 are not perpendicular \(100 deg\)"),
 ])
 def test_non_qualifying_models_name_the_failing_axes(change, match):
     base = kr6()

@@ -93,7 +93,7 @@ def test_track_chooses_its_position():
     assert np.all(choice.solutions.valid.any(axis=-1))
     Q = np.where(choice.solutions.valid[..., None], choice.solutions.q, 0.0)
     pos, ang = pose_errors(track, Q, T[:, None])
-    assert np.all(pos[choice.solutions.valid] < 1e-9)
+    assert np.all(pos[choice.solutions.valid] < 1e-9) and np.all(ang[choice.solutions.valid] < 1e-9)
     # The chosen value is at least as good as the value the target was generated with.
     at_orig = track._best(T[:, None], q[:, :1], None)[1]
     assert np.all(choice.manipulability >= at_orig - 1e-12)
@@ -167,7 +167,7 @@ def test_numeric_prismatic_chain():
     res = solve_numeric(robot, robot.fk(q))
     assert res.success.mean() >= 0.99
     pos, ang = pose_errors(robot, res.q, robot.fk(q))
-    assert np.all(pos[res.success] <= 1e-9)
+    assert np.all(pos[res.success] <= 1e-9) and np.all(ang[res.success] <= 1e-9)
 
 
 def test_numeric_input_errors():

@@ -8,7 +8,7 @@ all 8 solutions of every pose: ortho-parallel arms with a spherical wrist throug
 from __future__ import annotations
 
 import weakref
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from robotcell.robot import Robot
 
-__all__ = ["AXIS_TOL", "joint_axes", "line_distance", "closest_point"]
+__all__ = ["AXIS_TOL", "angle_deg", "closest_point", "joint_axes", "line_distance"]
 
 #: Tolerance of the structure tests: |cos| or |sin| of an angle between axes, and distances (m).
 AXIS_TOL = 1e-9

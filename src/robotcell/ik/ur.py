@@ -152,7 +152,10 @@ def ur_parameters(robot: Robot) -> URParameters:
     U = u @ T_O_R[:3, :3].T
     d1 = float(closest_point(P[0], U[0], P[1], U[1])[2])
     # Planar coordinates in the canonical frame 1 at theta1 = 0: (x_O, z_O - d1).
-    plane = lambda v: np.array([v[0], v[2] - d1])  # noqa: E731
+
+    def plane(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.array([v[0], v[2] - d1])
+
     a2, off2 = _signed_length(plane(P[2]) - plane(P[1]))
     a3, t23 = _signed_length(plane(P[3]) - plane(P[2]))
     off3 = t23 - off2
