@@ -79,11 +79,14 @@ def test_explain_recognises_its_own_table(capsys, tmp_path):
     assert code == 0 and "The derived table equals the table of derived" in out
 
 
-def test_symbolic_text_latex_numeric(capsys):
+def test_symbolic_text_latex_numeric(capsys, tmp_path):
     code, out, _ = run(capsys, "dh", "symbolic", "stanford_arm")
     assert code == 0 and "T_0_1 =" in out and "pz = d_1 + d_3*cos(theta_2)" in out
-    code, out, _ = run(capsys, "dh", "symbolic", "stanford_arm", "--numeric", "--latex")
-    assert code == 0 and r"\begin{align*}" in out and "412.0" in out
+    small = rc.Robot("rp", (rc.Joint("revolute", d=0.412, alpha=-1.5707963267948966),
+                            rc.Joint("prismatic", a=0.0203)))
+    rc.save_robot(small, tmp_path / "rp.yaml")
+    code, out, _ = run(capsys, "dh", "symbolic", str(tmp_path / "rp.yaml"), "--numeric", "--latex")
+    assert code == 0 and r"\begin{align*}" in out and "412.0" in out and "20.3" in out
 
 
 @pytest.mark.parametrize("sub", ["from-urdf", "convert", "explain", "symbolic"])
