@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from machine import describe  # noqa: E402
+from machine import describe
 
 from robotcell.ik import TrackRobot, solve, solve_numeric
 from robotcell.modelfile import load_robot

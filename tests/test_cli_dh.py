@@ -4,19 +4,13 @@ from importlib import resources
 
 import numpy as np
 import pytest
+from cli_helpers import run
 
 import robotcell as rc
-from robotcell.cli import main
 
 URDF = str(resources.files("robotcell") / "robots" / "urdf" / "ur5e.urdf")
 
 
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-        raise SystemExit(0)
-    out = capsys.readouterr()
-    return exc.value.code or 0, out.out, out.err
 
 
 def test_from_urdf_writes_a_model_that_moves_like_the_urdf(capsys, tmp_path):

@@ -222,33 +222,33 @@ KUKA_OFF = [0, -PI / 2, 0, 0, 0, 0]
 ABB_OFF = [0, 0, -PI / 2, 0, 0, 0]
 OPW = {
     # opw_kinematics include/opw_kinematics/opw_parameters_examples.h makeKukaKR6_R700_sixx
-    "kuka_kr6_r700_sixx": (dict(a1=0.025, a2=-0.035, b=0.0, c1=0.400, c2=0.315, c3=0.365, c4=0.080,
-                                offsets=KUKA_OFF, sign=KUKA_SIGN), KUKA_FROM_TOOL0),
+    "kuka_kr6_r700_sixx": ({"a1": 0.025, "a2": -0.035, "b": 0.0, "c1": 0.400, "c2": 0.315, "c3": 0.365, "c4": 0.080,
+                                "offsets": KUKA_OFF, "sign": KUKA_SIGN}, KUKA_FROM_TOOL0),
     # kuka_experimental kuka_kr6_support/config/opw_parameters_kr6r900_2.yaml
-    "kuka_kr6_r900": (dict(a1=0.025, a2=-0.025, b=0.0, c1=0.400, c2=0.455, c3=0.420, c4=0.090,
-                           offsets=KUKA_OFF, sign=KUKA_SIGN), KUKA_FROM_TOOL0),
+    "kuka_kr6_r900": ({"a1": 0.025, "a2": -0.025, "b": 0.0, "c1": 0.400, "c2": 0.455, "c3": 0.420, "c4": 0.090,
+                           "offsets": KUKA_OFF, "sign": KUKA_SIGN}, KUKA_FROM_TOOL0),
     # kuka_experimental kuka_kr16_support/config/opw_parameters_kr16_2.yaml
-    "kuka_kr16": (dict(a1=0.260, a2=0.035, b=0.0, c1=0.675, c2=0.680, c3=0.670, c4=0.158,
-                       offsets=KUKA_OFF, sign=KUKA_SIGN), KUKA_FROM_TOOL0),
+    "kuka_kr16": ({"a1": 0.260, "a2": 0.035, "b": 0.0, "c1": 0.675, "c2": 0.680, "c3": 0.670, "c4": 0.158,
+                       "offsets": KUKA_OFF, "sign": KUKA_SIGN}, KUKA_FROM_TOOL0),
     # read off kr210r2700extra_macro.xacro
-    "kuka_kr210_r2700": (dict(a1=0.350, a2=0.041, b=0.0, c1=0.675, c2=1.150, c3=1.200, c4=0.215,
-                              offsets=KUKA_OFF, sign=KUKA_SIGN), KUKA_FROM_TOOL0),
+    "kuka_kr210_r2700": ({"a1": 0.350, "a2": 0.041, "b": 0.0, "c1": 0.675, "c2": 1.150, "c3": 1.200, "c4": 0.215,
+                              "offsets": KUKA_OFF, "sign": KUKA_SIGN}, KUKA_FROM_TOOL0),
     # read off robotkinematicscatalogue KUKA_KR1000_L750_titan.py (A4 axis 65 mm above A3)
-    "kuka_kr1000_titan": (dict(a1=0.600, a2=-0.065, b=0.0, c1=1.100, c2=1.400, c3=1.600, c4=0.372,
-                               offsets=KUKA_OFF, sign=KUKA_SIGN), KUKA_FROM_TOOL0),
+    "kuka_kr1000_titan": ({"a1": 0.600, "a2": -0.065, "b": 0.0, "c1": 1.100, "c2": 1.400, "c3": 1.600, "c4": 0.372,
+                               "offsets": KUKA_OFF, "sign": KUKA_SIGN}, KUKA_FROM_TOOL0),
     # opw_kinematics opw_parameters_examples.h makeIrb2400_10
-    "abb_irb2400": (dict(a1=0.100, a2=-0.135, b=0.0, c1=0.615, c2=0.705, c3=0.755, c4=0.085,
-                         offsets=ABB_OFF, sign=[1] * 6), np.eye(4)),
+    "abb_irb2400": ({"a1": 0.100, "a2": -0.135, "b": 0.0, "c1": 0.615, "c2": 0.705, "c3": 0.755, "c4": 0.085,
+                         "offsets": ABB_OFF, "sign": [1] * 6}, np.eye(4)),
     # read off irb120_3_58_macro.xacro / irb6700_200_260_macro.xacro
-    "abb_irb120": (dict(a1=0.0, a2=-0.070, b=0.0, c1=0.290, c2=0.270, c3=0.302, c4=0.072,
-                        offsets=ABB_OFF, sign=[1] * 6), np.eye(4)),
-    "abb_irb6700": (dict(a1=0.320, a2=-0.200, b=0.0, c1=0.780, c2=1.125, c3=1.1425, c4=0.200,
-                         offsets=ABB_OFF, sign=[1] * 6), np.eye(4)),
+    "abb_irb120": ({"a1": 0.0, "a2": -0.070, "b": 0.0, "c1": 0.290, "c2": 0.270, "c3": 0.302, "c4": 0.072,
+                        "offsets": ABB_OFF, "sign": [1] * 6}, np.eye(4)),
+    "abb_irb6700": ({"a1": 0.320, "a2": -0.200, "b": 0.0, "c1": 0.780, "c2": 1.125, "c3": 1.1425, "c4": 0.200,
+                         "offsets": ABB_OFF, "sign": [1] * 6}, np.eye(4)),
     # read off the Fanuc URDFs; OPW base = robot foot, Fanuc world is c1 higher
-    "fanuc_lrmate200id": (dict(a1=0.050, a2=-0.035, b=0.0, c1=0.330, c2=0.330, c3=0.335, c4=0.080,
-                               offsets=ABB_OFF, sign=[1, 1, -1, -1, -1, -1]), FANUC_FROM_OPW),
-    "fanuc_m20ia": (dict(a1=0.150, a2=-0.250, b=0.0, c1=0.525, c2=0.790, c3=0.835, c4=0.100,
-                         offsets=ABB_OFF, sign=[1, 1, -1, -1, -1, -1]), FANUC_FROM_OPW),
+    "fanuc_lrmate200id": ({"a1": 0.050, "a2": -0.035, "b": 0.0, "c1": 0.330, "c2": 0.330, "c3": 0.335, "c4": 0.080,
+                               "offsets": ABB_OFF, "sign": [1, 1, -1, -1, -1, -1]}, FANUC_FROM_OPW),
+    "fanuc_m20ia": ({"a1": 0.150, "a2": -0.250, "b": 0.0, "c1": 0.525, "c2": 0.790, "c3": 0.835, "c4": 0.100,
+                         "offsets": ABB_OFF, "sign": [1, 1, -1, -1, -1, -1]}, FANUC_FROM_OPW),
 }
 OPW_BASE = {"fanuc_lrmate200id": hom(p=(0, 0, -0.330)), "fanuc_m20ia": hom(p=(0, 0, -0.525))}
 

@@ -81,7 +81,7 @@ def _run_chromium(exe, tmp_path, *args):
     base = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
             "--disable-background-networking", "--disable-component-update", "--disable-sync",
             f"--user-data-dir={tmp_path / 'profile'}"]
-    return subprocess.run(base + list(args), capture_output=True, text=True, timeout=120)
+    return subprocess.run(base + list(args), capture_output=True, text=True, timeout=120, check=False)
 
 
 def test_report_renders_figures_in_headless_chromium(tmp_path):
