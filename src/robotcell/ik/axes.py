@@ -62,3 +62,16 @@ def line_distance(p1: NDArray[np.float64], u1: NDArray[np.float64], p2: NDArray[
 def angle_deg(u1: NDArray[np.float64], u2: NDArray[np.float64]) -> float:
     """Angle between two unit vectors in degrees, for error messages."""
     return math.degrees(math.acos(max(-1.0, min(1.0, float(u1 @ u2)))))
+
+
+def six_revolute_problems(robot: Robot) -> list[str]:
+    """Why ``robot`` is not a chain of six revolute joints (empty if it is).
+
+    The first check of every analytic solver: both need exactly six revolute axes.
+    """
+    if robot.n_joints != 6:
+        return [f"it has {robot.n_joints} joints, not 6"]
+    prismatic = [i + 1 for i, j in enumerate(robot.joints) if j.prismatic]
+    if prismatic:
+        return [f"joint(s) {', '.join(map(str, prismatic))} are prismatic"]
+    return []

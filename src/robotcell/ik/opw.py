@@ -28,7 +28,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.errors import InputError
-from robotcell.ik.axes import AXIS_TOL, angle_deg, closest_point, joint_axes, line_distance
+from robotcell.ik.axes import (
+    AXIS_TOL,
+    angle_deg,
+    closest_point,
+    joint_axes,
+    line_distance,
+    six_revolute_problems,
+)
 from robotcell.robot import Robot
 from robotcell.transforms import invert, rot_y, rot_z
 
@@ -85,11 +92,9 @@ def opw_problems(robot: Robot) -> list[str]:
     list of str
         One sentence per failed condition, naming the axes.
     """
-    if robot.n_joints != 6:
-        return [f"it has {robot.n_joints} joints, not 6"]
-    prismatic = [i + 1 for i, j in enumerate(robot.joints) if j.prismatic]
-    if prismatic:
-        return [f"joint(s) {', '.join(map(str, prismatic))} are prismatic"]
+    basic = six_revolute_problems(robot)
+    if basic:
+        return basic
     p, u = joint_axes(robot)
     out = []
     for i, j in ((0, 1), (2, 3), (3, 4), (4, 5)):

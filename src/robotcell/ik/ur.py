@@ -32,7 +32,14 @@ from numpy.typing import NDArray
 
 from robotcell.dh import link_transform
 from robotcell.errors import InputError
-from robotcell.ik.axes import AXIS_TOL, angle_deg, closest_point, joint_axes, line_distance
+from robotcell.ik.axes import (
+    AXIS_TOL,
+    angle_deg,
+    closest_point,
+    joint_axes,
+    line_distance,
+    six_revolute_problems,
+)
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.ik.opw import _controller_angle
 from robotcell.robot import Robot
@@ -78,11 +85,9 @@ class URParameters:
 
 def ur_problems(robot: Robot) -> list[str]:
     """Reasons why ``robot`` is not a Universal-Robots-type arm (empty if it is)."""
-    if robot.n_joints != 6:
-        return [f"it has {robot.n_joints} joints, not 6"]
-    prismatic = [i + 1 for i, j in enumerate(robot.joints) if j.prismatic]
-    if prismatic:
-        return [f"joint(s) {', '.join(map(str, prismatic))} are prismatic"]
+    basic = six_revolute_problems(robot)
+    if basic:
+        return basic
     p, u = joint_axes(robot)
     out = []
     for i, j in ((0, 1), (3, 4), (4, 5)):
