@@ -29,7 +29,7 @@ import numpy as np
 import yaml
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell import coupled
+from robotcell import cellik, coupled
 from robotcell.coupled import RESERVED_FRAMES
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
@@ -444,6 +444,19 @@ class Cell:
            tool: str | ArrayLike | None = None, frame: str = "world") -> NDArray[np.float64]:
         """TCP pose in a frame of the cell; see :func:`robotcell.coupled.fk`."""
         return coupled.fk(self, q, track, table, tool, frame)
+
+    def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+           table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
+           samples: int = 65) -> cellik.CellIKSolutions:
+        """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cellik.ik`."""
+        return cellik.ik(self, T, frame, track, table, tool, samples)
+
+    def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+                table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
+                q_start: ArrayLike | None = None, max_step: float = cellik.MAX_STEP,
+                samples: int = 33) -> cellik.CellPath:
+        """A continuous trajectory through targets; see :func:`robotcell.cellik.ik_path`."""
+        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples)
 
     # -- files ------------------------------------------------------------------------------------
     @classmethod

@@ -30,7 +30,8 @@ from robotcell.transforms import invert, make_pose, rot_z, validate_pose
 if TYPE_CHECKING:
     from robotcell.cell import Cell
 
-__all__ = ["RESERVED_FRAMES", "fk", "frame_pose", "table_pose", "track_pose"]
+__all__ = ["RESERVED_FRAMES", "fk", "frame_pose", "robot_pose", "table_pose", "tool_pose",
+           "track_pose"]
 
 #: Frame names :func:`frame_pose` understands besides the cell's own frames, and what they mean.
 RESERVED_FRAMES = {
@@ -79,8 +80,21 @@ def table_pose(theta: ArrayLike) -> NDArray[np.float64]:
     return make_pose(rot_z(_scalar_batch(theta, "table angle")))
 
 
-def _robot_pose(cell: Cell, e: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``T_world_R(e)``, shape ``e.shape + (4, 4)``."""
+def robot_pose(cell: Cell, e: ArrayLike) -> NDArray[np.float64]:
+    """Pose of the robot base in the world at track positions ``e``.
+
+    Parameters
+    ----------
+    cell : Cell
+    e : array_like, shape (...)
+        Track positions (m); must be 0 in a cell without track.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+        ``T_world_R(e)`` (m).
+    """
+    e = _scalar_batch(e, "track position")
     if cell.track is None:
         if np.any(e != 0):
             raise InputError("the cell has no track; the track position must be 0")
@@ -95,7 +109,7 @@ def _table_root(cell: Cell, e: NDArray[np.float64]) -> NDArray[np.float64]:
     tt = cell.turntable
     if tt.parent == "world":
         return np.broadcast_to(tt.T_parent_B, e.shape + (4, 4))
-    return _robot_pose(cell, e) @ tt.T_parent_B
+    return robot_pose(cell, e) @ tt.T_parent_B
 
 
 def frame_pose(cell: Cell, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
@@ -132,7 +146,7 @@ def frame_pose(cell: Cell, name: str, track: ArrayLike = 0.0, table: ArrayLike =
             raise InputError("the cell has no track, so no frame 'track' (L)")
         return np.broadcast_to(cell.track.T_world_L, batch + (4, 4)).copy()
     if kind == "R":
-        return np.array(_robot_pose(cell, e))
+        return np.array(robot_pose(cell, e))
     if kind == "B":
         return np.array(_table_root(cell, e))
     if name not in cell.frames:
@@ -142,8 +156,29 @@ def frame_pose(cell: Cell, name: str, track: ArrayLike = 0.0, table: ArrayLike =
     if fr.parent == "world":
         return np.broadcast_to(fr.pose, batch + (4, 4)).copy()
     if fr.parent == "robot":
-        return _robot_pose(cell, e) @ fr.pose
+        return robot_pose(cell, e) @ fr.pose
     return _table_root(cell, e) @ table_pose(th) @ fr.pose
+
+
+def tool_pose(cell: Cell, tool: str | ArrayLike | None) -> NDArray[np.float64] | None:
+    """``T_F_TCP`` of a tool given by name (a tool of the cell) or as a pose; None stays None.
+
+    Parameters
+    ----------
+    cell : Cell
+    tool : str or array_like of shape (4, 4) or None
+        Tool name, or ``T_F_TCP`` (m), or None for the robot model's own tool.
+
+    Returns
+    -------
+    ndarray, shape (4, 4), or None
+    """
+    if isinstance(tool, str):
+        if tool not in cell.tools:
+            known = ", ".join(sorted(cell.tools)) or "none"
+            raise InputError(f"unknown tool {tool!r}; the cell has: {known}")
+        return cell.tools[tool].T_F_TCP
+    return None if tool is None else validate_pose(tool, "tool")
 
 
 def fk(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
@@ -174,14 +209,7 @@ def fk(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
     The lecture's track relation, for a cell ``c`` with a track along X_L at the world origin:
     ``c.fk(q, track=e, frame="track")[:3, 3] == e * X_L + L_Q_R @ robot.fk(q)[:3, 3]``.
     """
-    if isinstance(tool, str):
-        if tool not in cell.tools:
-            known = ", ".join(sorted(cell.tools)) or "none"
-            raise InputError(f"unknown tool {tool!r}; the cell has: {known}")
-        T_tool = cell.tools[tool].T_F_TCP
-    else:
-        T_tool = None if tool is None else validate_pose(tool, "tool")
-    T_R_TCP = cell.robot.fk(np.asarray(q, dtype=float), tool=T_tool)
+    T_R_TCP = cell.robot.fk(np.asarray(q, dtype=float), tool=tool_pose(cell, tool))
     e = _scalar_batch(track, "track position")
-    T_world_TCP = _robot_pose(cell, e) @ T_R_TCP
+    T_world_TCP = robot_pose(cell, e) @ T_R_TCP
     return invert(frame_pose(cell, frame, e, table)) @ T_world_TCP
