@@ -133,6 +133,30 @@ def test_result_statistics_json_and_summary():
     assert "radius (mm): 500.000" in s and "next step: do it" in s and "w1" in s
 
 
+def test_renamed_result_moves_value_sigma_kind_and_prefixed_json_fields():
+    r = make_result()
+    r.kinds["radius"] = "length"
+    r.json_fields["T_R_W_covariance_mm_rad"] = np.eye(6)
+    w = r.renamed("T_R_W", "T_world_fixture")
+    assert list(w.values) == ["T_world_fixture", "radius"]
+    assert w.values["T_world_fixture"] is r.values["T_R_W"]
+    assert set(w.sigma) == {"T_world_fixture_position", "T_world_fixture_rotation", "radius"}
+    assert "T_world_fixture_covariance_mm_rad" in w.json_fields
+    assert w.json_fields["matrix"] == r.json_fields["matrix"] and w.kinds == {"radius": "length"}
+    j = w.to_json()
+    assert j["sigma"]["T_world_fixture_position_mm"] == pytest.approx([0.1] * 3)
+    assert "T_R_W" not in json.dumps(j) and "T_R_W" not in w.summary()
+    assert "T_world_fixture (KUKA X,Y,Z mm, A,B,C deg)" in w.summary()
+    assert "T_R_W" in r.values and "T_R_W_covariance_mm_rad" in r.json_fields  # r unchanged
+    r2 = make_result()
+    r2.kinds["T_R_W"] = "pose"
+    assert r2.renamed("T_R_W", "T_R_X").kinds == {"T_R_X": "pose"}
+    with pytest.raises(InputError, match="has no value 'T_R_B' to rename"):
+        r.renamed("T_R_B", "T_world_B")
+    with pytest.raises(InputError, match="already has a value 'radius'"):
+        r.renamed("T_R_W", "radius")
+
+
 def test_tcp_positions_from_xyz_and_from_joints():
     cols = {"x": np.array([1000.0, 1100.0]), "y": np.array([0.0, 50.0]), "z": np.array([500.0, 400.0])}
     np.testing.assert_allclose(tcp_positions(cols, "m.csv"), [[1, 0, 0.5], [1.1, 0.05, 0.4]])

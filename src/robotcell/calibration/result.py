@@ -8,13 +8,14 @@ the vendor fields a procedure adds) and in :meth:`CalibrationResult.summary`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cli.common import format_table
+from robotcell.errors import InputError
 from robotcell.poseformats import pose_to_vendor
 
 __all__ = ["CalibrationResult", "pose_fields", "to_jsonable"]
@@ -176,6 +177,52 @@ class CalibrationResult:
         """Largest residual length (metres)."""
         n = self.residual_norms
         return float(n.max()) if n.size else 0.0
+
+    def renamed(self, old_key: str, new_key: str) -> CalibrationResult:
+        """The same result with one estimated quantity under another name.
+
+        Used when the touches were expressed in another frame than the procedure's names say,
+        e.g. ``T_R_B`` -> ``T_world_B`` for a turntable calibrated from touches mapped to the
+        world. The value itself is not changed.
+
+        Parameters
+        ----------
+        old_key : str
+            Key of ``values`` to rename.
+        new_key : str
+            Its new name; must not be another key of ``values``.
+
+        Returns
+        -------
+        CalibrationResult
+            A new result (arrays shared with this one) in which ``values[old_key]`` becomes
+            ``values[new_key]`` at the same place, its sigma keys follow (``old_key``,
+            ``old_key + "_position"``, ``old_key + "_rotation"``), ``kinds[old_key]`` too, and
+            every ``json_fields`` key starting with ``old_key + "_"`` (e.g.
+            ``T_R_B_covariance_mm_rad``). Other JSON fields, ``matrix`` and ``xyzabc`` among
+            them, are kept.
+
+        Raises
+        ------
+        InputError
+            ``old_key`` is not a value of the result, or ``new_key`` already is.
+        """
+        if old_key not in self.values:
+            raise InputError(f"the {self.procedure} result has no value {old_key!r} to rename "
+                             f"(it has: {', '.join(self.values)})")
+        if new_key != old_key and new_key in self.values:
+            raise InputError(f"the {self.procedure} result already has a value {new_key!r}")
+
+        def swap(d: dict[str, Any], names: dict[str, str]) -> dict[str, Any]:
+            return {names.get(k, k): v for k, v in d.items()}
+
+        sigma_names = {old_key + s: new_key + s for s in ("", "_position", "_rotation")}
+        json_names = {k: new_key + k[len(old_key):] for k in self.json_fields
+                      if k.startswith(old_key + "_")}
+        return replace(self, values=swap(self.values, {old_key: new_key}),
+                       sigma=swap(self.sigma, sigma_names),
+                       kinds=swap(self.kinds, {old_key: new_key}),
+                       json_fields=swap(self.json_fields, json_names))
 
     def _kind(self, key: str) -> str:
         if key in self.kinds:
