@@ -33,7 +33,7 @@ from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.robot import Robot
-from robotcell.transforms import invert, make_pose, rot_z
+from robotcell.transforms import invert, rot_z
 
 __all__ = ["PROCEDURES", "Touches", "simulate"]
 
