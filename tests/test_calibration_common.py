@@ -137,7 +137,9 @@ def test_renamed_result_moves_value_sigma_kind_and_prefixed_json_fields():
     r = make_result()
     r.kinds["radius"] = "length"
     r.json_fields["T_R_W_covariance_mm_rad"] = np.eye(6)
+    r.next_step = "enter T_R_W (not T_R_Wx) as the base"
     w = r.renamed("T_R_W", "T_world_fixture")
+    assert w.next_step == "enter T_world_fixture (not T_R_Wx) as the base"
     assert list(w.values) == ["T_world_fixture", "radius"]
     assert w.values["T_world_fixture"] is r.values["T_R_W"]
     assert set(w.sigma) == {"T_world_fixture_position", "T_world_fixture_rotation", "radius"}
@@ -145,7 +147,8 @@ def test_renamed_result_moves_value_sigma_kind_and_prefixed_json_fields():
     assert w.json_fields["matrix"] == r.json_fields["matrix"] and w.kinds == {"radius": "length"}
     j = w.to_json()
     assert j["sigma"]["T_world_fixture_position_mm"] == pytest.approx([0.1] * 3)
-    assert "T_R_W" not in json.dumps(j) and "T_R_W" not in w.summary()
+    assert not [k for k in (*j, *j["sigma"]) if k.startswith("T_R_W")]
+    assert "T_R_W " not in w.summary()
     assert "T_world_fixture (KUKA X,Y,Z mm, A,B,C deg)" in w.summary()
     assert "T_R_W" in r.values and "T_R_W_covariance_mm_rad" in r.json_fields  # r unchanged
     r2 = make_result()

@@ -8,6 +8,7 @@ the vendor fields a procedure adds) and in :meth:`CalibrationResult.summary`.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -200,7 +201,8 @@ class CalibrationResult:
             ``old_key + "_position"``, ``old_key + "_rotation"``), ``kinds[old_key]`` too, and
             every ``json_fields`` key starting with ``old_key + "_"`` (e.g.
             ``T_R_B_covariance_mm_rad``). Other JSON fields, ``matrix`` and ``xyzabc`` among
-            them, are kept.
+            them, are kept. Mentions of ``old_key`` as a whole word in ``next_step``,
+            ``warnings`` and ``undetermined`` are renamed as well.
 
         Raises
         ------
@@ -216,13 +218,21 @@ class CalibrationResult:
         def swap(d: dict[str, Any], names: dict[str, str]) -> dict[str, Any]:
             return {names.get(k, k): v for k, v in d.items()}
 
+        word = re.compile(rf"\b{re.escape(old_key)}\b")
+
+        def text(t: str) -> str:
+            return word.sub(new_key, t)
+
         sigma_names = {old_key + s: new_key + s for s in ("", "_position", "_rotation")}
         json_names = {k: new_key + k[len(old_key):] for k in self.json_fields
                       if k.startswith(old_key + "_")}
         return replace(self, values=swap(self.values, {old_key: new_key}),
                        sigma=swap(self.sigma, sigma_names),
                        kinds=swap(self.kinds, {old_key: new_key}),
-                       json_fields=swap(self.json_fields, json_names))
+                       json_fields=swap(self.json_fields, json_names),
+                       next_step=text(self.next_step),
+                       warnings=[text(w) for w in self.warnings],
+                       undetermined=[text(u) for u in self.undetermined])
 
     def _kind(self, key: str) -> str:
         if key in self.kinds:
