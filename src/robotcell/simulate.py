@@ -120,7 +120,7 @@ class Touches:
         elif self.table is not None:
             header.append("e1")
             cols.append([f"{math.degrees(v):.4f}" for v in self.table])
-        if self.track is not None and self.procedure != "track":
+        if self.track is not None and self.procedure not in ("track", "tcp"):
             header.append("track")
             cols.append([f"{v * 1e3:.3f}" for v in self.track])
         if self.roles is not None:
@@ -453,7 +453,8 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
     q, e, _ = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
     tt = cell.turntable
     return Touches("turntable", q, e if cell.track is not None else None, th, None,
-                   truth={"pose": tt.T_parent_B.copy(), "parent": tt.parent, "radius": radius},
+                   truth={"pose": tt.T_parent_B.copy(), "parent": tt.parent, "radius": radius,
+                          "height": height},
                    options=[f"--height={-height * 1e3:g}"], tool=tname, noise=noise)
 
 

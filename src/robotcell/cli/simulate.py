@@ -1,0 +1,177 @@
+"""``robotcell simulate``: measurement files of a virtual cell, to rehearse a procedure.
+
+The design options (mm, deg) shared with ``robotcell plan`` are defined here.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable
+from typing import Any
+
+import click
+import numpy as np
+
+from robotcell.cell import Cell
+from robotcell.cli.common import parse_numbers
+from robotcell.errors import InputError
+from robotcell.simulate import PROCEDURES, Touches
+from robotcell.simulate import simulate as simulate_touches
+
+#: Design options: CLI name -> (keyword of simulate, procedures it applies to, converter to SI).
+DESIGN_OPTIONS: dict[str, tuple[str, tuple[str, ...], Callable[[Any], Any]]] = {
+    "touches": ("touches", ("tcp", "turntable"), int),
+    "tilt": ("tilt", ("tcp",), math.radians),
+    "point": ("point", ("tcp",), lambda v: np.array(parse_numbers(v, "--point", 3)) * 1e-3),
+    "orientation": ("orientation", ("tcp",), bool),
+    "size": ("size", ("frame", "workpiece"), lambda v: v * 1e-3),
+    "repeats": ("repeats", ("frame", "workpiece"), int),
+    "reference": ("references", ("track",),
+                  lambda v: np.array([parse_numbers(r, "--reference", 3) for r in v]) * 1e-3),
+    "positions": ("positions", ("track",), int),
+    "travel": ("travel", ("track",), lambda v: v * 1e-3),
+    "angles": ("angles", ("turntable", "workpiece"),
+               lambda v: np.radians(parse_numbers(v, "--angles"))),
+    "radius": ("radius", ("turntable",), lambda v: v * 1e-3),
+    "height": ("height", ("turntable",), lambda v: v * 1e-3),
+}
+
+
+def cell_options(func: Callable) -> Callable:
+    """Options of simulate and plan that say what is touched: cell, noise, seed, tool, ..."""
+    opts = [
+        click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+                     help="The virtual cell (YAML, mm/deg): its values are the truth."),
+        click.option("--noise", type=float, default=0.1, show_default=True, metavar="MM",
+                     help="Touch-up error, 1-sigma per coordinate (mm)."),
+        click.option("--seed", type=int, default=None, help="Seed of the touch-up errors."),
+        click.option("--tool", default=None, metavar="NAME",
+                     help="Tool of the cell that touches (tcp: the tool to calibrate); needed "
+                          "when the cell has several."),
+        click.option("--frame", default=None, metavar="NAME",
+                     help="frame/workpiece: the frame of the cell to touch."),
+        click.option("--track", "track_mm", type=float, default=None, metavar="MM",
+                     help="Track position of the robot (not for the track procedure); default: "
+                          "where the touches are reached best."),
+        click.option("--touches", type=int, default=None,
+                     help="tcp: touches of the reference point (4); turntable: table angles (6)."),
+        click.option("--repeats", type=int, default=None,
+                     help="frame/workpiece: touches per point (2)."),
+    ]
+    for opt in reversed(opts):
+        func = opt(func)
+    return func
+
+
+def design_options(func: Callable) -> Callable:
+    """Options that fix the geometry of the touches (simulate only; plan searches them)."""
+    opts = [
+        click.option("--tilt", type=float, default=None, metavar="DEG",
+                     help="tcp: tilt of the tool between the touches (30)."),
+        click.option("--point", default=None, metavar="X,Y,Z",
+                     help="tcp: reference tip in the robot base (mm; 1100,0,250)."),
+        click.option("--orientation/--no-orientation", default=None,
+                     help="tcp: add the ABC 2-point touches for the tool orientation (yes)."),
+        click.option("--size", type=float, default=None, metavar="MM",
+                     help="frame/workpiece: distance of the +X and XY points from the origin "
+                          "(200 / 150)."),
+        click.option("--reference", multiple=True, metavar="X,Y,Z",
+                     help="track: reference point in the track frame L (mm), repeatable "
+                          "(default: two, a quarter of the travel from each end)."),
+        click.option("--positions", type=int, default=None,
+                     help="track: track positions per reference point (4)."),
+        click.option("--travel", type=float, default=None, metavar="MM",
+                     help="track: spread of the track positions per point (1000)."),
+        click.option("--angles", default=None, metavar="A,B,...",
+                     help="turntable: table angles (deg; default evenly around the turn); "
+                          "workpiece: one per touch."),
+        click.option("--radius", type=float, default=None, metavar="MM",
+                     help="turntable: distance of the touched point from the axis (300)."),
+        click.option("--height", type=float, default=None, metavar="MM",
+                     help="turntable: height of the touched point above the root frame (50)."),
+    ]
+    for opt in reversed(opts):
+        func = opt(func)
+    return func
+
+
+def design_keywords(procedure: str, given: dict[str, Any]) -> dict[str, Any]:
+    """The simulate keywords (SI) of the design options given, refusing ones that do not apply."""
+    out: dict[str, Any] = {}
+    for name, value in given.items():
+        if value is None or value == ():
+            continue
+        key, applies, convert = DESIGN_OPTIONS[name]
+        if procedure not in applies:
+            raise InputError(f"--{name} does not apply to {procedure} (it is for "
+                             f"{' and '.join(applies)})")
+        out[key] = convert(value)
+    return out
+
+
+def common_keywords(procedure: str, cell: Cell, tool: str | None, frame: str | None,
+                    track_mm: float | None) -> dict[str, Any]:
+    """Keywords of simulate for tool, frame and track position, checked against the procedure."""
+    kw: dict[str, Any] = {"tool": tool}
+    if frame is not None:
+        if procedure not in ("frame", "workpiece"):
+            raise InputError(f"--frame does not apply to {procedure} (it is for frame and "
+                             "workpiece)")
+        kw["frame"] = frame
+    if track_mm is not None:
+        kw["track"] = track_mm * 1e-3
+    return kw
+
+
+def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
+    """The command that calibrates the simulated file."""
+    parts = ["robotcell calibrate", t.procedure, csv_name, "--cell", cell_path]
+    if t.procedure == "tcp":
+        parts += ["--name", "TOOL"]
+    elif t.tool is not None:
+        parts += ["--tool", t.tool]
+    if t.procedure in ("frame", "workpiece"):
+        parts += ["--name", t.truth["name"]]
+    if t.procedure == "frame" and t.truth["parent"] != "world":
+        parts += ["--parent", t.truth["parent"]]
+    return " ".join(parts + t.options)
+
+
+@click.command()
+@click.argument("procedure", type=click.Choice(list(PROCEDURES)))
+@cell_options
+@design_options
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+              help="CSV file to write (default: standard output).")
+def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
+             frame: str | None, track_mm: float | None, output: str | None,
+             **design: Any) -> None:
+    """Simulate the touches of a calibration PROCEDURE in a virtual cell.
+
+    Writes the measurement CSV that 'robotcell calibrate PROCEDURE' reads: joint values
+    a1..a6 (deg) that really reach the touched points within every limit, with the touch-up
+    error --noise; e1 (track mm or table deg), track (mm, robot's track position), point.
+    The command line that calibrates the file is printed on stderr. Procedures: tcp, frame,
+    track, turntable, workpiece.
+
+    \b
+    Examples:
+      robotcell simulate turntable --cell cell.yaml --noise 0.1 -o turntable.csv
+      robotcell simulate tcp --cell cell.yaml --tool torch --tilt 40 --seed 1 -o tcp.csv
+    """
+    if not (math.isfinite(noise) and noise >= 0):
+        raise InputError(f"--noise must be a number of millimetres >= 0, got {noise}")
+    cell = Cell.load(cell_path)
+    kw = common_keywords(procedure, cell, tool, frame, track_mm)
+    kw.update(design_keywords(procedure, design))
+    t = simulate_touches(cell, procedure, noise=noise * 1e-3, seed=seed, **kw)
+    if output is None:
+        t.write_csv(sys.stdout)
+    else:
+        t.write_csv(output)
+    click.echo(f"simulated {len(t.q)} touches for '{procedure}' with a touch-up error of "
+               f"{noise:g} mm (1-sigma per coordinate)"
+               + (f"; wrote {output}" if output else ""), err=True)
+    click.echo("calibrate them (on a copy of the cell file: --cell updates it) with:\n  "
+               + calibrate_hint(t, output or "FILE.csv", cell_path), err=True)
