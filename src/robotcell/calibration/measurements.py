@@ -8,6 +8,8 @@ degrees. Column names are case-insensitive.
 - Flange poses (tool calibration): ``x, y, z, a, b, c`` (KUKA: ``R = Rz(A) Ry(B) Rx(C)``) or
   ``a1..an`` with a robot model (the flange pose is computed with no tool).
 - ``e1``: external axis value, mm for a linear track, deg for a turntable.
+- ``track``: track position of the robot at each touch (mm), for procedures whose touches are
+  mapped through a cell file (``--cell``); the track calibration itself uses ``e1``.
 - ``point``: the role of a touch in a 3-point frame (``origin``, ``x``, ``xy``).
 - ``nominal_x, nominal_y, nominal_z``: known coordinates of a touched point in the frame being
   calibrated (mm), for N-point frames.
@@ -38,6 +40,7 @@ __all__ = [
     "nominal_points",
     "point_roles",
     "tcp_positions",
+    "track_column",
 ]
 
 #: When every length in a column set stays below this many millimetres, the file is taken to be
@@ -283,3 +286,24 @@ def nominal_points(cols: Columns, source: str) -> NDArray[np.float64]:
     """
     return _numeric(cols, ("nominal_x", "nominal_y", "nominal_z"), source) * 1e-3
 
+
+def track_column(cols: Columns, source: str) -> NDArray[np.float64] | None:
+    """Track position of the robot at each touch from the optional column ``track``.
+
+    Parameters
+    ----------
+    cols : mapping
+        CSV columns; ``track`` in millimetres.
+    source : str
+
+    Returns
+    -------
+    ndarray, shape (N,), or None
+        Metres; None when the column is absent. Refused when every non-zero value is below
+        :data:`MM_LOOKS_LIKE_M` (metres by mistake); all zeros is a valid column.
+    """
+    if "track" not in cols:
+        return None
+    e = _numeric(cols, ("track",), source)[:, 0]
+    _check_mm(e[e != 0], "track (track position)", source)
+    return e * 1e-3

@@ -2,8 +2,10 @@
 
 Every subcommand reads a CSV (mm, deg; see docs/calibration.md), prints a report in mm/deg or,
 with ``--json``, one JSON object, and exits with status 2 and the reason on stderr when the input
-is refused. Subcommands of other modules are listed in ``REGISTERED`` at the bottom of this file
-and imported only when used.
+is refused. With ``--cell CELL.yaml`` (tcp, frame, track, turntable, workpiece) the result is
+written into the cell file through :class:`CellTarget`; notes about the update go to stderr.
+Subcommands of other modules are listed in ``REGISTERED`` at the bottom of this file and imported
+only when used.
 """
 
 from __future__ import annotations
@@ -12,9 +14,12 @@ import importlib
 import importlib.util
 import json
 from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
 
 import click
 import numpy as np
+from numpy.typing import NDArray
 
 from robotcell.calibration.measurements import (
     check_count,
@@ -23,12 +28,14 @@ from robotcell.calibration.measurements import (
     nominal_points,
     point_roles,
     tcp_positions,
+    track_column,
 )
 from robotcell.calibration.result import CalibrationResult
+from robotcell.cell import NAME_RE, Cell, Provenance
 from robotcell.cli.common import parse_numbers, read_csv
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
-from robotcell.poseformats import pose_from_vendor
+from robotcell.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.robot import Robot
 
 
@@ -55,7 +62,8 @@ def calibrate() -> None:
     \b
     CSV with a header, lengths in mm, angles in deg. Positions as x,y,z (TCP in the robot base)
     or joint values a1..a6 with --robot and --tool. Report in mm/deg, or --json.
-    Exit status 2 when the measurements are refused, with the reason on stderr.
+    With --cell CELL.yaml the result is written into the cell file (CELL.yaml.bak keeps the
+    previous version). Exit status 2 when the measurements are refused, with the reason on stderr.
     """
 
 
@@ -66,18 +74,135 @@ def measurement_options(func: Callable) -> Callable:
                         help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
                              "uncertainties instead of the residuals.")(func)
     func = click.option("--tool", default=None, metavar="X,Y,Z,A,B,C",
-                        help="Tool active during the touches (KUKA, mm/deg), for joint-value input; "
-                             "default: the robot model's tool.")(func)
+                        help="Tool active during the touches (KUKA, mm/deg; with --cell also the "
+                             "name of a tool of the cell), for joint-value input; default: the "
+                             "robot model's tool.")(func)
     func = click.option("--robot", default=None, metavar="NAME_OR_FILE",
                         help="Robot model for joint-value input (columns a1..a6).")(func)
     return func
 
 
-def robot_and_tool(robot: str | None, tool: str | None) -> tuple[Robot | None, np.ndarray | None]:
-    """Load ``--robot`` and parse ``--tool`` (KUKA X,Y,Z,A,B,C in mm/deg) into ``T_F_TCP`` (m)."""
+def cell_option(func: Callable) -> Callable:
+    """Option ``--cell CELL.yaml`` of the subcommands that can update a cell file."""
+    return click.option(
+        "--cell", "cell_path", default=None, metavar="CELL.yaml", type=click.Path(dir_okay=False),
+        help="Write the result into this cell file (atomically; the previous version is kept as "
+             "CELL.yaml.bak). Joint values a1..a6 then use the cell's robot, and --tool may name "
+             "a tool of the cell.")(func)
+
+
+@dataclass
+class CellTarget:
+    """A cell file that a calibration updates (``--cell``).
+
+    Attributes
+    ----------
+    path : str
+        The cell file as the user named it (used in messages).
+    cell : Cell
+        Its content; updated in place, then written back by :meth:`save`.
+    """
+
+    path: str
+    cell: Cell
+
+    @classmethod
+    def open(cls, path: str | None, robot: str | None) -> CellTarget | None:
+        """Load ``--cell`` (None without it), refusing ``--robot`` next to it."""
+        if path is None:
+            return None
+        if robot is not None:
+            raise InputError(f"--robot and --cell both give the robot model: with --cell the "
+                             f"robot is the cell's (robot.model in {path}); drop --robot")
+        return cls(path, Cell.load(path))
+
+    def tool(self, text: str) -> NDArray[np.float64]:
+        """``T_F_TCP`` (m) of ``--tool``: a tool name of the cell, or X,Y,Z,A,B,C (mm, deg)."""
+        name = text.strip()
+        if not NAME_RE.match(name):
+            return pose_from_vendor(parse_numbers(text, "--tool", 6), "kuka")
+        if name not in self.cell.tools:
+            known = ", ".join(self.cell.tools) or "none"
+            raise InputError(f"--tool {name!r} is not a tool of {self.path} (its tools: {known}); "
+                             "give one of them or X,Y,Z,A,B,C in mm/deg")
+        return self.cell.tools[name].T_F_TCP
+
+    def track_positions(self, cols: dict, source: str) -> NDArray[np.float64] | None:
+        """Column ``track`` (m), or None; refused with non-zero values in a cell without track."""
+        e = track_column(cols, source)
+        if self.cell.track is None and e is not None and np.any(e != 0):
+            raise InputError(f"{source}: column 'track' has non-zero values, but the cell "
+                             f"{self.path} has no track; remove the column or add the track to "
+                             "the cell file")
+        return e
+
+    def robot_in_world(self, cols: dict, source: str, n: int) -> NDArray[np.float64]:
+        """``T_world_R`` at each of ``n`` touches, shape (n, 4, 4), from column ``track``."""
+        e = self.track_positions(cols, source)
+        if e is None:
+            if self.cell.track is not None:
+                raise InputError(
+                    f"{source}: missing column 'track' (track position of the robot at each "
+                    f"touch, mm): the robot of {self.path} is on a track, and the touches are "
+                    "mapped to the world through it; add the column (0 where the track did not "
+                    "move)")
+            e = np.zeros(n)
+        return self.cell.frame_pose("robot", track=e)
+
+    def save(self, what: str) -> None:
+        """Write the cell file and say on stderr what was updated."""
+        try:
+            self.cell.save(self.path)
+        except OSError as exc:
+            raise InputError(f"cannot write {self.path}: {exc}") from None
+        click.echo(f"updated {self.path}: {what} (previous version: {self.path}.bak)", err=True)
+
+
+def cell_provenance(source: str, result: CalibrationResult, n: int, measurements: str
+                    ) -> Provenance:
+    """Provenance of a calibration read from ``measurements`` with ``n`` touches."""
+    return Provenance.now(source, rms_mm=result.rms * 1e3,
+                          note=f"{n} touches from {Path(measurements).name}")
+
+
+def require_name(name: str | None, target: CellTarget | None, what: str) -> None:
+    """``--name`` goes with ``--cell``: each needs the other."""
+    if target is None and name is not None:
+        raise InputError(f"--name says which {what} of a cell file to update; it needs --cell "
+                         "CELL.yaml")
+    if target is not None and name is None:
+        items = target.cell.tools if what == "tool" else target.cell.frames
+        known = ", ".join(items) or "none yet"
+        raise InputError(f"--cell needs --name: the {what} of {target.path} to write the result "
+                         f"to (existing: {known})")
+
+
+def refuse_track_column(cols: dict, source: str, why: str) -> None:
+    """Refuse column ``track`` where it is not used; ``why`` says what to do instead."""
+    if "track" in cols:
+        raise InputError(f"{source}: column 'track' (track position of each touch) {why}")
+
+
+def map_points(T: NDArray[np.float64], p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Points ``p`` (N, 3) through poses ``T`` (N, 4, 4), one per point."""
+    return np.einsum("nij,nj->ni", T[:, :3, :3], p) + T[:, :3, 3]
+
+
+def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | None = None
+                   ) -> tuple[Robot | None, np.ndarray | None]:
+    """The robot model and ``T_F_TCP`` (m) for joint-value input.
+
+    Without a cell: ``--robot`` loaded and ``--tool`` parsed (KUKA X,Y,Z,A,B,C in mm/deg). With
+    ``--cell``: the cell's robot, and ``--tool`` a tool name of the cell or X,Y,Z,A,B,C.
+    """
+    if target is not None:
+        return target.cell.robot, None if tool is None else target.tool(tool)
     model = load_robot(robot) if robot else None
     if tool is not None and model is None:
         raise InputError("--tool is only used with joint values and --robot")
+    if tool is not None and NAME_RE.match(tool.strip()):
+        raise InputError(f"--tool {tool.strip()!r} is not X,Y,Z,A,B,C (mm, deg); a tool name is "
+                         "understood only with --cell CELL.yaml")
     T = pose_from_vendor(parse_numbers(tool, "--tool", 6), "kuka") if tool is not None else None
     return model, T
 
@@ -112,14 +237,42 @@ def _line_labels(roles: list[str]) -> list[str]:
 POSE_COLUMNS = ["x", "y", "z", "a", "b", "c"] + [f"a{i}" for i in range(1, 10)]
 
 
+NO_CELL_TRACK = ("needs --cell CELL.yaml, which says where the track is; remove the column or "
+                 "pass --cell")
+
+
+def _write_tool(target: CellTarget, name: str, result: CalibrationResult, prov: Provenance) -> None:
+    """Set tool ``name`` from a TCP result; an unmeasured orientation is kept, and said so."""
+    if "T_F_TCP" in result.values:
+        target.cell.set_tool(name, result.values["T_F_TCP"], prov)
+        return
+    T = np.eye(4)
+    old = target.cell.tools.get(name)
+    advice = "ABC 2-point or ABC World touches measure it"
+    if old is not None:
+        T[:3, :3] = old.T_F_TCP[:3, :3]
+        abc = ", ".join(f"{v:.3f}" for v in pose_to_vendor(old.T_F_TCP, "kuka")[3:] + 0.0)
+        click.echo(f"note: the touches do not measure the tool orientation: kept the orientation "
+                   f"of tool {name!r} in {target.path} (A,B,C = {abc} deg); {advice}", err=True)
+    else:
+        click.echo(f"note: the touches do not measure the tool orientation and {target.path} has "
+                   f"no tool {name!r} yet: its orientation is the flange's (A,B,C = 0, 0, 0 deg); "
+                   f"{advice}", err=True)
+    T[:3, 3] = result.values["tcp"]
+    target.cell.set_tool(name, T, prov)
+
+
 @calibrate.command("tcp")
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--world", "world_mode", type=click.Choice(["6d", "5d"]), default="6d",
               help="ABC World alignment of rows with point=world: 6d (tool X along world -Z, Y along "
                    "world Y) or 5d (tool X along world -Z only).")
+@click.option("--name", default=None, metavar="TOOL",
+              help="With --cell: the tool of the cell to write (added when new).")
+@cell_option
 @measurement_options
-def tcp(measurements: str, world_mode: str, robot: str | None, tool: str | None,
-        sigma: float | None, as_json: bool) -> None:
+def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | None,
+        robot: str | None, tool: str | None, sigma: float | None, as_json: bool) -> None:
     """Tool TCP (XYZ 4-point / N-point) and orientation (ABC 2-point, ABC World).
 
     \b
@@ -127,14 +280,24 @@ def tcp(measurements: str, world_mode: str, robot: str | None, tool: str | None,
     Optional column point: tcp (TCP on the reference point; the default), -x (reference point
     on the tool's -X axis), xy (reference point in the tool's XY plane, +Y), world (tool
     aligned to the world axes, see --world).
+    With --cell and --name the tool is written into the cell file; without an orientation
+    method its orientation is kept (or the flange's for a new tool), as stderr says.
+
+    \b
+    Examples:
+      robotcell calibrate tcp touches.csv
+      robotcell calibrate tcp joints.csv --robot kuka_kr16
+      robotcell calibrate tcp joints.csv --cell cell.yaml --name torch
     """
     from robotcell.calibration.tcp import calibrate_tool
 
     if tool is not None:
         raise InputError("--tool is not used by 'calibrate tcp': the flange poses are computed "
                          "without a tool; give only --robot")
+    target = CellTarget.open(cell_path, robot)
+    require_name(name, target, "tool")
     prior = sigma_m(sigma)
-    model, _ = robot_and_tool(robot, None)
+    model, _ = robot_and_tool(robot, None, target)
     cols = read_csv(measurements)
     T = flange_poses(cols, measurements, model)
     roles = [str(r).strip().lower() for r in cols["point"]] if "point" in cols else ["tcp"] * len(T)
@@ -142,22 +305,55 @@ def tcp(measurements: str, world_mode: str, robot: str | None, tool: str | None,
     if bad:
         raise InputError(f"{measurements}: column 'point' must hold tcp, -x, xy or world; "
                          f"found {', '.join(bad)}")
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS), measurements)
+    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track"]), measurements)
     check_count(roles.count("tcp"), 3, "touches of the reference point (point=tcp)", measurements)
+    if target is None:
+        refuse_track_column(cols, measurements, NO_CELL_TRACK)
+    else:
+        e = target.track_positions(cols, measurements)
+        if e is not None and target.cell.track is not None:
+            T = target.cell.frame_pose("robot", track=e) @ T
+            click.echo("note: the flange poses were mapped to the world through column 'track': "
+                       "the reference point (pivot) is in world coordinates, and ABC World "
+                       "alignments refer to the world axes", err=True)
     r = np.array(roles)
     labels = _line_labels(roles)
     order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
                             world_mode=world_mode, prior_sigma=prior,
                             labels=[labels[i] for i in order])
+    if target is not None and name is not None:
+        _write_tool(target, name, result, cell_provenance("tcp", result, len(T), measurements))
+        target.save(f"tool {name!r}")
     emit(result, as_json)
+
+
+def _frame_parent(target: CellTarget, name: str | None, parent: str | None) -> str:
+    """Parent of the frame to write: ``--parent``, else the existing frame's, else world."""
+    if parent is not None:
+        return parent
+    old = target.cell.frames.get(name)
+    if old is None:
+        return "world"
+    if old.parent == "turntable":
+        raise InputError(f"frame {name!r} of {target.path} is carried by the turntable: "
+                         "calibrate it with 'robotcell calibrate workpiece', or pass --parent "
+                         "world or --parent robot to replace it by a frame fixed there")
+    return old.parent
 
 
 @calibrate.command("frame")
 @click.argument("measurements", type=click.Path(dir_okay=False))
+@click.option("--name", default=None, metavar="FRAME",
+              help="With --cell: the frame of the cell to write (added when new).")
+@click.option("--parent", type=click.Choice(["world", "robot"]), default=None,
+              help="With --cell: world (fixed in the cell; touches are mapped to the world, in a "
+                   "track cell through column 'track') or robot (fixed to the robot base). "
+                   "Default: the existing frame's parent, else world.")
+@cell_option
 @measurement_options
-def frame(measurements: str, robot: str | None, tool: str | None, sigma: float | None,
-          as_json: bool) -> None:
+def frame(measurements: str, name: str | None, parent: str | None, cell_path: str | None,
+          robot: str | None, tool: str | None, sigma: float | None, as_json: bool) -> None:
     """Frame (base / user frame): 3-point, or N-point best fit to known coordinates.
 
     \b
@@ -165,15 +361,37 @@ def frame(measurements: str, robot: str | None, tool: str | None, sigma: float |
     each may be touched several times.
     N-point: columns nominal_x, nominal_y, nominal_z (mm) give each touched point's coordinates
     in the frame (at least 3 points, not on one line).
+    With --cell and --name the frame is written into the cell file; a frame in the world of a
+    cell with a track needs column track (mm, the track position at each touch).
+
+    \b
+    Examples:
+      robotcell calibrate frame touches.csv
+      robotcell calibrate frame joints.csv --cell cell.yaml --name fixture --tool torch
     """
     from robotcell.calibration.frame import frame_3point, frame_npoint
 
+    target = CellTarget.open(cell_path, robot)
+    require_name(name, target, "frame")
+    if target is None and parent is not None:
+        raise InputError("--parent says what carries the frame in a cell file; it needs --cell "
+                         "CELL.yaml")
     prior = sigma_m(sigma)
-    model, T_tool = robot_and_tool(robot, tool)
+    model, T_tool = robot_and_tool(robot, tool, target)
     cols = read_csv(measurements)
     p = tcp_positions(cols, measurements, model, T_tool)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["nominal_x", "nominal_y", "nominal_z"]),
-                     measurements)
+    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y",
+                                                    "nominal_z"]), measurements)
+    in_world = False
+    if target is None:
+        refuse_track_column(cols, measurements, NO_CELL_TRACK)
+    else:
+        parent = _frame_parent(target, name, parent)
+        if parent == "world":
+            p = map_points(target.robot_in_world(cols, measurements, len(p)), p)
+            in_world = True
+        else:
+            target.track_positions(cols, measurements)
     if "nominal_x" in cols:
         check_count(len(p), 3, "points", measurements)
         q = nominal_points(cols, measurements)
@@ -181,6 +399,14 @@ def frame(measurements: str, robot: str | None, tool: str | None, sigma: float |
     else:
         roles = point_roles(cols, measurements)
         result = frame_3point(p, roles, prior, _line_labels(roles))
+    if target is not None and name is not None:
+        key = f"T_world_{name}" if in_world else "T_R_W"
+        if in_world:
+            result = result.renamed("T_R_W", key)
+        target.cell.update_frame(name, result.values[key],
+                                 cell_provenance("frame", result, len(p), measurements),
+                                 parent=parent)
+        target.save(f"frame {name!r} (parent {parent})")
     emit(result, as_json)
 
 
@@ -202,6 +428,8 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
     cols = read_csv(measurements)
+    refuse_track_column(cols, measurements, "is not used by 'calibrate external-tcp': touch the "
+                        "fixed tool with the track at one position and remove the column")
     p = tcp_positions(cols, measurements, model, T_tool)
     if "point" in cols:
         roles = [str(v).strip().lower() for v in cols["point"]]
@@ -216,7 +444,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
 # A module listed here is imported only when its subcommand is used; an entry whose module does
 # not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m and emit from this module.
+# sigma_m, emit, and for --cell cell_option, CellTarget and the helpers around it, from this module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",
