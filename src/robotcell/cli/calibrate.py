@@ -64,6 +64,11 @@ def calibrate() -> None:
     or joint values a1..a6 with --robot and --tool. Report in mm/deg, or --json.
     With --cell CELL.yaml the result is written into the cell file (CELL.yaml.bak keeps the
     previous version). Exit status 2 when the measurements are refused, with the reason on stderr.
+
+    \b
+    Examples:
+      robotcell calibrate tcp tcp.csv --robot kuka_kr16
+      robotcell calibrate turntable turntable.csv --cell cell.yaml --tool torch --json
     """
 
 
@@ -422,6 +427,10 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     reference tool). Column point: tcp (the fixed TCP, at least 3 touches from different
     directions), optionally x (a point on the fixed tool's +X axis) and xy (a point in its XY
     plane with +Y) for the orientation.
+
+    \b
+    Example:
+      robotcell calibrate external-tcp gun.csv --robot kuka_kr16 --tool 250,0,0,0,0,0
     """
     from robotcell.calibration.frame import external_tcp
 

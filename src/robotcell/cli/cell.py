@@ -27,7 +27,12 @@ def _row(name: str, kind: str, number: object, T, p: Provenance) -> list[object]
 
 @click.group()
 def cell() -> None:
-    """Inspect cell files."""
+    """Inspect cell files.
+
+    \b
+    Example:
+      robotcell cell show examples/cell_kr16_track_turntable.yaml
+    """
 
 
 @cell.command()
