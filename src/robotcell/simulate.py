@@ -415,10 +415,13 @@ def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.fl
     tt = cell.turntable
     assert tt is not None
     if angles is None:
-        lo = tt.lower if math.isfinite(tt.lower) else -math.pi
-        hi = tt.upper if math.isfinite(tt.upper) else math.pi
+        # An open side: a full turn from the other limit (or -180 .. 180 deg when both are open).
+        lo = tt.lower if math.isfinite(tt.lower) else min(-math.pi, tt.upper - 2 * math.pi)
+        hi = tt.upper if math.isfinite(tt.upper) else max(math.pi, lo + 2 * math.pi)
         if hi - lo >= 2 * math.pi:
-            return np.linspace(0.0, 2 * math.pi, n, endpoint=False) - math.pi + math.pi / n
+            # Evenly around a full turn centred in the limits (which need not be centred on 0).
+            mid = (lo + hi) / 2
+            return mid + np.linspace(0.0, 2 * math.pi, n, endpoint=False) - math.pi + math.pi / n
         return np.linspace(lo, hi, n)
     th = np.atleast_1d(np.asarray(angles, dtype=float))
     if th.ndim != 1 or not np.all(np.isfinite(th)):
@@ -469,7 +472,8 @@ def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
     n = len(roles)
     if angles is None:
         spread = np.radians(np.linspace(-20.0, 20.0, repeats)) if repeats > 1 else np.zeros(1)
-        th = np.tile(spread, 3)
+        # +-20 deg, moved onto the nearest limit where the table cannot turn that far.
+        th = np.clip(np.tile(spread, 3), cell.turntable.lower, cell.turntable.upper)
     else:
         th = _table_angles(cell, angles, n)
         if th.shape != (n,):
