@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Iterable, Sized
 from typing import Any
 
@@ -35,7 +36,7 @@ def _row(c: Candidate, best: Candidate) -> list[object]:
 
 
 def _progress(items: Sized, label: str) -> Iterable[Any]:
-    with click.progressbar(items, label=label, file=click.get_text_stream("stderr"),
+    with click.progressbar(items, label=label, file=sys.stderr,
                            show_pos=True) as bar:
         yield from bar
 
