@@ -33,7 +33,7 @@ from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.track import TrackRobot
 from robotcell.robot import Robot
-from robotcell.transforms import invert, validate_pose
+from robotcell.transforms import finite_array, invert, validate_pose
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
@@ -142,16 +142,6 @@ def depends_on_track(cell: Cell, frame: str) -> bool:
     return parent == "robot" or (parent == "turntable" and table_on_robot)
 
 
-def _numbers(x: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be numeric, got {x!r}") from None
-    if not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} contains NaN or infinite values")
-    return arr
-
-
 def _limits_ok(cell: Cell, e: NDArray[np.float64], th: NDArray[np.float64]) -> NDArray[np.bool_]:
     ok = np.ones(np.broadcast_shapes(e.shape, th.shape), dtype=bool)
     if cell.track is not None:
@@ -218,7 +208,7 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
     >>> sol.q[sol.valid]                                                          # doctest: +SKIP
     """
     arr = validate_pose(T, "target pose")
-    th = _numbers(table, "table angle")
+    th = finite_array(table, "table angle")
     T_tool = tool_pose(cell, tool)
     if track is None and cell.track is not None:
         _check_track_choice(cell, frame)
@@ -231,7 +221,7 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         valid, reachable = choice.solutions.valid, choice.solutions.reachable
         method = choice.solutions.method
     else:
-        e = _numbers(0.0 if track is None else track, "track position")
+        e = finite_array(0.0 if track is None else track, "track position")
         batch = np.broadcast_shapes(arr.shape[:-2], th.shape, e.shape)
         e = np.broadcast_to(e, batch)
         T_world = frame_pose(cell, frame, e, th) @ arr
@@ -245,8 +235,8 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
 def _path_inputs(cell: Cell, T: ArrayLike, table: ArrayLike, track: ArrayLike | None
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
     arr = validate_pose(T, "path targets")
-    th = _numbers(table, "table angle")
-    e = None if track is None else _numbers(track, "track position")
+    th = finite_array(table, "table angle")
+    e = None if track is None else finite_array(track, "track position")
     shapes = [arr.shape[:-2], th.shape] + ([] if e is None else [e.shape])
     try:
         batch = np.broadcast_shapes(*shapes)
@@ -341,7 +331,7 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     T_tool = tool_pose(cell, tool)
     robot = cell.robot
     if q_start is not None:
-        q_start = _numbers(q_start, "q_start")
+        q_start = finite_array(q_start, "q_start")
         if q_start.shape != (robot.n_joints,):
             raise InputError(f"q_start must be one configuration of shape ({robot.n_joints},), "
                              f"got {q_start.shape}")

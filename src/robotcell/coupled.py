@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
-from robotcell.transforms import invert, make_pose, rot_z, validate_pose
+from robotcell.transforms import finite_array, invert, make_pose, rot_z, validate_pose
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
@@ -40,16 +40,6 @@ RESERVED_FRAMES = {
     "robot": "R", "R": "R",
     "turntable": "B", "B": "B",
 }
-
-
-def _scalar_batch(x: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be numeric, got {x!r}") from None
-    if not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} contains NaN or infinite values")
-    return arr
 
 
 def track_pose(T_L_R0: ArrayLike, step: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:
@@ -69,7 +59,7 @@ def track_pose(T_L_R0: ArrayLike, step: ArrayLike, e: ArrayLike) -> NDArray[np.f
     ndarray, shape (..., 4, 4)
         ``T_L_R(e)``.
     """
-    e_arr = _scalar_batch(e, "track position")
+    e_arr = finite_array(e, "track position")
     T = np.broadcast_to(np.asarray(T_L_R0, dtype=float), e_arr.shape + (4, 4)).copy()
     T[..., :3, 3] += e_arr[..., None] * np.asarray(step, dtype=float)
     return T
@@ -77,7 +67,7 @@ def track_pose(T_L_R0: ArrayLike, step: ArrayLike, e: ArrayLike) -> NDArray[np.f
 
 def table_pose(theta: ArrayLike) -> NDArray[np.float64]:
     """The table's turn ``Rz(theta)`` as poses, shape ``(..., 4, 4)`` (``theta`` in radians)."""
-    return make_pose(rot_z(_scalar_batch(theta, "table angle")))
+    return make_pose(rot_z(finite_array(theta, "table angle")))
 
 
 def robot_pose(cell: Cell, e: ArrayLike) -> NDArray[np.float64]:
@@ -94,7 +84,7 @@ def robot_pose(cell: Cell, e: ArrayLike) -> NDArray[np.float64]:
     ndarray, shape (..., 4, 4)
         ``T_world_R(e)`` (m).
     """
-    e = _scalar_batch(e, "track position")
+    e = finite_array(e, "track position")
     if cell.track is None:
         if np.any(e != 0):
             raise InputError("the cell has no track; the track position must be 0")
@@ -132,8 +122,8 @@ def frame_pose(cell: Cell, name: str, track: ArrayLike = 0.0, table: ArrayLike =
     ndarray, shape (..., 4, 4)
         ``T_world_X`` with the broadcast batch shape of ``track`` and ``table`` (metres).
     """
-    e = _scalar_batch(track, "track position")
-    th = _scalar_batch(table, "table angle")
+    e = finite_array(track, "track position")
+    th = finite_array(table, "table angle")
     if cell.turntable is None and np.any(th != 0):
         raise InputError("the cell has no turntable; the table angle must be 0")
     batch = np.broadcast_shapes(e.shape, th.shape)
@@ -210,6 +200,6 @@ def fk(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
     ``c.fk(q, track=e, frame="track")[:3, 3] == e * X_L + L_Q_R @ robot.fk(q)[:3, 3]``.
     """
     T_R_TCP = cell.robot.fk(np.asarray(q, dtype=float), tool=tool_pose(cell, tool))
-    e = _scalar_batch(track, "track position")
+    e = finite_array(track, "track position")
     T_world_TCP = robot_pose(cell, e) @ T_R_TCP
     return invert(frame_pose(cell, frame, e, table)) @ T_world_TCP

@@ -15,6 +15,7 @@ __all__ = [
     "as_points",
     "check_pose",
     "compose",
+    "finite_array",
     "invert",
     "make_pose",
     "rot_x",
@@ -28,7 +29,9 @@ __all__ = [
 POSE_TOL = 1e-6
 
 
-def _finite_array(x: ArrayLike, name: str) -> NDArray[np.float64]:
+def finite_array(x: ArrayLike, name: str) -> NDArray[np.float64]:
+    """``x`` as a float array, or an :class:`InputError` naming ``name`` if it is not numeric
+    or holds NaN or infinite values."""
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -52,7 +55,7 @@ def as_points(p: ArrayLike, name: str = "points") -> NDArray[np.float64]:
     -------
     ndarray, shape (..., 3)
     """
-    arr = _finite_array(p, name)
+    arr = finite_array(p, name)
     if arr.ndim < 1 or arr.shape[-1] != 3:
         raise InputError(f"{name} must have shape (..., 3), got {arr.shape}")
     return arr
