@@ -33,7 +33,7 @@ from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.robot import Robot
-from robotcell.transforms import invert, rot_z
+from robotcell.transforms import invert, make_pose, rot_z, transform_points
 
 __all__ = ["PROCEDURES", "Touches", "simulate"]
 
@@ -166,7 +166,7 @@ def _candidate_tracks(cell: Cell, track: float | None, n: int) -> NDArray[np.flo
 def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float64]],
            E: NDArray[np.float64], tool_T: NDArray[np.float64] | None, labels: Sequence[str],
            rng: np.random.Generator, noise: float
-           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Joint values that put the TCP at the touches, plus the touch-up error.
 
     Parameters
@@ -183,8 +183,6 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
         Joint values of the placement with the error (rad).
     e : ndarray, shape (N,)
         Track positions (m).
-    T_nominal : ndarray, shape (N, 4, 4)
-        Chosen TCP poses in the world without the error (m).
     """
     robot = cell.robot
     T = targets(E)                                                          # (K, N, M, 4, 4)
@@ -221,7 +219,7 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
     # The branch's principal values may differ from the nominal ones by whole turns: keep the
     # nominal representation (the one inside the limits nearest to it).
     q = q_nom + np.where(robot.prismatic, 0.0, (q - q_nom + math.pi) % (2 * math.pi) - math.pi)
-    return q, e, T_nom
+    return q, e
 
 
 def _usual_configuration(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -233,16 +231,6 @@ def _usual_configuration(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.flo
     front, elbow = arm_sides(robot, q)
     home_front, home_elbow = arm_sides(robot, robot.home)
     return np.where((front == home_front) & (elbow == home_elbow), 1.0, 1e-3)
-
-
-def _poses(R: NDArray[np.float64], p: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Poses from rotations (..., 3, 3) and positions (..., 3), broadcast."""
-    shape = np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
-    T = np.zeros(shape + (4, 4))
-    T[..., :3, :3] = R
-    T[..., :3, 3] = p
-    T[..., 3, 3] = 1.0
-    return T
 
 
 def _rng(seed: int | np.random.Generator | None) -> np.random.Generator:
@@ -306,7 +294,7 @@ def _tcp(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
         T_wR = robot_pose(cell, Ek[:, :1])                                   # (K, 1, 4, 4)
-        p_w = T_wR[..., :3, :3] @ p_R + T_wR[..., :3, 3]                     # (K, 1, 3)
+        p_w = transform_points(T_wR, p_R)                                    # (K, 1, 3)
         R_w = T_wR[..., None, :3, :3] @ yaw @ down                            # (K, 1, 12, 3, 3)
         R_tcp = np.concatenate([tilt_R[None, :, None] @ R_w, np.broadcast_to(
             R_w, (R_w.shape[0], n - n_tcp) + R_w.shape[2:])], axis=1)        # (K, n, 12, 3, 3)
@@ -315,10 +303,10 @@ def _tcp(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
             X, Y = R_tcp[:, n_tcp, :, :, 0], R_tcp[:, n_tcp + 1, :, :, 1]
             pos[:, n_tcp] += distance * X                  # the point on the tool's -X axis
             pos[:, n_tcp + 1] -= distance * Y              # the point in the XY plane, +Y
-        return _poses(R_tcp, pos)
+        return make_pose(R_tcp, pos)
 
     labels = [f"touch {i + 1} ({r})" for i, r in enumerate(roles)]
-    q, e, _ = _reach(cell, targets, E, T_F_TCP, labels, rng, noise)
+    q, e = _reach(cell, targets, E, T_F_TCP, labels, rng, noise)
     return Touches("tcp", q, e if cell.track is not None else None, None, roles,
                    truth={"T_F_TCP": T_F_TCP.copy(), "tcp": T_F_TCP[:3, 3].copy()},
                    options=[], tool=None, noise=noise)
@@ -345,11 +333,11 @@ def _frame(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
         T_wX = frame_pose(cell, name, Ek)                                    # (K, n, 4, 4)
-        p_w = np.einsum("knij,nj->kni", T_wX[..., :3, :3], p_X) + T_wX[..., :3, 3]
-        return _poses(DOWN[None, None], p_w[:, :, None])
+        p_w = transform_points(T_wX, p_X)                                    # (K, n, 3)
+        return make_pose(DOWN[None, None], p_w[:, :, None])
 
     labels = [f"touch {i + 1} ({r})" for i, r in enumerate(roles)]
-    q, e, _ = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
+    q, e = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
     fr = cell.frames[name]
     return Touches("frame", q, e if cell.track is not None else None, None, roles,
                    truth={"pose": fr.pose.copy(), "parent": fr.parent, "name": name},
@@ -396,15 +384,13 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
             raise InputError(f"reference point {k + 1} is beyond the end of the track: its touches "
                              "cannot be spread along the travel")
     n = len(point)
-    R_wL = t.T_world_L[:3, :3]
-    p_w = refs[point] @ R_wL.T + t.T_world_L[:3, 3]                           # (n, 3)
-    R_cand = DOWN
+    p_w = transform_points(t.T_world_L, refs[point])                         # (n, 3)
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
-        return _poses(R_cand[None, None], np.broadcast_to(p_w[None, :, None], (Ek.shape[0], n, 1, 3)))
+        return make_pose(DOWN[None, None], np.broadcast_to(p_w[None, :, None], (Ek.shape[0], n, 1, 3)))
 
     labels = [f"touch {i + 1} (reference {point[i] + 1})" for i in range(n)]
-    q, e, _ = _reach(cell, targets, e_all[None, :], tool_pose(cell, tname), labels, rng, noise)
+    q, e = _reach(cell, targets, e_all[None, :], tool_pose(cell, tname), labels, rng, noise)
     options = [f"--reference={','.join(f'{v * 1e3:.3f}' for v in r)}" for r in refs]
     return Touches("track", q, e, None, [str(p + 1) for p in point],
                    truth={"T_L_R": t.T_L_R0.copy(), "scale": t.scale, "references": refs},
@@ -447,13 +433,12 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
         T_wB = frame_pose(cell, "turntable", Ek)                              # (K, n, 4, 4)
-        p = T_wB[..., :3, :3] @ (rot_z(th) @ p_B)[None, :, :, None]
-        p_w = p[..., 0] + T_wB[..., :3, 3]
-        return _poses(DOWN[None, None], p_w[:, :, None])
+        p_w = transform_points(T_wB, rot_z(th) @ p_B)                       # (K, n, 3)
+        return make_pose(DOWN[None, None], p_w[:, :, None])
 
     E = _candidate_tracks(cell, track, n)
     labels = [f"touch {i + 1} ({math.degrees(v):.0f} deg)" for i, v in enumerate(th)]
-    q, e, _ = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
+    q, e = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
     tt = cell.turntable
     return Touches("turntable", q, e if cell.track is not None else None, th, None,
                    truth={"pose": tt.T_parent_B.copy(), "parent": tt.parent, "radius": radius,
@@ -479,17 +464,16 @@ def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
         if th.shape != (n,):
             raise InputError(f"give one table angle per touch ({n}), got {th.size}")
     T_B_W = cell.frames[name].pose
-    p_B = p_W @ T_B_W[:3, :3].T + T_B_W[:3, 3]
+    p_B = transform_points(T_B_W, p_W)
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
         T_wB = frame_pose(cell, "turntable", Ek)                              # (K, n, 4, 4)
-        p = T_wB[..., :3, :3] @ (rot_z(th) @ p_B[:, :, None])
-        p_w = p[..., 0] + T_wB[..., :3, 3]
-        return _poses(DOWN[None, None], p_w[:, :, None])
+        p_w = transform_points(T_wB, (rot_z(th) @ p_B[:, :, None])[..., 0])  # (K, n, 3)
+        return make_pose(DOWN[None, None], p_w[:, :, None])
 
     E = _candidate_tracks(cell, track, n)
     labels = [f"touch {i + 1} ({r}, {math.degrees(v):.0f} deg)" for i, (r, v) in enumerate(zip(roles, th))]
-    q, e, _ = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
+    q, e = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
     return Touches("workpiece", q, e if cell.track is not None else None, th, roles,
                    truth={"pose": T_B_W.copy(), "parent": "turntable", "name": name},
                    tool=tname, noise=noise)

@@ -37,6 +37,7 @@ from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.robot import Robot
+from robotcell.transforms import transform_points
 
 
 class CalibrateGroup(click.Group):
@@ -186,11 +187,6 @@ def refuse_track_column(cols: dict, source: str, why: str) -> None:
     """Refuse column ``track`` where it is not used; ``why`` says what to do instead."""
     if "track" in cols:
         raise InputError(f"{source}: column 'track' (track position of each touch) {why}")
-
-
-def map_points(T: NDArray[np.float64], p: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Points ``p`` (N, 3) through poses ``T`` (N, 4, 4), one per point."""
-    return np.einsum("nij,nj->ni", T[:, :3, :3], p) + T[:, :3, 3]
 
 
 def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | None = None
@@ -393,7 +389,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
     else:
         parent = _frame_parent(target, name, parent)
         if parent == "world":
-            p = map_points(target.robot_in_world(cols, measurements, len(p)), p)
+            p = transform_points(target.robot_in_world(cols, measurements, len(p)), p)
             in_world = True
         else:
             target.track_positions(cols, measurements)

@@ -28,7 +28,6 @@ from robotcell.cli.calibrate import (
     cell_option,
     cell_provenance,
     emit,
-    map_points,
     measurement_options,
     raw_rows,
     refuse_track_column,
@@ -38,7 +37,7 @@ from robotcell.cli.calibrate import (
 )
 from robotcell.cli.common import parse_numbers, read_csv, require_columns
 from robotcell.errors import InputError
-from robotcell.transforms import invert, validate_pose
+from robotcell.transforms import invert, transform_points, validate_pose
 
 
 def _labels(n: int) -> list[str]:
@@ -200,7 +199,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
     elif parent == "world":
-        f = map_points(target.robot_in_world(cols, measurements, len(f)), f)
+        f = transform_points(target.robot_in_world(cols, measurements, len(f)), f)
     else:
         target.track_positions(cols, measurements)
     result = calibrate_turntable(theta, f, height=height * 1e-3, labels=_labels(len(f)),
@@ -340,7 +339,7 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
     elif _cell_turntable(target).parent == "world":
-        f = map_points(target.robot_in_world(cols, measurements, len(f)), f)
+        f = transform_points(target.robot_in_world(cols, measurements, len(f)), f)
     else:
         target.track_positions(cols, measurements)
     result = calibrate_workpiece(theta, f, roles, T_B, T_R_B_covariance=cov, noise_sigma=noise,
