@@ -243,9 +243,7 @@ def _tool_name(cell: Cell, tool: str | None) -> str:
             known = ", ".join(sorted(cell.tools)) or "none"
             raise InputError(f"say which tool touches (the cell has: {known})")
         return next(iter(cell.tools))
-    if tool not in cell.tools:
-        known = ", ".join(sorted(cell.tools)) or "none"
-        raise InputError(f"unknown tool {tool!r}; the cell has: {known}")
+    tool_pose(cell, tool)  # refuses a name the cell does not have
     return tool
 
 

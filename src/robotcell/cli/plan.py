@@ -74,7 +74,7 @@ def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: s
     if not (math.isfinite(noise) and noise > 0):
         raise InputError(f"--noise must be a positive number of millimetres, got {noise}")
     cell = Cell.load(cell_path)
-    common = common_keywords(procedure, cell, tool, frame, track_mm)
+    common = common_keywords(procedure, tool, frame, track_mm)
     common.update(design_keywords(procedure, {"touches": touches, "repeats": repeats}))
     designs = DESIGNS[procedure]
     for name, limit, key, applies in (("--max-size", max_size, "size", ("frame", "workpiece")),

@@ -110,7 +110,7 @@ def design_keywords(procedure: str, given: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def common_keywords(procedure: str, cell: Cell, tool: str | None, frame: str | None,
+def common_keywords(procedure: str, tool: str | None, frame: str | None,
                     track_mm: float | None) -> dict[str, Any]:
     """Keywords of simulate for tool, frame and track position, checked against the procedure."""
     kw: dict[str, Any] = {"tool": tool}
@@ -163,7 +163,7 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
     if not (math.isfinite(noise) and noise >= 0):
         raise InputError(f"--noise must be a number of millimetres >= 0, got {noise}")
     cell = Cell.load(cell_path)
-    kw = common_keywords(procedure, cell, tool, frame, track_mm)
+    kw = common_keywords(procedure, tool, frame, track_mm)
     kw.update(design_keywords(procedure, design))
     t = simulate_touches(cell, procedure, noise=noise * 1e-3, seed=seed, **kw)
     if output is None:
