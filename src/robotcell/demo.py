@@ -224,7 +224,7 @@ def _compare(calibrated: Cell, truth: Cell,
 
 
 def _comparison_table(rows: list[Comparison]) -> str:
-    from robotcell.cli.common import format_table
+    from robotcell.tables import format_table
     from robotcell.poseformats import pose_to_vendor
 
     body = []

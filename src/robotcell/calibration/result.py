@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.cli.common import format_table
+from robotcell.tables import format_table
 from robotcell.errors import InputError
 from robotcell.poseformats import pose_to_vendor
 
