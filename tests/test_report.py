@@ -15,24 +15,27 @@ from robotcell.report import load_result, verdict, write_report
 from robotcell.transforms import make_pose, rot_z, transform_points
 
 
-def frame_result(seed=0, outlier=False):
+def frame_result(seed=0, outlier=False, size=0.004):
     rng = np.random.default_rng(seed)
     T = make_pose(rot_z(0.4), [1.2, -0.3, 0.5])
     nominal = rng.uniform(-0.4, 0.4, (8, 3))
     measured = transform_points(T, nominal) + rng.normal(0, 1e-4, (8, 3))
     if outlier:
-        measured[3] += [0.004, 0, 0]
+        measured[3] += [size, 0, 0]
     return frame_npoint(measured, nominal).to_json()
 
 
 def test_verdicts():
     good = frame_result()
     assert verdict(good)[0] == "good"
+    # A flagged touch asks for a check; one far beyond the touch accuracy makes the result poor.
     grade, reasons = verdict(frame_result(outlier=True))
-    assert grade == "poor" and any("outlier" in r for r in reasons)
+    assert grade == "check" and any("outlier" in r for r in reasons)
+    grade, reasons = verdict(frame_result(outlier=True, size=0.04))
+    assert grade == "poor" and any("far beyond the default touch accuracy" in r for r in reasons)
     assert verdict({**good, "condition": 500.0})[0] == "check"
     assert verdict({**good, "condition": 5000.0})[0] == "poor"
-    assert verdict({**good, "noise_source": "none"})[0] == "check"
+    assert verdict({**good, "dof": 0, "noise_source": "none"})[0] == "check"
 
 
 def test_write_report_files(tmp_path):

@@ -17,15 +17,11 @@ from typing import Any
 
 import numpy as np
 
+from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
+from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
-
-#: Condition numbers up to this are a good measurement design (Schroer, as cited by Nahvi and
-#: Hollerbach, ICRA 1996).
-CONDITION_GOOD = 100.0
-#: Above this the result is not trustworthy.
-CONDITION_POOR = 1000.0
 
 _REQUIRED = ("procedure", "residuals_mm", "rms_mm", "max_mm", "warnings")
 
@@ -56,9 +52,8 @@ def load_result(path: str | Path) -> dict[str, Any]:
 def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
     """Grade a result: ``"good"``, ``"check"`` or ``"poor"``, with the reasons.
 
-    ``poor``: condition number above :data:`CONDITION_POOR` or a touch flagged as an outlier.
-    ``check``: any other warning, a condition number above :data:`CONDITION_GOOD`, or unknown
-    uncertainty (no redundant touches and no prior noise). ``good`` otherwise.
+    The same rule as the terminal report and ``--json``:
+    :func:`robotcell.calibration.verdict.verdict` (see ``docs/calibration.md``, "Verdict").
 
     Parameters
     ----------
@@ -70,31 +65,8 @@ def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
     grade : str
     reasons : list of str
     """
-    reasons: list[str] = []
-    grade = "good"
-    cond = result.get("condition")
-    warnings = list(result.get("warnings", []))
-    if cond is not None and cond > CONDITION_POOR:
-        grade = "poor"
-        reasons.append(f"condition number {cond:.0f} > {CONDITION_POOR:.0f}: the touches do not "
-                       "determine the result")
-    if any("outlier" in w for w in warnings):
-        grade = "poor"
-        reasons.append("a touch is an outlier: re-touch it")
-    if grade != "poor":
-        if cond is not None and cond > CONDITION_GOOD:
-            grade = "check"
-            reasons.append(f"condition number {cond:.0f} > {CONDITION_GOOD:.0f}: spread the touches")
-        if warnings:
-            grade = "check"
-            reasons.append(f"{len(warnings)} warning(s), listed below")
-        if result.get("noise_source") == "none":
-            grade = "check"
-            reasons.append("no redundant touches: the uncertainty is unknown")
-    if grade == "good":
-        reasons.append(f"RMS {result['rms_mm']:.3f} mm, max {result['max_mm']:.3f} mm, "
-                       f"condition {cond:.0f}" if cond is not None else "no warnings")
-    return grade, reasons
+    v = judge(result)
+    return v.level, v.reasons
 
 
 def _frames(result: dict[str, Any]) -> list[tuple[str, np.ndarray]]:
