@@ -200,7 +200,7 @@ def touch_statistics(J: NDArray[np.float64], residuals: ArrayLike,
     """
     r = np.asarray(residuals, dtype=float)
     n = r.shape[-2]
-    m, p = J.shape
+    m = J.shape[0]
     u, sv, _ = np.linalg.svd(J, full_matrices=False)
     u = u[:, sv > sv[0] * 1e-12] if sv.size and sv[0] > 0 else u[:, :0]
     ub = u.reshape(n, 3, -1)

@@ -22,9 +22,9 @@ from robotcell.calibration.verdict import (
     format_condition,
 )
 from robotcell.calibration.verdict import verdict as judge
-from robotcell.tables import format_table
 from robotcell.errors import InputError
 from robotcell.poseformats import pose_to_vendor
+from robotcell.tables import format_table
 
 __all__ = ["CalibrationResult", "pose_fields", "to_jsonable"]
 

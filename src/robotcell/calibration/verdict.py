@@ -168,16 +168,17 @@ def _lengths(result: Mapping[str, Any]) -> list[tuple[str, float]]:
                 t = _floats(v)[:3, 3]
             except (TypeError, ValueError, IndexError):
                 continue
-            out.append(("origin" if key == "matrix" else "turntable origin", float(np.max(np.abs(t)))))
+            if not np.any(np.isnan(t)):
+                out.append(("origin" if key == "matrix" else "turntable origin",
+                            float(np.max(np.abs(t)))))
         elif key == "points_mm" or (key.endswith("_mm") and key not in _NOT_LENGTHS):
             try:
                 a = np.abs(_floats(v))
             except (TypeError, ValueError):
                 continue
-            if a.size and np.all(np.isfinite(a)):
+            a = a[~np.isnan(a)]  # null: not determined
+            if a.size:
                 out.append(("touched points" if key == "points_mm" else key[:-3], float(a.max())))
-            elif a.size:
-                out.append(("touched points" if key == "points_mm" else key[:-3], float("inf")))
     return out
 
 
@@ -265,7 +266,8 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         level, reasons = "check", check
     else:
         level = "good"
-        reasons = [f"RMS {math.sqrt(ssr / n) if n else 0.0:.3f} mm within {what}, condition "
-                   f"number {format_condition(cond)}, no warnings"]
+        rms = math.sqrt(ssr / n) if n else 0.0
+        reasons = [f"RMS {rms:.3f} mm within {what}, condition number "
+                   + f"{format_condition(cond)}, no warnings"]
     return Verdict(level=level, reasons=reasons, condition=cond, touch_sigma_mm=s,
                    accuracy_source=source, chi2=x2, chi2_bound=bound, touches_needed=needed)
