@@ -183,9 +183,9 @@ def test_measurement_refusals():
     with pytest.raises(InputError, match="NaN"):
         tcp_positions({"x": np.array([np.nan, 900.0]), "y": np.ones(2), "z": np.ones(2)}, "m.csv")
     # Identical rows are data (averaged by the fit), and only earn a note.
-    assert repeated_rows(np.array([[1.0, 2.0], [3.0, 4.0], [1.0, 2.0]]), "m.csv") == [
-        "m.csv: line 2, line 4 are identical; each is used as a measurement of its own (if one "
-        "is a copied line, delete it)"]
+    note = ("m.csv: line 2, line 4 are identical; each is used as a measurement of its own (if "
+            "one is a copied line, delete it)")
+    assert repeated_rows(np.array([[1.0, 2.0], [3.0, 4.0], [1.0, 2.0]]), "m.csv") == [note]
     assert repeated_rows(np.array([[1.0, 2.0], [3.0, 4.0]]), "m.csv") == []
     with pytest.raises(InputError, match=r"m.csv: points: 2 given, at least 3 needed"):
         check_count(2, 3, "points", "m.csv")
