@@ -344,3 +344,19 @@ def test_tcp_minimum_in_the_cli(tmp_path, capsys):
     csv = write(tmp_path / "tcp3.csv", list("xyzabc"), rows)
     code, out, _ = run(capsys, "calibrate", "tcp", csv)
     assert code == 0 and "take 5 or more touches" in out.splitlines()[-1]
+
+
+def test_every_command_gates_a_poor_result(tmp_path, capsys):
+    rng = np.random.default_rng(32)
+    local = np.array([[0, 0, 0]] * 4 + [[0.3, 0, 0], [0.1, 0.2, 0]])
+    p = (transform_points(T_R_B, local) + rng.normal(0.0, NOISE, (6, 3))) * 1e3
+    p[1] /= 1000.0  # one row in metres
+    roles = ["origin"] * 4 + ["x", "xy"]
+    frame = write(tmp_path / "f.csv", ["point", "x", "y", "z"], [[r, *v] for r, v in zip(roles, p)])
+    ext = write(tmp_path / "e.csv", ["point", "x", "y", "z"],
+                [["tcp" if r == "origin" else r, *v] for r, v in zip(roles, p)])
+    for args in (["frame", frame], ["external-tcp", ext]):
+        code, out, err = run(capsys, "calibrate", *args)
+        assert code == 3 and out.splitlines()[-1].startswith("verdict: POOR: RMS")
+        assert err.startswith("error: poor calibration, nothing written")
+        assert run(capsys, "calibrate", *args, "--accept-poor")[0] == 0

@@ -165,7 +165,7 @@ def _fmt(v: Any) -> str:
 
 
 _SKIP = {"procedure", "residuals_mm", "residuals_xyz_mm", "labels", "points_mm", "warnings",
-         "undetermined", "next_step", "sigma"}
+         "undetermined", "next_step", "sigma", "verdict"}
 
 _CSS = """
 body { font-family: sans-serif; max-width: 960px; margin: 2em auto; color: #222; }

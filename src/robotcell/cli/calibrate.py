@@ -252,7 +252,8 @@ def gate(result: CalibrationResult, as_json: bool, accept_poor: bool) -> None:
     if accept_poor:
         click.echo("warning: the verdict is poor; written anyway (--accept-poor)", err=True)
         return
-    emit(result, as_json)
+    # The report goes to stdout only, never to an output file: a poor result writes nothing.
+    click.echo(json.dumps(result.to_json(), indent=2) if as_json else result.summary())
     raise PoorCalibration(f"poor calibration, nothing written: {'; '.join(v.reasons)}. Fix the "
                           "measurements, or pass --accept-poor to use the result anyway")
 
