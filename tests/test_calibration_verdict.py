@@ -360,3 +360,18 @@ def test_every_command_gates_a_poor_result(tmp_path, capsys):
         assert code == 3 and out.splitlines()[-1].startswith("verdict: POOR: RMS")
         assert err.startswith("error: poor calibration, nothing written")
         assert run(capsys, "calibrate", *args, "--accept-poor")[0] == 0
+
+
+def test_repeated_data_pass_the_cli(tmp_path, capsys):
+    rng = np.random.default_rng(33)
+    angles = np.array([0.0, 90.0, 90.0, 180.0, 360.0, 250.0])
+    f = table_touches(rng, np.radians(angles)) * 1e3
+    rows = [[*p, a] for p, a in zip(f, angles)] + [[*f[3], angles[3]]]  # and a copied line
+    csv = write(tmp_path / "t.csv", ["x", "y", "z", "e1"], rows)
+    code, out, err = run(capsys, "calibrate", "turntable", csv)
+    assert code == 0 and "over 7 measurements" in out and "line 5, line 8 are identical" in err
+    e = np.array([0.0, 400.0, 800.0, 804.2, 1200.0, 1600.0])
+    f = track_touches(rng, e * 1e-3) * 1e3
+    csv = write(tmp_path / "k.csv", ["x", "y", "z", "e1"], [[*p, v] for p, v in zip(f, e)])
+    code, out, _ = run(capsys, "calibrate", "track", csv, "--json")
+    assert code == 0 and json.loads(out)["dof"] == 12
