@@ -104,6 +104,17 @@ def track(rng, prior):
                                      prior_sigma=prior)
 
 
+REF2 = np.array([2.1, -0.6, 0.1])
+
+
+def track_references(rng, prior):
+    """Two known points, alternately touched: rotation, scale and carriage offset."""
+    k = np.arange(len(E)) % 2
+    r = np.array([REF, REF2])[k]
+    return track_mod.calibrate_track(E, noisy(rng, (r - np.outer(E, [1, 0, 0])) @ Q),
+                                     references=[REF, REF2], point=k, prior_sigma=prior)
+
+
 THETA = np.radians([0.0, 60.0, 130.0, 200.0, 270.0, 320.0])
 
 
@@ -131,6 +142,7 @@ PROCEDURES = {
     "frame-3point": (frame_mod, frame_3point),
     "frame-npoint": (frame_mod, frame_npoint),
     "track": (track_mod, track),
+    "track-references": (track_mod, track_references),
     "turntable": (turntable_mod, turntable),
     "workpiece": (workpiece_mod, workpiece),
 }
