@@ -375,3 +375,13 @@ def test_repeated_data_pass_the_cli(tmp_path, capsys):
     csv = write(tmp_path / "k.csv", ["x", "y", "z", "e1"], [[*p, v] for p, v in zip(f, e)])
     code, out, _ = run(capsys, "calibrate", "track", csv, "--json")
     assert code == 0 and json.loads(out)["dof"] == 12
+
+
+def test_verdict_of_a_malformed_result_is_poor_or_check_never_an_exception():
+    good = calibrate_tool(flange_poses(np.random.default_rng(34), 8)).to_json()
+    for key, bad in [("condition", "x"), ("dof", None), ("residuals_xyz_mm", [[1, "a"]]),
+                     ("residuals_xyz_mm", [[1, 2], [3]]), ("warnings", 7), ("matrix", "eye"),
+                     ("tcp_mm", {"x": 1}), ("noise_sigma_mm", "0.1"), ("scale", None)]:
+        v = verdict({**good, key: bad})
+        assert v.level in ("good", "check", "poor")
+    assert verdict({**good, "residuals_xyz_mm": [[1, "a"]]}).level == "poor"

@@ -125,6 +125,8 @@ class Verdict:
 
 def format_condition(condition: float) -> str:
     """The condition number as every report prints it (one decimal)."""
+    if math.isnan(condition):
+        return "unknown"
     return f"{condition:.1f}" if math.isfinite(condition) else "infinite"
 
 
@@ -151,6 +153,13 @@ def touches_for_outlier_check(n_touches: int, dof: int) -> int | None:
     if missing <= 0:
         return None
     return n_touches + math.ceil(missing / 3)
+
+
+def _number(v: Any, default: float = float("nan")) -> float:
+    """A JSON number as float; ``default`` for null, text or anything else."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return default
+    return float(v) if math.isfinite(v) else default
 
 
 def _floats(v: Any) -> np.ndarray:
@@ -199,17 +208,20 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
     """
     poor: list[str] = []
     check: list[str] = []
-    cond = result.get("condition")
-    cond = float("nan") if cond is None else float(cond)
-    dof = int(result.get("dof") or 0)
+    cond = _number(result.get("condition"))
+    dof = int(_number(result.get("dof"), 0.0))
     res = result.get("residuals_xyz_mm")
     if res is None:
         res = result.get("residuals_mm") or []
-    r = _floats(res).reshape(-1, 3) if result.get("residuals_xyz_mm") is not None else _floats(res)
-    n = len(r)
+    try:
+        r = _floats(res)
+    except (TypeError, ValueError):
+        r = np.full(1, np.nan)  # unreadable residuals: no bound can hold
+    n = len(r) if r.ndim else 0
     ssr = float(np.sum(r**2)) if np.all(np.isfinite(r)) else float("inf")
-    stated = result.get("noise_source") == "prior" and result.get("noise_sigma_mm")
-    s = float(stated) if stated else DEFAULT_TOUCH_SIGMA_MM
+    stated = _number(result.get("noise_sigma_mm")) if result.get("noise_source") == "prior" else 0.0
+    stated = stated if stated > 0 else 0.0
+    s = stated or DEFAULT_TOUCH_SIGMA_MM
     source = "stated" if stated else "default"
     what = (f"the stated touch accuracy {s:g} mm" if stated
             else f"the default touch accuracy {s:g} mm (state yours with --sigma)")
@@ -246,7 +258,8 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
     elif cond > CONDITION_GOOD:
         check.append(f"condition number {format_condition(cond)} > {CONDITION_GOOD:.0f}: "
                      "spread the touches")
-    warnings = list(result.get("warnings") or [])
+    warnings = result.get("warnings") or []
+    warnings = list(warnings) if isinstance(warnings, list) else [str(warnings)]
     outliers = sum("outlier" in str(w) for w in warnings)
     if outliers:
         check.append(f"{outliers} touch(es) flagged as outlier: re-touch them")
