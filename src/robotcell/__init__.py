@@ -40,6 +40,9 @@ _LAZY = {
     **dict.fromkeys(["check_pose", "compose", "invert", "make_pose", "rot_x", "rot_y", "rot_z",
                      "transform_points", "validate_pose"], "robotcell.transforms"),
 }
+#: Submodules that ``import robotcell`` used to load as a side effect, still reachable as
+#: attributes (``robotcell.transforms``) and loaded on first access.
+_SUBMODULES = {"dh", "modelfile", "poseformats", "robot", "transforms"}
 
 __all__ = [
     "FORMATS",
@@ -68,6 +71,8 @@ __all__ = [
 
 def __getattr__(name: str) -> Any:
     """Import a public name from its module on first access (PEP 562)."""
+    if name in _SUBMODULES:
+        return importlib.import_module(f"robotcell.{name}")
     if name not in _LAZY:
         raise AttributeError(f"module 'robotcell' has no attribute {name!r}")
     value = getattr(importlib.import_module(_LAZY[name]), name)
