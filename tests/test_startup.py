@@ -74,9 +74,9 @@ def test_every_public_name_is_importable_as_before():
         robotcell.__all__)
     assert set(robotcell.__all__) <= set(dir(robotcell))
     # Submodules that `import robotcell` loaded before are still attributes, in a fresh process.
-    subprocess.run([sys.executable, "-c", "import robotcell; robotcell.dh.Chain; "
-                    "robotcell.transforms.make_pose; robotcell.modelfile.load_robot"],
-                   env={"PYTHONPATH": SRC}, check=True, timeout=120)
+    code = ("import robotcell; robotcell.dh.Chain; robotcell.transforms.make_pose; "
+            "robotcell.modelfile.load_robot")
+    subprocess.run([sys.executable, "-c", code], env={"PYTHONPATH": SRC}, check=True, timeout=120)
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
         robotcell.no_such_name  # noqa: B018
 
