@@ -60,12 +60,17 @@ class LazyGroup(click.Group):
             formatter.write_dl(rows)
 
 
+#: Decorators that make a click command of a function.
+_DECORATORS = {"command", "group"}
+
+
 def _help_command(name: str) -> click.Command:
     """A stand-in for command ``name`` that carries its help text, read from the source.
 
     The help of a command is the docstring of its decorated function (click's default); it is
     read with :mod:`ast`, so the module and its imports are not loaded. A command whose
-    docstring cannot be found this way is imported.
+    docstring cannot be found this way, or whose ``@click.command``/``@click.group`` sets its
+    help or visibility itself, is imported.
     """
     module, attr = COMMANDS[name].split(":")
     spec = importlib.util.find_spec(module)
@@ -73,8 +78,11 @@ def _help_command(name: str) -> click.Command:
         tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
         for node in tree.body:
             if isinstance(node, ast.FunctionDef) and node.name == attr:
+                own = {k.arg for d in node.decorator_list if isinstance(d, ast.Call)
+                       and getattr(d.func, "attr", getattr(d.func, "id", None)) in _DECORATORS
+                       for k in d.keywords}
                 doc = ast.get_docstring(node)
-                if doc:
+                if doc and not own & {"help", "short_help", "hidden", "deprecated"}:
                     return click.Command(name, help=doc)
     return getattr(importlib.import_module(module), attr)
 
