@@ -253,8 +253,8 @@ def _controller_angle(signs: NDArray[np.float64], offsets: NDArray[np.float64]):
     return f
 
 
-def reach_distance(err_sq: NDArray[np.float64], d: NDArray[np.float64],
-                   rnd: NDArray[np.float64]) -> NDArray[np.float64]:
+def reach_distance(err_sq: NDArray[np.float64] | float, d: NDArray[np.float64],
+                   rnd: float) -> NDArray[np.float64]:
     """Add the square of an excess distance ``d`` (m) to ``err_sq``; ``d <= rnd`` counts as 0."""
     return err_sq + np.where(d > rnd, d * d, 0.0)
 
@@ -308,9 +308,9 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
     cz = P[:, 2] - pa.c4 * R[:, 2, 2]
     rho2 = cx * cx + cy * cy
     b = pa.b
-    # Rounding of the wrist centre and of the lengths: excesses below it count as 0.
-    rnd = ROUND * (np.abs(P).sum(axis=1) + abs(pa.c4) + abs(pa.a1) + abs(b) + abs(pa.c1)
-                   + pa.c2 + kappa)
+    # Rounding of the wrist centre and of the lengths (a reachable pose is within their sum of
+    # the origin): excesses below it count as 0.
+    rnd = ROUND * 2 * (abs(pa.c4) + abs(pa.a1) + abs(b) + abs(pa.c1) + pa.c2 + kappa)
     # The wrist centre must not be nearer to axis 1 than the lateral offset |b| (Puma type).
     err_sh = reach_distance(0.0, abs(b) - np.sqrt(rho2), rnd)
     n = np.sqrt(np.maximum(rho2 - b * b, 0.0))

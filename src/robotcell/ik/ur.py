@@ -272,7 +272,7 @@ def ur_kernel(params: URParameters, R: NDArray[np.float64], P: NDArray[np.float6
     r2 = p5x * p5x + p5y * p5y
     a2, a3 = pa.a2, pa.a3
     rmax, rmin = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
-    rnd = ROUND * (np.abs(P).sum(axis=1) + abs(pa.d1) + rmax + abs(pa.d4) + abs(pa.d5) + abs(pa.d6))
+    rnd = ROUND * 2 * (abs(pa.d1) + rmax + abs(pa.d4) + abs(pa.d5) + abs(pa.d6))
     r = np.sqrt(r2)
     # The wrist-2 point must not be nearer to axis 1 than d4.
     err_sh = reach_distance(0.0, abs(pa.d4) - r, rnd)
