@@ -15,7 +15,7 @@ import click
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.cell import Cell
+from robotcell.cell import Cell, Track, Turntable
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.poseformats import pose_from_vendor
@@ -37,38 +37,40 @@ def cell_tool(text: str | None) -> str | NDArray[np.float64] | None:
     return text
 
 
+def _checked(values: NDArray[np.float64], unit_scale: float, unit: str, axis: Track | Turntable | None,
+             what: str, option: str) -> NDArray[np.float64]:
+    """``values`` (SI) if the cell has the axis and they are within its limits, else an error
+    naming the first offending value in ``unit`` (``unit_scale`` units per SI unit)."""
+    if axis is None:
+        if np.any(values != 0):
+            raise InputError(f"the cell has no {option}; leave out --{option} (or the {option} column)")
+        return values
+    bad = np.atleast_1d(~axis.within_limits(values))
+    if np.any(bad):
+        first = float(np.atleast_1d(values)[bad][0]) * unit_scale
+        raise InputError(f"{what} {first:g} {unit} is outside the {axis_name(axis)} limits "
+                         f"[{axis.lower * unit_scale:g}, {axis.upper * unit_scale:g}] {unit}")
+    return values
+
+
+def axis_name(axis: Track | Turntable) -> str:
+    """``track`` or ``turntable``, as the limits are named in messages."""
+    return "track" if isinstance(axis, Track) else "turntable"
+
+
 def track_values(cell: Cell, mm: NDArray[np.float64] | float | None
                  ) -> NDArray[np.float64] | None:
     """Track positions in m from mm, checked against the cell's track and its limits."""
     if mm is None:
         return None
-    e = np.asarray(mm, dtype=float) * 1e-3
-    if cell.track is None:
-        if np.any(e != 0):
-            raise InputError("the cell has no track; leave out --track (or the track column)")
-        return e
-    bad = ~cell.track.within_limits(e)
-    if np.any(bad):
-        first = float(np.atleast_1d(e)[np.atleast_1d(bad)][0]) * 1e3
-        raise InputError(f"track position {first:g} mm is outside the track limits "
-                         f"[{cell.track.lower * 1e3:g}, {cell.track.upper * 1e3:g}] mm")
-    return e
+    return _checked(np.asarray(mm, dtype=float) * 1e-3, 1e3, "mm", cell.track, "track position",
+                    "track")
 
 
 def table_angles(cell: Cell, deg: NDArray[np.float64] | float) -> NDArray[np.float64]:
     """Table angles in rad from deg, checked against the cell's turntable and its limits."""
-    th = np.radians(np.asarray(deg, dtype=float))
-    if cell.turntable is None:
-        if np.any(th != 0):
-            raise InputError("the cell has no turntable; leave out --table (or the table column)")
-        return th
-    bad = ~cell.turntable.within_limits(th)
-    if np.any(bad):
-        first = math.degrees(float(np.atleast_1d(th)[np.atleast_1d(bad)][0]))
-        raise InputError(f"table angle {first:g} deg is outside the turntable limits "
-                         f"[{math.degrees(cell.turntable.lower):g}, "
-                         f"{math.degrees(cell.turntable.upper):g}] deg")
-    return th
+    return _checked(np.radians(np.asarray(deg, dtype=float)), 180.0 / math.pi, "deg",
+                    cell.turntable, "table angle", "table")
 
 
 def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[np.float64] | None:

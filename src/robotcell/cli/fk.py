@@ -86,20 +86,34 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
             click.echo("warning: joint values outside the robot's limits", err=True)
         if fmt == "matrix":
             click.echo("T_R_TCP (translation in mm):")
-            M = T.copy()
-            M[:3, 3] *= 1e3
-            for row in M:
-                click.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
-            return
-        v = pose_to_vendor(T, fmt)
-        fields = FORMATS[fmt].fields
-        click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
-                            for i, (n, x) in enumerate(zip(fields, v))))
+        _echo_pose(T, fmt)
         return
     cols = read_csv(input_path)
     names = [f"a{i}" for i in range(1, r.n_joints + 1)]
     q = joints_to_si(r, require_columns(cols, names, input_path))
     T = r.fk(q, tool=T_tool)
+    outside = int(np.count_nonzero(~r.within_limits(q)))
+    if outside:
+        click.echo(f"warning: {outside} row(s) outside the robot's joint limits", err=True)
+    _write_poses(T, fmt, output_path)
+
+
+def _echo_pose(T: np.ndarray, fmt: str) -> None:
+    """Print one pose (m) as the vendor format's fields, or as a matrix with mm translation."""
+    if fmt == "matrix":
+        M = T.copy()
+        M[:3, 3] *= 1e3
+        for row in M:
+            click.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
+        return
+    v = pose_to_vendor(T, fmt)
+    fields = FORMATS[fmt].fields
+    click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
+                        for i, (n, x) in enumerate(zip(fields, v))))
+
+
+def _write_poses(T: np.ndarray, fmt: str, output_path: str | None) -> None:
+    """Write poses (N, 4, 4) (m) as CSV in the vendor format (mm, deg) or as matrix rows."""
     if fmt == "matrix":
         header = [f"t{i}{j}" for i in range(3) for j in range(4)]
         M = T[:, :3, :].copy()
@@ -107,9 +121,6 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
         rows = M.reshape(-1, 12)
     else:
         header, rows = list(FORMATS[fmt].fields), pose_to_vendor(T, fmt)
-    outside = int(np.count_nonzero(~r.within_limits(q)))
-    if outside:
-        click.echo(f"warning: {outside} row(s) outside the robot's joint limits", err=True)
     write_csv(output_path if output_path else sys.stdout, header, rows)
 
 
@@ -136,21 +147,6 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
         click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
     if joints is not None:
         click.echo(f"{cell.name}: TCP in frame {frame!r} ({fmt}, mm, deg)")
-        if fmt == "matrix":
-            M = T.copy()
-            M[:3, 3] *= 1e3
-            for row in M:
-                click.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
-            return
-        v = pose_to_vendor(T, fmt)
-        click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
-                            for i, (n, x) in enumerate(zip(FORMATS[fmt].fields, v))))
+        _echo_pose(T, fmt)
         return
-    if fmt == "matrix":
-        header = [f"t{i}{j}" for i in range(3) for j in range(4)]
-        M = T[:, :3, :].copy()
-        M[:, :, 3] *= 1e3
-        rows = M.reshape(-1, 12)
-    else:
-        header, rows = list(FORMATS[fmt].fields), pose_to_vendor(T, fmt)
-    write_csv(output_path if output_path else sys.stdout, header, rows)
+    _write_poses(T, fmt, output_path)

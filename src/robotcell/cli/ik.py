@@ -156,7 +156,13 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
     else:
         header = ["pose", "branch", *axes]
         out_rows = [[i, k, *(sol.q[i, k] * deg).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
-    none = int(np.count_nonzero(~sol.valid.any(axis=1)))
+    _finish_batch(sol.valid, header, out_rows, output_path)
+
+
+def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[object]],
+                  output_path: str | None) -> None:
+    """Warn about poses without a valid branch (valid: (N, 8)), then write the batch CSV."""
+    none = int(np.count_nonzero(~valid.any(axis=1)))
     if none:
         click.echo(f"warning: {none} pose(s) without a valid solution", err=True)
     if output_path:
@@ -252,11 +258,4 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
         out_rows = [[int(i), int(k), *([int(valid[i, k])] if show_all else []), track[i], table[i],
                      *(sel[j] * deg).tolist(), *(flags[j].tolist() if reach[i, k] else ["-"] * len(names_f))]
                     for j, (i, k) in enumerate(idx)]
-    none = int(np.count_nonzero(~valid.any(axis=1)))
-    if none:
-        click.echo(f"warning: {none} pose(s) without a valid solution", err=True)
-    if output_path:
-        with open(output_path, "w", newline="", encoding="utf-8") as fh:
-            _write(fh, header, out_rows)
-    else:
-        _write(sys.stdout, header, out_rows)
+    _finish_batch(valid, header, out_rows, output_path)
