@@ -194,7 +194,7 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         home = data["home"]
         axes = [j for j in joints if not j.passive]
         if not isinstance(home, list) or len(home) != len(axes):
-            raise InputError(f"{origin}: key 'home' must be a list of {len(axes)} controller axis values")
+            raise InputError(f"{origin}: key 'home' must be a list of {len(axes)} joint values (one per controller axis)")
         kwargs["home"] = np.array([
             _number(v, f"{origin}: key 'home' value {k}") * (ls if j.prismatic else as_)
             for k, (v, j) in enumerate(zip(home, axes), start=1)

@@ -195,7 +195,9 @@ class TrackRobot:
         Returns
         -------
         Robot
-            Joint values ``(x, q1, ..., q6)`` as in :meth:`fk`; limits ``lower``, ``upper`` on x.
+            Joint values ``(x, q1, ..., q6)`` as in :meth:`fk` (controller values; an arm's
+            coupling is carried over, extended by the uncoupled track axis); limits ``lower``,
+            ``upper`` on x.
         """
         arm = self.arm
         j1 = arm.joints[0]
@@ -224,6 +226,8 @@ class TrackRobot:
         if arm.home is not None:
             mid = 0.5 * (self.lower + self.upper) if math.isfinite(self.lower + self.upper) else 0.0
             home = np.concatenate([[mid], arm.home])
+        coupling = None if arm.coupling is None else arm.coupling.extended(1)
         return Robot(f"{arm.name}_on_{self.name}", (track, first) + arm.joints[1:], arm.convention,
                      base=base, flange=arm.flange, tool=arm.tool, home=home,
-                     title=f"{arm.title or arm.name} on a linear track", source=arm.source)
+                     title=f"{arm.title or arm.name} on a linear track", source=arm.source,
+                     coupling=coupling)
