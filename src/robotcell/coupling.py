@@ -186,11 +186,7 @@ class Coupling:
         """
         arr = np.asarray(q, dtype=float)
         if self.square:
-            out = arr.copy()
-            new = [(i, _combine(arr, terms, off)) for i, terms, off in self._to_model_rows]
-            for i, v in new:
-                out[..., i] = v
-            return out
+            return _apply_rows(arr, self._to_model_rows)
         return arr @ self.matrix.T + self.offset
 
     def to_model_list(self, q: list[float]) -> list[float]:
@@ -216,11 +212,7 @@ class Coupling:
         """
         arr = np.asarray(q_model, dtype=float)
         if self.square:
-            out = arr.copy()
-            new = [(i, _combine(arr, terms, off)) for i, terms, off in self._to_ctrl_rows]
-            for i, v in new:
-                out[..., i] = v
-            return out
+            return _apply_rows(arr, self._to_ctrl_rows)
         return (arr - self.offset) @ self._inverse.T
 
     def jacobian(self, J_model: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -282,6 +274,15 @@ class Coupling:
         A[:, k:] = self.interaction
         return Coupling(C, np.concatenate([np.zeros(k), self.offset]), A,
                         self.interaction_lower, self.interaction_upper)
+
+
+def _apply_rows(arr: NDArray[np.float64], rows: tuple) -> NDArray[np.float64]:
+    """A copy of ``arr`` (..., m) with the given sparse rows of a square map recomputed."""
+    out = arr.copy()
+    new = [(i, _combine(arr, terms, off)) for i, terms, off in rows]
+    for i, v in new:
+        out[..., i] = v
+    return out
 
 
 def _combine(arr: NDArray[np.float64], terms: tuple, off: float) -> NDArray[np.float64]:
