@@ -12,7 +12,17 @@ from scipy.spatial.transform import Rotation
 from robotcell import load_robot
 from robotcell.coupling import Coupling
 from robotcell.errors import InputError
-from robotcell.ik import TrackRobot, analytic_solver, arm_sides, nearest, solve, solve_numeric
+from robotcell.ik import (
+    TrackRobot,
+    abb_confdata,
+    analytic_solver,
+    arm_sides,
+    kuka_status_turn,
+    nearest,
+    select_abb,
+    solve,
+    solve_numeric,
+)
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.modelfile import robot_from_dict, robot_to_dict, save_robot
 from robotcell.transforms import make_pose, rot_z
@@ -268,3 +278,41 @@ def test_cli_shows_the_coupling_and_works_in_controller_values(capsys):
     np.testing.assert_allclose([float(v) for v in row[-7:-1]], [10, 30, -20, 30, -40, 50], atol=1e-3)
     code, out, _ = run(capsys, "ik", "abb_irb460", "--pose", "1510,0,1438.5,0,180,0", "--all")
     assert code == 0 and "3 back down" in out and "A6" in out
+
+
+def test_cell_with_a_coupled_arm_works_in_controller_values():
+    from robotcell.cell import Cell, Track, Turntable
+
+    robot = load_robot("fanuc_m20ia")
+    cell = Cell(robot=robot, robot_model="fanuc_m20ia",
+                track=Track(make_pose(rot_z(0.01), [0.1, -0.2, 0.0]), make_pose(np.eye(3), [0, 0, 0.45]),
+                            axis="x", lower=0.0, upper=4.0),
+                turntable=Turntable(make_pose(rot_z(0.5), [2.0, 1.5, 0.6])))
+    rng = np.random.default_rng(9)
+    q = in_limits(robot, rng, 100)
+    e, th = rng.uniform(0, 4, 100), rng.uniform(-3, 3, 100)
+    T = cell.fk(q, e, th, frame="turntable")
+    # The cell's FK is the arm's FK of the pendant values (with J2/J3 coupling) placed in the cell.
+    T_R = robot.fk(q)
+    np.testing.assert_allclose(cell.fk(q, e, th, frame="robot"), T_R, atol=1e-12)
+    sol = cell.ik(T, "turntable", track=e, table=th)
+    d = np.abs(wrap_to_pi(sol.q - q[:, None])).max(axis=-1)
+    assert np.all(np.where(sol.valid, d, np.inf).min(axis=-1) < 1e-9)
+
+
+def test_configuration_flags_select_the_pendant_configuration():
+    # ABB confdata of the IRB 2400 (coupled axis 3): the taught configuration comes back.
+    robot = load_robot("abb_irb2400")
+    q = in_limits(robot, np.random.default_rng(10), 3000)
+    sol = robot.ik(robot.fk(q))
+    got, found = select_abb(robot, sol, abb_confdata(robot, q))
+    assert found.mean() > 0.999
+    np.testing.assert_allclose(got[found], q[found], atol=1e-6)
+    # The 8 branches of a FANUC arm are 8 different arm configurations.
+    fanuc = load_robot("fanuc_m20ia")
+    q = in_limits(fanuc, np.random.default_rng(11), 2000)
+    sol = fanuc.ik(fanuc.fk(q))
+    status, _ = kuka_status_turn(fanuc, sol.q)
+    full = sol.reachable.all(axis=1)
+    assert full.any()
+    assert np.all(np.sort(status[full], axis=1) == np.arange(8))

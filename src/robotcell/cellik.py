@@ -355,6 +355,8 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
     reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
     inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
+    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
+        inside &= robot.coupling.within_interaction(q)
     step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
     smooth = np.concatenate([np.ones_like(step[:, :1], dtype=bool), step <= max_step], axis=1)
     ok = reach & inside & smooth

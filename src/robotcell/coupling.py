@@ -120,24 +120,6 @@ class Coupling:
         object.__setattr__(self, "_to_model_rows", _sparse_rows(C, off))
         object.__setattr__(self, "_to_ctrl_rows", _sparse_rows(inv, -inv @ off))
 
-    # -- construction ---------------------------------------------------------------------------
-    @classmethod
-    def j23(cls, factor: float, n: int = 6) -> Coupling:
-        """The J2/J3 linkage ``q3_model = J3 + factor * J2`` of an ``n``-axis arm.
-
-        Parameters
-        ----------
-        factor : float
-            ROS-Industrial's ``J23_factor``: +1, -1 (or 0, no coupling).
-        n : int
-            Number of axes (>= 3).
-        """
-        if n < 3:
-            raise InputError(f"a J2/J3 coupling needs at least 3 axes, got {n}")
-        C = np.eye(n)
-        C[2, 1] = factor
-        return cls(C)
-
     # -- shape ----------------------------------------------------------------------------------
     @property
     def n_model(self) -> int:
@@ -145,19 +127,9 @@ class Coupling:
         return self.matrix.shape[0]
 
     @property
-    def n_controller(self) -> int:
-        """Number of controller axes ``n`` (columns of C)."""
-        return self.matrix.shape[1]
-
-    @property
     def square(self) -> bool:
         """True when every model joint has its own controller axis (no passive joint)."""
         return self.matrix.shape[0] == self.matrix.shape[1]
-
-    @property
-    def inverse(self) -> NDArray[np.float64]:
-        """``C^-1`` (square) or the left inverse ``pinv(C)`` (rectangular), shape ``(n, m)``."""
-        return self._inverse
 
     @property
     def j23_factor(self) -> float | None:
