@@ -221,12 +221,12 @@ class Robot:
         return arr
 
     def within_limits(self, q: ArrayLike, tol: float = 0.0) -> NDArray[np.bool_]:
-        """Whether joint values respect the limits.
+        """Whether controller values respect the joint limits and the coupling's interaction limits.
 
         Parameters
         ----------
         q : array_like, shape (..., n)
-            Joint values (rad, m).
+            Controller axis values (rad, m).
         tol : float
             Allowed excess beyond a limit (rad or m).
 
