@@ -316,3 +316,21 @@ def test_configuration_flags_select_the_pendant_configuration():
     full = sol.reachable.all(axis=1)
     assert full.any()
     assert np.all(np.sort(status[full], axis=1) == np.arange(8))
+
+
+def test_palletizer_ik_holds_for_another_coupling_and_a_tool():
+    # The same arm with axis 3 counted from the upper arm (no J2/J3 coupling on the controller):
+    # only the passive joint is coupled. The solver reads the geometry off the model, so it holds.
+    data = robot_to_dict(load_robot("abb_irb460"))
+    data["coupling"]["matrix"] = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, -1, -1, 0], [0, 0, 0, 1]]
+    data["joints"][2].update(min=-60, max=60)
+    robot = robot_from_dict(data, "irb460_serial.yaml")
+    tool = make_pose(rot_z(0.3), [0.05, 0.02, 0.3])
+    rng = np.random.default_rng(12)
+    q = in_limits(robot, rng, 3000)
+    T = robot.fk(q, tool=tool)
+    R = T[:, :3, :3]
+    assert np.abs(R[:, 2, 2] - R[0, 2, 2]).max() < 1e-12  # level for every configuration
+    sol = robot.ik(T, tool=tool)
+    d = np.abs(wrap_to_pi(sol.q - q[:, None])).max(axis=-1)
+    assert np.all(np.where(sol.valid, d, np.inf).min(axis=-1) < 1e-9)
