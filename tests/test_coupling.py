@@ -334,3 +334,11 @@ def test_palletizer_ik_holds_for_another_coupling_and_a_tool():
     sol = robot.ik(T, tool=tool)
     d = np.abs(wrap_to_pi(sol.q - q[:, None])).max(axis=-1)
     assert np.all(np.where(sol.valid, d, np.inf).min(axis=-1) < 1e-9)
+
+
+def test_four_axis_arms_without_the_structure_are_refused_with_reasons():
+    data = robot_to_dict(load_robot("abb_irb460"))
+    data["coupling"]["matrix"][3] = [0, 0, 0, 0]  # the passive joint no longer compensates
+    robot = robot_from_dict(data, "tilting.yaml")
+    with pytest.raises(InputError, match=r"nor a 4-axis palletizer \(the flange orientation changes"):
+        robot.ik(robot.fk(np.zeros(4)))

@@ -116,7 +116,9 @@ def palletizer_problems(robot: Robot) -> list[str]:
     T0 = _end(robot, np.zeros(4))
     w1 = _turn(T0[:3, :3], _end(robot, np.array([_STEP, 0, 0, 0]))[:3, :3])
     w4 = _turn(T0[:3, :3], _end(robot, np.array([0, 0, 0, _STEP]))[:3, :3])
-    if np.linalg.norm(np.cross(w1, w4)) > AXIS_TOL * max(1.0, float(np.linalg.norm(w1))):
+    if min(np.linalg.norm(w1), np.linalg.norm(w4)) < AXIS_TOL:
+        out.append("axis 1 or axis 4 does not turn the flange")
+    elif np.linalg.norm(np.cross(w1, w4)) > AXIS_TOL * max(1.0, float(np.linalg.norm(w1))):
         out.append("axis 4 is not parallel to axis 1")
     return out
 
