@@ -168,7 +168,8 @@ class Coupling:
             out[i] = sum(c * q[j] for j, c in terms) + off
         return out
 
-    def to_controller(self, q_model: ArrayLike) -> NDArray[np.float64]:
+    def to_controller(self, q_model: ArrayLike, out: NDArray[np.float64] | None = None
+                      ) -> NDArray[np.float64]:
         """Controller values of model joint values.
 
         Parameters
@@ -176,6 +177,9 @@ class Coupling:
         q_model : array_like, shape (..., m)
             Model joint values (rad, m). For a rectangular ``C`` they must satisfy the coupling
             (the passive joints follow the others); the left inverse then recovers ``q`` exactly.
+        out : ndarray, shape (..., n), optional
+            Square ``C`` only: write the result here (may be ``q_model`` itself; only the values
+            the coupling changes are written, the others must already be there).
 
         Returns
         -------
@@ -184,7 +188,7 @@ class Coupling:
         """
         arr = np.asarray(q_model, dtype=float)
         if self.square:
-            return _apply_rows(arr, self._to_ctrl_rows)
+            return _apply_rows(arr, self._to_ctrl_rows, out)
         return (arr - self.offset) @ self._inverse.T
 
     def jacobian(self, J_model: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -248,9 +252,11 @@ class Coupling:
                         self.interaction_lower, self.interaction_upper)
 
 
-def _apply_rows(arr: NDArray[np.float64], rows: tuple) -> NDArray[np.float64]:
-    """A copy of ``arr`` (..., m) with the given sparse rows of a square map recomputed."""
-    out = arr.copy()
+def _apply_rows(arr: NDArray[np.float64], rows: tuple, out: NDArray[np.float64] | None = None
+                ) -> NDArray[np.float64]:
+    """``arr`` (..., m) with the given sparse rows of a square map recomputed (into a copy, or
+    into ``out``, which may be ``arr``: every new row is computed before any is written)."""
+    out = arr.copy() if out is None else out
     new = [(i, _combine(arr, terms, off)) for i, terms, off in rows]
     for i, v in new:
         out[..., i] = v

@@ -104,7 +104,7 @@ class AnalyticSolver:
         """Map a block of kernel solutions to controller values in place; return ``valid``."""
         coupling = self.robot.coupling
         if self._mapped:
-            q[...] = coupling.to_controller(q)
+            coupling.to_controller(q, out=q)
             for j in self._wrap:
                 q[..., j] = wrap_to_pi(q[..., j])
         per, fixed, lo, hi, inter = self._limits
