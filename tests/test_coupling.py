@@ -342,3 +342,23 @@ def test_four_axis_arms_without_the_structure_are_refused_with_reasons():
     robot = robot_from_dict(data, "tilting.yaml")
     with pytest.raises(InputError, match=r"nor a 4-axis palletizer \(the flange orientation changes"):
         robot.ik(robot.fk(np.zeros(4)))
+
+
+def test_cli_joint_files_hold_pendant_values(tmp_path, capsys):
+    """simulate writes a1..a6 as the pendant shows them, calibrate reads them back as such."""
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(example.read_text().replace("model: kuka_kr16", "model: fanuc_m20ia"))
+    touches = tmp_path / "t.csv"
+    code, _, err = run(capsys, "simulate", "tcp", "--cell", cell, "--tool", "torch", "--seed", "1",
+                       "--noise", "0", "-o", touches)
+    assert code == 0, err
+    code, out, _ = run(capsys, "calibrate", "tcp", touches, "--robot", "fanuc_m20ia")
+    assert code == 0 and "tcp (mm): 312.500, -1.200, 95.000" in out and "RMS 0.000 mm" in out
+    # Read as serial (uncoupled) joint values, the same file gives a wrong tool.
+    serial = tmp_path / "m20ia_serial.yaml"
+    save_robot(load_robot("fanuc_m20ia").uncoupled(), serial)
+    code, out, _ = run(capsys, "calibrate", "tcp", touches, "--robot", serial)
+    assert code == 0 and "tcp (mm): 312.500, -1.200, 95.000" not in out
