@@ -109,8 +109,8 @@ def coupled_vs_uncoupled(n: int = N_POSES // 2, rounds: int = 7) -> None:
         solve(coupled, T[:10]), solve(plain, T[:10])
         tc, tp = [], []
         for _ in range(rounds):
-            tc.append(median_time(lambda: solve(coupled, T), repeats=1))
-            tp.append(median_time(lambda: solve(plain, T), repeats=1))
+            tc.append(median_time(lambda c=coupled, T=T: solve(c, T), repeats=1))
+            tp.append(median_time(lambda p=plain, T=T: solve(p, T), repeats=1))
         uc, up = np.median(tc) / n * 1e6, np.median(tp) / n * 1e6
         print(f"  {name:20s} coupled {uc:6.2f} us/pose, uncoupled {up:6.2f} us/pose, "
               f"ratio {uc / up:4.2f}   (target <= 1.2)")
