@@ -362,3 +362,10 @@ def test_cli_joint_files_hold_pendant_values(tmp_path, capsys):
     save_robot(load_robot("fanuc_m20ia").uncoupled(), serial)
     code, out, _ = run(capsys, "calibrate", "tcp", touches, "--robot", serial)
     assert code == 0 and "tcp (mm): 312.500, -1.200, 95.000" not in out
+
+
+def test_robots_show_prints_the_interaction_limit(tmp_path, capsys):
+    path = tmp_path / "m20ia.yaml"
+    save_robot(fanuc_with_interaction(-60, 150), path)
+    code, out, _ = run(capsys, "robots", "show", path)
+    assert code == 0 and "interaction limit: -60 <= +1 J2 +1 J3 <= 150" in out
