@@ -369,3 +369,30 @@ def test_robots_show_prints_the_interaction_limit(tmp_path, capsys):
     save_robot(fanuc_with_interaction(-60, 150), path)
     code, out, _ = run(capsys, "robots", "show", path)
     assert code == 0 and "interaction limit: -60 <= +1 J2 +1 J3 <= 150" in out
+
+
+def test_palletizer_in_a_cell_is_refused_where_six_axes_are_needed():
+    from robotcell.cell import Cell, Track
+    from robotcell.cellik import ik_path
+
+    robot = load_robot("abb_irb460")
+    cell = Cell(robot=robot, robot_model="abb_irb460",
+                track=Track(np.eye(4), np.eye(4), axis="x", lower=0.0, upper=4.0))
+    T = robot.fk(np.zeros((2, 4)))
+    with pytest.raises(InputError, match=r"path IK needs a six-axis arm .* abb_irb460 has 4 axes"):
+        ik_path(cell, T, frame="robot", track=np.zeros(2))
+    with pytest.raises(InputError, match=r"choosing the track value needs a six-axis arm"):
+        cell.ik(T, frame="track")
+    # With the track value given, the palletizer's 4 solutions come back.
+    sol = cell.ik(T, frame="robot", track=np.zeros(2))
+    assert sol.q.shape == (2, 4, 4) and sol.valid.any(axis=-1).all()
+
+
+def test_simulated_touches_need_a_six_axis_arm():
+    from robotcell.cell import Cell, Tool
+    from robotcell.simulate import simulate
+
+    robot = load_robot("abb_irb460")
+    cell = Cell(robot=robot, robot_model="abb_irb460", tools={"gripper": Tool(make_pose(np.eye(3), [0, 0, 0.2]))})
+    with pytest.raises(InputError, match=r"simulated touches need a six-axis arm; abb_irb460 has 4 axes"):
+        simulate(cell, "tcp", tool="gripper", seed=1)

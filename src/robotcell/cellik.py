@@ -330,6 +330,9 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     n_pts = arr.shape[0]
     T_tool = tool_pose(cell, tool)
     robot = cell.robot
+    if robot.n_joints != 6:
+        raise InputError(f"path IK needs a six-axis arm (8 branches); {robot.name} has "
+                         f"{robot.n_joints} axes: use cell.ik for its solutions")
     if q_start is not None:
         q_start = finite_array(q_start, "q_start")
         if q_start.shape != (robot.n_joints,):

@@ -159,6 +159,9 @@ class TrackRobot:
         """
         if not (math.isfinite(self.lower) and math.isfinite(self.upper)):
             raise InputError("choosing the track value needs finite track limits (lower, upper)")
+        if self.arm.n_joints != 6:
+            raise InputError(f"choosing the track value needs a six-axis arm; {self.arm.name} has "
+                             f"{self.arm.n_joints} axes: give the track value (ik_at)")
         if samples < 3:
             raise InputError(f"samples must be at least 3, got {samples}")
         arr = validate_pose(T, "target pose")
