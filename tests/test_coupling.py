@@ -396,3 +396,25 @@ def test_simulated_touches_need_a_six_axis_arm():
     cell = Cell(robot=robot, robot_model="abb_irb460", tools={"gripper": Tool(make_pose(np.eye(3), [0, 0, 0.2]))})
     with pytest.raises(InputError, match=r"simulated touches need a six-axis arm; abb_irb460 has 4 axes"):
         simulate(cell, "tcp", tool="gripper", seed=1)
+
+
+def test_real_wrist_coupling_fk_jacobian_and_ik():
+    # A wrist whose axis 5 motor also turns the flange by half its angle: model J6 = A6 + 0.5 A5.
+    data = robot_to_dict(load_robot("kuka_kr16"))
+    C = np.eye(6)
+    C[5, 4] = 0.5
+    data["coupling"] = {"matrix": C.tolist()}
+    robot = robot_from_dict(data, "wrist.yaml")
+    assert robot_to_dict(robot)["coupling"] == {"matrix": [[float(v) if v % 1 else int(v) for v in r] for r in C]}
+    q = in_limits(robot, np.random.default_rng(13), 3000)
+    serial = q.copy()
+    serial[:, 5] += 0.5 * q[:, 4]
+    np.testing.assert_allclose(robot.fk(q), robot.uncoupled().fk(serial), atol=1e-12)
+    J = robot.jacobian(q[:3])
+    h = 1e-6
+    num = np.stack([(robot.fk(q[:3] + h * e)[:, :3, 3] - robot.fk(q[:3] - h * e)[:, :3, 3]) / (2 * h)
+                    for e in np.eye(6)], axis=-1)
+    np.testing.assert_allclose(J[:, :3], num, atol=1e-7)
+    sol = robot.ik(robot.fk(q))
+    d = np.abs(wrap_to_pi(sol.q - q[:, None])).max(axis=-1)
+    assert np.all(np.where(sol.valid, d, np.inf).min(axis=-1) < 1e-9)
