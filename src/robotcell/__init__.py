@@ -3,6 +3,7 @@
 Conventions (pose naming ``T_a_b``, units, array shapes) are in ``docs/conventions.md``.
 """
 
+from robotcell.coupling import Coupling
 from robotcell.errors import IllPosedError, InputError, RobotcellError
 from robotcell.modelfile import list_robots, load_robot, robot_from_dict, save_robot
 from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
@@ -23,6 +24,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "FORMATS",
+    "Coupling",
     "IllPosedError",
     "InputError",
     "Joint",
