@@ -1,0 +1,10 @@
+"""Kinematic identification: the model a real arm or positioner has, from measurements.
+
+See ``docs/identification.md``.
+"""
+
+from robotcell.identification.engine import identify
+from robotcell.identification.measurements import Measurements, read_measurements
+from robotcell.identification.result import IdentificationResult, Parameter
+
+__all__ = ["IdentificationResult", "Measurements", "Parameter", "identify", "read_measurements"]
