@@ -247,7 +247,8 @@ class Chain:
     def predict(self, x: NDArray[np.float64], q: NDArray[np.float64]):
         """Predicted points ``(N, K, 3)`` and target rotations ``(N, 3, 3)`` in D (m)."""
         ev = self.evaluate(x, q, jac=False)
-        pts = ev.p[:, None, :] + np.einsum("nij,kj->nki", ev.R, self.targets(x))
+        r = np.zeros((1, 3)) if self.pose_target else self.targets(x)
+        pts = ev.p[:, None, :] + np.einsum("nij,kj->nki", ev.R, r)
         return pts, ev.R
 
     def point_jacobian(self, x: NDArray[np.float64], q: NDArray[np.float64], ev: Evaluation,

@@ -287,6 +287,13 @@ def identify(
         cand.append(chain.coupling_param)
     J1 = prob.jacobian(x1)
     kept, fixed = _identifiable(J1, cand, set(prio), chain.names, rank_tol)
+    m = prob.N * prob.ncomp
+    if m < 2 * kept.size:
+        raise IllPosedError(
+            f"{prob.N} rows give {m} measured coordinates for {kept.size} identifiable unknowns; "
+            f"at least twice as many coordinates as unknowns are needed to check the result: "
+            f"measure at least {-(-2 * kept.size // prob.ncomp)} configurations (better 3 to 5 times "
+            "as many, spread over the joint ranges)")
     x2 = _solve(prob, x1, kept)
     return _result(nominal, chain, prob, x2, kept, fixed, rp0, rr0, name)
 
