@@ -65,3 +65,32 @@ def measure(ch: Chain, x: np.ndarray, q: np.ndarray, rng: np.random.Generator, n
     if ch.pose_target:
         rot = Rotation.from_rotvec(rng.normal(0.0, angle_noise, (len(q), 3))).as_matrix() @ R
     return Measurements(q, pts, rot)
+
+
+def write_csv(path, meas: Measurements, prismatic=None) -> None:
+    """Write measurements as the CLI's CSV (deg / mm)."""
+    n, K = meas.q.shape[1], meas.n_targets
+    pris = np.zeros(n, dtype=bool) if prismatic is None else np.asarray(prismatic)
+    q = np.where(pris, meas.q * 1e3, np.degrees(meas.q))
+    head = [f"a{i}" for i in range(1, n + 1)]
+    head += ["x", "y", "z"] if K == 1 else [f"{c}{k}" for k in range(1, K + 1) for c in "xyz"]
+    cols = [q, meas.points.reshape(len(q), -1) * 1e3]
+    if meas.rotations is not None:
+        head += ["qw", "qx", "qy", "qz"]
+        xyzw = Rotation.from_matrix(meas.rotations).as_quat()
+        cols.append(xyzw[:, [3, 0, 1, 2]])
+    rows = np.concatenate(cols, axis=1)
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(",".join(head) + "\n")
+        fh.writelines(",".join(f"{v:.9f}" for v in r) + "\n" for r in rows)
+
+
+def one_joint_rows(robot: Robot, per_joint: int = 7, span_deg: float = 60.0) -> np.ndarray:
+    """Rows moving each joint alone about zero (rad)."""
+    rows = []
+    for j in range(robot.n_joints):
+        for v in np.linspace(-np.radians(span_deg), np.radians(span_deg), per_joint):
+            q = np.zeros(robot.n_joints)
+            q[j] = v
+            rows.append(q)
+    return np.array(rows)

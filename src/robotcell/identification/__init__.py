@@ -3,8 +3,9 @@
 See ``docs/identification.md``.
 """
 
-from robotcell.identification.engine import identify
+from robotcell.identification.engine import identify, identify_with_coupling
 from robotcell.identification.measurements import Measurements, read_measurements
 from robotcell.identification.result import IdentificationResult, Parameter
 
-__all__ = ["IdentificationResult", "Measurements", "Parameter", "identify", "read_measurements"]
+__all__ = ["IdentificationResult", "Measurements", "Parameter", "identify", "identify_with_coupling",
+           "read_measurements"]

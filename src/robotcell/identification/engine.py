@@ -40,7 +40,7 @@ from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult, Parameter
 from robotcell.robot import Robot
 
-__all__ = ["identify"]
+__all__ = ["identify", "identify_with_coupling"]
 
 #: Default measurement accuracies: a laser tracker (m per coordinate) and a 6D probe (rad).
 POINT_SIGMA = 0.05e-3
@@ -364,3 +364,42 @@ def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | 
         tool = np.eye(4)
         tool[:3, 3] = chain.targets(x)[0]
     return replace(der.robot, tool=tool, home=nominal.home)
+
+
+def identify_with_coupling(nominal: Robot, measurements: Measurements, k: float,
+                           **options) -> IdentificationResult:
+    """Identify with a stated J2/J3 coupling ``k`` and say whether the data support it.
+
+    Fits three times: with ``k`` held, without coupling (``k = 0`` held) and with ``k`` free.
+    ``coupling_check`` of the returned result (the fit with ``k`` held) holds ``k``,
+    ``rms_with_mm``, ``rms_without_mm``, ``k_fitted``, ``k_sigma`` and a ``verdict`` sentence.
+
+    Parameters
+    ----------
+    nominal : Robot
+    measurements : Measurements
+    k : float
+        Stated factor: ``q3_model = J3 + k * J2`` (FANUC: -1 when J3 is the forearm's angle to the
+        horizontal, as the ROS-Industrial FANUC driver's ``J23_factor``).
+    **options
+        Passed to :func:`identify` (accuracies, ``scale``, ``rank_tol``, ``name``).
+
+    Returns
+    -------
+    IdentificationResult
+    """
+    with_k = identify(nominal, measurements, coupling=k, **options)
+    without = identify(nominal, measurements, coupling=0.0, **options)
+    free = identify(nominal, measurements, coupling=k, fit_coupling=True, **options)
+    p = free.parameter("j23_factor")
+    consistent = abs(p.value - k) <= 3 * p.sigma if p.free else False
+    if consistent:
+        verdict = f"the data support k = {k:g} (fitted {p.value:.5f} +- {p.sigma:.5f})"
+    else:
+        verdict = (f"the data do not support k = {k:g}: fitted k = {p.value:.5f} +- {p.sigma:.5f}; "
+                   "check the controller's J2/J3 convention")
+    with_k.coupling_check = {
+        "k": k, "rms_with_mm": with_k.rms_after * 1e3, "rms_without_mm": without.rms_after * 1e3,
+        "k_fitted": p.value, "k_sigma": p.sigma, "supported": consistent, "verdict": verdict,
+    }
+    return with_k
