@@ -24,7 +24,7 @@ from robotcell.identification.chain import PARALLEL_TOL
 from robotcell.identification.measurements import Measurements, read_measurements
 from robotcell.robot import Robot
 
-__all__ = ["axis_lines", "first_estimate"]
+__all__ = ["axis_lines", "first_estimate", "start_model"]
 
 #: Smallest motion of the moved joint in a group (radians, or metres for prismatic joints).
 MIN_SPAN = math.radians(10.0)
@@ -154,18 +154,17 @@ def first_estimate(path: str | Path, name: str = "identified") -> tuple[Robot, M
     ----------
     path : str or Path
         Measurement CSV (``docs/identification.md``) containing, for every joint, rows that move
-        that joint alone.
+        that joint alone; a joint whose targets move on straight lines is prismatic (its column
+        in mm).
     name : str
         Name of the model.
 
     Returns
     -------
     robot : Robot
-        Standard-DH model from the axes (DH procedure); its base frame R has ``Z`` along axis 1,
-        the origin on axis 1 nearest axis 2, ``X`` toward axis 2; the flange ``Z`` along the last
-        axis, its origin on that axis nearest the first target, ``X`` toward the target.
+        See :func:`start_model`.
     measurements : Measurements
-        The CSV in SI units, prismatic joints (detected as lines) in metres.
+        The CSV in SI units, prismatic joints in metres.
 
     Raises
     ------
@@ -173,11 +172,33 @@ def first_estimate(path: str | Path, name: str = "identified") -> tuple[Robot, M
         A joint that no rows move alone.
     """
     raw = read_measurements(path)
-    pts, dirs, types = axis_lines(raw)
+    types = axis_lines(raw)[2]
     pris = np.array([t == "prismatic" for t in types])
     meas = read_measurements(path, pris) if pris.any() else raw
-    if pris.any():  # again with the prismatic values in metres
-        pts, dirs, types = axis_lines(meas, pris)
+    return start_model(meas, pris, name), meas
+
+
+def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
+                name: str = "identified") -> Robot:
+    """Standard-DH start model from rows moving one joint at a time (circle point analysis).
+
+    Parameters
+    ----------
+    meas : Measurements
+        Joint values (rad, m) and measured targets in the device frame (m).
+    prismatic : ndarray of bool, shape (n,), optional
+        Known prismatic joints (default: from the fits, see :func:`axis_lines`).
+    name : str
+
+    Returns
+    -------
+    Robot
+        Its base frame R has ``Z`` along axis 1, the origin on axis 1 nearest axis 2, ``X`` toward
+        axis 2; the flange ``Z`` along the last axis, its origin on that axis nearest the first
+        target, ``X`` toward the target. Nearly parallel consecutive axes (within 1 deg) are made
+        exactly parallel. Joint names ``A1..An``, no limits.
+    """
+    pts, dirs, types = axis_lines(meas, prismatic)
     T_D_R = _base_frame(pts, dirs)
     R, t = T_D_R[:3, :3], T_D_R[:3, 3]
     pts_R, dirs_R = (pts - t) @ R, dirs @ R
@@ -204,9 +225,8 @@ def first_estimate(path: str | Path, name: str = "identified") -> tuple[Robot, M
     F[:3, 3] = foot
     names = tuple(f"A{i}" for i in range(1, len(types) + 1))
     chain = AxisChain(points=pts_R, directions=dirs_R, types=tuple(types), flange=F, names=names)
-    robot = dh_from_axes(chain, "standard", name=name, title=name,
-                         source="circle point analysis of the measurements").robot
-    return robot, meas
+    return dh_from_axes(chain, "standard", name=name, title=name,
+                        source="circle point analysis of the measurements").robot
 
 
 def _any_perpendicular(z: NDArray[np.float64]) -> NDArray[np.float64]:
