@@ -295,10 +295,10 @@ def identify(
             f"measure at least {-(-2 * kept.size // prob.ncomp)} configurations (better 3 to 5 times "
             "as many, spread over the joint ranges)")
     x2 = _solve(prob, x1, kept)
-    return _result(nominal, chain, prob, x2, kept, fixed, rp0, rr0, name)
+    return _result(nominal, chain, prob, x2, kept, fixed, rp0, rr0, name, x1)
 
 
-def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name) -> IdentificationResult:
+def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> IdentificationResult:
     rp, rr = prob.raw(x)
     w = prob.weighted(x)
     J = prob.jacobian(x, kept)
@@ -346,6 +346,7 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name) -> Identificat
         scale=x[chain.scale_params].copy(),
         coupling=float(x[chain.coupling_param]) if chain.coupling_param >= 0 else 0.0,
         point_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, _chain=chain, _x=x,
+        _x_nominal=x_nominal,
     )
 
 

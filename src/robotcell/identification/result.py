@@ -125,6 +125,7 @@ class IdentificationResult:
     angle_sigma: float
     _chain: Any = None
     _x: Any = None
+    _x_nominal: Any = None
     coupling_check: dict[str, Any] = field(default_factory=dict)
 
     # -- figures --------------------------------------------------------------------------------
@@ -165,8 +166,11 @@ class IdentificationResult:
         flat = arr.reshape(-1, arr.shape[-1])
         return self._chain.model_joints(self._x, flat).reshape(arr.shape)
 
-    def predict(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def predict(self, q: ArrayLike, nominal: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Predicted targets in the device frame for controller values ``q`` (N, n).
+
+        With ``nominal=True``: the nominal links with the base and targets fitted to them (the
+        model behind ``rms_before``).
 
         Returns
         -------
@@ -175,7 +179,8 @@ class IdentificationResult:
         rotations : ndarray, shape (N, 3, 3)
             Orientation of the target frame (meaningful for pose measurements).
         """
-        return self._chain.predict(self._x, np.atleast_2d(np.asarray(q, dtype=float)))
+        x = self._x_nominal if nominal else self._x
+        return self._chain.predict(x, np.atleast_2d(np.asarray(q, dtype=float)))
 
     @property
     def verdict(self) -> tuple[str, str]:
