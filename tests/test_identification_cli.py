@@ -15,8 +15,10 @@ from identification_helpers import (
     write_csv,
 )
 
-from robotcell import load_robot
+from robotcell import load_robot, save_robot
 from robotcell.identification import Measurements
+from robotcell.robot import Joint, Robot
+from robotcell.transforms import make_pose, rot_y
 
 NOISE = 0.02e-3
 
@@ -141,3 +143,25 @@ def test_identify_without_nominal_needs_one_joint_rows(tmp_path, capsys):
     write_csv(csv, Measurements(rng.uniform(-1, 1, (30, 6)), rng.uniform(-1, 1, (30, 3))))
     code, _, stderr = run(capsys, "identify", csv)
     assert code == 2 and "joint 1: no rows move it alone" in stderr
+
+
+def test_identify_positioner_with_quaternions(tmp_path, capsys):
+    nominal = Robot(name="positioner", convention="standard", base=make_pose(rot_y(math.pi / 2), [0, 0, 0.8]),
+                    joints=(Joint("revolute", alpha=-math.pi / 2, name="tilt"),
+                            Joint("revolute", d=0.25, name="rotate")))
+    model = tmp_path / "positioner.yaml"
+    save_robot(nominal, model)
+    rng = np.random.default_rng(24)
+    ch, x = truth_chain(perturbed(nominal, rng), 1, True, rng)
+    q = rng.uniform(-1.5, 1.5, (30, 2))
+    csv = tmp_path / "camera.csv"
+    write_csv(csv, measure(ch, x, q, rng, NOISE, math.radians(0.01)))
+    assert "qw,qx,qy,qz" in csv.read_text().splitlines()[0]
+    code, stdout, stderr = run(capsys, "identify", csv, "--robot", model, "--json", "--accuracy", "0.02",
+                               "--angle-accuracy", "0.01")
+    assert code == 0, stderr
+    data = json.loads(stdout)
+    assert np.array(data["target"]).shape == (4, 4)
+    assert data["rms_after_mm"] < 0.05 and data["rotation_rms_after_deg"] < 0.03
+    assert {p["name"] for p in data["parameters"] if p["free"] and not p["name"].startswith(
+        ("base", "target"))} == {"tilt.a", "tilt.alpha"}
