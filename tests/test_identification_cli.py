@@ -38,9 +38,11 @@ def test_identify_json_and_model_file(kr16_truth, tmp_path, capsys):
     write_csv(csv, meas)
     out = tmp_path / "kr16_identified.yaml"
     code, stdout, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out, "--json",
-                               "--accuracy", "0.02")
+                               "--accuracy", "0.02", "--folds", "5")
     assert code == 0, stderr
     data = json.loads(stdout)
+    cv = data["cross_validation"]
+    assert cv["folds"] == 5 and cv["after_rms_mm"] < 0.06 and cv["before_rms_mm"] > 10 * cv["after_rms_mm"]
     for key in ("base", "targets", "rms_before_mm", "rms_after_mm", "fixed", "parameters"):
         assert key in data
     base = np.array(data["base"])
@@ -63,9 +65,11 @@ def test_identify_report_and_poor_result(kr16_truth, tmp_path, capsys):
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
     csv = tmp_path / "tracker.csv"
     write_csv(csv, meas)
-    code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16")
+    code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--folds", "4")
     assert code == 0
     assert "verdict: good" in stdout and "held at nominal" in stdout
+    assert "rows by position error, identified model" in stdout and "#" in stdout
+    assert "cross-validation, 4 folds" in stdout
     # Joint values off by a gross amount in one axis (a scale of 2): exit 3, no model file.
     q = meas.q.copy()
     q[:, 1] *= 2.0

@@ -124,7 +124,9 @@ def _start_base(chain: Chain, meas: Measurements, x: NDArray[np.float64]):
         return kabsch(model.reshape(-1, 3), m.reshape(-1, 3)), r, np.eye(4)
     # Hand-eye: M_i = B F_i X. Rotation of X from the rotation axes of relative motions.
     Rm, pm = meas.rotations, meas.points[:, 0, :]
-    i, j = np.triu_indices(meas.n_rows, 1)
+    n = meas.n_rows  # pairs of rows a step and half the set apart: O(N), not O(N^2)
+    i = np.concatenate([np.arange(n - 1), np.arange(n)])
+    j = np.concatenate([np.arange(1, n), (np.arange(n) + max(n // 2, 1)) % n])
     a = Rotation.from_matrix(np.swapaxes(Rf[i], 1, 2) @ Rf[j]).as_rotvec()
     b = Rotation.from_matrix(np.swapaxes(Rm[i], 1, 2) @ Rm[j]).as_rotvec()
     keep = (np.linalg.norm(a, axis=1) > 0.05) & (np.linalg.norm(a, axis=1) < 3.0)

@@ -278,6 +278,8 @@ class IdentificationResult:
         lines += ["", "position error (mm)      mean      RMS      max",
                   f"  nominal model     {e0.mean():9.4f} {self.rms_before * 1e3:8.4f} {e0.max():8.4f}",
                   f"  identified model  {e1.mean():9.4f} {self.rms_after * 1e3:8.4f} {e1.max():8.4f}"]
+        for title, e in (("nominal", e0.max(axis=1)), ("identified", e1.max(axis=1))):
+            lines += [f"rows by position error, {title} model (mm):"] + _histogram(e)
         if self.rotation_residuals is not None:
             lines.append(f"orientation error RMS (deg): nominal "
                          f"{math.degrees(self._rms(self.rotation_residuals_before)):.4f}, identified "
@@ -294,6 +296,14 @@ class IdentificationResult:
         v, why = self.verdict
         lines += ["", f"verdict: {v} ({why})"]
         return "\n".join(lines)
+
+
+def _histogram(values: NDArray[np.float64], bins: int = 6, width: int = 40) -> list[str]:
+    """Text histogram lines ``  lo - hi  ####  count`` of ``values``."""
+    counts, edges = np.histogram(values, bins=bins)
+    top = max(int(counts.max()), 1)
+    return [f"  {lo:8.4f} - {hi:8.4f}  {'#' * round(width * c / top):<{width}} {c}"
+            for lo, hi, c in zip(edges[:-1], edges[1:], counts)]
 
 
 def _chi2_bound(dof: int) -> float:
