@@ -212,3 +212,19 @@ def test_refused_input():
         Measurements(q, np.zeros((4, 3)))
     with pytest.raises(InputError, match="not a proper rotation"):
         Measurements(q, np.zeros((5, 3)), np.tile(np.diag([1.0, 1.0, -1.0]), (5, 1, 1)))
+
+
+def test_modified_dh_nominal_with_hayati_beta(tmp_path):
+    nominal = convert_convention(load_robot("kuka_kr16"), "modified")
+    rng = np.random.default_rng(6)
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
+    assert ch.beta_joints == [2]  # A3: its axis parallel to A2's, Craig's row 3
+    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
+    res = identify(nominal, meas, point_sigma=NOISE)
+    assert res.parameter("A3.beta").free
+    qv = configurations(nominal, 200, rng)
+    assert _prediction_rms(res, ch, x, qv) < NOISE
+    save_robot(res.robot, tmp_path / "m.yaml")
+    robot = load_robot(tmp_path / "m.yaml")
+    assert robot.convention == "modified"
+    assert np.allclose((res.base @ robot.fk(qv))[:, :3, 3], res.predict(qv)[0][:, 0], atol=1e-7)
