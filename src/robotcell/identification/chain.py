@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.robot import Robot
-from robotcell.transforms import rot_x, rot_y, rot_z
+from robotcell.transforms import make_pose, rot_x, rot_y, rot_z
 
 __all__ = ["PARALLEL_TOL", "Chain", "Op"]
 
@@ -163,7 +163,6 @@ class Chain:
         self.names = names
         self.values = np.array(values)
         self.groups = groups
-        self.theta_params = [next(o.param for o in ops if o.joint == i) for i in range(self.n)]
 
     def index(self, name: str) -> int:
         """Index of the parameter called ``name``."""
@@ -320,7 +319,7 @@ class Chain:
             if o.joint >= 0:
                 dirs[o.joint] = o.sign * u[0]
                 pts[o.joint] = org[0]
-        T_R_T = _pose(ev.R[0], ev.p[0])
+        T_R_T = make_pose(ev.R[0], ev.p[0])
         return pts, dirs, T_R_T @ np.linalg.inv(self.tool_pose(x))
 
 
@@ -329,13 +328,6 @@ def _motion(v: NDArray[np.float64]) -> NDArray[np.float64]:
     T = np.eye(4)
     T[:3, 3] = v[:3]
     T[:3, :3] = rot_x(v[3]) @ rot_y(v[4]) @ rot_z(v[5])
-    return T
-
-
-def _pose(R, p) -> NDArray[np.float64]:
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = p
     return T
 
 

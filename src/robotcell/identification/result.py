@@ -278,7 +278,7 @@ class IdentificationResult:
         lines += ["", "position error (mm)      mean      RMS      max",
                   f"  nominal model     {e0.mean():9.4f} {self.rms_before * 1e3:8.4f} {e0.max():8.4f}",
                   f"  identified model  {e1.mean():9.4f} {self.rms_after * 1e3:8.4f} {e1.max():8.4f}"]
-        for title, e in (("nominal", e0.max(axis=1)), ("identified", e1.max(axis=1))):
+        for title, e in (("nominal", e0.max(axis=1)), ("identified", self.row_errors * 1e3)):
             lines += [f"rows by position error, {title} model (mm):"] + _histogram(e)
         if self.rotation_residuals is not None:
             lines.append(f"orientation error RMS (deg): nominal "
