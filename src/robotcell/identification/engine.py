@@ -27,7 +27,6 @@ from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import qr
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
@@ -169,6 +168,39 @@ def _solve(prob: _Problem, x0: NDArray[np.float64], free: NDArray[np.int_]) -> N
     return out
 
 
+def _pivoted_qr(A: NDArray[np.float64], Q: NDArray[np.float64], tol: float,
+                ) -> tuple[list[int], NDArray[np.float64]]:
+    """QR with column pivoting (Businger and Golub) of ``A`` after the orthonormal columns ``Q``.
+
+    Each step takes the column with the largest norm orthogonal to the span so far; among
+    columns within 1e-6 of that norm (duplicates, such as the two ``d`` of a parallel pair) the
+    first in order, so that the choice does not depend on rounding. Stops when no remaining
+    column is longer than ``tol`` (columns of unit length).
+
+    Returns
+    -------
+    chosen : list of int
+        Indices of the kept columns of ``A``, in pivot order.
+    Q : ndarray
+        ``Q`` extended by the new orthonormal directions.
+    """
+    R = A - Q @ (Q.T @ A)
+    chosen: list[int] = []
+    for _ in range(A.shape[1]):
+        n = np.linalg.norm(R, axis=0)
+        n[chosen] = -1.0
+        if n.max() <= tol:
+            break
+        k = int(np.flatnonzero(n >= n.max() * (1.0 - 1e-6))[0])
+        chosen.append(k)
+        v = R[:, k] / n[k]
+        v -= Q @ (Q.T @ v)  # re-orthogonalise against rounding
+        v /= np.linalg.norm(v)
+        Q = np.concatenate([Q, v[:, None]], axis=1)
+        R = R - np.outer(v, v @ R)
+    return chosen, Q
+
+
 def _identifiable(J: NDArray[np.float64], cand: Sequence[int], prio: Sequence[int],
                   names: Sequence[str], tol: float):
     """Split ``cand`` into kept and fixed columns; a reason for every fixed one."""
@@ -182,16 +214,9 @@ def _identifiable(J: NDArray[np.float64], cand: Sequence[int], prio: Sequence[in
     kept: list[int] = []
     Q = np.zeros((J.shape[0], 0))
     for group in ([c for c in live if c in prio], [c for c in live if c not in prio]):
-        if not group:
-            continue
-        res = Jn[:, group] - Q @ (Q.T @ Jn[:, group])
-        Qg, Rg, piv = qr(res, mode="economic", pivoting=True)
-        d = np.abs(np.diag(Rg))
-        rank = int(np.sum(d > tol))
-        kept += [group[k] for k in piv[:rank]]
-        Q = np.concatenate([Q, Qg[:, :rank]], axis=1)
-        for k in piv[rank:]:
-            fixed[group[k]] = ""
+        chosen, Q = _pivoted_qr(Jn[:, group], Q, tol)
+        kept += [group[k] for k in chosen]
+        fixed.update({c: "" for k, c in enumerate(group) if k not in chosen})
     for c, why in list(fixed.items()):
         if why:
             continue
