@@ -344,7 +344,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
 
 def _clean(v: Any) -> Any:
     if isinstance(v, float):
-        r = round(v, 9)
+        r = round(float(v), 9)  # float(): numpy scalars are floats yaml cannot write
         return int(r) if r == int(r) and abs(r) < 1e15 else r
     return v
 
