@@ -248,3 +248,41 @@ def test_reported_sigma_matches_the_errors_over_seeds():
         fixed_sets.add(tuple(n for n, _ in exact.fixed))
     assert len(fixed_sets) == 1
     assert 0.75 <= np.std(z) <= 1.25
+
+
+def test_identified_model_file_ik_is_seeded_by_its_nominal(kr16_result, tmp_path):
+    nominal, _, _, meas, res = kr16_result
+    path = tmp_path / "identified.yaml"
+    save_robot(res.robot, path)
+    assert "ik_seed: kuka_kr16" in path.read_text()
+    robot = load_robot(path)
+    assert robot.ik_seed is not None and robot.ik_seed.name == "kuka_kr16"
+    q = meas.q[:12]
+    T = robot.fk(q)
+    sol = robot.ik(T)  # FK -> IK -> FK on the identified model: all branches, fixed shape
+    assert sol.q.shape == (12, 8, 6) and sol.method == "opw"
+    assert np.all(sol.valid.any(axis=-1))
+    back = robot.fk(np.where(sol.reachable[..., None], sol.q, 0.0))
+    err = np.linalg.norm(back[..., :3, 3] - T[:, None, :3, 3], axis=-1)
+    assert err[sol.reachable].max() < 1e-9
+    assert np.all(np.isnan(sol.q[~sol.reachable]))
+    diff = np.angle(np.exp(1j * (sol.q - q[:, None, :])))
+    assert np.all(np.where(sol.valid, np.abs(diff).max(axis=-1), np.inf).min(axis=-1) < 1e-6)
+    # The rest of the IK code keeps working: nearest branch and configuration flags.
+    from robotcell.ik import kuka_status_turn, nearest
+    best, found, _ = nearest(robot, sol, q)
+    assert np.all(found) and np.allclose(np.angle(np.exp(1j * (best - q))), 0.0, atol=1e-6)
+    status, _ = kuka_status_turn(robot, best)
+    assert np.array_equal(status, kuka_status_turn(nominal, q)[0])
+    # A new base moves the seed with the chain.
+    B = make_pose(rot_y(0.3), [0.5, 0.0, 1.0])
+    moved = robot.with_base(B @ robot.base)
+    sol2 = moved.ik(B @ T[:3])
+    assert np.allclose(np.nan_to_num(sol2.q), np.nan_to_num(sol.q[:3]), atol=1e-7)
+
+
+def test_model_without_closed_form_or_seed_is_refused(kr16_result):
+    _, _, _, _, res = kr16_result
+    from dataclasses import replace
+    with pytest.raises(InputError, match="no analytic inverse kinematics.*ik_seed"):
+        replace(res.robot, ik_seed=None).ik(np.eye(4))

@@ -17,6 +17,7 @@ from identification_helpers import (
 
 from robotcell import load_robot, save_robot
 from robotcell.identification import Measurements
+from robotcell.poseformats import pose_to_vendor
 from robotcell.robot import Joint, Robot
 from robotcell.transforms import make_pose, rot_y
 
@@ -169,3 +170,26 @@ def test_identify_positioner_with_quaternions(tmp_path, capsys):
     assert data["rms_after_mm"] < 0.05 and data["rotation_rms_after_deg"] < 0.03
     assert {p["name"] for p in data["parameters"] if p["free"] and not p["name"].startswith(
         ("base", "target"))} == {"tilt.a", "tilt.alpha"}
+
+
+def test_identified_model_file_in_fk_and_ik(kr16_truth, tmp_path, capsys):
+    nominal, ch, x, rng = kr16_truth
+    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
+    csv = tmp_path / "tracker.csv"
+    write_csv(csv, meas)
+    out = tmp_path / "kr16_identified.yaml"
+    code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out, "--accuracy", "0.02")
+    assert code == 0, stderr
+    joints = [10.0, -70.0, 100.0, 20.0, 40.0, -30.0]
+    code, stdout, stderr = run(capsys, "fk", out, "--joints", ",".join(map(str, joints)))
+    assert code == 0, stderr
+    T = load_robot(out).fk(np.radians(joints))  # full precision for the round trip
+    pose = ",".join(f"{v:.9f}" for v in pose_to_vendor(T, "kuka"))
+    code, stdout, stderr = run(capsys, "ik", out, "--pose", pose, "--near", ",".join(map(str, joints)))
+    assert code == 0, stderr
+    assert "numeric, seeded by kuka_kr16 (opw)" in stdout
+    row = stdout.strip().splitlines()[-1].split()
+    k = row.index("yes")
+    assert np.allclose([float(v) for v in row[k - 6:k]], joints, atol=1e-3)  # printed to 0.001 deg
+    code, stdout, stderr = run(capsys, "ik", out, "--pose", pose, "--all")
+    assert code == 0 and len(stdout.strip().splitlines()) == 3 + 8, stderr

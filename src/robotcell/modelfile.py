@@ -9,6 +9,7 @@ A model file is written by hand in the vendor's units (see ``docs/models.md``)::
       - {type: revolute,  a: 25, alpha: -90, d: 400, theta: 0,  min: -170, max: 170}
       - {type: prismatic, a: 0,  alpha: 0,   d: 0,   theta: 90, min: 0,    max: 1500}
     coupling: {j23_factor: 1}   # optional: q_model = C q_controller + offset
+    ik_seed: kuka_kr16          # optional: nominal model whose analytic IK seeds this one's
 
 The loader converts to SI and reports any problem with the file, the joint and the key.
 """
@@ -37,7 +38,7 @@ _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name",
 _COUPLING_KEYS = {"j23_factor", "matrix", "offset", "interaction"}
 _POSE_KEYS = {"x", "y", "z", "a", "b", "c"}
 _TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
-             "source", "verified", "verification", "coupling"}
+             "source", "verified", "verification", "coupling", "ik_seed"}
 
 
 def _library_dir():
@@ -187,6 +188,8 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
     elif any(j.passive for j in joints):
         raise InputError(f"{origin}: passive joints need key 'coupling' with a 'matrix' that says "
                          "how they move")
+    if "ik_seed" in data:
+        kwargs["ik_seed"] = _ik_seed(data["ik_seed"], origin)
     for key in ("base", "flange", "tool"):
         if key in data:
             kwargs[key] = _pose(data[key], f"{origin}: key '{key}'", ls, as_)
@@ -213,6 +216,19 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         )
     except InputError as exc:
         raise InputError(f"{origin}: {exc}") from None
+
+
+def _ik_seed(value: Any, origin: str) -> Robot:
+    """Parse key ``ik_seed``: a library name or a nested model (mapping)."""
+    where = f"{origin}: key 'ik_seed'"
+    if isinstance(value, str):
+        if value not in list_robots():
+            raise InputError(f"{where}: {value!r} is not a library robot; give a library name or "
+                             "the nominal model itself as a nested mapping (name, joints, ...)")
+        return load_robot(value)
+    if isinstance(value, dict):
+        return robot_from_dict(value, where)
+    raise InputError(f"{where} must be a library robot name or a nested model mapping")
 
 
 def _coupling(value: Any, joints: list[Joint], origin: str, ls: float, as_: float) -> Coupling:
@@ -334,11 +350,22 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
             data[key] = dict(zip("xyzabc", (_clean(v) for v in pose_to_vendor(T, "kuka"))))
     if robot.coupling is not None:
         data["coupling"] = _coupling_to_dict(robot)
+    if robot.ik_seed is not None:
+        data["ik_seed"] = _ik_seed_to_dict(robot.ik_seed)
     if robot.home is not None:
         data["home"] = [
             _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.axes)
         ]
     data.update(source=robot.source, verified=robot.verified, verification=robot.verification)
+    return data
+
+
+def _ik_seed_to_dict(seed: Robot) -> str | dict[str, Any]:
+    """Key ``ik_seed``: the library name when the seed is that library model, else the model."""
+    data = robot_to_dict(seed)
+    data.pop("ik_seed", None)
+    if seed.name in list_robots() and robot_to_dict(load_robot(seed.name)) == data:
+        return seed.name
     return data
 
 

@@ -97,6 +97,9 @@ class Robot:
     coupling : Coupling or None
         Linear map from controller axis values to the chain's joint values (one row per joint,
         one column per non-passive joint); None when every joint is its own controller axis.
+    ik_seed : Robot or None
+        A nearby model with a closed-form IK (an identified arm's nominal model): when this model
+        has none, :meth:`ik` refines the seed's analytic branches numerically (docs/ik.md).
     """
 
     name: str
@@ -111,6 +114,7 @@ class Robot:
     verified: bool = False
     verification: str = ""
     coupling: Coupling | None = None
+    ik_seed: Robot | None = None
 
     def __post_init__(self) -> None:
         if self.convention not in ("standard", "modified"):
@@ -202,8 +206,15 @@ class Robot:
         return replace(self, tool=np.asarray(tool, dtype=float))
 
     def with_base(self, base: ArrayLike) -> Robot:
-        """Return a copy whose base transform is ``base`` (``T_R_0``, shape (4, 4), metres)."""
-        return replace(self, base=np.asarray(base, dtype=float))
+        """Return a copy whose base transform is ``base`` (``T_R_0``, shape (4, 4), metres).
+
+        An ``ik_seed`` moves with the chain (its frame 0 keeps its place relative to this one's).
+        """
+        new = validate_pose(base, "base")
+        seed = self.ik_seed
+        if seed is not None:
+            seed = seed.with_base(new @ np.linalg.inv(self.base) @ seed.base)
+        return replace(self, base=new, ik_seed=seed)
 
     # -- validation -----------------------------------------------------------------------------
     def _joints(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
@@ -359,6 +370,9 @@ class Robot:
 
     def ik(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
         """Analytic inverse kinematics: every solution, see :func:`robotcell.ik.solve`.
+
+        A model without a closed form but with an ``ik_seed`` gets the seed's analytic branches
+        refined numerically to 1e-9 m and rad (:class:`robotcell.ik.seeded.SeededSolver`).
 
         Parameters
         ----------

@@ -145,7 +145,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         if not rows:
             raise click.ClickException("no valid solution (unreachable or outside the joint limits); "
                                        "--all lists every branch")
-        click.echo(f"{r.name}, {solver.method} solver, controller axis values in degrees")
+        click.echo(f"{r.name}, {solver.description}, controller axis values in degrees")
         click.echo(format_table(headers, rows))
         return
     cols = read_csv(input_path)

@@ -37,6 +37,8 @@ from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import Chain
 from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult, Parameter
+from robotcell.ik import analytic_solver
+from robotcell.ik.seeded import SeededSolver
 from robotcell.robot import Robot
 
 __all__ = ["identify", "identify_with_coupling"]
@@ -391,7 +393,16 @@ def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | 
     if not chain.pose_target and chain.n_targets:
         tool = np.eye(4)
         tool[:3, 3] = chain.targets(x)[0]
-    return replace(der.robot, tool=tool, home=nominal.home)
+    return replace(der.robot, tool=tool, home=nominal.home, ik_seed=_ik_seed(nominal))
+
+
+def _ik_seed(nominal: Robot) -> Robot | None:
+    """The model whose analytic IK seeds the identified one's: the nominal (or its own seed)."""
+    try:
+        solver = analytic_solver(nominal)
+    except InputError:
+        return None
+    return nominal.ik_seed if isinstance(solver, SeededSolver) else nominal
 
 
 def identify_with_coupling(nominal: Robot, measurements: Measurements, k: float,

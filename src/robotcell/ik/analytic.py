@@ -9,6 +9,10 @@ A robot with a joint coupling (:mod:`robotcell.coupling`) is solved on its uncou
 model solutions are mapped to controller values right after the kernel, and the 2*pi rule, the
 joint limits and the interaction limits are then applied to the controller values, as the pendant
 shows them. Robots without a coupling skip the mapping.
+
+A robot with neither structure but with an ``ik_seed`` (an identified arm names its nominal
+model) gets a :class:`~robotcell.ik.seeded.SeededSolver`: the seed's analytic branches refined
+numerically on the robot, with the same result shape.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from robotcell.ik.palletizer import (
     palletizer_problems,
 )
 from robotcell.ik.result import IKSolutions
+from robotcell.ik.seeded import SeededSolver
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
 from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, validate_pose
@@ -80,10 +85,12 @@ class AnalyticSolver:
             raise InputError(
                 f"no analytic inverse kinematics for {robot.name}: not an ortho-parallel arm "
                 f"with a spherical wrist ({'; '.join(opw)}), nor a Universal-Robots-type arm "
-                f"({'; '.join(ur)}), nor a 4-axis palletizer ({'; '.join(pal)}). Use "
-                "robotcell.ik.solve_numeric for this model."
+                f"({'; '.join(ur)}), nor a 4-axis palletizer ({'; '.join(pal)}). Name a nearby "
+                "model with a closed form (its nominal model) with the model file key 'ik_seed', "
+                "or use robotcell.ik.solve_numeric for this model."
             )
         self.robot = robot
+        self.description = f"{self.method} solver"
         self._T_O_R = invert(self.params.T_R_O)
         self._fold = JointFolder(robot.lower, robot.upper)
         self._limits = None
@@ -192,14 +199,23 @@ class AnalyticSolver:
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))
 
 
-_CACHE: weakref.WeakKeyDictionary[Robot, AnalyticSolver] = weakref.WeakKeyDictionary()
+_CACHE: weakref.WeakKeyDictionary[Robot, AnalyticSolver | SeededSolver] = weakref.WeakKeyDictionary()
 
 
-def analytic_solver(robot: Robot) -> AnalyticSolver:
-    """The (cached) analytic solver of ``robot``; raises :class:`InputError` if it has none."""
+def analytic_solver(robot: Robot) -> AnalyticSolver | SeededSolver:
+    """The (cached) IK solver of ``robot``; raises :class:`InputError` if it has none.
+
+    The analytic solver of its structure; for a robot without one but with an ``ik_seed``, the
+    seed's analytic branches refined numerically (:class:`~robotcell.ik.seeded.SeededSolver`).
+    """
     solver = _CACHE.get(robot)
     if solver is None:
-        solver = AnalyticSolver(robot)
+        try:
+            solver = AnalyticSolver(robot)
+        except InputError:
+            if robot.ik_seed is None:
+                raise
+            solver = SeededSolver(robot, analytic_solver(robot.ik_seed))
         _CACHE[robot] = solver
     return solver
 
