@@ -224,8 +224,8 @@ def _compare(calibrated: Cell, truth: Cell,
 
 
 def _comparison_table(rows: list[Comparison]) -> str:
-    from robotcell.poseformats import pose_to_vendor
     from robotcell.tables import format_table
+    from robotcell.poseformats import pose_to_vendor
 
     body = []
     for c in rows:
