@@ -31,8 +31,13 @@ def perturbed(nominal: Robot, rng: np.random.Generator) -> Robot:
 
 
 def truth_chain(truth: Robot, n_targets: int, pose: bool, rng: np.random.Generator,
-                coupling: float = 0.0, scale=None):
-    """A chain in the tracker frame with Hayati tilts at the parallel axes; returns (chain, x)."""
+                coupling: float | None = None, scale=None):
+    """A chain in the tracker frame with Hayati tilts at the parallel axes; returns (chain, x).
+
+    ``coupling``: the J2/J3 factor; default the model's own (``coupling: {j23_factor: k}``).
+    """
+    if coupling is None:
+        coupling = truth.coupling.j23_factor if truth.coupling is not None else 0.0
     tool = make_pose(Rotation.from_euler("xyz", [10.0, -20.0, 95.0], degrees=True).as_matrix(),
                      [0.02, -0.03, 0.12]) if pose else np.eye(4)
     ch = Chain(truth, 0 if pose else n_targets, pose, T_D_R, tool)

@@ -198,6 +198,55 @@ def test_coupling_and_scale_are_identified():
                        * (1 + res.scale[2]))
 
 
+def test_scale_and_coupling_round_trip_through_the_model_file(tmp_path):
+    # Truth: q3_model = (1 + s3)(J3 - J2), qm2 = (1 + s2) J2. The model file's coupling key holds
+    # C = diag(1 + s) with C[2, 1] = k (1 + s3), so its FK takes the CSV's controller values.
+    rng = np.random.default_rng(8)
+    nominal = load_robot("kuka_kr16")
+    scale = np.array([0.0, 2e-4, -3e-4, 0.0, 0.0, 0.0])
+    ch, x = truth_chain(perturbed(nominal, rng), 3, False, rng, coupling=-1.0, scale=scale)
+    meas = measure(ch, x, configurations(nominal, 60, rng), rng, NOISE)
+    res = identify(nominal, meas, point_sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
+    C = res.robot.coupling.matrix
+    assert np.allclose(np.diag(C), 1.0 + res.scale)
+    assert C[2, 1] == pytest.approx(res.coupling * (1.0 + res.scale[2]))
+    path = tmp_path / "identified.yaml"
+    save_robot(res.robot, path)
+    assert "coupling:" in path.read_text() and "matrix:" in path.read_text()
+    robot = load_robot(path)
+    q = configurations(nominal, 20, rng)
+    pred = (res.base @ robot.fk(q))[:, :3, 3]  # controller values, as in the CSV
+    assert np.allclose(pred, res.predict(q)[0][:, 0], atol=1e-7)
+    assert np.allclose(pred, ch.predict(x, q)[0][:, 0], atol=5 * NOISE)
+    T = robot.fk(q[:4])
+    sol = robot.ik(T)  # the seeded IK honours the coupling
+    back = robot.fk(np.where(sol.reachable[..., None], sol.q, 0.0))
+    assert np.abs(back - T[:, None])[sol.reachable].max() < 1e-9
+    # A full turn is no longer exactly 2 pi with a scale error: equal up to 2 pi * scale.
+    d = np.where(sol.valid, np.abs(np.angle(np.exp(1j * (sol.q - q[:4, None])))).max(axis=-1), np.inf)
+    assert np.all(d.min(axis=-1) < 1e-4)
+
+
+def test_nominal_j23_coupling_is_used_and_kept():
+    # FANUC M-20iA: its library model states coupling {j23_factor: 1}; identify uses it without
+    # --j23-factor, and the identified model keeps it as j23_factor.
+    rng = np.random.default_rng(12)
+    nominal = load_robot("fanuc_m20ia")
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng, coupling=1.0)
+    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
+    res = identify(nominal, meas, point_sigma=NOISE)
+    assert res.rms_after < 2 * NOISE * math.sqrt(3)
+    assert res.robot.coupling.j23_factor == 1.0
+    q = configurations(nominal, 5, rng)
+    assert np.allclose((res.base @ res.robot.fk(q))[:, :3, 3], res.predict(q)[0][:, 0], atol=1e-7)
+
+
+def test_nominal_with_passive_joints_is_refused():
+    nominal = load_robot("abb_irb460")
+    with pytest.raises(InputError, match="only 'coupling: {j23_factor: k}'"):
+        identify(nominal, Measurements(np.zeros((30, 4)), np.zeros((30, 3))))
+
+
 def test_refused_input():
     nominal = load_robot("kuka_kr16")
     q = np.zeros((5, 6))

@@ -32,6 +32,7 @@ from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from robotcell.calibration.fitting import kabsch, scaled_condition
+from robotcell.coupling import Coupling
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import Chain
@@ -243,7 +244,7 @@ def identify(
     point_sigma: float = POINT_SIGMA,
     angle_sigma: float = ANGLE_SIGMA,
     scale: bool = False,
-    coupling: float = 0.0,
+    coupling: float | None = None,
     fit_coupling: bool = False,
     rank_tol: float = 1e-6,
     name: str | None = None,
@@ -264,9 +265,9 @@ def identify(
         Accuracy of a measured orientation (rad per axis); weights the rotation residuals.
     scale : bool
         Also identify a scale error per axis (gear ratio): ``qm = (1 + scale) q``.
-    coupling : float
+    coupling : float, optional
         J2/J3 coupling factor ``k`` with ``q3_model = J3 + k J2`` (0: none). Held unless
-        ``fit_coupling``.
+        ``fit_coupling``. Default: the nominal model's ``j23_factor`` (0 without a coupling).
     fit_coupling : bool
         Identify ``k`` too (starting at ``coupling``).
     rank_tol : float
@@ -282,7 +283,8 @@ def identify(
     Raises
     ------
     InputError
-        Measurements that do not fit the robot (number of joints), bad accuracies.
+        Measurements that do not fit the robot (number of joints), bad accuracies, a nominal
+        model whose coupling is not a J2/J3 factor.
     IllPosedError
         Too few rows for the unknowns, or orientations that do not change.
     """
@@ -293,6 +295,12 @@ def identify(
         if not (math.isfinite(s) and s > 0):
             raise InputError(f"{label} must be a positive number, got {s}")
     pose = measurements.rotations is not None
+    if nominal.coupling is not None and nominal.coupling.j23_factor is None:
+        raise InputError(f"{nominal.name} has a joint coupling other than a J2/J3 factor (passive "
+                         "joints or a general matrix); identification handles only "
+                         "'coupling: {j23_factor: k}'")
+    if coupling is None:
+        coupling = 0.0 if nominal.coupling is None else nominal.coupling.j23_factor
     if coupling and nominal.n_joints < 3:
         raise InputError("a J2/J3 coupling needs a chain with at least 3 joints")
     chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, np.eye(4), np.eye(4))
@@ -393,7 +401,25 @@ def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | 
     if not chain.pose_target and chain.n_targets:
         tool = np.eye(4)
         tool[:3, 3] = chain.targets(x)[0]
-    return replace(der.robot, tool=tool, home=nominal.home, ik_seed=_ik_seed(nominal))
+    return replace(der.robot, tool=tool, home=nominal.home, ik_seed=_ik_seed(nominal),
+                   coupling=_coupling(nominal, chain, x))
+
+
+def _coupling(nominal: Robot, chain: Chain, x: NDArray[np.float64]) -> Coupling | None:
+    """The identified scale and J2/J3 factor as a joint coupling ``q_model = C q`` (or None).
+
+    ``C = diag(1 + scale)`` with ``C[2, 1] = k (1 + scale_3)`` (see ``Chain.model_joints``); the
+    nominal coupling's interaction limits are kept.
+    """
+    C = np.diag(1.0 + x[chain.scale_params])
+    if chain.coupling_param >= 0:
+        C[2, 1] = x[chain.coupling_param] * C[2, 2]
+    if np.array_equal(C, np.eye(chain.n)):
+        return None
+    old = nominal.coupling
+    if old is None:
+        return Coupling(C)
+    return Coupling(C, None, old.interaction, old.interaction_lower, old.interaction_upper)
 
 
 def _ik_seed(nominal: Robot) -> Robot | None:

@@ -59,8 +59,9 @@ class IdentificationResult:
     Attributes
     ----------
     robot : Robot
-        The identified model (nominal convention, names, signs, limits). Its FK takes the model
-        joint values (the controller's when there is no scale and no coupling); its tool is the
+        The identified model (nominal convention, names, signs, limits). Its FK takes the
+        controller values: identified scales and J2/J3 factor are its ``coupling``; ``ik_seed``
+        is the nominal model (when that has an analytic IK); its tool is the
         measured target (the first reflector for points), so ``base @ robot.fk(q)`` predicts the
         measurement in the device frame.
     nominal : Robot

@@ -38,7 +38,9 @@ class SeededSolver:
     robot : Robot
         The model to solve (e.g. an identified arm; its coupling, if any, is honoured).
     seed : AnalyticSolver
-        Analytic solver of a nearby model with the same joints (its nominal model).
+        Analytic solver of a nearby model with the same chain of joints (its nominal model); its
+        solutions are mapped through both couplings (seed controller -> chain -> ``robot``
+        controller values) before the refinement.
     tol : float
         Position (m) and orientation (rad) tolerance of the refinement.
 
@@ -85,7 +87,10 @@ class SeededSolver:
         tool_T = self.robot.tool if tool is None else validate_pose(tool, "tool")
         seeds = self.seed.solve(arr, tool_T, q_ref)
         nb, n = self.branches, self.robot.n_joints
-        q = seeds.q.reshape(-1, nb, n).copy()
+        q = seeds.q.reshape(-1, nb, seeds.q.shape[-1])
+        if self.seed.robot.coupling is not None:  # seed values -> chain values -> ours
+            q = self.seed.robot.coupling.to_model(q)
+        q = self.robot.coupling.to_controller(q) if self.robot.coupling is not None else q.copy()
         reach = seeds.reachable.reshape(-1, nb).copy()
         err = np.full(reach.shape, math.inf)
         targets = np.broadcast_to(arr.reshape(-1, 1, 4, 4), q.shape[:2] + (4, 4))
