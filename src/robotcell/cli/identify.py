@@ -11,7 +11,8 @@ import click
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
-from robotcell.identification.validation import cross_validate
+from robotcell.identification.report import write_identification_report
+from robotcell.identification.validation import compare_observability, cross_validate
 from robotcell.modelfile import load_robot, save_robot
 
 
@@ -31,9 +32,11 @@ from robotcell.modelfile import load_robot, save_robot
 @click.option("--force", "force", is_flag=True, help="Write -o even when the verdict is poor.")
 @click.option("--folds", "folds", type=int, help="Also K-fold cross-validate: every row predicted "
               "by the models identified without it (mean, RMS, max before and after).")
+@click.option("--report", "report", type=click.Path(dir_okay=False), help="Also write a "
+              "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
 def identify(measurements: str, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool, force: bool,
-             folds: int | None) -> None:
+             folds: int | None, report: str | None) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -41,7 +44,9 @@ def identify(measurements: str, robot: str | None, output: str | None, as_json: 
     target optionally its orientation qw,qx,qy,qz. See docs/identification.md.
 
     --folds K adds a K-fold cross-validation: every row predicted by the nominal and the
-    identified model fitted without it.
+    identified model fitted without it. --report FILE.html writes the report as one HTML page
+    with figures (errors before and after, cross-validation, parameters, correlations,
+    observability of the measured configurations against random ones).
 
     Exit status: 0 identified; 2 refused input (reason on stderr); 3 poor result (the model
     file is not written unless --force).
@@ -62,11 +67,19 @@ def identify(measurements: str, robot: str | None, output: str | None, as_json: 
     else:
         result = run_identify(nominal, meas, **options)
     verdict, why = result.verdict
-    cv = None
+    cv = cross = None
+    if report is not None and folds is None:
+        folds = min(5, meas.n_rows)
     if folds is not None:
         if j23 is not None:
             options["coupling"] = j23
-        cv = cross_validate(nominal, meas, folds=folds, **options).stats()
+        cross = cross_validate(nominal, meas, folds=folds, **options)
+        cv = cross.stats()
+    if report is not None:
+        obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
+                                    pose=meas.rotations is not None, point_sigma=options["point_sigma"],
+                                    angle_sigma=options["angle_sigma"])
+        write_identification_report(result, report, cross, obs)
     if as_json:
         data = result.to_json()
         if cv is not None:
@@ -83,6 +96,8 @@ def identify(measurements: str, robot: str | None, output: str | None, as_json: 
         save_robot(result.robot, output)
         if not as_json:
             click.echo(f"identified model written to {output}")
+    if report is not None and not as_json:
+        click.echo(f"report written to {report}")
     if verdict == "poor":
         kept = " (written anyway: --force)" if output and force else (" (model file not written)" if output else "")
         click.echo(f"poor result: {why}{kept}", err=True)

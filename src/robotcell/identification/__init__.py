@@ -11,12 +11,13 @@ from robotcell.identification.result import IdentificationResult, Parameter
 from robotcell.identification.validation import (
     CrossValidation,
     PoseSelection,
+    compare_observability,
     cross_validate,
     observability,
     select_configurations,
 )
 
 __all__ = ["CrossValidation", "IdentificationResult", "Measurements", "Parameter", "PoseSelection",
-           "PositionerCalibration", "calibrate_positioner", "cross_validate", "identify",
+           "PositionerCalibration", "calibrate_positioner", "compare_observability", "cross_validate", "identify",
            "identify_with_coupling", "observability", "read_measurements", "select_configurations",
            "solve_identified"]

@@ -28,7 +28,8 @@ from robotcell.identification.engine import _identifiable, _Problem, identify
 from robotcell.identification.measurements import Measurements
 from robotcell.robot import Robot
 
-__all__ = ["CrossValidation", "PoseSelection", "cross_validate", "observability", "select_configurations"]
+__all__ = ["CrossValidation", "PoseSelection", "compare_observability", "cross_validate", "observability",
+           "select_configurations"]
 
 
 @dataclass(frozen=True)
@@ -99,6 +100,8 @@ def _jacobian_blocks(nominal: Robot, q: NDArray[np.float64], n_targets: int, pos
     """Weighted identification Jacobian at the nominal model, rows grouped per configuration."""
     ch = Chain(nominal, 0 if pose else n_targets, pose, np.eye(4), np.eye(4))
     x = ch.values.copy()
+    if ch.coupling_param >= 0 and nominal.coupling is not None:
+        x[ch.coupling_param] = nominal.coupling.j23_factor or 0.0
     # Targets spread over a 100 mm flange, in front of it.
     spots = np.array([[0.1, 0.0, 0.05], [-0.05, 0.087, 0.05], [-0.05, -0.087, 0.05]])
     for k in range(ch.n_targets):
@@ -140,6 +143,48 @@ class PoseSelection:
     o1_random: NDArray[np.float64]
 
 
+def _random_configurations(nominal: Robot, rng: np.random.Generator, m: int) -> NDArray[np.float64]:
+    """``m`` uniform configurations within the limits (unlimited: +-180 deg, +-1 m), (m, n)."""
+    lo = np.where(np.isfinite(nominal.lower), nominal.lower, np.where(nominal.prismatic, -1.0, -math.pi))
+    hi = np.where(np.isfinite(nominal.upper), nominal.upper, np.where(nominal.prismatic, 1.0, math.pi))
+    return rng.uniform(lo, hi, (m, nominal.n_joints))
+
+
+def compare_observability(nominal: Robot, q: NDArray[np.float64], *, n_targets: int = 1,
+                          pose: bool = False, n_random: int = 20, seed: int = 0,
+                          point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
+                          ) -> tuple[float, NDArray[np.float64]]:
+    """O1 of measured configurations against random sets of the same size within the limits.
+
+    Parameters
+    ----------
+    nominal : Robot
+    q : ndarray, shape (N, n)
+        The measured configurations (rad, m).
+    n_targets, pose, point_sigma, angle_sigma
+        As in :func:`select_configurations`.
+    n_random : int
+        Number of random sets.
+    seed : int
+        Seed of ``np.random.default_rng`` for the random sets.
+
+    Returns
+    -------
+    o1 : float
+        O1 of ``q`` (columns scaled by their norm over ``q`` and all random sets together).
+    o1_random : ndarray, shape (n_random,)
+    """
+    q = np.asarray(q, dtype=float)
+    N = len(q)
+    rand = _random_configurations(nominal, np.random.default_rng(seed), N * n_random)
+    B = _jacobian_blocks(nominal, np.concatenate([q, rand]), n_targets, pose, point_sigma, angle_sigma)
+    p = B.shape[2]
+    B = B / np.linalg.norm(B.reshape(-1, p), axis=0)
+    o1 = observability(B[:N].reshape(-1, p))
+    sets = B[N:].reshape(n_random, -1, p)
+    return o1, np.array([observability(b) for b in sets])
+
+
 def select_configurations(
     nominal: Robot, n: int, *, n_targets: int = 1, pose: bool = False,
     candidates: NDArray[np.float64] | None = None, n_candidates: int = 1000, seed: int = 0,
@@ -173,9 +218,7 @@ def select_configurations(
     """
     rng = np.random.default_rng(seed)
     if candidates is None:
-        lo = np.where(np.isfinite(nominal.lower), nominal.lower, np.where(nominal.prismatic, -1.0, -math.pi))
-        hi = np.where(np.isfinite(nominal.upper), nominal.upper, np.where(nominal.prismatic, 1.0, math.pi))
-        candidates = rng.uniform(lo, hi, (n_candidates, nominal.n_joints))
+        candidates = _random_configurations(nominal, rng, n_candidates)
     cand = np.asarray(candidates, dtype=float)
     if cand.ndim != 2 or cand.shape[1] != nominal.n_joints or len(cand) < n:
         raise InputError(f"candidates must have shape (C, {nominal.n_joints}) with C >= {n}, got {cand.shape}")
