@@ -2,6 +2,7 @@
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -193,3 +194,41 @@ def test_identified_model_file_in_fk_and_ik(kr16_truth, tmp_path, capsys):
     assert np.allclose([float(v) for v in row[k - 6:k]], joints, atol=1e-3)  # printed to 0.001 deg
     code, stdout, stderr = run(capsys, "ik", out, "--pose", pose, "--all")
     assert code == 0 and len(stdout.strip().splitlines()) == 3 + 8, stderr
+
+
+def test_propose_configurations_then_identify_them(kr16_truth, tmp_path, capsys):
+    nominal, ch, x, rng = kr16_truth
+    out = tmp_path / "to_measure.csv"
+    code, stdout, stderr = run(capsys, "identify", "--propose", 15, "--robot", "kuka_kr16",
+                               "--targets", 2, "-o", out)
+    assert code == 0, stderr
+    o1, best = (float(v) for v in re.search(r"O1 of the 15 proposed configurations: ([\d.e-]+); "
+                                             r"20 random .* best ([\d.e-]+)", stdout).groups())
+    assert o1 > best
+    cols = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert out.read_text().startswith("a1,a2,a3,a4,a5,a6\n") and cols.shape == (15, 6)
+    q = np.radians(cols)
+    assert np.all(nominal.within_limits(q))
+    # Measured (simulated) at those configurations, the CSV identifies the arm.
+    meas = measure(ch, x, q, rng, NOISE)
+    write_csv(tmp_path / "measured.csv", meas)
+    code, stdout, stderr = run(capsys, "identify", tmp_path / "measured.csv", "--robot", "kuka_kr16",
+                               "--json", "--accuracy", "0.02")
+    assert code == 0, stderr
+    assert json.loads(stdout)["rms_after_mm"] < 0.05
+    # --json without -o: the configurations in the object.
+    code, stdout, _ = run(capsys, "identify", "--propose", 15, "--robot", "kuka_kr16", "--json")
+    data = json.loads(stdout)
+    assert code == 0 and len(data["configurations"]) == 15 and len(data["o1_random"]) == 20
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--propose", "10"], "--propose needs --robot"),
+    (["x.csv", "--propose", "10", "--robot", "kuka_kr16"], "give no MEASUREMENTS"),
+    (["--propose", "2", "--robot", "kuka_kr16"], "propose at least"),
+    (["--propose", "10", "--robot", "kuka_kr16", "--targets", "2", "--orientation"], "one target"),
+    ([], "give MEASUREMENTS.csv"),
+])
+def test_propose_refusals(args, message, capsys):
+    code, _, stderr = run(capsys, "identify", *args)
+    assert code == 2 and message in stderr

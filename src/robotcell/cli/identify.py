@@ -7,20 +7,59 @@ import math
 import sys
 
 import click
+import numpy as np
 
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
 from robotcell.identification.report import write_identification_report
 from robotcell.identification.validation import compare_observability, cross_validate
+from robotcell.errors import InputError
+from robotcell.identification.validation import select_configurations
 from robotcell.modelfile import load_robot, save_robot
+from robotcell.robot import Robot
+from robotcell.tables import write_csv
+
+
+def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int, accuracy: float,
+             angle_accuracy: float, output: str | None, as_json: bool) -> None:
+    """``--propose N``: write the selected configurations (deg, mm) and print O1 against random."""
+    if n < 1 or targets < 1:
+        raise InputError(f"--propose and --targets must be positive, got {n} and {targets}")
+    if orientation and targets != 1:
+        raise InputError("--orientation goes with one target per configuration (--targets 1)")
+    sel = select_configurations(nominal, n, n_targets=targets, pose=orientation, seed=seed,
+                                point_sigma=accuracy * 1e-3, angle_sigma=math.radians(angle_accuracy))
+    q = np.where(nominal.prismatic, sel.q * 1e3, np.degrees(sel.q))
+    header = [f"a{i}" for i in range(1, nominal.n_joints + 1)]
+    if output is not None:
+        write_csv(output, header, q)
+    rand = sel.o1_random
+    if as_json:
+        data = {"robot": nominal.name, "o1": sel.o1, "o1_random": rand.tolist()}
+        if output is None:
+            data["configurations"] = q.tolist()
+        click.echo(json.dumps(data))
+        return
+    if output is None:
+        write_csv(sys.stdout, header, q)
+    click.echo(f"observability O1 of the {n} proposed configurations: {sel.o1:.4g}; {len(rand)} "
+               f"random sets within the joint limits: median {np.median(rand):.4g}, best "
+               f"{rand.max():.4g} ({(sel.o1 / rand.max() - 1) * 100:+.0f} % over the best)",
+               err=output is None)
+    if output is not None:
+        cols = "x,y,z" if targets == 1 else "x1,y1,z1,x2,..."
+        cols += ",qw,qx,qy,qz" if orientation else ""
+        click.echo(f"configurations written to {output} (a1..a{nominal.n_joints}, deg; mm for "
+                   f"prismatic joints); measure them and add the columns {cols}")
 
 
 @click.command()
-@click.argument("measurements", type=click.Path())
+@click.argument("measurements", type=click.Path(), required=False)
 @click.option("--robot", "robot", help="Nominal model: library name or model file. Without it the "
               "circle point analysis builds the start model (rows moving one joint at a time).")
-@click.option("-o", "--output", "output", type=click.Path(), help="Write the identified model file (YAML).")
+@click.option("-o", "--output", "output", type=click.Path(), help="Write the identified model file "
+              "(YAML); with --propose, the proposed configurations (CSV).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of the report.")
 @click.option("--j23-factor", "j23", type=float, help="J2/J3 coupling k: q3_model = J3 + k * J2 "
               "(FANUC: -1). The report says whether the data support it.")
@@ -34,9 +73,19 @@ from robotcell.modelfile import load_robot, save_robot
               "by the models identified without it (mean, RMS, max before and after).")
 @click.option("--report", "report", type=click.Path(dir_okay=False), help="Also write a "
               "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
-def identify(measurements: str, robot: str | None, output: str | None, as_json: bool,
+@click.option("--propose", "propose", type=int, metavar="N", help="Instead of identifying: propose "
+              "N configurations within the joint limits of --robot that maximise the observability "
+              "O1; CSV a1..aN (deg, mm) to -o or standard output.")
+@click.option("--targets", "targets", type=int, default=1, show_default=True,
+              help="With --propose: reflectors measured per configuration.")
+@click.option("--orientation", "orientation", is_flag=True,
+              help="With --propose: the orientation is measured too (6D probe, camera).")
+@click.option("--seed", "seed", type=int, default=0, show_default=True,
+              help="With --propose: seed of the random candidates and comparison sets.")
+def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool, force: bool,
-             folds: int | None, report: str | None) -> None:
+             folds: int | None, report: str | None, propose: int | None, targets: int,
+             orientation: bool, seed: int) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -51,11 +100,24 @@ def identify(measurements: str, robot: str | None, output: str | None, as_json: 
     Exit status: 0 identified; 2 refused input (reason on stderr); 3 poor result (the model
     file is not written unless --force).
 
+    --propose N (no MEASUREMENTS) proposes N configurations to measure instead: those that
+    maximise Borm and Menq's observability index O1 for --robot, compared with random sets.
+
     \b
     Examples:
       robotcell identify tracker.csv --robot kuka_kr16 -o kr16_identified.yaml
       robotcell identify tracker.csv --robot fanuc_m20ia --j23-factor -1 --json
+      robotcell identify --propose 30 --robot kuka_kr16 --targets 3 -o to_measure.csv
     """
+    if propose is not None:
+        if measurements is not None:
+            raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
+        if robot is None:
+            raise InputError("--propose needs --robot NOMINAL (library name or model file)")
+        return _propose(load_robot(robot), propose, targets, orientation, seed, accuracy,
+                        angle_accuracy, output, as_json)
+    if measurements is None:
+        raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
     options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale}
     if robot is not None:
         nominal = load_robot(robot)
