@@ -34,7 +34,7 @@ __all__ = ["list_robots", "load_robot", "robot_from_dict", "robot_to_dict", "sav
 
 _LENGTH = {"mm": 1e-3, "m": 1.0}
 _ANGLE = {"deg": math.pi / 180, "rad": 1.0}
-_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name", "passive"}
+_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name", "passive", "mass", "com"}
 _COUPLING_KEYS = {"j23_factor", "matrix", "offset", "interaction"}
 _POSE_KEYS = {"x", "y", "z", "a", "b", "c"}
 _TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
@@ -173,7 +173,15 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         if passive and ("min" in jd or "max" in jd):
             raise InputError(f"{where}: a passive joint has no limits of its own (remove 'min', 'max'); "
                              "state limits on the controller axes or under coupling.interaction")
+        mass = _number(jd.get("mass", 0.0), f"{where}: key 'mass'")
+        if mass < 0:
+            raise InputError(f"{where}: key 'mass' must be >= 0 (kg), got {jd['mass']!r}")
+        com = jd.get("com", [0.0, 0.0, 0.0])
+        if not isinstance(com, list) or len(com) != 3:
+            raise InputError(f"{where}: key 'com' must be [x, y, z], the centre of mass in the "
+                             "link's DH frame (file length unit)")
         joints.append(Joint(
+            mass=mass, com=tuple(_number(v, f"{where}: key 'com'") * ls for v in com),
             type=jtype,
             a=_number(jd["a"], f"{where}: key 'a'") * ls,
             alpha=_number(jd["alpha"], f"{where}: key 'alpha'") * as_,
@@ -339,6 +347,9 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         if j.passive:
             entry.pop("min", None)
             entry["passive"] = True
+        if j.mass > 0:
+            entry["mass"] = j.mass
+            entry["com"] = [_clean(v * 1e3) for v in j.com]
         joints.append({k: _clean(v) for k, v in entry.items()})
     data: dict[str, Any] = {
         "name": robot.name, "title": robot.title, "convention": robot.convention,

@@ -52,6 +52,11 @@ class Joint:
     passive : bool
         A joint without a controller axis, moved by a linkage (a palletizer's parallelogram);
         its value comes from the robot's coupling and its limits are not used.
+    mass : float
+        Mass of the link this joint moves (kg); 0 when not stated. Used only for gravity
+        compliance in identification.
+    com : tuple of 3 float
+        Centre of mass of that link in its DH frame (m).
     """
 
     type: Literal["revolute", "prismatic"]
@@ -64,6 +69,8 @@ class Joint:
     upper: float = math.inf
     name: str = ""
     passive: bool = False
+    mass: float = 0.0
+    com: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @property
     def prismatic(self) -> bool:

@@ -9,13 +9,16 @@ import sys
 import click
 import numpy as np
 
+from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
 from robotcell.identification.report import write_identification_report
-from robotcell.identification.validation import compare_observability, cross_validate
-from robotcell.errors import InputError
-from robotcell.identification.validation import select_configurations
+from robotcell.identification.validation import (
+    compare_observability,
+    cross_validate,
+    select_configurations,
+)
 from robotcell.modelfile import load_robot, save_robot
 from robotcell.robot import Robot
 from robotcell.tables import write_csv
@@ -68,6 +71,8 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
 @click.option("--angle-accuracy", "angle_accuracy", type=float, default=0.02, show_default=True,
               help="Accuracy of a measured orientation (deg).")
 @click.option("--scale", "scale", is_flag=True, help="Also identify a scale error (gear ratio) per axis.")
+@click.option("--compliance", "compliance", is_flag=True, help="Also identify the gravity compliance "
+              "of axes 2 and 3 (needs the link masses: joint keys mass, com in the model file).")
 @click.option("--force", "force", is_flag=True, help="Write -o even when the verdict is poor.")
 @click.option("--folds", "folds", type=int, help="Also K-fold cross-validate: every row predicted "
               "by the models identified without it (mean, RMS, max before and after).")
@@ -83,8 +88,8 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
 @click.option("--seed", "seed", type=int, default=0, show_default=True,
               help="With --propose: seed of the random candidates and comparison sets.")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
-             j23: float | None, accuracy: float, angle_accuracy: float, scale: bool, force: bool,
-             folds: int | None, report: str | None, propose: int | None, targets: int,
+             j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
+             compliance: bool, force: bool, folds: int | None, report: str | None, propose: int | None, targets: int,
              orientation: bool, seed: int) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
@@ -118,7 +123,8 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
                         angle_accuracy, output, as_json)
     if measurements is None:
         raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
-    options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale}
+    options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale,
+               "compliance": compliance}
     if robot is not None:
         nominal = load_robot(robot)
         meas = read_measurements(measurements, nominal.prismatic)

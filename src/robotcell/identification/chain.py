@@ -22,7 +22,10 @@ nominally parallel. There plain DH is discontinuous (a tilt of 0.01 deg moves th
 metres away), while with ``beta`` every small tilt is a small change of parameters. The joint
 variable enters as ``theta_i = sign_i * qm_i + theta_i`` (revolute) or ``d_i = sign_i * qm_i + d_i``
 (prismatic) with the model joint value ``qm_i = (1 + scale_i) q_i``, plus ``k * q_2`` on joint 3 for
-a J2/J3 coupling ``q3_model = J3 + k * J2`` (the ROS-Industrial FANUC driver's ``J23_factor``).
+a J2/J3 coupling ``q3_model = J3 + k * J2`` (the ROS-Industrial FANUC driver's ``J23_factor``),
+plus ``sign_i * compliance_i * tau_i(q)`` on joints 2 and 3: their turn under the gravity torque
+``tau_i`` of the nominal link masses (:mod:`robotcell.identification.gravity`), so that the DH
+variable changes by ``compliance_i * tau_i`` (rad per N m times N m).
 
 The derivative of ``p_D`` with respect to the constant of a rotation about unit axis ``u``
 through ``o`` (both in D, at the current row) is ``u × (p_D - o)``, and ``u`` for a translation:
@@ -37,10 +40,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.identification.gravity import gravity_torques
 from robotcell.robot import Robot
 from robotcell.transforms import make_pose, rot_x, rot_y, rot_z
 
-__all__ = ["PARALLEL_TOL", "Chain", "Op"]
+__all__ = ["COMPLIANT_JOINTS", "PARALLEL_TOL", "Chain", "Op"]
+
+#: Joints (0-based) with a gravity compliance parameter: axes 2 and 3.
+COMPLIANT_JOINTS = (1, 2)
 
 #: Consecutive nominal axes closer than this to parallel (radians) get a Hayati ``beta``.
 PARALLEL_TOL = math.radians(1.0)
@@ -97,7 +104,7 @@ class Chain:
     names : list of str
         Parameter names; ``values`` the nominal parameter vector (m, rad).
     groups : list of str
-        Per parameter: ``base``, ``target``, ``link``, ``scale`` or ``coupling``.
+        Per parameter: ``base``, ``target``, ``link``, ``scale``, ``coupling`` or ``compliance``.
     """
 
     def __init__(self, robot: Robot, n_targets: int, pose_target: bool,
@@ -160,6 +167,10 @@ class Chain:
             self.target_params.append([add(f"{tag}.{c}", 0.0, "target") for c in "xyz"])
         self.scale_params = [add(f"{nm}.scale", 0.0, "scale") for nm in self.joint_names]
         self.coupling_param = add("j23_factor", 0.0, "coupling") if self.n >= 3 else -1
+        self.compliance_params = ([add(f"{self.joint_names[j]}.compliance", 0.0, "compliance")
+                                   for j in COMPLIANT_JOINTS] if self.n >= 3 else [])
+        self._masses = any(j.mass > 0 for j in robot.joints)
+        self._tau_cache: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
         self.names = names
         self.values = np.array(values)
         self.groups = groups
@@ -169,15 +180,35 @@ class Chain:
         return self.names.index(name)
 
     # -- evaluation -----------------------------------------------------------------------------
-    def model_joints(self, x: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Model joint values ``(1 + scale) q`` plus ``k q_2`` on joint 3, shape (N, n)."""
+    def torques(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Gravity torques on axes 2 and 3 of the nominal model at ``q`` (N m), shape (N, 2)."""
+        if not (self._masses and self.compliance_params):
+            return np.zeros((q.shape[0], len(self.compliance_params)))
+        hit = self._tau_cache
+        if hit is None or hit[0].shape != q.shape or not np.array_equal(hit[0], q):
+            hit = (q.copy(), gravity_torques(self.robot, q, COMPLIANT_JOINTS))
+            self._tau_cache = hit
+        return hit[1]
+
+    def model_joints(self, x: NDArray[np.float64], q: NDArray[np.float64],
+                     gravity: bool = True) -> NDArray[np.float64]:
+        """Model joint values ``(1 + scale) q`` plus ``k q_2`` on joint 3, shape (N, n).
+
+        With ``gravity``, plus ``sign * compliance * tau`` on axes 2 and 3 (the deflection).
+        """
         qm = q * (1.0 + x[self.scale_params])
         if self.coupling_param >= 0:
             qm[:, 2] += x[self.coupling_param] * q[:, 1] * (1.0 + x[self.scale_params[2]])
+        if gravity and self._masses and self.compliance_params:
+            c = x[self.compliance_params]
+            if np.any(c):
+                tau = self.torques(q)
+                for col, j in enumerate(COMPLIANT_JOINTS):
+                    qm[:, j] += self.robot.joints[j].sign * c[col] * tau[:, col]
         return qm
 
     def evaluate(self, x: NDArray[np.float64], q: NDArray[np.float64], jac: bool = True,
-                 base: bool = True) -> Evaluation:
+                 base: bool = True, gravity: bool = True) -> Evaluation:
         """Walk the chain for every row.
 
         Parameters
@@ -190,13 +221,15 @@ class Chain:
             Record the axis and origin of every motion (for the Jacobian).
         base : bool
             Include ``T_D_R`` (False: frames in the robot base frame R).
+        gravity : bool
+            Include the gravity deflection of axes 2 and 3.
 
         Returns
         -------
         Evaluation
         """
         N = q.shape[0]
-        qm = self.model_joints(x, q)
+        qm = self.model_joints(x, q, gravity)
         start = self.base_start if base else np.eye(4)
         cols = [np.broadcast_to(start[:3, k], (N, 3)) for k in range(4)]
         axes: list[NDArray[np.float64]] = []
@@ -285,6 +318,10 @@ class Chain:
         j = o.joint
         base_q = q[:, j] if j != 2 or self.coupling_param < 0 else q[:, 2] + x[self.coupling_param] * q[:, 1]
         J[..., self.scale_params[j]] += o.sign * base_q[extra] * col
+        if j in COMPLIANT_JOINTS and self.compliance_params and self._masses:
+            # d(DH variable)/d(compliance) = sign * sign * tau = tau.
+            J[..., self.compliance_params[COMPLIANT_JOINTS.index(j)]] += (
+                self.torques(q)[:, COMPLIANT_JOINTS.index(j)][extra] * col)
         if j == 2 and self.coupling_param >= 0:
             J[..., self.coupling_param] += (o.sign * (1.0 + x[self.scale_params[2]]) * q[:, 1])[extra] * col
 
@@ -313,7 +350,7 @@ class Chain:
         flange : ndarray, shape (4, 4)
             ``T_R_F`` at ``q = 0`` (m).
         """
-        ev = self.evaluate(x, np.zeros((1, self.n)), jac=True, base=False)
+        ev = self.evaluate(x, np.zeros((1, self.n)), jac=True, base=False, gravity=False)
         pts, dirs = np.zeros((self.n, 3)), np.zeros((self.n, 3))
         for o, u, org in zip(self.ops, ev.axes, ev.origins):
             if o.joint >= 0:

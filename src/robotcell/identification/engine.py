@@ -35,7 +35,8 @@ from robotcell.calibration.fitting import kabsch, scaled_condition
 from robotcell.coupling import Coupling
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError, InputError
-from robotcell.identification.chain import Chain
+from robotcell.identification.chain import COMPLIANT_JOINTS, Chain
+from robotcell.identification.gravity import require_masses
 from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult, Parameter
 from robotcell.ik import analytic_solver
@@ -244,6 +245,7 @@ def identify(
     point_sigma: float = POINT_SIGMA,
     angle_sigma: float = ANGLE_SIGMA,
     scale: bool = False,
+    compliance: bool = False,
     coupling: float | None = None,
     fit_coupling: bool = False,
     rank_tol: float = 1e-6,
@@ -265,6 +267,9 @@ def identify(
         Accuracy of a measured orientation (rad per axis); weights the rotation residuals.
     scale : bool
         Also identify a scale error per axis (gear ratio): ``qm = (1 + scale) q``.
+    compliance : bool
+        Also identify the gravity compliance of axes 2 and 3 (rad per N m), multiplied by the
+        gravity torque of the nominal link masses (``Joint.mass``, ``Joint.com``).
     coupling : float, optional
         J2/J3 coupling factor ``k`` with ``q3_model = J3 + k J2`` (0: none). Held unless
         ``fit_coupling``. Default: the nominal model's ``j23_factor`` (0 without a coupling).
@@ -301,6 +306,10 @@ def identify(
                          "'coupling: {j23_factor: k}'")
     if coupling is None:
         coupling = 0.0 if nominal.coupling is None else nominal.coupling.j23_factor
+    if compliance:
+        if nominal.n_joints < 3 or any(nominal.joints[j].prismatic for j in COMPLIANT_JOINTS):
+            raise InputError("gravity compliance needs revolute axes 2 and 3")
+        require_masses(nominal, COMPLIANT_JOINTS)
     if coupling and nominal.n_joints < 3:
         raise InputError("a J2/J3 coupling needs a chain with at least 3 joints")
     chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, np.eye(4), np.eye(4))
@@ -320,6 +329,8 @@ def identify(
     cand = list(prio) + list(np.flatnonzero(groups == "link"))
     if scale:
         cand += list(np.flatnonzero(groups == "scale"))
+    if compliance:
+        cand += list(np.flatnonzero(groups == "compliance"))
     if fit_coupling and chain.coupling_param >= 0:
         cand.append(chain.coupling_param)
     J1 = prob.jacobian(x1)
@@ -364,12 +375,13 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
     sig_full = dict(zip(kept.tolist(), sig))
     for i, nm in enumerate(chain.names):
         g = chain.groups[i]
-        if g in ("scale", "coupling") and i not in sig_full and i not in fixed:
+        if g in ("scale", "coupling", "compliance") and i not in sig_full and i not in fixed:
             continue
         params.append(Parameter(nm, float(x[i]), float(chain.values[i]) if g == "link" else float("nan"),
                                 float(sig_full.get(i, float("nan"))), i in sig_full, fixed.get(i, ""),
                                 "length" if (nm.split(".")[-1] in ("a", "d", "x", "y", "z")) else
-                                ("number" if g in ("scale", "coupling") else "angle")))
+                                ("number" if g in ("scale", "coupling") else
+                                 "compliance" if g == "compliance" else "angle")))
     robot = _to_robot(nominal, chain, x, name)
     return IdentificationResult(
         robot=robot, nominal=nominal, base=chain.base_pose(x), targets=chain.targets(x),
@@ -397,11 +409,12 @@ def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | 
     der = dh_from_axes(axes, nominal.convention, signs=[j.sign for j in nominal.joints], name=nm,
                        title=f"{nominal.title or nominal.name}, identified",
                        source=f"identified from measurements, nominal {nominal.name}")
+    joints = tuple(replace(j, mass=n.mass, com=n.com) for j, n in zip(der.robot.joints, nominal.joints))
     tool = chain.tool_pose(x)
     if not chain.pose_target and chain.n_targets:
         tool = np.eye(4)
         tool[:3, 3] = chain.targets(x)[0]
-    return replace(der.robot, tool=tool, home=nominal.home, ik_seed=_ik_seed(nominal),
+    return replace(der.robot, joints=joints, tool=tool, home=nominal.home, ik_seed=_ik_seed(nominal),
                    coupling=_coupling(nominal, chain, x))
 
 

@@ -35,7 +35,8 @@ class Parameter:
         True when identified, False when held at its nominal value.
     why : str
         Why a fixed parameter was held.
-    kind : {"length", "angle", "number"}
+    kind : {"length", "angle", "number", "compliance"}
+        ``compliance``: rad per N m (shown in urad/Nm).
     """
 
     name: str
@@ -47,8 +48,9 @@ class Parameter:
     kind: str
 
     def vendor(self) -> tuple[float, float, float, str]:
-        """Value, nominal and sigma in mm / deg, and the unit."""
-        s, unit = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "number": (1.0, "")}[self.kind]
+        """Value, nominal and sigma in mm / deg / urad per N m, and the unit."""
+        s, unit = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "number": (1.0, ""),
+                   "compliance": (1e6, "urad/Nm")}[self.kind]
         return self.value * s, self.nominal * s, self.sigma * s, unit
 
 
@@ -196,7 +198,7 @@ class IdentificationResult:
             return "poor", (f"the residuals are {s0:.1f} times the stated accuracy (RMS "
                             f"{self.rms_after * 1e3:.3f} mm); the model or the joint values do "
                             "not explain the measurements")
-        if not any(p.free and p.kind != "number" and not p.name.startswith(("base.", "target"))
+        if not any(p.free and p.kind in ("length", "angle") and not p.name.startswith(("base.", "target"))
                    for p in self.parameters):
             return "poor", "no link parameter is identifiable from these measurements"
         reasons = []
