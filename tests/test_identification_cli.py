@@ -232,3 +232,29 @@ def test_propose_configurations_then_identify_them(kr16_truth, tmp_path, capsys)
 def test_propose_refusals(args, message, capsys):
     code, _, stderr = run(capsys, "identify", *args)
     assert code == 2 and message in stderr
+
+
+@pytest.mark.parametrize("vendor,unit,scale", [("kuka", "deg", 180 / math.pi), ("abb", "rad", 1.0)])
+def test_joint_offsets_for_controllers(kr16_truth, tmp_path, capsys, vendor, unit, scale):
+    nominal, ch, x, rng = kr16_truth
+    meas = measure(ch, x, configurations(nominal, 50, rng), rng, NOISE)
+    csv = tmp_path / "tracker.csv"
+    write_csv(csv, meas)
+    code, stdout, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--accuracy", "0.02",
+                               "--json", "--offsets-for", vendor)
+    assert code == 0, stderr
+    axes = json.loads(stdout)["joint_offsets"]["axes"]
+    # The true zero error of each axis, as a counter correction: sign * (theta_true - theta_nominal).
+    for j, a in zip(range(6), axes):
+        assert a["unit"] == unit
+        key = f"A{j + 1}.theta"
+        if j in (0, 5):  # absorbed by the base pose and by the target: not determined, and why
+            assert a["delta"] is None or math.isnan(a["delta"])
+            assert "absorbed" in a["why"]
+            continue
+        truth = nominal.joints[j].sign * (x[ch.index(key)] - nominal.joints[j].theta) * scale
+        assert abs(a["delta"] - truth) <= 3 * a["sigma"] + 1e-9, key
+    code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--offsets-for", vendor)
+    assert code == 0 and ("$MAMES[i]" in stdout if vendor == "kuka" else "no MOC.cfg line" in stdout)
+    code, _, stderr = run(capsys, "identify", csv, "--offsets-for", vendor)
+    assert code == 2 and "--offsets-for needs --robot" in stderr

@@ -13,6 +13,7 @@ from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
+from robotcell.identification.offsets import joint_offsets
 from robotcell.identification.report import write_identification_report
 from robotcell.identification.validation import (
     compare_observability,
@@ -21,7 +22,33 @@ from robotcell.identification.validation import (
 )
 from robotcell.modelfile import load_robot, save_robot
 from robotcell.robot import Robot
-from robotcell.tables import write_csv
+from robotcell.tables import format_table, write_csv
+
+
+def _offsets(result, vendor: str) -> dict:
+    """Joint zero offsets in the controller's units: KUKA deg (mm), ABB rad (m)."""
+    rows = []
+    for o in joint_offsets(result):
+        f = (1e3 if o.prismatic else 180 / math.pi) if vendor == "kuka" else 1.0
+        unit = ("mm" if o.prismatic else "deg") if vendor == "kuka" else ("m" if o.prismatic else "rad")
+        rows.append({"axis": o.axis, "delta": o.delta * f, "sigma": o.sigma * f, "unit": unit,
+                     "why": o.why})
+    return {"controller": vendor, "axes": rows}
+
+
+def _print_offsets(offsets: dict, vendor: str) -> None:
+    if vendor == "kuka":
+        click.echo("\njoint zero corrections for KUKA: add to the current $MAMES[i] in $machine.dat "
+                   "(deg; mm for linear axes)")
+        head = ["axis", "add to $MAMES[i]", "1-sigma", "unit", "note"]
+    else:
+        click.echo("\njoint zero offsets for ABB, arm side (rad; m for linear axes); robotcell writes "
+                   "no MOC.cfg line: apply them with ABB's calibration tools (docs/identification.md)")
+        head = ["axis", "offset", "1-sigma", "unit", "note"]
+    rows = [[a["axis"], "-" if math.isnan(a["delta"]) else f"{a['delta']:+.6f}",
+             "-" if math.isnan(a["sigma"]) else f"{a['sigma']:.6f}", a["unit"],
+             "not determined: " + a["why"] if a["why"] else ""] for a in offsets["axes"]]
+    click.echo(format_table(head, rows))
 
 
 def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int, accuracy: float,
@@ -78,6 +105,9 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               "by the models identified without it (mean, RMS, max before and after).")
 @click.option("--report", "report", type=click.Path(dir_okay=False), help="Also write a "
               "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
+@click.option("--offsets-for", "offsets_for", type=click.Choice(["kuka", "abb"]), help="Also print "
+              "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "
+              "ABB arm-side offsets (rad). Needs --robot.")
 @click.option("--propose", "propose", type=int, metavar="N", help="Instead of identifying: propose "
               "N configurations within the joint limits of --robot that maximise the observability "
               "O1; CSV a1..aN (deg, mm) to -o or standard output.")
@@ -89,8 +119,9 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               help="With --propose: seed of the random candidates and comparison sets.")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
-             compliance: bool, force: bool, folds: int | None, report: str | None, propose: int | None, targets: int,
-             orientation: bool, seed: int) -> None:
+             compliance: bool, force: bool, folds: int | None, report: str | None,
+             offsets_for: str | None, propose: int | None, targets: int, orientation: bool,
+             seed: int) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -123,6 +154,9 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
                         angle_accuracy, output, as_json)
     if measurements is None:
         raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
+    if offsets_for is not None and robot is None:
+        raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
+                         "the controller uses")
     options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale,
                "compliance": compliance}
     if robot is not None:
@@ -148,13 +182,18 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
                                     pose=meas.rotations is not None, point_sigma=options["point_sigma"],
                                     angle_sigma=options["angle_sigma"])
         write_identification_report(result, report, cross, obs)
+    offsets = None if offsets_for is None else _offsets(result, offsets_for)
     if as_json:
         data = result.to_json()
         if cv is not None:
             data["cross_validation"] = {"folds": folds, **cv}
+        if offsets is not None:
+            data["joint_offsets"] = offsets
         click.echo(json.dumps(data))
     else:
         click.echo(result.summary())
+        if offsets is not None:
+            _print_offsets(offsets, offsets_for)
         if cv is not None:
             click.echo(f"cross-validation, {folds} folds (held-out rows, mm): nominal mean "
                        f"{cv['before_mean_mm']:.4f} RMS {cv['before_rms_mm']:.4f} max "
