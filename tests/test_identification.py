@@ -335,3 +335,26 @@ def test_model_without_closed_form_or_seed_is_refused(kr16_result):
     from dataclasses import replace
     with pytest.raises(InputError, match="no analytic inverse kinematics.*ik_seed"):
         replace(res.robot, ik_seed=None).ik(np.eye(4))
+
+
+def test_seeded_ik_at_the_edge_of_the_nominal_workspace():
+    # The identified forearm is 1 mm longer: with the arm stretched, the pose is outside the
+    # nominal arm's reach, so the nominal has no branch there; the target pulled in by the miss
+    # seeds it, and the refinement reaches 1e-9 on the identified model.
+    rng = np.random.default_rng(2)
+    nominal = load_robot("kuka_kr16")
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
+    x[ch.index("A4.d")] += 1e-3
+    robot = identify(nominal, measure(ch, x, configurations(nominal, 40, rng), rng, NOISE),
+                     point_sigma=NOISE).robot
+    q3 = np.radians(np.linspace(-10, 10, 2001))
+    qs = np.zeros((len(q3), 6))
+    qs[:, 1], qs[:, 2], qs[:, 4] = -math.pi / 4, q3, 0.5
+    F = robot.frames(qs)
+    q = qs[[int(np.argmax(np.linalg.norm(F[:, 4, :3, 3] - F[:, 1, :3, 3], axis=1)))]]  # stretched
+    T = robot.fk(q)
+    assert not nominal.ik(T, tool=robot.tool).reachable.any()
+    sol = robot.ik(T)
+    assert sol.valid.any()
+    err = np.linalg.norm(robot.fk(sol.q[sol.reachable])[:, :3, 3] - T[0, :3, 3], axis=-1)
+    assert err.max() < 1e-9

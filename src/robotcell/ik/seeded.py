@@ -28,6 +28,8 @@ __all__ = ["SEEDED_TOL", "SeededSolver"]
 
 #: Position (m) and orientation (rad) tolerance of the refinement.
 SEEDED_TOL = 1e-9
+#: Largest miss of the seed model's reach (m) for which a pulled-in target still seeds a branch.
+EDGE = 0.02
 
 
 class SeededSolver:
@@ -87,11 +89,12 @@ class SeededSolver:
         tool_T = self.robot.tool if tool is None else validate_pose(tool, "tool")
         seeds = self.seed.solve(arr, tool_T, q_ref)
         nb, n = self.branches, self.robot.n_joints
-        q = seeds.q.reshape(-1, nb, seeds.q.shape[-1])
+        q = seeds.q.reshape(-1, nb, seeds.q.shape[-1]).copy()
+        reach = seeds.reachable.reshape(-1, nb).copy()
+        self._edge_seeds(arr.reshape(-1, 4, 4), tool_T, q_ref, seeds, q, reach)
         if self.seed.robot.coupling is not None:  # seed values -> chain values -> ours
             q = self.seed.robot.coupling.to_model(q)
-        q = self.robot.coupling.to_controller(q) if self.robot.coupling is not None else q.copy()
-        reach = seeds.reachable.reshape(-1, nb).copy()
+        q = self.robot.coupling.to_controller(q) if self.robot.coupling is not None else q
         err = np.full(reach.shape, math.inf)
         targets = np.broadcast_to(arr.reshape(-1, 1, 4, 4), q.shape[:2] + (4, 4))
         idx = np.nonzero(reach)
@@ -104,3 +107,28 @@ class SeededSolver:
         batch = arr.shape[:-2]
         return IKSolutions(q.reshape(batch + (nb, n)), valid.reshape(batch + (nb,)),
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))
+
+    def _edge_seeds(self, flat, tool_T, q_ref, seeds, q, reach) -> None:
+        """Seeds for branches just outside the seed model's reach (at the workspace edge).
+
+        The identified arm may reach a pose the nominal one misses by up to ``EDGE``: those
+        branches are seeded by the nominal solution of the target pulled toward the robot base
+        by the miss plus 1 mm (filled into ``q`` and ``reach`` in place).
+        """
+        if seeds.reach_error is None:
+            return
+        miss = seeds.reach_error.reshape(reach.shape)
+        near = ~reach & np.isfinite(miss) & (miss < EDGE)
+        rows = np.flatnonzero(near.any(axis=1))
+        if rows.size == 0:
+            return
+        pulled = flat[rows].copy()
+        p = pulled[:, :3, 3]
+        pull = np.where(near[rows], miss[rows], 0.0).max(axis=1) + 1e-3
+        pulled[:, :3, 3] = p - p / np.linalg.norm(p, axis=1, keepdims=True) * pull[:, None]
+        ref = None if q_ref is None else np.broadcast_to(q_ref, flat.shape[:1] + (q.shape[-1],))[rows]
+        again = self.seed.solve(pulled, tool_T, ref)
+        fill = near[rows] & again.reachable
+        sub_q, sub_r = q[rows], reach[rows]
+        sub_q[fill], sub_r[fill] = again.q[fill], True
+        q[rows], reach[rows] = sub_q, sub_r
