@@ -358,3 +358,21 @@ def test_seeded_ik_at_the_edge_of_the_nominal_workspace():
     assert sol.valid.any()
     err = np.linalg.norm(robot.fk(sol.q[sol.reachable])[:, :3, 3] - T[0, :3, 3], axis=-1)
     assert err.max() < 1e-9
+
+
+def test_nominal_that_is_not_a_library_model_is_nested_as_ik_seed(kr16_result, tmp_path):
+    from dataclasses import replace
+    nominal, _, _, meas, res = kr16_result
+    custom = replace(nominal, name="my_kr16")
+    robot = replace(res.robot, ik_seed=custom)
+    save_robot(robot, tmp_path / "id.yaml")
+    text = (tmp_path / "id.yaml").read_text()
+    assert "ik_seed:\n  name: my_kr16" in text
+    back = load_robot(tmp_path / "id.yaml")
+    assert back.ik_seed.name == "my_kr16"
+    T = back.fk(meas.q[:3])
+    sol = back.ik(T)
+    assert sol.valid.any(axis=-1).all()
+    (tmp_path / "bad2.yaml").write_text("name: a\njoints:\n  - {type: revolute, a: 0, alpha: 0, d: 0, theta: 0}\nik_seed: nosuch_robot\n")
+    with pytest.raises(InputError, match="key 'ik_seed': 'nosuch_robot' is not a library robot"):
+        load_robot(tmp_path / "bad2.yaml")
