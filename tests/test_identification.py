@@ -376,3 +376,21 @@ def test_nominal_that_is_not_a_library_model_is_nested_as_ik_seed(kr16_result, t
     (tmp_path / "bad2.yaml").write_text("name: a\njoints:\n  - {type: revolute, a: 0, alpha: 0, d: 0, theta: 0}\nik_seed: nosuch_robot\n")
     with pytest.raises(InputError, match="key 'ik_seed': 'nosuch_robot' is not a library robot"):
         load_robot(tmp_path / "bad2.yaml")
+
+
+def test_identified_model_in_a_cell_solves_ik(kr16_result, tmp_path):
+    from pathlib import Path
+
+    from robotcell.cell import Cell
+    _, _, _, meas, res = kr16_result
+    save_robot(res.robot, tmp_path / "kr16_identified.yaml")
+    example = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
+    (tmp_path / "cell.yaml").write_text(example.read_text().replace("model: kuka_kr16",
+                                                                     "model: kr16_identified.yaml"))
+    cell = Cell.load(tmp_path / "cell.yaml")
+    q = meas.q[:3]
+    T = cell.fk(q, track=1.5, tool="torch")
+    sol = cell.ik(T, track=1.5, tool="torch")
+    back = cell.fk(np.where(sol.reachable[..., None], sol.q, 0.0), track=1.5, tool="torch")
+    assert sol.valid.any(axis=-1).all()
+    assert np.abs(back - T[:, None])[sol.reachable].max() < 1e-9
