@@ -100,7 +100,7 @@ class SeededSolver:
         idx = np.nonzero(reach)
         if idx[0].size:
             num = solve_numeric(self._free, targets[idx], q[idx], tol_position=self.tol,
-                                tol_orientation=self.tol, max_iterations=30, restarts=0, tool=tool_T)
+                                tol_orientation=self.tol, max_iterations=100, restarts=0, tool=tool_T)
             q[idx], reach[idx], err[idx] = num.q, num.success, num.position_error
         q[~reach] = np.nan
         valid = reach & self.robot.within_limits(np.nan_to_num(q))
