@@ -119,11 +119,19 @@ def test_identify_j23_factor_report(tmp_path, capsys):
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
     csv = tmp_path / "fanuc.csv"
     write_csv(csv, meas)
+    out = tmp_path / "fanuc_identified.yaml"
     code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--j23-factor", "-1",
-                          "--json", "--accuracy", "0.02")
+                          "--json", "--accuracy", "0.02", "-o", out)
     assert code == 0
-    check = json.loads(stdout)["coupling_check"]
+    data = json.loads(stdout)
+    check = data["coupling_check"]
     assert check["supported"] and check["rms_without_mm"] > 10 * check["rms_with_mm"]
+    # The model file holds the coupling: its FK takes the CSV's controller values.
+    assert "coupling: {j23_factor: -1}" in out.read_text()
+    base = np.array(data["base"])
+    base[:3, 3] /= 1e3
+    pred = (base @ load_robot(out).fk(meas.q))[:, :3, 3]
+    assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 0.05e-3
 
 
 @pytest.mark.parametrize("content,message", [
