@@ -100,3 +100,21 @@ def test_masses_round_trip_and_compliance_refused_without_them(tmp_path, capsys)
     (tmp_path / "bad.yaml").write_text((tmp_path / "m.yaml").read_text().replace("mass: 40", "mass: -40"))
     with pytest.raises(InputError, match="joint 2: key 'mass' must be >= 0"):
         load_robot(tmp_path / "bad.yaml")
+
+
+def test_compliance_from_the_command_line(tmp_path, capsys):
+    import json
+    rng = np.random.default_rng(6)
+    nominal = with_masses(load_robot("kuka_kr16"))
+    save_robot(nominal, tmp_path / "kr16_masses.yaml")
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
+    x[ch.compliance_params] = [2e-6, 2e-6]
+    write_csv(tmp_path / "m.csv", measure(ch, x, configurations(nominal, 50, rng), rng, NOISE))
+    code, stdout, stderr = run(capsys, "identify", tmp_path / "m.csv", "--robot", tmp_path / "kr16_masses.yaml",
+                               "--compliance", "--accuracy", "0.02", "--json")
+    assert code == 0, stderr
+    data = json.loads(stdout)
+    p = {d["name"]: d for d in data["parameters"]}
+    assert p["A2.compliance"]["unit"] == "urad/Nm"
+    assert abs(p["A2.compliance"]["value"] - 2.0) <= 3 * p["A2.compliance"]["sigma"]
+    assert data["rms_after_mm"] < 0.05
