@@ -17,7 +17,7 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from robotcell.ik.numeric import solve_numeric
 from robotcell.ik.result import IKSolutions
@@ -91,7 +91,9 @@ class SeededSolver:
         nb, n = self.branches, self.robot.n_joints
         q = seeds.q.reshape(-1, nb, seeds.q.shape[-1]).copy()
         reach = seeds.reachable.reshape(-1, nb).copy()
-        self._edge_seeds(arr.reshape(-1, 4, 4), tool_T, q_ref, seeds, q, reach)
+        ref = None if q_ref is None else np.broadcast_to(
+            np.asarray(q_ref, dtype=float), arr.shape[:-2] + (q.shape[-1],)).reshape(-1, q.shape[-1])
+        self._edge_seeds(arr.reshape(-1, 4, 4), tool_T, ref, seeds, q, reach)
         if self.seed.robot.coupling is not None:  # seed values -> chain values -> ours
             q = self.seed.robot.coupling.to_model(q)
         q = self.robot.coupling.to_controller(q) if self.robot.coupling is not None else q
@@ -108,7 +110,9 @@ class SeededSolver:
         return IKSolutions(q.reshape(batch + (nb, n)), valid.reshape(batch + (nb,)),
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))
 
-    def _edge_seeds(self, flat, tool_T, q_ref, seeds, q, reach) -> None:
+    def _edge_seeds(self, flat: NDArray[np.float64], tool_T: NDArray[np.float64],
+                    ref: NDArray[np.float64] | None, seeds: IKSolutions, q: NDArray[np.float64],
+                    reach: NDArray[np.bool_]) -> None:
         """Seeds for branches just outside the seed model's reach (at the workspace edge).
 
         The identified arm may reach a pose the nominal one misses by up to ``EDGE``: those
@@ -125,9 +129,9 @@ class SeededSolver:
         pulled = flat[rows].copy()
         p = pulled[:, :3, 3]
         pull = np.where(near[rows], miss[rows], 0.0).max(axis=1) + 1e-3
-        pulled[:, :3, 3] = p - p / np.linalg.norm(p, axis=1, keepdims=True) * pull[:, None]
-        ref = None if q_ref is None else np.broadcast_to(q_ref, flat.shape[:1] + (q.shape[-1],))[rows]
-        again = self.seed.solve(pulled, tool_T, ref)
+        norm = np.maximum(np.linalg.norm(p, axis=1, keepdims=True), 1e-9)
+        pulled[:, :3, 3] = p - p / norm * pull[:, None]
+        again = self.seed.solve(pulled, tool_T, None if ref is None else ref[rows])
         fill = near[rows] & again.reachable
         sub_q, sub_r = q[rows], reach[rows]
         sub_q[fill], sub_r[fill] = again.q[fill], True
