@@ -128,6 +128,20 @@ class Touches:
             cols.append(list(self.roles))
         return header, [list(r) for r in zip(*cols)]
 
+    def to_table(self) -> dict[str, Any]:
+        """The measurement table as :func:`robotcell.tables.read_csv` reads the CSV (mm, deg).
+
+        Returns
+        -------
+        dict
+            Column name to a float array (or a list of strings), the input of
+            :mod:`robotcell.cellcal`.
+        """
+        from robotcell.cellcal.touches import load_table
+
+        header, rows = self.columns()
+        return load_table(dict(zip(header, map(list, zip(*rows)))))[0]
+
     def write_csv(self, out: str | Path | TextIO) -> None:
         """Write the measurement CSV to a path or an open text stream."""
         header, rows = self.columns()

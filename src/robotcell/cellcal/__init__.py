@@ -1,0 +1,23 @@
+"""Calibrating into a cell: each procedure the technician runs is one call on a Cell.
+
+``cellcal.tcp``, ``cellcal.frame``, ``cellcal.track``, ``cellcal.turntable`` and
+``cellcal.workpiece`` take a :class:`~robotcell.cell.Cell`, a measurement table (mm, deg, as
+:func:`robotcell.tables.read_csv` returns it) and options in SI units, and return a
+:class:`CellCalibration`: the result, the updated cell (a new object) and its provenance.
+See ``docs/python-api.md``.
+"""
+
+from robotcell.cellcal.procedures import (
+    SAME_POSE,
+    CellCalibration,
+    TurntablePose,
+    frame,
+    tcp,
+    track,
+    turntable,
+    workpiece,
+)
+from robotcell.cellcal.touches import load_table, robot_in_world, track_positions
+
+__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "load_table",
+           "robot_in_world", "tcp", "track", "track_positions", "turntable", "workpiece"]
