@@ -29,19 +29,6 @@ def fixed_time(monkeypatch):
     monkeypatch.setattr(Provenance, "now", classmethod(now))
 
 
-def _options_to_keywords(procedure, options):
-    """The library keywords of the CLI options a simulation asks for (mm -> m)."""
-    kw = {}
-    for opt in options:
-        key, value = opt.lstrip("-").split("=")
-        numbers = np.array([float(v) for v in value.split(",")]) * 1e-3
-        if key == "reference":
-            kw.setdefault("references", []).append(numbers)
-        elif key == "height":
-            kw["height"] = float(numbers[0])
-    return kw
-
-
 # procedure, CLI arguments besides the file, library keywords, simulation keywords
 STEPS = [
     ("tcp", ["--name", "torch"], {"name": "torch"}, {"tool": "torch"}),
@@ -76,7 +63,7 @@ def test_cli_cell_results_equal_the_library_call_byte_for_byte(tmp_path, capsys,
         before = Cell.load(lib_file)
         call = getattr(cellcal, procedure)
         got = call(before, read_csv(csv), source=str(csv),
-                   **lib_kw, **_options_to_keywords(procedure, touches.options))
+                   **lib_kw, **touches.keywords())
         got.cell.save(lib_file)
         assert cli_file.read_bytes() == lib_file.read_bytes(), procedure
         assert json.loads(out) == got.result.to_json(), procedure

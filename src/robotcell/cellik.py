@@ -23,20 +23,17 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.coupled import RESERVED_FRAMES, frame_pose, robot_pose, tool_pose
+from robotcell.coupled import CellModel as Cell  # what is read of a robotcell.cell.Cell
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.track import TrackRobot
 from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, validate_pose
-
-if TYPE_CHECKING:
-    from robotcell.cell import Cell
 
 __all__ = ["CellIKSolutions", "CellPath", "depends_on_track", "ik", "ik_path"]
 

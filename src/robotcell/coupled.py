@@ -13,24 +13,26 @@ With the lecture's notation (``docs/conventions.md`` for the frame names):
 - TCP: ``T_world_TCP = T_world_R(e) T_R_TCP(q)`` and, in any frame X of the cell,
   ``T_X_TCP = inv(T_world_X(e, theta)) T_world_TCP``.
 
+The cell model (:mod:`robotcell.cell`) imports this module, never the other way: the functions
+take any object with the attributes of :class:`CellModel`, which :class:`robotcell.cell.Cell` has.
+
 Every function broadcasts the batch shapes of the joints ``(..., n)``, the track positions
 ``(...)`` and the table angles ``(...)``. SI units: metres, radians.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
+from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, make_pose, rot_z, validate_pose
 
-if TYPE_CHECKING:
-    from robotcell.cell import Cell
-
-__all__ = ["RESERVED_FRAMES", "fk", "frame_pose", "robot_pose", "table_pose", "tool_pose",
+__all__ = ["RESERVED_FRAMES", "CellModel", "fk", "frame_pose", "robot_pose", "table_pose", "tool_pose",
            "track_pose"]
 
 #: Frame names :func:`frame_pose` understands besides the cell's own frames, and what they mean.
@@ -40,6 +42,39 @@ RESERVED_FRAMES = {
     "robot": "R", "R": "R",
     "turntable": "B", "B": "B",
 }
+
+
+class CellModel(Protocol):
+    """What coupled kinematics read of a cell; :class:`robotcell.cell.Cell` is one.
+
+    Attributes
+    ----------
+    robot : Robot
+    T_world_R : ndarray, shape (4, 4)
+        Robot base in the world for a cell without track (metres).
+    track : robotcell.cell.Track or None
+    turntable : robotcell.cell.Turntable or None
+    tools : mapping of str to robotcell.cell.Tool
+    frames : mapping of str to robotcell.cell.Frame
+    """
+
+    @property
+    def robot(self) -> Robot: ...
+
+    @property
+    def T_world_R(self) -> NDArray[np.float64]: ...
+
+    @property
+    def track(self) -> Any: ...
+
+    @property
+    def turntable(self) -> Any: ...
+
+    @property
+    def tools(self) -> Mapping[str, Any]: ...
+
+    @property
+    def frames(self) -> Mapping[str, Any]: ...
 
 
 def track_pose(T_L_R0: ArrayLike, step: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:
@@ -70,12 +105,12 @@ def table_pose(theta: ArrayLike) -> NDArray[np.float64]:
     return make_pose(rot_z(finite_array(theta, "table angle")))
 
 
-def robot_pose(cell: Cell, e: ArrayLike) -> NDArray[np.float64]:
+def robot_pose(cell: CellModel, e: ArrayLike) -> NDArray[np.float64]:
     """Pose of the robot base in the world at track positions ``e``.
 
     Parameters
     ----------
-    cell : Cell
+    cell : CellModel
     e : array_like, shape (...)
         Track positions (m); must be 0 in a cell without track.
 
@@ -92,7 +127,7 @@ def robot_pose(cell: Cell, e: ArrayLike) -> NDArray[np.float64]:
     return cell.track.T_world_L @ cell.track.T_L_R(e)
 
 
-def _table_root(cell: Cell, e: NDArray[np.float64]) -> NDArray[np.float64]:
+def _table_root(cell: CellModel, e: NDArray[np.float64]) -> NDArray[np.float64]:
     """``T_world_B(e)``: the table root, moved by the track when the table rides on the robot."""
     if cell.turntable is None:
         raise InputError("the cell has no turntable")
@@ -102,13 +137,13 @@ def _table_root(cell: Cell, e: NDArray[np.float64]) -> NDArray[np.float64]:
     return robot_pose(cell, e) @ tt.T_parent_B
 
 
-def frame_pose(cell: Cell, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
+def frame_pose(cell: CellModel, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
                ) -> NDArray[np.float64]:
     """Pose of a frame of the cell in the world.
 
     Parameters
     ----------
-    cell : Cell
+    cell : CellModel
     name : str
         ``world``; ``track`` or ``L``; ``robot`` or ``R``; ``turntable`` or ``B`` (the table's
         fixed root frame); or the name of one of the cell's frames.
@@ -150,12 +185,12 @@ def frame_pose(cell: Cell, name: str, track: ArrayLike = 0.0, table: ArrayLike =
     return _table_root(cell, e) @ table_pose(th) @ fr.pose
 
 
-def tool_pose(cell: Cell, tool: str | ArrayLike | None) -> NDArray[np.float64] | None:
+def tool_pose(cell: CellModel, tool: str | ArrayLike | None) -> NDArray[np.float64] | None:
     """``T_F_TCP`` of a tool given by name (a tool of the cell) or as a pose; None stays None.
 
     Parameters
     ----------
-    cell : Cell
+    cell : CellModel
     tool : str or array_like of shape (4, 4) or None
         Tool name, or ``T_F_TCP`` (m), or None for the robot model's own tool.
 
@@ -171,13 +206,13 @@ def tool_pose(cell: Cell, tool: str | ArrayLike | None) -> NDArray[np.float64] |
     return None if tool is None else validate_pose(tool, "tool")
 
 
-def fk(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
+def fk(cell: CellModel, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
        tool: str | ArrayLike | None = None, frame: str = "world") -> NDArray[np.float64]:
     """TCP pose in a frame of the cell, given arm joints, track position and table angle.
 
     Parameters
     ----------
-    cell : Cell
+    cell : CellModel
     q : array_like, shape (..., n)
         Arm joint values (controller values; radians, metres for prismatic joints).
     track : array_like, shape (...)

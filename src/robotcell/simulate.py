@@ -142,6 +142,25 @@ class Touches:
         header, rows = self.columns()
         return load_table(dict(zip(header, map(list, zip(*rows)))))[0]
 
+    def keywords(self) -> dict[str, Any]:
+        """The :mod:`robotcell.cellcal` keywords equal to :attr:`options` (SI, same rounding).
+
+        Returns
+        -------
+        dict
+            ``references`` (list of (3,) arrays, m) and ``height`` (m), where the options have
+            them.
+        """
+        kw: dict[str, Any] = {}
+        for opt in self.options:
+            key, value = opt.lstrip("-").split("=")
+            numbers = np.array([float(v) for v in value.split(",")]) * 1e-3
+            if key == "reference":
+                kw.setdefault("references", []).append(numbers)
+            else:
+                kw[key] = float(numbers[0])
+        return kw
+
     def write_csv(self, out: str | Path | TextIO) -> None:
         """Write the measurement CSV to a path or an open text stream."""
         header, rows = self.columns()
