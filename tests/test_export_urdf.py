@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 from cli_helpers import run
 from scipy.spatial.transform import Rotation
+from test_positioner import tilt_rotate
 
 from robotcell import load_robot, pose_from_vendor
-from robotcell.cell import Cell, Frame, Tool, Turntable
+from robotcell.cell import Cell, Frame, Positioner, Tool, Turntable
 from robotcell.demo import demo_cells
 from robotcell.export import export_cell
 from robotcell.export.urdf import urdf_origin
@@ -55,7 +56,8 @@ def vertical_track_cell():
 
 CELLS = {"track_turntable": lambda: Cell.load(EXAMPLE), "modified_dh": modified_cell,
          "prismatic": prismatic_cell, "demo_truth": lambda: demo_cells()[0],
-         "vertical_track": vertical_track_cell}
+         "vertical_track": vertical_track_cell, "positioner": tilt_rotate,
+         "positioner_modified": lambda: tilt_rotate("modified")}
 
 
 def random_values(cell, rng, n=20):
@@ -64,6 +66,8 @@ def random_values(cell, rng, n=20):
     q = rng.uniform(lo, hi, (n, cell.robot.n_joints))
     e = rng.uniform(cell.track.lower, cell.track.upper, n) if cell.track else np.zeros(n)
     th = rng.uniform(-math.pi, math.pi, n) if cell.turntable else np.zeros(n)
+    if isinstance(cell.turntable, Positioner):
+        th = rng.uniform(-math.pi, math.pi, (n, cell.turntable.n_axes))
     return q, e, th
 
 
@@ -73,7 +77,9 @@ def urdf_joint_values(cell, q, e, th):
     values = dict(zip(names, np.asarray(q).T))
     if cell.track is not None:
         values["track_axis"] = e * cell.track.scale
-    if cell.turntable is not None:
+    if isinstance(cell.turntable, Positioner):
+        values.update({f"turntable_axis_{i + 1}": th[..., i] for i in range(th.shape[-1])})
+    elif cell.turntable is not None:
         values["turntable_axis"] = th
     return values
 
@@ -141,6 +147,7 @@ def test_urdf_parser_py_fk_equals_the_cells(kind):
 def test_robotics_toolbox_loads_it_and_its_fk_equals_the_cells(kind, tmp_path):
     import roboticstoolbox as rtb
     from roboticstoolbox.models.URDF.URDFRobot import URDF_read
+    from urdf_parser_py.urdf import URDF
 
     cell = CELLS[kind]()
     path = tmp_path / "cell.urdf"
@@ -149,8 +156,7 @@ def test_robotics_toolbox_loads_it_and_its_fk_equals_the_cells(kind, tmp_path):
     robot = rtb.Robot(elinks, name=name)
     assert name == cell.name
     # the toolbox numbers its joints; each moving link is the child of one URDF joint
-    child_joint = {"track_carriage": "track_axis", "turntable": "turntable_axis"}
-    child_joint.update({f"link_{i + 1}": j.name for i, j in enumerate(cell.robot.joints)})
+    child_joint = {j.child: j.name for j in URDF.from_xml_string(path.read_bytes()).joints}
     q, e, th = random_values(cell, np.random.default_rng(2), n=5)
     values = urdf_joint_values(cell, q, e, th)
     for i in range(len(q)):

@@ -9,7 +9,10 @@ With the lecture's notation (``docs/conventions.md`` for the frame names):
   ``u = X_L``) and ``L_Q_TCP = L_Q_R R_Q_TCP``.
 - Turntable: a frame W carried by the table is at ``T_parent_W(theta) = T_parent_B Rz(theta)
   T_B_W``; with the table's parent the robot base this is the lecture's
-  ``R_T_W(theta) = R_T_B Rz(theta) B_T_W``.
+  ``R_T_W(theta) = R_T_B Rz(theta) B_T_W``. A positioner chain generalises it:
+  ``T_parent_W(v) = T_parent_0 T_0_P(v) T_P_W`` with ``v`` the axis values ``(..., n)`` and
+  ``T_0_P`` the chain's DH product up to its plate P (``Positioner.T_root_P``); the ``table``
+  argument of every function below is then ``v``.
 - TCP: ``T_world_TCP = T_world_R(e) T_R_TCP(q)`` and, in any frame X of the cell,
   ``T_X_TCP = inv(T_world_X(e, theta)) T_world_TCP``.
 
@@ -32,8 +35,8 @@ from robotcell.errors import InputError
 from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, make_pose, rot_z, validate_pose
 
-__all__ = ["RESERVED_FRAMES", "CellModel", "fk", "frame_pose", "robot_pose", "table_pose", "tool_pose",
-           "track_pose"]
+__all__ = ["RESERVED_FRAMES", "CellModel", "broadcast_table", "fk", "frame_pose", "robot_pose", "table_batch",
+           "table_pose", "table_values", "tool_pose", "track_pose"]
 
 #: Frame names :func:`frame_pose` understands besides the cell's own frames, and what they mean.
 RESERVED_FRAMES = {
@@ -105,6 +108,39 @@ def table_pose(theta: ArrayLike) -> NDArray[np.float64]:
     return make_pose(rot_z(finite_array(theta, "table angle")))
 
 
+def table_values(cell: CellModel, table: ArrayLike) -> NDArray[np.float64]:
+    """Values of the axes carrying the work: table angles ``(...)`` or positioner axes ``(..., n)``.
+
+    Parameters
+    ----------
+    cell : CellModel
+    table : array_like
+        Table angle (rad), shape ``(...)``, for a turntable (and 0 for a cell without one); axis
+        values (rad), shape ``(..., n)`` or a scalar for every axis, for a positioner chain.
+
+    Returns
+    -------
+    ndarray
+    """
+    if cell.turntable is None:
+        th = finite_array(table, "table angle")
+        if np.any(th != 0):
+            raise InputError("the cell has no turntable; the table angle must be 0")
+        return th
+    return cell.turntable.axis_values(table)
+
+
+def table_batch(cell: CellModel, th: NDArray[np.float64]) -> tuple[int, ...]:
+    """Batch shape of the values from :func:`table_values`: ``(...)``."""
+    return th.shape if cell.turntable is None else cell.turntable.batch_shape(th)
+
+
+def broadcast_table(cell: CellModel, th: NDArray[np.float64], batch: tuple[int, ...]
+                    ) -> NDArray[np.float64]:
+    """Values from :func:`table_values` broadcast to the batch shape ``batch``."""
+    return np.broadcast_to(th, batch + th.shape[len(table_batch(cell, th)):])
+
+
 def robot_pose(cell: CellModel, e: ArrayLike) -> NDArray[np.float64]:
     """Pose of the robot base in the world at track positions ``e``.
 
@@ -133,8 +169,8 @@ def _table_root(cell: CellModel, e: NDArray[np.float64]) -> NDArray[np.float64]:
         raise InputError("the cell has no turntable")
     tt = cell.turntable
     if tt.parent == "world":
-        return np.broadcast_to(tt.T_parent_B, e.shape + (4, 4))
-    return robot_pose(cell, e) @ tt.T_parent_B
+        return np.broadcast_to(tt.T_parent_root, e.shape + (4, 4))
+    return robot_pose(cell, e) @ tt.T_parent_root
 
 
 def frame_pose(cell: CellModel, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
@@ -149,8 +185,9 @@ def frame_pose(cell: CellModel, name: str, track: ArrayLike = 0.0, table: ArrayL
         fixed root frame); or the name of one of the cell's frames.
     track : array_like, shape (...)
         Track position (metres); must be 0 in a cell without track.
-    table : array_like, shape (...)
-        Table angle (radians); must be 0 in a cell without turntable.
+    table : array_like, shape (...) or (..., n)
+        Table angle (radians), or a positioner's axis values (:func:`table_values`); must be 0
+        in a cell without turntable.
 
     Returns
     -------
@@ -158,10 +195,8 @@ def frame_pose(cell: CellModel, name: str, track: ArrayLike = 0.0, table: ArrayL
         ``T_world_X`` with the broadcast batch shape of ``track`` and ``table`` (metres).
     """
     e = finite_array(track, "track position")
-    th = finite_array(table, "table angle")
-    if cell.turntable is None and np.any(th != 0):
-        raise InputError("the cell has no turntable; the table angle must be 0")
-    batch = np.broadcast_shapes(e.shape, th.shape)
+    th = table_values(cell, table)
+    batch = np.broadcast_shapes(e.shape, table_batch(cell, th))
     e = np.broadcast_to(e, batch)
     kind = RESERVED_FRAMES.get(name)
     if kind == "world":
@@ -182,7 +217,7 @@ def frame_pose(cell: CellModel, name: str, track: ArrayLike = 0.0, table: ArrayL
         return np.broadcast_to(fr.pose, batch + (4, 4)).copy()
     if fr.parent == "robot":
         return robot_pose(cell, e) @ fr.pose
-    return _table_root(cell, e) @ table_pose(th) @ fr.pose
+    return _table_root(cell, e) @ cell.turntable.T_root_P(th) @ fr.pose
 
 
 def tool_pose(cell: CellModel, tool: str | ArrayLike | None) -> NDArray[np.float64] | None:
@@ -217,8 +252,8 @@ def fk(cell: CellModel, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike =
         Arm joint values (controller values; radians, metres for prismatic joints).
     track : array_like, shape (...)
         Track position (metres); must be 0 in a cell without track.
-    table : array_like, shape (...)
-        Table angle (radians); must be 0 in a cell without turntable.
+    table : array_like, shape (...) or (..., n)
+        Table angle (radians), or a positioner's axis values; must be 0 without turntable.
     tool : str or array_like of shape (4, 4), optional
         A tool of the cell by name, or ``T_F_TCP`` (metres); default: the robot model's tool.
     frame : str

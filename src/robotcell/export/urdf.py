@@ -9,9 +9,12 @@ ROS tools (RViz, MoveIt, tf) and the Robotics Toolbox then see the calibrated ce
   position 0; without a track a fixed joint places ``base_link`` at ``T_world_R``;
 - the arm's DH chain: revolute (or prismatic) joints ``<name>`` (the model's joint names, else
   ``joint_1..n``) moving the links ``link_1..n``; each joint's origin holds the constant part of
-  the DH link before it, so its axis is the DH joint axis; then ``flange`` at ``T_n_F``;
-- the turntable: ``turntable_root`` (B) fixed in ``world`` or ``base_link`` at ``T_parent_B``, and
-  a revolute joint ``turntable_axis`` about its Z carrying the link ``turntable``;
+  the DH link before it (:func:`robotcell.axischain.axis_frames`), so its axis is the DH joint
+  axis; then ``flange`` fixed at the rest of the chain;
+- the turntable: ``turntable_root`` (B) fixed in ``world`` or ``base_link`` at ``T_parent_B``, a
+  revolute joint ``turntable_axis`` about its Z moving ``turntable_link_1`` and the fixed link
+  ``turntable`` that carries the frames; a positioner chain the same way, with the joints
+  ``turntable_axis_1..n`` and the links ``turntable_link_1..n``, ``turntable`` at its plate;
 - every tool of the cell as a fixed link ``tool_<name>`` on the flange at ``T_F_TCP``, every frame
   as a fixed link ``frame_<name>`` on its parent (``world``, ``base_link`` or ``turntable``).
 
@@ -35,8 +38,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.cell import Cell
-from robotcell.dh import link_transform
+from robotcell.axischain import axis_frames
+from robotcell.cell import Cell, Turntable
 from robotcell.robot import Robot
 
 __all__ = ["chain_elements", "export", "urdf_origin"]
@@ -87,58 +90,37 @@ def _joint(root: ET.Element, name: str, kind: str, parent: str, child: str,
         ET.SubElement(j, "limit", lower=_num(lo), upper=_num(hi), effort="0", velocity="0")
 
 
-def _static_part(robot: Robot, i: int) -> NDArray[np.float64]:
-    """The constant part of DH link ``i`` that follows (standard) or precedes (modified) its motion.
-
-    Standard: ``T_{i-1,i}(q) = M(q) S`` with ``M`` the joint's motion along/about ``Z_{i-1}`` and
-    ``S = Rot(z, theta0) Trans(z, d0) Trans(x, a) Rot(x, alpha)``. Modified: ``T = S M(q)`` with
-    ``S = Rot(x, alpha) Trans(x, a) Rot(z, theta0) Trans(z, d0)``.
-    """
-    j = robot.joints[i]
-    return link_transform(j.theta, j.d, j.a, j.alpha, robot.convention)
-
-
-def chain_elements(root: ET.Element, robot: Robot, parent: str, prefix: str,
-                   names: list[str] | None = None) -> str:
-    """Add the DH chain of ``robot`` (base, joints; no flange) under link ``parent``.
+def chain_elements(root: ET.Element, robot: Robot, parent: str, prefix: str, end: str,
+                   names: list[str] | None = None) -> None:
+    """Add the DH chain of ``robot`` under link ``parent``, ending in the fixed link ``end``.
 
     Parameters
     ----------
     root : xml.etree.ElementTree.Element
         The ``<robot>`` element.
     robot : Robot
-        A DH chain; ``robot.base`` places frame 0 in ``parent``.
+        A DH chain; ``robot.base`` places frame 0 in ``parent``, ``robot.flange`` places ``end``
+        on the last DH frame.
     parent : str
         Link the chain is fixed to.
     prefix : str
-        Prefix of the link names ``<prefix>link_1..n``.
+        Prefix of the moving links ``<prefix>link_1..n``.
+    end : str
+        Name of the link at the chain's flange.
     names : list of str, optional
         Joint names; default the model's, else ``<prefix>joint_1..n``.
-
-    Returns
-    -------
-    str
-        Name of the link at the last DH frame ``n``.
     """
-    n = robot.n_joints
     names = names or [j.name or f"{prefix}joint_{i + 1}" for i, j in enumerate(robot.joints)]
-    pending = robot.base  # constant transform from the last link written to the next joint
+    pre, post = axis_frames(robot)
     last = parent
     for i, j in enumerate(robot.joints):
-        S = _static_part(robot, i)
-        before = pending if robot.convention == "standard" else pending @ S
         child = f"{prefix}link_{i + 1}"
         _link(root, child)
-        _joint(root, names[i], j.type, last, child, before, np.array([0.0, 0.0, j.sign]),
-               j.lower, j.upper)
-        pending = S if robot.convention == "standard" else np.eye(4)
+        _joint(root, names[i], j.type, last, child, robot.base @ pre[i] if i == 0 else pre[i],
+               np.array([0.0, 0.0, j.sign]), j.lower, j.upper)
         last = child
-    if n and not np.allclose(pending, np.eye(4), atol=0):
-        child = f"{prefix}link_{n}_dh"
-        _link(root, child)
-        _joint(root, f"{prefix}link_{n}_dh_fixed", "fixed", last, child, pending)
-        last = child
-    return last
+    _link(root, end)
+    _joint(root, f"{end}_fixed", "fixed", last, end, post)
 
 
 def export(cell: Cell) -> str:
@@ -170,17 +152,16 @@ def export(cell: Cell) -> str:
                np.linalg.solve(T_L_J, t.T_L_R0))
     else:
         _joint(root, "robot_frame", "fixed", "world", "base_link", cell.T_world_R)
-    last = chain_elements(root, cell.robot, "base_link", "")
-    _link(root, "flange")
-    _joint(root, "flange_fixed", "fixed", last, "flange", cell.robot.flange)
+    chain_elements(root, cell.robot, "base_link", "", "flange")
     if cell.turntable is not None:
         b = cell.turntable
         _link(root, "turntable_root")
         _joint(root, "turntable_frame", "fixed", "world" if b.parent == "world" else "base_link",
-               "turntable_root", b.T_parent_B)
-        _link(root, "turntable")
-        _joint(root, "turntable_axis", "revolute", "turntable_root", "turntable", np.eye(4),
-               np.array([0.0, 0.0, 1.0]), b.lower, b.upper)
+               "turntable_root", b.T_parent_root)
+        names = (["turntable_axis"] if isinstance(b, Turntable)
+                 else [f"turntable_axis_{i + 1}" for i in range(b.n_axes)])
+        chain_elements(root, b.chain.with_base(np.eye(4)), "turntable_root", "turntable_",
+                       "turntable", names)
     for name, tool in cell.tools.items():
         _link(root, f"tool_{name}")
         _joint(root, f"tool_{name}_fixed", "fixed", "flange", f"tool_{name}", tool.T_F_TCP)

@@ -1,0 +1,207 @@
+"""External axes as kinematic chains: positioners of 1-3 axes in the cell model, FK, IK, files.
+
+The reference for a positioner's motion is the product of screw motions about its axis lines
+(``robotcell.dhprocedure.AxisChain.fk``), which shares no choice with a DH table; the positioner
+itself is the DH chain the DH procedure derives from those lines, the form an identified chain
+takes.
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robotcell import make_pose, rot_x, rot_y
+from robotcell.cell import Cell, Frame, Positioner, Provenance, Tool, Turntable
+from robotcell.demo import demo_cells
+from robotcell.dhprocedure import AxisChain, dh_from_axes
+from robotcell.errors import InputError
+from robotcell.modelfile import load_robot
+from robotcell.poseformats import pose_from_vendor
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = Path(__file__).resolve().parent / "data"
+EXAMPLE = ROOT / "examples" / "cell_kr16_track_turntable.yaml"
+
+#: Tilt-rotate positioner at q = 0, in its root frame: tilt about Y at 0.8 m height, rotate about
+#: Z through a point 50 mm off the tilt axis (the common normal is not zero), plate at 0.7 m.
+AXES = AxisChain(points=[[0.0, 0.0, 0.8], [0.05, 0.0, 0.6]],
+                 directions=[[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                 types=("revolute", "revolute"),
+                 flange=make_pose(np.eye(3), [0.05, 0.0, 0.7]),
+                 names=("E1", "E2"),
+                 lower=np.radians([-95.0, -400.0]), upper=np.radians([95.0, 400.0]))
+T_WORLD_ROOT = pose_from_vendor([1100, 200, 0, 20, 0, 0], "kuka")
+T_P_PART = pose_from_vendor([80, -40, 30, 15, 0, 0], "kuka")
+
+
+def tilt_rotate(convention="standard", axes=AXES, T_world_root=T_WORLD_ROOT):
+    """A KR 16 on the floor beside a tilt-rotate positioner carrying frame 'part'."""
+    chain = dh_from_axes(axes, convention, name="tilt_rotate").robot
+    pos = Positioner(chain.with_base(T_world_root @ chain.base), name="DKP_2")
+    return Cell(robot=load_robot("kuka_kr16"), robot_model="kuka_kr16", name="positioner_cell",
+                turntable=pos, tools={"torch": Tool(pose_from_vendor([312.5, 0, 95, 0, 45, 0],
+                                                                     "kuka"))},
+                frames={"part": Frame(T_P_PART, parent="turntable", number=1)})
+
+
+@pytest.mark.parametrize("source, golden", [
+    (EXAMPLE, "cell_kr16_track_turntable.saved.yaml"),
+    (DATA / "cell_kr16_track_turntable.saved.yaml", "cell_kr16_track_turntable.saved.yaml"),
+    (DATA / "demo_truth.saved.yaml", "demo_truth.saved.yaml"),
+    (DATA / "demo_nominal.saved.yaml", "demo_nominal.saved.yaml"),
+])
+def test_old_cell_files_load_and_save_unchanged(source, golden, tmp_path):
+    # the golden files were written by robotcell before positioners existed
+    out = tmp_path / "cell.yaml"
+    Cell.load(source).save(out)
+    assert out.read_bytes() == (DATA / golden).read_bytes()
+
+
+def test_the_demo_cells_save_as_before(tmp_path):
+    truth, nominal = demo_cells()
+    for cell, golden in ((truth, "demo_truth.saved.yaml"), (nominal, "demo_nominal.saved.yaml")):
+        cell.save(tmp_path / golden)
+        assert (tmp_path / golden).read_bytes() == (DATA / golden).read_bytes()
+    assert isinstance(truth.turntable, Turntable) and truth.positioner is truth.turntable
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_positioner_file_round_trip(convention, tmp_path):
+    cell = tilt_rotate(convention)
+    cell.save(tmp_path / "a.yaml")
+    text = (tmp_path / "a.yaml").read_text()
+    assert "positioner:" in text and "turntable:" not in text and "axes:" in text
+    back = Cell.load(tmp_path / "a.yaml")
+    back.save(tmp_path / "b.yaml")
+    assert (tmp_path / "a.yaml").read_bytes() == (tmp_path / "b.yaml").read_bytes()
+    pos = back.turntable
+    assert isinstance(pos, Positioner) and pos.n_axes == 2 and pos.name == "DKP_2"
+    assert pos.chain.convention == convention
+    v = np.radians([[10.0, 30.0], [-40.0, 200.0]])
+    assert np.allclose(back.frame_pose("part", table=v), cell.frame_pose("part", table=v),
+                       atol=1e-9)
+    assert np.allclose(pos.lower, np.radians([-95, -400])) and np.allclose(pos.upper,
+                                                                           np.radians([95, 400]))
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_two_axis_positioner_moves_about_its_axis_lines(convention):
+    cell = tilt_rotate(convention)
+    rng = np.random.default_rng(3)
+    v = rng.uniform(-1.5, 1.5, (50, 2))
+    want = T_WORLD_ROOT @ AXES.fk(v) @ T_P_PART
+    assert np.allclose(cell.frame_pose("part", table=v), want, atol=1e-12)
+    # the root frame is fixed; the batch shapes of track and table broadcast
+    assert np.allclose(cell.frame_pose("turntable", table=v[:3]),
+                       np.broadcast_to(cell.turntable.T_parent_root, (3, 4, 4)))
+    assert cell.fk(np.zeros((4, 1, 6)), table=v[:5]).shape == (4, 5, 4, 4)
+
+
+def test_one_axis_positioner_is_the_turntable():
+    truth, _ = demo_cells()
+    tt = truth.turntable
+    chain = tt.chain
+    pos_cell = Cell(robot=truth.robot, robot_model="kuka_kr16", track=truth.track,
+                    turntable=Positioner(chain, name=tt.name), frames=dict(truth.frames),
+                    tools=dict(truth.tools))
+    th = np.radians(np.linspace(-300, 300, 13))
+    assert np.allclose(pos_cell.frame_pose("part", track=2.0, table=th[:, None]),
+                       truth.frame_pose("part", track=2.0, table=th), atol=1e-12)
+    q = np.radians([10, -80, 90, 5, 30, 7])
+    assert np.allclose(pos_cell.fk(q, track=1.0, table=th[:, None], frame="part", tool="torch"),
+                       truth.fk(q, track=1.0, table=th, frame="part", tool="torch"), atol=1e-12)
+
+
+def test_an_identified_chain_drops_in_with_its_provenance():
+    cell = tilt_rotate()
+    identified = dh_from_axes(AxisChain(points=AXES.points + 0.001, directions=AXES.directions,
+                                        types=AXES.types, flange=AXES.flange,
+                                        lower=AXES.lower, upper=AXES.upper), "standard").robot
+    chain = identified.with_base(T_WORLD_ROOT @ identified.base)
+    pos = cell.update_positioner(Provenance("positioner", rms_mm=0.2), chain)
+    assert cell.turntable is pos and pos.name == "DKP_2" and pos.parent == "world"
+    assert pos.chain is chain and pos.provenance.source == "positioner"
+    # a turntable becomes a positioner the same way
+    truth, _ = demo_cells()
+    truth.update_positioner(Provenance("positioner"), truth.turntable.chain)
+    assert isinstance(truth.turntable, Positioner) and truth.turntable.name == "DKP_400"
+
+
+def test_cell_ik_takes_the_axis_values():
+    cell = tilt_rotate()
+    v = np.radians([[20.0, 45.0], [-30.0, 170.0], [0.0, -90.0]])
+    T_part_TCP = make_pose(rot_y(math.pi) @ rot_x(0.2), [0.05, 0.02, 0.01])
+    sol = cell.ik(T_part_TCP, frame="part", table=v, tool="torch")
+    assert sol.table.shape == (3, 2) and np.all(sol.count > 0)
+    for k in range(3):
+        q = sol.q[k][sol.valid[k]][0]
+        assert np.allclose(cell.fk(q, table=v[k], tool="torch", frame="part"), T_part_TCP,
+                           atol=1e-9)
+    out = np.radians([[100.0, 0.0]])  # tilt beyond its limit
+    assert not cell.ik(T_part_TCP, frame="part", table=out, tool="torch").valid.any()
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_normal_up_turns_the_normal_straight_up(convention):
+    cell = tilt_rotate(convention)
+    pos = cell.turntable
+    rng = np.random.default_rng(8)
+    # directions within 80 deg of the plate's Z: a tilt of +-95 deg reaches them
+    n = rng.normal(size=(200, 3))
+    n[:, 2] = np.abs(n[:, 2]) + 0.2 * np.linalg.norm(n[:, :2], axis=1)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    values, valid = pos.normal_up(n)
+    assert values.shape == (200, 2, 2) and valid.any(axis=-1).all()
+    for k in range(2):
+        ok = valid[:, k]
+        R = cell.frame_pose("part", table=values[ok, k])[:, :3, :3] @ T_P_PART[:3, :3].T
+        assert np.allclose(np.einsum("nij,nj->ni", R, n[ok]), [0, 0, 1], atol=1e-10)
+        assert np.all(pos.within_limits(values[ok, k]))
+
+
+def test_ik_chooses_the_positioner_values_that_put_the_weld_normal_up():
+    cell = tilt_rotate()
+    # torch 10 mm above points of a tilted weld surface of the part: tool Z into the surface
+    tilt = np.array([rot_x(a) @ rot_y(b) for a, b in np.radians([[30, 0], [0, -40], [20, 25]])])
+    T = make_pose(tilt @ rot_y(math.pi), [[0.0, 0.0, 0.0], [0.05, -0.05, 0.02], [0.1, 0.0, 0.0]])
+    sol = cell.ik(T, frame="part", table="normal_up", tool="torch")
+    assert sol.table.shape == (3, 2) and np.all(sol.count > 0)
+    for k in range(3):
+        q = sol.q[k][sol.valid[k]][0]
+        T_world_TCP = cell.fk(q, table=sol.table[k], tool="torch")
+        assert np.allclose(T_world_TCP[:3, 2], [0, 0, -1], atol=1e-9)  # torch straight down
+        assert np.allclose(cell.fk(q, table=sol.table[k], tool="torch", frame="part"), T[k],
+                           atol=1e-9)
+
+
+def test_positioner_errors_name_the_cause(tmp_path):
+    robot = load_robot("kuka_kr16")
+    with pytest.raises(InputError, match=r"a positioner is a chain of 1 to 3 revolute axes, got 6"):
+        Positioner(robot)
+    with pytest.raises(InputError, match=r"revolute axes, got 2 axes \(revolute, prismatic\)"):
+        Positioner(load_robot("stanford_arm").with_base(np.eye(4)).__class__(
+            "x", load_robot("stanford_arm").joints[1:3]))
+    cell = tilt_rotate()
+    with pytest.raises(InputError, match=r"positioner 'DKP_2' has 2 axes: give its axis values "
+                                         r"with shape \(\.\.\., 2\), got \(3,\)"):
+        cell.frame_pose("part", table=[0.1, 0.2, 0.3])
+    with pytest.raises(InputError, match=r"table='normal_up' needs targets in a frame carried"):
+        cell.ik(np.eye(4), frame="world", table="normal_up")
+    truth, _ = demo_cells()
+    with pytest.raises(InputError, match=r"table='normal_up' needs a positioner of 2 axes"):
+        truth.ik(np.eye(4), frame="part", table="normal_up")
+    with pytest.raises(InputError, match=r"use update_positioner"):
+        cell.update_turntable(Provenance("turntable"))
+    path = tmp_path / "both.yaml"
+    cell.save(path)
+    text = path.read_text() + ("turntable: {name: t, frame: {x: 0}}\n")
+    path.write_text(text)
+    with pytest.raises(InputError, match=r"key 'positioner' and key 'turntable' both describe"):
+        Cell.load(path)
+    cell.save(path)
+    path.write_text(path.read_text().replace("alpha:", "alfa:", 1))
+    with pytest.raises(InputError, match=r"key 'positioner.axes\[1\]' has unknown key\(s\) "
+                                         r"\['alfa'\]"):
+        Cell.load(path)
