@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotcell import make_pose, rot_x, rot_y
+from robotcell import make_pose, rot_x, rot_y, rot_z
 from robotcell.cell import Cell, Frame, Positioner, Provenance, Tool, Turntable
 from robotcell.demo import demo_cells
 from robotcell.dhprocedure import AxisChain, dh_from_axes
@@ -205,3 +205,40 @@ def test_positioner_errors_name_the_cause(tmp_path):
     with pytest.raises(InputError, match=r"key 'positioner.axes\[1\]' has unknown key\(s\) "
                                          r"\['alfa'\]"):
         Cell.load(path)
+
+
+@pytest.mark.parametrize("fmt", ["kuka", "abb"])
+@pytest.mark.parametrize("convention, signs", [("standard", [1, 1]), ("modified", [1, -1]),
+                                               ("standard", [-1, -1])])
+def test_kuka_and_abb_exports_hold_the_axis_chain(fmt, convention, signs):
+    from robotcell.export import export_cell, parse_export
+
+    chain = dh_from_axes(AXES, convention, signs=signs).robot
+    cell = tilt_rotate()
+    cell.turntable = Positioner(chain.with_base(T_WORLD_ROOT @ chain.base), name="DKP_2")
+    data = parse_export(export_cell(cell, fmt), fmt)
+    frames = data.positioner_frames
+    assert len(frames) == (4 if fmt == "kuka" else 3)
+    part = next(s for s in data.frames if s.name == "part")
+    v = np.random.default_rng(4).uniform(-1.5, 1.5, (20, 2))
+    T = np.broadcast_to(data.turntable.pose, (20, 4, 4))
+    for i in range(len(frames) - 1):  # every axis turns by +value about its frame's Z
+        T = T @ frames[i]
+        if i < 2:
+            T = T @ make_pose(np.array([rot_z(a) for a in v[:, i]]))
+    T = T @ frames[-1] @ part.pose
+    want = cell.frame_pose("part", table=v)
+    assert np.allclose(T[:, :3, 3], want[:, :3, 3], atol=1e-8)  # exports keep 1e-6 mm
+    assert np.allclose(T[:, :3, :3], want[:, :3, :3], atol=1e-9)
+
+
+def test_kuka_positioner_next_to_a_linear_unit_is_et2():
+    from robotcell.export import export_cell
+
+    truth, _ = demo_cells()
+    chain = dh_from_axes(AXES, "standard").robot
+    truth.update_positioner(Provenance("positioner"),
+                            chain.with_base(truth.turntable.T_parent_B @ chain.base))
+    text = export_cell(truth, "kuka")
+    assert "$ET2_TA1KR=" in text and "$ET2_TFLA3=" in text and "$ET1_TFLA3=" in text
+    assert "$EX_KIN={ET2 #EASYS,...} with 2 axes" in text
