@@ -242,3 +242,18 @@ def test_kuka_positioner_next_to_a_linear_unit_is_et2():
     text = export_cell(truth, "kuka")
     assert "$ET2_TA1KR=" in text and "$ET2_TFLA3=" in text and "$ET1_TFLA3=" in text
     assert "$EX_KIN={ET2 #EASYS,...} with 2 axes" in text
+
+
+def test_one_axis_procedures_refuse_a_positioner_chain():
+    from robotcell import cellcal
+    from robotcell.simulate import simulate
+
+    cell = tilt_rotate()
+    with pytest.raises(InputError, match=r"positioner 'DKP_2' is a chain of 2 axes; the "
+                                         r"turntable and workpiece procedures"):
+        simulate(cell, "turntable")
+    table = {"x": [1000.0, 1100.0, 1200.0], "y": [0.0, 10.0, 0.0], "z": [500.0] * 3,
+             "e1": [0.0, 90.0, 180.0]}
+    with pytest.raises(InputError, match=r"calibrated by robotcell.calibration."
+                                         r"calibrate_positioner"):
+        cellcal.turntable(cell, table)

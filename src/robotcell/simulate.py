@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.cell import Cell
+from robotcell.cell import Cell, Turntable
 from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, arm_sides
@@ -428,6 +428,16 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                    options=options, tool=tname, noise=noise)
 
 
+def _one_axis_table(cell: Cell) -> None:
+    """Refuse a cell without a one-axis turntable (the turntable and workpiece procedures)."""
+    if cell.turntable is None:
+        raise InputError("the cell has no turntable")
+    if not isinstance(cell.turntable, Turntable):
+        raise InputError(f"the cell's positioner {cell.turntable.name!r} is a chain of "
+                         f"{cell.turntable.n_axes} axes; the turntable and workpiece procedures "
+                         "are for a one-axis turntable")
+
+
 def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.float64]:
     tt = cell.turntable
     assert tt is not None
@@ -453,8 +463,7 @@ def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.fl
 def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                track: float | None, touches: int = 6, angles: ArrayLike | None = None,
                radius: float = 0.3, height: float = 0.05) -> Touches:
-    if cell.turntable is None:
-        raise InputError("the cell has no turntable")
+    _one_axis_table(cell)
     tname = _tool_name(cell, tool)
     if not radius > 0:
         raise InputError(f"radius must be positive (m), got {radius}")
@@ -480,8 +489,7 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
 def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                track: float | None, frame: str | None = None, size: float = 0.15,
                repeats: int = 2, angles: ArrayLike | None = None) -> Touches:
-    if cell.turntable is None:
-        raise InputError("the cell has no turntable")
+    _one_axis_table(cell)
     name = _frame_name(cell, frame, ("turntable",), "workpiece")
     tname = _tool_name(cell, tool)
     p_W, roles = _three_point(size, repeats)

@@ -464,6 +464,12 @@ def _cell_turntable(cell: Cell, label: str) -> Turntable:
     if cell.turntable is None:
         raise InputError(f"{label} has no turntable; add a 'turntable' section to the cell "
                          "file first")
+    if not isinstance(cell.turntable, Turntable):
+        raise InputError(f"the positioner {cell.turntable.name!r} of {label} is a chain of "
+                         f"{cell.turntable.n_axes} axes: the turntable and workpiece procedures "
+                         "are for a one-axis turntable; a positioner chain is calibrated by "
+                         "robotcell.calibration.calibrate_positioner and written with "
+                         "Cell.update_positioner")
     return cell.turntable
 
 
