@@ -257,3 +257,14 @@ def test_one_axis_procedures_refuse_a_positioner_chain():
     with pytest.raises(InputError, match=r"calibrated by robotcell.calibration."
                                          r"calibrate_positioner"):
         cellcal.turntable(cell, table)
+
+
+@pytest.mark.parametrize("fmt", ["fanuc", "yaskawa"])
+def test_fanuc_and_yaskawa_write_frames_on_a_positioner_at_axis_zero(fmt):
+    from robotcell.export import export_cell, parse_export
+
+    cell = tilt_rotate("modified")
+    part = next(s for s in parse_export(export_cell(cell, fmt), fmt).frames if s.name == "part")
+    T_world_R = cell.frame_pose("robot")  # both refer to the robot base at track position 0
+    assert np.allclose(part.pose, np.linalg.inv(T_world_R) @ cell.frame_pose("part", table=[0, 0]),
+                       atol=1e-8)

@@ -225,8 +225,9 @@ def parse_float(text: str, where: str) -> float:
 def flatten_table(data: ControllerData) -> list[Slot]:
     """Frames for controllers without frames on a turntable: everything as fixed user frames.
 
-    Frames on the turntable become their pose at table axis 0 in the reference frame, and the
-    turntable root B itself becomes one more frame (the next free number) named after the unit.
+    Frames on the turntable become their pose at table axis 0 in the reference frame (on a
+    positioner chain: at every axis 0, through its axis frames), and the turntable root B itself
+    becomes one more frame (the next free number) named after the unit.
 
     Parameters
     ----------
@@ -238,10 +239,11 @@ def flatten_table(data: ControllerData) -> list[Slot]:
         Fixed frames, sorted by number.
     """
     out = []
+    plate = np.linalg.multi_dot([np.eye(4), np.eye(4), *data.positioner_frames])
     for s in data.frames:
         if s.on_table:
             assert data.turntable is not None
-            out.append(Slot(s.name, s.number, data.turntable.pose @ s.pose))
+            out.append(Slot(s.name, s.number, data.turntable.pose @ plate @ s.pose))
         else:
             out.append(s)
     if data.turntable is not None:
