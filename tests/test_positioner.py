@@ -268,3 +268,13 @@ def test_fanuc_and_yaskawa_write_frames_on_a_positioner_at_axis_zero(fmt):
     T_world_R = cell.frame_pose("robot")  # both refer to the robot base at track position 0
     assert np.allclose(part.pose, np.linalg.inv(T_world_R) @ cell.frame_pose("part", table=[0, 0]),
                        atol=1e-8)
+
+
+def test_cell_show_lists_the_positioner(tmp_path, capsys):
+    from cli_helpers import run
+
+    tilt_rotate().save(tmp_path / "cell.yaml")
+    code, out, err = run(capsys, "cell", "show", tmp_path / "cell.yaml")
+    assert code == 0, err
+    assert "positioner DKP_2: 2 axes, E1 -95 .. 95, E2 -400 .. 400 deg" in out
+    assert "positioner root (world)" in out
