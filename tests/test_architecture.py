@@ -116,6 +116,5 @@ def test_no_import_cycle():
                                   if n != "robotcell.cli" and not n.startswith("robotcell.cli.")])
 def test_library_module_imports_neither_the_cli_nor_click(name):
     bad = sorted(t for t in ALL_IMPORTS[name]
-                 if t == "click" or t.startswith("click.") or t == "robotcell.cli"
-                 or t.startswith("robotcell.cli."))
+                 if t in ("click", "robotcell.cli") or t.startswith(("click.", "robotcell.cli.")))
     assert not bad, f"{name} imports {bad}"
