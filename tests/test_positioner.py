@@ -278,3 +278,13 @@ def test_cell_show_lists_the_positioner(tmp_path, capsys):
     assert code == 0, err
     assert "positioner DKP_2: 2 axes, E1 -95 .. 95, E2 -400 .. 400 deg" in out
     assert "positioner root (world)" in out
+
+
+def test_ik_path_follows_the_positioner_axes():
+    cell = tilt_rotate()
+    v = np.column_stack([np.full(31, np.radians(20.0)), np.radians(np.linspace(45, 105, 31))])
+    T_part_TCP = make_pose(rot_y(math.pi) @ rot_x(0.2), [0.05, 0.02, 0.01])
+    path = cell.ik_path(T_part_TCP, frame="part", table=v, tool="torch")
+    assert path.q.shape == (31, 6) and path.table.shape == (31, 2)
+    assert np.allclose(cell.fk(path.q, table=v, tool="torch", frame="part"), T_part_TCP,
+                       atol=1e-9)
