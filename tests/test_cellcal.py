@@ -69,7 +69,8 @@ def test_cli_cell_results_equal_the_library_call_byte_for_byte(tmp_path, capsys,
         assert json.loads(out) == got.result.to_json(), procedure
         assert f"updated {cli_file}: {got.item}" in err
         assert all(note in err for note in (n.replace("cell 'demo_kr16_track_turntable'",
-                                                       str(cli_file)) for n in got.notes))
+                                                       str(cli_file))
+                                            for n in got.notes + got.update_notes))
         assert got.provenance.source == procedure and got.provenance.time == STAMP
         # the cell given is not changed: the result is a new cell
         assert got.cell is not before and cell_to_dict(before) == content

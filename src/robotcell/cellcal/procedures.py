@@ -7,7 +7,11 @@ options in SI units. It maps the touches into the frames of the cell (through co
 when the robot is on a track), runs the estimator of :mod:`robotcell.calibration` and returns a
 :class:`CellCalibration`: the :class:`~robotcell.calibration.result.CalibrationResult`, a new
 :class:`~robotcell.cell.Cell` with the calibrated value written in, stamped with its
-:class:`~robotcell.cell.Provenance` (the cell given is not changed), and notes on what was kept.
+:class:`~robotcell.cell.Provenance` (the cell given is not changed), and notes: on the
+measurements (identical rows, touches mapped to the world, where the turntable comes from), each
+also passed to ``on_note`` as soon as it arises (so that a caller shows them even when the
+measurements are then refused), and on the update (a value kept because the touches do not
+measure it).
 Nothing is written to a file: save the new cell with :meth:`Cell.save`.
 
 The 2-axis positioner is calibrated by :func:`robotcell.calibration.calibrate_positioner` on the
@@ -17,6 +21,7 @@ kinematic-identification engine; its result is written into the cell with
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
@@ -26,7 +31,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.measurements import (
     check_count,
-    check_no_repeats,
     external_axis,
     flange_poses,
     nominal_points,
@@ -40,7 +44,7 @@ from robotcell.cellcal.touches import (
     Table,
     line_labels,
     load_table,
-    raw_rows,
+    repeat_notes,
     robot_in_world,
     tool_transform,
     track_positions,
@@ -76,8 +80,10 @@ class CellCalibration:
     provenance : Provenance or None
         The provenance stamped on the written value.
     notes : tuple of str
-        Remarks for the user, each starting ``note:`` or ``warning:`` (a value kept because the
-        touches do not measure it, touches mapped to the world, ...).
+        Remarks on the measurements, each starting ``note:`` or ``warning:`` (identical rows,
+        touches mapped to the world, ...), as passed to ``on_note``.
+    update_notes : tuple of str
+        Remarks on what was written (a value kept because the touches do not measure it).
     """
 
     result: CalibrationResult
@@ -85,6 +91,21 @@ class CellCalibration:
     item: str = ""
     provenance: Provenance | None = None
     notes: tuple[str, ...] = ()
+    update_notes: tuple[str, ...] = ()
+
+
+class _Notes(list):
+    """Notes of a calibration, each passed on to ``on_note`` as it is added."""
+
+    def __init__(self, on_note: Callable[[str], None] | None):
+        super().__init__()
+        self.on_note = on_note
+
+    def add(self, notes: list[str]) -> None:
+        for note in notes:
+            self.append(note)
+            if self.on_note is not None:
+                self.on_note(note)
 
 
 @dataclass(frozen=True)
@@ -150,6 +171,11 @@ def _refuse_track_column(cols: Table, source: str, why: str) -> None:
         raise InputError(f"{source}: column 'track' (track position of each touch) {why}")
 
 
+#: Note of a tool calibrated from touches at several track positions.
+MAPPED_NOTE = ("note: the flange poses were mapped to the world through column 'track': the "
+               "reference point (pivot) is in world coordinates, and ABC World alignments refer "
+               "to the world axes")
+
 #: Why column ``track`` is refused without a cell.
 _NO_CELL_TRACK = ("needs --cell CELL.yaml (in Python: a Cell), which says where the track is; "
                   "remove the column or pass --cell")
@@ -188,7 +214,8 @@ def _write_tool(cell: Cell, name: str, result: CalibrationResult, prov: Provenan
 def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
         robot: Robot | None = None, world_mode: Literal["6d", "5d"] = "6d",
         sigma: float | None = None, source: str | None = None, cell_label: str | None = None,
-        time: str | None = None) -> CellCalibration:
+        time: str | None = None, on_note: Callable[[str], None] | None = None
+        ) -> CellCalibration:
     """Tool TCP (XYZ 4-point / N-point) and orientation (ABC 2-point, ABC World) into a cell.
 
     Parameters
@@ -214,6 +241,8 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
         Name of the cell in messages (e.g. its file); default ``cell 'NAME'``.
     time : str, optional
         ISO 8601 time of the provenance; default now.
+    on_note : callable, optional
+        Receives each note on the measurements as it arises (e.g. to print it on stderr).
 
     Returns
     -------
@@ -231,18 +260,16 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     if bad:
         raise InputError(f"{source}: column 'point' must hold tcp, -x, xy or world; "
                          f"found {', '.join(bad)}")
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track"]), source)
+    notes = _Notes(on_note)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + ["track"], source))
     check_count(roles.count("tcp"), 3, "touches of the reference point (point=tcp)", source)
-    notes: list[str] = []
     if cell is None:
         _refuse_track_column(cols, source, _NO_CELL_TRACK)
     else:
         e = track_positions(cell, cols, source, label)
         if e is not None and cell.track is not None:
             T = cell.frame_pose("robot", track=e) @ T
-            notes.append("note: the flange poses were mapped to the world through column "
-                         "'track': the reference point (pivot) is in world coordinates, and ABC "
-                         "World alignments refer to the world axes")
+            notes.add([MAPPED_NOTE])
     r = np.array(roles)
     labels = line_labels(len(roles), roles)
     order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
@@ -253,8 +280,8 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
         return CellCalibration(result, notes=tuple(notes))
     prov = _provenance("tcp", result, len(T), source, time)
     new = _copy(cell)
-    notes += _write_tool(new, name, result, prov, label)
-    return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes))
+    kept = _write_tool(new, name, result, prov, label)
+    return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes), tuple(kept))
 
 
 # -- frame -----------------------------------------------------------------------------------------
@@ -279,7 +306,8 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
           parent: Literal["world", "robot"] | None = None, robot: Robot | None = None,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
           source: str | None = None, cell_label: str | None = None,
-          time: str | None = None) -> CellCalibration:
+          time: str | None = None, on_note: Callable[[str], None] | None = None
+        ) -> CellCalibration:
     """A base / user frame (3-point, or N-point to known coordinates) into a cell.
 
     Parameters
@@ -300,7 +328,7 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
     tool : str or array_like of shape (4, 4), optional
         Tool that touched: a tool of the cell by name, or ``T_F_TCP`` (m); default the robot
         model's tool.
-    sigma, source, cell_label, time
+    sigma, source, cell_label, time, on_note
         As for :func:`tcp`.
 
     Returns
@@ -315,8 +343,9 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
     cols, source = load_table(measurements, source)
     label = _label(cell, cell_label)
     p = tcp_positions(cols, source, _arm(cell, robot), tool_transform(cell, tool))
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y",
-                                                    "nominal_z"]), source)
+    notes = _Notes(on_note)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y", "nominal_z"],
+                           source))
     in_world = False
     if cell is None:
         _refuse_track_column(cols, source, _NO_CELL_TRACK)
@@ -334,14 +363,14 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
         roles = point_roles(cols, source)
         result = frame_3point(p, roles, sigma, line_labels(len(roles), roles))
     if cell is None or name is None:
-        return CellCalibration(result)
+        return CellCalibration(result, notes=tuple(notes))
     key = f"T_world_{name}" if in_world else "T_R_W"
     if in_world:
         result = result.renamed("T_R_W", key)
     prov = _provenance("frame", result, len(p), source, time)
     new = _copy(cell)
     new.update_frame(name, result.values[key], prov, parent=parent)
-    return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov)
+    return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov, tuple(notes))
 
 
 # -- track -----------------------------------------------------------------------------------------
@@ -390,7 +419,8 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
           roll: Literal["zero"] | None = None, robot: Robot | None = None,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
           source: str | None = None, cell_label: str | None = None,
-          time: str | None = None) -> CellCalibration:
+          time: str | None = None, on_note: Callable[[str], None] | None = None
+        ) -> CellCalibration:
     """Linear track (direction, scale, straightness, rotation when determined) into a cell.
 
     Parameters
@@ -407,7 +437,7 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
         Axis of L along which the carriage moves; default the cell's, else x.
     roll : {"zero"}, optional
         Without references: fix the rotation about the track axis to zero (a convention).
-    robot, tool, sigma, source, cell_label, time
+    robot, tool, sigma, source, cell_label, time, on_note
         As for :func:`frame`.
 
     Returns
@@ -432,7 +462,8 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
     f = tcp_positions(cols, source, model, T_tool)
     e = external_axis(cols, source, "track")
     check_count(len(f), 3, "touches", source)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["e1", "point"]), source)
+    notes = _Notes(on_note)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "point"], source))
     idx = _reference_indices(cols, len(refs), source)
     keep_offset = cell is not None and len(refs) < 2
     if keep_offset:
@@ -442,20 +473,20 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
                              axis=axis or "x", roll=roll, labels=line_labels(len(f)),
                              prior_sigma=sigma)
     if cell is None:
-        return CellCalibration(result)
+        return CellCalibration(result, notes=tuple(notes))
     tr = cell.track
-    notes = []
     T_L_R0 = result.values["T_L_R"].copy()
+    kept = []
     if keep_offset:
         T_L_R0[:3, 3] = tr.T_L_R0[:3, 3]
         offset = ", ".join(f"{v:.3f}" for v in tr.T_L_R0[:3, 3] * 1e3 + 0.0)
-        notes.append(f"note: the carriage offset is not measured (two or more --reference "
+        kept.append(f"note: the carriage offset is not measured (two or more --reference "
                      f"points measure it): kept the offset of {label} ({offset} mm)")
     prov = _provenance("track", result, len(f), source, time)
     new = _copy(cell)
     new.update_track(prov, T_L_R0=T_L_R0, scale=float(result.values["scale"]))
     return CellCalibration(result, new, f"track {tr.name!r} (robot_at_zero, scale)", prov,
-                           tuple(notes))
+                           tuple(notes), tuple(kept))
 
 
 # -- turntable -------------------------------------------------------------------------------------
@@ -488,7 +519,8 @@ def _table_touches(cell: Cell | None, cols: Table, source: str, f: NDArray[np.fl
 def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: float = 0.0,
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
               sigma: float | None = None, source: str | None = None,
-              cell_label: str | None = None, time: str | None = None) -> CellCalibration:
+              cell_label: str | None = None, time: str | None = None,
+              on_note: Callable[[str], None] | None = None) -> CellCalibration:
     """Turntable root frame B and radius, from touches of one point on the table, into a cell.
 
     Parameters
@@ -500,7 +532,7 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
         turntable in the world of a cell with a track, ``track`` (mm).
     height : float
         Shift of the frame origin along the table axis from the plane of the touched point (m).
-    robot, tool, sigma, source, cell_label, time
+    robot, tool, sigma, source, cell_label, time, on_note
         As for :func:`frame`.
 
     Returns
@@ -518,12 +550,13 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     f = tcp_positions(cols, source, model, T_tool)
     theta = external_axis(cols, source, "table")
     check_count(len(f), 3, "touches", source)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["e1", "track"]), source)
+    notes = _Notes(on_note)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
     f = _table_touches(cell, cols, source, f, label)
     result = calibrate_turntable(theta, f, height=height, labels=line_labels(len(f)),
                                  prior_sigma=sigma)
     if cell is None:
-        return CellCalibration(result)
+        return CellCalibration(result, notes=tuple(notes))
     key = "T_R_B"
     if parent == "world":
         key = "T_world_B"
@@ -531,7 +564,7 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     prov = _provenance("turntable", result, len(f), source, time)
     new = _copy(cell)
     tt = new.update_turntable(prov, T_parent_B=result.values[key])
-    return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov)
+    return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov, tuple(notes))
 
 
 # -- workpiece -------------------------------------------------------------------------------------
@@ -575,7 +608,8 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
               turntable: TurntablePose | CalibrationResult | None = None,
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
               sigma: float | None = None, source: str | None = None,
-              cell_label: str | None = None, time: str | None = None) -> CellCalibration:
+              cell_label: str | None = None, time: str | None = None,
+              on_note: Callable[[str], None] | None = None) -> CellCalibration:
     """Workpiece frame ``T_B_W`` on a calibrated turntable into a cell (parent turntable).
 
     Parameters
@@ -591,7 +625,7 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     turntable : TurntablePose or CalibrationResult, optional
         The turntable calibration, whose uncertainty is then propagated; default the cell's
         turntable (without uncertainty).
-    robot, tool, sigma, source, cell_label, time
+    robot, tool, sigma, source, cell_label, time, on_note
         As for :func:`frame`.
 
     Returns
@@ -605,12 +639,14 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
         turntable = TurntablePose.from_result(turntable)
     model = _arm(cell, robot)
     T_tool = tool_transform(cell, tool)
-    tt, notes = _workpiece_turntable(cell, turntable, label)
+    tt, where = _workpiece_turntable(cell, turntable, label)
+    notes = _Notes(on_note)
+    notes.add(where)
     cols, source = load_table(measurements, source)
     f = tcp_positions(cols, source, model, T_tool)
-    theta = np.radians(require_columns(cols, ["e1"], source)[:, 0])
+    theta = external_axis(cols, source, "workpiece")
     roles = point_roles(cols, source)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["e1", "track"]), source)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
     f = _table_touches(cell, cols, source, f, label)
     result = calibrate_workpiece(theta, f, roles, tt.T, T_R_B_covariance=tt.covariance,
                                  noise_sigma=tt.noise_sigma, prior_sigma=sigma,

@@ -15,15 +15,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import track_column
+from robotcell.calibration.measurements import repeated_rows, track_column
 from robotcell.cell import Cell
 from robotcell.coupled import tool_pose
 from robotcell.errors import InputError
 from robotcell.tables import read_csv
 from robotcell.transforms import validate_pose
 
-__all__ = ["POSE_COLUMNS", "Table", "line_labels", "load_table", "raw_rows", "robot_in_world",
-           "tool_transform", "track_positions"]
+__all__ = ["POSE_COLUMNS", "Table", "line_labels", "load_table", "raw_rows", "repeat_notes",
+           "robot_in_world", "tool_transform", "track_positions"]
 
 #: A measurement table: column name (lower case) to numbers (mm, deg) or strings, one per touch.
 Table = Mapping[str, Any]
@@ -76,9 +76,14 @@ def load_table(measurements: Table | str | Path, source: str | None = None
 
 
 def raw_rows(cols: Table, names: Sequence[str]) -> NDArray[np.float64]:
-    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row check."""
+    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note."""
     use = [n for n in names if n in cols and isinstance(cols[n], np.ndarray)]
     return np.stack([cols[n] for n in use], axis=1)
+
+
+def repeat_notes(cols: Table, names: Sequence[str], source: str) -> list[str]:
+    """``note: ...`` per group of identical rows: repeated touches are data, each one used."""
+    return [f"note: {n}" for n in repeated_rows(raw_rows(cols, names), source)]
 
 
 def line_labels(n: int, roles: Sequence[str] | None = None) -> list[str]:

@@ -23,10 +23,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell import cellcal
-from robotcell.calibration.measurements import check_no_repeats, tcp_positions
+from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
-from robotcell.cellcal.touches import POSE_COLUMNS, line_labels, raw_rows
+from robotcell.cellcal.touches import POSE_COLUMNS, line_labels, repeat_notes
 from robotcell.cli.common import parse_numbers, read_csv
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
@@ -59,6 +59,8 @@ def calibrate() -> None:
     or joint values a1..a6 with --robot and --tool. Report in mm/deg, or --json.
     With --cell CELL.yaml the result is written into the cell file (CELL.yaml.bak keeps the
     previous version). Exit status 2 when the measurements are refused, with the reason on stderr.
+    Every report ends with a verdict (good / check / poor); a poor result prints its report,
+    exits with status 3 and writes nothing, unless --accept-poor is given.
 
     \b
     Examples:
@@ -68,7 +70,11 @@ def calibrate() -> None:
 
 
 def measurement_options(func: Callable) -> Callable:
-    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json."""
+    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json,
+    --accept-poor."""
+    func = click.option("--accept-poor", is_flag=True,
+                        help="Write and exit 0 even when the verdict is poor (default: a poor "
+                             "result exits with status 3 and changes no file).")(func)
     func = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
                         help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
@@ -127,8 +133,10 @@ class CellTarget:
                              "give one of them or X,Y,Z,A,B,C in mm/deg")
         return self.cell.tools[name].T_F_TCP
 
-    def save(self, cell: Cell, what: str) -> None:
-        """Write ``cell`` into the cell file and say on stderr what was updated."""
+    def save(self, cell: Cell, what: str, notes: tuple[str, ...] = ()) -> None:
+        """Write ``cell`` into the cell file; say on stderr ``notes`` and what was updated."""
+        for note in notes:
+            echo_note(note)
         self.cell = cell
         try:
             self.cell.save(self.path)
@@ -188,10 +196,9 @@ def cell_of(target: CellTarget | None) -> tuple[Cell | None, str | None]:
     return (None, None) if target is None else (target.cell, target.path)
 
 
-def echo_notes(out: cellcal.CellCalibration) -> None:
-    """Print the notes of a calibration into a cell on stderr."""
-    for note in out.notes:
-        click.echo(note, err=True)
+def echo_note(note: str) -> None:
+    """Print a note of a calibration on stderr."""
+    click.echo(note, err=True)
 
 
 def emit(result: CalibrationResult, as_json: bool) -> None:
@@ -200,6 +207,33 @@ def emit(result: CalibrationResult, as_json: bool) -> None:
         click.echo(json.dumps(result.to_json(), indent=2))
     else:
         click.echo(result.summary())
+
+
+class PoorCalibration(click.ClickException):
+    """A calibration whose verdict is poor: exit status 3, ``error: ...`` on stderr."""
+
+    exit_code = 3
+
+    def show(self, file: object = None) -> None:
+        click.echo(f"error: {self.message}", err=True)
+
+
+def gate(result: CalibrationResult, as_json: bool, accept_poor: bool) -> None:
+    """Stop before anything is written when the verdict is poor, unless ``--accept-poor``.
+
+    The report is printed (stdout) so the technician sees why; then :class:`PoorCalibration`
+    exits with status 3. Call it right after the calibration, before any file is written.
+    """
+    v = result.verdict
+    if v.level != "poor":
+        return
+    if accept_poor:
+        click.echo("warning: the verdict is poor; written anyway (--accept-poor)", err=True)
+        return
+    # The report goes to stdout only, never to an output file: a poor result writes nothing.
+    click.echo(json.dumps(result.to_json(), indent=2) if as_json else result.summary())
+    raise PoorCalibration(f"poor calibration, nothing written: {'; '.join(v.reasons)}. Fix the "
+                          "measurements, or pass --accept-poor to use the result anyway")
 
 
 @calibrate.command("tcp")
@@ -212,7 +246,8 @@ def emit(result: CalibrationResult, as_json: bool) -> None:
 @cell_option
 @measurement_options
 def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | None,
-        robot: str | None, tool: str | None, sigma: float | None, as_json: bool) -> None:
+        robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+        accept_poor: bool) -> None:
     """Tool TCP (XYZ 4-point / N-point) and orientation (ABC 2-point, ABC World).
 
     \b
@@ -239,10 +274,10 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     cols = read_csv(measurements)
     cell, label = cell_of(target)
     out = cellcal.tcp(cell, cols, name, robot=None if cell else model, world_mode=world_mode,
-                      sigma=prior, source=measurements, cell_label=label)
-    echo_notes(out)
+                      sigma=prior, source=measurements, cell_label=label, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
     if out.cell is not None:
-        target.save(out.cell, out.item)
+        target.save(out.cell, out.item, out.update_notes)
     emit(out.result, as_json)
 
 
@@ -257,7 +292,8 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
 @cell_option
 @measurement_options
 def frame(measurements: str, name: str | None, parent: str | None, cell_path: str | None,
-          robot: str | None, tool: str | None, sigma: float | None, as_json: bool) -> None:
+          robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+          accept_poor: bool) -> None:
     """Frame (base / user frame): 3-point, or N-point best fit to known coordinates.
 
     \b
@@ -283,10 +319,11 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
     cols = read_csv(measurements)
     cell, label = cell_of(target)
     out = cellcal.frame(cell, cols, name, parent=parent, robot=None if cell else model,
-                        tool=T_tool, sigma=prior, source=measurements, cell_label=label)
-    echo_notes(out)
+                        tool=T_tool, sigma=prior, source=measurements, cell_label=label,
+                        on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
     if out.cell is not None:
-        target.save(out.cell, out.item)
+        target.save(out.cell, out.item, out.update_notes)
     emit(out.result, as_json)
 
 
@@ -294,7 +331,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @measurement_options
 def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sigma: float | None,
-                     as_json: bool) -> None:
+                     as_json: bool, accept_poor: bool) -> None:
     """Fixed (external) tool touched with a robot-held reference tool of known TCP.
 
     \b
@@ -319,8 +356,10 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
         roles = [str(v).strip().lower() for v in cols["point"]]
     else:
         roles = ["tcp"] * len(p)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS), measurements)
+    for note in repeat_notes(cols, POSE_COLUMNS, measurements):
+        echo_note(note)
     result = external_tcp(p, roles, prior, line_labels(len(roles), roles))
+    gate(result, as_json, accept_poor)
     emit(result, as_json)
 
 
@@ -328,7 +367,8 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
 # A module listed here is imported only when its subcommand is used; an entry whose module does
 # not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m, emit, and for --cell cell_option, CellTarget, cell_of and echo_notes, from this module.
+# sigma_m, gate, emit, and for --cell cell_option, CellTarget, cell_of and echo_note, from this
+# module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",

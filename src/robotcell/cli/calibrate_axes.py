@@ -19,8 +19,9 @@ from robotcell.cli.calibrate import (
     CellTarget,
     cell_of,
     cell_option,
-    echo_notes,
+    echo_note,
     emit,
+    gate,
     measurement_options,
     require_name,
     robot_and_tool,
@@ -46,7 +47,7 @@ from robotcell.transforms import validate_pose
 @measurement_options
 def track(measurements: str, references: tuple[str, ...], axis: str | None, roll: str | None,
           cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
-          as_json: bool) -> None:
+          as_json: bool, accept_poor: bool) -> None:
     """Linear track: direction in the robot base, scale, straightness; rotation when determined.
 
     \b
@@ -71,10 +72,10 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     cell, label = cell_of(target)
     out = cellcal.track(cell, cols, references=refs, axis=axis, roll=roll,
                         robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
-                        source=measurements, cell_label=label)
-    echo_notes(out)
+                        source=measurements, cell_label=label, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
     if out.cell is not None:
-        target.save(out.cell, out.item)
+        target.save(out.cell, out.item, out.update_notes)
     emit(out.result, as_json)
 
 
@@ -86,7 +87,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
 @cell_option
 @measurement_options
 def turntable(measurements: str, height: float, cell_path: str | None, robot: str | None,
-              tool: str | None, sigma: float | None, as_json: bool) -> None:
+              tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
     """Turntable root frame B (R_T_B) and radius from touches of one point on the table.
 
     \b
@@ -108,10 +109,10 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     cell, label = cell_of(target)
     out = cellcal.turntable(cell, cols, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label)
-    echo_notes(out)
+                            cell_label=label, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
     if out.cell is not None:
-        target.save(out.cell, out.item)
+        target.save(out.cell, out.item, out.update_notes)
     emit(out.result, as_json)
 
 
@@ -167,7 +168,7 @@ def _load_turntable(path: str) -> cellcal.TurntablePose:
 @measurement_options
 def workpiece(measurements: str, turntable_json: str | None, name: str | None,
               cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
-              as_json: bool) -> None:
+              as_json: bool, accept_poor: bool) -> None:
     """Workpiece frame B_T_W on a calibrated turntable (3-point, or several touches per point).
 
     \b
@@ -191,8 +192,8 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     cell, label = cell_of(target)
     out = cellcal.workpiece(cell, cols, name, turntable=given, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label)
-    echo_notes(out)
+                            cell_label=label, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
     if out.cell is not None:
-        target.save(out.cell, out.item)
+        target.save(out.cell, out.item, out.update_notes)
     emit(out.result, as_json)
