@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from robotcell import cellcal
 from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
-from robotcell.errors import RobotcellError
+from robotcell.errors import InputError, RobotcellError
 from robotcell.export import EXPORT_FORMATS, export_cell
 from robotcell.modelfile import load_robot
 from robotcell.plan import pose_error
@@ -185,6 +185,10 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
             kw["turntable"] = turntable
         done = getattr(cellcal, procedure)(cell, read_csv(csv_path), source=str(csv_path),
                                             cell_label=str(cell_file), **kw, **touches.keywords())
+        verdict = done.result.verdict
+        if verdict.level == "poor":  # the command refuses to write it (exit 3); so does the demo
+            raise InputError(f"{procedure}: poor calibration, nothing written: "
+                             f"{'; '.join(verdict.reasons)}; try a smaller --noise")
         if procedure == "turntable":
             turntable = cellcal.TurntablePose.from_result(done.result, str(out / "turntable.json"))
         done.cell.save(cell_file)
