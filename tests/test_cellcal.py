@@ -140,3 +140,16 @@ def test_library_errors_name_the_cause():
         cellcal.turntable(bare, table)
     with pytest.raises(InputError, match=r"cell 'cell' has no track to calibrate"):
         cellcal.track(bare, table, roll="zero")
+
+
+def test_notes_reach_on_note_before_a_refusal():
+    truth, nominal = demo_cells()
+    table = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch").to_table()
+    rows = [0, 0, 1]  # a copied line: two of the three orientations are the same
+    short = {k: (np.asarray(v)[rows] if isinstance(v, np.ndarray) else [v[i] for i in rows])
+             for k, v in table.items()}
+    seen = []
+    with pytest.raises(InputError, match=r"flange orientations of the touches are too similar"):
+        cellcal.tcp(nominal, short, "torch", on_note=seen.append)
+    assert len(seen) == 1 and seen[0].startswith("note: measurements: line 2, line 3 are "
+                                                 "identical")
