@@ -187,6 +187,10 @@ def test_positioner_errors_name_the_cause(tmp_path):
     with pytest.raises(InputError, match=r"positioner 'DKP_2' has 2 axes: give its axis values "
                                          r"with shape \(\.\.\., 2\), got \(3,\)"):
         cell.frame_pose("part", table=[0.1, 0.2, 0.3])
+    with pytest.raises(InputError, match=r"positioner 'DKP_2' has 2 axes: give one value per "
+                                         r"axis, shape \(\.\.\., 2\), not the single value 0.5 rad"):
+        cell.fk(np.zeros(6), table=0.5)
+    assert np.allclose(cell.frame_pose("part", table=0.0), cell.frame_pose("part", table=[0, 0]))
     with pytest.raises(InputError, match=r"table='normal_up' needs targets in a frame carried"):
         cell.ik(np.eye(4), frame="world", table="normal_up")
     truth, _ = demo_cells()

@@ -298,9 +298,17 @@ class Positioner:
         return self.chain.upper
 
     def axis_values(self, values: ArrayLike) -> NDArray[np.float64]:
-        """Axis values as an array of shape ``(..., n)`` (radians); a scalar is every axis."""
+        """Axis values as an array of shape ``(..., n)`` (radians).
+
+        A single number is every axis of a 1-axis positioner; of a longer chain only 0 (every
+        axis at 0, the default of the kinematic functions) is taken, any other is refused.
+        """
         v = finite_array(values, "positioner axis value")
         if v.ndim == 0:
+            if self.n_axes > 1 and v != 0:
+                raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give one "
+                                 f"value per axis, shape (..., {self.n_axes}), not the single "
+                                 f"value {float(v):g} rad")
             return np.broadcast_to(v, (self.n_axes,))
         if v.shape[-1] != self.n_axes:
             raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give its axis "
