@@ -292,3 +292,19 @@ def test_ik_path_follows_the_positioner_axes():
     assert path.q.shape == (31, 6) and path.table.shape == (31, 2)
     assert np.allclose(cell.fk(path.q, table=v, tool="torch", frame="part"), T_part_TCP,
                        atol=1e-9)
+
+
+def test_positioner_touches_map_a_touched_point_into_the_parent_frame():
+    from robotcell import cellcal
+
+    cell = tilt_rotate()
+    v = np.radians([[0.0, 0.0], [30.0, 90.0], [-20.0, 200.0], [10.0, -45.0]])
+    p_P = np.array([0.2, 0.1, 0.02])  # a point on the plate
+    p_world = (cell.frame_pose("part", table=v) @ np.linalg.inv(T_P_PART) @ [*p_P, 1])[:, :3]
+    table = {"x": p_world[:, 0] * 1e3, "y": p_world[:, 1] * 1e3, "z": p_world[:, 2] * 1e3,
+             "e1": np.degrees(v[:, 0]), "e2": np.degrees(v[:, 1])}
+    values, points = cellcal.positioner_touches(cell, table)
+    assert np.allclose(values, v) and np.allclose(points, p_world, atol=1e-12)
+    del table["e2"]
+    with pytest.raises(InputError, match=r"missing column\(s\) e2"):
+        cellcal.positioner_touches(cell, table)

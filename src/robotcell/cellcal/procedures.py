@@ -55,8 +55,8 @@ from robotcell.robot import Robot
 from robotcell.tables import require_columns
 from robotcell.transforms import invert, transform_points, validate_pose
 
-__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "tcp", "track", "turntable",
-           "workpiece"]
+__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "positioner_touches", "tcp",
+           "track", "turntable", "workpiece"]
 
 #: Largest difference between a given turntable pose and the cell's that counts as the same
 #: calibration (m, rad): far above the cell file's rounding, far below any recalibration.
@@ -514,6 +514,49 @@ def _table_touches(cell: Cell | None, cols: Table, source: str, f: NDArray[np.fl
         return transform_points(robot_in_world(cell, cols, source, len(f), label), f)
     track_positions(cell, cols, source, label)
     return f
+
+
+def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
+                       tool: str | ArrayLike | None = None, source: str | None = None,
+                       cell_label: str | None = None
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Touches of a point on a positioner, as its calibration takes them.
+
+    The input of the positioner calibration (:func:`robotcell.calibration.calibrate_positioner`,
+    on the kinematic-identification engine): the axis values of each touch and the touched
+    point in the positioner's parent frame, mapped through the robot's track like the turntable
+    touches. Its identified chain goes into the cell with :meth:`Cell.update_positioner`.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell with a positioner (or a turntable, the 1-axis case).
+    measurements : mapping or str or Path
+        TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg), the axis values ``e1..en`` (deg, one
+        column per positioner axis) and, for a positioner in the world of a cell with a track,
+        ``track`` (mm).
+    tool, source, cell_label
+        As for :func:`frame`.
+
+    Returns
+    -------
+    values : ndarray, shape (N, n)
+        Axis values (rad).
+    points : ndarray, shape (N, 3)
+        The touched point in the positioner's parent frame (world or robot base; m).
+    """
+    label = _label(cell, cell_label)
+    if cell.turntable is None:
+        raise InputError(f"{label} has no positioner; add a 'positioner' section to the cell "
+                         "file first")
+    cols, source = load_table(measurements, source)
+    f = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool))
+    n = cell.turntable.n_axes
+    values = np.radians(require_columns(cols, [f"e{i + 1}" for i in range(n)], source))
+    if cell.turntable.parent == "world":
+        return values, transform_points(robot_in_world(cell, cols, source, len(f), label), f)
+    track_positions(cell, cols, source, label)
+    return values, f
 
 
 def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: float = 0.0,
