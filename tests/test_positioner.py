@@ -254,12 +254,13 @@ def test_one_axis_procedures_refuse_a_positioner_chain():
 
     cell = tilt_rotate()
     with pytest.raises(InputError, match=r"positioner 'DKP_2' is a chain of 2 axes; the "
-                                         r"turntable and workpiece procedures"):
+                                         r"simulation of the turntable and workpiece procedures"):
         simulate(cell, "turntable")
     table = {"x": [1000.0, 1100.0, 1200.0], "y": [0.0, 10.0, 0.0], "z": [500.0] * 3,
              "e1": [0.0, 90.0, 180.0]}
-    with pytest.raises(InputError, match=r"calibrated by robotcell.calibration."
-                                         r"calibrate_positioner"):
+    with pytest.raises(InputError, match=r"the turntable procedure is for a one-axis turntable; "
+                                         r"a positioner chain is calibrated by "
+                                         r"robotcell.cellcal.positioner"):
         cellcal.turntable(cell, table)
 
 
@@ -308,3 +309,65 @@ def test_positioner_touches_map_a_touched_point_into_the_parent_frame():
     del table["e2"]
     with pytest.raises(InputError, match=r"missing column\(s\) e2"):
         cellcal.positioner_touches(cell, table)
+
+
+def test_positioner_calibration_into_the_cell_recovers_the_true_chain(tmp_path):
+    from robotcell import cellcal
+
+    true_axes = AxisChain(points=AXES.points + [[0.002, -0.001, 0.003], [0.001, 0.002, 0.0]],
+                          directions=AXES.directions + [[0.0, 0.0, 0.004], [0.003, -0.002, 0.0]],
+                          types=AXES.types, flange=AXES.flange, names=AXES.names,
+                          lower=AXES.lower, upper=AXES.upper)
+    truth, nominal = tilt_rotate(axes=true_axes), tilt_rotate()
+    grid = np.array([[t, r] for t in np.radians([-40, 0, 40])
+                     for r in np.radians([0, 90, 180, 270])])
+    p_P = np.array([0.2, 0.1, 0.0, 1.0])  # a point on the plate, touched at every (tilt, rotate)
+    rng = np.random.default_rng(5)
+    points = (truth.frame_pose("part", table=grid) @ np.linalg.inv(T_P_PART) @ p_P)[:, :3]
+    points = points + rng.normal(0.0, 1e-4, points.shape)
+    table = {"x": points[:, 0] * 1e3, "y": points[:, 1] * 1e3, "z": points[:, 2] * 1e3,
+             "e1": np.degrees(grid[:, 0]), "e2": np.degrees(grid[:, 1])}
+    done = cellcal.positioner(nominal, table, sigma=1e-4, time="2026-01-01T00:00:00+00:00")
+    pos = done.cell.turntable
+    assert isinstance(pos, Positioner) and pos.name == "DKP_2" and done.item.startswith("positioner")
+    assert done.provenance.source == "positioner" and nominal.turntable.chain is not pos.chain
+    # the table moves as the true one: a point of the table at axis 0 goes where it truly goes
+    # (the motion T_world_P(v) inv(T_world_P(0)) does not depend on where the plate frame is)
+    v = rng.uniform(-1.2, 1.2, (30, 2))
+    x0 = np.array([1.0, 0.3, 0.75, 1.0])  # in the world, on the table at axis 0
+
+    def moved(cell):
+        return (cell.frame_pose("part", table=v) @ np.linalg.inv(cell.frame_pose("part")) @ x0)
+
+    got, want, before = moved(done.cell), moved(truth), moved(nominal)
+    assert np.max(np.linalg.norm(got[:, :3] - want[:, :3], axis=1)) < 0.5e-3
+    assert np.max(np.linalg.norm(before[:, :3] - want[:, :3], axis=1)) > 2e-3
+    done.cell.save(tmp_path / "cell.yaml")
+    assert Cell.load(tmp_path / "cell.yaml").turntable.provenance.source == "positioner"
+    with pytest.raises(InputError, match=r"has no positioner of 2 axes"):
+        cellcal.positioner(demo_cells()[1], table)
+
+
+def test_workpiece_on_a_positioner_chain_is_touched_into_its_plate():
+    from robotcell import cellcal
+
+    cell = tilt_rotate("modified")
+    p_W = np.array([[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]] * 2, dtype=float)  # origin, x, xy
+    roles = ["origin", "x", "xy"] * 2
+    v = np.radians([[10.0, 30.0], [10.0, 30.0], [-20.0, 100.0],
+                    [0.0, 0.0], [25.0, -60.0], [5.0, 200.0]])
+    T_world_W = cell.frame_pose("part", table=v)
+    rng = np.random.default_rng(9)
+    p = np.einsum("nij,nj->ni", T_world_W[:, :3, :3], p_W) + T_world_W[:, :3, 3]
+    p = p + rng.normal(0.0, 5e-5, p.shape)
+    table = {"x": p[:, 0] * 1e3, "y": p[:, 1] * 1e3, "z": p[:, 2] * 1e3,
+             "e1": np.degrees(v[:, 0]), "e2": np.degrees(v[:, 1]), "point": roles}
+    seen = []
+    done = cellcal.workpiece(cell, table, "part2", on_note=seen.append)
+    T = done.cell.frames["part2"].pose
+    assert done.cell.frames["part2"].parent == "turntable"
+    assert np.linalg.norm(T[:3, 3] - T_P_PART[:3, 3]) < 3e-4
+    assert np.allclose(T[:3, :3], T_P_PART[:3, :3], atol=5e-3)
+    assert "T_P_W" in done.result.values and "does not include the positioner's" in seen[0]
+    with pytest.raises(InputError, match=r"carries its own calibration: give no turntable"):
+        cellcal.workpiece(cell, table, "part2", turntable=cellcal.TurntablePose(np.eye(4)))

@@ -591,7 +591,7 @@ class Cell:
     def update_positioner(self, provenance: Provenance, chain: Robot) -> Positioner:
         """Write a calibrated positioner chain into the cell, keeping its parent and name.
 
-        The hook of the positioner calibration (:func:`robotcell.calibration.calibrate_positioner`
+        The hook of the positioner calibration (:func:`robotcell.identification.calibrate_positioner`
         returns the identified chain as a :class:`~robotcell.robot.Robot`): a turntable becomes a
         :class:`Positioner` with that chain.
 

@@ -437,8 +437,8 @@ def _one_axis_table(cell: Cell) -> None:
         raise InputError("the cell has no turntable")
     if not isinstance(cell.turntable, Turntable):
         raise InputError(f"the cell's positioner {cell.turntable.name!r} is a chain of "
-                         f"{cell.turntable.n_axes} axes; the turntable and workpiece procedures "
-                         "are for a one-axis turntable")
+                         f"{cell.turntable.n_axes} axes; the simulation of the turntable and "
+                         "workpiece procedures needs a one-axis turntable")
 
 
 def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.float64]:

@@ -4,8 +4,8 @@
 ``cellcal.workpiece`` take a :class:`~robotcell.cell.Cell`, a measurement table (mm, deg, as
 :func:`robotcell.tables.read_csv` returns it) and options in SI units, and return a
 :class:`CellCalibration`: the result, the updated cell (a new object) and its provenance.
-``cellcal.positioner_touches`` prepares the touches of a positioner for its calibration, whose
-identified chain :meth:`Cell.update_positioner` writes.
+``cellcal.positioner`` calibrates a 2-axis positioner's chain into the cell (on the
+identification engine); ``cellcal.positioner_touches`` gives its input.
 See ``docs/python-api.md``.
 """
 
@@ -14,6 +14,7 @@ from robotcell.cellcal.procedures import (
     CellCalibration,
     TurntablePose,
     frame,
+    positioner,
     positioner_touches,
     tcp,
     track,
@@ -23,5 +24,5 @@ from robotcell.cellcal.procedures import (
 from robotcell.cellcal.touches import load_table, robot_in_world, track_positions
 
 __all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "load_table",
-           "positioner_touches", "robot_in_world", "tcp", "track", "track_positions", "turntable",
+           "positioner", "positioner_touches", "robot_in_world", "tcp", "track", "track_positions", "turntable",
            "workpiece"]

@@ -14,9 +14,9 @@ measurements are then refused), and on the update (a value kept because the touc
 measure it).
 Nothing is written to a file: save the new cell with :meth:`Cell.save`.
 
-The 2-axis positioner is calibrated by :func:`robotcell.calibration.calibrate_positioner` on the
-kinematic-identification engine; its result is written into the cell with
-:meth:`Cell.update_positioner` the same way.
+The 2-axis positioner is calibrated by :func:`robotcell.identification.calibrate_positioner` on
+the kinematic-identification engine; :func:`positioner` runs it on the touches of a cell and
+writes the identified chain with :meth:`Cell.update_positioner`.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from robotcell.calibration.measurements import (
     tcp_positions,
 )
 from robotcell.calibration.result import CalibrationResult
-from robotcell.cell import Cell, Provenance, Turntable
+from robotcell.cell import Cell, Positioner, Provenance, Turntable
 from robotcell.cellcal.touches import (
     POSE_COLUMNS,
     Table,
@@ -55,8 +55,8 @@ from robotcell.robot import Robot
 from robotcell.tables import require_columns
 from robotcell.transforms import invert, transform_points, validate_pose
 
-__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "positioner_touches", "tcp",
-           "track", "turntable", "workpiece"]
+__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "positioner",
+           "positioner_touches", "tcp", "track", "turntable", "workpiece"]
 
 #: Largest difference between a given turntable pose and the cell's that counts as the same
 #: calibration (m, rad): far above the cell file's rounding, far below any recalibration.
@@ -497,10 +497,10 @@ def _cell_turntable(cell: Cell, label: str) -> Turntable:
                          "file first")
     if not isinstance(cell.turntable, Turntable):
         raise InputError(f"the positioner {cell.turntable.name!r} of {label} is a chain of "
-                         f"{cell.turntable.n_axes} axes: the turntable and workpiece procedures "
-                         "are for a one-axis turntable; a positioner chain is calibrated by "
-                         "robotcell.calibration.calibrate_positioner and written with "
-                         "Cell.update_positioner")
+                         f"{cell.turntable.n_axes} axes: the turntable procedure is for a "
+                         "one-axis turntable; a positioner chain is calibrated by "
+                         "robotcell.cellcal.positioner (robotcell.identification."
+                         "calibrate_positioner)")
     return cell.turntable
 
 
@@ -522,7 +522,7 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Touches of a point on a positioner, as its calibration takes them.
 
-    The input of the positioner calibration (:func:`robotcell.calibration.calibrate_positioner`,
+    The input of the positioner calibration (:func:`robotcell.identification.calibrate_positioner`,
     on the kinematic-identification engine): the axis values of each touch and the touched
     point in the positioner's parent frame, mapped through the robot's track like the turntable
     touches. Its identified chain goes into the cell with :meth:`Cell.update_positioner`.
@@ -557,6 +557,54 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
         return values, transform_points(robot_in_world(cell, cols, source, len(f), label), f)
     track_positions(cell, cols, source, label)
     return values, f
+
+
+def positioner(cell: Cell, measurements: Table | str | Path, *,
+               tool: str | ArrayLike | None = None, sigma: float | None = None,
+               source: str | None = None, cell_label: str | None = None,
+               time: str | None = None, on_note: Callable[[str], None] | None = None
+               ) -> CellCalibration:
+    """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
+
+    The touches (:func:`positioner_touches`) go to
+    :func:`robotcell.identification.calibrate_positioner` with the cell's chain as the nominal
+    model; the identified chain (axis lines, common normal, zeros and root; the touched point is
+    not part of it) replaces the cell's, keeping the plate frame of its parameterisation, so
+    frames carried by the positioner keep their poses on the plate.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell with a positioner of 2 axes.
+    measurements : mapping or str or Path
+        As for :func:`positioner_touches`: one point on the table touched at several (tilt,
+        rotate) values ``e1``, ``e2`` (deg).
+    tool, sigma, source, cell_label, time, on_note
+        As for :func:`frame`.
+
+    Returns
+    -------
+    CellCalibration
+        ``result`` is the positioner calibration's (procedure ``positioner-2axis``, values in
+        the positioner's parent frame).
+    """
+    from robotcell.identification import calibrate_positioner
+
+    label = _label(cell, cell_label)
+    pos = cell.turntable
+    if pos is None or pos.n_axes != 2:
+        raise InputError(f"{label} has no positioner of 2 axes (tilt, rotate) to calibrate")
+    cols, source = load_table(measurements, source)
+    notes = _Notes(on_note)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2", "track"], source))
+    values, points = positioner_touches(cell, cols, tool=tool, source=source, cell_label=label)
+    done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
+                                labels=line_labels(len(points)))
+    prov = _provenance("positioner", done.result, len(points), source, time)
+    new = _copy(cell)
+    new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
+    return CellCalibration(done.result, new, f"positioner {pos.name!r} (axes, root)", prov,
+                           tuple(notes))
 
 
 def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: float = 0.0,
@@ -647,6 +695,35 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
     return given, notes
 
 
+def _positioner_workpiece(cell: Cell, measurements: Table | str | Path, name: str | None, *,
+                          tool: str | ArrayLike | None, sigma: float | None, source: str | None,
+                          label: str, time: str | None,
+                          on_note: Callable[[str], None] | None) -> CellCalibration:
+    """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P."""
+    from robotcell.calibration.frame import frame_3point
+
+    values, points = positioner_touches(cell, measurements, tool=tool, source=source,
+                                        cell_label=label)
+    cols, source = load_table(measurements, source)
+    pos = cell.turntable
+    notes = _Notes(on_note)
+    notes.add([(f"note: the touches are taken into the plate of positioner {pos.name!r} "
+                f"through its chain in {label}, which holds no covariance: the 1-sigma of T_P_W "
+                "does not include the positioner's uncertainty")])
+    roles = point_roles(cols, source)
+    notes.add(repeat_notes(cols, POSE_COLUMNS + [f"e{i + 1}" for i in range(pos.n_axes)]
+                           + ["track"], source))
+    p_P = transform_points(invert(pos.T_parent_root @ pos.T_root_P(values)), points)
+    result = frame_3point(p_P, roles, sigma, line_labels(len(roles), roles)).renamed("T_R_W",
+                                                                                    "T_P_W")
+    if name is None:
+        return CellCalibration(result, notes=tuple(notes))
+    prov = _provenance("workpiece", result, len(points), source, time)
+    new = _copy(cell)
+    new.update_frame(name, result.values["T_P_W"], prov, parent="turntable")
+    return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes))
+
+
 def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
               turntable: TurntablePose | CalibrationResult | None = None,
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
@@ -659,6 +736,8 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     ----------
     cell : Cell or None
         The cell whose frame ``name`` on the turntable is calibrated; None: needs ``turntable``.
+        On a positioner chain the touches, with its axis values ``e1..en`` (deg), are taken
+        into its plate frame P through the cell's chain and give ``T_P_W`` (3-point).
     measurements : mapping or str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) with the table angle ``e1`` (deg) and
         column ``point`` (``origin``, ``x``, ``xy``); for a turntable in the world of a cell with
@@ -678,6 +757,12 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     from robotcell.calibration.workpiece import calibrate_workpiece
 
     label = _label(cell, cell_label)
+    if cell is not None and isinstance(cell.turntable, Positioner):
+        if turntable is not None:
+            raise InputError(f"{label} has a positioner chain, which carries its own "
+                             "calibration: give no turntable result")
+        return _positioner_workpiece(cell, measurements, name, tool=tool, sigma=sigma,
+                                     source=source, label=label, time=time, on_note=on_note)
     if isinstance(turntable, CalibrationResult):
         turntable = TurntablePose.from_result(turntable)
     model = _arm(cell, robot)
