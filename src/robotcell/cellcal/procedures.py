@@ -559,11 +559,11 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
     return values, f
 
 
-def positioner(cell: Cell, measurements: Table | str | Path, *,
-               tool: str | ArrayLike | None = None, sigma: float | None = None,
-               source: str | None = None, cell_label: str | None = None,
-               time: str | None = None, on_note: Callable[[str], None] | None = None
-               ) -> CellCalibration:
+def positioner(cell: Cell | None, measurements: Table | str | Path, *,
+               robot: Robot | None = None, tool: str | ArrayLike | None = None,
+               sigma: float | None = None, source: str | None = None,
+               cell_label: str | None = None, time: str | None = None,
+               on_note: Callable[[str], None] | None = None) -> CellCalibration:
     """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
 
     The touches (:func:`positioner_touches`) go to
@@ -574,11 +574,15 @@ def positioner(cell: Cell, measurements: Table | str | Path, *,
 
     Parameters
     ----------
-    cell : Cell
-        A cell with a positioner of 2 axes.
+    cell : Cell or None
+        A cell with a positioner of 2 axes. None: a plain calibration in the robot base, started
+        from the circle point analysis of the touches (which then need, for each axis, at least
+        3 that move that axis alone, e.g. a grid of 3 tilt by 4 rotate values); nothing written.
     measurements : mapping or str or Path
         As for :func:`positioner_touches`: one point on the table touched at several (tilt,
         rotate) values ``e1``, ``e2`` (deg).
+    robot : Robot, optional
+        Robot model for joint values when no cell is given.
     tool, sigma, source, cell_label, time, on_note
         As for :func:`frame`.
 
@@ -586,24 +590,36 @@ def positioner(cell: Cell, measurements: Table | str | Path, *,
     -------
     CellCalibration
         ``result`` is the positioner calibration's (procedure ``positioner-2axis``, values in
-        the positioner's parent frame).
+        the positioner's parent frame: ``T_world_B`` instead of ``T_R_B`` for a positioner in
+        the world; in the robot base without a cell).
     """
     from robotcell.identification import calibrate_positioner
 
     label = _label(cell, cell_label)
+    cols, source = load_table(measurements, source)
+    notes = _Notes(on_note)
+    if cell is None:
+        _refuse_track_column(cols, source, _NO_CELL_TRACK)
+        points = tcp_positions(cols, source, robot, tool_transform(None, tool))
+        values = np.radians(require_columns(cols, ["e1", "e2"], source))
+        notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2"], source))
+        done = calibrate_positioner(values, points, prior_sigma=sigma,
+                                    labels=line_labels(len(points)))
+        return CellCalibration(done.result, notes=tuple(notes))
     pos = cell.turntable
     if pos is None or pos.n_axes != 2:
         raise InputError(f"{label} has no positioner of 2 axes (tilt, rotate) to calibrate")
-    cols, source = load_table(measurements, source)
-    notes = _Notes(on_note)
+    if robot is not None:
+        raise InputError("the robot is the cell's: give a cell or a robot, not both")
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2", "track"], source))
     values, points = positioner_touches(cell, cols, tool=tool, source=source, cell_label=label)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
                                 labels=line_labels(len(points)))
-    prov = _provenance("positioner", done.result, len(points), source, time)
+    result = done.result.renamed("T_R_B", "T_world_B") if pos.parent == "world" else done.result
+    prov = _provenance("positioner", result, len(points), source, time)
     new = _copy(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
-    return CellCalibration(done.result, new, f"positioner {pos.name!r} (axes, root)", prov,
+    return CellCalibration(result, new, f"positioner {pos.name!r} (axes, root)", prov,
                            tuple(notes))
 
 
