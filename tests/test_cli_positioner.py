@@ -295,3 +295,67 @@ def test_example_positioner_cell_levels_the_plate_at_zero():
     # the tilt axis is world Y, the rotate axis the plate's Z
     T30 = cell.frame_pose("part", table=np.radians([30, 0])) @ np.linalg.inv(cell.frames["part"].pose)
     assert np.allclose(T30[:3, 2], [math.sin(math.radians(30)), 0, math.cos(math.radians(30))])
+
+
+def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, monkeypatch):
+    from robotcell import cellcal
+    from robotcell.cell import Provenance
+    from robotcell.tables import read_csv
+
+    stamp = "2026-01-02T03:04:05+00:00"
+    monkeypatch.setattr(Provenance, "now", classmethod(
+        lambda cls, source, rms_mm=None, note="": cls(source=source, time=stamp, rms_mm=rms_mm,
+                                                      note=note)))
+    truth = truth_file(tmp_path)
+    csv = tmp_path / "touches.csv"
+    assert run(capsys, "simulate", "positioner", "--cell", truth, "--seed", "5", "--tool",
+               "pointer", "-o", csv)[0] == 0
+    cli_file, lib_file = tmp_path / "cli.yaml", tmp_path / "lib.yaml"
+    shutil.copy(EXAMPLE, cli_file)
+    code, out, err = run(capsys, "calibrate", "positioner", csv, "--cell", cli_file, "--tool",
+                         "pointer", "--json")
+    assert code == 0, err
+    got = cellcal.positioner(Cell.load(EXAMPLE), read_csv(csv), tool="pointer", source=str(csv))
+    got.cell.save(lib_file)
+    assert cli_file.read_bytes() == lib_file.read_bytes()
+    assert json.loads(out) == got.result.to_json()
+    assert "T_world_B" in got.result.values and "T_R_B" not in got.result.values
+
+
+def track_positioner_cell(tmp_path, shift_mm=0.0):
+    """The example track cell with a 2-axis positioner in the world instead of its turntable."""
+    text = TURNTABLE_CELL.read_text(encoding="utf-8")
+    start, end = text.index("turntable:\n"), text.index("tools:\n")
+    text = text[:start] + f"""positioner:
+  name: DKP_2
+  parent: world
+  frame: {{x: {3000 + shift_mm}, y: 1400, z: 650, a: 180, b: 0, c: 90}}
+  convention: standard
+  axes:
+    - {{name: E1, a: 0, alpha: -90, d: 0, theta: 0, sign: 1, min: -95, max: 95}}
+    - {{name: E2, a: 0, alpha: 0, d: 150, theta: {shift_mm / 10}, sign: 1, min: -400, max: 400}}
+  plate: {{x: 0, y: 0, z: 0, a: 0, b: 0, c: 0}}
+""" + text[end:]
+    path = tmp_path / f"track_positioner_{shift_mm:g}.yaml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_positioner_in_a_track_cell_reads_the_track_column(tmp_path, capsys):
+    truth, nominal = track_positioner_cell(tmp_path, 2.0), track_positioner_cell(tmp_path)
+    csv = tmp_path / "touches.csv"
+    code, _, err = run(capsys, "simulate", "positioner", "--cell", truth, "--seed", "6", "--tool",
+                       "pointer", "-o", csv)
+    assert code == 0, err
+    assert csv.read_text().splitlines()[0].endswith("e1,e2,track")
+    code, out, err = run(capsys, "calibrate", "positioner", csv, "--cell", nominal, "--tool",
+                         "pointer", "--json")
+    assert code == 0, err
+    root = np.array(json.loads(out)["matrix"])
+    assert np.allclose(root[:3, 3], [3002.0, 1400.0, 650.0], atol=0.5)  # T_world_B, mm
+    lines = csv.read_text().splitlines()
+    no_track = tmp_path / "no_track.csv"
+    no_track.write_text("\n".join(r.rsplit(",", 1)[0] for r in lines) + "\n")
+    code, _, err = run(capsys, "calibrate", "positioner", no_track, "--cell", nominal, "--tool",
+                       "pointer")
+    assert code == 2 and "error: " in err and "missing column 'track' (track position of the robot" in err
