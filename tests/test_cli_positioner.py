@@ -148,6 +148,12 @@ def test_calibrate_positioner_refusals(tmp_path, capsys):
     code, _, err = run(capsys, "calibrate", "positioner", no_e2, "--cell", truth, "--tool",
                        "pointer")
     assert code == 2 and "missing column(s) e2" in err
+    small = tmp_path / "small.csv"
+    small.write_text("\n".join(lines[:4]) + "\n")  # tilt -30 only, rotate 0, 90, 180
+    code, _, err = run(capsys, "calibrate", "positioner", small, "--robot", "kuka_kr16")
+    assert code == 2 and "no 3 touches turn e1 (tilt) alone over 10 deg or more" in err
+    code, _, err = run(capsys, "calibrate", "positioner", small, "--cell", truth)
+    assert code == 2 and "3 rows give 9 measured coordinates for 7 identifiable unknowns" in err
     with_track = tmp_path / "track.csv"
     with_track.write_text("\n".join(r + (",track" if i == 0 else ",0")
                                     for i, r in enumerate(lines)) + "\n")

@@ -21,6 +21,7 @@ writes the identified chain with :meth:`Cell.update_positioner`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -49,7 +50,7 @@ from robotcell.cellcal.touches import (
     tool_transform,
     track_positions,
 )
-from robotcell.errors import InputError
+from robotcell.errors import IllPosedError, InputError
 from robotcell.poseformats import pose_to_vendor
 from robotcell.robot import Robot
 from robotcell.tables import require_columns
@@ -559,6 +560,24 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
     return values, f
 
 
+def _check_alone(values: NDArray[np.float64], source: str) -> None:
+    """Refuse touches in which no 3 rows turn one axis alone over 10 deg (no start without a cell).
+
+    ``values`` (N, 2) are tilt and rotate (rad); the circle point analysis that starts the fit
+    without a nominal chain needs such a group per axis.
+    """
+    for k, name in enumerate(("e1 (tilt)", "e2 (rotate)")):
+        other = np.round(values[:, 1 - k], 9)
+        if not any(len(np.unique(np.round(values[other == o, k], 9))) >= 3
+                   and np.ptp(values[other == o, k]) >= math.radians(10.0) * 0.999
+                   for o in np.unique(other)):
+            raise IllPosedError(
+                f"{source}: no 3 touches turn {name} alone over 10 deg or more; without --cell "
+                "(in Python: a Cell) the positioner calibration starts from the circles of such "
+                "touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give the cell with the "
+                "positioner's nominal chain")
+
+
 def positioner(cell: Cell | None, measurements: Table | str | Path, *,
                robot: Robot | None = None, tool: str | ArrayLike | None = None,
                sigma: float | None = None, source: str | None = None,
@@ -603,6 +622,7 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
         points = tcp_positions(cols, source, robot, tool_transform(None, tool))
         values = np.radians(require_columns(cols, ["e1", "e2"], source))
         notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2"], source))
+        _check_alone(values, source)
         done = calibrate_positioner(values, points, prior_sigma=sigma,
                                     labels=line_labels(len(points)))
         return CellCalibration(done.result, notes=tuple(notes))
