@@ -365,3 +365,17 @@ def test_positioner_in_a_track_cell_reads_the_track_column(tmp_path, capsys):
     code, _, err = run(capsys, "calibrate", "positioner", no_track, "--cell", nominal, "--tool",
                        "pointer")
     assert code == 2 and "error: " in err and "missing column 'track' (track position of the robot" in err
+
+
+def test_simulated_positioner_touches_reach_the_point_within_the_limits():
+    from robotcell.simulate import simulate
+
+    cell = Cell.load(EXAMPLE)
+    t = simulate(cell, "positioner", noise=0.0, seed=1, tool="pointer", radius=0.15)
+    assert t.table.shape == (12, 2) and t.procedure == "positioner"
+    assert np.all(cell.robot.within_limits(t.q)) and np.all(cell.turntable.within_limits(t.table))
+    tip = cell.fk(t.q, table=t.table, tool="pointer", frame="world")[:, :3, 3]
+    T_wP = cell.frame_pose("turntable") @ cell.turntable.T_root_P(t.table)
+    want = (T_wP @ np.append(t.truth["point"], 1.0))[:, :3]
+    assert np.allclose(t.truth["point"], [0.15, 0.0, 0.0])
+    assert np.allclose(tip, want, atol=1e-9)
