@@ -447,7 +447,7 @@ class Cell:
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
            table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
-           samples: int = 65) -> cellik.CellIKSolutions:
+           samples: int | None = None) -> cellik.CellIKSolutions:
         """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cellik.ik`."""
         return cellik.ik(self, T, frame, track, table, tool, samples)
 

@@ -30,15 +30,18 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.coupled import RESERVED_FRAMES, frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
+from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.limits import TWO_PI
-from robotcell.ik.track import TrackRobot
+from robotcell.ik.track import TrackChoice, TrackRobot
+from robotcell.ik.trackchoice import choose_track
 from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, validate_pose
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
 
-__all__ = ["CellIKSolutions", "CellPath", "depends_on_track", "ik", "ik_path"]
+__all__ = ["CellIKSolutions", "CellPath", "choose_track_value", "depends_on_track", "ik",
+           "ik_path"]
 
 #: Largest joint change between two consecutive targets of a path that still counts as
 #: continuous (rad). A configuration that passes a singularity (wrist flip, stretched elbow)
@@ -167,9 +170,41 @@ def _check_track_choice(cell: Cell, frame: str) -> None:
                          "fix the track position; give the track position")
 
 
+def choose_track_value(track: TrackRobot, T_L: NDArray[np.float64], tool: ArrayLike | None,
+                       samples: int | None = None, prefer: ArrayLike | None = None
+                       ) -> TrackChoice:
+    """Track value per target and the arm's solutions there, vectorised over targets.
+
+    For an ortho-parallel arm: :func:`robotcell.ik.trackchoice.choose_track` (closed-form
+    interval of the track value, closed-form manipulability scanned inside it, one analytic
+    solve; about 10 us per target, docs/performance.md). Other arms (UR type): the sampled
+    search of :meth:`robotcell.ik.TrackRobot.ik` (``prefer`` is ignored there).
+
+    Parameters
+    ----------
+    track : TrackRobot
+    T_L : ndarray, shape (..., 4, 4)
+        Targets ``T_L_TCP`` in the track frame (m).
+    tool : array_like, shape (4, 4), optional
+        ``T_F_TCP`` (m).
+    samples : int, optional
+        Track values per search stage (default 24, or 65 for the sampled search).
+    prefer : array_like, shape (...), optional
+        Preferred track values (m; e.g. the previous target's on a path).
+
+    Returns
+    -------
+    TrackChoice
+        Track values in metres of motion (divide by the track's scale for controller values).
+    """
+    if analytic_solver(track.arm).method == "opw":
+        return choose_track(track, T_L, tool=tool, samples=samples or 24, prefer=prefer)
+    return track.ik(T_L, samples=samples or 65, tool=tool)
+
+
 def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
        table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
-       samples: int = 65) -> CellIKSolutions:
+       samples: int | None = None) -> CellIKSolutions:
     """Every arm solution for TCP targets given in a frame of the cell.
 
     Parameters
@@ -182,13 +217,14 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
     track : array_like, shape (...), optional
         Track position (m). Default: 0 without a track; with a track, chosen per target where
         the arm reaches it with the largest manipulability (needs the track limits; refused for
-        frames that move with the track).
+        frames that move with the track; see :func:`choose_track_value`).
     table : array_like, shape (...)
         Table angle (rad) at which the target is given; must be 0 without turntable.
     tool : str or array_like of shape (4, 4), optional
         A tool of the cell by name, or ``T_F_TCP`` (m); default: the robot model's tool.
-    samples : int
-        Track values per search stage when the track position is chosen.
+    samples : int, optional
+        Track values per search stage when the track position is chosen (default 24 for the
+        closed-form scan of an ortho-parallel arm, 65 for the sampled search of other arms).
 
     Returns
     -------
@@ -215,7 +251,7 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         batch = np.broadcast_shapes(arr.shape[:-2], th.shape)
         T_world = frame_pose(cell, frame, 0.0, th) @ arr
         T_L = invert(cell.track.T_world_L) @ np.broadcast_to(T_world, batch + (4, 4))
-        choice = _track_robot(cell).ik(T_L, samples=samples, tool=T_tool)
+        choice = choose_track_value(_track_robot(cell), T_L, T_tool, samples)
         e = choice.track / cell.track.scale
         q = choice.solutions.q[..., 1:]
         valid, reachable = choice.solutions.valid, choice.solutions.reachable

@@ -1,0 +1,362 @@
+"""Fast choice of the track value for an ortho-parallel arm on a linear track.
+
+For a target ``T_L_TCP`` the wrist centre of the arm, written in the arm's frame O (see
+:mod:`robotcell.ik.opw`), moves on a straight line as the track value ``x`` changes:
+``C(x) = C0 + x w`` with ``w = -R_O_R Q^T u`` (``Q`` the mounting rotation, ``u`` the track
+direction); the orientation ``R_O_e`` does not change. Hence, with ``S = (0, 0, c1)`` the centre
+of the shoulder circle on axis 1,
+
+    |C(x) - S|^2 = |w|^2 x^2 + 2 (C0 - S).w x + |C0 - S|^2      (quadratic in x),
+
+and the arm reaches the wrist centre only if the shoulder-to-wrist-centre distance is at most
+``c2 + sqrt(a2^2 + c3^2)`` (stretched elbow); since the shoulder (axis 2) is ``a1`` off axis 1
+and the wrist centre ``b`` off the arm plane, ``|C(x) - S|^2 <= (c2 + kappa + |a1|)^2 + b^2``.
+The roots of that quadratic give, in closed form, an interval of the track value that contains
+every reachable value (:func:`track_interval`).
+
+Inside it, the choice maximises the manipulability ``|det J|`` (Yoshikawa 1985), the criterion of
+:meth:`robotcell.ik.TrackRobot.ik`. For an ortho-parallel arm with a spherical wrist it has a
+closed form from the wrist-centre geometry alone (the Jacobian is block triangular at the wrist
+centre and ``det J`` does not depend on the reference point):
+
+    |det J| = n * c2 * kappa * |sin(gamma)| * |sin(t5)|,
+
+``n`` the distance of the wrist centre from axis 1 in the arm plane (0: shoulder singularity),
+``gamma`` the angle between the upper arm and the line from axis 3 to the wrist centre (0 or pi:
+stretched or folded elbow), ``t5`` the wrist bend (0: wrist singularity). So it is evaluated on
+many track values for the price of a few arithmetic operations each, with the limits of the axes
+that do not turn a full circle (axes 1, 2, 3 and 5 where they are limited) checked on the way.
+The arm is then solved once, analytically, at the chosen value; where that has no valid branch
+(a limit of axis 4 or 6) the target falls back to the sampled search of
+:meth:`~robotcell.ik.TrackRobot.ik`. Every returned solution is exact and within all limits. A
+target that the arm reaches only within a window of track values narrower than one step of the
+scan (1/23 of the interval by default) can be missed: the choice then has a lower
+manipulability than the sampled search, or none (about 1 random target in 1000 on a KR 16).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.errors import InputError
+from robotcell.ik.analytic import analytic_solver
+from robotcell.ik.limits import TWO_PI
+from robotcell.ik.opw import OPWParameters
+from robotcell.ik.result import IKSolutions
+from robotcell.ik.track import TrackChoice, TrackRobot
+from robotcell.transforms import invert, validate_pose
+
+__all__ = ["TrackScan", "choose_track", "manipulability", "scan_track", "track_interval"]
+
+#: Within this fraction of the best manipulability, a preferred track value (the previous
+#: target's on a path) wins over a larger manipulability.
+PREFER_WITHIN = 0.1
+#: Peaks of the coarse scan refined, refinement stages per peak and samples per stage.
+PEAKS, REFINE_STAGES, REFINE = 2, 2, 9
+#: Targets per block of the scan.
+_BLOCK = 128
+
+
+@dataclass(frozen=True)
+class TrackScan:
+    """Manipulability of a batch of targets over sampled track values.
+
+    Attributes
+    ----------
+    x : ndarray, shape (N, K)
+        Track values (m), inside the track limits and the closed-form interval.
+    manipulability : ndarray, shape (N, K)
+        Best ``|det J|`` over the arm branches that reach the target there within the limits of
+        axes 1, 2, 3 and 5 (m^3; 0 where none does).
+    lower, upper : ndarray, shape (N,)
+        The closed-form interval of :func:`track_interval`, clipped to the track limits (m);
+        NaN where it is empty.
+    """
+
+    x: NDArray[np.float64]
+    manipulability: NDArray[np.float64]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+
+
+def _wrist_line(track: TrackRobot, T: NDArray[np.float64], tool: ArrayLike | None
+                ) -> tuple[OPWParameters, NDArray[np.float64], NDArray[np.float64],
+                           NDArray[np.float64]]:
+    """``(params, R_O_e (N,3,3), C0 (N,3), w (3,))`` for targets ``T_L_TCP`` (N, 4, 4)."""
+    solver = analytic_solver(track.arm)
+    if solver.method != "opw":
+        raise InputError("the fast track choice needs an ortho-parallel arm with a spherical wrist")
+    pa = solver.params
+    arm = track.arm
+    tool_T = arm.tool if tool is None else validate_pose(tool, "tool")
+    T_tcp_end = invert(pa.T_e_n @ arm.flange @ tool_T)
+    T_O_L = invert(pa.T_R_O) @ invert(track.T_L_R0)
+    T_O_e = T_O_L @ T @ T_tcp_end
+    R = T_O_e[:, :3, :3]
+    C0 = T_O_e[:, :3, 3] - pa.c4 * R[:, :, 2]
+    w = -(T_O_L[:3, :3] @ track.direction)
+    return pa, R, C0, w
+
+
+def track_interval(pa: OPWParameters, C0: NDArray[np.float64], w: NDArray[np.float64]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Closed-form interval of track values that contains every reachable one.
+
+    Parameters
+    ----------
+    pa : OPWParameters
+    C0 : ndarray, shape (N, 3)
+        Wrist centre in O at track value 0 (m).
+    w : ndarray, shape (3,)
+        Its displacement in O per metre of track (unit vector).
+
+    Returns
+    -------
+    lower, upper : ndarray, shape (N,)
+        Roots of ``|C0 + x w - S|^2 = (c2 + kappa + |a1|)^2 + b^2`` (m); NaN where the wrist
+        centre never comes that close to the shoulder.
+    """
+    D = C0 - np.array([0.0, 0.0, pa.c1])
+    r_max = pa.c2 + math.hypot(pa.a2, pa.c3) + abs(pa.a1)
+    a = float(w @ w)
+    half_b = D @ w
+    c = np.einsum("ij,ij->i", D, D) - (r_max * r_max + pa.b * pa.b)
+    disc = half_b * half_b - a * c
+    root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    return (-half_b - root) / a, (-half_b + root) / a
+
+
+class _Limits:
+    """Limits of axes 1, 2, 3, 5 as cones on the paper's angles: ``q`` in ``[lo, hi]`` (some
+    2*pi-equivalent) iff ``cos(t - mid) >= cos(half)`` for ``t = sign * q + offset``, tested on
+    the (cos t, sin t) pair the geometry gives, without an arctangent."""
+
+    def __init__(self, pa: OPWParameters, lower: NDArray[np.float64],
+                 upper: NDArray[np.float64]) -> None:
+        self.cone: dict[int, tuple[float, float, float]] = {}
+        for j in (0, 1, 2, 4):
+            if upper[j] - lower[j] >= TWO_PI:
+                continue
+            mid = pa.signs[j] * 0.5 * (lower[j] + upper[j]) + pa.offsets[j]
+            self.cone[j] = (math.cos(mid), math.sin(mid), math.cos(0.5 * (upper[j] - lower[j])))
+
+    def ok(self, j: int, c: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.bool_] | bool:
+        if j not in self.cone:
+            return True
+        cm, sm, ch = self.cone[j]
+        return c * cm + s * sm >= ch
+
+    def ok_either_wrist(self, c: NDArray[np.float64], h: NDArray[np.float64]
+                        ) -> NDArray[np.bool_] | bool:
+        """Axis 5 within limits for ``t5`` or ``-t5`` (the two wrist flips), ``h = |sin t5|``."""
+        if 4 not in self.cone:
+            return True
+        cm, sm, ch = self.cone[4]
+        return c * cm + h * abs(sm) >= ch
+
+
+def _manipulability(pa: OPWParameters, R: NDArray[np.float64], C: NDArray[np.float64],
+                    limits: _Limits) -> NDArray[np.float64]:
+    """Best ``|det J|`` over the arm branches for wrist centres ``C`` (3, N, K) (m^3)."""
+    kappa = math.hypot(pa.a2, pa.c3)
+    cpsi, spsi = pa.c3 / kappa, pa.a2 / kappa
+    cx, cy, cz = C
+    b = pa.b
+    rho2 = cx * cx + cy * cy
+    n2 = rho2 - b * b
+    n = np.sqrt(np.maximum(n2, 0.0))
+    inv = 1.0 / np.maximum(rho2, 1e-300)
+    Z = cz - pa.c1
+    R02, R12, R22 = (R[:, i, 2][:, None] for i in range(3))
+    denom = 1.0 / (2.0 * pa.c2 * kappa)
+    base = pa.c2 * pa.c2 + kappa * kappa
+    best = np.zeros(cx.shape)
+    for sh in (0, 1):
+        if sh == 0:
+            c1, s1, X = (cx * n + cy * b) * inv, (cy * n - cx * b) * inv, n - pa.a1
+        else:
+            c1, s1, X = -(cx * n - cy * b) * inv, -(cy * n + cx * b) * inv, -(n + pa.a1)
+        s_2 = X * X + Z * Z
+        K = (s_2 - base) * denom
+        reach = (n2 >= 0) & (np.abs(K) <= 1.0) & limits.ok(0, c1, s1)
+        S = np.sqrt(np.maximum(1.0 - K * K, 0.0))
+        M02 = c1 * R02 + s1 * R12
+        wz = pa.c2 + kappa * K
+        for sphi in (S, -S):
+            c3 = K * cpsi + sphi * spsi
+            s3 = sphi * cpsi - K * spsi
+            wx = kappa * sphi
+            cu = wx * X + wz * Z
+            su = wz * X - wx * Z
+            inv_norm = 1.0 / np.maximum(np.sqrt(s_2 * (wx * wx + wz * wz)), 1e-300)
+            c2, s2 = cu * inv_norm, su * inv_norm
+            c23 = c2 * c3 - s2 * s3
+            s23 = s2 * c3 + c2 * s3
+            r22 = s23 * M02 + c23 * R22
+            h = np.sqrt(np.maximum(1.0 - r22 * r22, 0.0))
+            ok = reach & limits.ok(1, c2, s2) & limits.ok(2, c3, s3) & limits.ok_either_wrist(r22, h)
+            best = np.maximum(best, np.where(ok, n * S * h, 0.0))
+    return best * (pa.c2 * kappa)
+
+
+def scan_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
+               samples: int = 24) -> TrackScan:
+    """Manipulability of every target on ``samples`` track values of its reachable interval.
+
+    Parameters
+    ----------
+    track : TrackRobot
+        With an ortho-parallel arm and finite track limits.
+    T : array_like, shape (N, 4, 4)
+        ``T_L_TCP`` (m).
+    tool : array_like, shape (4, 4), optional
+        ``T_F_TCP`` instead of the arm's default tool (m).
+    samples : int
+        Track values per target (>= 2), evenly spaced over the interval.
+
+    Returns
+    -------
+    TrackScan
+    """
+    arr = validate_pose(T, "target pose").reshape(-1, 4, 4)
+    pa, R, C0, w = _wrist_line(track, arr, tool)
+    lo, hi = track_interval(pa, C0, w)
+    lo, hi = np.maximum(lo, track.lower), np.minimum(hi, track.upper)
+    empty = ~(lo <= hi)
+    lo, hi = np.where(empty, np.nan, lo), np.where(empty, np.nan, hi)
+    x = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, samples)
+    return TrackScan(x, _score(track, pa, R, C0, w, x), lo, hi)
+
+
+def _score(track: TrackRobot, pa: OPWParameters, R: NDArray[np.float64],
+           C0: NDArray[np.float64], w: NDArray[np.float64], x: NDArray[np.float64]
+           ) -> NDArray[np.float64]:
+    limits = _Limits(pa, track.arm.lower, track.arm.upper)
+    out = np.empty(x.shape)
+    for s in range(0, x.shape[0], _BLOCK):  # blocks of targets keep the temporaries in cache
+        xb = x[s:s + _BLOCK]
+        C = C0[s:s + _BLOCK].T[:, :, None] + w[:, None, None] * xb[None]  # (3, N, K)
+        out[s:s + _BLOCK] = _manipulability(pa, R[s:s + _BLOCK], C, limits)
+    return np.where(np.isnan(x), 0.0, out)
+
+
+def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
+                 samples: int = 24, prefer: ArrayLike | None = None) -> TrackChoice:
+    """Choose the track value per target and solve the arm there (vectorised over targets).
+
+    The criterion: the largest manipulability ``|det J|`` over the arm branches within the
+    limits (as :meth:`TrackRobot.ik`), searched on ``samples`` values of the closed-form
+    interval of :func:`track_interval` and refined on ``samples`` values between the best one's
+    neighbours. With ``prefer`` (e.g. the previous target's value on a path), the value nearest
+    to it among those within :data:`PREFER_WITHIN` of the best manipulability. Targets where
+    the chosen value has no valid branch are searched again by :meth:`TrackRobot.ik`.
+
+    Parameters
+    ----------
+    track : TrackRobot
+        Ortho-parallel arm, finite track limits.
+    T : array_like, shape (..., 4, 4)
+        ``T_L_TCP`` (m).
+    tool : array_like, shape (4, 4), optional
+        ``T_F_TCP`` instead of the arm's default tool (m).
+    samples : int
+        Track values per search stage (>= 3).
+    prefer : array_like, shape (...), optional
+        Preferred track values (m).
+
+    Returns
+    -------
+    TrackChoice
+        Solutions ``(..., 8, 7)`` at the chosen values; ``manipulability`` is ``|det J|`` of the
+        best valid branch there (m^3; 0 where nothing is reachable).
+    """
+    if not (math.isfinite(track.lower) and math.isfinite(track.upper)):
+        raise InputError("choosing the track value needs finite track limits (lower, upper)")
+    if samples < 3:
+        raise InputError(f"samples must be at least 3, got {samples}")
+    arr = validate_pose(T, "target pose")
+    batch = arr.shape[:-2]
+    flat = arr.reshape(-1, 4, 4)
+    scan = scan_track(track, flat, tool, samples)
+    pa, R, C0, w = _wrist_line(track, flat, tool)
+    xs, ms = [scan.x], [scan.manipulability]
+    m = scan.manipulability.copy()
+    rows = np.arange(flat.shape[0])
+    step = np.nan_to_num((scan.upper - scan.lower) / (samples - 1))
+    for _ in range(PEAKS):  # refine around the best peaks, so that a second mode is not lost
+        k = np.argmax(m, axis=1)
+        centre = np.nan_to_num(scan.x[rows, k])
+        m[rows[:, None], np.clip(k[:, None] + np.arange(-1, 2), 0, samples - 1)] = -1.0
+        half = step
+        for _ in range(REFINE_STAGES):
+            fine = np.clip(centre[:, None] + half[:, None] * np.linspace(-1.0, 1.0, REFINE),
+                           scan.lower[:, None], scan.upper[:, None])
+            fine = np.where(np.isnan(fine), centre[:, None], fine)
+            mf = _score(track, pa, R, C0, w, fine)
+            xs.append(fine)
+            ms.append(mf)
+            centre = fine[rows, np.argmax(mf, axis=1)]
+            half = half * (2.0 / (REFINE - 1))
+    xs_all, ms_all = np.concatenate(xs, axis=1), np.concatenate(ms, axis=1)
+    if prefer is None:
+        x = xs_all[rows, np.argmax(ms_all, axis=1)]
+    else:
+        p = np.broadcast_to(np.asarray(prefer, dtype=float), batch).reshape(-1)
+        near = np.where(ms_all >= (1.0 - PREFER_WITHIN) * ms_all.max(axis=1, keepdims=True),
+                        np.abs(xs_all - p[:, None]), np.inf)
+        x = xs_all[rows, np.argmin(near, axis=1)]
+    # Nothing found: the closed-form interval is empty (out of reach at every track value) or
+    # no sampled value reaches within the limits of axes 1, 2, 3, 5.
+    found = ms_all.max(axis=1) > 0
+    x = np.where(found, x, np.nan_to_num(scan.lower, nan=track.lower))
+    sol = track.ik_at(flat, x, tool)
+    retry = ~np.any(sol.valid, axis=-1) & found
+    if np.any(retry):
+        again = track.ik(flat[retry], samples=65, tool=tool)
+        x[retry] = again.track
+        sol = _replace_rows(sol, retry, again.solutions)
+    return TrackChoice(_reshape(sol, batch), x.reshape(batch), _best_valid(pa, sol).reshape(batch))
+
+
+def manipulability(pa: OPWParameters, q: ArrayLike) -> NDArray[np.float64]:
+    """``|det J|`` of an ortho-parallel arm in closed form (m^3).
+
+    Parameters
+    ----------
+    pa : OPWParameters
+    q : array_like, shape (..., 6)
+        Controller axis values (rad); NaN gives NaN.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        ``n * c2 * kappa * |sin(gamma)| * |sin(t5)|`` (see the module docstring); equal to
+        ``|det robot.jacobian(q)|``.
+    """
+    th = np.asarray(q, dtype=float) * pa.signs + pa.offsets
+    t2, t23, t5 = th[..., 1], th[..., 1] + th[..., 2], th[..., 4]
+    fx = pa.a2 * np.cos(t23) + pa.c3 * np.sin(t23)  # axis 3 to the wrist centre, in the plane
+    fz = pa.c3 * np.cos(t23) - pa.a2 * np.sin(t23)
+    n = np.abs(pa.a1 + pa.c2 * np.sin(t2) + fx)
+    cross = np.abs(np.sin(t2) * fz - np.cos(t2) * fx)  # kappa * |sin(gamma)|
+    return n * pa.c2 * cross * np.abs(np.sin(t5))
+
+
+def _best_valid(pa: OPWParameters, sol: IKSolutions) -> NDArray[np.float64]:
+    """``|det J|`` of the best valid branch of track solutions ``(N, 8, 7)`` (0 if none)."""
+    return np.where(sol.valid, np.nan_to_num(manipulability(pa, sol.q[..., 1:])), 0.0).max(axis=-1)
+
+
+def _replace_rows(sol: IKSolutions, rows: NDArray[np.bool_], new: IKSolutions) -> IKSolutions:
+    q, valid, reach = sol.q.copy(), sol.valid.copy(), sol.reachable.copy()
+    q[rows], valid[rows], reach[rows] = new.q, new.valid, new.reachable
+    return IKSolutions(q, valid, reach, sol.method)
+
+
+def _reshape(sol: IKSolutions, batch: tuple[int, ...]) -> IKSolutions:
+    return IKSolutions(sol.q.reshape(batch + sol.q.shape[-2:]), sol.valid.reshape(batch + (8,)),
+                       sol.reachable.reshape(batch + (8,)), sol.method)
