@@ -454,9 +454,10 @@ class Cell:
     def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                 table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
                 q_start: ArrayLike | None = None, max_step: float = cellik.MAX_STEP,
-                samples: int = 33) -> cellik.CellPath:
+                samples: int = 33, track_motion: str = "fixed") -> cellik.CellPath:
         """A continuous trajectory through targets; see :func:`robotcell.cellik.ik_path`."""
-        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples)
+        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples,
+                              track_motion)
 
     # -- files ------------------------------------------------------------------------------------
     @classmethod
