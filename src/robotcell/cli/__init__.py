@@ -28,6 +28,7 @@ COMMANDS = {
     "plan": "robotcell.cli.plan:plan",
     "report": "robotcell.cli.report:report",
     "demo": "robotcell.cli.demo:demo",
+    "reach": "robotcell.cli.reach:reach",
 }
 
 

@@ -1,0 +1,83 @@
+"""``robotcell reach``: reachability map of targets in a cell (mm, deg)."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import click
+import numpy as np
+
+from robotcell.cell import Cell
+from robotcell.cli.common import write_csv
+from robotcell.poseformats import FORMATS
+from robotcell.reach import ReachMap, reach_html, reach_map, read_targets
+
+
+def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:
+    """CSV header and rows of a reachability map (mm, deg)."""
+    header = ["target", "reachable", "score", "track_mm", "table_deg", "branch",
+              *[f"a{i + 1}_deg" for i in range(n_axes)], "limit_margin_deg", "track_margin_mm",
+              "manipulability_m3"]
+    rows = np.column_stack([
+        np.arange(rm.reachable.size), rm.reachable.astype(float), rm.score, rm.track * 1e3,
+        np.degrees(rm.table), rm.branch, np.degrees(rm.q), np.degrees(rm.limit_margin),
+        rm.track_margin * 1e3, rm.manipulability,
+    ])
+    return header, rows
+
+
+@click.command()
+@click.argument("targets", type=click.Path(dir_okay=False))
+@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file (YAML).")
+@click.option("--frame", default="world", show_default=True,
+              help="Frame of the targets: world, track, robot, turntable or a frame of the cell.")
+@click.option("--tool", default=None, help="Tool of the cell (default: the robot model's tool).")
+@click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka",
+              show_default=True, help="Pose columns of TARGETS.")
+@click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
+              help="Table angle (deg) for targets without a 'table' column.")
+@click.option("--track", "track_mm", type=float, default=None,
+              help="Track position (mm) for every target (default: chosen per target).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+              help="CSV to write (default: standard output).")
+@click.option("--html", "html_path", type=click.Path(dir_okay=False), default=None,
+              help="Self-contained HTML page with the map (default: next to -o, .html).")
+def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
+          table_deg: float, track_mm: float | None, output: str | None,
+          html_path: str | None) -> None:
+    """Reachability map: can the robot reach every target, and how well.
+
+    TARGETS is a CSV of poses in --frame with the columns of --format (kuka: x,y,z,a,b,c in mm
+    and deg) and optionally a column 'table' (deg). The track position is chosen per target
+    unless --track is given. Every target gets: reachable (1/0), score (0..1: 1 when the arm is
+    as far from singularities as it gets and every axis is at least 10 deg from its limits),
+    track_mm, table_deg, branch (0..7), a1_deg.., limit_margin_deg (smallest distance of an axis
+    to its limits), track_margin_mm and manipulability_m3 (|det J|). Unreachable targets have
+    nan axis values. A summary goes to stderr.
+
+    \b
+    Examples:
+      robotcell reach --cell cell.yaml seam.csv --frame part --tool torch -o reach.csv
+      robotcell reach --cell cell.yaml seam.csv --tool torch --html reach.html
+    """
+    cell = Cell.load(cell_path)
+    T, table = read_targets(targets, fmt)
+    th = np.radians(table_deg) if table is None else table
+    track = None if track_mm is None else track_mm * 1e-3
+    rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track)
+    header, rows = reach_rows(rm, cell.robot.n_joints)
+    write_csv(output if output else sys.stdout, header, rows, 6)
+    if html_path is None and output:
+        html_path = str(Path(output).with_suffix(".html"))
+    if html_path:
+        page = reach_html(rm, T[:, :3, 3], title=f"Reachability: {Path(targets).name} in "
+                          f"{cell.name}", frame=frame)
+        Path(html_path).write_text(page, encoding="utf-8")
+    n_ok = int(np.count_nonzero(rm.reachable))
+    margin = math.degrees(float(np.nanmin(rm.limit_margin))) if n_ok else float("nan")
+    click.echo(f"{n_ok} of {rm.reachable.size} targets reachable, mean score "
+               f"{float(np.mean(rm.score)):.3f}, smallest limit margin {margin:.1f} deg"
+               + (f"; map in {html_path}" if html_path else ""), err=True)
