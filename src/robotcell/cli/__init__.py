@@ -29,6 +29,7 @@ COMMANDS = {
     "report": "robotcell.cli.report:report",
     "demo": "robotcell.cli.demo:demo",
     "reach": "robotcell.cli.reach:reach",
+    "sweep": "robotcell.cli.sweep:sweep_cmd",
 }
 
 
