@@ -69,7 +69,7 @@ def main() -> None:
     us_old = t_old / N_SAME * 1e6
     us_same = t_fast_same / N_SAME * 1e6
     us_fast = t_fast / n * 1e6
-    print(f"\ntrack position chosen per target, KR 16 on a 6 m track, torch tool:")
+    print("\ntrack position chosen per target, KR 16 on a 6 m track, torch tool:")
     print(f"  sampled search (before)   {us_old:8.1f} us/target  ({N_SAME} targets)")
     print(f"  fast choice, same targets {us_same:8.1f} us/target  ratio {us_old / us_same:6.0f}x")
     print(f"  fast choice               {us_fast:8.1f} us/target  ({n} targets) "
