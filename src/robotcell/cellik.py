@@ -396,6 +396,10 @@ def _moving_track(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArray[
     T_L = invert(cell.track.T_world_L) @ frame_pose(cell, frame, 0.0, th) @ arr
     choice = choose_track_value(t, T_L, T_tool, max(samples, 3))
     x = choice.track
+    found = choice.solutions.valid.any(axis=-1)
+    if np.any(found) and not np.all(found):  # bridge unreachable targets from their neighbours
+        idx = np.arange(x.size)
+        x = np.interp(idx, idx[found], x[found])
     if analytic_solver(t.arm).method == "opw":
         scan = scan_track(t, T_L, T_tool, max(samples, 3))
         m = scan.manipulability

@@ -55,10 +55,12 @@ __all__ = ["TrackScan", "choose_track", "manipulability", "scan_track", "track_i
 #: Within this fraction of the best manipulability, a preferred track value (the previous
 #: target's on a path) wins over a larger manipulability.
 PREFER_WITHIN = 0.1
-#: Peaks of the coarse scan refined, refinement stages per peak and samples per stage.
-PEAKS, REFINE_STAGES, REFINE = 2, 2, 9
+#: Refinement stages per peak of the coarse scan and samples per stage.
+REFINE_STAGES, REFINE = 2, 9
+#: A second peak of the coarse scan is refined too when it reaches this fraction of the first.
+SECOND_PEAK = 0.9
 #: Targets per block of the scan.
-_BLOCK = 128
+_BLOCK = 256
 
 
 @dataclass(frozen=True)
@@ -186,20 +188,20 @@ def _manipulability(pa: OPWParameters, R: NDArray[np.float64], C: NDArray[np.flo
         S = np.sqrt(np.maximum(1.0 - K * K, 0.0))
         M02 = c1 * R02 + s1 * R12
         wz = pa.c2 + kappa * K
-        for sphi in (S, -S):
-            c3 = K * cpsi + sphi * spsi
-            s3 = sphi * cpsi - K * spsi
-            wx = kappa * sphi
-            cu = wx * X + wz * Z
-            su = wz * X - wx * Z
-            inv_norm = 1.0 / np.maximum(np.sqrt(s_2 * (wx * wx + wz * wz)), 1e-300)
-            c2, s2 = cu * inv_norm, su * inv_norm
-            c23 = c2 * c3 - s2 * s3
-            s23 = s2 * c3 + c2 * s3
-            r22 = s23 * M02 + c23 * R22
+        kS = kappa * S
+        # Shared by both elbows (sphi = +-S): the norm of (cu, su) and the products below.
+        inv_norm = 1.0 / np.maximum(np.sqrt(s_2 * (kS * kS + wz * wz)), 1e-300)
+        kSX, kSZ = kS * X * inv_norm, kS * Z * inv_norm
+        wzX, wzZ = wz * X * inv_norm, wz * Z * inv_norm
+        Kc, Ks, Sc, Ss = K * cpsi, K * spsi, S * cpsi, S * spsi
+        nS = n * S
+        for sg in (1.0, -1.0):
+            c2, s2 = wzZ + sg * kSX, wzX - sg * kSZ
+            c3, s3 = Kc + sg * Ss, sg * Sc - Ks
+            r22 = (s2 * c3 + c2 * s3) * M02 + (c2 * c3 - s2 * s3) * R22   # cos(t5)
             h = np.sqrt(np.maximum(1.0 - r22 * r22, 0.0))
             ok = reach & limits.ok(1, c2, s2) & limits.ok(2, c3, s3) & limits.ok_either_wrist(r22, h)
-            best = np.maximum(best, np.where(ok, n * S * h, 0.0))
+            best = np.maximum(best, np.where(ok, nS * h, 0.0))
     return best * (pa.c2 * kappa)
 
 
@@ -223,7 +225,11 @@ def scan_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
     TrackScan
     """
     arr = validate_pose(T, "target pose").reshape(-1, 4, 4)
-    pa, R, C0, w = _wrist_line(track, arr, tool)
+    return _scan(track, *_wrist_line(track, arr, tool), samples)
+
+
+def _scan(track: TrackRobot, pa: OPWParameters, R: NDArray[np.float64], C0: NDArray[np.float64],
+          w: NDArray[np.float64], samples: int) -> TrackScan:
     lo, hi = track_interval(pa, C0, w)
     lo, hi = np.maximum(lo, track.lower), np.minimum(hi, track.upper)
     empty = ~(lo <= hi)
@@ -237,11 +243,40 @@ def _score(track: TrackRobot, pa: OPWParameters, R: NDArray[np.float64],
            ) -> NDArray[np.float64]:
     limits = _Limits(pa, track.arm.lower, track.arm.upper)
     out = np.empty(x.shape)
+    # Single precision (7 digits: micrometres over the track) is plenty to choose the value;
+    # the arm is then solved in double precision at the chosen one.
+    R32, C32, w32 = R.astype(np.float32), C0.astype(np.float32), w.astype(np.float32)
     for s in range(0, x.shape[0], _BLOCK):  # blocks of targets keep the temporaries in cache
-        xb = x[s:s + _BLOCK]
-        C = C0[s:s + _BLOCK].T[:, :, None] + w[:, None, None] * xb[None]  # (3, N, K)
-        out[s:s + _BLOCK] = _manipulability(pa, R[s:s + _BLOCK], C, limits)
+        xb = x[s:s + _BLOCK].astype(np.float32)
+        C = C32[s:s + _BLOCK].T[:, :, None] + w32[:, None, None] * xb[None]  # (3, N, K)
+        out[s:s + _BLOCK] = _manipulability(pa, R32[s:s + _BLOCK], C, limits)
     return np.where(np.isnan(x), 0.0, out)
+
+
+def _refine(track: TrackRobot, pa: OPWParameters, R: NDArray[np.float64],
+            C0: NDArray[np.float64], w: NDArray[np.float64], centre: NDArray[np.float64],
+            half: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Grids of REFINE values around ``centre`` (M,), +-``half``, shrinking REFINE_STAGES
+    times around the best; returns every value tried and its score, each (M, stages * REFINE)."""
+    xs, ms = [], []
+    for _ in range(REFINE_STAGES):
+        fine = np.clip(centre[:, None] + half[:, None] * np.linspace(-1.0, 1.0, REFINE),
+                       lo[:, None], hi[:, None])
+        fine = np.where(np.isnan(fine), centre[:, None], fine)
+        mf = _score(track, pa, R, C0, w, fine)
+        xs.append(fine)
+        ms.append(mf)
+        centre = fine[np.arange(fine.shape[0]), np.argmax(mf, axis=1)]
+        half = half * (2.0 / (REFINE - 1))
+    return np.concatenate(xs, axis=1), np.concatenate(ms, axis=1)
+
+
+def _scatter_rows(a: NDArray[np.float64], rows: NDArray[np.int_], n: int, fill: float
+                  ) -> NDArray[np.float64]:
+    out = np.full((n, a.shape[1]), fill)
+    out[rows] = a
+    return out
 
 
 def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
@@ -281,26 +316,32 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
     arr = validate_pose(T, "target pose")
     batch = arr.shape[:-2]
     flat = arr.reshape(-1, 4, 4)
-    scan = scan_track(track, flat, tool, samples)
     pa, R, C0, w = _wrist_line(track, flat, tool)
-    xs, ms = [scan.x], [scan.manipulability]
-    m = scan.manipulability.copy()
-    rows = np.arange(flat.shape[0])
+    scan = _scan(track, pa, R, C0, w, samples)
+    m = scan.manipulability
+    n_t = flat.shape[0]
+    rows = np.arange(n_t)
     step = np.nan_to_num((scan.upper - scan.lower) / (samples - 1))
-    for _ in range(PEAKS):  # refine around the best peaks, so that a second mode is not lost
-        k = np.argmax(m, axis=1)
-        centre = np.nan_to_num(scan.x[rows, k])
-        m[rows[:, None], np.clip(k[:, None] + np.arange(-1, 2), 0, samples - 1)] = -1.0
-        half = step
-        for _ in range(REFINE_STAGES):
-            fine = np.clip(centre[:, None] + half[:, None] * np.linspace(-1.0, 1.0, REFINE),
-                           scan.lower[:, None], scan.upper[:, None])
-            fine = np.where(np.isnan(fine), centre[:, None], fine)
-            mf = _score(track, pa, R, C0, w, fine)
-            xs.append(fine)
-            ms.append(mf)
-            centre = fine[rows, np.argmax(mf, axis=1)]
-            half = half * (2.0 / (REFINE - 1))
+    k1 = np.argmax(m, axis=1)
+    # A second peak: the best local maximum outside the first's neighbours, refined only where
+    # it comes within SECOND_PEAK of the first (a second mode that could win after refinement).
+    pad = np.pad(m, ((0, 0), (1, 1)), constant_values=-1.0)
+    local = (m >= pad[:, :-2]) & (m >= pad[:, 2:])
+    near1 = np.abs(np.arange(samples) - k1[:, None]) <= 1
+    m2 = np.where(local & ~near1, m, -1.0)
+    k2 = np.argmax(m2, axis=1)
+    second = np.nonzero(m2[rows, k2] >= SECOND_PEAK * m[rows, k1])[0]
+    xs, ms = [scan.x], [m]
+    for sub, k in ((rows, k1), (second, k2[second])):
+        if sub.size == 0:
+            continue
+        xr, mr = _refine(track, pa, R[sub], C0[sub], w, np.nan_to_num(scan.x[sub, k]),
+                         step[sub], scan.lower[sub], scan.upper[sub])
+        if sub.size < n_t:
+            xr = _scatter_rows(xr, sub, n_t, np.nan)
+            mr = _scatter_rows(mr, sub, n_t, -1.0)
+        xs.append(xr)
+        ms.append(mr)
     xs_all, ms_all = np.concatenate(xs, axis=1), np.concatenate(ms, axis=1)
     if prefer is None:
         x = xs_all[rows, np.argmax(ms_all, axis=1)]
@@ -313,7 +354,7 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
     # no sampled value reaches within the limits of axes 1, 2, 3, 5.
     found = ms_all.max(axis=1) > 0
     x = np.where(found, x, np.nan_to_num(scan.lower, nan=track.lower))
-    sol = track.ik_at(flat, x, tool)
+    sol = _solve_at(track, flat, x, tool)
     retry = ~np.any(sol.valid, axis=-1) & found
     if np.any(retry):
         again = track.ik(flat[retry], samples=65, tool=tool)
@@ -347,8 +388,25 @@ def manipulability(pa: OPWParameters, q: ArrayLike) -> NDArray[np.float64]:
 
 
 def _best_valid(pa: OPWParameters, sol: IKSolutions) -> NDArray[np.float64]:
-    """``|det J|`` of the best valid branch of track solutions ``(N, 8, 7)`` (0 if none)."""
-    return np.where(sol.valid, np.nan_to_num(manipulability(pa, sol.q[..., 1:])), 0.0).max(axis=-1)
+    """``|det J|`` of the best valid branch of track solutions ``(N, 8, 7)`` (0 if none).
+
+    The two wrists of an arm configuration (branches ``2k``, ``2k + 1``) have the same value."""
+    valid = sol.valid[..., ::2] | sol.valid[..., 1::2]
+    m = np.nan_to_num(manipulability(pa, sol.q[..., ::2, 1:]))
+    return np.where(valid, m, 0.0).max(axis=-1)
+
+
+def _solve_at(track: TrackRobot, T: NDArray[np.float64], x: NDArray[np.float64],
+              tool: ArrayLike | None) -> IKSolutions:
+    """:meth:`TrackRobot.ik_at` for validated targets (N, 4, 4) and values (N,) in the limits."""
+    T_R = T.copy()  # T_R_TCP = T_L_R(x)^-1 T_L_TCP: the base only translates along u
+    Q = track.T_L_R0[:3, :3]
+    T_R[:, :3, :3] = Q.T @ T[:, :3, :3]
+    T_R[:, :3, 3] = (T[:, :3, 3] - track.T_L_R0[:3, 3] - x[:, None] * track.direction) @ Q
+    sol = analytic_solver(track.arm).solve(T_R, tool)
+    xcol = np.broadcast_to(x[:, None, None], sol.q.shape[:-1] + (1,))
+    return IKSolutions(np.concatenate([xcol, sol.q], axis=-1), sol.valid, sol.reachable,
+                       sol.method)
 
 
 def _replace_rows(sol: IKSolutions, rows: NDArray[np.bool_], new: IKSolutions) -> IKSolutions:
