@@ -309,10 +309,7 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
         Solutions ``(..., 8, 7)`` at the chosen values; ``manipulability`` is ``|det J|`` of the
         best valid branch there (m^3; 0 where nothing is reachable).
     """
-    if not (math.isfinite(track.lower) and math.isfinite(track.upper)):
-        raise InputError("choosing the track value needs finite track limits (lower, upper)")
-    if samples < 3:
-        raise InputError(f"samples must be at least 3, got {samples}")
+    track.check_choice(samples)
     arr = validate_pose(T, "target pose")
     batch = arr.shape[:-2]
     flat = arr.reshape(-1, 4, 4)
