@@ -83,3 +83,26 @@ def test_cli_errors(capsys, tmp_path):
     assert code == 2 and "moves with the track" in err
     with pytest.raises(InputError, match="unknown frame"):
         reach_map(Cell.load(CELL), np.eye(4)[None], frame="nowhere")
+
+
+def test_chosen_table_angle_reaches_and_scores_at_least_as_well_as_zero(capsys, tmp_path):
+    cell = Cell.load(CELL)
+    rng = np.random.default_rng(5)
+    q = rng.uniform(cell.robot.lower, cell.robot.upper, (40, 6)) * 0.7
+    T = cell.fk(q, track=rng.uniform(1.5, 4.5, 40), table=rng.uniform(-3, 3, 40), tool="torch",
+                frame="part")
+    chosen = reach_map(cell, T, frame="part", tool="torch", table=None)
+    at_zero = reach_map(cell, T, frame="part", tool="torch", table=0.0)
+    assert chosen.reachable.sum() > at_zero.reachable.sum()
+    assert np.all(chosen.score >= at_zero.score - 1e-12)  # 0 is one of the candidate angles
+    ok = chosen.reachable
+    back = cell.fk(chosen.q[ok], track=chosen.track[ok], table=chosen.table[ok], tool="torch",
+                   frame="part")
+    assert np.allclose(back, T[ok], atol=1e-9)
+    deg = np.degrees(chosen.table)
+    assert np.allclose(np.round(deg / 10) * 10, deg, atol=1e-9)  # one of the 36 candidates
+    with pytest.raises(InputError, match="needs a turntable"):
+        reach_map(Cell(robot=cell.robot, robot_model="kuka_kr16"), T[:1], table=None)
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part",
+                       "--choose-table")
+    assert code == 2 and "leave it out to --choose-table" in err

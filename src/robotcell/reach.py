@@ -36,6 +36,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cellik import ik
 from robotcell.coupled import tool_pose
+from robotcell.errors import InputError
+from robotcell.ik.limits import TWO_PI
 from robotcell.poseformats import FORMATS, pose_from_vendor
 from robotcell.robot import Robot
 from robotcell.tables import read_csv, require_columns
@@ -112,8 +114,22 @@ class ReachMap:
         return float(np.mean(self.reachable)) if self.reachable.size else 0.0
 
 
+def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:
+    """Table angles (rad) to choose from: one turn, or the limits when they span less."""
+    tt = cell.turntable
+    if tt is None:
+        raise InputError("choosing the table angle needs a turntable in the cell")
+    if samples < 2:
+        raise InputError(f"table_samples must be at least 2, got {samples}")
+    if tt.upper - tt.lower >= TWO_PI:
+        mid = 0.5 * (tt.lower + tt.upper)
+        return mid + np.linspace(-math.pi, math.pi, samples, endpoint=False)
+    return np.linspace(tt.lower, tt.upper, samples)
+
+
 def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayLike | None = None,
-              table: ArrayLike = 0.0, track: ArrayLike | None = None) -> ReachMap:
+              table: ArrayLike | None = 0.0, track: ArrayLike | None = None,
+              table_samples: int = 36) -> ReachMap:
     """Score every target: reachable or not, axis values, limit margin, manipulability.
 
     Parameters
@@ -125,32 +141,45 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
         Frame of the targets (see :func:`robotcell.coupled.frame_pose`).
     tool : str or array_like of shape (4, 4), optional
         A tool of the cell by name, or ``T_F_TCP`` (m).
-    table : array_like, shape (N,) or ()
-        Table angles (rad).
+    table : array_like of shape (N,) or (), or None
+        Table angles (rad). None: chosen per target among ``table_samples`` angles evenly
+        spread over one turn (or over the table's limits when they span less), the one where
+        the target gets the best score.
     track : array_like, shape (N,) or (), optional
         Track positions (m); default: chosen per target (:func:`robotcell.cellik.ik`).
+    table_samples : int
+        Candidate table angles when ``table`` is None (10 deg apart by default).
 
     Returns
     -------
     ReachMap
     """
-    sol = ik(cell, np.asarray(T, dtype=float).reshape(-1, 4, 4), frame=frame, track=track,
-             table=table, tool=tool)
+    arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
+    if table is None:
+        grid = _table_grid(cell, table_samples)
+        arr = np.broadcast_to(arr[:, None], (arr.shape[0], grid.size, 4, 4))
+        table = np.broadcast_to(grid, arr.shape[:2])
+    sol = ik(cell, arr, frame=frame, track=track, table=table, tool=tool)
     robot = cell.robot
     T_tool = tool_pose(cell, tool)
-    q = np.where(sol.valid[..., None], sol.q, 0.0)                     # (N, 8, n)
-    manip = np.where(sol.valid, np.abs(np.linalg.det(robot.jacobian(q, tool=T_tool))), 0.0)
+    n = arr.shape[0]
+    valid = sol.valid.reshape(n, -1)                                    # (N, M * 8)
+    q_all = sol.q.reshape(n, valid.shape[1], -1)
+    q = np.where(valid[..., None], q_all, 0.0)
+    manip = np.where(valid, np.abs(np.linalg.det(robot.jacobian(q, tool=T_tool))), 0.0)
     lo, hi = robot.lower, robot.upper
     with np.errstate(invalid="ignore"):
         gap = np.minimum(np.where(np.isfinite(lo), q - lo, np.inf),
-                         np.where(np.isfinite(hi), hi - q, np.inf)).min(axis=-1)   # (N, 8)
+                         np.where(np.isfinite(hi), hi - q, np.inf)).min(axis=-1)
     score = (np.minimum(1.0, manip / manipulability_scale(robot))
              * np.minimum(1.0, gap / LIMIT_REF))
-    score = np.where(sol.valid, score, -1.0)
+    score = np.where(valid, score, -1.0)
     best = np.argmax(score, axis=-1)
-    rows = np.arange(best.size)
-    ok = sol.valid[rows, best]
-    e = np.broadcast_to(sol.track, ok.shape).astype(float)
+    rows = np.arange(n)
+    ok = valid[rows, best]
+    e = np.broadcast_to(sol.track, sol.valid.shape[:-1]).reshape(n, -1)[rows, best // 8]
+    th = np.broadcast_to(sol.table, sol.valid.shape[:-1]).reshape(n, -1)[rows, best // 8]
+    e = np.array(e, dtype=float)
     if track is None and cell.track is not None:
         e = np.where(ok, e, np.nan)  # no track position was chosen for an unreachable target
     if cell.track is not None:
@@ -159,10 +188,10 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
         e_margin = np.full(ok.shape, np.inf)
     return ReachMap(
         reachable=ok,
-        q=np.where(ok[:, None], sol.q[rows, best], np.nan),
-        branch=np.where(ok, best, -1),
+        q=np.where(ok[:, None], q_all[rows, best], np.nan),
+        branch=np.where(ok, best % 8, -1),
         track=e,
-        table=np.broadcast_to(sol.table, ok.shape).astype(float),
+        table=np.array(th, dtype=float),
         limit_margin=np.where(ok, gap[rows, best], np.nan),
         track_margin=e_margin,
         manipulability=np.where(ok, manip[rows, best], 0.0),

@@ -221,7 +221,7 @@ def apply_layout(cell: Cell, layout: Layout) -> Cell:
 
 
 def evaluate_layout(cell: Cell, layout: Layout, index: int, T: NDArray[np.float64], frame: str,
-                    tool: str | ArrayLike | None, table: ArrayLike) -> LayoutScore:
+                    tool: str | ArrayLike | None, table: ArrayLike | None) -> LayoutScore:
     """Score one layout on the targets (a pure function: the unit of work of :func:`sweep`)."""
     rm = reach_map(apply_layout(cell, layout), T, frame=frame, tool=tool, table=table)
     score = rm.score
@@ -230,7 +230,7 @@ def evaluate_layout(cell: Cell, layout: Layout, index: int, T: NDArray[np.float6
 
 
 def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
-          tool: str | ArrayLike | None = None, table: ArrayLike = 0.0,
+          tool: str | ArrayLike | None = None, table: ArrayLike | None = 0.0,
           executor: Executor | None = None,
           progress: Callable[[int, int], None] | None = None) -> list[LayoutScore]:
     """Score every layout on the targets and rank them, best first.
@@ -243,7 +243,8 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
     layouts : list of Layout
         From :func:`read_layouts`.
     frame, tool, table
-        As for :func:`robotcell.reach.reach_map` (table angles in rad).
+        As for :func:`robotcell.reach.reach_map` (table angles in rad; None: chosen per
+        target).
     executor : concurrent.futures.Executor, optional
         Runs one task per layout (e.g. ``ProcessPoolExecutor(4)`` or
         ``distributed.Client(address).get_executor()``); default: serially in this process.
@@ -256,7 +257,7 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
         Sorted by :attr:`LayoutScore.key`.
     """
     arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
-    table = np.asarray(table, dtype=float)
+    table = None if table is None else np.asarray(table, dtype=float)
     if layouts:  # refuse a component the cell lacks before sending work anywhere
         apply_layout(cell, layouts[0])
     total = len(layouts)

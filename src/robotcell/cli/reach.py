@@ -11,6 +11,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import write_csv
+from robotcell.errors import InputError
 from robotcell.poseformats import FORMATS
 from robotcell.reach import ReachMap, reach_html, reach_map, read_targets
 
@@ -39,6 +40,8 @@ def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:
               show_default=True, help="Pose columns of TARGETS.")
 @click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
               help="Table angle (deg) for targets without a 'table' column.")
+@click.option("--choose-table", is_flag=True,
+              help="Choose the table angle per target (36 angles over one turn, best score).")
 @click.option("--track", "track_mm", type=float, default=None,
               help="Track position (mm) for every target (default: chosen per target).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
@@ -46,13 +49,13 @@ def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:
 @click.option("--html", "html_path", type=click.Path(dir_okay=False), default=None,
               help="Self-contained HTML page with the map (default: next to -o, .html).")
 def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
-          table_deg: float, track_mm: float | None, output: str | None,
+          table_deg: float, choose_table: bool, track_mm: float | None, output: str | None,
           html_path: str | None) -> None:
     """Reachability map: can the robot reach every target, and how well.
 
     TARGETS is a CSV of poses in --frame with the columns of --format (kuka: x,y,z,a,b,c in mm
     and deg) and optionally a column 'table' (deg). The track position is chosen per target
-    unless --track is given. Every target gets: reachable (1/0), score (0..1: 1 when the arm is
+    unless --track is given; the table angle too with --choose-table. Every target gets: reachable (1/0), score (0..1: 1 when the arm is
     as far from singularities as it gets and every axis is at least 10 deg from its limits),
     track_mm, table_deg, branch (0..7), a1_deg.., limit_margin_deg (smallest distance of an axis
     to its limits), track_margin_mm and manipulability_m3 (|det J|). Unreachable targets have
@@ -66,6 +69,10 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
     cell = Cell.load(cell_path)
     T, table = read_targets(targets, fmt)
     th = np.radians(table_deg) if table is None else table
+    if choose_table:
+        if table is not None:
+            raise InputError(f"{targets} has a 'table' column; leave it out to --choose-table")
+        th = None
     track = None if track_mm is None else track_mm * 1e-3
     rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track)
     header, rows = reach_rows(rm, cell.robot.n_joints)

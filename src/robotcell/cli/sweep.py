@@ -71,6 +71,8 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
               show_default=True, help="Pose columns of --targets.")
 @click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
               help="Table angle (deg) for targets without a 'table' column.")
+@click.option("--choose-table", is_flag=True,
+              help="Choose the table angle per target (36 angles over one turn, best score).")
 @click.option("--workers", type=int, default=None,
               help="Local worker processes (default: one per CPU; 1: no subprocess).")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
@@ -80,8 +82,8 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
               help="CSV of every layout, ranked.")
 def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool: str | None,
-              fmt: str, table_deg: float, workers: int | None, scheduler: str | None, top: int,
-              output: str | None) -> None:
+              fmt: str, table_deg: float, choose_table: bool, workers: int | None,
+              scheduler: str | None, top: int, output: str | None) -> None:
     """Rank layouts of the cell by how well the robot reaches the targets.
 
     Each layout (one combination of the offsets in --layouts, see docs/reach.md) is scored on
@@ -99,6 +101,10 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
     T, table = read_targets(targets, fmt)
     layouts = read_layouts(layouts_path)
     th = np.radians(table_deg) if table is None else table
+    if choose_table:
+        if table is not None:
+            raise InputError(f"{targets} has a 'table' column; leave it out to --choose-table")
+        th = None
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
         ranked = sweep(cell, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
