@@ -106,3 +106,23 @@ def test_chosen_table_angle_reaches_and_scores_at_least_as_well_as_zero(capsys, 
     code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part",
                        "--choose-table")
     assert code == 2 and "leave it out to --choose-table" in err
+
+
+def test_progress_in_blocks_gives_the_same_map(capsys, tmp_path, monkeypatch):
+    import robotcell.cli.progress as cli_progress
+    from robotcell import reach
+
+    cell = Cell.load(CELL)
+    T, table = read_targets(SEAM)
+    whole = reach_map(cell, T, frame="part", tool="torch", table=table)
+    monkeypatch.setattr(reach, "BLOCK", 10)
+    calls = []
+    blocks = reach_map(cell, T, frame="part", tool="torch", table=table,
+                       progress=lambda d, n: calls.append((d, n)))
+    assert calls == [(10, 36), (20, 36), (30, 36), (36, 36)]
+    for name in ("reachable", "q", "track", "table", "score", "branch"):
+        assert np.array_equal(getattr(blocks, name), getattr(whole, name), equal_nan=True)
+    monkeypatch.setattr(cli_progress, "PROGRESS_AFTER", 0.0)
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--tool",
+                       "torch", "-o", tmp_path / "r.csv")
+    assert code == 0 and err.startswith("targets")  # the bar (plain text off a terminal)

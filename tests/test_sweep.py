@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from cli_helpers import run
 
-import robotcell.cli.sweep as cli_sweep
+import robotcell.cli.progress as cli_progress
 from robotcell import InputError
 from robotcell.cell import Cell
 from robotcell.reach import reach_map, read_targets
@@ -104,7 +104,7 @@ def test_cli_ranks_writes_csv_and_shows_progress(capsys, tmp_path, monkeypatch):
     lay = tmp_path / "layouts.yaml"
     lay.write_text("robot:\n  y: [-600, 0, 300]\nturntable:\n  a: {from: 0, to: 90, steps: 2}\n")
     out = tmp_path / "rank.csv"
-    monkeypatch.setattr(cli_sweep, "PROGRESS_AFTER", 0.0)
+    monkeypatch.setattr(cli_progress, "PROGRESS_AFTER", 0.0)
     code, stdout, err = run(capsys, "sweep", "--cell", CELL, "--targets", SEAM, "--layouts", lay,
                             "--frame", "part", "--tool", "torch", "--workers", "1", "-o", out)
     assert code == 0, err
@@ -128,3 +128,17 @@ def test_cli_errors(capsys, tmp_path, monkeypatch):
     code, _, err = run(capsys, "sweep", "--cell", CELL, "--targets", SEAM, "--layouts",
                        tmp_path / "none.yaml")
     assert code == 2 and "cannot read" in err
+
+
+def test_cli_runs_on_a_dask_scheduler_by_address(capsys, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    lay = tmp_path / "layouts.yaml"
+    lay.write_text("robot:\n  y: [-600, 0, 300]\nturntable:\n  a: {from: 0, to: 90, steps: 2}\n")
+    args = ["sweep", "--cell", CELL, "--targets", SEAM, "--layouts", lay, "--frame", "part",
+            "--tool", "torch"]
+    code, serial, err = run(capsys, *args, "--workers", "1")
+    assert code == 0, err
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as c:
+        code, remote, err = run(capsys, *args, "--scheduler", c.scheduler_address)
+    assert code == 0, err
+    assert remote == serial

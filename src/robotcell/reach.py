@@ -27,7 +27,8 @@ import html
 import io
 import math
 import weakref
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -50,6 +51,8 @@ __all__ = ["LIMIT_REF", "ReachMap", "manipulability_scale", "reach_html", "reach
 
 #: Distance to the joint limits (rad) from which a target counts as fully clear of them.
 LIMIT_REF = math.radians(10.0)
+#: Targets per block when :func:`reach_map` reports progress.
+BLOCK = 2000
 #: Random configurations that set the manipulability scale of an arm.
 SCALE_SAMPLES = 4096
 
@@ -114,6 +117,13 @@ class ReachMap:
         return float(np.mean(self.reachable)) if self.reachable.size else 0.0
 
 
+def _rows(v: ArrayLike | None, sl: slice, n: int) -> ArrayLike | None:
+    """Rows ``sl`` of a per-target value given as a scalar or an array of length ``n``."""
+    if v is None or np.ndim(v) == 0:
+        return v
+    return np.broadcast_to(np.asarray(v, dtype=float), (n,))[sl]
+
+
 def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:
     """Table angles (rad) to choose from: one turn, or the limits when they span less."""
     tt = cell.turntable
@@ -129,7 +139,8 @@ def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:
 
 def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayLike | None = None,
               table: ArrayLike | None = 0.0, track: ArrayLike | None = None,
-              table_samples: int = 36) -> ReachMap:
+              table_samples: int = 36,
+              progress: Callable[[int, int], None] | None = None) -> ReachMap:
     """Score every target: reachable or not, axis values, limit margin, manipulability.
 
     Parameters
@@ -149,12 +160,25 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
         Track positions (m); default: chosen per target (:func:`robotcell.cellik.ik`).
     table_samples : int
         Candidate table angles when ``table`` is None (10 deg apart by default).
+    progress : callable, optional
+        With it, the targets are solved in blocks of :data:`BLOCK` and ``progress(done, total)``
+        is called after each.
 
     Returns
     -------
     ReachMap
     """
     arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
+    if progress is not None:
+        n = arr.shape[0]
+        parts = []
+        for s in range(0, n, BLOCK):
+            sl = slice(s, s + BLOCK)
+            parts.append(reach_map(cell, arr[sl], frame, tool, _rows(table, sl, n),
+                                   _rows(track, sl, n), table_samples))
+            progress(min(s + BLOCK, n), n)
+        return ReachMap(*(np.concatenate([getattr(p, f.name) for p in parts])
+                          for f in fields(ReachMap)))
     if table is None:
         grid = _table_grid(cell, table_samples)
         arr = np.broadcast_to(arr[:, None], (arr.shape[0], grid.size, 4, 4))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import sys
+from contextlib import ExitStack
 from pathlib import Path
 
 import click
@@ -11,6 +12,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import write_csv
+from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.poseformats import FORMATS
 from robotcell.reach import ReachMap, reach_html, reach_map, read_targets
@@ -74,7 +76,9 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
             raise InputError(f"{targets} has a 'table' column; leave it out to --choose-table")
         th = None
     track = None if track_mm is None else track_mm * 1e-3
-    rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track)
+    with ExitStack() as stack:
+        rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
+                       progress=DeferredProgress(stack, "targets"))
     header, rows = reach_rows(rm, cell.robot.n_joints)
     write_csv(output if output else sys.stdout, header, rows, 6)
     if html_path is None and output:

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import os
-import sys
-import time
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import ExitStack
 
@@ -13,32 +11,11 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import format_table, write_csv
+from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.poseformats import FORMATS
 from robotcell.reach import read_targets
 from robotcell.sweep import read_layouts, sweep
-
-#: Seconds after which a running sweep shows a progress bar on stderr.
-PROGRESS_AFTER = 2.0
-
-
-class _Progress:
-    """A progress bar on stderr that appears only once the job has run for PROGRESS_AFTER s."""
-
-    def __init__(self, stack: ExitStack, label: str) -> None:
-        self.stack, self.label = stack, label
-        self.start = time.monotonic()
-        self.bar = None
-        self.shown = 0
-
-    def __call__(self, done: int, total: int) -> None:
-        if self.bar is None:
-            if time.monotonic() - self.start < PROGRESS_AFTER or done >= total:
-                return
-            self.bar = self.stack.enter_context(click.progressbar(
-                length=total, label=self.label, file=sys.stderr, show_pos=True))
-        self.bar.update(done - self.shown)
-        self.shown = done
 
 
 def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> Executor | None:
@@ -108,7 +85,7 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
         ranked = sweep(cell, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
-                       progress=_Progress(stack, "layouts"))
+                       progress=DeferredProgress(stack, "layouts"))
     names = list(layouts[0].values) if layouts else []
     if output:
         rows = np.array([[rank + 1, r.index, *r.layout.values.values(), r.fraction,
