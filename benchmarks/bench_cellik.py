@@ -9,9 +9,10 @@ prints the time per target of
 - the fast choice (:func:`robotcell.cellik.ik`: closed-form interval, closed-form manipulability
   scanned inside it, one analytic solve),
 
-both in this run on the same targets, their ratio (target >= 150x, <= 20 us/target), and how the
-two choices compare: valid targets, and the ratio of their manipulability ``|det J|`` at the
-chosen track value.
+both in this run on the same targets, interleaved, best of 3 rounds each, as wall time and as
+CPU time of this process (less disturbed when other jobs share the machine); their ratio
+(target >= 150x, <= 20 us/target); and how the two choices compare: valid targets, and the
+ratio of their manipulability ``|det J|`` at the chosen track value.
 """
 
 from __future__ import annotations

@@ -8,14 +8,18 @@ becomes a target of the arm with
 
 (:mod:`robotcell.coupled` for ``T_world_X``). The track position ``e`` is given, or chosen: the
 value within the track limits where the arm reaches the target with the largest manipulability
-(:meth:`robotcell.ik.TrackRobot.ik`). Then every analytic branch of the arm is returned.
+(:func:`choose_track_value`: closed form for an ortho-parallel arm, see
+:mod:`robotcell.ik.trackchoice`). Then every analytic branch of the arm is returned.
 
 :func:`ik_path` solves a sequence of targets (e.g. the TCP holding a point of a workpiece while
 the table turns) as one continuous joint trajectory: it keeps one analytic branch (one arm
 configuration: shoulder, elbow, wrist) along the whole path, unwraps the revolute joints so that
 no joint jumps by a turn, fits the whole trajectory inside the joint limits, and refuses a path
 on which every configuration would flip (cross a singularity) or leave the limits, naming where
-and why. Vectorised over the path: one batched IK call per candidate track value.
+and why. Vectorised over the path: one batched IK call per candidate track value. With
+``track_motion="moving"`` the track follows the path smoothly instead of standing still, and
+:func:`split_path` cuts a path that cannot be followed in one piece into continuous segments,
+naming each break (out of reach, a joint limit, a singularity).
 """
 
 from __future__ import annotations
