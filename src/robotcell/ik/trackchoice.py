@@ -331,17 +331,15 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
     m2 = np.where(local & ~near1, m, -1.0)
     k2 = np.argmax(m2, axis=1)
     second = np.nonzero(m2[rows, k2] >= SECOND_PEAK * m[rows, k1])[0]
-    xs, ms = [scan.x], [m]
-    for sub, k in ((rows, k1), (second, k2[second])):
-        if sub.size == 0:
-            continue
-        xr, mr = _refine(track, pa, R[sub], C0[sub], w, np.nan_to_num(scan.x[sub, k]),
-                         step[sub], scan.lower[sub], scan.upper[sub])
-        if sub.size < n_t:
-            xr = _scatter_rows(xr, sub, n_t, np.nan)
-            mr = _scatter_rows(mr, sub, n_t, -1.0)
-        xs.append(xr)
-        ms.append(mr)
+    # Both peaks refined together: one evaluation per stage (fewer numpy calls per batch).
+    sub = np.concatenate([rows, second])
+    k = np.concatenate([k1, k2[second]])
+    xr, mr = _refine(track, pa, R[sub], C0[sub], w, np.nan_to_num(scan.x[sub, k]), step[sub],
+                     scan.lower[sub], scan.upper[sub])
+    xs, ms = [scan.x, xr[:n_t]], [m, mr[:n_t]]
+    if second.size:
+        xs.append(_scatter_rows(xr[n_t:], second, n_t, np.nan))
+        ms.append(_scatter_rows(mr[n_t:], second, n_t, -1.0))
     xs_all, ms_all = np.concatenate(xs, axis=1), np.concatenate(ms, axis=1)
     if prefer is None:
         x = xs_all[rows, np.argmax(ms_all, axis=1)]
