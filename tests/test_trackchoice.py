@@ -106,3 +106,29 @@ def test_errors():
         choose_track(track, np.eye(4))
     with pytest.raises(InputError, match="samples must be at least 3"):
         choose_track(kr16_track(), np.eye(4), samples=2)
+
+
+def test_cell_ik_choice_matches_the_sampled_search_in_a_frame_on_the_table():
+    from test_cellik import track_cell
+
+    from robotcell.cellik import _track_robot
+    from robotcell.transforms import invert
+
+    cell = track_cell()
+    rng = np.random.default_rng(6)
+    q = rng.uniform(cell.robot.lower, cell.robot.upper, (200, 6))
+    th = rng.uniform(-3, 3, 200)
+    T = cell.fk(q, track=rng.uniform(0.0, 6.0, 200), table=th, tool="torch", frame="part")
+    sol = cell.ik(T, frame="part", table=th, tool="torch")
+    T_L = invert(cell.track.T_world_L) @ cell.frame_pose("part", 0.0, th) @ T
+    old = _track_robot(cell).ik(T_L, tool=cell.tools["torch"].T_F_TCP)
+    ok_old = old.solutions.valid.any(-1)
+    assert np.all(sol.valid.any(-1)[ok_old])
+    i, b = np.nonzero(sol.valid)
+    back = cell.fk(sol.q[i, b], track=sol.track[i], table=th[i], tool="torch", frame="part")
+    assert np.allclose(back, T[i], atol=1e-9)
+    assert np.all(cell.robot.within_limits(sol.q[i, b]))
+    pa = analytic_solver(cell.robot).params
+    m_new = np.where(sol.valid, np.nan_to_num(manipulability(pa, sol.q)), 0.0).max(-1)
+    ratio = m_new[ok_old] / old.manipulability[ok_old]
+    assert np.median(ratio) > 0.9999 and np.mean(ratio >= 0.99) >= 0.98
