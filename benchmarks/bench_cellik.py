@@ -28,8 +28,7 @@ from machine import describe
 
 from robotcell.cell import Cell
 from robotcell.cellik import _track_robot
-from robotcell.ik.analytic import analytic_solver
-from robotcell.ik.trackchoice import manipulability
+from robotcell.ik.trackchoice import arm_manipulability
 from robotcell.transforms import invert
 
 CELL = Path(__file__).parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
@@ -89,11 +88,10 @@ def main() -> None:
         print(f"  {label:40s} wall {uw:8.1f} ({rw:4.0f}x)   CPU {uc:8.1f} ({rc:4.0f}x)")
     print("  target: <= 20 us/target and >= 150x")
 
-    pa = analytic_solver(arm).params
     ok_old = old.solutions.valid.any(-1)
     ok_new = fast.valid.any(-1)
     m_old = old.manipulability
-    m_new = np.where(fast.valid, np.nan_to_num(manipulability(pa, fast.q)), 0.0).max(-1)
+    m_new = np.where(fast.valid, np.nan_to_num(arm_manipulability(arm, fast.q)), 0.0).max(-1)
     r = m_new[ok_old] / m_old[ok_old]
     print(f"\n  valid targets: before {ok_old.sum()}/{N_SAME}, fast {ok_new.sum()}/{N_SAME}, "
           f"valid before but not now: {np.count_nonzero(ok_old & ~ok_new)}")

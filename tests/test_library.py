@@ -303,7 +303,9 @@ def test_ur_matches_calibration_chain(name):
 @pytest.mark.parametrize("name", sorted(URDF_CHAINS))
 def test_matches_ros_industrial_urdf(name):
     chain, pre, post = URDF_CHAINS[name]
-    robot = robotcell.load_robot(name)
+    # URDFs (and the OPW closed form below) count serial joint angles: compare the model's chain;
+    # the J2/J3 coupling of the FANUC and IRB 2400 controllers is tested in test_coupling.py.
+    robot = robotcell.load_robot(name).uncoupled()
     rng = np.random.default_rng(3)
     for q in random_q(robot, rng, 25):
         assert_pose(robot.fk(q), urdf_fk(chain, q, pre, post), TOL, name)
@@ -313,7 +315,7 @@ def test_matches_ros_industrial_urdf(name):
 def test_matches_opw_closed_form(name):
     params, fix = OPW[name]
     base = OPW_BASE.get(name, np.eye(4))
-    robot = robotcell.load_robot(name)
+    robot = robotcell.load_robot(name).uncoupled()
     rng = np.random.default_rng(5)
     for q in random_q(robot, rng, 25):
         assert_pose(robot.fk(q), base @ opw_fk(params, q) @ fix, TOL, name)
@@ -345,9 +347,9 @@ HAND = {
     "fanuc_lrmate200id": ([0] * 6, (50 + 335 + 80, 0, 330 + 35)),
     "fanuc_m20ia": ([0] * 6, (150 + 835 + 100, 0, 790 + 250)),
     # Puma 560 (Corke): fkine(qz) = (a2 + a3, -d3, d1 + d4) -- RVC's (0.4521, -0.1500, 0.4318)
-    # with the 672 mm base height added; fkine(qr) (arm up) = (a3, -d3, d1 + a2 + d4).
-    "puma560": ([0] * 6, (431.8 + 20.3, -150.05, 672 + 431.8)),
-    "puma560@qr": ([0, 90, -90, 0, 0, 0], (20.3, -150.05, 672 + 431.8 + 431.8)),
+    # with the 671.83 mm (26.45 in) base height added; fkine(qr) (arm up) = (a3, -d3, d1 + a2 + d4).
+    "puma560": ([0] * 6, (431.8 + 20.3, -150.05, 671.83 + 431.8)),
+    "puma560@qr": ([0, 90, -90, 0, 0, 0], (20.3, -150.05, 671.83 + 431.8 + 431.8)),
     # Stanford arm with q1 = q2 = 0: boom vertical, flange at (0, d2 - a3, d1 + d3)
     "stanford_arm": ([0, 0, 500, 0, 0, 0], (0, 154 - 20.3, 412 + 500)),
     "stanford_arm@1000": ([0, 0, 1000, 0, 0, 0], (0, 154 - 20.3, 412 + 1000)),

@@ -6,7 +6,13 @@ import pytest
 from robotcell import InputError, load_robot
 from robotcell.cellik import choose_track_value
 from robotcell.ik import TrackRobot, analytic_solver
-from robotcell.ik.trackchoice import choose_track, manipulability, scan_track, track_interval
+from robotcell.ik.trackchoice import (
+    arm_manipulability,
+    choose_track,
+    manipulability,
+    scan_track,
+    track_interval,
+)
 from robotcell.transforms import make_pose, rot_x, rot_z
 
 ARM = load_robot("kuka_kr16")
@@ -29,7 +35,27 @@ def test_closed_form_manipulability_equals_det_of_jacobian(name):
     arm = load_robot(name)
     q = np.random.default_rng(0).uniform(arm.lower, arm.upper, (500, 6))
     det = np.abs(np.linalg.det(arm.jacobian(q)))
-    assert np.allclose(manipulability(analytic_solver(arm).params, q), det, rtol=0, atol=1e-12)
+    assert np.allclose(arm_manipulability(arm, q), det, rtol=0, atol=1e-12)
+    if arm.coupling is None:  # the model's angles are the controller's
+        assert np.allclose(manipulability(analytic_solver(arm).params, q), det, atol=1e-12)
+    else:  # FANUC J2/J3 and the IRB 2400 parallelogram: J = J_model C
+        assert set(arm.coupling.changed_axes()) & {1, 2}
+
+
+@pytest.mark.parametrize("name", ["abb_irb2400", "fanuc_m20ia"])
+def test_choice_for_coupled_arms_is_valid_and_as_good_as_the_sampled_search(name):
+    arm = load_robot(name)
+    track = TrackRobot(arm, make_pose(rot_z(0.2), [0.0, 0.1, 0.3]), np.array([1.0, 0.0, 0.0]),
+                       0.0, 4.0)
+    T = reachable_targets(track, 120, 7)
+    old, new = track.ik(T), choose_track(track, T)
+    ok_old = old.solutions.valid.any(-1)
+    assert np.all(new.solutions.valid.any(-1)[ok_old])
+    i, b = np.nonzero(new.solutions.valid)
+    assert np.allclose(track.fk(new.solutions.q[i, b]), T[i], atol=1e-9)
+    assert np.all(arm.within_limits(new.solutions.q[i, b, 1:]))
+    ratio = new.manipulability[ok_old] / old.manipulability[ok_old]
+    assert np.median(ratio) > 0.9999 and np.mean(ratio >= 0.99) >= 0.97
 
 
 def test_closed_form_interval_contains_every_reachable_track_value():

@@ -430,6 +430,8 @@ def _path_solutions(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArra
     q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
     reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
     inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
+    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
+        inside &= robot.coupling.within_interaction(q)
     step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
     first = np.ones((step.shape[0], 1, step.shape[2]), dtype=bool)
     smooth = np.concatenate([first, step <= max_step], axis=1)
@@ -444,6 +446,9 @@ def _path_setup(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None, t
     n_pts = arr.shape[0]
     T_tool = tool_pose(cell, tool)
     robot = cell.robot
+    if robot.n_joints != 6:
+        raise InputError(f"path IK needs a six-axis arm (8 branches); {robot.name} has "
+                         f"{robot.n_joints} axes: use cell.ik for its solutions")
     if q_start is not None:
         q_start = finite_array(q_start, "q_start")
         if q_start.shape != (robot.n_joints,):

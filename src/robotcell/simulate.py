@@ -185,6 +185,9 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
         Track positions (m).
     """
     robot = cell.robot
+    if robot.n_joints != 6:
+        raise InputError(f"simulated touches need a six-axis arm; {robot.name} has "
+                         f"{robot.n_joints} axes")
     T = targets(E)                                                          # (K, N, M, 4, 4)
     T_R = invert(robot_pose(cell, E))[:, :, None] @ T
     sol = robot.ik(T_R, tool=tool_T)                                        # (K, N, M, 8, n)

@@ -10,15 +10,20 @@ from typing import TextIO
 import click
 import numpy as np
 
+from robotcell.cell import Cell
+from robotcell.cli.cellargs import cell_tool, chunks, row_values, table_angles, track_values
 from robotcell.cli.common import format_table, parse_numbers, read_csv, require_columns
+from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
-from robotcell.ik import abb_confdata, analytic_solver, kuka_status_turn, nearest
+from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import FORMATS, pose_from_vendor
 from robotcell.robot import Robot
 
 BRANCHES = ["front up", "front up flip", "front down", "front down flip",
             "back up", "back up flip", "back down", "back down flip"]
+#: Branch names of a 4-axis palletizer (``k = 2 * shoulder + elbow``).
+BRANCHES_4 = ["front up", "front down", "back up", "back down"]
 
 
 def _flags(robot: Robot, method: str, fmt: str, q: np.ndarray) -> list[str] | None:
@@ -41,31 +46,51 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 
 
 @click.command()
-@click.argument("robot")
+@click.argument("robot", required=False)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
 @click.option("--output", "output_path", type=click.Path(), help="CSV to write (default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,
               help="Pose format of --pose / --input.")
 @click.option("--all", "show_all", is_flag=True, help="Also list unreachable and out-of-limit branches.")
-@click.option("--near", "near", help="Only the valid solution nearest to a1,...,a6 (deg).")
-@click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention).")
-def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | None, fmt: str,
-       show_all: bool, near: str | None, tool: str | None) -> None:
+@click.option("--near", "near", help="Only the valid solution nearest to a1,...,an (deg).")
+@click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention); "
+              "with --cell also a tool name of the cell.")
+@click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
+              help="Solve in a cell file (robot, track, turntable, tools, frames) instead of ROBOT.")
+@click.option("--frame", "frame", default="world", show_default=True,
+              help="--cell: frame of the target (world, track, robot, turntable or a frame of the cell).")
+@click.option("--track", "track_mm", type=float, metavar="MM",
+              help="--cell: track position (mm); chosen per pose when omitted in a cell with a track.")
+@click.option("--table", "table_deg", type=float, default=0.0, metavar="DEG",
+              help="--cell: turntable angle (deg) at which the target is given.")
+def ik(robot: str | None, pose: str | None, input_path: str | None, output_path: str | None, fmt: str,
+       show_all: bool, near: str | None, tool: str | None, cell_path: str | None, frame: str,
+       track_mm: float | None, table_deg: float) -> None:
     """Inverse kinematics: every arm configuration that reaches a TCP pose.
 
     ROBOT is a library name (see 'robotcell robots') or a model file with an ortho-parallel
-    arm and spherical wrist (KUKA, ABB, Fanuc, ...) or a Universal-Robots-type arm.
+    arm and spherical wrist (KUKA, ABB, Fanuc, ...), a Universal-Robots-type arm or a 4-axis
+    palletizer.
 
-    The table lists the 8 branches (front/back of axis 1, elbow up/down, wrist flipped or not),
-    joint values in degrees, and for --format kuka/abb the configuration flags (KUKA Status/Turn,
-    ABB confdata [cf1,cf4,cf6,cfx]).
+    The table lists the 8 branches (front/back of axis 1, elbow up/down, wrist flipped or not;
+    4 for a palletizer), controller axis values in degrees (as the pendant shows them: FANUC J3
+    with the J2/J3 interaction), and for --format kuka/abb the configuration flags (KUKA
+    Status/Turn, ABB confdata [cf1,cf4,cf6,cfx]).
 
     Batch CSV: --input has the pose columns of --format (kuka: x,y,z,a,b,c; abb:
     x,y,z,q1,q2,q3,q4; ...). --output has one row per valid solution with columns
     pose (0-based input row), branch (0..7), a1..a6 (deg); with --all every branch and a column
     valid (1/0; unreachable branches have nan angles); with --near one row per pose with columns
-    pose, found (1/0), a1..a6.
+    pose, found (1/0), a1..a6. A palletizer has branches 0..3 and columns a1..a4.
+
+    With --cell CELL.yaml instead of ROBOT the target is given in a frame of the cell (--frame)
+    at a table angle (--table), for a track position (--track, chosen per pose where the arm
+    reaches best when omitted); the output adds track (mm) and table (deg) and, for --format
+    kuka/abb, the configuration flags (batch columns status,turn or cf1,cf4,cf6,cfx). A batch
+    file may hold per-row columns track and table. Batches of 2000 poses or more show a progress
+    bar on stderr. Refused with exit status 2: unknown frame or tool, track or table outside
+    their limits, no valid solution for --pose.
 
     \b
     Examples:
@@ -73,14 +98,25 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
       robotcell ik abb_irb2400 --pose 940,0,1455,0.7071068,0,0.7071068,0 --format abb --all
       robotcell ik ur5e --pose 0.5,0.1,0.4,0,3.1416,0 --format ur --near 0,-90,90,-90,-90,0
       robotcell ik kuka_kr16 --input poses.csv --output joints.csv
+      robotcell ik --cell cell.yaml --frame part --table 90 --tool torch --pose 0,0,50,0,180,0
     """
+    if cell_path is not None:
+        if robot is not None:
+            raise InputError("give either ROBOT or --cell CELL.yaml, not both")
+        return _ik_cell(cell_path, pose, input_path, output_path, fmt, show_all, near, tool, frame,
+                        track_mm, table_deg)
+    if robot is None:
+        raise InputError("give a ROBOT (library name or model file) or --cell CELL.yaml")
     r = load_robot(robot)
     solver = analytic_solver(r)
     if (pose is None) == (input_path is None):
         raise InputError("give exactly one of --pose ... or --input poses.csv")
     T_tool = None if tool is None else pose_from_vendor(parse_numbers(tool, "--tool", 6), "kuka")
     deg = 180.0 / math.pi
-    ref = None if near is None else np.radians(parse_numbers(near, "--near", 6))
+    n = r.n_joints
+    names_k = BRANCHES if solver.branches == 8 else BRANCHES_4
+    ref = None if near is None else joints_to_si(r, np.array(parse_numbers(near, "--near", n)))
+    scale = np.where(r.prismatic, 1e3, deg)  # controller values to deg (mm for prismatic axes)
     if pose is not None:
         T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
         sol = solver.solve(T, T_tool)
@@ -91,44 +127,50 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
             q, valid, reach, ks = q[None], np.array([True]), np.array([True]), [int(branch)]
         else:
             q, valid, reach = sol.q, sol.valid, sol.reachable
-            ks = [k for k in range(8) if show_all or valid[k]]
+            ks = [k for k in range(solver.branches) if show_all or valid[k]]
         flags = _flags(r, solver.method, fmt, q)
-        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
+        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.axes)], "valid"]
         if flags is not None:
             headers.append("S/T" if fmt == "kuka" else "confdata")
         rows = []
         for i, k in enumerate(ks):
             row_i = 0 if ref is not None else k
             state = "yes" if valid[row_i] else ("limits" if reach[row_i] else "unreachable")
-            vals = [float(v * deg) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
-                    for v in q[row_i]]
-            row = [f"{k} {BRANCHES[k]}", *vals, state]
+            vals = [float(v * f) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
+                    for v, f in zip(q[row_i], scale)]
+            row = [f"{k} {names_k[k]}", *vals, state]
             if flags is not None:
                 row.append(flags[row_i] if reach[row_i] else "-")
             rows.append(row)
         if not rows:
             raise click.ClickException("no valid solution (unreachable or outside the joint limits); "
                                        "--all lists every branch")
-        click.echo(f"{r.name}, {solver.method} solver, angles in degrees")
+        click.echo(f"{r.name}, {solver.method} solver, controller axis values in degrees")
         click.echo(format_table(headers, rows))
         return
     cols = read_csv(input_path)
     names = [f.lower() for f in FORMATS[fmt].fields]
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     sol = solver.solve(T, T_tool)
-    axes = [f"a{i}" for i in range(1, 7)]
+    axes = [f"a{i}" for i in range(1, n + 1)]
     if ref is not None:
         q, found, _ = nearest(r, sol, ref)
         header = ["pose", "found", *axes]
-        out_rows = [[i, int(found[i]), *(q[i] * deg).tolist()] for i in range(len(q))]
+        out_rows = [[i, int(found[i]), *(q[i] * scale).tolist()] for i in range(len(q))]
     elif show_all:
         header = ["pose", "branch", "valid", *axes]
-        out_rows = [[i, k, int(sol.valid[i, k]), *(sol.q[i, k] * deg).tolist()]
-                    for i in range(len(sol.q)) for k in range(8)]
+        out_rows = [[i, k, int(sol.valid[i, k]), *(sol.q[i, k] * scale).tolist()]
+                    for i in range(len(sol.q)) for k in range(solver.branches)]
     else:
         header = ["pose", "branch", *axes]
-        out_rows = [[i, k, *(sol.q[i, k] * deg).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
-    none = int(np.count_nonzero(~sol.valid.any(axis=1)))
+        out_rows = [[i, k, *(sol.q[i, k] * scale).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
+    _finish_batch(sol.valid, header, out_rows, output_path)
+
+
+def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[object]],
+                  output_path: str | None) -> None:
+    """Warn about poses without a valid branch (valid: (N, branches)), then write the batch CSV."""
+    none = int(np.count_nonzero(~valid.any(axis=1)))
     if none:
         click.echo(f"warning: {none} pose(s) without a valid solution", err=True)
     if output_path:
@@ -136,3 +178,92 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
             _write(fh, header, out_rows)
     else:
         _write(sys.stdout, header, out_rows)
+
+
+def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
+                       ) -> tuple[list[str], np.ndarray]:
+    """Batch columns of the configuration flags (KUKA status,turn; ABB cf1..cfx) per row of q."""
+    if method != "opw" or fmt not in ("kuka", "abb"):
+        return [], np.empty((len(q), 0), dtype=int)
+    qq = np.nan_to_num(q)
+    if fmt == "kuka":
+        s, t = kuka_status_turn(robot, qq)
+        return ["status", "turn"], np.column_stack([s, t])
+    return ["cf1", "cf4", "cf6", "cfx"], np.atleast_2d(abb_confdata(robot, qq))
+
+
+def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_path: str | None,
+             fmt: str, show_all: bool, near: str | None, tool: str | None, frame: str,
+             track_mm: float | None, table_deg: float) -> None:
+    """``robotcell ik --cell``: :meth:`Cell.ik` for one pose or a batch (mm, deg)."""
+    cell = Cell.load(cell_path)
+    r = cell.robot
+    if (pose is None) == (input_path is None):
+        raise InputError("give exactly one of --pose ... or --input poses.csv")
+    T_tool = cell_tool(tool)
+    deg = 180.0 / math.pi
+    ref = None if near is None else np.radians(parse_numbers(near, "--near", r.n_joints))
+    if pose is not None:
+        T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
+        sol = cell.ik(T, frame, track_values(cell, track_mm), table_angles(cell, table_deg), T_tool)
+        valid = sol.valid
+        if ref is not None:
+            q, found, branch = nearest(r, IKSolutions(sol.q, valid, sol.reachable, sol.method), ref)
+            ks, qs = ([int(branch)], q[None]) if found else ([], q[None])
+        else:
+            ks = [k for k in range(8) if show_all or valid[k]]
+            qs = sol.q[ks]
+        if not any(valid[k] for k in ks) and not show_all:
+            raise InputError(f"no valid solution for the target in frame {frame!r}: out of reach, "
+                             "or outside the joint, track or table limits (--all lists every branch)")
+        flags = _flags(r, sol.method, fmt, qs) if ks else None
+        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
+        if flags is not None:
+            headers.append("S/T" if fmt == "kuka" else "confdata")
+        rows = []
+        for i, k in enumerate(ks):
+            state = "yes" if valid[k] else ("limits" if sol.reachable[k] else "unreachable")
+            vals = [float(v * deg) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
+                    for v in qs[i]]
+            row = [f"{k} {BRANCHES[k]}", *vals, state]
+            if flags is not None:
+                row.append(flags[i] if sol.reachable[k] else "-")
+            rows.append(row)
+        how = "chosen" if track_mm is None else "given"
+        where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
+        where += f", table {float(sol.table) * deg:g} deg" if cell.turntable is not None else ""
+        click.echo(f"{cell.name}: {r.name}, {sol.method} solver, target in frame {frame!r}{where}; "
+                   "angles in degrees")
+        click.echo(format_table(headers, rows))
+        return
+    cols = read_csv(input_path)
+    names = [f.lower() for f in FORMATS[fmt].fields]
+    T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
+    n = len(T)
+    e = track_values(cell, row_values(cols, "track", track_mm, n))
+    th = table_angles(cell, row_values(cols, "table", table_deg, n))
+    parts = []
+    for sl in chunks(n, "ik"):
+        parts.append(cell.ik(T[sl], frame, None if e is None else e[sl], th[sl], T_tool))
+    q = np.concatenate([p.q for p in parts])
+    valid = np.concatenate([p.valid for p in parts])
+    reach = np.concatenate([p.reachable for p in parts])
+    track = np.concatenate([np.broadcast_to(p.track, p.valid.shape[:-1]) for p in parts]) * 1e3
+    table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1]) for p in parts]) * deg
+    method = parts[0].method
+    axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
+    if ref is not None:
+        qn, found, _ = nearest(r, IKSolutions(q, valid, reach, method), ref)
+        names_f, flags = _cell_flag_columns(r, method, fmt, qn)
+        header = ["pose", "found", "track", "table", *axes, *names_f]
+        out_rows = [[i, int(found[i]), track[i], table[i], *(qn[i] * deg).tolist(),
+                     *(flags[i].tolist() if found[i] else ["-"] * len(names_f))] for i in range(n)]
+    else:
+        idx = [(i, k) for i in range(n) for k in range(8)] if show_all else list(zip(*np.nonzero(valid)))
+        sel = np.array([q[i, k] for i, k in idx]).reshape(-1, r.n_joints)
+        names_f, flags = _cell_flag_columns(r, method, fmt, sel)
+        header = ["pose", "branch", *(["valid"] if show_all else []), "track", "table", *axes, *names_f]
+        out_rows = [[int(i), int(k), *([int(valid[i, k])] if show_all else []), track[i], table[i],
+                     *(sel[j] * deg).tolist(), *(flags[j].tolist() if reach[i, k] else ["-"] * len(names_f))]
+                    for j, (i, k) in enumerate(idx)]
+    _finish_batch(valid, header, out_rows, output_path)

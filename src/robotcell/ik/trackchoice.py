@@ -49,9 +49,11 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.opw import OPWParameters
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.track import TrackChoice, TrackRobot
+from robotcell.robot import Robot
 from robotcell.transforms import invert, validate_pose
 
-__all__ = ["TrackScan", "choose_track", "manipulability", "scan_track", "track_interval"]
+__all__ = ["TrackScan", "arm_manipulability", "choose_track", "manipulability", "scan_track",
+           "track_interval"]
 
 #: Within this fraction of the best manipulability, a preferred track value (the previous
 #: target's on a path) wins over a larger manipulability.
@@ -140,14 +142,43 @@ class _Limits:
     2*pi-equivalent) iff ``cos(t - mid) >= cos(half)`` for ``t = sign * q + offset``, tested on
     the (cos t, sin t) pair the geometry gives, without an arctangent."""
 
-    def __init__(self, pa: OPWParameters, lower: NDArray[np.float64],
-                 upper: NDArray[np.float64]) -> None:
+    def __init__(self, pa: OPWParameters, arm: Robot) -> None:
         self.cone: dict[int, tuple[float, float, float]] = {}
+        lower, upper = arm.lower, arm.upper
+        # A coupled axis's limit is on the controller value, not on the model angle: left to
+        # the exact check after the solve.
+        coupled = set() if arm.coupling is None else set(arm.coupling.changed_axes())
         for j in (0, 1, 2, 4):
-            if upper[j] - lower[j] >= TWO_PI:
+            if upper[j] - lower[j] >= TWO_PI or j in coupled:
                 continue
             mid = pa.signs[j] * 0.5 * (lower[j] + upper[j]) + pa.offsets[j]
             self.cone[j] = (math.cos(mid), math.sin(mid), math.cos(0.5 * (upper[j] - lower[j])))
+        # Coupled axes among 1..3 whose controller value depends on model joints 1..3 only
+        # (FANUC J2/J3, a parallel arm): q_j = row . q_model[:3] + const, checked on angles.
+        self.rows: list[tuple[int, NDArray[np.float64], float, float, float]] = []
+        c = arm.coupling
+        if c is not None and c.matrix.shape[0] == c.matrix.shape[1]:
+            inv = np.linalg.inv(c.matrix)
+            off = inv @ (np.zeros(6) if c.offset is None else c.offset)
+            for j in sorted(coupled & {0, 1, 2}):
+                if np.any(inv[j, 3:] != 0) or upper[j] - lower[j] >= TWO_PI:
+                    continue
+                self.rows.append((j, inv[j, :3], -float(off[j]), float(lower[j]),
+                                  float(upper[j])))
+        self.signs, self.offsets = pa.signs[:3], pa.offsets[:3]
+
+    def ok_coupled(self, cs: tuple[tuple[NDArray[np.float64], NDArray[np.float64]], ...]
+                   ) -> NDArray[np.bool_] | bool:
+        """Coupled axes within limits, given (cos, sin) of the paper's angles t1, t2, t3."""
+        if not self.rows:
+            return True
+        qm = [self.signs[j] * (np.arctan2(sv, cv) - self.offsets[j])
+              for j, (cv, sv) in enumerate(cs)]
+        ok: NDArray[np.bool_] | bool = True
+        for _, row, const, lo, hi in self.rows:
+            q = row[0] * qm[0] + row[1] * qm[1] + row[2] * qm[2] + const
+            ok = ok & (np.mod(q - lo, TWO_PI) <= hi - lo)
+        return ok
 
     def ok(self, j: int, c: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.bool_] | bool:
         if j not in self.cone:
@@ -204,6 +235,8 @@ def _manipulability(pa: OPWParameters, R: NDArray[np.float64], C: NDArray[np.flo
             r22 = (s2 * c3 + c2 * s3) * M02 + (c2 * c3 - s2 * s3) * R22   # cos(t5)
             h = np.sqrt(np.maximum(1.0 - r22 * r22, 0.0))
             ok = reach & limits.ok(1, c2, s2) & limits.ok(2, c3, s3) & limits.ok_either_wrist(r22, h)
+            if limits.rows:
+                ok = ok & limits.ok_coupled(((c1, s1), (c2, s2), (c3, s3)))
             best = np.maximum(best, np.where(ok, nS * h, 0.0))
     return best * (pa.c2 * kappa)
 
@@ -244,7 +277,7 @@ def _scan(track: TrackRobot, pa: OPWParameters, R: NDArray[np.float64], C0: NDAr
 def _score(track: TrackRobot, pa: OPWParameters, R: NDArray[np.float64],
            C0: NDArray[np.float64], w: NDArray[np.float64], x: NDArray[np.float64]
            ) -> NDArray[np.float64]:
-    limits = _Limits(pa, track.arm.lower, track.arm.upper)
+    limits = _Limits(pa, track.arm)
     out = np.empty(x.shape)
     # Single precision (7 digits: micrometres over the track) is plenty to choose the value;
     # the arm is then solved in double precision at the chosen one.
@@ -367,7 +400,7 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
         again = track.ik(flat[retry], samples=65, tool=tool)
         x[retry] = again.track
         sol = _replace_rows(sol, retry, again.solutions)
-    return TrackChoice(_reshape(sol, batch), x.reshape(batch), _best_valid(pa, sol).reshape(batch))
+    return TrackChoice(_reshape(sol, batch), x.reshape(batch), _best_valid(track.arm, sol).reshape(batch))
 
 
 def manipulability(pa: OPWParameters, q: ArrayLike) -> NDArray[np.float64]:
@@ -394,12 +427,28 @@ def manipulability(pa: OPWParameters, q: ArrayLike) -> NDArray[np.float64]:
     return n * pa.c2 * cross * np.abs(np.sin(t5))
 
 
-def _best_valid(pa: OPWParameters, sol: IKSolutions) -> NDArray[np.float64]:
+def arm_manipulability(arm: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """``|det J|`` of an ortho-parallel ``arm`` at controller values ``q`` (..., 6) (m^3).
+
+    The closed form of :func:`manipulability` on the model's joint values; for an arm with a
+    joint coupling ``q_model = C q + offset`` (square ``C``) it is multiplied by ``|det C|``
+    (``J = J_model C``). Equal to ``|det arm.jacobian(q)|``.
+    """
+    pa = analytic_solver(arm).params
+    c = arm.coupling
+    if c is None:
+        return manipulability(pa, q)
+    if c.matrix.shape[0] != c.matrix.shape[1]:  # passive joints: no closed form here
+        return np.abs(np.linalg.det(arm.jacobian(np.nan_to_num(q))))
+    return manipulability(pa, c.to_model(q)) * abs(float(np.linalg.det(c.matrix)))
+
+
+def _best_valid(arm: Robot, sol: IKSolutions) -> NDArray[np.float64]:
     """``|det J|`` of the best valid branch of track solutions ``(N, 8, 7)`` (0 if none).
 
     The two wrists of an arm configuration (branches ``2k``, ``2k + 1``) have the same value."""
     valid = sol.valid[..., ::2] | sol.valid[..., 1::2]
-    m = np.nan_to_num(manipulability(pa, sol.q[..., ::2, 1:]))
+    m = np.nan_to_num(arm_manipulability(arm, sol.q[..., ::2, 1:]))
     return np.where(valid, m, 0.0).max(axis=-1)
 
 
@@ -413,15 +462,20 @@ def _solve_at(track: TrackRobot, T: NDArray[np.float64], x: NDArray[np.float64],
     sol = analytic_solver(track.arm).solve(T_R, tool)
     xcol = np.broadcast_to(x[:, None, None], sol.q.shape[:-1] + (1,))
     return IKSolutions(np.concatenate([xcol, sol.q], axis=-1), sol.valid, sol.reachable,
-                       sol.method)
+                       sol.method, sol.reach_error)
 
 
 def _replace_rows(sol: IKSolutions, rows: NDArray[np.bool_], new: IKSolutions) -> IKSolutions:
     q, valid, reach = sol.q.copy(), sol.valid.copy(), sol.reachable.copy()
     q[rows], valid[rows], reach[rows] = new.q, new.valid, new.reachable
-    return IKSolutions(q, valid, reach, sol.method)
+    err = None
+    if sol.reach_error is not None and new.reach_error is not None:
+        err = sol.reach_error.copy()
+        err[rows] = new.reach_error
+    return IKSolutions(q, valid, reach, sol.method, err)
 
 
 def _reshape(sol: IKSolutions, batch: tuple[int, ...]) -> IKSolutions:
+    err = None if sol.reach_error is None else sol.reach_error.reshape(batch + (8,))
     return IKSolutions(sol.q.reshape(batch + sol.q.shape[-2:]), sol.valid.reshape(batch + (8,)),
-                       sol.reachable.reshape(batch + (8,)), sol.method)
+                       sol.reachable.reshape(batch + (8,)), sol.method, err)
