@@ -1,4 +1,4 @@
-"""Cell IK with the track position chosen by the software: today's sampled search vs the fast choice.
+"""Cell IK with the track position chosen by the software: the sampled search vs the fast choice.
 
 Run: ``python benchmarks/bench_cellik.py``. On the example cell (a KUKA KR 16 on a 6 m track,
 ``examples/cell_kr16_track_turntable.yaml``) and reachable random targets in the world frame,
@@ -96,7 +96,8 @@ def main() -> None:
     print(f"\n  valid targets: before {ok_old.sum()}/{N_SAME}, fast {ok_new.sum()}/{N_SAME}, "
           f"valid before but not now: {np.count_nonzero(ok_old & ~ok_new)}")
     print(f"  manipulability |det J| fast / before: median {np.median(r):.6f}, "
-          f">= 0.9999 for {np.mean(r >= 0.9999) * 100:.1f} %, better for {np.mean(r > 1) * 100:.1f} %, "
+          f">= 0.9999 for {np.mean(r >= 0.9999) * 100:.1f} %, "
+          f"better for {np.mean(r > 1) * 100:.1f} %, "
           f"min {r.min():.3f}")
 
 

@@ -181,8 +181,8 @@ def choose_track_value(track: TrackRobot, T_L: NDArray[np.float64], tool: ArrayL
 
     For an ortho-parallel arm: :func:`robotcell.ik.trackchoice.choose_track` (closed-form
     interval of the track value, closed-form manipulability scanned inside it, one analytic
-    solve; under 10 us per target in batches, docs/performance.md). Other arms (UR type): the sampled
-    search of :meth:`robotcell.ik.TrackRobot.ik` (``prefer`` is ignored there).
+    solve; under 10 us per target in batches, docs/performance.md). Other arms (UR type): the
+    sampled search of :meth:`robotcell.ik.TrackRobot.ik` (``prefer`` is ignored there).
 
     Parameters
     ----------

@@ -57,11 +57,12 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
 
     TARGETS is a CSV of poses in --frame with the columns of --format (kuka: x,y,z,a,b,c in mm
     and deg) and optionally a column 'table' (deg). The track position is chosen per target
-    unless --track is given; the table angle too with --choose-table. Every target gets: reachable (1/0), score (0..1: 1 when the arm is
-    as far from singularities as it gets and every axis is at least 10 deg from its limits),
-    track_mm, table_deg, branch (0..7), a1_deg.., limit_margin_deg (smallest distance of an axis
-    to its limits), track_margin_mm and manipulability_m3 (|det J|). Unreachable targets have
-    nan axis values. A summary goes to stderr.
+    unless --track is given; the table angle too with --choose-table. Every target gets:
+    reachable (1/0), score (0..1: 1 when the arm is as far from singularities as it gets and
+    every axis is at least 10 deg from its limits), track_mm, table_deg, branch (0..7),
+    a1_deg.., limit_margin_deg (smallest distance of an axis to its limits), track_margin_mm and
+    manipulability_m3 (|det J|). Unreachable targets have nan axis values. A summary goes to
+    stderr.
 
     \b
     Examples:

@@ -71,8 +71,10 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
 
     \b
     Examples:
-      robotcell sweep --cell cell.yaml --targets seam.csv --layouts layouts.yaml --frame part --tool torch
-      robotcell sweep --cell cell.yaml --targets seam.csv --layouts layouts.yaml --scheduler tcp://head:8786
+      robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --frame part
+      robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --workers 8
+      robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml \
+          --scheduler tcp://head:8786
     """
     cell = Cell.load(cell_path)
     T, table = read_targets(targets, fmt)

@@ -180,7 +180,8 @@ class _Limits:
             ok = ok & (np.mod(q - lo, TWO_PI) <= hi - lo)
         return ok
 
-    def ok(self, j: int, c: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.bool_] | bool:
+    def ok(self, j: int, c: NDArray[np.float64], s: NDArray[np.float64]
+           ) -> NDArray[np.bool_] | bool:
         if j not in self.cone:
             return True
         cm, sm, ch = self.cone[j]
@@ -234,7 +235,8 @@ def _manipulability(pa: OPWParameters, R: NDArray[np.float64], C: NDArray[np.flo
             c3, s3 = Kc + sg * Ss, sg * Sc - Ks
             r22 = (s2 * c3 + c2 * s3) * M02 + (c2 * c3 - s2 * s3) * R22   # cos(t5)
             h = np.sqrt(np.maximum(1.0 - r22 * r22, 0.0))
-            ok = reach & limits.ok(1, c2, s2) & limits.ok(2, c3, s3) & limits.ok_either_wrist(r22, h)
+            ok = (reach & limits.ok(1, c2, s2) & limits.ok(2, c3, s3)
+                  & limits.ok_either_wrist(r22, h))
             if limits.rows:
                 ok = ok & limits.ok_coupled(((c1, s1), (c2, s2), (c3, s3)))
             best = np.maximum(best, np.where(ok, nS * h, 0.0))
@@ -400,7 +402,8 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
         again = track.ik(flat[retry], samples=65, tool=tool)
         x[retry] = again.track
         sol = _replace_rows(sol, retry, again.solutions)
-    return TrackChoice(_reshape(sol, batch), x.reshape(batch), _best_valid(track.arm, sol).reshape(batch))
+    return TrackChoice(_reshape(sol, batch), x.reshape(batch),
+                       _best_valid(track.arm, sol).reshape(batch))
 
 
 def manipulability(pa: OPWParameters, q: ArrayLike) -> NDArray[np.float64]:
