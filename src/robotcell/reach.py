@@ -39,6 +39,7 @@ from robotcell.cellik import ik
 from robotcell.coupled import tool_pose
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
+from robotcell.ik.trackchoice import arm_manipulability
 from robotcell.poseformats import FORMATS, pose_from_vendor
 from robotcell.robot import Robot
 from robotcell.tables import read_csv, require_columns
@@ -190,7 +191,10 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
     valid = sol.valid.reshape(n, -1)                                    # (N, M * 8)
     q_all = sol.q.reshape(n, valid.shape[1], -1)
     q = np.where(valid[..., None], q_all, 0.0)
-    manip = np.where(valid, np.abs(np.linalg.det(robot.jacobian(q, tool=T_tool))), 0.0)
+    if sol.method == "opw":  # closed form; |det J| does not depend on the tool
+        manip = np.where(valid, arm_manipulability(robot, q), 0.0)
+    else:
+        manip = np.where(valid, np.abs(np.linalg.det(robot.jacobian(q, tool=T_tool))), 0.0)
     lo, hi = robot.lower, robot.upper
     with np.errstate(invalid="ignore"):
         gap = np.minimum(np.where(np.isfinite(lo), q - lo, np.inf),
