@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Callable
 from contextlib import ExitStack
 from pathlib import Path
 
@@ -31,19 +32,43 @@ def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:
     return header, rows
 
 
+def target_options(f: Callable[..., None]) -> Callable[..., None]:
+    """The options of ``reach`` and ``sweep`` that say where the targets are and how to reach
+    them: --cell, --frame, --tool, --format, --table, --choose-table."""
+    for opt in reversed((
+        click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+                     help="Cell file (YAML)."),
+        click.option("--frame", default="world", show_default=True,
+                     help="Frame of the targets: world, track, robot, turntable or a frame of "
+                          "the cell."),
+        click.option("--tool", default=None,
+                     help="Tool of the cell (default: the robot model's tool)."),
+        click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka",
+                     show_default=True, help="Pose columns of the targets file."),
+        click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
+                     help="Table angle (deg) for targets without a 'table' column."),
+        click.option("--choose-table", is_flag=True,
+                     help="Choose the table angle per target (36 angles over one turn, best "
+                          "score)."),
+    )):
+        f = opt(f)
+    return f
+
+
+def load_targets(path: str, fmt: str, table_deg: float, choose_table: bool
+                 ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Targets (m) and table angles (rad; None: to be chosen) from the targets file."""
+    T, table = read_targets(path, fmt)
+    if choose_table:
+        if table is not None:
+            raise InputError(f"{path} has a 'table' column; leave it out to --choose-table")
+        return T, None
+    return T, np.radians(table_deg) if table is None else table
+
+
 @click.command()
 @click.argument("targets", type=click.Path(dir_okay=False))
-@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
-              help="Cell file (YAML).")
-@click.option("--frame", default="world", show_default=True,
-              help="Frame of the targets: world, track, robot, turntable or a frame of the cell.")
-@click.option("--tool", default=None, help="Tool of the cell (default: the robot model's tool).")
-@click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka",
-              show_default=True, help="Pose columns of TARGETS.")
-@click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
-              help="Table angle (deg) for targets without a 'table' column.")
-@click.option("--choose-table", is_flag=True,
-              help="Choose the table angle per target (36 angles over one turn, best score).")
+@target_options
 @click.option("--track", "track_mm", type=float, default=None,
               help="Track position (mm) for every target (default: chosen per target).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
@@ -70,12 +95,7 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
       robotcell reach --cell cell.yaml seam.csv --tool torch --html reach.html
     """
     cell = Cell.load(cell_path)
-    T, table = read_targets(targets, fmt)
-    th = np.radians(table_deg) if table is None else table
-    if choose_table:
-        if table is not None:
-            raise InputError(f"{targets} has a 'table' column; leave it out to --choose-table")
-        th = None
+    T, th = load_targets(targets, fmt, table_deg, choose_table)
     track = None if track_mm is None else track_mm * 1e-3
     with ExitStack() as stack:
         rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,

@@ -12,9 +12,8 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.common import format_table, write_csv
 from robotcell.cli.progress import DeferredProgress
+from robotcell.cli.reach import load_targets, target_options
 from robotcell.errors import InputError
-from robotcell.poseformats import FORMATS
-from robotcell.reach import read_targets
 from robotcell.sweep import read_layouts, sweep
 
 
@@ -36,20 +35,11 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
 
 
 @click.command()
-@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
-              help="Cell file (YAML).")
+@target_options
 @click.option("--targets", "targets", required=True, type=click.Path(dir_okay=False),
               help="CSV of target poses (columns of --format; optional 'table' in deg).")
 @click.option("--layouts", "layouts_path", required=True, type=click.Path(dir_okay=False),
               help="YAML of offsets per component (mm, deg); every combination is a layout.")
-@click.option("--frame", default="world", show_default=True, help="Frame of the targets.")
-@click.option("--tool", default=None, help="Tool of the cell (default: the robot model's tool).")
-@click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka",
-              show_default=True, help="Pose columns of --targets.")
-@click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
-              help="Table angle (deg) for targets without a 'table' column.")
-@click.option("--choose-table", is_flag=True,
-              help="Choose the table angle per target (36 angles over one turn, best score).")
 @click.option("--workers", type=int, default=None,
               help="Local worker processes (default: one per CPU; 1: no subprocess).")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
@@ -73,17 +63,11 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
     Examples:
       robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --frame part
       robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --workers 8
-      robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml \
-          --scheduler tcp://head:8786
+      robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
     cell = Cell.load(cell_path)
-    T, table = read_targets(targets, fmt)
+    T, th = load_targets(targets, fmt, table_deg, choose_table)
     layouts = read_layouts(layouts_path)
-    th = np.radians(table_deg) if table is None else table
-    if choose_table:
-        if table is not None:
-            raise InputError(f"{targets} has a 'table' column; leave it out to --choose-table")
-        th = None
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
         ranked = sweep(cell, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
