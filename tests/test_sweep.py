@@ -142,3 +142,29 @@ def test_cli_runs_on_a_dask_scheduler_by_address(capsys, tmp_path):
         code, remote, err = run(capsys, *args, "--scheduler", c.scheduler_address)
     assert code == 0, err
     assert remote == serial
+
+
+def test_reach_and_sweep_with_a_two_axis_positioner(capsys, tmp_path):
+    from test_positioner import tilt_rotate
+
+    cell = tilt_rotate()
+    rng = np.random.default_rng(8)
+    q = rng.uniform(cell.robot.lower, cell.robot.upper, (30, 6)) * 0.6
+    v = np.column_stack([rng.uniform(-0.5, 0.5, 30), rng.uniform(-3, 3, 30)])
+    T = cell.fk(q, table=v, tool="torch", frame="part")
+    rm = reach_map(cell, T, frame="part", tool="torch", table=v)
+    assert rm.reachable.all() and rm.table.shape == (30, 2) and np.allclose(rm.table, v)
+    back = cell.fk(rm.q, table=rm.table, tool="torch", frame="part")
+    assert np.allclose(back, T, atol=1e-9)
+    with pytest.raises(InputError, match="give a positioner's axis values"):
+        reach_map(cell, T, frame="part", tool="torch", table=None)
+    layouts = read_layouts({"turntable": {"x": [0, 2000], "c": [0, 20]}})
+    moved = apply_layout(cell, layouts[3])
+    assert np.allclose(moved.turntable.chain.base[:3, 3] - cell.turntable.chain.base[:3, 3],
+                       [2.0, 0, 0])
+    ranked = sweep(cell, T, layouts, frame="part", tool="torch", table=v)
+    assert ranked[0].index == 0 and ranked[0].fraction == 1.0    # as built: every target
+    assert all(r.fraction < 1.0 for r in ranked if r.layout.values["turntable.x"] == 2000)
+    from robotcell.reach import reach_html
+    page = reach_html(rm, T[:, :3, 3], frame="part")
+    assert "30 of 30 targets reachable" in page

@@ -89,8 +89,8 @@ class ReachMap:
     track : ndarray, shape (N,)
         Track position (m; chosen unless given, NaN where chosen and unreachable; 0 without
         track).
-    table : ndarray, shape (N,)
-        Table angle (rad; 0 without turntable).
+    table : ndarray, shape (N,) or (N, n)
+        Table angle (rad; 0 without turntable), or a positioner's axis values.
     limit_margin : ndarray, shape (N,)
         Smallest distance of an arm axis to its limits (rad; NaN where unreachable).
     track_margin : ndarray, shape (N,)
@@ -128,8 +128,9 @@ def _rows(v: ArrayLike | None, sl: slice, n: int) -> ArrayLike | None:
 def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:
     """Table angles (rad) to choose from: one turn, or the limits when they span less."""
     tt = cell.turntable
-    if tt is None:
-        raise InputError("choosing the table angle needs a turntable in the cell")
+    if tt is None or tt.n_axes != 1 or np.ndim(tt.lower) != 0:
+        raise InputError("choosing the table angle needs a turntable (one axis) in the cell; "
+                         "give a positioner's axis values")
     if samples < 2:
         raise InputError(f"table_samples must be at least 2, got {samples}")
     if tt.upper - tt.lower >= TWO_PI:
@@ -206,7 +207,10 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
     rows = np.arange(n)
     ok = valid[rows, best]
     e = np.broadcast_to(sol.track, sol.valid.shape[:-1]).reshape(n, -1)[rows, best // 8]
-    th = np.broadcast_to(sol.table, sol.valid.shape[:-1]).reshape(n, -1)[rows, best // 8]
+    tab = np.asarray(sol.table)
+    extra = tab.shape[sol.valid.ndim - 1:]  # () for a turntable, (n,) for a positioner's axes
+    th = np.broadcast_to(tab, sol.valid.shape[:-1] + extra).reshape((n, -1) + extra)[rows,
+                                                                                    best // 8]
     e = np.array(e, dtype=float)
     if track is None and cell.track is not None:
         e = np.where(ok, e, np.nan)  # no track position was chosen for an unreachable target
@@ -272,8 +276,9 @@ def reach_html(rm: ReachMap, points: ArrayLike, title: str = "Reachability map",
     ax.set_xlabel("target")
     ax.set_ylabel("track position (mm)", color="tab:blue")
     ax2 = ax.twinx()
-    ax2.plot(idx, np.degrees(rm.table), color="tab:orange", marker=".", label="table (deg)")
-    ax2.set_ylabel("table angle (deg)", color="tab:orange")
+    ax2.plot(idx, np.degrees(rm.table), marker=".", color="tab:orange" if rm.table.ndim == 1
+             else None)
+    ax2.set_ylabel("table / positioner axes (deg)", color="tab:orange")
     ax.set_title("external axes along the targets")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90)

@@ -207,8 +207,11 @@ def apply_layout(cell: Cell, layout: Layout) -> Cell:
         elif comp == "robot":
             new.T_world_R = _moved(new.T_world_R, off)
         elif comp == "turntable" and cell.turntable is not None:
-            new.turntable = replace(new.turntable, T_parent_B=_moved(new.turntable.T_parent_B,
-                                                                     off))
+            tt = new.turntable
+            if hasattr(tt, "T_parent_B"):
+                new.turntable = replace(tt, T_parent_B=_moved(tt.T_parent_B, off))
+            else:  # a positioner chain: its base is the root pose
+                new.turntable = replace(tt, chain=tt.chain.with_base(_moved(tt.chain.base, off)))
         elif comp in cell.frames:
             fr = new.frames[comp]
             new.frames[comp] = replace(fr, pose=_moved(fr.pose, off))

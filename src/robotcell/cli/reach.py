@@ -21,7 +21,9 @@ from robotcell.reach import ReachMap, reach_html, reach_map, read_targets
 
 def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:
     """CSV header and rows of a reachability map (mm, deg)."""
-    header = ["target", "reachable", "score", "track_mm", "table_deg", "branch",
+    table = (["table_deg"] if rm.table.ndim == 1
+             else [f"table{i + 1}_deg" for i in range(rm.table.shape[1])])
+    header = ["target", "reachable", "score", "track_mm", *table, "branch",
               *[f"a{i + 1}_deg" for i in range(n_axes)], "limit_margin_deg", "track_margin_mm",
               "manipulability_m3"]
     rows = np.column_stack([
