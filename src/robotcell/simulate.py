@@ -18,6 +18,7 @@ worst touch is best.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -31,6 +32,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.cell import Cell
 from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_write
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.robot import Robot
 from robotcell.transforms import invert, make_pose, rot_z, transform_points
@@ -129,13 +131,20 @@ class Touches:
         return header, [list(r) for r in zip(*cols)]
 
     def write_csv(self, out: str | Path | TextIO) -> None:
-        """Write the measurement CSV to a path or an open text stream."""
+        """Write the measurement CSV to an open text stream, or to a path atomically.
+
+        Raises
+        ------
+        InputError
+            The path cannot be written (missing folder, a folder, no permission).
+        """
         header, rows = self.columns()
         if hasattr(out, "write"):
             _write(out, header, rows)
             return
-        with Path(out).open("w", newline="", encoding="utf-8") as fh:
-            _write(fh, header, rows)
+        buf = io.StringIO(newline="")
+        _write(buf, header, rows)
+        atomic_write(out, buf.getvalue())
 
 
 def _write(fh: TextIO, header: list[str], rows: list[list[str]]) -> None:

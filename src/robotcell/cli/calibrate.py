@@ -32,7 +32,7 @@ from robotcell.calibration.measurements import (
 )
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell, Provenance
-from robotcell.cli.common import parse_numbers, read_csv
+from robotcell.cli.common import check_output, parse_numbers, read_csv, write_output
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
@@ -73,8 +73,22 @@ def calibrate() -> None:
     """
 
 
+#: Key of ``click.Context.meta`` under which ``-o FILE`` is kept for :func:`emit`.
+OUTPUT_KEY = "robotcell.calibrate.output"
+
+
+def _keep_output(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+    ctx.meta[OUTPUT_KEY] = check_output(ctx, param, value)
+
+
 def measurement_options(func: Callable) -> Callable:
-    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json."""
+    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o."""
+    func = click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+                        expose_value=False, callback=_keep_output,
+                        help="Also write the result to FILE, atomically and only when the run "
+                             "succeeds: the JSON object with --json, else the report. Use it "
+                             "instead of '--json > FILE', which empties FILE when a run is "
+                             "refused.")(func)
     func = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
                         help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
@@ -218,11 +232,19 @@ def sigma_m(sigma_mm: float | None) -> float | None:
 
 
 def emit(result: CalibrationResult, as_json: bool) -> None:
-    """Print a result: the terminal report, or one JSON object with ``--json``."""
-    if as_json:
-        click.echo(json.dumps(result.to_json(), indent=2))
-    else:
-        click.echo(result.summary())
+    """Print a result: the terminal report, or one JSON object with ``--json``.
+
+    With ``-o FILE`` the terminal shows the report and FILE gets the JSON object (``--json``) or
+    the report, written atomically.
+    """
+    output = click.get_current_context().meta.get(OUTPUT_KEY)
+    text = json.dumps(result.to_json(), indent=2) if as_json else result.summary()
+    if output is None:
+        click.echo(text)
+        return
+    click.echo(result.summary())
+    write_output(output, text + "\n")
+    click.echo(f"wrote {output}", err=True)
 
 
 def raw_rows(cols: dict, names: list[str]) -> np.ndarray:
@@ -236,6 +258,7 @@ def _line_labels(roles: list[str]) -> list[str]:
 
 
 POSE_COLUMNS = ["x", "y", "z", "a", "b", "c"] + [f"a{i}" for i in range(1, 10)]
+NOMINAL_COLUMNS = ["nominal_x", "nominal_y", "nominal_z"]
 
 
 NO_CELL_TRACK = ("needs --cell CELL.yaml, which says where the track is; remove the column or "
@@ -299,7 +322,7 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     require_name(name, target, "tool")
     prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     T = flange_poses(cols, measurements, model)
     roles = [str(r).strip().lower() for r in cols["point"]] if "point" in cols else ["tcp"] * len(T)
     bad = sorted(set(roles) - {"tcp", "-x", "xy", "world"})
@@ -379,10 +402,9 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
                          "CELL.yaml")
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track", *NOMINAL_COLUMNS])
     p = tcp_positions(cols, measurements, model, T_tool)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y",
-                                                    "nominal_z"]), measurements)
+    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track", *NOMINAL_COLUMNS]), measurements)
     in_world = False
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
@@ -432,7 +454,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     refuse_track_column(cols, measurements, "is not used by 'calibrate external-tcp': touch the "
                         "fixed tool with the track at one position and remove the column")
     p = tcp_positions(cols, measurements, model, T_tool)

@@ -123,7 +123,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     if target is not None:
         axis = _cell_track_axis(target, axis, references, roll)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
     refuse_track_column(cols, measurements, "is not used by 'calibrate track': its track "
                         "positions are column e1")
     f = tcp_positions(cols, measurements, model, T_tool)
@@ -191,7 +191,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     target = CellTarget.open(cell_path, robot)
     parent = _cell_turntable(target).parent if target is not None else None
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "track"])
     f = tcp_positions(cols, measurements, model, T_tool)
     theta = external_axis(cols, measurements, "table")
     check_count(len(f), 3, "touches", measurements)
@@ -331,7 +331,7 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     require_name(name, target, "frame")
     model, T_tool = robot_and_tool(robot, tool, target)
     T_B, cov, noise = _workpiece_turntable(turntable_json, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
     f = tcp_positions(cols, measurements, model, T_tool)
     theta = np.radians(require_columns(cols, ["e1"], measurements)[:, 0])
     roles = point_roles(cols, measurements)

@@ -8,7 +8,7 @@ import sys
 import click
 import numpy as np
 
-from robotcell.cli.common import parse_numbers, read_csv, require_columns, write_csv
+from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
@@ -34,7 +34,8 @@ def tool_option(text: str | None) -> np.ndarray | None:
 @click.argument("robot")
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
-@click.option("--output", "output_path", type=click.Path(), help="CSV to write (default: standard output).")
+@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+              help="CSV to write, atomically (default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,
               help="Pose format of the result.")
 @click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention).")
@@ -71,8 +72,8 @@ def fk(robot: str, joints: str | None, input_path: str | None, output_path: str 
         click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
                             for i, (n, x) in enumerate(zip(fields, v))))
         return
-    cols = read_csv(input_path)
     names = [f"a{i}" for i in range(1, r.n_joints + 1)]
+    cols = read_csv(input_path, known=names)
     q = joints_to_si(r, require_columns(cols, names, input_path))
     T = r.fk(q, tool=T_tool)
     if fmt == "matrix":

@@ -3,14 +3,21 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
-import sys
 from typing import TextIO
 
 import click
 import numpy as np
 
-from robotcell.cli.common import format_table, parse_numbers, read_csv, require_columns
+from robotcell.cli.common import (
+    check_output,
+    format_table,
+    parse_numbers,
+    read_csv,
+    require_columns,
+    write_output,
+)
 from robotcell.errors import InputError
 from robotcell.ik import abb_confdata, analytic_solver, kuka_status_turn, nearest
 from robotcell.modelfile import load_robot
@@ -44,7 +51,8 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 @click.argument("robot")
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
-@click.option("--output", "output_path", type=click.Path(), help="CSV to write (default: standard output).")
+@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+              help="CSV to write, atomically (default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,
               help="Pose format of --pose / --input.")
 @click.option("--all", "show_all", is_flag=True, help="Also list unreachable and out-of-limit branches.")
@@ -87,7 +95,7 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
         if ref is not None:
             q, found, branch = nearest(r, sol, ref)
             if not found:
-                raise click.ClickException("no valid solution (unreachable or outside the joint limits)")
+                raise InputError("no valid solution (unreachable or outside the joint limits)")
             q, valid, reach, ks = q[None], np.array([True]), np.array([True]), [int(branch)]
         else:
             q, valid, reach = sol.q, sol.valid, sol.reachable
@@ -107,13 +115,13 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
                 row.append(flags[row_i] if reach[row_i] else "-")
             rows.append(row)
         if not rows:
-            raise click.ClickException("no valid solution (unreachable or outside the joint limits); "
-                                       "--all lists every branch")
+            raise InputError("no valid solution (unreachable or outside the joint limits); "
+                             "--all lists every branch")
         click.echo(f"{r.name}, {solver.method} solver, angles in degrees")
         click.echo(format_table(headers, rows))
         return
-    cols = read_csv(input_path)
     names = [f.lower() for f in FORMATS[fmt].fields]
+    cols = read_csv(input_path, known=names)
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     sol = solver.solve(T, T_tool)
     axes = [f"a{i}" for i in range(1, 7)]
@@ -131,8 +139,6 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
     none = int(np.count_nonzero(~sol.valid.any(axis=1)))
     if none:
         click.echo(f"warning: {none} pose(s) without a valid solution", err=True)
-    if output_path:
-        with open(output_path, "w", newline="", encoding="utf-8") as fh:
-            _write(fh, header, out_rows)
-    else:
-        _write(sys.stdout, header, out_rows)
+    buf = io.StringIO(newline="")
+    _write(buf, header, out_rows)
+    write_output(output_path, buf.getvalue())

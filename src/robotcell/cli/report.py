@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import click
 
+from robotcell.cli.common import check_not_folder
 from robotcell.report import load_result, verdict, write_report
 
 
 @click.command()
 @click.argument("result", type=click.Path())
 @click.option("-o", "--output", default="report.html", show_default=True, type=click.Path(),
+              callback=check_not_folder,
               help="HTML file to write; PNG figures go beside it.")
 def report(result: str, output: str) -> None:
     """Write an HTML report (and PNG figures) for a calibration result.

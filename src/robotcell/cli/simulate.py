@@ -14,7 +14,7 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import parse_numbers
+from robotcell.cli.common import check_output, parse_numbers
 from robotcell.errors import InputError
 from robotcell.simulate import PROCEDURES, Touches
 from robotcell.simulate import simulate as simulate_touches
@@ -142,8 +142,8 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
 @click.argument("procedure", type=click.Choice(list(PROCEDURES)))
 @cell_options
 @design_options
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="CSV file to write (default: standard output).")
+@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+              help="CSV file to write, atomically (default: standard output).")
 def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
              frame: str | None, track_mm: float | None, output: str | None,
              **design: Any) -> None:
