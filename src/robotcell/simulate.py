@@ -51,6 +51,12 @@ PROCEDURES = {
 #: Candidate track positions when the track position of a procedure is chosen.
 TRACK_SAMPLES = 25
 
+#: Most touches one simulation places (memory of the configuration search grows with them).
+MAX_TOUCHES = 200
+
+#: Fewest touches each procedure's calibration accepts, as ``robotcell calibrate`` checks them.
+MIN_TOUCHES = {"turntable": 3, "track": 3}
+
 
 def _down_orientations() -> NDArray[np.float64]:
     """Candidate TCP orientations in the world: tool Z down, tilted 0/15/30 deg, 12 turns."""
@@ -193,6 +199,9 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
     e : ndarray, shape (N,)
         Track positions (m).
     """
+    if len(labels) > MAX_TOUCHES:
+        raise InputError(f"{len(labels)} touches asked for; a simulation places at most "
+                         f"{MAX_TOUCHES}")
     robot = cell.robot
     T = targets(E)                                                          # (K, N, M, 4, 4)
     T_R = invert(robot_pose(cell, E))[:, :, None] @ T
@@ -243,7 +252,11 @@ def _usual_configuration(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.flo
 
 
 def _rng(seed: int | np.random.Generator | None) -> np.random.Generator:
-    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise InputError(f"seed must be a whole number >= 0, got {seed}")
+    return np.random.default_rng(seed)
 
 
 def _tool_name(cell: Cell, tool: str | None) -> str:
@@ -367,6 +380,8 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                          f"along {t.axis}")
     if positions < 2:
         raise InputError(f"each reference point needs at least 2 track positions, got {positions}")
+    if not (math.isfinite(travel) and travel > 0):
+        raise InputError(f"travel must be a positive length (m), got {travel}")
     tname = _tool_name(cell, tool)
     u = t.direction
     o = t.T_L_R0[:3, 3]
@@ -385,6 +400,10 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
     offsets = np.linspace(-travel / 2, travel / 2, positions) / t.scale
     e_all = np.clip(centre[:, None] + offsets, t.lower, t.upper)
     point = np.repeat(np.arange(len(refs)), positions)
+    if len(point) < MIN_TOUCHES["track"]:
+        raise InputError(f"the track calibration needs at least {MIN_TOUCHES['track']} touches; "
+                         f"{len(refs)} reference point(s) x {positions} positions give "
+                         f"{len(point)}: add positions or reference points")
     e_all = e_all.ravel()
     for k in range(len(refs)):
         if np.ptp(e_all[point == k]) < 0.05:
@@ -432,10 +451,19 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
     if cell.turntable is None:
         raise InputError("the cell has no turntable")
     tname = _tool_name(cell, tool)
-    if not radius > 0:
+    if not (math.isfinite(radius) and radius > 0):
         raise InputError(f"radius must be positive (m), got {radius}")
+    if not math.isfinite(height):
+        raise InputError(f"height must be a finite length (m), got {height}")
+    least = MIN_TOUCHES["turntable"]
+    if angles is None and touches < least:
+        raise InputError(f"the turntable calibration needs at least {least} table angles "
+                         f"(touches), got {touches}")
     th = _table_angles(cell, angles, touches)
     n = len(th)
+    if n < least:
+        raise InputError(f"the turntable calibration needs at least {least} table angles, "
+                         f"got {n}")
     p_B = np.array([radius, 0.0, height])
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -19,9 +19,13 @@ import numpy as np
 from robotcell.errors import InputError
 from robotcell.fileio import atomic_write, read_text
 
-__all__ = ["NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
+__all__ = ["MAX_ABS_VALUE", "NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
            "write_csv"]
 
+
+#: Largest magnitude of a number in a table or an option (mm, deg): a float64 of 1e15 resolves
+#: only 0.125 mm, so a larger value cannot be a measurement; it is a typing error.
+MAX_ABS_VALUE = 1e15
 
 #: Columns every reader accepts and ignores: free text beside the measurements.
 NOTE_COLUMNS = ("note", "notes", "comment", "comments", "remark", "remarks", "description")
@@ -54,8 +58,8 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     Raises
     ------
     InputError
-        Missing or binary file, empty file, ragged rows, an empty cell, NaN or infinity, or a
-        number written with a thousands separator.
+        Missing or binary file, empty file, ragged rows, an empty cell, NaN or infinity, a number
+        beyond :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
     """
     p = Path(path)
     if not p.is_file():
@@ -98,6 +102,11 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
         arr = np.array(values, dtype=float)
         if not np.all(np.isfinite(arr)):
             raise InputError(f"{path}: column '{h}' contains NaN or infinite values")
+        huge = np.flatnonzero(np.abs(arr) > MAX_ABS_VALUE)
+        if huge.size:
+            raise InputError(f"{path}: line {huge[0] + 2}: column '{h}' has {cells[huge[0]]}, "
+                             f"beyond {MAX_ABS_VALUE:.0e} in size: no "
+                             "measurement in mm or deg is that large; correct the typing error")
         out[h] = arr
     return out
 

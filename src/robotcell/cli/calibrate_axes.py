@@ -9,6 +9,7 @@ robot at each touch (mm) for the turntable and workpiece.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import click
@@ -37,6 +38,7 @@ from robotcell.cli.calibrate import (
 )
 from robotcell.cli.common import parse_numbers, read_csv, require_columns
 from robotcell.errors import InputError
+from robotcell.fileio import read_text
 from robotcell.transforms import invert, transform_points, validate_pose
 
 
@@ -226,8 +228,8 @@ def _load_turntable(path: str) -> tuple[np.ndarray, np.ndarray | None, float | N
     if not p.is_file():
         raise InputError(f"{path}: no such file")
     try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        data = json.loads(read_text(p))
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise InputError(f"{path}: not JSON ({exc}); pass the --json output of "
                          "'robotcell calibrate turntable'") from None
     if not isinstance(data, dict) or data.get("procedure") != "turntable" or "matrix" not in data:
@@ -243,16 +245,36 @@ def _load_turntable(path: str) -> tuple[np.ndarray, np.ndarray | None, float | N
     T = validate_pose(T, f"{path}: matrix")
     sigma = data.get("sigma") if isinstance(data.get("sigma"), dict) else {}
     frame = "world" if any(str(k).startswith("T_world_B") for k in [*data, *sigma]) else "robot"
-    cov = data.get("T_world_B_covariance_mm_rad" if frame == "world" else "T_R_B_covariance_mm_rad")
+    key = "T_world_B_covariance_mm_rad" if frame == "world" else "T_R_B_covariance_mm_rad"
+    cov = data.get(key)
     if cov is not None:
-        cov = np.array(cov, dtype=float)
-        if cov.shape != (6, 6) or not np.all(np.isfinite(cov)):
-            cov = None
-        else:
-            to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
-            cov = cov * np.outer(to_si, to_si)
+        cov = _covariance(cov, f"{path}: {key!r}")
+        to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+        cov = cov * np.outer(to_si, to_si)
     noise = data.get("noise_sigma_mm")
+    if noise is not None and (isinstance(noise, bool) or not isinstance(noise, (int, float))
+                              or not math.isfinite(noise) or noise < 0):
+        raise InputError(f"{path}: 'noise_sigma_mm' must be a number of millimetres >= 0, got "
+                         f"{noise!r}; pass the unchanged --json output of 'robotcell calibrate "
+                         "turntable'")
     return T, cov, (float(noise) * 1e-3 if noise is not None else None), frame
+
+
+def _covariance(value: object, where: str) -> np.ndarray:
+    """A 6x6 symmetric positive semi-definite covariance (mm, rad) from JSON, or refused."""
+    advice = "; pass the unchanged --json output of 'robotcell calibrate turntable'"
+    try:
+        cov = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where} must be a 6x6 array of numbers{advice}") from None
+    if cov.shape != (6, 6) or not np.all(np.isfinite(cov)):
+        raise InputError(f"{where} must be a 6x6 array of finite numbers, got shape "
+                         f"{cov.shape}{advice}")
+    scale = max(float(np.abs(cov).max()), 1e-300)
+    if np.abs(cov - cov.T).max() > 1e-9 * scale or np.linalg.eigvalsh(cov).min() < -1e-9 * scale:
+        raise InputError(f"{where} is not a covariance (symmetric, no negative variance)"
+                         f"{advice}")
+    return cov
 
 
 #: Largest difference between a turntable file's pose and the cell's that counts as the same

@@ -33,6 +33,9 @@ def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]
         raise InputError(f"{what} needs {count} comma-separated values, got {len(values)}")
     if not all(math.isfinite(v) for v in values):
         raise InputError(f"{what} contains NaN or infinite values")
+    if any(abs(v) > tables.MAX_ABS_VALUE for v in values):
+        raise InputError(f"{what} has a value beyond {tables.MAX_ABS_VALUE:.0e} in size: no "
+                         "length in mm or angle in deg is that large")
     return values
 
 

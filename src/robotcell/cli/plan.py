@@ -44,7 +44,7 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
 @click.command()
 @click.argument("procedure", type=click.Choice(list(DESIGNS)))
 @cell_options
-@click.option("--runs", type=int, default=100, show_default=True,
+@click.option("--runs", type=click.IntRange(min=0), default=100, show_default=True,
               help="Monte Carlo runs at the best design (0: none).")
 @click.option("--max-size", type=float, default=None, metavar="MM",
               help="frame/workpiece: largest triangle that fits on the part (mm).")
