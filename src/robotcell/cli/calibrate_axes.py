@@ -185,7 +185,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
 
     \b
     Examples:
-      robotcell calibrate turntable table.csv --json > turntable.json
+      robotcell calibrate turntable table.csv --json -o turntable.json
       robotcell calibrate turntable table.csv --cell cell.yaml --tool pointer
     """
     from robotcell.calibration.turntable import calibrate_turntable

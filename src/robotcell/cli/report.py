@@ -20,7 +20,7 @@ def report(result: str, output: str) -> None:
 
     \b
     Example:
-      robotcell calibrate frame base.csv --json > base.json
+      robotcell calibrate frame base.csv --json -o base.json
       robotcell report base.json -o base.html
     """
     data = load_result(result)

@@ -21,6 +21,7 @@ from robotcell.errors import InputError
 from robotcell.simulate import PROCEDURES, Touches
 from robotcell.simulate import simulate as simulate_touches
 
+
 def _mm(option: str, positive: bool = False) -> Callable[[float], float]:
     """Converter of a length option: mm to m, refusing (in mm) what the option cannot be."""
     def convert(value: float) -> float:
