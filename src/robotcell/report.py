@@ -80,8 +80,9 @@ def _malformed(data: dict[str, Any]) -> str | None:
         if not _is_number(data[key]):
             return f"{key!r} must be a number"
     for key in ("warnings", "undetermined"):
-        v = data.get(key) or []
-        if not isinstance(v, list) or not all(isinstance(w, str) for w in v):
+        v = data.get(key, [])
+        if (v is not None or key == "warnings") and (
+                not isinstance(v, list) or not all(isinstance(w, str) for w in v)):
             return f"{key!r} must be a list of texts"
     checks = {
         "condition": lambda v: _is_number(v),

@@ -226,8 +226,9 @@ def sigma_m(sigma_mm: float | None) -> float | None:
     """``--sigma`` in mm to metres, refusing non-positive values."""
     if sigma_mm is None:
         return None
-    if not sigma_mm > 0:
-        raise InputError(f"--sigma must be a positive number of millimetres, got {sigma_mm}")
+    if not 0 < sigma_mm <= 1000:
+        raise InputError(f"--sigma must be a positive number of millimetres (at most 1000), got "
+                         f"{sigma_mm}")
     return sigma_mm * 1e-3
 
 
