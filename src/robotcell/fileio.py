@@ -35,6 +35,17 @@ from robotcell.errors import InputError
 __all__ = ["atomic_copy", "atomic_write", "check_destination", "decode_text", "read_text"]
 
 
+def _as_latin1(exc: UnicodeError) -> tuple[str, int]:
+    """Codec error handler: a byte that Windows-1252 leaves undefined, read as Latin-1."""
+    if not isinstance(exc, UnicodeDecodeError):
+        raise exc
+    return exc.object[exc.start:exc.end].decode("latin-1"), exc.end
+
+
+_LATIN1_FALLBACK = "robotcell-latin1"
+codecs.register_error(_LATIN1_FALLBACK, _as_latin1)
+
+
 def decode_text(data: bytes, origin: str) -> str:
     """Decode the bytes of a text file by the rule of this module.
 
@@ -61,10 +72,7 @@ def decode_text(data: bytes, origin: str) -> str:
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
-        try:
-            text = data.decode("cp1252")
-        except UnicodeDecodeError:
-            text = data.decode("latin-1")
+        text = data.decode("cp1252", errors=_LATIN1_FALLBACK)
     if "\x00" in text:
         raise InputError(f"{origin}: not a text file (it holds NUL characters); save it as CSV "
                          "or YAML text")
