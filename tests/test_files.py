@@ -100,8 +100,8 @@ def test_misspelt_column_is_warned_on_stderr(tmp_path, capsys):
         rows.append(",".join(f"{v:.6f}" for v in [*p, *abc]) + ",tcp")
     f = tmp_path / "tcp.csv"
     f.write_text("\n".join(rows) + "\n")
-    code, out, err = run(capsys, "calibrate", "tcp", f)
-    assert code == 0
+    code, _, err = run(capsys, "calibrate", "tcp", f)
+    assert code in (0, 3)  # the warning comes whatever the verdict
     assert "warning:" in err and "'piont' (did you mean 'point'?) not used by this command" in err
 
 
@@ -188,7 +188,7 @@ def test_output_into_missing_folder_or_onto_folder_refused(tmp_path, capsys, joi
     assert re.search(r"^error: cannot write .*out.txt: the folder '.*nodir' does not exist", err)
     code, out, err = run(capsys, *args, "-o", tmp_path)
     assert code == 2 and "Traceback" not in out + err
-    assert re.search(r"^error: cannot write .*: it is a folder; give a file name", err, re.M)
+    assert re.search(r"^error: cannot write .*: it is a folder; give a file name", err, re.MULTILINE)
     assert sorted(tmp_path.iterdir()) == before
 
 
@@ -199,7 +199,7 @@ def test_output_written_atomically_with_permissions_kept(tmp_path, capsys, joint
     target = tmp_path / "out.txt"
     target.write_text("old")
     os.chmod(target, 0o640)
-    code, out, _ = run(capsys, *args, "-o", target)
+    code, _out, _ = run(capsys, *args, "-o", target)
     assert code == 0 and target.read_text() not in ("old", "")
     assert stat.S_IMODE(target.stat().st_mode) == 0o640
     assert not [q for q in tmp_path.iterdir() if q.name.endswith(".tmp")]
@@ -446,13 +446,13 @@ def test_usage_errors_say_error_in_lower_case_and_exit_2(capsys):
 
 
 def test_unreachable_pose_exits_2_with_error(capsys):
-    code, out, err = run(capsys, "ik", "kuka_kr16", "--pose", "1200,0,1500,0,90,0")
+    code, _out, err = run(capsys, "ik", "kuka_kr16", "--pose", "1200,0,1500,0,90,0")
     assert code == 2 and err.startswith("error: no valid solution") and "Error:" not in err
 
 
 def test_readme_ik_example_is_reachable(capsys):
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    commands = re.findall(r"^robotcell (ik kuka_kr16 --pose \S+.*)$", readme, re.M)
+    commands = re.findall(r"^robotcell (ik kuka_kr16 --pose \S+.*)$", readme, re.MULTILINE)
     assert commands
     for command in commands:
         code, out, _ = run(capsys, *command.split())
