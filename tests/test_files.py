@@ -472,3 +472,21 @@ def test_references_exist_and_no_citation_of_a_missing_file():
         if re.search(r"(?<![\w/])REFERENCES\.md|/work/shared", body) and p.name != "test_files.py":
             cited.append(p.name)
     assert cited == []
+
+
+def test_european_csv_gives_the_same_calibration(tmp_path, capsys):
+    table = _turntable_csv(tmp_path)
+    eu = tmp_path / "eu.csv"
+    eu.write_bytes(b"\xef\xbb\xbf" + table.read_text().replace(",", ";").replace(".", ",")
+                   .encode("utf-8"))
+    _, plain, _ = run(capsys, "calibrate", "turntable", table, "--json")
+    code, european, err = run(capsys, "calibrate", "turntable", eu, "--json")
+    assert code == 0 and "warning" not in err
+    assert json.loads(european)["matrix"] == json.loads(plain)["matrix"]
+
+
+def test_plan_refuses_a_missing_output_folder_before_any_work(tmp_path, capsys):
+    code, out, err = run(capsys, "plan", "turntable", "--cell", EXAMPLE, "--tool", "pointer",
+                         "-o", tmp_path / "nodir" / "touches.csv")
+    assert code == 2 and "the folder" in err and "does not exist" in err
+    assert "plan for" not in out  # refused before the designs were compared
