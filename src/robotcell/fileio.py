@@ -28,7 +28,9 @@ import codecs
 import os
 import shutil
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
 
 from robotcell.errors import InputError
 
@@ -134,11 +136,6 @@ def _new_file_mode() -> int:
     return 0o666 & ~mask
 
 
-def _replace(tmp: str, dst: Path, mode: int) -> None:
-    os.chmod(tmp, mode)
-    os.replace(tmp, dst)
-
-
 def _fsync_dir(directory: Path) -> None:
     try:
         fd = os.open(directory, os.O_RDONLY)
@@ -150,6 +147,28 @@ def _fsync_dir(directory: Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+def _atomic(dst: Path, write: Callable[[BinaryIO], object], mode: int, what: str) -> None:
+    """Write ``dst`` through a temporary file in its folder, then ``os.replace`` it over ``dst``."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
+    except OSError as exc:
+        raise InputError(f"{what}: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, dst)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"{what}: {exc.strerror or exc}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    _fsync_dir(dst.parent)
 
 
 def atomic_write(path: str | Path, content: str | bytes) -> None:
@@ -169,25 +188,9 @@ def atomic_write(path: str | Path, content: str | bytes) -> None:
         message names the file and the system's reason).
     """
     p = check_destination(path)
-    try:
-        mode = (p.stat().st_mode & 0o7777) if p.exists() else _new_file_mode()
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    except OSError as exc:
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    try:
-        data = content.encode("utf-8") if isinstance(content, str) else content
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        _replace(tmp, p, mode)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    _fsync_dir(p.parent)
+    data = content.encode("utf-8") if isinstance(content, str) else content
+    mode = (p.stat().st_mode & 0o7777) if p.exists() else _new_file_mode()
+    _atomic(p, lambda fh: fh.write(data), mode, f"cannot write {path}")
 
 
 def atomic_copy(src: str | Path, dst: str | Path) -> None:
@@ -199,20 +202,14 @@ def atomic_copy(src: str | Path, dst: str | Path) -> None:
         ``src`` cannot be read or ``dst`` cannot be written.
     """
     s, d = Path(src), check_destination(dst)
+    what = f"cannot copy {src} to {dst}"
     try:
         mode = s.stat().st_mode & 0o7777
-        fd, tmp = tempfile.mkstemp(prefix=f".{d.name}.", suffix=".tmp", dir=d.parent)
     except OSError as exc:
-        raise InputError(f"cannot copy {src} to {dst}: {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(fd, "wb") as out, s.open("rb") as inp:
-            shutil.copyfileobj(inp, out)
-            out.flush()
-            os.fsync(out.fileno())
-        _replace(tmp, d, mode)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"cannot copy {src} to {dst}: {exc.strerror or exc}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        raise InputError(f"{what}: {exc.strerror or exc}") from None
+
+    def copy(fh: BinaryIO) -> None:
+        with s.open("rb") as inp:
+            shutil.copyfileobj(inp, fh)
+
+    _atomic(d, copy, mode, what)
