@@ -290,8 +290,9 @@ def test_simulate_lengths_refused_in_millimetres(capsys, option, value, message)
 @pytest.mark.parametrize("procedure, option, value, message", [
     ("track", "--travel", "-100", "--travel must be a positive number of millimetres, got -100"),
     ("frame", "--size", "-5", "--size must be a positive number of millimetres, got -5"),
-    ("frame", "--repeats", "100000", "300000 touches asked for; a simulation places at most 200"),
+    ("frame", "--repeats", "100", "300 touches asked for; a simulation places at most 200"),
     ("tcp", "--seed", "-1", "Invalid value for '--seed'"),
+    ("turntable", "--touches", "1000000000000", "a simulation places at most 200 touches"),
 ])
 def test_simulate_design_options_refused(capsys, procedure, option, value, message):
     code, out, err = run(capsys, "simulate", procedure, "--cell", EXAMPLE, "--tool", "pointer",
@@ -490,3 +491,10 @@ def test_plan_refuses_a_missing_output_folder_before_any_work(tmp_path, capsys):
                          "-o", tmp_path / "nodir" / "touches.csv")
     assert code == 2 and "the folder" in err and "does not exist" in err
     assert "plan for" not in out  # refused before the designs were compared
+
+
+def test_plan_refuses_huge_counts_up_front(capsys):
+    code, out, err = run(capsys, "plan", "turntable", "--cell", EXAMPLE, "--tool", "pointer",
+                         "--touches", "1000000000000")
+    assert code == 2 and "a simulation places at most 200 touches" in err
+    assert "Traceback" not in out + err

@@ -37,7 +37,7 @@ from robotcell.ik import analytic_solver, arm_sides
 from robotcell.robot import Robot
 from robotcell.transforms import invert, make_pose, rot_z, transform_points
 
-__all__ = ["PROCEDURES", "Touches", "simulate"]
+__all__ = ["MAX_TOUCHES", "PROCEDURES", "Touches", "check_counts", "simulate"]
 
 #: Procedures that can be simulated, with what they calibrate.
 PROCEDURES = {
@@ -282,6 +282,20 @@ def _frame_name(cell: Cell, frame: str | None, parents: tuple[str, ...], what: s
         raise InputError(f"frame {frame!r} is carried by {cell.frames[frame].parent}; the {what} "
                          f"procedure touches frames carried by {' or '.join(parents)}")
     return frame
+
+
+def check_counts(design: dict[str, Any]) -> None:
+    """Refuse ``touches``, ``positions`` or ``repeats`` above :data:`MAX_TOUCHES` up front.
+
+    Raises
+    ------
+    InputError
+        A count that would place more touches than a simulation places.
+    """
+    for key in ("touches", "positions", "repeats"):
+        if isinstance(design.get(key), (int, np.integer)) and design[key] > MAX_TOUCHES:
+            raise InputError(f"{key} {design[key]}: a simulation places at most {MAX_TOUCHES} "
+                             "touches")
 
 
 def _check_noise(noise: float) -> float:
@@ -566,6 +580,7 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
     if procedure not in _SIMULATORS:
         raise InputError(f"unknown procedure {procedure!r}; choose from {', '.join(PROCEDURES)}")
     noise = _check_noise(noise)
+    check_counts(design)
     try:
         return _SIMULATORS[procedure](cell, _rng(seed), noise, tool, track, **design)
     except TypeError as exc:
