@@ -76,8 +76,8 @@ def decode_text(data: bytes, origin: str) -> str:
     except UnicodeDecodeError:
         text = data.decode("cp1252", errors=_LATIN1_FALLBACK)
     if "\x00" in text:
-        raise InputError(f"{origin}: not a text file (it holds NUL characters); save it as CSV "
-                         "or YAML text")
+        raise InputError(f"{origin}: not a text file (it holds NUL characters); give the text "
+                         "file (CSV, YAML, URDF, JSON), saved as UTF-8")
     return text
 
 
