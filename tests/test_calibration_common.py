@@ -18,11 +18,11 @@ from robotcell.calibration import (
 )
 from robotcell.calibration.measurements import (
     check_count,
-    check_no_repeats,
     external_axis,
     flange_poses,
     nominal_points,
     point_roles,
+    repeated_rows,
     tcp_positions,
 )
 
@@ -182,14 +182,27 @@ def test_measurement_refusals():
         tcp_positions({"u": np.ones(2)}, "m.csv")
     with pytest.raises(InputError, match="NaN"):
         tcp_positions({"x": np.array([np.nan, 900.0]), "y": np.ones(2), "z": np.ones(2)}, "m.csv")
-    with pytest.raises(InputError, match="line 2 and line 4 are identical"):
-        check_no_repeats(np.array([[1.0, 2.0], [3.0, 4.0], [1.0, 2.0]]), "m.csv")
-    with pytest.raises(InputError, match="2 points given, at least 3 needed"):
+    # Identical rows are data (averaged by the fit), and only earn a note.
+    note = ("m.csv: line 2, line 4 are identical; each is used as a measurement of its own (if "
+            "one is a copied line, delete it)")
+    assert repeated_rows(np.array([[1.0, 2.0], [3.0, 4.0], [1.0, 2.0]]), "m.csv") == [note]
+    assert repeated_rows(np.array([[1.0, 2.0], [3.0, 4.0]]), "m.csv") == []
+    with pytest.raises(InputError, match=r"m.csv: points: 2 given, at least 3 needed"):
         check_count(2, 3, "points", "m.csv")
-    with pytest.raises(InputError, match="looks like metres"):
-        external_axis({"e1": np.array([0.0, 0.5, 1.0])}, "m.csv", "track")
-    with pytest.raises(InputError, match="looks like radians"):
+    with pytest.raises(InputError, match=r"touches: 1 given, at least 3 needed"):
+        check_count(1, 3, "touches", "m.csv")
+    # Track positions below 5 are a short travel, not a unit: e1 in metres shows as a scale of
+    # about 1000, which the track calibration refuses.
+    np.testing.assert_allclose(external_axis({"e1": np.array([0.0, 1.0, 2.0, 3.0])}, "m.csv",
+                                             "track"), [0, 1e-3, 2e-3, 3e-3])
+    with pytest.raises(InputError, match=r"looks like radians; the CSV must be in degrees "
+                       r"\(multiply radians by 57.2958\)\. In degrees these touches would span "
+                       r"only 3\.10 deg of table rotation; spread them over 90 degrees or more"):
         external_axis({"e1": np.array([0.0, 1.5, 3.1])}, "m.csv", "table")
+    with pytest.raises(InputError, match=r"looks like radians; the CSV must be in degrees "
+                       r"\(multiply radians by 57.2958\)$"):
+        external_axis({"e1": np.array([0.0, 1.5708, 3.1416])}, "m.csv", "workpiece")
+    np.testing.assert_allclose(external_axis({"e1": np.zeros(3)}, "m.csv", "workpiece"), 0)
     np.testing.assert_allclose(external_axis({"e1": np.array([0.0, 90.0])}, "m.csv", "table"),
                                [0, np.pi / 2])
     np.testing.assert_allclose(external_axis({"e1": np.array([0.0, 900.0])}, "m.csv", "track"),

@@ -172,12 +172,9 @@ def test_refusals():
     f = cell.touches(REF, E)
     with pytest.raises(InputError, match="at least 3 needed"):
         calibrate_track(E[:2], f[:2])
-    e = E.copy()
-    e[2] = e[1] + 0.001
-    with pytest.raises(IllPosedError, match="touches 2 and 3 .* too close track positions"):
-        calibrate_track(e, cell.touches(REF, e))
-    e = np.array([1.0, 1.01, 1.02, 1.03])
-    with pytest.raises(IllPosedError, match="nearly the same track position"):
+    e = np.full(4, 1.0)
+    with pytest.raises(IllPosedError, match=r"all 4 touches are at the same track position "
+                       r"\(1000.000 mm\), so the track direction and scale are not determined"):
         calibrate_track(e, cell.touches(REF, e))
     with pytest.raises(InputError, match="not in the track's length unit"):
         calibrate_track(E * 1e3, f)  # track values in mm passed as metres

@@ -56,13 +56,60 @@ def test_round_trip_every_format_batched(fmt):
 
 
 def test_abb_quaternion_is_canonical_and_normalised():
-    q = pose_to_vendor(pose_from_vendor([0, 0, 0, 0, 0, 0, 1], "abb"), "abb")[3:]
-    assert q[0] >= 0 and np.isclose(np.linalg.norm(q), 1.0)
+    """Quaternions with a negative scalar part come back as their positive equivalent."""
+    rng = np.random.default_rng(4)
+    q_in = rng.normal(size=(500, 4))
+    q_in /= np.linalg.norm(q_in, axis=1, keepdims=True)
+    q_in[:, 0] = -np.abs(q_in[:, 0])  # every input has w < 0
+    v = np.column_stack([np.zeros((500, 3)), q_in])
+    q = pose_to_vendor(pose_from_vendor(v, "abb"), "abb")[:, 3:]
+    assert np.all(q[:, 0] > 0)
+    np.testing.assert_allclose(q, -q_in, atol=1e-15)  # the same rotation, sign flipped
+    np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-15)
 
 
 def test_euler_gimbal_lock_is_still_exact():
     T = pose_from_vendor([0, 0, 0, 40, 90, 10], "kuka")
     np.testing.assert_allclose(pose_from_vendor(pose_to_vendor(T, "kuka"), "kuka"), T, atol=1e-12)
+
+
+def rotation_error(T1: np.ndarray, T2: np.ndarray) -> np.ndarray:
+    """Angle (rad) of the rotation between the orientations of two batches of poses."""
+    return Rotation.from_matrix(np.swapaxes(T1[..., :3, :3], -1, -2) @ T2[..., :3, :3]).magnitude()
+
+
+@pytest.mark.parametrize("fmt", ["kuka", "fanuc", "yaskawa", "staubli"])
+def test_euler_exact_next_to_gimbal_lock(fmt):
+    """Middle angle within 1e-5 .. 1e-12 deg of +-90 deg: the round trip is exact to 1e-12 rad
+    (scipy alone takes its gimbal-lock branch there, sets the third angle to 0 and misses the
+    rotation by up to 1.75e-7 rad)."""
+    f = FORMATS[fmt]
+    rng = np.random.default_rng(sum(map(ord, fmt)))
+    n = 4000
+    v = np.column_stack([rng.uniform(-500, 500, (n, 3)), rng.uniform(-180, 180, (n, 3))])
+    mid = 3 + f.angle_order[1]  # the vendor's middle angle (B, P, Ry)
+    off = 10.0 ** rng.uniform(-12, -5, n)
+    v[:, mid] = rng.choice([-1.0, 1.0], n) * (90.0 - off)
+    T = pose_from_vendor(v, fmt)
+    out = pose_to_vendor(T, fmt)
+    assert np.all(np.abs(out[:, mid]) <= 90.0)
+    assert rotation_error(T, pose_from_vendor(out, fmt)).max() < 1e-12
+    # Away from the lock the angles themselves come back.
+    v[:, mid] = rng.uniform(-89, 89, n)
+    np.testing.assert_allclose(pose_to_vendor(pose_from_vendor(v, fmt), fmt), v, atol=1e-9)
+
+
+@pytest.mark.parametrize("fmt", ["abb", "ur"])
+def test_quaternion_and_rotation_vector_exact(fmt):
+    """Rotations near the identity, near 180 deg and about the axes: round trip to 1e-12 rad."""
+    rng = np.random.default_rng(8)
+    axis = rng.normal(size=(3000, 3))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    angle = np.concatenate([10.0 ** rng.uniform(-12, 0, 1000), np.pi - 10.0 ** rng.uniform(-12, 0, 1000),
+                            rng.uniform(0, np.pi, 1000)])
+    T = np.tile(np.eye(4), (3000, 1, 1))
+    T[:, :3, :3] = Rotation.from_rotvec(axis * angle[:, None]).as_matrix()
+    assert rotation_error(T, pose_from_vendor(pose_to_vendor(T, fmt), fmt)).max() < 1e-12
 
 
 def test_errors():

@@ -1,25 +1,48 @@
 """robotcell: kinematics and calibration of industrial robot cells.
 
 Conventions (pose naming ``T_a_b``, units, array shapes) are in ``docs/conventions.md``.
+
+The public names below are imported on first use (PEP 562), so ``import robotcell`` and the
+command line's ``--version`` and ``--help`` do not pay for numpy and scipy.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from robotcell.errors import IllPosedError, InputError, RobotcellError
-from robotcell.modelfile import list_robots, load_robot, robot_from_dict, save_robot
-from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
-from robotcell.robot import Joint, Robot
-from robotcell.transforms import (
-    check_pose,
-    compose,
-    invert,
-    make_pose,
-    rot_x,
-    rot_y,
-    rot_z,
-    transform_points,
-    validate_pose,
-)
+
+if TYPE_CHECKING:
+    from robotcell.modelfile import list_robots, load_robot, robot_from_dict, save_robot
+    from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
+    from robotcell.robot import Joint, Robot
+    from robotcell.transforms import (
+        check_pose,
+        compose,
+        invert,
+        make_pose,
+        rot_x,
+        rot_y,
+        rot_z,
+        transform_points,
+        validate_pose,
+    )
 
 __version__ = "0.1.0"
+
+#: public name -> module that defines it, imported on first access
+_LAZY = {
+    **dict.fromkeys(["list_robots", "load_robot", "robot_from_dict", "save_robot"],
+                    "robotcell.modelfile"),
+    **dict.fromkeys(["FORMATS", "pose_from_vendor", "pose_to_vendor"], "robotcell.poseformats"),
+    **dict.fromkeys(["Joint", "Robot"], "robotcell.robot"),
+    **dict.fromkeys(["check_pose", "compose", "invert", "make_pose", "rot_x", "rot_y", "rot_z",
+                     "transform_points", "validate_pose"], "robotcell.transforms"),
+}
+#: Submodules that ``import robotcell`` used to load as a side effect, still reachable as
+#: attributes (``robotcell.transforms``) and loaded on first access.
+_SUBMODULES = {"dh", "modelfile", "poseformats", "robot", "transforms"}
 
 __all__ = [
     "FORMATS",
@@ -44,3 +67,18 @@ __all__ = [
     "transform_points",
     "validate_pose",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name from its module on first access (PEP 562)."""
+    if name in _SUBMODULES:
+        return importlib.import_module(f"robotcell.{name}")
+    if name not in _LAZY:
+        raise AttributeError(f"module 'robotcell' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

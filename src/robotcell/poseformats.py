@@ -84,6 +84,54 @@ def _format(fmt: str) -> PoseFormat:
         ) from None
 
 
+#: Below this cosine of the middle angle scipy's Euler angles are replaced (see :func:`_euler`).
+NEAR_LOCK = 1e-6
+
+
+def _euler(rot: Rotation, R: NDArray[np.float64], seq: str) -> NDArray[np.float64]:
+    """Intrinsic Tait-Bryan angles ``(a, b, c)`` (rad) of ``seq`` that reproduce ``R`` to rounding.
+
+    Within about 1e-7 rad of gimbal lock scipy sets the third angle to 0 and gives the first the
+    whole rotation about the locked axis, which misses the rotation by up to that distance. There
+    (``cos b < NEAR_LOCK``) the third angle is taken from the first axis's row of ``R``,
+    ``R[i, i] = cos b cos c``, ``R[i, j] = +-cos b sin c`` (absolute rounding 1e-16, so ``c``
+    is determined to 1e-16 / cos b), and the first angle from the rest of the rotation,
+    ``R_i(a) = R R_k(-c) R_j(-b)``, so that the three angles reproduce ``R`` to rounding. At exact
+    lock (both entries below 1e-15) the third angle stays scipy's 0.
+
+    Parameters
+    ----------
+    rot : Rotation
+        The rotations, ``N`` of them.
+    R : ndarray, shape (N, 3, 3)
+        The same rotations as matrices.
+    seq : str
+        Intrinsic scipy sequence of three distinct axes (``"ZYX"``, ``"XYZ"``).
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+    """
+    with warnings.catch_warnings():
+        # At gimbal lock scipy warns that the third angle is set to zero; handled below.
+        warnings.simplefilter("ignore", UserWarning)
+        e = rot.as_euler(seq)
+    near = np.flatnonzero(np.cos(e[:, 1]) < NEAR_LOCK)
+    if near.size == 0:
+        return e
+    i, j = ("XYZ".index(seq[0]), "XYZ".index(seq[1]))
+    # Sign of R[i, j] relative to cos b sin c for this sequence (right- or left-handed order).
+    sign = -1.0 if (j - i) % 3 == 1 else 1.0
+    Rn = R[near]
+    ci, cj = Rn[:, i, i], sign * Rn[:, i, j]
+    locked = np.hypot(ci, cj) < 1e-15
+    c = np.where(locked, e[near, 2], np.arctan2(cj, ci))
+    rest = Rotation.from_matrix(Rn) * Rotation.from_euler(seq[1:], np.column_stack([e[near, 1], c])).inv()
+    e[near, 0] = rest.as_euler(seq)[:, 0]  # a rotation about axis i: its middle angle is ~0
+    e[near, 2] = c
+    return e
+
+
 def pose_from_vendor(values: ArrayLike, fmt: str) -> NDArray[np.float64]:
     """Convert poses written in a vendor format to 4x4 matrices.
 
@@ -163,13 +211,12 @@ def pose_to_vendor(T: ArrayLike, fmt: str) -> NDArray[np.float64]:
     elif f.name == "ur":
         ang = rot.as_rotvec()
     else:
-        with warnings.catch_warnings():
-            # At gimbal lock scipy sets the third angle to zero and warns; the rotation is still
-            # exact and the convention is documented in docs/conventions.md.
-            warnings.simplefilter("ignore", UserWarning)
-            e = rot.as_euler(f.euler, degrees=True)
+        e = np.degrees(_euler(rot, flat[:, :3, :3], f.euler))
         ang = np.empty_like(e)
         ang[:, list(f.angle_order)] = e
     out = np.concatenate([flat[:, :3, 3] / f.length_scale, ang], axis=1)
-    out[np.abs(out) < 1e-12] = 0.0  # no "-0.0" in printed values
+    # No "-0.0" in printed values; quaternion and rotation-vector parts only below 1e-15, so that
+    # the orientation stays exact to 1e-12 rad.
+    tiny = np.where(np.arange(f.size) < 3, 1e-12, 1e-15 if f.euler is None else 1e-12)
+    out[np.abs(out) < tiny] = 0.0
     return out.reshape(batch + (f.size,))

@@ -1,32 +1,33 @@
-"""HTML reports of calibration results, with PNG figures.
+"""HTML reports of calibration results: one self-contained page, its figures embedded.
 
 A report is made from the JSON a calibration writes (``robotcell calibrate ... --json``, or
 ``CalibrationResult.to_json()``), so it can be produced later and elsewhere. It shows, at a glance,
 whether the calibration is good (a verdict with its reasons), the result, the 1-sigma
 uncertainties, residuals per touch, and a 3D view of the measured points with their residual
-vectors magnified. matplotlib is imported only here, and only when a report is written.
+vectors magnified. The figures are PNG images embedded in the page (``data:`` URIs), so the
+HTML file alone is the whole report: it can be mailed or copied anywhere. matplotlib is imported
+only here, and only when a report is written.
 """
 
 from __future__ import annotations
 
+import base64
 import html
+import io
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
+from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
 from robotcell.fileio import atomic_write, read_text
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
-
-#: Condition numbers up to this are a good measurement design (Schroer, as cited by Nahvi and
-#: Hollerbach, ICRA 1996).
-CONDITION_GOOD = 100.0
-#: Above this the result is not trustworthy.
-CONDITION_POOR = 1000.0
 
 _REQUIRED = ("procedure", "residuals_mm", "rms_mm", "max_mm", "warnings")
 
@@ -104,9 +105,8 @@ def _malformed(data: dict[str, Any]) -> str | None:
 def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
     """Grade a result: ``"good"``, ``"check"`` or ``"poor"``, with the reasons.
 
-    ``poor``: condition number above :data:`CONDITION_POOR` or a touch flagged as an outlier.
-    ``check``: any other warning, a condition number above :data:`CONDITION_GOOD`, or unknown
-    uncertainty (no redundant touches and no prior noise). ``good`` otherwise.
+    The same rule as the terminal report and ``--json``:
+    :func:`robotcell.calibration.verdict.verdict` (see ``docs/calibration.md``, "Verdict").
 
     Parameters
     ----------
@@ -118,43 +118,51 @@ def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
     grade : str
     reasons : list of str
     """
-    reasons: list[str] = []
-    grade = "good"
-    cond = result.get("condition")
-    warnings = list(result.get("warnings", []))
-    if cond is not None and cond > CONDITION_POOR:
-        grade = "poor"
-        reasons.append(f"condition number {cond:.0f} > {CONDITION_POOR:.0f}: the touches do not "
-                       "determine the result")
-    if any("outlier" in w for w in warnings):
-        grade = "poor"
-        reasons.append("a touch is an outlier: re-touch it")
-    if grade != "poor":
-        if cond is not None and cond > CONDITION_GOOD:
-            grade = "check"
-            reasons.append(f"condition number {cond:.0f} > {CONDITION_GOOD:.0f}: spread the touches")
-        if warnings:
-            grade = "check"
-            reasons.append(f"{len(warnings)} warning(s), listed below")
-        if result.get("noise_source") == "none":
-            grade = "check"
-            reasons.append("no redundant touches: the uncertainty is unknown")
-    if grade == "good":
-        reasons.append(f"RMS {result['rms_mm']:.3f} mm, max {result['max_mm']:.3f} mm, "
-                       f"condition {cond:.0f}" if cond is not None else "no warnings")
-    return grade, reasons
+    v = judge(result)
+    return v.level, v.reasons
 
 
-def _frames(result: dict[str, Any]) -> list[tuple[str, np.ndarray]]:
-    """Poses the result contains, as (label, 4x4 with translation in mm)."""
-    out = []
-    if isinstance(result.get("matrix"), list):
-        out.append((result["procedure"], np.array(result["matrix"], dtype=float)))
-    out.append(("robot base", np.eye(4)))
-    return out
+#: Names of the frames of docs/conventions.md, for figure labels.
+_FRAME_NAMES = {"R": "robot base R", "world": "world", "L": "track L", "B": "turntable B",
+                "F": "flange F", "W": "workpiece W", "TCP": "TCP"}
+#: A key of a result's pose ``T_a_b`` (its sigma or covariance), giving frames a and b.
+_POSE_KEY = re.compile(r"T_(R|world|L|B|F)_(\w+?)_(?:position_mm|rotation_deg|covariance_mm_rad)")
 
 
-def _figure_view(result: dict[str, Any], path: Path) -> None:
+def _frames(result: dict[str, Any]) -> tuple[str, list[tuple[str, np.ndarray]]]:
+    """The frame the measured points are in, and the poses to draw in it.
+
+    The result's ``matrix`` is the pose ``T_a_b`` its key names (e.g. ``T_world_B_position_mm``):
+    the figure is drawn in frame a, with frame a at the origin and frame b at ``matrix``. A tool
+    on the flange (``T_F_TCP``) and a result without ``matrix`` (the track) have their points in
+    the robot base, where there is no pose of theirs to draw.
+
+    Returns
+    -------
+    name : str
+        Name of the frame of the figure, e.g. ``"world"``.
+    frames : list of (str, ndarray of shape (4, 4))
+        Label and pose (translation in mm) of each frame to draw.
+    """
+    keys = [*result, *(result.get("sigma") or {})]
+    match = next((m for m in map(_POSE_KEY.fullmatch, keys) if m), None)
+    if match is None or match[1] == "F" or not isinstance(result.get("matrix"), list):
+        return _FRAME_NAMES["R"], [(_FRAME_NAMES["R"], np.eye(4))]
+    a, b = _FRAME_NAMES[match[1]], _FRAME_NAMES.get(match[2], match[2])
+    return a, [(a, np.eye(4)), (b, np.array(result["matrix"], dtype=float))]
+
+
+def _png(fig: Any) -> str:
+    """A matplotlib figure as a ``data:image/png;base64,...`` URI; the figure is closed."""
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _figure_view(result: dict[str, Any]) -> str:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -169,7 +177,7 @@ def _figure_view(result: dict[str, Any], path: Path) -> None:
         anchor = np.array(pts, dtype=float).reshape(-1, 3)
     elif result.get("pivot_mm") is not None:
         anchor = np.repeat(np.array(result["pivot_mm"], dtype=float)[None], len(res), axis=0)
-    frames = _frames(result)
+    where, frames = _frames(result)
     cloud = [T[:3, 3] for _, T in frames]
     if anchor is not None:
         cloud += list(anchor)
@@ -192,16 +200,15 @@ def _figure_view(result: dict[str, Any], path: Path) -> None:
     ax.set_xlabel("X [mm]")
     ax.set_ylabel("Y [mm]")
     ax.set_zlabel("Z [mm]")
-    title = "Frames and measured points (robot base, mm)"
+    title = f"Frames and measured points (in {where}, mm)"
     if gain is not None:
         title += f"\nresidual vectors magnified {gain:.0f}x"
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return _png(fig)
 
 
-def _figure_residuals(result: dict[str, Any], path: Path) -> None:
+def _figure_residuals(result: dict[str, Any]) -> str:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -224,13 +231,16 @@ def _figure_residuals(result: dict[str, Any], path: Path) -> None:
     ax.set_title("Residual per touch (measured - model)", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return _png(fig)
 
 
 def _fmt(v: Any) -> str:
     if isinstance(v, float):
-        return "n/a" if not math.isfinite(v) else f"{v:.4f}"
+        if not math.isfinite(v):
+            return "n/a"
+        # Four decimals for everyday magnitudes; significant digits for tiny or huge ones (a
+        # covariance in rad^2, a sigma of 1e-7), which four decimals would show as 0.0000.
+        return f"{v:.4f}" if v == 0 or 1e-3 <= abs(v) < 1e7 else f"{v:.4g}"
     if isinstance(v, list):
         if v and isinstance(v[0], list):
             return "<br>".join(_fmt(row) for row in v)
@@ -240,8 +250,12 @@ def _fmt(v: Any) -> str:
     return html.escape(str(v))
 
 
+#: Units of the fields whose name does not end with one.
+_UNITS = {"_covariance_mm_rad": "6x6 over the origin x, y, z (mm) and the rotation vector rx, ry, rz "
+                                "(rad): entries in mm², mm·rad, rad²"}
+
 _SKIP = {"procedure", "residuals_mm", "residuals_xyz_mm", "labels", "points_mm", "warnings",
-         "undetermined", "next_step", "sigma"}
+         "undetermined", "next_step", "sigma", "verdict"}
 
 _CSS = """
 body { font-family: sans-serif; max-width: 960px; margin: 2em auto; color: #222; }
@@ -263,30 +277,33 @@ window.addEventListener('load', function () {
 
 
 def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
-    """Write an HTML report and its PNG figures next to it.
+    """Write an HTML report: one self-contained file, its figures embedded as PNG data URIs.
 
     Parameters
     ----------
     result : dict
         A calibration result as JSON (mm, deg), e.g. from :func:`load_result`.
     path : str or Path
-        The HTML file to write; figures are written beside it as ``<stem>_view.png`` and
-        ``<stem>_residuals.png``.
+        The HTML file to write. Nothing else is written beside it.
 
     Returns
     -------
     list of Path
-        The files written: the HTML page first, then the figures.
+        The files written: the HTML page.
     """
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    view = out.with_name(out.stem + "_view.png")
-    resid = out.with_name(out.stem + "_residuals.png")
-    _figure_view(result, view)
-    _figure_residuals(result, resid)
+    where = _frames(result)[0]
+    view = _figure_view(result)
+    resid = _figure_residuals(result)
     grade, reasons = verdict(result)
     proc = html.escape(str(result["procedure"]))
-    rows = "".join(f"<tr><th>{html.escape(k)}</th><td>{_fmt(v)}</td></tr>"
+
+    def head(key: str) -> str:
+        units = [u for suffix, u in _UNITS.items() if key.endswith(suffix)]
+        return html.escape(key) + "".join(f"<br><small>{html.escape(u)}</small>" for u in units)
+
+    rows = "".join(f"<tr><th>{head(k)}</th><td>{_fmt(v)}</td></tr>"
                    for k, v in result.items() if k not in _SKIP)
     sig = "".join(f"<tr><th>{html.escape(k)}</th><td>{_fmt(v)}</td></tr>"
                   for k, v in (result.get("sigma") or {}).items())
@@ -311,11 +328,12 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
 <h2>Not determined by the measurements</h2>{items('undetermined')}
 <h2>Warnings</h2>{items('warnings')}
 <h2>Figures</h2>
-<img src="{view.name}" alt="3D view of frames and measured points">
-<img src="{resid.name}" alt="residual per touch">
+<figure><img src="{view}" alt="3D view of frames and measured points">
+<figcaption>Frames and measured points in the {html.escape(where)} frame (mm).</figcaption></figure>
+<figure><img src="{resid}" alt="residual per touch"></figure>
 <h2>Residuals per touch (mm)</h2>
 <table><tr><th>touch</th><th>|residual|</th><th>x, y, z</th></tr>{touches}</table>
 </body></html>
 """
     atomic_write(out, page)
-    return [out, view, resid]
+    return [out]

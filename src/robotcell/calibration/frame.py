@@ -29,10 +29,12 @@ __all__ = ["external_tcp", "frame_3point", "frame_npoint"]
 MIN_X_DISTANCE = 0.010
 #: Below this distance (m) from origin to the +X touch a warning recommends spreading further.
 GOOD_X_DISTANCE = 0.100
-#: Sine of the angle between the +X line and the XY-plane touch below which the points count as
-#: collinear (about 1 degree) ...
-COLLINEAR_SIN = 0.02
-#: ... and below which they count as nearly collinear (about 10 degrees), with a warning.
+#: Sine of the angle between the +X line and the XY-plane touch (3-point), or ratio of the second
+#: to the first singular value of the centred nominal points (N-point), below which the points
+#: are collinear to rounding: the rotation about the line is then not determined and refused ...
+COLLINEAR_SIN = 1e-9
+#: ... and below which they count as nearly collinear (about 10 degrees), with a warning; the
+#: condition number and the verdict say how much that costs.
 NEAR_COLLINEAR_SIN = 0.17
 
 
@@ -64,9 +66,9 @@ def _check_roles(p: NDArray[np.float64], roles: list[str]) -> None:
     sin = np.linalg.norm(np.cross(x / lx, xy)) / max(np.linalg.norm(xy), 1e-12)
     if sin < COLLINEAR_SIN:
         raise IllPosedError(
-            f"the origin, +X and XY-plane touches are collinear (the XY touch is "
-            f"{np.degrees(np.arcsin(min(sin, 1.0))):.2f} deg off the X line), so the rotation about "
-            "X is not determined; touch the XY-plane point well away from the X axis, ideally near +Y")
+            "the origin, +X and XY-plane touches are collinear (the XY touch lies on the X line), "
+            "so the rotation about X is not determined; touch the XY-plane point well away from "
+            "the X axis, ideally near +Y")
 
 
 def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | None):
@@ -220,12 +222,12 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
     if q.shape != p.shape:
         raise InputError(f"{len(q)} nominal points for {len(p)} touched points")
     if len(p) < 3:
-        raise IllPosedError(f"{len(p)} points given; a best-fit frame needs at least 3 points that "
+        raise IllPosedError(f"points: {len(p)} given; a best-fit frame needs at least 3 points that "
                             "are not on one line (4 or more give a check of the fit)")
     s = np.linalg.svd(q - q.mean(axis=0), compute_uv=False)
     if s[0] == 0 or s[1] / s[0] < COLLINEAR_SIN:
-        raise IllPosedError("the nominal points are collinear, so the rotation about their line is not "
-                            "determined; add points well away from that line")
+        raise IllPosedError("the nominal points are collinear (all on one line), so the rotation "
+                            "about their line is not determined; add points well away from that line")
     labs = _labels(len(p), labels)
     T0 = kabsch(q, p)
     R0 = T0[:3, :3]
@@ -241,8 +243,9 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
     T[:3, 3] = res.x[:3]
     warnings = []
     if s[1] / s[0] < NEAR_COLLINEAR_SIN:
-        warnings.append("the nominal points are nearly collinear: the rotation about their line is "
-                        "poorly determined; add points away from that line")
+        warnings.append(f"the nominal points are nearly collinear (they spread {s[1] / s[0]:.1%} "
+                        "as much across their best-fit line as along it): the rotation about that "
+                        "line is poorly determined; add points away from that line")
     return _common("frame-npoint", "T_R_W", T, res, labs, warnings,
                    "enter matrix/xyzabc as the base (user frame); touch one more known point and check "
                    "that transform_points(T_R_W, nominal) matches it within the residual RMS",
@@ -285,7 +288,7 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
         raise InputError(f"external TCP touches must have role tcp, x or xy; found {', '.join(bad)}")
     n_tcp = roles.count("tcp")
     if n_tcp < 3:
-        raise IllPosedError(f"{n_tcp} touches of the fixed TCP given; touch it at least 3 times "
+        raise IllPosedError(f"touches of the fixed TCP: {n_tcp} given; touch it at least 3 times "
                             "(4 recommended) with the reference tool from different directions")
     labs = _labels(len(p), labels, roles)
     next_step = ("enter matrix/xyzabc as the external tool (KUKA: fixed tool as BASE, ABB: stationary "

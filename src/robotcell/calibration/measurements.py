@@ -33,12 +33,12 @@ from robotcell.robot import Robot
 __all__ = [
     "MM_LOOKS_LIKE_M",
     "check_count",
-    "check_no_repeats",
-    "external_axis",
+        "external_axis",
     "flange_poses",
     "joint_columns",
     "nominal_points",
     "point_roles",
+    "repeated_rows",
     "tcp_positions",
     "track_column",
 ]
@@ -94,17 +94,19 @@ def check_count(n: int, minimum: int, what: str, source: str) -> None:
     minimum : int
         Smallest number the procedure can use.
     what : str
-        What one measurement is, for the message (e.g. ``"touches of the reference point"``).
+        What the measurements are, plural, for the message (e.g. ``"touches of the reference
+        point"``); the message reads ``"<source>: <what>: <n> given, at least <minimum> needed"``.
     source : str
         File name or description, prefixed to the message.
     """
     if n < minimum:
-        raise InputError(f"{source}: {n} {what} given, at least {minimum} needed "
+        raise InputError(f"{source}: {what}: {n} given, at least {minimum} needed "
                          f"(more than {minimum} give a redundancy check and uncertainties)")
 
 
-def check_no_repeats(rows: NDArray[np.float64], source: str, labels: Sequence[str] | None = None) -> None:
-    """Refuse identical measurement rows (a copied line, or a touch recorded twice unchanged).
+def repeated_rows(rows: NDArray[np.float64], source: str,
+                  labels: Sequence[str] | None = None) -> list[str]:
+    """Notes on identical measurement rows: repeated touches are data, averaged by the fit.
 
     Parameters
     ----------
@@ -114,17 +116,19 @@ def check_no_repeats(rows: NDArray[np.float64], source: str, labels: Sequence[st
         File name or description.
     labels : sequence of str, optional
         Name of each row for the message; defaults to CSV line numbers (header is line 1).
+
+    Returns
+    -------
+    list of str
+        One note per group of identical rows (empty when every row differs).
     """
     names = labels if labels is not None else [f"line {i + 2}" for i in range(len(rows))]
-    seen: dict[bytes, int] = {}
+    groups: dict[bytes, list[int]] = {}
     for i, r in enumerate(np.asarray(rows, dtype=float)):
-        key = np.round(r, 9).tobytes()
-        if key in seen:
-            raise InputError(
-                f"{source}: {names[seen[key]]} and {names[i]} are identical; every touch must be a "
-                "separate approach to the point (a copied line adds no information)"
-            )
-        seen[key] = i
+        groups.setdefault((np.round(r, 9) + 0.0).tobytes(), []).append(i)
+    return [f"{source}: {', '.join(names[i] for i in g)} are identical; each is used as a "
+            "measurement of its own (if one is a copied line, delete it)"
+            for g in groups.values() if len(g) > 1]
 
 
 def joint_columns(cols: Columns, robot: Robot, source: str) -> NDArray[np.float64]:
@@ -217,30 +221,32 @@ def external_axis(cols: Columns, source: str, kind: str) -> NDArray[np.float64]:
     ----------
     cols : mapping
     source : str
-    kind : {"track", "table"}
-        ``"track"``: millimetres, refused when every value is below
-        :data:`MM_LOOKS_LIKE_M` (metres by mistake). ``"table"``: degrees, refused when every
-        value lies within one radian-sized turn (|e1| <= 2 pi, radians by mistake, or touches too
-        close together to use either way).
+    kind : {"track", "table", "workpiece"}
+        ``"track"``: millimetres (a track position in metres by mistake shows as a scale of
+        about 1000, which the track calibration refuses). ``"table"``: degrees, refused when every
+        value lies within +-2 pi (+-6.28): radians by mistake (in degrees such touches would span
+        less than 6.28 deg, far below the 90 deg a table axis needs). ``"workpiece"``: degrees,
+        refused likewise when every value lies within +-6.28 and one is not 0 (all touches at
+        table angle 0 are a valid workpiece calibration).
 
     Returns
     -------
     ndarray, shape (N,)
-        Metres (track) or radians (table).
+        Metres (track) or radians (table, workpiece).
     """
     e = _numeric(cols, ("e1",), source)[:, 0]
     if kind == "track":
-        _check_mm(e, "e1 (track position)", source)
         return e * 1e-3
-    if kind == "table":
-        if np.max(np.abs(e)) <= 2 * np.pi:
+    if kind in ("table", "workpiece"):
+        small = e.size and np.max(np.abs(e)) <= 2 * np.pi
+        if small and (kind == "table" or np.any(e != 0)):
+            tail = (f". In degrees these touches would span only {np.ptp(e):.2f} deg of table "
+                    "rotation; spread them over 90 degrees or more" if kind == "table" else "")
             raise InputError(
                 f"{source}: every e1 (table angle) value is within +-6.28, which looks like radians; "
-                "the CSV must be in degrees. If these are degrees, the touches are too close "
-                "together: spread them over at least 90 degrees of table rotation"
-            )
+                f"the CSV must be in degrees (multiply radians by 57.2958){tail}")
         return np.radians(e)
-    raise InputError(f"external axis kind must be 'track' or 'table', got {kind!r}")
+    raise InputError(f"external axis kind must be 'track', 'table' or 'workpiece', got {kind!r}")
 
 
 def point_roles(cols: Columns, source: str) -> list[str]:

@@ -15,15 +15,22 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.tables import format_table
+from robotcell.calibration.verdict import (
+    CONDITION_GOOD,
+    CONDITION_POOR,
+    Verdict,
+    format_condition,
+)
+from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
 from robotcell.poseformats import pose_to_vendor
+from robotcell.tables import format_table
 
 __all__ = ["CalibrationResult", "pose_fields", "to_jsonable"]
 
 #: Conditioning figure above which a result is flagged: Schroer's threshold of about 100 for
 #: a trustworthy identification, as cited by Nahvi and Hollerbach (ICRA 1996).
-CONDITION_LIMIT = 100.0
+CONDITION_LIMIT = CONDITION_GOOD
 
 
 def to_jsonable(value: Any) -> Any:
@@ -270,7 +277,8 @@ class CalibrationResult:
             ``noise_sigma_mm`` and ``noise_source``, ``sigma`` (1-sigma of each estimated
             quantity, keys with units), ``undetermined``, ``warnings``, ``next_step``,
             ``points_mm`` (N x 3, when the procedure records its measured points), then the
-            procedure's own fields (``json_fields``).
+            procedure's own fields (``json_fields``), and ``verdict`` (level, reasons, the
+            condition number and the chi-square figures it used; see :attr:`verdict`).
         """
         out: dict[str, Any] = {
             "procedure": self.procedure,
@@ -291,7 +299,15 @@ class CalibrationResult:
         if self.points is not None:
             out["points_mm"] = np.asarray(self.points, dtype=float).reshape(-1, 3) * 1e3
         out.update(self.json_fields)
-        return to_jsonable(out)
+        out = to_jsonable(out)
+        out["verdict"] = judge(out).to_json()
+        return out
+
+    @property
+    def verdict(self) -> Verdict:
+        """The verdict (good / check / poor, and why): :func:`robotcell.calibration.verdict.verdict`
+        on :meth:`to_json`, so the terminal, the JSON and the HTML report agree."""
+        return judge(self.to_json())
 
     def _value_lines(self) -> list[str]:
         lines = []
@@ -323,7 +339,8 @@ class CalibrationResult:
         -------
         str
             The estimate with 1-sigma uncertainties, a table of residuals per measurement, RMS,
-            max, conditioning, undetermined quantities, warnings and the next step.
+            max, conditioning, undetermined quantities, warnings, the next step and, last, the
+            one-line verdict (``verdict: GOOD|CHECK|POOR: why``).
         """
         r = self.residuals * 1e3
         rows = [[lab, float(a), float(b), float(c), float(n)]
@@ -337,7 +354,7 @@ class CalibrationResult:
                      "calibration (no redundant touches here)")
         else:
             noise = "unknown (no redundant measurements and no --sigma given)"
-        cond = "good" if self.condition <= CONDITION_LIMIT else "poor"
+        v = self.verdict
         lines = [f"calibration: {self.procedure}", "", "result:"]
         lines += self._value_lines()
         lines += ["", "residuals (measured - model, mm):",
@@ -345,7 +362,8 @@ class CalibrationResult:
                   (f"RMS {self.rms * 1e3:.3f} mm, max {self.max * 1e3:.3f} mm "
                    f"over {len(r)} measurements, redundancy {self.dof}"),
                   f"measurement noise: {noise}",
-                  f"condition number: {self.condition:.1f} ({cond}; below {CONDITION_LIMIT:.0f} is good)"]
+                  (f"condition number: {format_condition(v.condition)} (below "
+                   f"{CONDITION_GOOD:.0f} is good, above {CONDITION_POOR:.0f} poor)")]
         if self.undetermined:
             lines += ["", "not determined by these measurements:"]
             lines += [f"  - {u}" for u in self.undetermined]
@@ -354,4 +372,5 @@ class CalibrationResult:
             lines += [f"  - {w}" for w in self.warnings]
         if self.next_step:
             lines += ["", f"next step: {self.next_step}"]
+        lines += ["", v.line()]
         return "\n".join(lines)

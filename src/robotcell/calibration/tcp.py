@@ -103,7 +103,10 @@ def calibrate_tool(
     ----------
     touches : array_like, shape (N, 4, 4)
         Flange poses ``T_R_F`` (metres) with the TCP on the reference point, N >= 3 (4 is KUKA's
-        XYZ 4-point; more are used in full).
+        XYZ 4-point; more are used in full). Two touches never suffice: ``R_1 t + p_1 = R_2 t +
+        p_2`` leaves the TCP component along the axis of ``R_1^T R_2`` free, since ``R_1 - R_2``
+        has rank 2; three touches rotated about different axes determine the TCP and the
+        reference point (6 unknowns, 9 equations).
     axis_touches : array_like, shape (Na, 4, 4), optional
         ABC 2-point: flange poses with the reference point on the tool's negative X axis.
     plane_touches : array_like, shape (Np, 4, 4), optional
@@ -141,8 +144,8 @@ def calibrate_tool(
     if world_mode not in ("6d", "5d"):
         raise InputError(f"world_mode must be '6d' or '5d', got {world_mode!r}")
     if len(T) < 3:
-        raise IllPosedError(f"{len(T)} touches of the reference point given; the TCP needs at least 3 "
-                            f"(4 recommended, more are better): {ADVICE}")
+        raise IllPosedError(f"touches of the reference point: {len(T)} given; the TCP needs at least 3 "
+                            f"(4 recommended, 5 or more let a wrong touch be singled out): {ADVICE}")
     if (len(Ta) > 0) != (len(Tp) > 0):
         raise IllPosedError("ABC 2-point needs both a touch with the reference point on the tool's -X "
                             "axis and one with it in the tool's XY plane (positive Y)")

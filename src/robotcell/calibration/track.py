@@ -49,6 +49,10 @@ TRACK_AXES = {"x": np.array([1.0, 0.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
 #: Relative deviation of the track scale from 1 above which a warning is given.
 SCALE_WARN = 0.02
 
+#: Travel (m) spanned by the touches below which a warning asks to spread them: the direction's
+#: uncertainty is about the touch noise divided by the travel.
+TRAVEL_WARN = 0.05
+
 #: Scale outside ``[1 / SCALE_REFUSE, SCALE_REFUSE]`` means the data are not of one fixed point or
 #: the track values are not in the track's own length unit.
 SCALE_REFUSE = 2.0
@@ -97,27 +101,15 @@ def _axis_vector(axis: str) -> NDArray[np.float64]:
     return TRACK_AXES[axis]
 
 
-def _check_positions(e: NDArray[np.float64], groups: NDArray[np.int_], labels: Sequence[str],
-                     min_step: float, min_travel: float) -> None:
+def _check_positions(e: NDArray[np.float64]) -> float:
+    """Refuse touches that leave the track direction undetermined; return the travel (m)."""
     travel = float(e.max() - e.min())
-    if travel < min_travel:
+    if travel == 0.0:
         raise IllPosedError(
-            f"all touches are at nearly the same track position (they span {travel * 1e3:.1f} mm); "
-            f"the track direction needs touches spread over at least {min_travel * 1e3:.0f} mm of "
-            "travel, ideally the whole track"
-        )
-    for k in np.unique(groups):
-        idx = np.flatnonzero(groups == k)
-        order = idx[np.argsort(e[idx])]
-        gaps = np.diff(e[order])
-        if gaps.size and gaps.min() < min_step:
-            j = int(np.argmin(gaps))
-            i1, i2 = order[j], order[j + 1]
-            raise IllPosedError(
-                f"touches {labels[i1]} and {labels[i2]} of the same point are at repeated or too "
-                f"close track positions ({e[i1] * 1e3:.3f} and {e[i2] * 1e3:.3f} mm); move the "
-                f"track by at least {min_step * 1e3:.0f} mm between touches of one point"
-            )
+            f"all {len(e)} touches are at the same track position ({e[0] * 1e3:.3f} mm), so the "
+            "track direction and scale are not determined; touch at two or more track positions, "
+            f"spread over at least {TRAVEL_WARN * 1e3:.0f} mm of travel, ideally the whole track")
+    return travel
 
 
 def _check_references(refs: NDArray[np.float64], d: NDArray[np.float64], min_lever: float) -> None:
@@ -194,8 +186,6 @@ def calibrate_track(
     roll: str | None = None,
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
-    min_step: float = 0.005,
-    min_travel: float = 0.05,
     min_lever: float = 0.05,
 ) -> CalibrationResult:
     """Calibrate a linear track from TCP touches of fixed reference points.
@@ -228,10 +218,6 @@ def calibrate_track(
     prior_sigma : float, optional
         Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
         the residuals.
-    min_step : float
-        Smallest track movement between two touches of the same point (metres).
-    min_travel : float
-        Smallest span of track positions over all touches (metres).
     min_lever : float
         Smallest distance of a single known point from the track axis, or of two known points from
         one line parallel to it (metres).
@@ -254,7 +240,9 @@ def calibrate_track(
         or a scale so far from 1 that the data cannot be touches of one fixed point in the track's
         length unit.
     IllPosedError
-        Repeated or too close track positions, too little travel, reference points on the axis.
+        All touches at one track position, reference points on the axis, or touches that do not
+        determine the parameters (see :func:`robotcell.calibration.fit`). Repeated track
+        positions are data: they are averaged by the fit.
     """
     f = as_points(f, "TCP positions")
     e = np.asarray(e, dtype=float)
@@ -265,7 +253,7 @@ def calibrate_track(
         raise InputError("track positions contain NaN or infinite values")
     n = len(f)
     if n < 3:
-        raise InputError(f"{n} touches given, at least 3 needed (3 touches at different track "
+        raise InputError(f"touches: {n} given, at least 3 needed (3 touches at different track "
                          "positions give the direction and a straightness check; use 5 or more)")
     d = _axis_vector(axis)
     if roll not in (None, "zero"):
@@ -292,7 +280,7 @@ def calibrate_track(
         if unused:
             raise InputError(f"reference point(s) {', '.join(str(u + 1) for u in unused)} were "
                              "never touched; drop them or add their touches")
-    _check_positions(e, groups, labels, min_step, min_travel)
+    travel = _check_positions(e)
     if refs is not None:
         _check_references(refs, d, min_lever)
 
@@ -377,9 +365,14 @@ def calibrate_track(
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: "
                         "spread the touches over more of the track travel")
+    direction_sigma = float(np.sqrt(np.abs(np.trace(direction_cov))))
+    if travel < TRAVEL_WARN:
+        warnings.append(f"the touches span only {travel * 1e3:.1f} mm of track travel: the track "
+                        f"direction is poorly determined (1-sigma {np.degrees(direction_sigma):.2f} "
+                        f"deg); spread them over at least {TRAVEL_WARN * 1e3:.0f} mm, ideally "
+                        "the whole track")
     warnings += outlier_warnings(res, labels)
     across = res.residuals - np.outer(res.residuals @ direction, direction)
-    direction_sigma = float(np.sqrt(np.abs(np.trace(direction_cov))))
     json_fields = {
         "axis": axis,
         "direction": direction,

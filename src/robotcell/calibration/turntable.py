@@ -52,27 +52,19 @@ def angular_spread(theta: ArrayLike) -> float:
     return float(2.0 * np.pi - gaps.max())
 
 
-def _check_angles(theta: NDArray[np.float64], labels: Sequence[str], min_step: float,
-                  min_spread: float) -> float:
-    t = np.mod(theta, 2.0 * np.pi)
-    order = np.argsort(t)
-    gaps = np.diff(np.concatenate([t[order], [t[order[0]] + 2.0 * np.pi]]))
-    j = int(np.argmin(gaps))
-    if gaps[j] < min_step:
-        i1, i2 = sorted((order[j], order[(j + 1) % len(order)]))
+def _check_angles(theta: NDArray[np.float64]) -> float:
+    """Refuse angles that leave the circle undetermined (fewer than 3 distinct); return the spread.
+
+    Repeated angles (90 twice, 0 and 360) are data, averaged by the fit.
+    """
+    on_circle = np.round(np.stack([np.cos(theta), np.sin(theta)], axis=1), 9) + 0.0
+    distinct = len(np.unique(on_circle, axis=0))
+    if distinct < 3:
         raise IllPosedError(
-            f"touches {labels[i1]} and {labels[i2]} are at the same or too close table angles "
-            f"({np.degrees(theta[i1]):.3f} and {np.degrees(theta[i2]):.3f} deg, modulo 360); turn "
-            f"the table by at least {np.degrees(min_step):.0f} deg between touches"
-        )
-    spread = angular_spread(theta)
-    if spread < min_spread:
-        raise IllPosedError(
-            f"the touches span only {np.degrees(spread):.1f} deg of table rotation, too little to "
-            "separate the axis from the radius; spread them over at least "
-            f"{np.degrees(min_spread):.0f} deg (better 90 deg or more, ideally around the full turn)"
-        )
-    return spread
+            f"the touches are at only {distinct} distinct table angle(s) (modulo 360 deg): a "
+            "circle needs 3, so the axis and the radius are not determined; turn the table to at "
+            "least 3 different angles, ideally spread around the full turn")
+    return angular_spread(theta)
 
 
 def _linear_start(theta: NDArray[np.float64], f: NDArray[np.float64], min_radius: float):
@@ -100,8 +92,6 @@ def calibrate_turntable(
     height: float = 0.0,
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
-    min_step: float = np.radians(1.0),
-    min_spread: float = np.radians(20.0),
     min_radius: float = 0.01,
 ) -> CalibrationResult:
     """Calibrate the root frame B of a turntable from touches of one point on the table.
@@ -112,7 +102,8 @@ def calibrate_turntable(
     Parameters
     ----------
     theta : array_like, shape (N,)
-        Table angle at each touch (radians), N >= 3 distinct angles.
+        Table angle at each touch (radians), at least 3 distinct angles modulo a full turn;
+        repeated angles are averaged by the fit. Below 90 deg of spread a warning is given.
     f : array_like, shape (N, 3)
         TCP position at each touch in the robot base frame R (metres).
     height : float
@@ -123,10 +114,6 @@ def calibrate_turntable(
     prior_sigma : float, optional
         Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
         the residuals.
-    min_step : float
-        Smallest angle between two touches, modulo a full turn (radians).
-    min_spread : float
-        Smallest arc covered by the touches (radians); below 90 deg a warning is given.
     min_radius : float
         Smallest distance of the reference point from the axis (metres).
 
@@ -148,7 +135,8 @@ def calibrate_turntable(
     InputError
         Wrong shapes, NaN, fewer than 3 touches.
     IllPosedError
-        Repeated or too close angles, too small a spread, a reference point on the axis.
+        Fewer than 3 distinct angles, a reference point on the axis, or touches that do not
+        determine the parameters (see :func:`robotcell.calibration.fit`).
     """
     f = as_points(f, "TCP positions")
     theta = np.asarray(theta, dtype=float)
@@ -159,10 +147,10 @@ def calibrate_turntable(
         raise InputError("table angles or height contain NaN or infinite values")
     n = len(f)
     if n < 3:
-        raise InputError(f"{n} touches given, at least 3 needed at different table angles (4 or "
-                         "more give a check on every touch)")
+        raise InputError(f"touches: {n} given, at least 3 needed at different table angles (6 or "
+                         "more let a wrong touch be singled out)")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
-    spread = _check_angles(theta, labels, min_step, min_spread)
+    spread = _check_angles(theta)
     b_plane, R0, r0 = _linear_start(theta, f, min_radius)
     rot_theta = rot_z(theta)
 
@@ -198,9 +186,6 @@ def calibrate_turntable(
         warnings.append(f"the touches span only {np.degrees(spread):.0f} deg of table rotation; "
                         "spread them over at least 90 deg (ideally around the full turn) for a "
                         "well-determined axis")
-    if n < 4:
-        warnings.append("only 3 touches: no touch can be checked against the others; take 4 or "
-                        "more (ABB's RobotAxisRot asks for at least 4)")
     if tilt > np.pi / 2:
         warnings.append("Z_B points downward in the robot base: positive table angles turn the "
                         "table clockwise seen from above; check the axis sign in the controller's "

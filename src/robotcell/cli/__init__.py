@@ -1,15 +1,18 @@
 """The ``robotcell`` command line.
 
 Subcommands live in their own modules and are imported only when used, so that
-``robotcell --help`` and every command start fast.
+``robotcell --help`` and every command start fast: ``--help`` reads each command's one-line help
+from its source instead of importing it (and numpy, scipy with it).
 """
 
 from __future__ import annotations
 
+import ast
 import importlib
 import importlib.util
 import os
 import sys
+from pathlib import Path
 
 import click
 
@@ -46,6 +49,43 @@ class LazyGroup(click.Group):
             return None
         module, attr = COMMANDS[name].split(":")
         return getattr(importlib.import_module(module), attr)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """List the commands and their one-line help, as click does, without importing them."""
+        names = self.list_commands(ctx)
+        if not names:
+            return
+        limit = formatter.width - 6 - max(len(name) for name in names)
+        rows = [(name, _help_command(name).get_short_help_str(limit)) for name in names]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+#: Decorators that make a click command of a function.
+_DECORATORS = {"command", "group"}
+
+
+def _help_command(name: str) -> click.Command:
+    """A stand-in for command ``name`` that carries its help text, read from the source.
+
+    The help of a command is the docstring of its decorated function (click's default); it is
+    read with :mod:`ast`, so the module and its imports are not loaded. A command whose
+    docstring cannot be found this way, or whose ``@click.command``/``@click.group`` sets its
+    help or visibility itself, is imported.
+    """
+    module, attr = COMMANDS[name].split(":")
+    spec = importlib.util.find_spec(module)
+    if spec is not None and spec.origin is not None and spec.origin.endswith(".py"):
+        tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
+        for node in tree.body:
+            if isinstance(node, ast.FunctionDef) and node.name == attr:
+                own = {k.arg for d in node.decorator_list if isinstance(d, ast.Call)
+                       and getattr(d.func, "attr", getattr(d.func, "id", None)) in _DECORATORS
+                       for k in d.keywords}
+                doc = ast.get_docstring(node)
+                if doc and not own & {"help", "short_help", "hidden", "deprecated"}:
+                    return click.Command(name, help=doc)
+    return getattr(importlib.import_module(module), attr)
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})

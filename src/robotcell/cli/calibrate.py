@@ -23,10 +23,10 @@ from numpy.typing import NDArray
 
 from robotcell.calibration.measurements import (
     check_count,
-    check_no_repeats,
     flange_poses,
     nominal_points,
     point_roles,
+    repeated_rows,
     tcp_positions,
     track_column,
 )
@@ -65,6 +65,8 @@ def calibrate() -> None:
     or joint values a1..a6 with --robot and --tool. Report in mm/deg, or --json.
     With --cell CELL.yaml the result is written into the cell file (CELL.yaml.bak keeps the
     previous version). Exit status 2 when the measurements are refused, with the reason on stderr.
+    Every report ends with a verdict (good / check / poor); a poor result prints its report,
+    exits with status 3 and writes nothing, unless --accept-poor is given.
 
     \b
     Examples:
@@ -82,7 +84,11 @@ def _keep_output(ctx: click.Context, param: click.Parameter, value: str | None) 
 
 
 def measurement_options(func: Callable) -> Callable:
-    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o."""
+    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o,
+    --accept-poor."""
+    func = click.option("--accept-poor", is_flag=True,
+                        help="Write and exit 0 even when the verdict is poor (default: a poor "
+                             "result exits with status 3 and changes no file).")(func)
     func = click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
                         expose_value=False, callback=_keep_output,
                         help="Also write the result to FILE, atomically and only when the run "
@@ -248,10 +254,43 @@ def emit(result: CalibrationResult, as_json: bool) -> None:
     click.echo(f"wrote {output}", err=True)
 
 
+class PoorCalibration(click.ClickException):
+    """A calibration whose verdict is poor: exit status 3, ``error: ...`` on stderr."""
+
+    exit_code = 3
+
+    def show(self, file: object = None) -> None:
+        click.echo(f"error: {self.message}", err=True)
+
+
+def gate(result: CalibrationResult, as_json: bool, accept_poor: bool) -> None:
+    """Stop before anything is written when the verdict is poor, unless ``--accept-poor``.
+
+    The report is printed (stdout) so the technician sees why; then :class:`PoorCalibration`
+    exits with status 3. Call it right after the calibration, before any file is written.
+    """
+    v = result.verdict
+    if v.level != "poor":
+        return
+    if accept_poor:
+        click.echo("warning: the verdict is poor; written anyway (--accept-poor)", err=True)
+        return
+    # The report goes to stdout only, never to an output file: a poor result writes nothing.
+    click.echo(json.dumps(result.to_json(), indent=2) if as_json else result.summary())
+    raise PoorCalibration(f"poor calibration, nothing written: {'; '.join(v.reasons)}. Fix the "
+                          "measurements, or pass --accept-poor to use the result anyway")
+
+
 def raw_rows(cols: dict, names: list[str]) -> np.ndarray:
-    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row check."""
+    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note."""
     use = [n for n in names if n in cols and isinstance(cols[n], np.ndarray)]
     return np.stack([cols[n] for n in use], axis=1)
+
+
+def note_repeats(cols: dict, names: list[str], source: str) -> None:
+    """Say on stderr which rows are identical (they are used, each as a measurement)."""
+    for note in repeated_rows(raw_rows(cols, names), source):
+        click.echo(f"note: {note}", err=True)
 
 
 def _line_labels(roles: list[str]) -> list[str]:
@@ -297,7 +336,8 @@ def _write_tool(target: CellTarget, name: str, result: CalibrationResult, prov: 
 @cell_option
 @measurement_options
 def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | None,
-        robot: str | None, tool: str | None, sigma: float | None, as_json: bool) -> None:
+        robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+        accept_poor: bool) -> None:
     """Tool TCP (XYZ 4-point / N-point) and orientation (ABC 2-point, ABC World).
 
     \b
@@ -330,7 +370,7 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     if bad:
         raise InputError(f"{measurements}: column 'point' must hold tcp, -x, xy or world; "
                          f"found {', '.join(bad)}")
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track"]), measurements)
+    note_repeats(cols, POSE_COLUMNS + ["track"], measurements)
     check_count(roles.count("tcp"), 3, "touches of the reference point (point=tcp)", measurements)
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
@@ -347,6 +387,7 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
                             world_mode=world_mode, prior_sigma=prior,
                             labels=[labels[i] for i in order])
+    gate(result, as_json, accept_poor)
     if target is not None and name is not None:
         _write_tool(target, name, result, cell_provenance("tcp", result, len(T), measurements))
         target.save(f"tool {name!r}")
@@ -378,7 +419,8 @@ def _frame_parent(target: CellTarget, name: str | None, parent: str | None) -> s
 @cell_option
 @measurement_options
 def frame(measurements: str, name: str | None, parent: str | None, cell_path: str | None,
-          robot: str | None, tool: str | None, sigma: float | None, as_json: bool) -> None:
+          robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+          accept_poor: bool) -> None:
     """Frame (base / user frame): 3-point, or N-point best fit to known coordinates.
 
     \b
@@ -405,7 +447,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
     model, T_tool = robot_and_tool(robot, tool, target)
     cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track", *NOMINAL_COLUMNS])
     p = tcp_positions(cols, measurements, model, T_tool)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["track", *NOMINAL_COLUMNS]), measurements)
+    note_repeats(cols, POSE_COLUMNS + ["track", *NOMINAL_COLUMNS], measurements)
     in_world = False
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
@@ -423,6 +465,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
     else:
         roles = point_roles(cols, measurements)
         result = frame_3point(p, roles, prior, _line_labels(roles))
+    gate(result, as_json, accept_poor)
     if target is not None and name is not None:
         key = f"T_world_{name}" if in_world else "T_R_W"
         if in_world:
@@ -438,7 +481,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @measurement_options
 def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sigma: float | None,
-                     as_json: bool) -> None:
+                     as_json: bool, accept_poor: bool) -> None:
     """Fixed (external) tool touched with a robot-held reference tool of known TCP.
 
     \b
@@ -463,8 +506,9 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
         roles = [str(v).strip().lower() for v in cols["point"]]
     else:
         roles = ["tcp"] * len(p)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS), measurements)
+    note_repeats(cols, POSE_COLUMNS, measurements)
     result = external_tcp(p, roles, prior, _line_labels(roles))
+    gate(result, as_json, accept_poor)
     emit(result, as_json)
 
 
@@ -472,7 +516,8 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
 # A module listed here is imported only when its subcommand is used; an entry whose module does
 # not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m, emit, and for --cell cell_option, CellTarget and the helpers around it, from this module.
+# sigma_m, gate, emit, and for --cell cell_option, CellTarget and the helpers around it, from this
+# module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",

@@ -17,7 +17,6 @@ import numpy as np
 
 from robotcell.calibration.measurements import (
     check_count,
-    check_no_repeats,
     external_axis,
     point_roles,
     tcp_positions,
@@ -29,8 +28,9 @@ from robotcell.cli.calibrate import (
     cell_option,
     cell_provenance,
     emit,
+    gate,
     measurement_options,
-    raw_rows,
+    note_repeats,
     refuse_track_column,
     require_name,
     robot_and_tool,
@@ -101,7 +101,7 @@ def _cell_track_axis(target: CellTarget, axis: str | None, references: tuple[str
 @measurement_options
 def track(measurements: str, references: tuple[str, ...], axis: str | None, roll: str | None,
           cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
-          as_json: bool) -> None:
+          as_json: bool, accept_poor: bool) -> None:
     """Linear track: direction in the robot base, scale, straightness; rotation when determined.
 
     \b
@@ -131,7 +131,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     f = tcp_positions(cols, measurements, model, T_tool)
     e = external_axis(cols, measurements, "track")
     check_count(len(f), 3, "touches", measurements)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["e1", "point"]), measurements)
+    note_repeats(cols, POSE_COLUMNS + ["e1", "point"], measurements)
     refs = np.array([parse_numbers(r, "--reference", 3) for r in references]).reshape(-1, 3) * 1e-3
     idx = _reference_indices(cols, len(refs), measurements)
     keep_offset = target is not None and len(refs) < 2
@@ -141,6 +141,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     result = calibrate_track(e, f, references=refs if len(refs) else None, point=idx,
                              axis=axis or "x", roll=roll, labels=_labels(len(f)),
                              prior_sigma=sigma_m(sigma))
+    gate(result, as_json, accept_poor)
     if target is not None:
         tr = target.cell.track
         T_L_R0 = result.values["T_L_R"].copy()
@@ -172,7 +173,7 @@ def _cell_turntable(target: CellTarget):
 @cell_option
 @measurement_options
 def turntable(measurements: str, height: float, cell_path: str | None, robot: str | None,
-              tool: str | None, sigma: float | None, as_json: bool) -> None:
+              tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
     """Turntable root frame B (R_T_B) and radius from touches of one point on the table.
 
     \b
@@ -197,7 +198,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     f = tcp_positions(cols, measurements, model, T_tool)
     theta = external_axis(cols, measurements, "table")
     check_count(len(f), 3, "touches", measurements)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["e1", "track"]), measurements)
+    note_repeats(cols, POSE_COLUMNS + ["e1", "track"], measurements)
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
     elif parent == "world":
@@ -206,6 +207,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
         target.track_positions(cols, measurements)
     result = calibrate_turntable(theta, f, height=height * 1e-3, labels=_labels(len(f)),
                                  prior_sigma=sigma_m(sigma))
+    gate(result, as_json, accept_poor)
     if target is not None:
         key = "T_R_B"
         if parent == "world":
@@ -331,7 +333,7 @@ def _workpiece_turntable(turntable_json: str | None, target: CellTarget | None
 @measurement_options
 def workpiece(measurements: str, turntable_json: str | None, name: str | None,
               cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
-              as_json: bool) -> None:
+              as_json: bool, accept_poor: bool) -> None:
     """Workpiece frame B_T_W on a calibrated turntable (3-point, or several touches per point).
 
     \b
@@ -355,9 +357,9 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     T_B, cov, noise = _workpiece_turntable(turntable_json, target)
     cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
     f = tcp_positions(cols, measurements, model, T_tool)
-    theta = np.radians(require_columns(cols, ["e1"], measurements)[:, 0])
+    theta = external_axis(cols, measurements, "workpiece")
     roles = point_roles(cols, measurements)
-    check_no_repeats(raw_rows(cols, POSE_COLUMNS + ["e1", "track"]), measurements)
+    note_repeats(cols, POSE_COLUMNS + ["e1", "track"], measurements)
     if target is None:
         refuse_track_column(cols, measurements, NO_CELL_TRACK)
     elif _cell_turntable(target).parent == "world":
@@ -367,6 +369,7 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     result = calibrate_workpiece(theta, f, roles, T_B, T_R_B_covariance=cov, noise_sigma=noise,
                                  prior_sigma=sigma_m(sigma),
                                  labels=[f"line {i + 2} ({r})" for i, r in enumerate(roles)])
+    gate(result, as_json, accept_poor)
     if target is not None and name is not None:
         target.cell.update_frame(name, result.values["T_B_W"],
                                  cell_provenance("workpiece", result, len(f), measurements),

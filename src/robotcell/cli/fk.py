@@ -8,6 +8,8 @@ import sys
 import click
 import numpy as np
 
+from robotcell.cell import Cell
+from robotcell.cli.cellargs import cell_tool, row_values, table_angles, track_values
 from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
@@ -31,26 +33,49 @@ def tool_option(text: str | None) -> np.ndarray | None:
 
 
 @click.command()
-@click.argument("robot")
+@click.argument("robot", required=False)
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
 @click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
               help="CSV to write, atomically (default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,
               help="Pose format of the result.")
-@click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention).")
-def fk(robot: str, joints: str | None, input_path: str | None, output_path: str | None,
-       fmt: str, tool: str | None) -> None:
+@click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention); "
+              "with --cell also a tool name of the cell.")
+@click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
+              help="Forward kinematics in a cell file (robot, track, turntable, tools, frames).")
+@click.option("--frame", "frame", default="world", show_default=True,
+              help="--cell: frame of the result (world, track, robot, turntable or a frame of the cell).")
+@click.option("--track", "track_mm", type=float, default=0.0, metavar="MM",
+              help="--cell: track position (mm).")
+@click.option("--table", "table_deg", type=float, default=0.0, metavar="DEG",
+              help="--cell: turntable angle (deg).")
+def fk(robot: str | None, joints: str | None, input_path: str | None, output_path: str | None,
+       fmt: str, tool: str | None, cell_path: str | None, frame: str, track_mm: float,
+       table_deg: float) -> None:
     """Forward kinematics: pose of the TCP in the robot base frame.
 
     ROBOT is a library name (see 'robotcell robots') or a model file.
+
+    With --cell CELL.yaml instead of ROBOT: joints plus track position (--track, mm) and table
+    angle (--table, deg) give the TCP pose in a frame of the cell (--frame). A batch file may hold
+    per-row columns track and table. Refused with exit status 2: unknown frame or tool, track or
+    table outside their limits.
 
     \b
     Examples:
       robotcell fk kuka_kr16 --joints 0,-90,90,0,0,0
       robotcell fk ur5e --joints 0,-90,90,0,90,0 --format ur
       robotcell fk abb_irb2400 --input joints.csv --output poses.csv --format abb
+      robotcell fk --cell cell.yaml --joints 0,-90,90,0,45,0 --track 1500 --tool torch --frame part
     """
+    if cell_path is not None:
+        if robot is not None:
+            raise InputError("give either ROBOT or --cell CELL.yaml, not both")
+        return _fk_cell(cell_path, joints, input_path, output_path, fmt, tool, frame, track_mm,
+                        table_deg)
+    if robot is None:
+        raise InputError("give a ROBOT (library name or model file) or --cell CELL.yaml")
     r = load_robot(robot)
     T_tool = tool_option(tool)
     if (joints is None) == (input_path is None):
@@ -62,20 +87,34 @@ def fk(robot: str, joints: str | None, input_path: str | None, output_path: str 
             click.echo("warning: joint values outside the robot's limits", err=True)
         if fmt == "matrix":
             click.echo("T_R_TCP (translation in mm):")
-            M = T.copy()
-            M[:3, 3] *= 1e3
-            for row in M:
-                click.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
-            return
-        v = pose_to_vendor(T, fmt)
-        fields = FORMATS[fmt].fields
-        click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
-                            for i, (n, x) in enumerate(zip(fields, v))))
+        _echo_pose(T, fmt)
         return
     names = [f"a{i}" for i in range(1, r.n_joints + 1)]
     cols = read_csv(input_path, known=names)
     q = joints_to_si(r, require_columns(cols, names, input_path))
     T = r.fk(q, tool=T_tool)
+    outside = int(np.count_nonzero(~r.within_limits(q)))
+    if outside:
+        click.echo(f"warning: {outside} row(s) outside the robot's joint limits", err=True)
+    _write_poses(T, fmt, output_path)
+
+
+def _echo_pose(T: np.ndarray, fmt: str) -> None:
+    """Print one pose (m) as the vendor format's fields, or as a matrix with mm translation."""
+    if fmt == "matrix":
+        M = T.copy()
+        M[:3, 3] *= 1e3
+        for row in M:
+            click.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
+        return
+    v = pose_to_vendor(T, fmt)
+    fields = FORMATS[fmt].fields
+    click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
+                        for i, (n, x) in enumerate(zip(fields, v))))
+
+
+def _write_poses(T: np.ndarray, fmt: str, output_path: str | None) -> None:
+    """Write poses (N, 4, 4) (m) as CSV in the vendor format (mm, deg) or as matrix rows."""
     if fmt == "matrix":
         header = [f"t{i}{j}" for i in range(3) for j in range(4)]
         M = T[:, :3, :].copy()
@@ -83,7 +122,32 @@ def fk(robot: str, joints: str | None, input_path: str | None, output_path: str 
         rows = M.reshape(-1, 12)
     else:
         header, rows = list(FORMATS[fmt].fields), pose_to_vendor(T, fmt)
+    write_csv(output_path if output_path else sys.stdout, header, rows)
+
+
+def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_path: str | None,
+             fmt: str, tool: str | None, frame: str, track_mm: float, table_deg: float) -> None:
+    """``robotcell fk --cell``: :meth:`Cell.fk` for one configuration or a batch (mm, deg)."""
+    cell = Cell.load(cell_path)
+    r = cell.robot
+    T_tool = cell_tool(tool)
+    if (joints is None) == (input_path is None):
+        raise InputError("give exactly one of --joints a1,a2,... or --input joints.csv")
+    if joints is not None:
+        q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
+        e, th = track_values(cell, track_mm), table_angles(cell, table_deg)
+    else:
+        names = [f"a{i}" for i in range(1, r.n_joints + 1)]
+        cols = read_csv(input_path, known=[*names, "track", "table"])
+        q = joints_to_si(r, require_columns(cols, names, input_path))
+        e = track_values(cell, row_values(cols, "track", track_mm, len(q)))
+        th = table_angles(cell, row_values(cols, "table", table_deg, len(q)))
+    T = cell.fk(q, e, th, T_tool, frame)
     outside = int(np.count_nonzero(~r.within_limits(q)))
     if outside:
-        click.echo(f"warning: {outside} row(s) outside the robot's joint limits", err=True)
-    write_csv(output_path if output_path else sys.stdout, header, rows)
+        click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
+    if joints is not None:
+        click.echo(f"{cell.name}: TCP in frame {frame!r} ({fmt}, mm, deg)")
+        _echo_pose(T, fmt)
+        return
+    _write_poses(T, fmt, output_path)

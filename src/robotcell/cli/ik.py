@@ -10,6 +10,8 @@ from typing import TextIO
 import click
 import numpy as np
 
+from robotcell.cell import Cell
+from robotcell.cli.cellargs import cell_tool, chunks, row_values, table_angles, track_values
 from robotcell.cli.common import (
     check_output,
     format_table,
@@ -19,7 +21,7 @@ from robotcell.cli.common import (
     write_output,
 )
 from robotcell.errors import InputError
-from robotcell.ik import abb_confdata, analytic_solver, kuka_status_turn, nearest
+from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import FORMATS, pose_from_vendor
 from robotcell.robot import Robot
@@ -48,7 +50,7 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 
 
 @click.command()
-@click.argument("robot")
+@click.argument("robot", required=False)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
 @click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
@@ -57,9 +59,19 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
               help="Pose format of --pose / --input.")
 @click.option("--all", "show_all", is_flag=True, help="Also list unreachable and out-of-limit branches.")
 @click.option("--near", "near", help="Only the valid solution nearest to a1,...,a6 (deg).")
-@click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention).")
-def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | None, fmt: str,
-       show_all: bool, near: str | None, tool: str | None) -> None:
+@click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention); "
+              "with --cell also a tool name of the cell.")
+@click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
+              help="Solve in a cell file (robot, track, turntable, tools, frames) instead of ROBOT.")
+@click.option("--frame", "frame", default="world", show_default=True,
+              help="--cell: frame of the target (world, track, robot, turntable or a frame of the cell).")
+@click.option("--track", "track_mm", type=float, metavar="MM",
+              help="--cell: track position (mm); chosen per pose when omitted in a cell with a track.")
+@click.option("--table", "table_deg", type=float, default=0.0, metavar="DEG",
+              help="--cell: turntable angle (deg) at which the target is given.")
+def ik(robot: str | None, pose: str | None, input_path: str | None, output_path: str | None, fmt: str,
+       show_all: bool, near: str | None, tool: str | None, cell_path: str | None, frame: str,
+       track_mm: float | None, table_deg: float) -> None:
     """Inverse kinematics: every arm configuration that reaches a TCP pose.
 
     ROBOT is a library name (see 'robotcell robots') or a model file with an ortho-parallel
@@ -75,13 +87,29 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
     valid (1/0; unreachable branches have nan angles); with --near one row per pose with columns
     pose, found (1/0), a1..a6.
 
+    With --cell CELL.yaml instead of ROBOT the target is given in a frame of the cell (--frame)
+    at a table angle (--table), for a track position (--track, chosen per pose where the arm
+    reaches best when omitted); the output adds track (mm) and table (deg) and, for --format
+    kuka/abb, the configuration flags (batch columns status,turn or cf1,cf4,cf6,cfx). A batch
+    file may hold per-row columns track and table. Batches of 2000 poses or more show a progress
+    bar on stderr. Refused with exit status 2: unknown frame or tool, track or table outside
+    their limits, no valid solution for --pose.
+
     \b
     Examples:
       robotcell ik kuka_kr6_r700_sixx --pose 470,0,750,0,0,0
       robotcell ik abb_irb2400 --pose 940,0,1455,0.7071068,0,0.7071068,0 --format abb --all
       robotcell ik ur5e --pose 0.5,0.1,0.4,0,3.1416,0 --format ur --near 0,-90,90,-90,-90,0
       robotcell ik kuka_kr16 --input poses.csv --output joints.csv
+      robotcell ik --cell cell.yaml --frame part --table 90 --tool torch --pose 0,0,50,0,180,0
     """
+    if cell_path is not None:
+        if robot is not None:
+            raise InputError("give either ROBOT or --cell CELL.yaml, not both")
+        return _ik_cell(cell_path, pose, input_path, output_path, fmt, show_all, near, tool, frame,
+                        track_mm, table_deg)
+    if robot is None:
+        raise InputError("give a ROBOT (library name or model file) or --cell CELL.yaml")
     r = load_robot(robot)
     solver = analytic_solver(r)
     if (pose is None) == (input_path is None):
@@ -136,9 +164,104 @@ def ik(robot: str, pose: str | None, input_path: str | None, output_path: str | 
     else:
         header = ["pose", "branch", *axes]
         out_rows = [[i, k, *(sol.q[i, k] * deg).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
-    none = int(np.count_nonzero(~sol.valid.any(axis=1)))
+    _finish_batch(sol.valid, header, out_rows, output_path)
+
+
+def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[object]],
+                  output_path: str | None) -> None:
+    """Warn about poses without a valid branch (valid: (N, 8)), then write the batch CSV."""
+    none = int(np.count_nonzero(~valid.any(axis=1)))
     if none:
         click.echo(f"warning: {none} pose(s) without a valid solution", err=True)
     buf = io.StringIO(newline="")
     _write(buf, header, out_rows)
     write_output(output_path, buf.getvalue())
+
+
+def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
+                       ) -> tuple[list[str], np.ndarray]:
+    """Batch columns of the configuration flags (KUKA status,turn; ABB cf1..cfx) per row of q."""
+    if method != "opw" or fmt not in ("kuka", "abb"):
+        return [], np.empty((len(q), 0), dtype=int)
+    qq = np.nan_to_num(q)
+    if fmt == "kuka":
+        s, t = kuka_status_turn(robot, qq)
+        return ["status", "turn"], np.column_stack([s, t])
+    return ["cf1", "cf4", "cf6", "cfx"], np.atleast_2d(abb_confdata(robot, qq))
+
+
+def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_path: str | None,
+             fmt: str, show_all: bool, near: str | None, tool: str | None, frame: str,
+             track_mm: float | None, table_deg: float) -> None:
+    """``robotcell ik --cell``: :meth:`Cell.ik` for one pose or a batch (mm, deg)."""
+    cell = Cell.load(cell_path)
+    r = cell.robot
+    if (pose is None) == (input_path is None):
+        raise InputError("give exactly one of --pose ... or --input poses.csv")
+    T_tool = cell_tool(tool)
+    deg = 180.0 / math.pi
+    ref = None if near is None else np.radians(parse_numbers(near, "--near", r.n_joints))
+    if pose is not None:
+        T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
+        sol = cell.ik(T, frame, track_values(cell, track_mm), table_angles(cell, table_deg), T_tool)
+        valid = sol.valid
+        if ref is not None:
+            q, found, branch = nearest(r, IKSolutions(sol.q, valid, sol.reachable, sol.method), ref)
+            ks, qs = ([int(branch)], q[None]) if found else ([], q[None])
+        else:
+            ks = [k for k in range(8) if show_all or valid[k]]
+            qs = sol.q[ks]
+        if not any(valid[k] for k in ks) and not show_all:
+            raise InputError(f"no valid solution for the target in frame {frame!r}: out of reach, "
+                             "or outside the joint, track or table limits (--all lists every branch)")
+        flags = _flags(r, sol.method, fmt, qs) if ks else None
+        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
+        if flags is not None:
+            headers.append("S/T" if fmt == "kuka" else "confdata")
+        rows = []
+        for i, k in enumerate(ks):
+            state = "yes" if valid[k] else ("limits" if sol.reachable[k] else "unreachable")
+            vals = [float(v * deg) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
+                    for v in qs[i]]
+            row = [f"{k} {BRANCHES[k]}", *vals, state]
+            if flags is not None:
+                row.append(flags[i] if sol.reachable[k] else "-")
+            rows.append(row)
+        how = "chosen" if track_mm is None else "given"
+        where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
+        where += f", table {float(sol.table) * deg:g} deg" if cell.turntable is not None else ""
+        click.echo(f"{cell.name}: {r.name}, {sol.method} solver, target in frame {frame!r}{where}; "
+                   "angles in degrees")
+        click.echo(format_table(headers, rows))
+        return
+    names = [f.lower() for f in FORMATS[fmt].fields]
+    cols = read_csv(input_path, known=[*names, "track", "table"])
+    T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
+    n = len(T)
+    e = track_values(cell, row_values(cols, "track", track_mm, n))
+    th = table_angles(cell, row_values(cols, "table", table_deg, n))
+    parts = []
+    for sl in chunks(n, "ik"):
+        parts.append(cell.ik(T[sl], frame, None if e is None else e[sl], th[sl], T_tool))
+    q = np.concatenate([p.q for p in parts])
+    valid = np.concatenate([p.valid for p in parts])
+    reach = np.concatenate([p.reachable for p in parts])
+    track = np.concatenate([np.broadcast_to(p.track, p.valid.shape[:-1]) for p in parts]) * 1e3
+    table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1]) for p in parts]) * deg
+    method = parts[0].method
+    axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
+    if ref is not None:
+        qn, found, _ = nearest(r, IKSolutions(q, valid, reach, method), ref)
+        names_f, flags = _cell_flag_columns(r, method, fmt, qn)
+        header = ["pose", "found", "track", "table", *axes, *names_f]
+        out_rows = [[i, int(found[i]), track[i], table[i], *(qn[i] * deg).tolist(),
+                     *(flags[i].tolist() if found[i] else ["-"] * len(names_f))] for i in range(n)]
+    else:
+        idx = [(i, k) for i in range(n) for k in range(8)] if show_all else list(zip(*np.nonzero(valid)))
+        sel = np.array([q[i, k] for i, k in idx]).reshape(-1, r.n_joints)
+        names_f, flags = _cell_flag_columns(r, method, fmt, sel)
+        header = ["pose", "branch", *(["valid"] if show_all else []), "track", "table", *axes, *names_f]
+        out_rows = [[int(i), int(k), *([int(valid[i, k])] if show_all else []), track[i], table[i],
+                     *(sel[j] * deg).tolist(), *(flags[j].tolist() if reach[i, k] else ["-"] * len(names_f))]
+                    for j, (i, k) in enumerate(idx)]
+    _finish_batch(valid, header, out_rows, output_path)

@@ -12,9 +12,9 @@ from robotcell.report import load_result, verdict, write_report
 @click.argument("result", type=click.Path())
 @click.option("-o", "--output", default="report.html", show_default=True, type=click.Path(),
               callback=check_not_folder,
-              help="HTML file to write; PNG figures go beside it.")
+              help="HTML file to write; its figures are embedded, nothing else is written.")
 def report(result: str, output: str) -> None:
-    """Write an HTML report (and PNG figures) for a calibration result.
+    """Write a self-contained HTML report, figures embedded, for a calibration result.
 
     RESULT is the JSON written by 'robotcell calibrate ... --json'.
 

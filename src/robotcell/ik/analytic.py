@@ -19,7 +19,7 @@ from robotcell.ik.opw import OPWParameters, opw_kernel, opw_parameters, opw_prob
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
 from robotcell.robot import Robot
-from robotcell.transforms import invert, validate_pose
+from robotcell.transforms import finite_array, invert, validate_pose
 
 __all__ = ["AnalyticSolver", "analytic_solver", "solve"]
 
@@ -64,7 +64,8 @@ class AnalyticSolver:
         self._T_O_R = invert(self.params.T_R_O)
         self._fold = JointFolder(robot.lower, robot.upper)
 
-    def solve(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
+    def solve(self, T: ArrayLike, tool: ArrayLike | None = None,
+              q_ref: ArrayLike | None = None) -> IKSolutions:
         """All 8 solutions for poses of the TCP.
 
         Parameters
@@ -73,14 +74,28 @@ class AnalyticSolver:
             ``T_R_TCP``: target poses of the TCP in the robot base frame (m).
         tool : array_like, shape (4, 4), optional
             ``T_F_TCP`` instead of the robot's default tool (m).
+        q_ref : array_like, shape (6,) or (..., 6), optional
+            Reference configuration(s) (rad), e.g. the current or the taught one. Used only where
+            an axis is free (singular configurations, see docs/ik.md): that axis takes the value
+            nearest to the reference. Without it, a free axis takes a fixed choice.
 
         Returns
         -------
         IKSolutions
-            ``q`` of shape ``(..., 8, 6)`` (rad).
+            ``q`` of shape ``(..., 8, 6)`` (rad), ``reach_error`` of shape ``(..., 8)`` (m).
         """
         arr = validate_pose(T, "target pose")
         tool_T = self.robot.tool if tool is None else validate_pose(tool, "tool")
+        ref = None
+        if q_ref is not None:
+            ref = finite_array(q_ref, "q_ref")
+            if ref.ndim == 0 or ref.shape[-1] != 6:
+                raise InputError(f"q_ref must have shape (..., 6), got {ref.shape}")
+            try:
+                ref = np.broadcast_to(ref, arr.shape[:-2] + (6,)).reshape(-1, 6)
+            except ValueError:
+                raise InputError(f"q_ref of shape {ref.shape} does not match the "
+                                 f"{arr.shape[:-2]} poses") from None
         # T_O_end = T_O_R @ T_R_TCP @ T_TCP_end, with T_TCP_end = inv(T_end_n @ flange @ tool).
         T_tcp_end = invert(self.params.T_e_n @ self.robot.flange @ tool_T)
         batch = arr.shape[:-2]
@@ -89,6 +104,8 @@ class AnalyticSolver:
         q = np.empty((N, 8, 6))
         reach = np.empty((N, 8), dtype=bool)
         valid = np.empty((N, 8), dtype=bool)
+        err = np.empty((N, 8))
+        lo, hi = self.robot.lower, self.robot.upper
         A = self._T_O_R[:3, :3]
         a = self._T_O_R[:3, 3]
         B = T_tcp_end[:3, :3]
@@ -99,11 +116,12 @@ class AnalyticSolver:
             R = A @ (Rt @ B)
             P = (Rt @ bvec + blk[:, :3, 3]) @ A.T + a
             qb = q[s:s + _BLOCK]
-            rb = self._kernel(self.params, R, P, qb)
+            rb = self._kernel(self.params, R, P, qb, err[s:s + _BLOCK],
+                              None if ref is None else ref[s:s + _BLOCK], lo, hi)
             valid[s:s + _BLOCK] = rb & self._fold(qb)  # 2*pi rule and limits, in cache
             reach[s:s + _BLOCK] = rb
         return IKSolutions(q.reshape(batch + (8, 6)), valid.reshape(batch + (8,)),
-                           reach.reshape(batch + (8,)), self.method)
+                           reach.reshape(batch + (8,)), self.method, err.reshape(batch + (8,)))
 
 
 _CACHE: weakref.WeakKeyDictionary[Robot, AnalyticSolver] = weakref.WeakKeyDictionary()
@@ -118,7 +136,8 @@ def analytic_solver(robot: Robot) -> AnalyticSolver:
     return solver
 
 
-def solve(robot: Robot, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
+def solve(robot: Robot, T: ArrayLike, tool: ArrayLike | None = None,
+          q_ref: ArrayLike | None = None) -> IKSolutions:
     """All analytic IK solutions of ``robot`` for TCP poses ``T`` (see :meth:`AnalyticSolver.solve`).
 
     Parameters
@@ -128,9 +147,11 @@ def solve(robot: Robot, T: ArrayLike, tool: ArrayLike | None = None) -> IKSoluti
         ``T_R_TCP`` (m), including the robot's base, flange and tool transforms.
     tool : array_like, shape (4, 4), optional
         ``T_F_TCP`` instead of the robot's default tool (m).
+    q_ref : array_like, shape (6,) or (..., 6), optional
+        Reference configuration (rad) for axes that are free at singular configurations.
 
     Returns
     -------
     IKSolutions
     """
-    return analytic_solver(robot).solve(T, tool)
+    return analytic_solver(robot).solve(T, tool, q_ref)

@@ -36,18 +36,21 @@ from robotcell.ik.axes import (
     line_distance,
     six_revolute_problems,
 )
+from robotcell.ik.limits import TWO_PI, wrap_to_pi
+from robotcell.ik.result import REACH_TOL
 from robotcell.robot import Robot
 from robotcell.transforms import invert, rot_y, rot_z
 
-__all__ = ["OPWParameters", "opw_fk", "opw_kernel", "opw_parameters", "opw_problems"]
+__all__ = ["OPWParameters", "clamp_circular", "opw_fk", "opw_kernel", "opw_parameters", "opw_problems",
+           "reach_distance"]
 
 #: Below this distance (m) of the wrist centre from axis 1, and this sine of the paper's angle
-#: t5, the configuration is treated as exactly singular: axis 1, respectively axis 4, keeps the
-#: paper's zero angle (the pose error this admits is at most this size).
+#: t5, the configuration is treated as exactly singular: axis 1, respectively axis 4, is free and
+#: chosen (see :func:`opw_kernel`; the pose error this admits is at most this size).
 SINGULAR_TOL = 1e-12
-#: Allowed excess of the cosine of the elbow angle beyond +-1 that still counts as reachable
-#: (the stretched and the folded elbow); the position error it admits is far below 1e-9 m.
-COS_TOL = 1e-10
+#: Relative rounding of the wrist centre and the arm's lengths (times their size in m): a pose
+#: outside reach by less is inside up to rounding (reported with ``reach_error`` 0).
+ROUND = 64 * np.finfo(float).eps
 
 
 @dataclass(frozen=True)
@@ -250,8 +253,26 @@ def _controller_angle(signs: NDArray[np.float64], offsets: NDArray[np.float64]):
     return f
 
 
+def reach_distance(err_sq: NDArray[np.float64] | float, d: NDArray[np.float64],
+                   rnd: float) -> NDArray[np.float64]:
+    """Add the square of an excess distance ``d`` (m) to ``err_sq``; ``d <= rnd`` counts as 0."""
+    return err_sq + np.where(d > rnd, d * d, 0.0)
+
+
+def clamp_circular(q: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
+    """The 2*pi-equivalent of ``q`` (rad) inside ``[lo, hi]``, else the nearer limit (circularly)."""
+    k = np.ceil((lo - q) / TWO_PI)
+    up = q + TWO_PI * k  # smallest equivalent >= lo
+    d_lo = np.abs(wrap_to_pi(q - lo))
+    d_hi = np.abs(wrap_to_pi(q - hi))
+    return np.where(up <= hi, up, np.where(d_lo <= d_hi, lo, hi))
+
+
 def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.float64],
-               out: NDArray[np.float64]) -> NDArray[np.bool_]:
+               out: NDArray[np.float64], err: NDArray[np.float64],
+               ref: NDArray[np.float64] | None = None,
+               lower: NDArray[np.float64] | None = None,
+               upper: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
     """All 8 solutions, as controller axis values, for poses already expressed in O.
 
     Parameters
@@ -266,11 +287,18 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
         branch ``k = 4 * shoulder + 2 * elbow + wrist``:
         shoulder 1 = wrist centre behind axis 1, elbow 1 = wrist centre behind the line of axes 2
         and 3, wrist 1 = negative paper angle ``t5``. Unreachable branches are NaN.
+    err : ndarray, shape (N, 8)
+        Receives the distance (m) of the wrist centre outside the branch's reach (0 inside).
+    ref : ndarray, shape (N, 6), optional
+        Reference controller values (rad). Where axis 1 or axis 4 is free (wrist centre on axis 1,
+        wrist singularity), it takes the reference's value (axis 1: behind = reference + pi).
+    lower, upper : ndarray, shape (6,), optional
+        Joint limits (rad): a free axis 1 is chosen inside them.
 
     Returns
     -------
     ndarray of bool, shape (N, 8)
-        Which branches reach the pose.
+        Which branches reach the pose (``err <= REACH_TOL``).
     """
     pa = params
     kappa = math.hypot(pa.a2, pa.c3)
@@ -279,12 +307,15 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
     cy = P[:, 1] - pa.c4 * R[:, 1, 2]
     cz = P[:, 2] - pa.c4 * R[:, 2, 2]
     rho2 = cx * cx + cy * cy
-    n2 = rho2 - pa.b * pa.b
-    ok_shoulder = n2 >= -AXIS_TOL * AXIS_TOL
-    n = np.sqrt(np.maximum(n2, 0.0))
+    b = pa.b
+    # Rounding of the wrist centre and of the lengths (a reachable pose is within their sum of
+    # the origin): excesses below it count as 0.
+    rnd = ROUND * 2 * (abs(pa.c4) + abs(pa.a1) + abs(b) + abs(pa.c1) + pa.c2 + kappa)
+    # The wrist centre must not be nearer to axis 1 than the lateral offset |b| (Puma type).
+    err_sh = reach_distance(0.0, abs(b) - np.sqrt(rho2), rnd)
+    n = np.sqrt(np.maximum(rho2 - b * b, 0.0))
     axial = rho2 < SINGULAR_TOL * SINGULAR_TOL
     inv = 1.0 / np.where(axial, 1.0, rho2)
-    b = pa.b
     Z = cz - pa.c1
     R00, R01, R02 = R[:, 0, 0], R[:, 0, 1], R[:, 0, 2]
     R10, R11, R12 = R[:, 1, 0], R[:, 1, 1], R[:, 1, 2]
@@ -293,19 +324,36 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
     base = pa.c2 * pa.c2 + kappa * kappa
     reach = np.empty((P.shape[0], 8), dtype=bool)
     ang = _controller_angle(pa.signs, pa.offsets)
+    free1 = np.flatnonzero(axial)
+    if free1.size:
+        # Axis 1 is free: the reference's value, else the one that puts axis 6 in the arm plane
+        # (axis 4 at its zero, the wrist least bent), moved inside the limits.
+        if ref is not None:
+            q1_free = ref[free1, 0]
+        else:
+            q1_free = pa.signs[0] * np.arctan2(R12[free1], R02[free1])
+        lo1 = -math.inf if lower is None else float(lower[0])
+        hi1 = math.inf if upper is None else float(upper[0])
+    straight_ref = None if ref is None else pa.signs[3] * ref[:, 3] + pa.offsets[3]
     for sh in (0, 1):
         if sh == 0:
-            c1 = np.where(axial, 1.0, (cx * n + cy * b) * inv)
-            s1 = np.where(axial, 0.0, (cy * n - cx * b) * inv)
+            c1 = (cx * n + cy * b) * inv
+            s1 = (cy * n - cx * b) * inv
             X = n - pa.a1
         else:
-            c1 = np.where(axial, -1.0, -(cx * n - cy * b) * inv)
-            s1 = np.where(axial, 0.0, -(cy * n + cx * b) * inv)
+            c1 = -(cx * n - cy * b) * inv
+            s1 = -(cy * n + cx * b) * inv
             X = -(n + pa.a1)
+        if free1.size:
+            t1 = pa.signs[0] * clamp_circular(q1_free + sh * math.pi, lo1, hi1) + pa.offsets[0]
+            c1[free1], s1[free1] = np.cos(t1), np.sin(t1)
         s_2 = X * X + Z * Z
-        K = (s_2 - base) * denom
-        ok = ok_shoulder & (np.abs(K) <= 1.0 + COS_TOL)
-        K = np.clip(K, -1.0, 1.0)
+        s = np.sqrt(s_2)
+        # The wrist centre must lie between the folded and the stretched elbow.
+        err_el = reach_distance(err_sh, np.maximum(s - (pa.c2 + kappa), abs(pa.c2 - kappa) - s), rnd)
+        e = np.sqrt(err_el)
+        ok = e <= REACH_TOL
+        K = np.clip((s_2 - base) * denom, -1.0, 1.0)
         S = np.sqrt(1.0 - K * K)
         M00 = c1 * R00 + s1 * R10
         M01 = c1 * R01 + s1 * R11
@@ -336,8 +384,13 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
             h = np.sqrt(r02 * r02 + M12 * M12)
             straight = h < SINGULAR_TOL
             inv_h = 1.0 / np.where(straight, 1.0, h)
-            c4 = np.where(straight, 1.0, r02 * inv_h)
+            c4 = r02 * inv_h
             s4 = M12 * inv_h
+            if straight_ref is None:
+                c4 = np.where(straight, 1.0, c4)
+            else:  # axis 4 keeps the reference's value, axis 6 takes the rest
+                c4 = np.where(straight, np.cos(straight_ref), c4)
+                s4 = np.where(straight, np.sin(straight_ref), s4)
             k = 4 * sh + 2 * el
             t2q = ang(1, s2, c2)
             t3q = ang(2, s3, c3)
@@ -350,5 +403,7 @@ def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.floa
                 out[:, k + 1, col] = val
             reach[:, k] = ok
             reach[:, k + 1] = ok
+            err[:, k] = e
+            err[:, k + 1] = e
     out[~reach] = np.nan
     return reach

@@ -7,7 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["IKSolutions", "NumericIKResult"]
+__all__ = ["REACH_TOL", "IKSolutions", "NumericIKResult"]
+
+#: A pose outside a branch's reach by at most this distance (m) is solved at the boundary of the
+#: reach, as controllers do with rounded poses; the distance is reported in
+#: :attr:`IKSolutions.reach_error`.
+REACH_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -26,12 +31,18 @@ class IKSolutions:
     method : str
         ``"opw"`` (ortho-parallel arm with a spherical wrist) or ``"ur"`` (three parallel axes).
         Branch ``k`` has ``k = 4 * shoulder + 2 * elbow + wrist`` (see docs/ik.md).
+    reach_error : ndarray, shape (..., 8), optional
+        Distance (m) by which the target's wrist point lies outside the branch's reach; 0 when it
+        is inside up to rounding. ``reachable`` is ``reach_error <= REACH_TOL`` (1 um); such a
+        branch is solved at the boundary of the reach, and its TCP position differs from the
+        target by ``reach_error`` (the orientation is exact).
     """
 
     q: NDArray[np.float64]
     valid: NDArray[np.bool_]
     reachable: NDArray[np.bool_]
     method: str
+    reach_error: NDArray[np.float64] | None = None
 
     @property
     def count(self) -> NDArray[np.int_]:

@@ -132,7 +132,7 @@ class TrackRobot:
         xcol = np.broadcast_to(xs[..., None, None], sol.q.shape[:-1] + (1,))
         xin = (xs >= self.lower) & (xs <= self.upper)
         return IKSolutions(np.concatenate([xcol, sol.q], axis=-1), sol.valid & xin[..., None],
-                           sol.reachable, sol.method)
+                           sol.reachable, sol.method, sol.reach_error)
 
     def ik(self, T: ArrayLike, samples: int = 65, tool: ArrayLike | None = None) -> TrackChoice:
         """Choose the track value, then return the 8 arm solutions there.

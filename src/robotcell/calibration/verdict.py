@@ -1,0 +1,286 @@
+"""The verdict on a calibration: good, check or poor, and why.
+
+One rule for every procedure, used by the terminal report, the ``--json`` output and the HTML
+report, so all three say the same. It reads the result in its JSON form
+(:meth:`robotcell.calibration.CalibrationResult.to_json`, millimetres and degrees), so a report
+made later from a saved result judges it exactly as the terminal did.
+
+The rule (``docs/calibration.md``, "Verdict"):
+
+- **Accuracy.** The touch accuracy ``s`` is the one stated with ``--sigma`` (``noise_source ==
+  "prior"``) or :data:`DEFAULT_TOUCH_SIGMA_MM`. If the touches were that accurate,
+  ``SSR / s^2`` (SSR the sum of squared residuals) would be chi-square distributed with the
+  redundancy ``dof`` as degrees of freedom. Above its :data:`CHI2_P` quantile the residuals are
+  larger than the accuracy explains: *check*; above that quantile for ``POOR_FACTOR * s``: *poor*.
+- **Scale** (track): more than :data:`SCALE_CHECK` from 1: *check*; more than
+  :data:`SCALE_POOR`: *poor*.
+- **Conditioning**: condition number above :data:`CONDITION_GOOD`: *check*; above
+  :data:`CONDITION_POOR`: *poor*.
+- **Size**: a length in the result (an origin, a TCP, a radius, an offset, a touched point)
+  beyond :data:`CELL_EXTENT_MM`: *poor* (no robot cell is that large; a unit or typing error).
+- **Redundancy**: without :data:`OUTLIER_REDUNDANCY` redundant coordinates a wrong touch cannot be
+  singled out (see :func:`touches_for_outlier_check`): *check*, naming how many touches would
+  make the check possible. With no redundancy at all nothing checks the result.
+- Any warning of the procedure (an outlier among them): *check*.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.special import chdtri
+
+__all__ = [
+    "CELL_EXTENT_MM",
+    "CHI2_P",
+    "CONDITION_GOOD",
+    "CONDITION_POOR",
+    "DEFAULT_TOUCH_SIGMA_MM",
+    "OUTLIER_REDUNDANCY",
+    "POOR_FACTOR",
+    "SCALE_CHECK",
+    "SCALE_POOR",
+    "Verdict",
+    "touches_for_outlier_check",
+    "verdict",
+]
+
+#: Touch-up accuracy assumed when none is stated (mm, 1-sigma per coordinate): a technician
+#: touching a sharp reference with a pointed tool by eye; the demo and ``simulate`` use 0.1 mm.
+DEFAULT_TOUCH_SIGMA_MM = 0.5
+#: Probability of the chi-square bound: good touches exceed it once in a thousand calibrations.
+CHI2_P = 0.999
+#: Residuals that need a noise more than this many times the accuracy are poor.
+POOR_FACTOR = 3.0
+#: Condition numbers up to this are a good measurement design (Schroer's threshold, as cited by
+#: Nahvi and Hollerbach, ICRA 1996) ...
+CONDITION_GOOD = 100.0
+#: ... and above this the result is not trustworthy.
+CONDITION_POOR = 1000.0
+#: Relative deviation of a track scale from 1 that asks for a check of the gear ratio ...
+SCALE_CHECK = 0.02
+#: ... and that no real track has (a unit error or touches of different points).
+SCALE_POOR = 0.10
+#: Largest length (mm) in any real robot cell: 100 m.
+CELL_EXTENT_MM = 1e5
+#: Redundant coordinates left after removing one touch (3 coordinates) needed to single out a
+#: wrong touch: with 6, an outlier flagged half the time is at most twice the one flagged with a
+#: known noise (the F(3, 6) against the chi-square(3) 3-sigma test); with 3 it is 3.7 times.
+OUTLIER_REDUNDANCY = 6
+
+#: JSON keys in mm that are not lengths of the result (residual statistics, uncertainties).
+_NOT_LENGTHS = {"residuals_mm", "residuals_xyz_mm", "rms_mm", "max_mm", "mean_mm", "min_mm",
+                "noise_sigma_mm", "straightness_mm"}
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Grade of a calibration result.
+
+    Attributes
+    ----------
+    level : {"good", "check", "poor"}
+    reasons : list of str
+        Why, most serious first; for ``good`` what was checked.
+    condition : float
+        The condition number the verdict used (as printed in the terminal report).
+    touch_sigma_mm : float
+        Touch accuracy the chi-square bound used (mm, 1-sigma per coordinate).
+    accuracy_source : {"stated", "default"}
+    chi2 : float or None
+        ``SSR / touch_sigma^2``; None without redundancy.
+    chi2_bound : float or None
+        Its :data:`CHI2_P` quantile for ``dof`` degrees of freedom; None without redundancy.
+    touches_needed : int or None
+        Number of touches (in all) that would let a wrong touch be singled out, when the
+        measurements have too little redundancy; else None.
+    """
+
+    level: str
+    reasons: list[str] = field(default_factory=list)
+    condition: float = float("nan")
+    touch_sigma_mm: float = DEFAULT_TOUCH_SIGMA_MM
+    accuracy_source: str = "default"
+    chi2: float | None = None
+    chi2_bound: float | None = None
+    touches_needed: int | None = None
+
+    def line(self) -> str:
+        """The one-line verdict of the terminal report: ``verdict: POOR: reason; reason``."""
+        return f"verdict: {self.level.upper()}: {'; '.join(self.reasons)}"
+
+    def to_json(self) -> dict[str, Any]:
+        """The verdict as plain JSON values (NaN becomes None)."""
+        def num(v: float | None) -> float | None:
+            return None if v is None or not math.isfinite(v) else float(v)
+        return {"level": self.level, "reasons": list(self.reasons),
+                "condition": num(self.condition), "touch_sigma_mm": self.touch_sigma_mm,
+                "accuracy_source": self.accuracy_source, "chi2": num(self.chi2),
+                "chi2_bound": num(self.chi2_bound), "touches_needed": self.touches_needed}
+
+
+def format_condition(condition: float) -> str:
+    """The condition number as every report prints it (one decimal)."""
+    if math.isnan(condition):
+        return "unknown"
+    return f"{condition:.1f}" if math.isfinite(condition) else "infinite"
+
+
+def touches_for_outlier_check(n_touches: int, dof: int) -> int | None:
+    """Touches needed so that a wrong touch can be singled out, or None when there are enough.
+
+    Removing one touch removes 3 coordinates; the rest must keep :data:`OUTLIER_REDUNDANCY`
+    redundant coordinates. Each further touch of the same point(s) adds 3.
+
+    Parameters
+    ----------
+    n_touches : int
+        Touches (measured points) used.
+    dof : int
+        Redundancy of the fit (coordinates minus parameters).
+
+    Returns
+    -------
+    int or None
+        Smallest number of touches in all, assuming every added touch adds 3 coordinates and no
+        parameter (a repeated touch of a point already touched); None when ``dof`` suffices.
+    """
+    missing = OUTLIER_REDUNDANCY + 3 - dof
+    if missing <= 0:
+        return None
+    return n_touches + math.ceil(missing / 3)
+
+
+def _number(v: Any, default: float = float("nan")) -> float:
+    """A JSON number as float; ``default`` for null, text or anything else."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return default
+    return float(v) if math.isfinite(v) else default
+
+
+def _floats(v: Any) -> np.ndarray:
+    """Numbers of a JSON value as a float array; None (a JSON null for NaN) becomes NaN."""
+    a = np.asarray(v, dtype=object)
+    return np.where(np.equal(a, None), np.nan, a).astype(float)
+
+
+def _lengths(result: Mapping[str, Any]) -> list[tuple[str, float]]:
+    """(name, largest |value| in mm) of every length in the result."""
+    out = []
+    for key, v in result.items():
+        if key == "matrix" or key == "turntable_matrix":
+            try:
+                t = _floats(v)[:3, 3]
+            except (TypeError, ValueError, IndexError):
+                continue
+            if not np.any(np.isnan(t)):
+                out.append(("origin" if key == "matrix" else "turntable origin",
+                            float(np.max(np.abs(t)))))
+        elif key == "points_mm" or (key.endswith("_mm") and key not in _NOT_LENGTHS):
+            try:
+                a = np.abs(_floats(v))
+            except (TypeError, ValueError):
+                continue
+            a = a[~np.isnan(a)]  # null: not determined
+            if a.size:
+                out.append(("touched points" if key == "points_mm" else key[:-3], float(a.max())))
+    return out
+
+
+def verdict(result: Mapping[str, Any]) -> Verdict:
+    """Grade a calibration result by the rule of this module.
+
+    Parameters
+    ----------
+    result : mapping
+        A calibration result as JSON (mm, deg): the output of ``CalibrationResult.to_json()`` or
+        of ``robotcell calibrate ... --json``. Used: ``residuals_xyz_mm`` (or ``residuals_mm``),
+        ``dof``, ``noise_source``, ``noise_sigma_mm``, ``condition``, ``warnings``, ``scale``,
+        ``matrix`` and the lengths ending in ``_mm``.
+
+    Returns
+    -------
+    Verdict
+    """
+    poor: list[str] = []
+    check: list[str] = []
+    cond = _number(result.get("condition"))
+    dof = int(_number(result.get("dof"), 0.0))
+    res = result.get("residuals_xyz_mm")
+    if res is None:
+        res = result.get("residuals_mm") or []
+    try:
+        r = _floats(res)
+    except (TypeError, ValueError):
+        r = np.full(1, np.nan)  # unreadable residuals: no bound can hold
+    n = len(r) if r.ndim else 0
+    ssr = float(np.sum(r**2)) if np.all(np.isfinite(r)) else float("inf")
+    stated = _number(result.get("noise_sigma_mm")) if result.get("noise_source") == "prior" else 0.0
+    stated = stated if stated > 0 else 0.0
+    s = stated or DEFAULT_TOUCH_SIGMA_MM
+    source = "stated" if stated else "default"
+    what = (f"the stated touch accuracy {s:g} mm" if stated
+            else f"the default touch accuracy {s:g} mm (state yours with --sigma)")
+
+    for name, size in _lengths(result):
+        if not size <= CELL_EXTENT_MM:
+            poor.append(f"{name} of {size:.3g} mm is beyond any real cell "
+                        f"({CELL_EXTENT_MM / 1e3:.0f} m): a unit or typing error in the measurements")
+    x2 = bound = None
+    if dof > 0:
+        x2 = ssr / s**2
+        bound = float(chdtri(dof, 1.0 - CHI2_P))
+        rms = math.sqrt(ssr / n) if n else 0.0
+        if x2 > bound * POOR_FACTOR**2:
+            poor.append(f"RMS {rms:.3f} mm is far beyond {what}: the residuals need a noise of "
+                        f"{math.sqrt(ssr / dof):.3f} mm per coordinate (chi-square "
+                        f"{x2:.3g} > {bound * POOR_FACTOR ** 2:.3g}, the {CHI2_P:.1%} bound "
+                        f"for {POOR_FACTOR:g} times the accuracy); look for a wrong row or unit")
+        elif x2 > bound:
+            check.append(f"RMS {rms:.3f} mm is larger than {what} explains (chi-square "
+                         f"{x2:.3g} > {bound:.3g}, the {CHI2_P:.1%} bound for {dof} redundant "
+                         "coordinates)")
+    scale = result.get("scale")
+    if isinstance(scale, (int, float)):
+        if not abs(scale - 1.0) <= SCALE_POOR:
+            poor.append(f"track scale {scale:.4f} is more than {SCALE_POOR:.0%} from 1: no real "
+                        "track has that gear ratio error; check the e1 column (mm) and that every "
+                        "touch is of the same point")
+        elif abs(scale - 1.0) > SCALE_CHECK:
+            check.append(f"track scale {scale:.4f} is more than {SCALE_CHECK:.0%} from 1")
+    if not cond <= CONDITION_POOR and not math.isnan(cond):
+        poor.append(f"condition number {format_condition(cond)} > {CONDITION_POOR:.0f}: the "
+                    "touches barely determine the result")
+    elif cond > CONDITION_GOOD:
+        check.append(f"condition number {format_condition(cond)} > {CONDITION_GOOD:.0f}: "
+                     "spread the touches")
+    warnings = result.get("warnings") or []
+    warnings = list(warnings) if isinstance(warnings, list) else [str(warnings)]
+    outliers = sum("outlier" in str(w) for w in warnings)
+    if outliers:
+        check.append(f"{outliers} touch(es) flagged as outlier: re-touch them")
+    if len(warnings) > outliers:
+        check.append(f"{len(warnings) - outliers} warning(s), listed below")
+    needed = touches_for_outlier_check(n, dof) if n else None
+    if needed is not None:
+        if dof <= 0:
+            check.append(f"no redundancy: {n} touches determine the result exactly, so nothing "
+                         f"checks it and a wrong touch goes unseen; take {needed} or more touches")
+        else:
+            check.append(f"redundancy {dof} is too little to single out a wrong touch; take "
+                         f"{needed} or more touches")
+    if poor:
+        level, reasons = "poor", poor + check
+    elif check:
+        level, reasons = "check", check
+    else:
+        level = "good"
+        rms = math.sqrt(ssr / n) if n else 0.0
+        reasons = [f"RMS {rms:.3f} mm within {what}, condition number "
+                   + f"{format_condition(cond)}, no warnings"]
+    return Verdict(level=level, reasons=reasons, condition=cond, touch_sigma_mm=s,
+                   accuracy_source=source, chi2=x2, chi2_bound=bound, touches_needed=needed)
