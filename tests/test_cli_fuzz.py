@@ -6,7 +6,8 @@ turntable, workpiece; fk; ik; export; report; cell show), applies one or two see
 files, binary junk, European CSV, ...) and runs the command in process. Each run must end with a
 documented exit status: 0 (done), 2 (refused input, with ``error:`` on stderr) or 3 (a poor
 calibration); 1 means an unexpected failure and fails the test. No ``Traceback`` may appear on
-stdout or stderr, and a run that is refused leaves no output file and no temporary file behind.
+stdout or stderr, and a run that is refused or poor leaves no output file and no temporary file
+behind.
 
 ``ROBOTCELL_FUZZ_SEED`` changes the seed (default 2026); the cases of a failing seed are printed.
 """
@@ -358,7 +359,7 @@ def test_cli_fuzz(command, tmp_path, capsys, good):
         if code == 2 and "error:" not in err:
             problems.append("exit 2 without 'error:'")
         left = sorted(p.name for p in (tmp_path / "out").iterdir())
-        if code == 2 and output is not None and left:
+        if code in (2, 3) and output is not None and left:
             problems.append(f"refused run left files {left}")
         if any(name.endswith(".tmp") for name in left):
             problems.append(f"temporary files left {left}")

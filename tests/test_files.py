@@ -498,3 +498,17 @@ def test_plan_refuses_huge_counts_up_front(capsys):
                          "--touches", "1000000000000")
     assert code == 2 and "a simulation places at most 200 touches" in err
     assert "Traceback" not in out + err
+
+
+def test_poor_calibration_writes_no_output_file(tmp_path, capsys):
+    table = _turntable_csv(tmp_path)
+    lines = table.read_text().splitlines()
+    x, rest = lines[2].split(",", 1)
+    lines[2] = f"{float(x) + 50.0:.4f},{rest}"  # one touch 50 mm off: a poor verdict
+    table.write_text("\n".join(lines) + "\n")
+    result = tmp_path / "tt.json"
+    code, out, err = run(capsys, "calibrate", "turntable", table, "--json", "-o", result)
+    assert code == 3 and not result.exists() and "Traceback" not in out + err
+    code, _, _ = run(capsys, "calibrate", "turntable", table, "--json", "-o", result,
+                     "--accept-poor")
+    assert code == 0 and json.loads(result.read_text())["procedure"] == "turntable"
