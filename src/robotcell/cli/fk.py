@@ -37,7 +37,8 @@ def tool_option(text: str | None) -> np.ndarray | None:
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
 @click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
-              help="CSV to write, atomically (default: standard output).")
+              help="CSV to write, atomically: the poses of --input, or one row for --joints "
+                   "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,
               help="Pose format of the result.")
 @click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention); "
@@ -85,6 +86,9 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
         T = r.fk(q, tool=T_tool)
         if not r.within_limits(q):
             click.echo("warning: joint values outside the robot's limits", err=True)
+        if output_path is not None:
+            _write_poses(T[None], fmt, output_path)
+            return
         if fmt == "matrix":
             click.echo("T_R_TCP (translation in mm):")
         _echo_pose(T, fmt)
@@ -146,8 +150,8 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
     outside = int(np.count_nonzero(~r.within_limits(q)))
     if outside:
         click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
-    if joints is not None:
+    if joints is not None and output_path is None:
         click.echo(f"{cell.name}: TCP in frame {frame!r} ({fmt}, mm, deg)")
         _echo_pose(T, fmt)
         return
-    _write_poses(T, fmt, output_path)
+    _write_poses(T.reshape(-1, 4, 4), fmt, output_path)

@@ -54,7 +54,8 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
 @click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
-              help="CSV to write, atomically (default: standard output).")
+              help="File to write, atomically: the CSV of --input, or the table of --pose "
+                   "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,
               help="Pose format of --pose / --input.")
 @click.option("--all", "show_all", is_flag=True, help="Also list unreachable and out-of-limit branches.")
@@ -145,8 +146,8 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         if not rows:
             raise InputError("no valid solution (unreachable or outside the joint limits); "
                              "--all lists every branch")
-        click.echo(f"{r.name}, {solver.method} solver, angles in degrees")
-        click.echo(format_table(headers, rows))
+        write_output(output_path, f"{r.name}, {solver.method} solver, angles in degrees\n"
+                     f"{format_table(headers, rows)}\n")
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
     cols = read_csv(input_path, known=names)
@@ -230,9 +231,8 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
         how = "chosen" if track_mm is None else "given"
         where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
         where += f", table {float(sol.table) * deg:g} deg" if cell.turntable is not None else ""
-        click.echo(f"{cell.name}: {r.name}, {sol.method} solver, target in frame {frame!r}{where}; "
-                   "angles in degrees")
-        click.echo(format_table(headers, rows))
+        write_output(output_path, f"{cell.name}: {r.name}, {sol.method} solver, target in frame "
+                     f"{frame!r}{where}; angles in degrees\n{format_table(headers, rows)}\n")
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
     cols = read_csv(input_path, known=[*names, "track", "table"])
