@@ -518,9 +518,8 @@ def test_o_with_single_pose_writes_the_file(tmp_path, capsys):
     out = tmp_path / "pose.csv"
     code, stdout, _ = run(capsys, "fk", "kuka_kr16", "--joints", "0,-90,90,0,0,0", "-o", out)
     assert code == 0 and stdout == ""
-    assert out.read_text().splitlines() == ["X,Y,Z,A,B,C",
-                                           "1088.000000,0.000000,1320.000000,0.000000,0.000000,"
-                                           "0.000000"]
+    row = "1088.000000,0.000000,1320.000000,0.000000,0.000000,0.000000"
+    assert out.read_text().splitlines() == ["X,Y,Z,A,B,C", row]
     table = tmp_path / "ik.txt"
     code, stdout, _ = run(capsys, "ik", "kuka_kr16", "--pose", "1200,0,1200,0,90,0", "-o", table)
     assert code == 0 and stdout == "" and "0 front up" in table.read_text()
