@@ -523,3 +523,22 @@ def test_o_with_single_pose_writes_the_file(tmp_path, capsys):
     table = tmp_path / "ik.txt"
     code, stdout, _ = run(capsys, "ik", "kuka_kr16", "--pose", "1200,0,1200,0,90,0", "-o", table)
     assert code == 0 and stdout == "" and "0 front up" in table.read_text()
+
+
+def test_read_only_file_is_not_replaced(tmp_path, capsys):
+    from robotcell.cell import Cell
+
+    cell = tmp_path / "cell.yaml"
+    cell.write_bytes(EXAMPLE.read_bytes())
+    os.chmod(cell, 0o444)
+    before = cell.read_bytes()
+    with pytest.raises(InputError, match=r"the file is read-only \(mode 444\)"):
+        Cell.load(cell).save(cell)
+    out = tmp_path / "kuka.dat"
+    out.write_text("kept")
+    os.chmod(out, 0o444)
+    code, _, err = run(capsys, "export", "--cell", cell, "--format", "kuka", "-o", out)
+    assert code == 2 and "the file is read-only (mode 444)" in err
+    assert cell.read_bytes() == before and out.read_text() == "kept"
+    assert stat.S_IMODE(cell.stat().st_mode) == 0o444
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "kuka.dat"]  # no .bak

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell import cellik, coupled
 from robotcell.coupled import RESERVED_FRAMES
 from robotcell.errors import InputError
-from robotcell.fileio import atomic_copy, atomic_write, read_text
+from robotcell.fileio import atomic_copy, atomic_write, check_destination, read_text
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.robot import Robot
@@ -505,6 +505,7 @@ class Cell:
         p = Path(path)
         text = _HEADER + yaml.safe_dump(cell_to_dict(self, p.resolve().parent), sort_keys=False,
                                         default_flow_style=None, width=100)
+        check_destination(p)  # a read-only file is refused before the backup is made
         if p.exists():
             atomic_copy(p, p.with_name(p.name + ".bak"))
         atomic_write(p, text)

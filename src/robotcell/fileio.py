@@ -16,7 +16,8 @@ text" saves) is not read: both are refused with :class:`~robotcell.errors.InputE
 
 **Writing.** :func:`atomic_write` writes a temporary file in the destination's folder, flushes and
 fsyncs it, gives it the permissions of the file it replaces (or the usual ones of a new file,
-``0o666`` less the umask), then moves it over the destination with ``os.replace``. A run that
+``0o666`` less the umask), then moves it over the destination with ``os.replace``. A file without
+write permission for its owner is refused, not replaced. A run that
 fails before the write leaves nothing behind, and one that dies during it leaves the old file or
 the new one in full, never a partial or empty file. A missing folder, or a destination that is a
 folder, is refused with :class:`~robotcell.errors.InputError` naming it.
@@ -112,12 +113,15 @@ def read_text(path: str | Path, what: str = "file") -> str:
 
 
 def check_destination(path: str | Path) -> Path:
-    """``path`` as a Path whose folder exists and which is not itself a folder.
+    """``path`` as a Path whose folder exists and which is neither a folder nor read-only.
+
+    A file without write permission for its owner is refused: ``os.replace`` would go over it,
+    so the owner's protection is respected instead.
 
     Raises
     ------
     InputError
-        ``path`` is a folder, or its folder does not exist.
+        ``path`` is a folder or a read-only file, or its folder does not exist.
     """
     p = Path(path)
     if str(path) == "" or p.is_dir():
@@ -126,6 +130,10 @@ def check_destination(path: str | Path) -> Path:
     if not folder.is_dir():
         raise InputError(f"cannot write {path}: the folder {str(folder)!r} does not exist; "
                          "create it first")
+    if p.exists() and not p.stat().st_mode & 0o200:
+        raise InputError(f"cannot write {path}: the file is read-only (mode "
+                         f"{p.stat().st_mode & 0o777:o}); make it writable or write to another "
+                         "file")
     return p
 
 
@@ -184,8 +192,8 @@ def atomic_write(path: str | Path, content: str | bytes) -> None:
     Raises
     ------
     InputError
-        The folder does not exist, ``path`` is a folder, or the file cannot be written (the
-        message names the file and the system's reason).
+        The folder does not exist, ``path`` is a folder or a read-only file, or the file cannot
+        be written (the message names the file and the system's reason).
     """
     p = check_destination(path)
     data = content.encode("utf-8") if isinstance(content, str) else content
