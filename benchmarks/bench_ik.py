@@ -3,7 +3,9 @@
 Run: ``python benchmarks/bench_ik.py``. Prints the machine, the batched analytic IK time per pose
 (all 8 solutions, including input validation, joint-limit and 2*pi handling) with its ratio to
 EAIK's batched C++ solver on one thread: measured in the same run when EAIK is installed
-(``pip install EAIK``), otherwise against 4.7 us/pose measured on a 2-core machine (docs/references.md); and the
+(``pip install EAIK``), otherwise against 4.7 us/pose measured on a 2-core machine
+(docs/references.md); J2/J3-coupled arms against the same arm without its coupling, timed
+alternately in the same run; and the
 convergence of numeric IK for a 7-axis robot on a linear track over reachable random targets.
 """
 
@@ -11,6 +13,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
@@ -86,6 +89,8 @@ def main() -> None:
         print(f"  {name:20s} {us:6.2f} us/pose   {how}: {ref:5.2f} us/pose, "
               f"ratio {ref / us:4.2f}x   (target >= 2x)")
 
+    coupled_vs_uncoupled()
+
     arm = load_robot("kuka_kr6_r700_sixx")
     track = TrackRobot(arm, make_pose(rot_z(0.3) @ rot_x(0.01), [0.1, 0.2, 0.3]),
                        np.array([1.0, 0.01, 0.0]), -1.0, 3.0)
@@ -104,6 +109,37 @@ def main() -> None:
     print(f"  converged {res.success.mean() * 100:.1f} % (target >= 99.5 %), false successes {false}, "
           f"median {int(np.median(res.iterations))} iterations, max {res.restarts.max()} restarts, "
           f"{dt / N_TARGETS * 1e3:.2f} ms/target (batched)")
+
+
+def coupled_vs_uncoupled(n: int = N_POSES // 2, rounds: int = 7) -> None:
+    """Analytic IK of J2/J3-coupled arms against the same arm without its coupling.
+
+    The reference is the identical model (same chain, same limits) with ``coupling=None``, so the
+    ratio is the cost of mapping model solutions to controller values. Both are timed alternately
+    in the same run (the machine is shared). Target: ratio <= 1.2. A palletizer (4 branches) is
+    reported for information.
+    """
+    print(f"\nanalytic IK with a J2/J3 coupling, batch of {n} poses, alternating {rounds} rounds:")
+    for name in ("fanuc_m20ia", "abb_irb2400"):
+        coupled = load_robot(name)
+        plain = replace(coupled, coupling=None)
+        rng = np.random.default_rng(0)
+        lo, hi = np.maximum(coupled.lower, -np.pi), np.minimum(coupled.upper, np.pi)
+        T = coupled.fk(rng.uniform(lo, hi, (n, 6)))
+        solve(coupled, T[:10]), solve(plain, T[:10])
+        tc, tp = [], []
+        for _ in range(rounds):
+            tc.append(median_time(lambda c=coupled, T=T: solve(c, T), repeats=1))
+            tp.append(median_time(lambda p=plain, T=T: solve(p, T), repeats=1))
+        uc, up = np.median(tc) / n * 1e6, np.median(tp) / n * 1e6
+        print(f"  {name:20s} coupled {uc:6.2f} us/pose, uncoupled {up:6.2f} us/pose, "
+              f"ratio {uc / up:4.2f}   (target <= 1.2)")
+    pal = load_robot("abb_irb460")
+    rng = np.random.default_rng(0)
+    T = pal.fk(rng.uniform(pal.lower, pal.upper, (n, 4)))
+    solve(pal, T[:10])
+    t = median_time(lambda: solve(pal, T), repeats=rounds)
+    print(f"  {'abb_irb460':20s} palletizer, all 4 solutions: {t / n * 1e6:6.2f} us/pose")
 
 
 if __name__ == "__main__":

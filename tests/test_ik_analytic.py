@@ -63,7 +63,7 @@ def check_round_trip(robot: Robot, q: np.ndarray, tool=None, original: bool = Tr
     """
     T = robot.fk(q, tool=tool)
     sol = solve(robot, T, tool=tool)
-    assert sol.q.shape == q.shape[:-1] + (8, 6)
+    assert sol.q.shape == q.shape[:-1] + ((8, 6) if robot.n_joints == 6 else (4, 4))  # 4: palletizer
     Q = np.where(sol.reachable[..., None], sol.q, 0.0)
     T2 = robot.fk(Q, tool=tool)
     pos = np.linalg.norm(T2[..., :3, 3] - T[..., None, :3, 3], axis=-1)

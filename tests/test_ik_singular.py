@@ -52,10 +52,14 @@ def families(robot: Robot, rng: np.random.Generator, n: int) -> dict[str, np.nda
     """Singular configurations (controller values, rad) with random axis 1 and random free axes."""
     s = analytic_solver(robot)
     p, sg, off = s.params, s.params.signs, s.params.offsets
-    th = sg * random_q(robot, rng, n) + off  # the solver's angles of random configurations
+    # The solver's angles of random configurations (of the uncoupled model for a coupled arm).
+    th = sg * robot.model_values(random_q(robot, rng, n)) + off
 
     def ctrl(theta: np.ndarray) -> np.ndarray:
-        return in_limits(robot, wrap_to_pi((theta - off) * sg))
+        q = (theta - off) * sg
+        if robot.coupling is not None:
+            q = robot.coupling.to_controller(q)
+        return in_limits(robot, wrap_to_pi(q))
 
     out = {}
     for name, t5 in (("q5=0", 0.0), ("q5=+1e-12", 1e-12), ("q5=-1e-12", -1e-12)):
@@ -131,7 +135,7 @@ def distances(robot: Robot, q: np.ndarray) -> dict[str, np.ndarray]:
     shoulder singularity (axis 1, the cylinder of radius |b| or |d4|)."""
     s = analytic_solver(robot)
     p = s.params
-    th = p.signs * q + p.offsets
+    th = p.signs * robot.model_values(q) + p.offsets
     t2, t23 = th[:, 1], th[:, 1] + th[:, 2]
     if s.method == "opw":
         elbow = np.sin(th[:, 2] + math.atan2(p.a2, p.c3))
@@ -163,6 +167,8 @@ def test_random_and_singular_families(name):
     rng = np.random.default_rng(sum(map(ord, name)) + 12)
     check(robot, random_q(robot, rng, N_RANDOM))
     method = analytic_solver(robot).method
+    if method == "palletizer":
+        return  # 4 axes and a level flange: none of the 6-axis singular families exists
     for fname, qf in families(robot, rng, N_FAMILY).items():
         if own_empty_ok(robot, fname, qf):
             continue
@@ -258,7 +264,7 @@ def outward(robot: Robot, q: np.ndarray) -> np.ndarray:
     """Unit vector (in R) from axis 2 to the wrist point within the arm plane at ``q``."""
     s = analytic_solver(robot)
     p = s.params
-    th = p.signs * q + p.offsets
+    th = p.signs * robot.model_values(q) + p.offsets
     if s.method == "opw":
         T = opw_fk(p, th)
         u = T[:3, 3] - p.c4 * T[:3, 2] - rot_z(th[0]) @ np.array([p.a1, p.b, p.c1])

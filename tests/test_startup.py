@@ -61,13 +61,13 @@ def test_calibrate_tcp_imports_what_it_needs_only(tmp_path, capsys):
 
 
 def test_every_public_name_is_importable_as_before():
-    from robotcell import errors, modelfile, poseformats, robot, transforms
+    from robotcell import coupling, errors, modelfile, poseformats, robot, transforms
 
     home = {**{n: errors for n in ("IllPosedError", "InputError", "RobotcellError")},
             **{n: modelfile for n in ("list_robots", "load_robot", "robot_from_dict",
                                       "save_robot")},
             **{n: poseformats for n in ("FORMATS", "pose_from_vendor", "pose_to_vendor")},
-            **{n: robot for n in ("Joint", "Robot")}}
+            **{n: robot for n in ("Joint", "Robot")}, "Coupling": coupling}
     for name in robotcell.__all__:
         assert getattr(robotcell, name) is getattr(home.get(name, transforms), name), name
     assert set(home) | {n for n in robotcell.__all__ if hasattr(transforms, n)} == set(

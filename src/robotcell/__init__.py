@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 from robotcell.errors import IllPosedError, InputError, RobotcellError
 
 if TYPE_CHECKING:
+    from robotcell.coupling import Coupling
     from robotcell.modelfile import list_robots, load_robot, robot_from_dict, save_robot
     from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
     from robotcell.robot import Joint, Robot
@@ -33,6 +34,7 @@ __version__ = "0.1.0"
 
 #: public name -> module that defines it, imported on first access
 _LAZY = {
+    "Coupling": "robotcell.coupling",
     **dict.fromkeys(["list_robots", "load_robot", "robot_from_dict", "save_robot"],
                     "robotcell.modelfile"),
     **dict.fromkeys(["FORMATS", "pose_from_vendor", "pose_to_vendor"], "robotcell.poseformats"),
@@ -42,10 +44,11 @@ _LAZY = {
 }
 #: Submodules that ``import robotcell`` used to load as a side effect, still reachable as
 #: attributes (``robotcell.transforms``) and loaded on first access.
-_SUBMODULES = {"dh", "modelfile", "poseformats", "robot", "transforms"}
+_SUBMODULES = {"coupling", "dh", "modelfile", "poseformats", "robot", "transforms"}
 
 __all__ = [
     "FORMATS",
+    "Coupling",
     "IllPosedError",
     "InputError",
     "Joint",

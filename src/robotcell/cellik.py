@@ -23,20 +23,25 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.coupled import RESERVED_FRAMES, frame_pose, robot_pose, tool_pose
+from robotcell.coupled import (
+    RESERVED_FRAMES,
+    broadcast_table,
+    frame_pose,
+    robot_pose,
+    table_batch,
+    table_values,
+    tool_pose,
+)
+from robotcell.coupled import CellModel as Cell  # what is read of a robotcell.cell.Cell
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.track import TrackRobot
 from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, validate_pose
-
-if TYPE_CHECKING:
-    from robotcell.cell import Cell
 
 __all__ = ["CellIKSolutions", "CellPath", "depends_on_track", "ik", "ik_path"]
 
@@ -143,7 +148,7 @@ def depends_on_track(cell: Cell, frame: str) -> bool:
 
 
 def _limits_ok(cell: Cell, e: NDArray[np.float64], th: NDArray[np.float64]) -> NDArray[np.bool_]:
-    ok = np.ones(np.broadcast_shapes(e.shape, th.shape), dtype=bool)
+    ok = np.ones(np.broadcast_shapes(e.shape, table_batch(cell, th)), dtype=bool)
     if cell.track is not None:
         ok &= cell.track.within_limits(e)
     if cell.turntable is not None:
@@ -183,8 +188,9 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         Track position (m). Default: 0 without a track; with a track, chosen per target where
         the arm reaches it with the largest manipulability (needs the track limits; refused for
         frames that move with the track).
-    table : array_like, shape (...)
-        Table angle (rad) at which the target is given; must be 0 without turntable.
+    table : array_like, shape (...) or (..., n)
+        Table angle (rad) at which the target is given, or a positioner's axis values; must be
+        0 without turntable.
     tool : str or array_like of shape (4, 4), optional
         A tool of the cell by name, or ``T_F_TCP`` (m); default: the robot model's tool.
     samples : int
@@ -208,11 +214,11 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
     >>> sol.q[sol.valid]                                                          # doctest: +SKIP
     """
     arr = validate_pose(T, "target pose")
-    th = finite_array(table, "table angle")
+    th = table_values(cell, table)
     T_tool = tool_pose(cell, tool)
     if track is None and cell.track is not None:
         _check_track_choice(cell, frame)
-        batch = np.broadcast_shapes(arr.shape[:-2], th.shape)
+        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th))
         T_world = frame_pose(cell, frame, 0.0, th) @ arr
         T_L = invert(cell.track.T_world_L) @ np.broadcast_to(T_world, batch + (4, 4))
         choice = _track_robot(cell).ik(T_L, samples=samples, tool=T_tool)
@@ -222,12 +228,12 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         method = choice.solutions.method
     else:
         e = finite_array(0.0 if track is None else track, "track position")
-        batch = np.broadcast_shapes(arr.shape[:-2], th.shape, e.shape)
+        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th), e.shape)
         e = np.broadcast_to(e, batch)
         T_world = frame_pose(cell, frame, e, th) @ arr
         sol = cell.robot.ik(invert(robot_pose(cell, e)) @ T_world, tool=T_tool)
         q, valid, reachable, method = sol.q, sol.valid, sol.reachable, sol.method
-    th = np.broadcast_to(th, batch)
+    th = broadcast_table(cell, th, batch)
     valid = valid & _limits_ok(cell, e, th)[..., None]
     return CellIKSolutions(q, valid, reachable, np.array(e, dtype=float), np.array(th), method)
 
@@ -235,9 +241,9 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
 def _path_inputs(cell: Cell, T: ArrayLike, table: ArrayLike, track: ArrayLike | None
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
     arr = validate_pose(T, "path targets")
-    th = finite_array(table, "table angle")
+    th = table_values(cell, table)
     e = None if track is None else finite_array(track, "track position")
-    shapes = [arr.shape[:-2], th.shape] + ([] if e is None else [e.shape])
+    shapes = [arr.shape[:-2], table_batch(cell, th)] + ([] if e is None else [e.shape])
     try:
         batch = np.broadcast_shapes(*shapes)
     except ValueError:
@@ -247,7 +253,7 @@ def _path_inputs(cell: Cell, T: ArrayLike, table: ArrayLike, track: ArrayLike | 
         raise InputError(f"a path needs a sequence of at least 2 targets (shape (N, 4, 4) or a "
                          f"sequence of table angles), got batch shape {batch}")
     arr = np.broadcast_to(arr, batch + (4, 4))
-    th = np.broadcast_to(th, batch)
+    th = broadcast_table(cell, th, batch)
     return arr, th, None if e is None else np.broadcast_to(e, batch)
 
 
@@ -330,6 +336,9 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     n_pts = arr.shape[0]
     T_tool = tool_pose(cell, tool)
     robot = cell.robot
+    if robot.n_joints != 6:
+        raise InputError(f"path IK needs a six-axis arm (8 branches); {robot.name} has "
+                         f"{robot.n_joints} axes: use cell.ik for its solutions")
     if q_start is not None:
         q_start = finite_array(q_start, "q_start")
         if q_start.shape != (robot.n_joints,):
@@ -355,6 +364,8 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
     reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
     inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
+    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
+        inside &= robot.coupling.within_interaction(q)
     step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
     smooth = np.concatenate([np.ones_like(step[:, :1], dtype=bool), step <= max_step], axis=1)
     ok = reach & inside & smooth

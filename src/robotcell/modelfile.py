@@ -8,6 +8,7 @@ A model file is written by hand in the vendor's units (see ``docs/models.md``)::
     joints:
       - {type: revolute,  a: 25, alpha: -90, d: 400, theta: 0,  min: -170, max: 170}
       - {type: prismatic, a: 0,  alpha: 0,   d: 0,   theta: 90, min: 0,    max: 1500}
+    coupling: {j23_factor: 1}   # optional: q_model = C q_controller + offset
 
 The loader converts to SI and reports any problem with the file, the joint and the key.
 """
@@ -23,6 +24,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from robotcell.coupling import Coupling
 from robotcell.errors import InputError
 from robotcell.fileio import atomic_write, read_text
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
@@ -32,10 +34,11 @@ __all__ = ["list_robots", "load_robot", "robot_from_dict", "robot_to_dict", "sav
 
 _LENGTH = {"mm": 1e-3, "m": 1.0}
 _ANGLE = {"deg": math.pi / 180, "rad": 1.0}
-_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name"}
+_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name", "passive"}
+_COUPLING_KEYS = {"j23_factor", "matrix", "offset", "interaction"}
 _POSE_KEYS = {"x", "y", "z", "a", "b", "c"}
 _TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
-             "source", "verified", "verification"}
+             "source", "verified", "verification", "coupling"}
 
 
 def _library_dir():
@@ -164,25 +167,38 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         hi = _number(jd["max"], f"{where}: key 'max'") * qscale if "max" in jd else math.inf
         if not lo < hi:
             raise InputError(f"{where}: key 'min' ({jd.get('min')}) must be below key 'max' ({jd.get('max')})")
+        passive = jd.get("passive", False)
+        if not isinstance(passive, bool):
+            raise InputError(f"{where}: key 'passive' must be true or false, got {passive!r}")
+        if passive and ("min" in jd or "max" in jd):
+            raise InputError(f"{where}: a passive joint has no limits of its own (remove 'min', 'max'); "
+                             "state limits on the controller axes or under coupling.interaction")
         joints.append(Joint(
             type=jtype,
             a=_number(jd["a"], f"{where}: key 'a'") * ls,
             alpha=_number(jd["alpha"], f"{where}: key 'alpha'") * as_,
             d=_number(jd["d"], f"{where}: key 'd'") * ls,
             theta=_number(jd["theta"], f"{where}: key 'theta'") * as_,
-            sign=sign, lower=lo, upper=hi, name=str(jd.get("name", f"A{i}")),
+            sign=sign, lower=lo, upper=hi, name=str(jd.get("name", f"P{i}" if passive else f"A{i}")),
+            passive=passive,
         ))
     kwargs: dict[str, Any] = {}
+    if "coupling" in data:
+        kwargs["coupling"] = _coupling(data["coupling"], joints, origin, ls, as_)
+    elif any(j.passive for j in joints):
+        raise InputError(f"{origin}: passive joints need key 'coupling' with a 'matrix' that says "
+                         "how they move")
     for key in ("base", "flange", "tool"):
         if key in data:
             kwargs[key] = _pose(data[key], f"{origin}: key '{key}'", ls, as_)
     if "home" in data:
         home = data["home"]
-        if not isinstance(home, list) or len(home) != len(joints):
-            raise InputError(f"{origin}: key 'home' must be a list of {len(joints)} joint values")
+        axes = [j for j in joints if not j.passive]
+        if not isinstance(home, list) or len(home) != len(axes):
+            raise InputError(f"{origin}: key 'home' must be a list of {len(axes)} joint values (one per controller axis)")
         kwargs["home"] = np.array([
             _number(v, f"{origin}: key 'home' value {k}") * (ls if j.prismatic else as_)
-            for k, (v, j) in enumerate(zip(home, joints), start=1)
+            for k, (v, j) in enumerate(zip(home, axes), start=1)
         ])
     convention = data.get("convention", "standard")
     if convention not in ("standard", "modified"):
@@ -200,6 +216,98 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         raise InputError(f"{origin}: {exc}") from None
 
 
+def _coupling(value: Any, joints: list[Joint], origin: str, ls: float, as_: float) -> Coupling:
+    """Parse key ``coupling`` (file units) into a :class:`Coupling` in SI units."""
+    where = f"{origin}: key 'coupling'"
+    if not isinstance(value, dict):
+        raise InputError(f"{where} must be a mapping with j23_factor, or matrix (and offset, interaction)")
+    unknown = set(value) - _COUPLING_KEYS
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_COUPLING_KEYS)}")
+    if ("j23_factor" in value) == ("matrix" in value):
+        raise InputError(f"{where} needs exactly one of 'j23_factor' or 'matrix'")
+    axes = [j for j in joints if not j.passive]
+    m, n = len(joints), len(axes)
+    # Scale of each joint's file unit in SI: C_SI[i, j] = C_file[i, j] * s_model[i] / s_axis[j].
+    s_model = np.array([ls if j.prismatic else as_ for j in joints])
+    s_axis = np.array([ls if j.prismatic else as_ for j in axes])
+    if "j23_factor" in value:
+        k = _number(value["j23_factor"], f"{where}.j23_factor")
+        if m != n or m < 3:
+            raise InputError(f"{where}.j23_factor needs at least 3 joints and no passive joint")
+        if joints[1].prismatic != joints[2].prismatic:
+            raise InputError(f"{where}.j23_factor couples joints 2 and 3, which must be of one type")
+        C = np.eye(m)
+        C[2, 1] = k
+    else:
+        rows = value["matrix"]
+        if (not isinstance(rows, list) or len(rows) != m
+                or not all(isinstance(r, list) and len(r) == n for r in rows)):
+            raise InputError(f"{where}.matrix must be {m} rows (one per joint) of {n} numbers (one "
+                             f"per controller axis, i.e. per joint that is not passive)")
+        C = np.array([[_number(v, f"{where}.matrix row {i} value {c}") for c, v in enumerate(r, start=1)]
+                      for i, r in enumerate(rows, start=1)])
+        C = C * s_model[:, None] / s_axis[None, :]
+    off = value.get("offset")
+    if off is not None:
+        if not isinstance(off, list) or len(off) != m:
+            raise InputError(f"{where}.offset must be a list of {m} numbers (one per joint)")
+        off = np.array([_number(v, f"{where}.offset value {i}") for i, v in enumerate(off, start=1)]) * s_model
+    A, lo, hi = [], [], []
+    limits = value.get("interaction", [])
+    if not isinstance(limits, list):
+        raise InputError(f"{where}.interaction must be a list of {{coefficients: [...], min: .., max: ..}}")
+    for i, lim in enumerate(limits, start=1):
+        w = f"{where}.interaction {i}"
+        if not isinstance(lim, dict) or set(lim) - {"coefficients", "min", "max"} or "coefficients" not in lim:
+            raise InputError(f"{w} must be a mapping with keys coefficients, min, max")
+        co = lim["coefficients"]
+        if not isinstance(co, list) or len(co) != n:
+            raise InputError(f"{w}: coefficients must be {n} numbers, one per controller axis")
+        a = np.array([_number(v, f"{w}: coefficient {c}") for c, v in enumerate(co, start=1)])
+        used = {axes[c].prismatic for c in np.flatnonzero(a)}
+        if len(used) != 1:
+            raise InputError(f"{w}: coefficients must be nonzero on axes of one type (all revolute or "
+                             "all prismatic), so that min and max have one unit")
+        scale = ls if used.pop() else as_
+        A.append(a * scale / s_axis)
+        lo.append(_number(lim["min"], f"{w}: key 'min'") * scale if "min" in lim else -math.inf)
+        hi.append(_number(lim["max"], f"{w}: key 'max'") * scale if "max" in lim else math.inf)
+    try:
+        return Coupling(C, off, np.array(A).reshape(-1, n), np.array(lo), np.array(hi))
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _coupling_to_dict(robot: Robot) -> dict[str, Any]:
+    """Key ``coupling`` of a model file (mm, deg) for ``robot.coupling``."""
+    c = robot.coupling
+    assert c is not None
+    k = c.j23_factor
+    s_model = np.array([1e3 if j.prismatic else 180 / math.pi for j in robot.joints])
+    s_axis = np.array([1e3 if j.prismatic else 180 / math.pi for j in robot.axes])
+    out: dict[str, Any]
+    if k is not None:
+        out = {"j23_factor": _clean(k)}
+    else:
+        C = c.matrix * s_model[:, None] / s_axis[None, :]
+        out = {"matrix": [[_clean(float(v)) for v in row] for row in C]}
+        if np.any(c.offset):
+            out["offset"] = [_clean(float(v)) for v in c.offset * s_model]
+    limits = []
+    for a, lo, hi in zip(c.interaction, c.interaction_lower, c.interaction_upper):
+        scale = 1e3 if robot.axes[int(np.flatnonzero(a)[0])].prismatic else 180 / math.pi
+        lim: dict[str, Any] = {"coefficients": [_clean(float(v)) for v in a * s_axis / scale]}
+        if math.isfinite(lo):
+            lim["min"] = _clean(float(lo * scale))
+        if math.isfinite(hi):
+            lim["max"] = _clean(float(hi * scale))
+        limits.append(lim)
+    if limits:
+        out["interaction"] = limits
+    return out
+
+
 def robot_to_dict(robot: Robot) -> dict[str, Any]:
     """The model-file content of ``robot`` (millimetres and degrees)."""
     joints = []
@@ -211,8 +319,11 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         }
         if math.isfinite(j.lower):
             entry["min"] = j.lower * qs
-        if math.isfinite(j.upper):
+        if math.isfinite(j.upper) and not j.passive:
             entry["max"] = j.upper * qs
+        if j.passive:
+            entry.pop("min", None)
+            entry["passive"] = True
         joints.append({k: _clean(v) for k, v in entry.items()})
     data: dict[str, Any] = {
         "name": robot.name, "title": robot.title, "convention": robot.convention,
@@ -222,9 +333,11 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         T = getattr(robot, key)
         if not np.allclose(T, np.eye(4), atol=1e-15):
             data[key] = dict(zip("xyzabc", (_clean(v) for v in pose_to_vendor(T, "kuka"))))
+    if robot.coupling is not None:
+        data["coupling"] = _coupling_to_dict(robot)
     if robot.home is not None:
         data["home"] = [
-            _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.joints)
+            _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.axes)
         ]
     data.update(source=robot.source, verified=robot.verified, verification=robot.verification)
     return data

@@ -3,6 +3,9 @@
 ``T_R_TCP(q) = T_R_0 · T_0_1(q_1) ··· T_{n-1,n}(q_n) · T_n_F · T_F_TCP`` with the base transform
 ``T_R_0``, the DH chain, the flange transform ``T_n_F`` and the tool ``T_F_TCP``. Joint values are
 controller axis values (see ``docs/conventions.md``): the DH variable is ``sign * q + offset``.
+A robot with a :class:`~robotcell.coupling.Coupling` (parallel linkage, passive joints) maps its
+controller values to the chain's joint values first, ``q_model = C q + offset``; every method
+takes and returns controller values.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from robotcell.coupling import Coupling
 from robotcell.dh import Chain, Convention
 from robotcell.errors import InputError
 from robotcell.transforms import validate_pose
@@ -45,6 +49,9 @@ class Joint:
         Limits of the controller axis value ``q`` (rad or m); infinite when unlimited.
     name : str
         Axis name as the controller shows it (``A1``, ``J1``, ...).
+    passive : bool
+        A joint without a controller axis, moved by a linkage (a palletizer's parallelogram);
+        its value comes from the robot's coupling and its limits are not used.
     """
 
     type: Literal["revolute", "prismatic"]
@@ -56,6 +63,7 @@ class Joint:
     lower: float = -math.inf
     upper: float = math.inf
     name: str = ""
+    passive: bool = False
 
     @property
     def prismatic(self) -> bool:
@@ -86,6 +94,9 @@ class Robot:
         Human name, citation of the parameters, and how they were checked.
     verified : bool
         True when the model was checked against an independent published value.
+    coupling : Coupling or None
+        Linear map from controller axis values to the chain's joint values (one row per joint,
+        one column per non-passive joint); None when every joint is its own controller axis.
     """
 
     name: str
@@ -99,6 +110,7 @@ class Robot:
     source: str = ""
     verified: bool = False
     verification: str = ""
+    coupling: Coupling | None = None
 
     def __post_init__(self) -> None:
         if self.convention not in ("standard", "modified"):
@@ -112,6 +124,16 @@ class Robot:
                 raise InputError(f"joint {i}: sign must be +1 or -1, got {j.sign}")
             if not j.lower < j.upper:
                 raise InputError(f"joint {i}: lower limit {j.lower} is not below upper limit {j.upper}")
+        axes = tuple(j for j in self.joints if not j.passive)
+        if self.coupling is None and len(axes) != len(self.joints):
+            raise InputError("passive joints need a coupling that says how they move")
+        if self.coupling is not None and self.coupling.matrix.shape != (len(self.joints), len(axes)):
+            raise InputError(
+                f"the coupling matrix must have one row per joint and one column per controller "
+                f"(non-passive) axis, shape ({len(self.joints)}, {len(axes)}); got "
+                f"{self.coupling.matrix.shape}"
+            )
+        object.__setattr__(self, "_axes", axes)
         for key in ("base", "flange", "tool"):
             object.__setattr__(self, key, validate_pose(getattr(self, key), key).copy())
         if self.home is not None:
@@ -133,23 +155,47 @@ class Robot:
     # -- properties -----------------------------------------------------------------------------
     @property
     def n_joints(self) -> int:
-        """Number of joints ``n``."""
-        return len(self.joints)
+        """Number of controller axes ``n`` (the chain's joints minus the passive ones)."""
+        return len(self._axes)
+
+    @property
+    def axes(self) -> tuple[Joint, ...]:
+        """The joints that are controller axes (all but the passive ones), in order."""
+        return self._axes
 
     @property
     def lower(self) -> NDArray[np.float64]:
-        """Lower joint limits, shape ``(n,)`` (rad or m)."""
-        return np.array([j.lower for j in self.joints])
+        """Lower limits of the controller axes, shape ``(n,)`` (rad or m)."""
+        return np.array([j.lower for j in self._axes])
 
     @property
     def upper(self) -> NDArray[np.float64]:
-        """Upper joint limits, shape ``(n,)`` (rad or m)."""
-        return np.array([j.upper for j in self.joints])
+        """Upper limits of the controller axes, shape ``(n,)`` (rad or m)."""
+        return np.array([j.upper for j in self._axes])
 
     @property
     def prismatic(self) -> NDArray[np.bool_]:
-        """Mask of prismatic joints, shape ``(n,)``."""
-        return np.array([j.prismatic for j in self.joints])
+        """Mask of prismatic controller axes, shape ``(n,)``."""
+        return np.array([j.prismatic for j in self._axes])
+
+    def uncoupled(self) -> Robot:
+        """The kinematic model alone: the same chain whose joint values are the model's.
+
+        For a robot without coupling this is the robot itself. Otherwise a robot with every joint
+        of the chain as an axis (passive ones included), no coupling and no joint limits (limits
+        are stated for controller values); ``uncoupled().fk(coupling.to_model(q)) == fk(q)``.
+        """
+        if self.coupling is None:
+            return self
+        model = self.__dict__.get("_uncoupled")
+        if model is None:
+            joints = tuple(replace(j, lower=-math.inf, upper=math.inf, passive=False) for j in self.joints)
+            home = None if self.home is None else self.coupling.to_model(self.home)
+            model = Robot(f"{self.name}_model", joints, self.convention, self.base, self.flange,
+                          self.tool, home, f"{self.title or self.name} (model joint values)",
+                          self.source)
+            object.__setattr__(self, "_uncoupled", model)
+        return model
 
     def with_tool(self, tool: ArrayLike) -> Robot:
         """Return a copy whose default tool is ``tool`` (``T_F_TCP``, shape (4, 4), metres)."""
@@ -175,12 +221,12 @@ class Robot:
         return arr
 
     def within_limits(self, q: ArrayLike, tol: float = 0.0) -> NDArray[np.bool_]:
-        """Whether joint values respect the limits.
+        """Whether controller values respect the joint limits and the coupling's interaction limits.
 
         Parameters
         ----------
         q : array_like, shape (..., n)
-            Joint values (rad, m).
+            Controller axis values (rad, m).
         tol : float
             Allowed excess beyond a limit (rad or m).
 
@@ -189,11 +235,30 @@ class Robot:
         ndarray of bool, shape (...)
         """
         arr = self._joints(q)
-        return np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
+        ok = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
+        if self.coupling is not None:
+            ok &= self.coupling.within_interaction(arr, tol)
+        return ok
+
+    def model_values(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Joint values of the chain for controller values ``q``.
+
+        Parameters
+        ----------
+        q : array_like, shape (..., n)
+            Controller axis values (rad, m).
+
+        Returns
+        -------
+        ndarray, shape (..., m)
+            ``C q + offset`` with the robot's coupling (a copy of ``q`` without one).
+        """
+        arr = self._joints(q)
+        return arr.copy() if self.coupling is None else self.coupling.to_model(arr)
 
     def dh_variables(self, q: ArrayLike) -> NDArray[np.float64]:
-        """DH variables ``sign * q + offset`` (theta for revolute, d for prismatic), ``(..., n)``."""
-        arr = self._joints(q)
+        """DH variables ``sign * q_model + offset`` (theta or d) of every joint, ``(..., m)``."""
+        arr = self.model_values(q)
         sign = np.array([j.sign for j in self.joints])
         off = np.array([j.d if j.prismatic else j.theta for j in self.joints])
         return sign * arr + off
@@ -223,6 +288,8 @@ class Robot:
             vals = q.tolist() if isinstance(q, np.ndarray) else [float(v) for v in q]
             if len(vals) != self.n_joints or not math.isfinite(sum(vals)):
                 self._joints(vals)  # raises the precise error
+            if self.coupling is not None:
+                vals = self.coupling.to_model_list(vals)
             m = self._chain.apply_one(self._start_cols, vals)
             if tool is None and self._tail_is_identity:
                 a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
@@ -233,27 +300,31 @@ class Robot:
             return _compose_cols(m, tc)
         arr = self._joints(q)
         batch = arr.shape[:-1]
-        T = self._chain.apply(self.base, arr.reshape(-1, self.n_joints), tail=tail)
+        if self.coupling is not None:
+            arr = self.coupling.to_model(arr)
+        T = self._chain.apply(self.base, arr.reshape(-1, len(self.joints)), tail=tail)
         return T.reshape(batch + (4, 4))
 
     def frames(self, q: ArrayLike) -> NDArray[np.float64]:
-        """Every DH frame in the robot base frame: ``T_R_i`` for ``i = 0..n``.
+        """Every DH frame in the robot base frame: ``T_R_i`` for ``i = 0..m``.
 
         Parameters
         ----------
         q : array_like, shape (..., n)
-            Joint values (rad, m).
+            Controller axis values (rad, m).
 
         Returns
         -------
-        ndarray, shape (..., n + 1, 4, 4)
-            ``frames[..., 0]`` is the base transform ``T_R_0``; ``frames[..., i]`` is ``T_R_i``.
-            The flange is ``frames[..., n] @ robot.flange``.
+        ndarray, shape (..., m + 1, 4, 4)
+            ``frames[..., 0]`` is the base transform ``T_R_0``; ``frames[..., i]`` is ``T_R_i``
+            (``m`` joints in the chain, ``m = n`` without passive joints). The flange is
+            ``frames[..., m] @ robot.flange``.
         """
-        arr = self._joints(q)
+        arr = self.model_values(q)
         batch = arr.shape[:-1]
-        F = self._chain.apply(self.base, arr.reshape(-1, self.n_joints), frames=True)
-        return F.reshape(batch + (self.n_joints + 1, 4, 4))
+        m = len(self.joints)
+        F = self._chain.apply(self.base, arr.reshape(-1, m), frames=True)
+        return F.reshape(batch + (m + 1, 4, 4))
 
     def jacobian(self, q: ArrayLike, tool: ArrayLike | None = None) -> NDArray[np.float64]:
         """Geometric Jacobian in the robot base frame, for the TCP.
@@ -269,7 +340,8 @@ class Robot:
         -------
         ndarray, shape (..., 6, n)
             Rows ``(vx, vy, vz, wx, wy, wz)``: the TCP's linear velocity (m/s) and the angular
-            velocity (rad/s) per unit velocity of each controller axis (rad/s or m/s).
+            velocity (rad/s) per unit velocity of each controller axis (rad/s or m/s); with a
+            coupling ``J_model @ C`` (chain rule).
         """
         F = self.frames(q)
         tail = self._tail if tool is None else self.flange @ validate_pose(tool, "tool")
@@ -279,11 +351,11 @@ class Robot:
         z = axes[..., :3, 2]
         o = axes[..., :3, 3]
         sign = np.array([j.sign for j in self.joints])[:, None]
-        pris = self.prismatic[:, None]
+        pris = np.array([j.prismatic for j in self.joints])[:, None]
         v = np.where(pris, z, np.cross(z, p_e[..., None, :] - o))
         w = np.where(pris, 0.0, z)
-        J = np.concatenate([v * sign, w * sign], axis=-1)  # (..., n, 6)
-        return np.swapaxes(J, -1, -2)
+        J = np.swapaxes(np.concatenate([v * sign, w * sign], axis=-1), -1, -2)  # (..., 6, m)
+        return J if self.coupling is None else self.coupling.jacobian(J)
 
     def ik(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
         """Analytic inverse kinematics: every solution, see :func:`robotcell.ik.solve`.
@@ -298,8 +370,9 @@ class Robot:
         Returns
         -------
         IKSolutions
-            ``q`` of shape ``(..., 8, 6)`` (rad, NaN for unreachable branches) and ``valid``
-            ``(..., 8)`` (reachable and within the joint limits).
+            ``q`` of shape ``(..., 8, 6)`` (``(..., 4, 4)`` for a palletizer) of controller values
+            (rad, NaN for unreachable branches) and ``valid`` ``(..., 8)`` (reachable and within
+            the joint limits).
         """
         from robotcell.ik import solve  # imported here: robotcell.ik depends on this module
 

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.cell import Cell
+from robotcell.cell import Cell, Turntable
 from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.fileio import atomic_write
@@ -136,6 +136,39 @@ class Touches:
             cols.append(list(self.roles))
         return header, [list(r) for r in zip(*cols)]
 
+    def to_table(self) -> dict[str, Any]:
+        """The measurement table as :func:`robotcell.tables.read_csv` reads the CSV (mm, deg).
+
+        Returns
+        -------
+        dict
+            Column name to a float array (or a list of strings), the input of
+            :mod:`robotcell.cellcal`.
+        """
+        from robotcell.cellcal.touches import load_table
+
+        header, rows = self.columns()
+        return load_table(dict(zip(header, map(list, zip(*rows)))))[0]
+
+    def keywords(self) -> dict[str, Any]:
+        """The :mod:`robotcell.cellcal` keywords equal to :attr:`options` (SI, same rounding).
+
+        Returns
+        -------
+        dict
+            ``references`` (list of (3,) arrays, m) and ``height`` (m), where the options have
+            them.
+        """
+        kw: dict[str, Any] = {}
+        for opt in self.options:
+            key, value = opt.lstrip("-").split("=")
+            numbers = np.array([float(v) for v in value.split(",")]) * 1e-3
+            if key == "reference":
+                kw.setdefault("references", []).append(numbers)
+            else:
+                kw[key] = float(numbers[0])
+        return kw
+
     def write_csv(self, out: str | Path | TextIO) -> None:
         """Write the measurement CSV to an open text stream, or to a path atomically.
 
@@ -203,6 +236,9 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
         raise InputError(f"{len(labels)} touches asked for; a simulation places at most "
                          f"{MAX_TOUCHES}")
     robot = cell.robot
+    if robot.n_joints != 6:
+        raise InputError(f"simulated touches need a six-axis arm; {robot.name} has "
+                         f"{robot.n_joints} axes")
     T = targets(E)                                                          # (K, N, M, 4, 4)
     T_R = invert(robot_pose(cell, E))[:, :, None] @ T
     sol = robot.ik(T_R, tool=tool_T)                                        # (K, N, M, 8, n)
@@ -437,6 +473,16 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                    options=options, tool=tname, noise=noise)
 
 
+def _one_axis_table(cell: Cell) -> None:
+    """Refuse a cell without a one-axis turntable (the turntable and workpiece procedures)."""
+    if cell.turntable is None:
+        raise InputError("the cell has no turntable")
+    if not isinstance(cell.turntable, Turntable):
+        raise InputError(f"the cell's positioner {cell.turntable.name!r} is a chain of "
+                         f"{cell.turntable.n_axes} axes; the simulation of the turntable and "
+                         "workpiece procedures needs a one-axis turntable")
+
+
 def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.float64]:
     tt = cell.turntable
     assert tt is not None
@@ -462,8 +508,7 @@ def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.fl
 def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                track: float | None, touches: int = 6, angles: ArrayLike | None = None,
                radius: float = 0.3, height: float = 0.05) -> Touches:
-    if cell.turntable is None:
-        raise InputError("the cell has no turntable")
+    _one_axis_table(cell)
     tname = _tool_name(cell, tool)
     if not (math.isfinite(radius) and radius > 0):
         raise InputError(f"radius must be positive (m), got {radius}")
@@ -498,8 +543,7 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
 def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                track: float | None, frame: str | None = None, size: float = 0.15,
                repeats: int = 2, angles: ArrayLike | None = None) -> Touches:
-    if cell.turntable is None:
-        raise InputError("the cell has no turntable")
+    _one_axis_table(cell)
     name = _frame_name(cell, frame, ("turntable",), "workpiece")
     tname = _tool_name(cell, tool)
     p_W, roles = _three_point(size, repeats)

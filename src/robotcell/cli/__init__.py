@@ -32,6 +32,7 @@ COMMANDS = {
     "plan": "robotcell.cli.plan:plan",
     "report": "robotcell.cli.report:report",
     "demo": "robotcell.cli.demo:demo",
+    "identify": "robotcell.cli.identify:identify",
 }
 
 

@@ -6,13 +6,13 @@ import click
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_output, write_output
-from robotcell.export import EXPORT_FORMATS, export_cell
+from robotcell.export import WRITE_FORMATS, export_cell
 
 
 @click.command()
 @click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file (YAML, mm/deg).")
-@click.option("--format", "fmt", required=True, type=click.Choice(list(EXPORT_FORMATS)),
+@click.option("--format", "fmt", required=True, type=click.Choice(list(WRITE_FORMATS)),
               help="Controller format.")
 @click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
               help="File to write, atomically (default: standard output).")
@@ -25,6 +25,8 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     abb      RAPID module: tooldata, wobjdata, base frames as pose
     fanuc    UTOOL/UFRAME values for Direct Entry (X Y Z W P R)
     yaskawa  TOOL/UFRAME values for the pendant (X Y Z Rx Ry Rz)
+    urdf     the calibrated cell as a URDF tree for ROS tools (m, rad): robot, track and
+             turntable joints, tools and frames as fixed links
 
     \b
     Examples:

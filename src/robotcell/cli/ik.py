@@ -20,6 +20,7 @@ from robotcell.cli.common import (
     require_columns,
     write_output,
 )
+from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
 from robotcell.modelfile import load_robot
@@ -28,6 +29,8 @@ from robotcell.robot import Robot
 
 BRANCHES = ["front up", "front up flip", "front down", "front down flip",
             "back up", "back up flip", "back down", "back down flip"]
+#: Branch names of a 4-axis palletizer (``k = 2 * shoulder + elbow``).
+BRANCHES_4 = ["front up", "front down", "back up", "back down"]
 
 
 def _flags(robot: Robot, method: str, fmt: str, q: np.ndarray) -> list[str] | None:
@@ -59,7 +62,7 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,
               help="Pose format of --pose / --input.")
 @click.option("--all", "show_all", is_flag=True, help="Also list unreachable and out-of-limit branches.")
-@click.option("--near", "near", help="Only the valid solution nearest to a1,...,a6 (deg).")
+@click.option("--near", "near", help="Only the valid solution nearest to a1,...,an (deg).")
 @click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention); "
               "with --cell also a tool name of the cell.")
 @click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
@@ -76,17 +79,19 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
     """Inverse kinematics: every arm configuration that reaches a TCP pose.
 
     ROBOT is a library name (see 'robotcell robots') or a model file with an ortho-parallel
-    arm and spherical wrist (KUKA, ABB, Fanuc, ...) or a Universal-Robots-type arm.
+    arm and spherical wrist (KUKA, ABB, Fanuc, ...), a Universal-Robots-type arm or a 4-axis
+    palletizer.
 
-    The table lists the 8 branches (front/back of axis 1, elbow up/down, wrist flipped or not),
-    joint values in degrees, and for --format kuka/abb the configuration flags (KUKA Status/Turn,
-    ABB confdata [cf1,cf4,cf6,cfx]).
+    The table lists the 8 branches (front/back of axis 1, elbow up/down, wrist flipped or not;
+    4 for a palletizer), controller axis values in degrees (as the pendant shows them: FANUC J3
+    with the J2/J3 interaction), and for --format kuka/abb the configuration flags (KUKA
+    Status/Turn, ABB confdata [cf1,cf4,cf6,cfx]).
 
     Batch CSV: --input has the pose columns of --format (kuka: x,y,z,a,b,c; abb:
     x,y,z,q1,q2,q3,q4; ...). --output has one row per valid solution with columns
     pose (0-based input row), branch (0..7), a1..a6 (deg); with --all every branch and a column
     valid (1/0; unreachable branches have nan angles); with --near one row per pose with columns
-    pose, found (1/0), a1..a6.
+    pose, found (1/0), a1..a6. A palletizer has branches 0..3 and columns a1..a4.
 
     With --cell CELL.yaml instead of ROBOT the target is given in a frame of the cell (--frame)
     at a table angle (--table), for a track position (--track, chosen per pose where the arm
@@ -117,7 +122,10 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         raise InputError("give exactly one of --pose ... or --input poses.csv")
     T_tool = None if tool is None else pose_from_vendor(parse_numbers(tool, "--tool", 6), "kuka")
     deg = 180.0 / math.pi
-    ref = None if near is None else np.radians(parse_numbers(near, "--near", 6))
+    n = r.n_joints
+    names_k = BRANCHES if solver.branches == 8 else BRANCHES_4
+    ref = None if near is None else joints_to_si(r, np.array(parse_numbers(near, "--near", n)))
+    scale = np.where(r.prismatic, 1e3, deg)  # controller values to deg (mm for prismatic axes)
     if pose is not None:
         T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
         sol = solver.solve(T, T_tool)
@@ -128,49 +136,49 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
             q, valid, reach, ks = q[None], np.array([True]), np.array([True]), [int(branch)]
         else:
             q, valid, reach = sol.q, sol.valid, sol.reachable
-            ks = [k for k in range(8) if show_all or valid[k]]
+            ks = [k for k in range(solver.branches) if show_all or valid[k]]
         flags = _flags(r, solver.method, fmt, q)
-        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
+        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.axes)], "valid"]
         if flags is not None:
             headers.append("S/T" if fmt == "kuka" else "confdata")
         rows = []
         for i, k in enumerate(ks):
             row_i = 0 if ref is not None else k
             state = "yes" if valid[row_i] else ("limits" if reach[row_i] else "unreachable")
-            vals = [float(v * deg) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
-                    for v in q[row_i]]
-            row = [f"{k} {BRANCHES[k]}", *vals, state]
+            vals = [float(v * f) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
+                    for v, f in zip(q[row_i], scale)]
+            row = [f"{k} {names_k[k]}", *vals, state]
             if flags is not None:
                 row.append(flags[row_i] if reach[row_i] else "-")
             rows.append(row)
         if not rows:
             raise InputError("no valid solution (unreachable or outside the joint limits); "
                              "--all lists every branch")
-        write_output(output_path, f"{r.name}, {solver.method} solver, angles in degrees\n"
-                     f"{format_table(headers, rows)}\n")
+        write_output(output_path, f"{r.name}, {solver.method} solver, controller axis values in "
+                     f"degrees\n{format_table(headers, rows)}\n")
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
     cols = read_csv(input_path, known=names)
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     sol = solver.solve(T, T_tool)
-    axes = [f"a{i}" for i in range(1, 7)]
+    axes = [f"a{i}" for i in range(1, n + 1)]
     if ref is not None:
         q, found, _ = nearest(r, sol, ref)
         header = ["pose", "found", *axes]
-        out_rows = [[i, int(found[i]), *(q[i] * deg).tolist()] for i in range(len(q))]
+        out_rows = [[i, int(found[i]), *(q[i] * scale).tolist()] for i in range(len(q))]
     elif show_all:
         header = ["pose", "branch", "valid", *axes]
-        out_rows = [[i, k, int(sol.valid[i, k]), *(sol.q[i, k] * deg).tolist()]
-                    for i in range(len(sol.q)) for k in range(8)]
+        out_rows = [[i, k, int(sol.valid[i, k]), *(sol.q[i, k] * scale).tolist()]
+                    for i in range(len(sol.q)) for k in range(solver.branches)]
     else:
         header = ["pose", "branch", *axes]
-        out_rows = [[i, k, *(sol.q[i, k] * deg).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
+        out_rows = [[i, k, *(sol.q[i, k] * scale).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
     _finish_batch(sol.valid, header, out_rows, output_path)
 
 
 def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[object]],
                   output_path: str | None) -> None:
-    """Warn about poses without a valid branch (valid: (N, 8)), then write the batch CSV."""
+    """Warn about poses without a valid branch (valid: (N, branches)), then write the batch CSV."""
     none = int(np.count_nonzero(~valid.any(axis=1)))
     if none:
         click.echo(f"warning: {none} pose(s) without a valid solution", err=True)

@@ -5,10 +5,12 @@ from __future__ import annotations
 import math
 
 import click
+import numpy as np
 
 from robotcell.cli.common import format_table
 from robotcell.modelfile import list_robots, load_robot
 from robotcell.poseformats import pose_to_vendor
+from robotcell.robot import Robot
 
 
 @click.group(invoke_without_command=True)
@@ -26,9 +28,20 @@ def robots(ctx: click.Context) -> None:
     rows = []
     for name in list_robots():
         r = load_robot(name)
-        kinds = "".join("P" if j.prismatic else "R" for j in r.joints)
-        rows.append((name, r.title, kinds, r.convention, "yes" if r.verified else "no"))
-    click.echo(format_table(("name", "robot", "joints", "DH", "verified"), rows))
+        kinds = "".join("P" if j.prismatic else "R" for j in r.axes)
+        rows.append((name, r.title, kinds, r.convention, coupling_summary(r), "yes" if r.verified else "no"))
+    click.echo(format_table(("name", "robot", "axes", "DH", "coupling", "verified"), rows))
+
+
+def coupling_summary(r: Robot) -> str:
+    """``J23 +1`` for a J2/J3 linkage, ``matrix`` for another coupling, ``-`` for none."""
+    if r.coupling is None:
+        return "-"
+    k = r.coupling.j23_factor
+    if k is not None:
+        return f"J23 {k:+g}"
+    passive = len(r.joints) - r.n_joints
+    return f"matrix, {passive} passive" if passive else "matrix"
 
 
 @robots.command()
@@ -41,7 +54,8 @@ def show(name: str) -> None:
       robotcell robots show ur5e
     """
     r = load_robot(name)
-    click.echo(f"{r.title} ({r.name}), {r.convention} DH, {r.n_joints} joints")
+    chain = f" ({len(r.joints)} joints in the chain)" if len(r.joints) != r.n_joints else ""
+    click.echo(f"{r.title} ({r.name}), {r.convention} DH, {r.n_joints} axes{chain}")
     if r.convention == "standard":
         click.echo("T_{i-1,i} = Trans(z, d) Rot(z, theta) Trans(x, a) Rot(x, alpha)")
         heads = ("joint", "type", "a [mm]", "alpha [deg]", "d [mm]", "theta [deg]")
@@ -55,16 +69,38 @@ def show(name: str) -> None:
         lo = f"{j.lower * unit:.1f}" if math.isfinite(j.lower) else "-inf"
         hi = f"{j.upper * unit:.1f}" if math.isfinite(j.upper) else "inf"
         rows.append((j.name, j.type, j.a * 1e3, math.degrees(j.alpha), j.d * 1e3,
-                     math.degrees(j.theta), f"{j.sign:+.0f}", f"{lo} .. {hi}",
+                     math.degrees(j.theta), f"{j.sign:+.0f}", "passive" if j.passive else f"{lo} .. {hi}",
                      "mm" if j.prismatic else "deg"))
     click.echo(format_table(heads + ("sign", "limits", "unit"), rows))
+    _show_coupling(r)
     for key, label in (("base", "base   T_R_0"), ("flange", "flange T_n_F"), ("tool", "tool   T_F_TCP")):
         v = pose_to_vendor(getattr(r, key), "kuka")
         click.echo(f"{label}: X {v[0]:.3f} Y {v[1]:.3f} Z {v[2]:.3f} mm, "
                    f"A {v[3]:.3f} B {v[4]:.3f} C {v[5]:.3f} deg")
     if r.home is not None:
-        home = [v * (1e3 if j.prismatic else 180 / math.pi) for v, j in zip(r.home, r.joints)]
-        click.echo("home: " + ", ".join(f"{v:g}" for v in home))
+        home = [v * (1e3 if j.prismatic else 180 / math.pi) for v, j in zip(r.home, r.axes)]
+        click.echo("home (controller values): " + ", ".join(f"{v:g}" for v in home))
     click.echo(f"source: {r.source or 'not given'}")
     click.echo(f"verified: {'yes' if r.verified else 'no'}"
                + (f" ({r.verification})" if r.verification else ""))
+
+
+def _show_coupling(r: Robot) -> None:
+    """Print the coupling ``q_model = C q + offset`` in the file's units (mm, deg)."""
+    c = r.coupling
+    if c is None:
+        click.echo("coupling: none (each joint is its controller axis; limits are on q)")
+        return
+    names = [j.name for j in r.axes]
+    click.echo(f"coupling: q_model = C q + offset ({coupling_summary(r)}); q are the controller "
+               "values (pendant), limits are on q")
+    s_model = np.array([1e3 if j.prismatic else 180 / math.pi for j in r.joints])
+    s_axis = np.array([1e3 if j.prismatic else 180 / math.pi for j in r.axes])
+    C = c.matrix * s_model[:, None] / s_axis[None, :]
+    rows = [(j.name, *(f"{v:g}" for v in row), f"{o:g}")
+            for j, row, o in zip(r.joints, C, c.offset * s_model)]
+    click.echo(format_table(("joint", *names, "offset"), rows))
+    for a, lo, hi in zip(c.interaction, c.interaction_lower, c.interaction_upper):
+        scale = 1e3 if r.axes[int(np.flatnonzero(a)[0])].prismatic else 180 / math.pi
+        expr = " ".join(f"{v * s_axis[i] / scale:+g} {names[i]}" for i, v in enumerate(a) if v)
+        click.echo(f"interaction limit: {lo * scale:g} <= {expr} <= {hi * scale:g}")

@@ -111,8 +111,11 @@ class AxisChain:
         Returns
         -------
         AxisChain
-            Axes in the robot base frame R (metres); flange ``T_R_F`` at ``q = 0``.
+            Axes in the robot base frame R (metres); flange ``T_R_F`` at ``q = 0``. For a robot
+            with a joint coupling these are the axes of its chain (:meth:`Robot.uncoupled`,
+            model joint values, passive joints included, no limits).
         """
+        robot = robot.uncoupled()
         F = robot.frames(np.zeros(robot.n_joints))
         axes = F[:-1] if robot.convention == "standard" else F[1:]
         sign = np.array([j.sign for j in robot.joints])

@@ -2,7 +2,13 @@
 
 :func:`solve` recognises the structure of the model once (cached per robot object) and returns
 all 8 solutions of every pose: ortho-parallel arms with a spherical wrist through
-:mod:`robotcell.ik.opw`, Universal-Robots-type arms through :mod:`robotcell.ik.ur`.
+:mod:`robotcell.ik.opw`, Universal-Robots-type arms through :mod:`robotcell.ik.ur`, and all 4
+solutions of 4-axis palletizers through :mod:`robotcell.ik.palletizer`.
+
+A robot with a joint coupling (:mod:`robotcell.coupling`) is solved on its uncoupled model; the
+model solutions are mapped to controller values right after the kernel, and the 2*pi rule, the
+joint limits and the interaction limits are then applied to the controller values, as the pendant
+shows them. Robots without a coupling skip the mapping.
 """
 
 from __future__ import annotations
@@ -14,8 +20,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
-from robotcell.ik.limits import JointFolder
+from robotcell.ik.limits import JointFolder, wrap_to_pi
 from robotcell.ik.opw import OPWParameters, opw_kernel, opw_parameters, opw_problems
+from robotcell.ik.palletizer import (
+    PalletizerParameters,
+    palletizer_kernel,
+    palletizer_parameters,
+    palletizer_problems,
+)
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
 from robotcell.robot import Robot
@@ -44,25 +56,69 @@ class AnalyticSolver:
     """
 
     def __init__(self, robot: Robot) -> None:
-        opw = opw_problems(robot)
+        coupling = robot.coupling
+        # The kernels see the model's joint values; a palletizer's kernel works on the controller
+        # values directly (its parameters are read off the coupled forward kinematics).
+        model = robot.uncoupled()
+        self.params: OPWParameters | URParameters | PalletizerParameters
+        opw = opw_problems(model)
+        self.branches, self._mapped = 8, coupling is not None
         if not opw:
             self.method = "opw"
-            self.params: OPWParameters | URParameters = opw_parameters(robot)
+            self.params = opw_parameters(model)
             self._kernel: Kernel = opw_kernel
-        else:
-            ur = ur_problems(robot)
-            if ur:
-                raise InputError(
-                    f"no analytic inverse kinematics for {robot.name}: not an ortho-parallel arm "
-                    f"with a spherical wrist ({'; '.join(opw)}), nor a Universal-Robots-type arm "
-                    f"({'; '.join(ur)}). Use robotcell.ik.solve_numeric for this model."
-                )
+        elif not (ur := ur_problems(model)):
             self.method = "ur"
-            self.params = ur_parameters(robot)
+            self.params = ur_parameters(model)
             self._kernel = ur_kernel
+        elif not (pal := palletizer_problems(robot)):
+            self.method = "palletizer"
+            self.params = palletizer_parameters(robot)
+            self._kernel = palletizer_kernel
+            self.branches, self._mapped = 4, False
+        else:
+            raise InputError(
+                f"no analytic inverse kinematics for {robot.name}: not an ortho-parallel arm "
+                f"with a spherical wrist ({'; '.join(opw)}), nor a Universal-Robots-type arm "
+                f"({'; '.join(ur)}), nor a 4-axis palletizer ({'; '.join(pal)}). Use "
+                "robotcell.ik.solve_numeric for this model."
+            )
         self.robot = robot
         self._T_O_R = invert(self.params.T_R_O)
         self._fold = JointFolder(robot.lower, robot.upper)
+        self._limits = None
+        if coupling is not None:
+            rev_model = np.array([not j.prismatic for j in robot.joints])
+            periodic = coupling.periodic(rev_model, ~robot.prismatic)
+            # Controller axes the mapping changes and that turn a full revolution: wrapped back to
+            # (-pi, pi] before the 2*pi rule; axes that do not are checked against plain limits.
+            self._wrap = [j for j in coupling.changed_axes() if periodic[j]] if self._mapped else []
+            fixed = np.flatnonzero(~periodic & ~robot.prismatic)
+            per = np.flatnonzero(periodic | robot.prismatic)
+            if fixed.size:
+                self._fold = JointFolder(robot.lower[per], robot.upper[per])
+            self._limits = (per, fixed, robot.lower[fixed], robot.upper[fixed],
+                            coupling if coupling.interaction.shape[0] else None)
+
+    def _controller(self, q: NDArray[np.float64], reach: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """Map a block of kernel solutions to controller values in place; return ``valid``."""
+        coupling = self.robot.coupling
+        if self._mapped:
+            coupling.to_controller(q, out=q)
+            for j in self._wrap:
+                q[..., j] = wrap_to_pi(q[..., j])
+        per, fixed, lo, hi, inter = self._limits
+        if fixed.size:
+            sub = q[..., per]
+            ok = self._fold(sub)
+            q[..., per] = sub
+            f = q[..., fixed]
+            ok &= np.all((f >= lo) & (f <= hi), axis=-1)
+        else:
+            ok = self._fold(q)
+        if inter is not None:
+            ok &= inter.within_interaction(q)
+        return reach & ok
 
     def solve(self, T: ArrayLike, tool: ArrayLike | None = None,
               q_ref: ArrayLike | None = None) -> IKSolutions:
@@ -82,17 +138,19 @@ class AnalyticSolver:
         Returns
         -------
         IKSolutions
-            ``q`` of shape ``(..., 8, 6)`` (rad), ``reach_error`` of shape ``(..., 8)`` (m).
+            ``q`` of shape ``(..., 8, 6)`` (``(..., 4, 4)`` for a palletizer): controller values
+            (rad); ``reach_error`` of shape ``(..., 8)`` (``(..., 4)``) (m).
         """
         arr = validate_pose(T, "target pose")
         tool_T = self.robot.tool if tool is None else validate_pose(tool, "tool")
         ref = None
         if q_ref is not None:
             ref = finite_array(q_ref, "q_ref")
-            if ref.ndim == 0 or ref.shape[-1] != 6:
-                raise InputError(f"q_ref must have shape (..., 6), got {ref.shape}")
+            n_ref = self.robot.n_joints
+            if ref.ndim == 0 or ref.shape[-1] != n_ref:
+                raise InputError(f"q_ref must have shape (..., {n_ref}), got {ref.shape}")
             try:
-                ref = np.broadcast_to(ref, arr.shape[:-2] + (6,)).reshape(-1, 6)
+                ref = np.broadcast_to(ref, arr.shape[:-2] + (n_ref,)).reshape(-1, n_ref)
             except ValueError:
                 raise InputError(f"q_ref of shape {ref.shape} does not match the "
                                  f"{arr.shape[:-2]} poses") from None
@@ -101,11 +159,14 @@ class AnalyticSolver:
         batch = arr.shape[:-2]
         flat = arr.reshape(-1, 4, 4)
         N = flat.shape[0]
-        q = np.empty((N, 8, 6))
-        reach = np.empty((N, 8), dtype=bool)
-        valid = np.empty((N, 8), dtype=bool)
-        err = np.empty((N, 8))
+        nb, n = self.branches, self.robot.n_joints
+        q = np.empty((N, nb, n))
+        reach = np.empty((N, nb), dtype=bool)
+        valid = np.empty((N, nb), dtype=bool)
+        err = np.zeros((N, nb))
         lo, hi = self.robot.lower, self.robot.upper
+        if ref is not None and self._mapped:
+            ref = self.robot.coupling.to_model(ref)  # the kernels see model values
         A = self._T_O_R[:3, :3]
         a = self._T_O_R[:3, 3]
         B = T_tcp_end[:3, :3]
@@ -116,12 +177,19 @@ class AnalyticSolver:
             R = A @ (Rt @ B)
             P = (Rt @ bvec + blk[:, :3, 3]) @ A.T + a
             qb = q[s:s + _BLOCK]
-            rb = self._kernel(self.params, R, P, qb, err[s:s + _BLOCK],
-                              None if ref is None else ref[s:s + _BLOCK], lo, hi)
-            valid[s:s + _BLOCK] = rb & self._fold(qb)  # 2*pi rule and limits, in cache
+            if self.method == "palletizer":  # no reach distance: inf where a branch misses
+                rb = self._kernel(self.params, R, P, qb)
+                err[s:s + _BLOCK][~rb] = np.inf
+            else:
+                rb = self._kernel(self.params, R, P, qb, err[s:s + _BLOCK],
+                                  None if ref is None else ref[s:s + _BLOCK], lo, hi)
+            if self._limits is None:
+                valid[s:s + _BLOCK] = rb & self._fold(qb)  # 2*pi rule and limits, in cache
+            else:
+                valid[s:s + _BLOCK] = self._controller(qb, rb)
             reach[s:s + _BLOCK] = rb
-        return IKSolutions(q.reshape(batch + (8, 6)), valid.reshape(batch + (8,)),
-                           reach.reshape(batch + (8,)), self.method, err.reshape(batch + (8,)))
+        return IKSolutions(q.reshape(batch + (nb, n)), valid.reshape(batch + (nb,)),
+                           reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))
 
 
 _CACHE: weakref.WeakKeyDictionary[Robot, AnalyticSolver] = weakref.WeakKeyDictionary()

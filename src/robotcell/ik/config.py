@@ -71,7 +71,8 @@ def arm_sides(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np
     robot : Robot
         An ortho-parallel arm with a spherical wrist.
     q : array_like, shape (..., 6)
-        Joint values (rad); NaN gives False.
+        Controller axis values (rad); NaN gives False. A coupled robot's values are mapped to the
+        model's joint values first (the geometry is the model's).
 
     Returns
     -------
@@ -84,6 +85,8 @@ def arm_sides(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np
     arr = np.asarray(q, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != 6:
         raise InputError(f"q must have shape (..., 6), got {arr.shape}")
+    if robot.coupling is not None:
+        arr = robot.coupling.to_model(arr)
     th = arr * p.signs + p.offsets
     t2, t3 = th[..., 1], th[..., 2]
     t23 = t2 + t3

@@ -90,7 +90,9 @@ def solve_numeric(
     Returns
     -------
     NumericIKResult
-        Fields of batch shape ``(...)``; ``q`` of shape ``(..., n)``.
+        Fields of batch shape ``(...)``; ``q`` of shape ``(..., n)``: controller values (the
+        robot's coupling, if any, is applied by its forward kinematics and Jacobian); ``success``
+        is False where an interaction limit of the coupling is broken.
     """
     if tol_position <= 0 or tol_orientation <= 0:
         raise InputError("tol_position and tol_orientation must be positive")
@@ -162,6 +164,8 @@ def solve_numeric(
     pos = np.linalg.norm(e[:, :3], axis=1)
     ang = np.linalg.norm(e[:, 3:], axis=1)
     success = (pos <= tol_position) & (ang <= tol_orientation)
+    if robot.coupling is not None:  # an interaction limit (e.g. FANUC J2/J3) is a limit too
+        success &= robot.coupling.within_interaction(best_q)
     return NumericIKResult(best_q.reshape(batch + (n,)), success.reshape(batch),
                            pos.reshape(batch), ang.reshape(batch), iterations.reshape(batch),
                            used_restarts.reshape(batch))

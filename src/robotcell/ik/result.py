@@ -22,20 +22,24 @@ class IKSolutions:
     Attributes
     ----------
     q : ndarray, shape (..., 8, n)
-        Joint values (rad, m) of the 8 branches; NaN where the branch does not reach the pose.
+        Controller axis values (rad, m) of the 8 branches (4 for a palletizer, ``method``
+        ``"palletizer"``, branch ``k = 2 * shoulder + elbow``); NaN where the branch does not
+        reach the pose.
         Revolute values are the 2*pi-equivalents chosen by :class:`robotcell.ik.limits.JointFolder`.
     valid : ndarray of bool, shape (..., 8)
         Branch reaches the pose and its joint values are within the joint limits.
     reachable : ndarray of bool, shape (..., 8)
         Branch reaches the pose (limits not considered); ``valid`` implies ``reachable``.
     method : str
-        ``"opw"`` (ortho-parallel arm with a spherical wrist) or ``"ur"`` (three parallel axes).
+        ``"opw"`` (ortho-parallel arm with a spherical wrist), ``"ur"`` (three parallel axes) or
+        ``"palletizer"`` (4 axes, level flange).
         Branch ``k`` has ``k = 4 * shoulder + 2 * elbow + wrist`` (see docs/ik.md).
     reach_error : ndarray, shape (..., 8), optional
         Distance (m) by which the target's wrist point lies outside the branch's reach; 0 when it
         is inside up to rounding. ``reachable`` is ``reach_error <= REACH_TOL`` (1 um); such a
         branch is solved at the boundary of the reach, and its TCP position differs from the
-        target by ``reach_error`` (the orientation is exact).
+        target by ``reach_error`` (the orientation is exact). A palletizer's solver gives no
+        distance: 0 where a branch reaches, ``inf`` where it does not.
     """
 
     q: NDArray[np.float64]

@@ -159,6 +159,9 @@ class TrackRobot:
         """
         if not (math.isfinite(self.lower) and math.isfinite(self.upper)):
             raise InputError("choosing the track value needs finite track limits (lower, upper)")
+        if self.arm.n_joints != 6:
+            raise InputError(f"choosing the track value needs a six-axis arm; {self.arm.name} has "
+                             f"{self.arm.n_joints} axes: give the track value (ik_at)")
         if samples < 3:
             raise InputError(f"samples must be at least 3, got {samples}")
         arr = validate_pose(T, "target pose")
@@ -195,7 +198,9 @@ class TrackRobot:
         Returns
         -------
         Robot
-            Joint values ``(x, q1, ..., q6)`` as in :meth:`fk`; limits ``lower``, ``upper`` on x.
+            Joint values ``(x, q1, ..., q6)`` as in :meth:`fk` (controller values; an arm's
+            coupling is carried over, extended by the uncoupled track axis); limits ``lower``,
+            ``upper`` on x.
         """
         arm = self.arm
         j1 = arm.joints[0]
@@ -224,6 +229,8 @@ class TrackRobot:
         if arm.home is not None:
             mid = 0.5 * (self.lower + self.upper) if math.isfinite(self.lower + self.upper) else 0.0
             home = np.concatenate([[mid], arm.home])
+        coupling = None if arm.coupling is None else arm.coupling.extended(1)
         return Robot(f"{arm.name}_on_{self.name}", (track, first) + arm.joints[1:], arm.convention,
                      base=base, flange=arm.flange, tool=arm.tool, home=home,
-                     title=f"{arm.title or arm.name} on a linear track", source=arm.source)
+                     title=f"{arm.title or arm.name} on a linear track", source=arm.source,
+                     coupling=coupling)

@@ -1,0 +1,433 @@
+"""The identification engine: Levenberg-Marquardt on the parameterised chain.
+
+Steps (``docs/identification.md``):
+
+1. **Start.** The nominal model (or the circle point analysis) gives the link constants; the pose
+   of the robot base in the device frame and the target positions on the last link come from a
+   closed form: alternating rigid fits (Kabsch) and linear least squares for points, the hand-eye
+   equation for poses.
+2. **Base and targets.** Levenberg-Marquardt with the nominal links: its residual is the nominal
+   model's error, ``rms_before``.
+3. **Identifiable set.** QR with column pivoting of the weighted identification Jacobian, columns
+   scaled to unit length, the base and target constants first (they always stay free). A column
+   whose distance to the span of the columns already chosen is below ``rank_tol`` is fixed at its
+   nominal value; the parameters it duplicates are named in the reason.
+4. **Identification.** Levenberg-Marquardt (``scipy.optimize.least_squares``, MINPACK) over the
+   identifiable set with the analytic Jacobian of :class:`~robotcell.identification.chain.Chain`.
+5. **Uncertainty.** ``cov = s0^2 (J^T J)^-1`` with the weighted Jacobian and the a-posteriori
+   variance factor ``s0^2 = chi^2 / dof``; correlations, the scaled condition number, and rows
+   whose residual is an outlier at 3 sigma (leave-one-out noise level, hat-matrix leverage).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+from scipy.stats import chi2
+
+from robotcell.calibration.fitting import kabsch, scaled_condition
+from robotcell.dhprocedure import AxisChain, dh_from_axes
+from robotcell.errors import IllPosedError, InputError
+from robotcell.identification.chain import Chain
+from robotcell.identification.measurements import Measurements
+from robotcell.identification.result import IdentificationResult, Parameter
+from robotcell.robot import Robot
+
+__all__ = ["identify", "identify_with_coupling"]
+
+#: Default measurement accuracies: a laser tracker (m per coordinate) and a 6D probe (rad).
+POINT_SIGMA = 0.05e-3
+ANGLE_SIGMA = math.radians(0.02)
+#: Probability inside "3 sigma" for a 1-D Gaussian: the outlier test level.
+_THREE_SIGMA_P = 0.9973
+
+
+class _Problem:
+    """Weighted residuals and analytic Jacobian of one measurement set over a free subset."""
+
+    def __init__(self, chain: Chain, meas: Measurements, point_sigma: float, angle_sigma: float):
+        self.chain, self.meas = chain, meas
+        self.wp, self.wr = 1.0 / point_sigma, 1.0 / angle_sigma
+        self.N, self.K = meas.n_rows, meas.n_targets
+        self.pose = meas.rotations is not None
+        self.ncomp = 3 * self.K + (3 if self.pose else 0)
+
+    def raw(self, x: NDArray[np.float64]):
+        """Unweighted residuals (measured - model): points (N, K, 3) m, rotations (N, 3) rad."""
+        pts, R = self.chain.predict(x, self.meas.q)
+        rp = self.meas.points - pts
+        rr = None
+        if self.pose:
+            rr = Rotation.from_matrix(self.meas.rotations @ np.swapaxes(R, 1, 2)).as_rotvec()
+        return rp, rr
+
+    def weighted(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Residuals scaled by the accuracies, shape (N, ncomp)."""
+        rp, rr = self.raw(x)
+        parts = [rp.reshape(self.N, -1) * self.wp]
+        if rr is not None:
+            parts.append(rr * self.wr)
+        return np.concatenate(parts, axis=1)
+
+    def jacobian(self, x: NDArray[np.float64], cols: NDArray[np.int_] | None = None) -> NDArray[np.float64]:
+        """``d weighted / d x`` over ``cols``: shape (N * ncomp, len(cols))."""
+        ch, q = self.chain, self.meas.q
+        ev = ch.evaluate(x, q)
+        pts, _ = ch.predict(x, q)
+        Jp = -ch.point_jacobian(x, q, ev, pts).reshape(self.N, 3 * self.K, -1) * self.wp
+        if self.pose:
+            rr = self.raw(x)[1]
+            W = ch.rotation_jacobian(x, q, ev)
+            Jr = -np.einsum("nij,njp->nip", _right_jacobian_inv(rr), W) * self.wr
+            Jp = np.concatenate([Jp, Jr], axis=1)
+        J = Jp.reshape(self.N * self.ncomp, -1)
+        return J if cols is None else J[:, cols]
+
+
+def _right_jacobian_inv(e: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Inverse right Jacobian of SO(3) at rotation vectors ``e`` (N, 3): ``d log(exp(e) exp(-w)) / dw = -J_r^-1``."""
+    th = np.linalg.norm(e, axis=1)
+    K = np.zeros((len(e), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -e[:, 2], e[:, 1], -e[:, 0]
+    K = K - np.swapaxes(K, 1, 2)
+    small = th < 1e-6
+    ts = np.where(small, 1.0, th)
+    c = np.where(small, 1.0 / 12.0, 1.0 / ts**2 - (1.0 + np.cos(ts)) / (2.0 * ts * np.sin(ts)))
+    return np.eye(3) + 0.5 * K + c[:, None, None] * (K @ K)
+
+
+def _start_base(chain: Chain, meas: Measurements, x: NDArray[np.float64]):
+    """Closed-form ``T_D_R`` and targets (points) or ``T_F_T`` (poses) for the nominal links."""
+    ev = chain.evaluate(x, meas.q, jac=False, base=False)
+    Rf, pf = ev.R, ev.p  # target frame at tool_start = I, in R
+    if meas.rotations is None:
+        K = meas.n_targets
+        r = np.zeros((K, 3))
+        m = meas.points
+        for _ in range(30):
+            model = pf[:, None, :] + np.einsum("nij,kj->nki", Rf, r)
+            T = kabsch(model.reshape(-1, 3), m.reshape(-1, 3))
+            loc = np.einsum("ji,nkj->nki", T[:3, :3], m - T[:3, 3]) - pf[:, None, :]
+            r_new = np.einsum("nji,nkj->nki", Rf, loc).mean(axis=0)
+            if np.abs(r_new - r).max() < 1e-10:
+                r = r_new
+                break
+            r = r_new
+        model = pf[:, None, :] + np.einsum("nij,kj->nki", Rf, r)
+        return kabsch(model.reshape(-1, 3), m.reshape(-1, 3)), r, np.eye(4)
+    # Hand-eye: M_i = B F_i X. Rotation of X from the rotation axes of relative motions.
+    Rm, pm = meas.rotations, meas.points[:, 0, :]
+    n = meas.n_rows  # pairs of rows a step and half the set apart: O(N), not O(N^2)
+    i = np.concatenate([np.arange(n - 1), np.arange(n)])
+    j = np.concatenate([np.arange(1, n), (np.arange(n) + max(n // 2, 1)) % n])
+    a = Rotation.from_matrix(np.swapaxes(Rf[i], 1, 2) @ Rf[j]).as_rotvec()
+    b = Rotation.from_matrix(np.swapaxes(Rm[i], 1, 2) @ Rm[j]).as_rotvec()
+    keep = (np.linalg.norm(a, axis=1) > 0.05) & (np.linalg.norm(a, axis=1) < 3.0)
+    if np.count_nonzero(keep) < 2:
+        raise IllPosedError("the measured orientations hardly change between rows; move the "
+                            "joints so that the target turns by several degrees about different axes")
+    Rx = Rotation.align_vectors(a[keep], b[keep])[0].as_matrix()
+    Rb = Rotation.from_matrix(Rm @ Rx.T @ np.swapaxes(Rf, 1, 2)).mean().as_matrix()
+    # p_m = Rb (Rf p_x + p_f) + p_b: linear in (p_b, p_x).
+    A = np.concatenate([np.broadcast_to(np.eye(3), (meas.n_rows, 3, 3)), Rb @ Rf], axis=2).reshape(-1, 6)
+    rhs = (pm - pf @ Rb.T).reshape(-1)
+    sol = np.linalg.lstsq(A, rhs, rcond=None)[0]
+    B, X = np.eye(4), np.eye(4)
+    B[:3, :3], B[:3, 3] = Rb, sol[:3]
+    X[:3, :3], X[:3, 3] = Rx, sol[3:]
+    return B, np.zeros((0, 3)), X
+
+
+def _solve(prob: _Problem, x0: NDArray[np.float64], free: NDArray[np.int_]) -> NDArray[np.float64]:
+    """Levenberg-Marquardt over the parameters ``free``; returns the full vector."""
+    x = x0.copy()
+
+    def full(v):
+        x[free] = v
+        return x
+
+    def fun(v):
+        return prob.weighted(full(v)).ravel()
+
+    def jac(v):
+        return prob.jacobian(full(v), free)
+
+    if prob.N * prob.ncomp < free.size:
+        raise IllPosedError(f"{prob.N} rows give {prob.N * prob.ncomp} measured coordinates for "
+                            f"{free.size} unknowns; measure more configurations")
+    sol = least_squares(fun, x0[free], jac=jac, method="lm", x_scale="jac",
+                        xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    out = x0.copy()
+    out[free] = sol.x
+    return out
+
+
+def _pivoted_qr(A: NDArray[np.float64], Q: NDArray[np.float64], tol: float,
+                ) -> tuple[list[int], NDArray[np.float64]]:
+    """QR with column pivoting (Businger and Golub) of ``A`` after the orthonormal columns ``Q``.
+
+    Each step takes the column with the largest norm orthogonal to the span so far; among
+    columns within 1e-6 of that norm (duplicates, such as the two ``d`` of a parallel pair) the
+    first in order, so that the choice does not depend on rounding. Stops when no remaining
+    column is longer than ``tol`` (columns of unit length).
+
+    Returns
+    -------
+    chosen : list of int
+        Indices of the kept columns of ``A``, in pivot order.
+    Q : ndarray
+        ``Q`` extended by the new orthonormal directions.
+    """
+    R = A - Q @ (Q.T @ A)
+    chosen: list[int] = []
+    for _ in range(A.shape[1]):
+        n = np.linalg.norm(R, axis=0)
+        n[chosen] = -1.0
+        if n.max() <= tol:
+            break
+        k = int(np.flatnonzero(n >= n.max() * (1.0 - 1e-6))[0])
+        chosen.append(k)
+        v = R[:, k] / n[k]
+        v -= Q @ (Q.T @ v)  # re-orthogonalise against rounding
+        v /= np.linalg.norm(v)
+        Q = np.concatenate([Q, v[:, None]], axis=1)
+        R = R - np.outer(v, v @ R)
+    return chosen, Q
+
+
+def _identifiable(J: NDArray[np.float64], cand: Sequence[int], prio: Sequence[int],
+                  names: Sequence[str], tol: float):
+    """Split ``cand`` into kept and fixed columns; a reason for every fixed one."""
+    norms = np.linalg.norm(J, axis=0)
+    fixed: dict[int, str] = {}
+    live = [c for c in cand if norms[c] > 0]
+    for c in cand:
+        if norms[c] == 0:
+            fixed[c] = "has no effect on these measurements"
+    Jn = J / np.where(norms > 0, norms, 1.0)
+    kept: list[int] = []
+    Q = np.zeros((J.shape[0], 0))
+    for group in ([c for c in live if c in prio], [c for c in live if c not in prio]):
+        chosen, Q = _pivoted_qr(Jn[:, group], Q, tol)
+        kept += [group[k] for k in chosen]
+        fixed.update({c: "" for k, c in enumerate(group) if k not in chosen})
+    for c, why in list(fixed.items()):
+        if why:
+            continue
+        coef = np.linalg.lstsq(Jn[:, kept], Jn[:, c], rcond=None)[0]
+        top = np.argsort(-np.abs(coef))
+        big = [kept[k] for k in top[:3] if abs(coef[k]) > 0.2 * abs(coef[top[0]])]
+        who = ", ".join(names[k] for k in big)
+        if all(names[k].startswith("base.") for k in big):
+            why = f"absorbed by the pose of the robot base in the device frame ({who})"
+        elif all(names[k].startswith("target") for k in big):
+            why = f"absorbed by the target's place on the last link ({who})"
+        else:
+            why = f"same effect as a combination of {who}: the measurements cannot separate them"
+        fixed[c] = why
+    return np.array(sorted(kept), dtype=int), fixed
+
+
+def identify(
+    nominal: Robot,
+    measurements: Measurements,
+    *,
+    point_sigma: float = POINT_SIGMA,
+    angle_sigma: float = ANGLE_SIGMA,
+    scale: bool = False,
+    coupling: float = 0.0,
+    fit_coupling: bool = False,
+    rank_tol: float = 1e-6,
+    name: str | None = None,
+) -> IdentificationResult:
+    """Identify the kinematic parameters of a serial chain from measured points or poses.
+
+    Parameters
+    ----------
+    nominal : Robot
+        Start model (library model, model file, or the circle point analysis): its convention,
+        joint types, signs, names and limits are kept.
+    measurements : Measurements
+        Joint values (rad, m) and measured targets in the device frame (m); with orientations,
+        one target per row.
+    point_sigma : float
+        Accuracy of a measured coordinate (m); weights the point residuals.
+    angle_sigma : float
+        Accuracy of a measured orientation (rad per axis); weights the rotation residuals.
+    scale : bool
+        Also identify a scale error per axis (gear ratio): ``qm = (1 + scale) q``.
+    coupling : float
+        J2/J3 coupling factor ``k`` with ``q3_model = J3 + k J2`` (0: none). Held unless
+        ``fit_coupling``.
+    fit_coupling : bool
+        Identify ``k`` too (starting at ``coupling``).
+    rank_tol : float
+        A scaled Jacobian column closer than this (sine of the angle) to the span of the columns
+        kept before it is fixed as not identifiable.
+    name : str, optional
+        Name of the identified model (default ``<nominal>_identified``).
+
+    Returns
+    -------
+    IdentificationResult
+
+    Raises
+    ------
+    InputError
+        Measurements that do not fit the robot (number of joints), bad accuracies.
+    IllPosedError
+        Too few rows for the unknowns, or orientations that do not change.
+    """
+    if measurements.q.shape[1] != nominal.n_joints:
+        raise InputError(f"the measurements have {measurements.q.shape[1]} joint values per row, "
+                         f"{nominal.name} has {nominal.n_joints} joints")
+    for label, s in (("point_sigma", point_sigma), ("angle_sigma", angle_sigma)):
+        if not (math.isfinite(s) and s > 0):
+            raise InputError(f"{label} must be a positive number, got {s}")
+    pose = measurements.rotations is not None
+    if coupling and nominal.n_joints < 3:
+        raise InputError("a J2/J3 coupling needs a chain with at least 3 joints")
+    chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, np.eye(4), np.eye(4))
+    x = chain.values.copy()
+    if chain.coupling_param >= 0:
+        x[chain.coupling_param] = coupling
+    B, r, X = _start_base(chain, measurements, x)
+    chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, B, X)
+    if not pose:
+        x[np.array(chain.target_params).ravel()] = r.ravel()
+    prob = _Problem(chain, measurements, point_sigma, angle_sigma)
+    groups = np.array(chain.groups)
+    prio = np.flatnonzero(np.isin(groups, ("base", "target")))
+    x1 = _solve(prob, x, prio)
+    rp0, rr0 = prob.raw(x1)
+
+    cand = list(prio) + list(np.flatnonzero(groups == "link"))
+    if scale:
+        cand += list(np.flatnonzero(groups == "scale"))
+    if fit_coupling and chain.coupling_param >= 0:
+        cand.append(chain.coupling_param)
+    J1 = prob.jacobian(x1)
+    kept, fixed = _identifiable(J1, cand, set(prio), chain.names, rank_tol)
+    m = prob.N * prob.ncomp
+    if m < 2 * kept.size:
+        raise IllPosedError(
+            f"{prob.N} rows give {m} measured coordinates for {kept.size} identifiable unknowns; "
+            f"at least twice as many coordinates as unknowns are needed to check the result: "
+            f"measure at least {-(-2 * kept.size // prob.ncomp)} configurations (better 3 to 5 times "
+            "as many, spread over the joint ranges)")
+    x2 = _solve(prob, x1, kept)
+    return _result(nominal, chain, prob, x2, kept, fixed, rp0, rr0, name, x1)
+
+
+def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> IdentificationResult:
+    rp, rr = prob.raw(x)
+    w = prob.weighted(x)
+    J = prob.jacobian(x, kept)
+    m, p = J.shape
+    dof = m - p
+    chi = float(np.sum(w**2))
+    s0 = math.sqrt(chi / dof) if dof > 0 else float("nan")
+    U, S, Vt = np.linalg.svd(J, full_matrices=False)
+    if S[-1] <= S[0] * 1e-14:
+        raise IllPosedError("the identification Jacobian is singular at the solution; measure "
+                            "configurations that move every joint over a wide range")
+    cov = (Vt.T / S**2) @ Vt * (s0**2 if dof > 0 else 1.0)
+    sig = np.sqrt(np.abs(np.diag(cov)))
+    corr = cov / np.outer(sig, sig)
+    # Outliers: leverage of each row from the hat matrix diagonal.
+    h = np.sum(U**2, axis=1).reshape(prob.N, prob.ncomp).sum(axis=1)
+    wrow = np.sum(w**2, axis=1)
+    expect = prob.ncomp - h
+    rest = dof - expect
+    s2 = np.where(rest > 0.5, (chi - wrow) / np.where(rest > 0.5, rest, 1.0), np.nan)
+    limit = chi2.ppf(_THREE_SIGMA_P, prob.ncomp)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        stat = wrow / (s2 * expect) * prob.ncomp
+    outliers = [int(i) for i in np.flatnonzero(stat > limit)]
+    params = []
+    sig_full = dict(zip(kept.tolist(), sig))
+    for i, nm in enumerate(chain.names):
+        g = chain.groups[i]
+        if g in ("scale", "coupling") and i not in sig_full and i not in fixed:
+            continue
+        params.append(Parameter(nm, float(x[i]), float(chain.values[i]) if g == "link" else float("nan"),
+                                float(sig_full.get(i, float("nan"))), i in sig_full, fixed.get(i, ""),
+                                "length" if (nm.split(".")[-1] in ("a", "d", "x", "y", "z")) else
+                                ("number" if g in ("scale", "coupling") else "angle")))
+    robot = _to_robot(nominal, chain, x, name)
+    return IdentificationResult(
+        robot=robot, nominal=nominal, base=chain.base_pose(x), targets=chain.targets(x),
+        target=chain.tool_pose(x) if chain.pose_target else None,
+        parameters=params, correlation=corr, covariance=cov,
+        free=[chain.names[k] for k in kept],
+        fixed=[(chain.names[k], why) for k, why in sorted(fixed.items())],
+        residuals=rp, rotation_residuals=rr, residuals_before=rp0, rotation_residuals_before=rr0,
+        condition=scaled_condition(J), dof=dof, variance_factor=s0, outliers=outliers,
+        labels=list(prob.meas.labels),
+        scale=x[chain.scale_params].copy(),
+        coupling=float(x[chain.coupling_param]) if chain.coupling_param >= 0 else 0.0,
+        point_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, _chain=chain, _x=x,
+        _x_nominal=x_nominal,
+    )
+
+
+def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | None) -> Robot:
+    """The identified chain as a DH model (the nominal's convention) via the DH procedure."""
+    pts, dirs, flange = chain.axis_lines(x)
+    axes = AxisChain(points=pts, directions=dirs, types=tuple(j.type for j in nominal.joints),
+                     flange=flange, names=tuple(chain.joint_names),
+                     lower=nominal.lower, upper=nominal.upper)
+    nm = name or f"{nominal.name}_identified"
+    der = dh_from_axes(axes, nominal.convention, signs=[j.sign for j in nominal.joints], name=nm,
+                       title=f"{nominal.title or nominal.name}, identified",
+                       source=f"identified from measurements, nominal {nominal.name}")
+    tool = chain.tool_pose(x)
+    if not chain.pose_target and chain.n_targets:
+        tool = np.eye(4)
+        tool[:3, 3] = chain.targets(x)[0]
+    return replace(der.robot, tool=tool, home=nominal.home)
+
+
+def identify_with_coupling(nominal: Robot, measurements: Measurements, k: float,
+                           **options) -> IdentificationResult:
+    """Identify with a stated J2/J3 coupling ``k`` and say whether the data support it.
+
+    Fits three times: with ``k`` held, without coupling (``k = 0`` held) and with ``k`` free.
+    ``coupling_check`` of the returned result (the fit with ``k`` held) holds ``k``,
+    ``rms_with_mm``, ``rms_without_mm``, ``k_fitted``, ``k_sigma`` and a ``verdict`` sentence.
+
+    Parameters
+    ----------
+    nominal : Robot
+    measurements : Measurements
+    k : float
+        Stated factor: ``q3_model = J3 + k * J2`` (FANUC: -1 when J3 is the forearm's angle to the
+        horizontal, as the ROS-Industrial FANUC driver's ``J23_factor``).
+    **options
+        Passed to :func:`identify` (accuracies, ``scale``, ``rank_tol``, ``name``).
+
+    Returns
+    -------
+    IdentificationResult
+    """
+    with_k = identify(nominal, measurements, coupling=k, **options)
+    without = identify(nominal, measurements, coupling=0.0, **options)
+    free = identify(nominal, measurements, coupling=k, fit_coupling=True, **options)
+    p = free.parameter("j23_factor")
+    consistent = abs(p.value - k) <= 3 * p.sigma if p.free else False
+    if consistent:
+        verdict = f"the data support k = {k:g} (fitted {p.value:.5f} +- {p.sigma:.5f})"
+    else:
+        verdict = (f"the data do not support k = {k:g}: fitted k = {p.value:.5f} +- {p.sigma:.5f}; "
+                   "check the controller's J2/J3 convention")
+    with_k.coupling_check = {
+        "k": k, "rms_with_mm": with_k.rms_after * 1e3, "rms_without_mm": without.rms_after * 1e3,
+        "k_fitted": p.value, "k_sigma": p.sigma, "supported": consistent, "verdict": verdict,
+    }
+    return with_k

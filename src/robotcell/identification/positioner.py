@@ -1,0 +1,221 @@
+"""Two-axis positioner (tilt and rotate) calibration from touches of one point on the table.
+
+The robot touches the same reference point on the table at several (tilt, rotate) combinations;
+its TCP positions in the robot base frame R are the measurements of a 2-joint chain whose device
+frame is R. :func:`robotcell.identification.identify` fits the chain (start: the nominal
+positioner, or the circle point analysis of the touches), and this module reads the geometry
+off the identified chain, with first-order uncertainties from its covariance:
+
+* the tilt axis (joint 1) and the rotate axis (joint 2) as lines in R at ``q = 0``;
+* their common normal: foot points on both axes, length, and the angle between the axes;
+* the zero of each: ``tilt_zero`` is the angle about the tilt axis from "up" (the robot base's
+  ``+Z`` made perpendicular to the tilt axis) to the rotate axis at tilt 0, so 0 for a level table;
+  ``rotate_zero`` is the angle about the rotate axis from the common normal (pointing away from
+  the tilt axis) to the reference point at rotate 0;
+* ``T_R_B``, the root frame: ``Z_B`` along the tilt axis, origin at the foot of the common normal
+  on it, ``X_B`` along the common normal toward the rotate axis (along ``z_tilt x z_rotate`` when
+  the axes intersect).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.calibration.propagate import propagate
+from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.errors import InputError
+from robotcell.identification.circles import start_model
+from robotcell.identification.engine import identify
+from robotcell.identification.measurements import Measurements
+from robotcell.identification.result import IdentificationResult
+from robotcell.robot import Robot
+from robotcell.transforms import as_points
+
+__all__ = ["PositionerCalibration", "calibrate_positioner"]
+
+#: Touch accuracy used to weight the fit when none is given (m per coordinate).
+DEFAULT_SIGMA = 0.1e-3
+
+
+@dataclass(frozen=True, eq=False)
+class PositionerCalibration:
+    """Outcome of :func:`calibrate_positioner`.
+
+    Attributes
+    ----------
+    result : CalibrationResult
+        Procedure ``"positioner-2axis"``; see :func:`calibrate_positioner` for its values.
+    robot : Robot
+        The identified positioner as a 2-joint DH chain whose ``base`` is its root pose in the
+        robot base frame R and whose tool is the reference point: ``robot.fk(q)[:3, 3]`` is the
+        touched point at tilt, rotate ``q`` (rad), in R (m).
+    identification : IdentificationResult
+        The engine's full result (parameters, fixed ones, correlations).
+    """
+
+    result: CalibrationResult
+    robot: Robot
+    identification: IdentificationResult
+
+
+def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    return v / np.linalg.norm(v)
+
+
+def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+    """Axis lines, common normal, zeros and root frame in R for the full parameter vector ``x``."""
+    ch = ident._chain
+    pts, dirs, _ = ch.axis_lines(x)
+    T = ch.base_pose(x)
+    p = pts @ T[:3, :3].T + T[:3, 3]
+    u = dirs @ T[:3, :3].T
+    w = np.cross(u[0], u[1])
+    if np.linalg.norm(w) < 1e-9:
+        raise InputError("the identified tilt and rotate axes are parallel: not a tilt-rotate positioner")
+    # Feet of the common normal: p0 + s u0 and p1 + t u1.
+    s, t, _ = np.linalg.solve(np.stack([u[0], -u[1], w], axis=1), p[1] - p[0])
+    f0, f1 = p[0] + s * u[0], p[1] + t * u[1]
+    n = f1 - f0
+    length = float(np.linalg.norm(n))
+    x_b = _unit(n) if length > 1e-6 else _unit(w)
+    up = np.array([0.0, 0.0, 1.0]) if abs(u[0][2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    up = _unit(up - (up @ u[0]) * u[0])
+    tilt_zero = math.atan2(np.cross(up, u[1]) @ u[0], up @ u[1])
+    # Reference point at q = 0.
+    ref = ident._chain.predict(x, np.zeros((1, 2)))[0][0, 0]
+    r = ref - f1 - ((ref - f1) @ u[1]) * u[1]
+    rotate_zero = math.atan2(np.cross(x_b, r) @ u[1], x_b @ r)
+    R = np.stack([x_b, np.cross(u[0], x_b), u[0]], axis=1)
+    return {"tilt_point": f0, "tilt_axis": u[0], "rotate_point": f1, "rotate_axis": u[1],
+            "normal_length": np.array(length), "axis_angle": np.array(math.acos(np.clip(u[0] @ u[1], -1, 1))),
+            "tilt_zero": np.array(tilt_zero), "rotate_zero": np.array(rotate_zero),
+            "radius": np.array(np.linalg.norm(r)), "R": R, "origin": f0}
+
+
+def calibrate_positioner(
+    angles: ArrayLike,
+    points: ArrayLike,
+    *,
+    nominal: Robot | None = None,
+    prior_sigma: float | None = None,
+    labels: Sequence[str] | None = None,
+) -> PositionerCalibration:
+    """Calibrate a tilt-rotate positioner from touches of one point on its table.
+
+    Parameters
+    ----------
+    angles : array_like, shape (N, 2)
+        Tilt and rotate axis values at each touch (rad).
+    points : array_like, shape (N, 3)
+        Touched TCP position in the robot base frame R (m).
+    nominal : Robot, optional
+        Nominal 2-joint model of the positioner (any base). Without it the touches must contain,
+        for each axis, at least 3 that move that axis alone over 10 deg or more (e.g. a grid of 3
+        tilt by 4 rotate values), and the circle point analysis gives the start.
+    prior_sigma : float, optional
+        Known touch accuracy (m per coordinate); default: estimated from the residuals.
+    labels : sequence of str, optional
+        Name of each touch (default ``"1".."N"``).
+
+    Returns
+    -------
+    PositionerCalibration
+        ``result.values`` (SI, in R, at ``q = 0``): ``T_R_B`` (root frame, see the module),
+        ``tilt_point``, ``tilt_axis``, ``rotate_point``, ``rotate_axis`` (feet of the common
+        normal and unit directions), ``normal_length`` (m), ``axis_angle`` (rad, 90 deg for a
+        perpendicular pair), ``tilt_zero``, ``rotate_zero`` (rad), ``radius`` (m, of the
+        reference point about the rotate axis); ``sigma`` for each (first order, from the
+        identification's covariance), ``T_R_B_position`` and ``T_R_B_rotation``.
+
+    Raises
+    ------
+    InputError
+        Wrong shapes, NaN, a nominal model that is not a 2-joint chain.
+    IllPosedError
+        Too few touches for the unknowns, or (without a nominal model) no touches moving one axis.
+    """
+    f = as_points(points, "touched points")
+    q = np.asarray(angles, dtype=float)
+    if f.ndim != 2 or q.shape != (len(f), 2):
+        raise InputError(f"angles must have shape (N, 2) (tilt, rotate) matching touched points (N, 3); "
+                         f"got {q.shape} and {f.shape}")
+    if nominal is not None and nominal.n_joints != 2:
+        raise InputError(f"a 2-axis positioner needs a 2-joint nominal model, {nominal.name} has "
+                         f"{nominal.n_joints}")
+    labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
+    meas = Measurements(q, f, None, tuple(labels))
+    start = nominal if nominal is not None else start_model(meas, np.zeros(2, dtype=bool), "positioner")
+    ident = identify(start, meas, point_sigma=prior_sigma or DEFAULT_SIGMA,
+                     name=f"{start.name}_calibrated")
+    ch, x = ident._chain, ident._x
+    kept = np.array([ch.index(nm) for nm in ident.free])
+    cov = ident.covariance
+    if prior_sigma is not None and math.isfinite(ident.variance_factor):
+        cov = cov / ident.variance_factor**2  # the stated accuracy, not the residuals
+        noise, source = prior_sigma, "prior"
+    else:
+        noise, source = ident.variance_factor * DEFAULT_SIGMA, "residuals"
+
+    def at(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        xx = x.copy()
+        xx[kept] = v
+        return xx
+
+    geo = _geometry(ident, x)
+    keys = ["tilt_point", "tilt_axis", "rotate_point", "rotate_axis", "normal_length", "axis_angle",
+            "tilt_zero", "rotate_zero", "radius"]
+
+    def flat(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        g = _geometry(ident, at(v))
+        rot = Rotation.from_matrix(g["R"] @ geo["R"].T).as_rotvec()
+        return np.concatenate([np.ravel(g[k]) for k in keys] + [g["origin"], rot])
+
+    C = propagate(flat, x[kept], cov)
+    sig = np.sqrt(np.abs(np.diag(C)))
+    sigma: dict[str, object] = {}
+    k0 = 0
+    for k in keys:
+        size = np.size(geo[k])
+        sigma[k] = sig[k0:k0 + size] if size > 1 else float(sig[k0])
+        k0 += size
+    sigma["T_R_B_position"], sigma["T_R_B_rotation"] = sig[k0:k0 + 3], sig[k0 + 3:k0 + 6]
+    T_R_B = np.eye(4)
+    T_R_B[:3, :3], T_R_B[:3, 3] = geo["R"], geo["origin"]
+    values = {"T_R_B": T_R_B, **{k: geo[k] if np.size(geo[k]) > 1 else float(geo[k]) for k in keys}}
+    robot = replace(ident.robot, base=ident.base @ ident.robot.base)
+    res = ident.residuals[:, 0, :]
+    warnings = []
+    if ident.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {ident.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
+                        "at more tilt and rotate values, spread over their ranges")
+    warnings += [f"touch {labels[i]} is an outlier at 3 sigma: re-touch it or remove it"
+                 for i in ident.outliers]
+    verdict, why = ident.verdict
+    if verdict != "good":
+        warnings.append(f"verdict {verdict}: {why}")
+    result = CalibrationResult(
+        procedure="positioner-2axis", values=values, sigma=sigma, residuals=res,
+        condition=ident.condition, dof=ident.dof, noise_sigma=noise, noise_source=source,
+        labels=labels, undetermined=[f"{n}: {w}" for n, w in ident.fixed], warnings=warnings,
+        next_step=("enter T_R_B and the axis geometry as the positioner's kinematics in the "
+                   "controller (KUKA: external kinematics ROOT and links; ABB: the mechanical unit's "
+                   "base frame and arm positions), then calibrate the workpiece on the table"),
+        kinds={"tilt_point": "length", "rotate_point": "length", "tilt_axis": "number",
+               "rotate_axis": "number", "normal_length": "length", "axis_angle": "angle",
+               "tilt_zero": "angle", "rotate_zero": "angle", "radius": "length"},
+        json_fields={**pose_fields(T_R_B), "normal_length_mm": geo["normal_length"] * 1e3,
+                     "axis_angle_deg": math.degrees(geo["axis_angle"]),
+                     "tilt_zero_deg": math.degrees(geo["tilt_zero"]),
+                     "rotate_zero_deg": math.degrees(geo["rotate_zero"])},
+        covariance=C, parameter_names=[f"{k}[{i}]" if np.size(geo[k]) > 1 else k for k in keys
+                                       for i in range(np.size(geo[k]))]
+        + ["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z"],
+        points=f,
+    )
+    return PositionerCalibration(result=result, robot=robot, identification=ident)

@@ -1,0 +1,310 @@
+"""The result of a kinematic identification: model, parameters with uncertainty, residuals."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.stats import chi2
+
+from robotcell.calibration.result import CONDITION_LIMIT, to_jsonable
+from robotcell.robot import Robot
+from robotcell.tables import format_table
+
+__all__ = ["IdentificationResult", "Parameter"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One model constant.
+
+    Attributes
+    ----------
+    name : str
+        ``base.x``, ``A2.alpha``, ``target1.y``, ``A3.scale``, ``j23_factor``, ...
+    value : float
+        Identified value (m, rad, or unitless for scale and coupling).
+    nominal : float
+        Nominal value for link constants (NaN for base and targets, which have none).
+    sigma : float
+        1-sigma (same unit); NaN when fixed.
+    free : bool
+        True when identified, False when held at its nominal value.
+    why : str
+        Why a fixed parameter was held.
+    kind : {"length", "angle", "number"}
+    """
+
+    name: str
+    value: float
+    nominal: float
+    sigma: float
+    free: bool
+    why: str
+    kind: str
+
+    def vendor(self) -> tuple[float, float, float, str]:
+        """Value, nominal and sigma in mm / deg, and the unit."""
+        s, unit = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "number": (1.0, "")}[self.kind]
+        return self.value * s, self.nominal * s, self.sigma * s, unit
+
+
+@dataclass(eq=False)
+class IdentificationResult:
+    """Outcome of :func:`robotcell.identification.identify` (SI units).
+
+    Attributes
+    ----------
+    robot : Robot
+        The identified model (nominal convention, names, signs, limits). Its FK takes the model
+        joint values (the controller's when there is no scale and no coupling); its tool is the
+        measured target (the first reflector for points), so ``base @ robot.fk(q)`` predicts the
+        measurement in the device frame.
+    nominal : Robot
+    base : ndarray, shape (4, 4)
+        ``T_D_R``: the robot base in the device frame (m).
+    targets : ndarray, shape (K, 3)
+        Reflector positions in the flange frame of the identified model (m); empty for poses.
+    target : ndarray, shape (4, 4) or None
+        ``T_F_T``: the measured target frame in the flange frame (poses only, m).
+    parameters : list of Parameter
+    correlation, covariance : ndarray, shape (p, p)
+        Over the free parameters, in the order of ``free``.
+    free : list of str
+    fixed : list of (str, str)
+        Name and reason of each parameter held because the data cannot identify it.
+    residuals, residuals_before : ndarray, shape (N, K, 3)
+        Measured minus model position per row and target, after identification and with the
+        nominal links (base and targets fitted) (m).
+    rotation_residuals, rotation_residuals_before : ndarray, shape (N, 3) or None
+        Rotation vector from the model to the measured orientation (rad).
+    condition : float
+        Condition number of the weighted Jacobian with unit columns (free parameters).
+    dof : int
+        Measured coordinates minus free parameters.
+    variance_factor : float
+        ``s0 = sqrt(chi^2 / dof)``: about 1 when the stated accuracies are right.
+    outliers : list of int
+        Rows (0-based) whose residual is an outlier at 3 sigma.
+    labels : list of str
+    scale : ndarray, shape (n,)
+        Per-axis scale errors (0 when not identified).
+    coupling : float
+        J2/J3 factor ``k`` (``q3_model = J3 + k J2``).
+    point_sigma, angle_sigma : float
+        Accuracies used as weights (m, rad).
+    coupling_check : dict
+        Filled by the CLI / :func:`compare_coupling`: RMS with and without the coupling.
+    """
+
+    robot: Robot
+    nominal: Robot
+    base: NDArray[np.float64]
+    targets: NDArray[np.float64]
+    target: NDArray[np.float64] | None
+    parameters: list[Parameter]
+    correlation: NDArray[np.float64]
+    covariance: NDArray[np.float64]
+    free: list[str]
+    fixed: list[tuple[str, str]]
+    residuals: NDArray[np.float64]
+    rotation_residuals: NDArray[np.float64] | None
+    residuals_before: NDArray[np.float64]
+    rotation_residuals_before: NDArray[np.float64] | None
+    condition: float
+    dof: int
+    variance_factor: float
+    outliers: list[int]
+    labels: list[str]
+    scale: NDArray[np.float64]
+    coupling: float
+    point_sigma: float
+    angle_sigma: float
+    _chain: Any = None
+    _x: Any = None
+    _x_nominal: Any = None
+    coupling_check: dict[str, Any] = field(default_factory=dict)
+
+    # -- figures --------------------------------------------------------------------------------
+    @staticmethod
+    def _rms(r: NDArray[np.float64]) -> float:
+        return float(np.sqrt(np.mean(np.sum(r**2, axis=-1)))) if r.size else 0.0
+
+    @property
+    def rms_before(self) -> float:
+        """RMS position error of the nominal model (base and targets fitted), m."""
+        return self._rms(self.residuals_before)
+
+    @property
+    def rms_after(self) -> float:
+        """RMS position error of the identified model, m."""
+        return self._rms(self.residuals)
+
+    @property
+    def max_after(self) -> float:
+        """Largest position error of the identified model, m."""
+        return float(np.linalg.norm(self.residuals, axis=-1).max())
+
+    @property
+    def row_errors(self) -> NDArray[np.float64]:
+        """Position error per row (largest over its targets), shape (N,), m."""
+        return np.linalg.norm(self.residuals, axis=-1).max(axis=1)
+
+    def parameter(self, name: str) -> Parameter:
+        """The parameter called ``name``."""
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def model_joints(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Model joint values for controller values ``q`` (..., n): scale and coupling applied."""
+        arr = np.asarray(q, dtype=float)
+        flat = arr.reshape(-1, arr.shape[-1])
+        return self._chain.model_joints(self._x, flat).reshape(arr.shape)
+
+    def predict(self, q: ArrayLike, nominal: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Predicted targets in the device frame for controller values ``q`` (N, n).
+
+        With ``nominal=True``: the nominal links with the base and targets fitted to them (the
+        model behind ``rms_before``).
+
+        Returns
+        -------
+        points : ndarray, shape (N, K, 3)
+            (m); one point per row (the target frame origin) for pose measurements.
+        rotations : ndarray, shape (N, 3, 3)
+            Orientation of the target frame (meaningful for pose measurements).
+        """
+        x = self._x_nominal if nominal else self._x
+        return self._chain.predict(x, np.atleast_2d(np.asarray(q, dtype=float)))
+
+    @property
+    def verdict(self) -> tuple[str, str]:
+        """``("good" | "check" | "poor", why)``.
+
+        Poor: the residuals are more than 3 times the stated accuracy (``s0 > 3``), or nothing
+        but the base could be identified. Check: ``s0`` above the 99 % chi-square bound, a
+        condition number above 100, or outlier rows.
+        """
+        s0 = self.variance_factor
+        if math.isfinite(s0) and s0 > 3.0:
+            return "poor", (f"the residuals are {s0:.1f} times the stated accuracy (RMS "
+                            f"{self.rms_after * 1e3:.3f} mm); the model or the joint values do "
+                            "not explain the measurements")
+        if not any(p.free and p.kind != "number" and not p.name.startswith(("base.", "target"))
+                   for p in self.parameters):
+            return "poor", "no link parameter is identifiable from these measurements"
+        reasons = []
+        bound = math.sqrt(_chi2_bound(self.dof)) if self.dof > 0 else float("inf")
+        if math.isfinite(s0) and s0 > bound:
+            reasons.append(f"residuals {s0:.2f} times the stated accuracy (bound {bound:.2f})")
+        if self.condition > CONDITION_LIMIT:
+            reasons.append(f"condition number {self.condition:.0f} above {CONDITION_LIMIT:.0f}")
+        if self.outliers:
+            reasons.append(f"{len(self.outliers)} outlier row(s): "
+                           + ", ".join(self.labels[i] for i in self.outliers[:5]))
+        if reasons:
+            return "check", "; ".join(reasons)
+        return "good", "residuals consistent with the stated accuracy, well conditioned"
+
+    # -- output ---------------------------------------------------------------------------------
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict in mm and degrees (the CLI's ``--json``)."""
+        base = self.base.copy()
+        base[:3, 3] *= 1e3
+        out: dict[str, Any] = {
+            "robot": self.robot.name,
+            "base": base,
+            "targets": self.targets * 1e3 if self.target is None else [self.target[:3, 3] * 1e3],
+            "rms_before_mm": self.rms_before * 1e3,
+            "rms_after_mm": self.rms_after * 1e3,
+            "max_after_mm": self.max_after * 1e3,
+            "fixed": [n for n, _ in self.fixed],
+            "fixed_why": {n: w for n, w in self.fixed},
+            "parameters": [
+                {"name": p.name, "value": p.vendor()[0], "nominal": p.vendor()[1], "sigma": p.vendor()[2],
+                 "unit": p.vendor()[3], "free": p.free}
+                for p in self.parameters
+            ],
+            "condition": self.condition,
+            "dof": self.dof,
+            "variance_factor": self.variance_factor,
+            "outliers": [self.labels[i] for i in self.outliers],
+            "residuals_mm": np.linalg.norm(self.residuals, axis=-1) * 1e3,
+            "residuals_before_mm": np.linalg.norm(self.residuals_before, axis=-1) * 1e3,
+            "labels": self.labels,
+            "j23_factor": self.coupling,
+            "verdict": self.verdict[0],
+            "verdict_why": self.verdict[1],
+        }
+        if self.target is not None:
+            T = self.target.copy()
+            T[:3, 3] *= 1e3
+            out["target"] = T
+            out["rotation_rms_before_deg"] = math.degrees(self._rms(self.rotation_residuals_before))
+            out["rotation_rms_after_deg"] = math.degrees(self._rms(self.rotation_residuals))
+        if self.coupling_check:
+            out["coupling_check"] = self.coupling_check
+        return to_jsonable(out)
+
+    def summary(self) -> str:
+        """Readable report in mm and degrees."""
+        orient = " with orientation" if self.target is not None else ""
+        lines = [(f"identification of {self.nominal.name}: {len(self.labels)} rows, "
+                  f"{self.residuals.shape[1]} target(s){orient}"), ""]
+        b = self.base
+        lines.append("robot base in the device frame (mm): "
+                     + ", ".join(f"{v:.3f}" for v in b[:3, 3] * 1e3))
+        for k, t in enumerate(self.targets):
+            lines.append(f"target {k + 1} on the flange (mm): " + ", ".join(f"{v:.3f}" for v in t * 1e3))
+        rows = []
+        for p in self.parameters:
+            v, nom, s, unit = p.vendor()
+            if p.name.startswith(("base.", "target")):
+                continue
+            rows.append([p.name, unit, f"{nom:.4f}" if math.isfinite(nom) else "",
+                         f"{v:.4f}", f"{v - nom:+.4f}" if math.isfinite(nom) else "",
+                         f"{s:.4f}" if p.free else "fixed"])
+        lines += ["", "parameters:", format_table(["name", "unit", "nominal", "identified", "change", "1-sigma"], rows)]
+        if self.fixed:
+            lines += ["", "held at nominal (not identifiable from these measurements):"]
+            lines += [f"  - {n}: {w}" for n, w in self.fixed]
+        e0 = np.linalg.norm(self.residuals_before, axis=-1) * 1e3
+        e1 = np.linalg.norm(self.residuals, axis=-1) * 1e3
+        lines += ["", "position error (mm)      mean      RMS      max",
+                  f"  nominal model     {e0.mean():9.4f} {self.rms_before * 1e3:8.4f} {e0.max():8.4f}",
+                  f"  identified model  {e1.mean():9.4f} {self.rms_after * 1e3:8.4f} {e1.max():8.4f}"]
+        for title, e in (("nominal", e0.max(axis=1)), ("identified", self.row_errors * 1e3)):
+            lines += [f"rows by position error, {title} model (mm):"] + _histogram(e)
+        if self.rotation_residuals is not None:
+            lines.append(f"orientation error RMS (deg): nominal "
+                         f"{math.degrees(self._rms(self.rotation_residuals_before)):.4f}, identified "
+                         f"{math.degrees(self._rms(self.rotation_residuals)):.4f}")
+        lines.append(f"condition number {self.condition:.1f}, redundancy {self.dof}, variance factor "
+                     f"{self.variance_factor:.3f} (1 when the stated accuracy "
+                     f"{self.point_sigma * 1e3:.3f} mm is right)")
+        if self.outliers:
+            lines.append("outlier rows (3 sigma): " + ", ".join(self.labels[i] for i in self.outliers))
+        if self.coupling_check:
+            c = self.coupling_check
+            lines.append(f"J2/J3 coupling k = {c['k']:g}: RMS {c['rms_with_mm']:.4f} mm with it, "
+                         f"{c['rms_without_mm']:.4f} mm without; {c['verdict']}")
+        v, why = self.verdict
+        lines += ["", f"verdict: {v} ({why})"]
+        return "\n".join(lines)
+
+
+def _histogram(values: NDArray[np.float64], bins: int = 6, width: int = 40) -> list[str]:
+    """Text histogram lines ``  lo - hi  ####  count`` of ``values``."""
+    counts, edges = np.histogram(values, bins=bins)
+    top = max(int(counts.max()), 1)
+    return [f"  {lo:8.4f} - {hi:8.4f}  {'#' * round(width * c / top):<{width}} {c}"
+            for lo, hi, c in zip(edges[:-1], edges[1:], counts)]
+
+
+def _chi2_bound(dof: int) -> float:
+    return float(chi2.ppf(0.99, dof) / dof)

@@ -1,0 +1,171 @@
+"""``robotcell identify``: the command-line contract (CSV in, report / JSON / model file out)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import run
+from identification_helpers import (
+    configurations,
+    measure,
+    one_joint_rows,
+    perturbed,
+    truth_chain,
+    write_csv,
+)
+
+from robotcell import load_robot, save_robot
+from robotcell.identification import Measurements
+from robotcell.robot import Joint, Robot
+from robotcell.transforms import make_pose, rot_y
+
+NOISE = 0.02e-3
+
+
+@pytest.fixture(scope="module")
+def kr16_truth():
+    rng = np.random.default_rng(21)
+    nominal = load_robot("kuka_kr16")
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
+    return nominal, ch, x, rng
+
+
+def test_identify_json_and_model_file(kr16_truth, tmp_path, capsys):
+    nominal, ch, x, rng = kr16_truth
+    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
+    csv = tmp_path / "tracker.csv"
+    write_csv(csv, meas)
+    out = tmp_path / "kr16_identified.yaml"
+    code, stdout, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out, "--json",
+                               "--accuracy", "0.02", "--folds", "5")
+    assert code == 0, stderr
+    data = json.loads(stdout)
+    cv = data["cross_validation"]
+    assert cv["folds"] == 5 and cv["after_rms_mm"] < 0.06 and cv["before_rms_mm"] > 10 * cv["after_rms_mm"]
+    for key in ("base", "targets", "rms_before_mm", "rms_after_mm", "fixed", "parameters"):
+        assert key in data
+    base = np.array(data["base"])
+    assert np.allclose(base[:3, 3], ch.base_start[:3, 3] * 1e3, atol=2.0)  # mm
+    assert len(data["targets"]) == 2
+    assert data["rms_after_mm"] < 0.05 < data["rms_before_mm"]
+    assert "A1.theta" in data["fixed"]
+    p = {d["name"]: d for d in data["parameters"]}
+    assert p["A2.a"]["free"] and p["A2.a"]["sigma"] > 0
+    # The model file: its FK takes the CSV's joint values and predicts the measured target 1.
+    robot = load_robot(out)
+    T = np.array(data["base"])
+    T[:3, 3] /= 1e3
+    pred = (T @ robot.fk(meas.q))[:, :3, 3]
+    assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 0.05e-3
+
+
+def test_identify_report_and_poor_result(kr16_truth, tmp_path, capsys):
+    nominal, ch, x, rng = kr16_truth
+    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
+    csv = tmp_path / "tracker.csv"
+    write_csv(csv, meas)
+    code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--folds", "4")
+    assert code == 0
+    assert "verdict: good" in stdout and "held at nominal" in stdout
+    assert "rows by position error, identified model" in stdout and "#" in stdout
+    assert "cross-validation, 4 folds" in stdout
+    # Joint values off by a gross amount in one axis (a scale of 2): exit 3, no model file.
+    q = meas.q.copy()
+    q[:, 1] *= 2.0
+    write_csv(csv, Measurements(q, meas.points))
+    out = tmp_path / "bad.yaml"
+    code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out)
+    assert code == 3
+    assert "poor result" in stderr and "not written" in stderr
+    assert not out.exists()
+    code, _, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out, "--force")
+    assert code == 3 and out.exists()
+
+
+def test_identify_without_nominal_uses_circle_point_analysis(tmp_path, capsys):
+    rng = np.random.default_rng(22)
+    nominal = load_robot("stanford_arm")  # with a prismatic joint, read in mm
+    ch, x = truth_chain(perturbed(nominal, rng), 1, False, rng)
+    q1 = one_joint_rows(nominal)
+    q1[:, 2] = 0.4 + q1[:, 2] * 0.3 / math.radians(60)  # d3 from 0.1 to 0.7 m, else 0.4 m
+    q2 = configurations(nominal, 40, rng)
+    q2[:, 2] = rng.uniform(0.1, 0.9, 40)
+    q = np.concatenate([q1, q2])
+    meas = measure(ch, x, q, rng, NOISE)
+    csv = tmp_path / "tracker.csv"
+    write_csv(csv, meas, nominal.prismatic)
+    out = tmp_path / "arm.yaml"
+    code, stdout, stderr = run(capsys, "identify", csv, "-o", out, "--json", "--accuracy", "0.02")
+    assert code == 0, stderr
+    data = json.loads(stdout)
+    assert data["rms_after_mm"] < 0.05
+    robot = load_robot(out)
+    assert [j.type for j in robot.joints] == [j.type for j in nominal.joints]
+    qv = configurations(nominal, 100, rng)
+    qv[:, 2] = rng.uniform(0.1, 0.9, 100)
+    T = np.array(data["base"])
+    T[:3, 3] /= 1e3
+    err = (T @ robot.fk(qv))[:, :3, 3] - ch.predict(x, qv)[0][:, 0]
+    assert np.sqrt(np.mean(np.sum(err**2, axis=1))) < 0.03e-3
+
+
+def test_identify_j23_factor_report(tmp_path, capsys):
+    rng = np.random.default_rng(23)
+    nominal = load_robot("kuka_kr16")
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng, coupling=-1.0)
+    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
+    csv = tmp_path / "fanuc.csv"
+    write_csv(csv, meas)
+    code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--j23-factor", "-1",
+                          "--json", "--accuracy", "0.02")
+    assert code == 0
+    check = json.loads(stdout)["coupling_check"]
+    assert check["supported"] and check["rms_without_mm"] > 10 * check["rms_with_mm"]
+
+
+@pytest.mark.parametrize("content,message", [
+    ("a1,a2,x,y,z\n0,0,1,2,3\n", "6 joints"),
+    ("a1,a2,a3,a4,a5,a6,x,y\n0,0,0,0,0,0,1,2\n", "x,y,z"),
+    ("b1,x,y,z\n0,1,2,3\n", "a1..aN"),
+    ("a1,a2,a3,a4,a5,a6,x,y,z,qw,qx\n0,0,0,0,0,0,1,2,3,1,0\n", "qw,qx,qy,qz"),
+    ("a1,a2,a3,a4,a5,a6,x,y,z,qw,qx,qy,qz\n0,0,0,0,0,0,1,2,3,2,0,0,0\n", "length"),
+    ("a1,a2,a3,a4,a5,a6,x,y,z\n0,0,0,0,0,0,1,2,abc\n", "numeric"),
+])
+def test_identify_refuses_bad_csv(tmp_path, capsys, content, message):
+    csv = tmp_path / "bad.csv"
+    csv.write_text(content)
+    code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16")
+    assert code == 2
+    assert stderr.startswith("error:") and message in stderr
+    assert "Traceback" not in stderr
+
+
+def test_identify_without_nominal_needs_one_joint_rows(tmp_path, capsys):
+    rng = np.random.default_rng(1)
+    csv = tmp_path / "random.csv"
+    write_csv(csv, Measurements(rng.uniform(-1, 1, (30, 6)), rng.uniform(-1, 1, (30, 3))))
+    code, _, stderr = run(capsys, "identify", csv)
+    assert code == 2 and "joint 1: no rows move it alone" in stderr
+
+
+def test_identify_positioner_with_quaternions(tmp_path, capsys):
+    nominal = Robot(name="positioner", convention="standard", base=make_pose(rot_y(math.pi / 2), [0, 0, 0.8]),
+                    joints=(Joint("revolute", alpha=-math.pi / 2, name="tilt"),
+                            Joint("revolute", d=0.25, name="rotate")))
+    model = tmp_path / "positioner.yaml"
+    save_robot(nominal, model)
+    rng = np.random.default_rng(24)
+    ch, x = truth_chain(perturbed(nominal, rng), 1, True, rng)
+    q = rng.uniform(-1.5, 1.5, (30, 2))
+    csv = tmp_path / "camera.csv"
+    write_csv(csv, measure(ch, x, q, rng, NOISE, math.radians(0.01)))
+    assert "qw,qx,qy,qz" in csv.read_text().splitlines()[0]
+    code, stdout, stderr = run(capsys, "identify", csv, "--robot", model, "--json", "--accuracy", "0.02",
+                               "--angle-accuracy", "0.01")
+    assert code == 0, stderr
+    data = json.loads(stdout)
+    assert np.array(data["target"]).shape == (4, 4)
+    assert data["rms_after_mm"] < 0.05 and data["rotation_rms_after_deg"] < 0.03
+    assert {p["name"] for p in data["parameters"] if p["free"] and not p["name"].startswith(
+        ("base", "target"))} == {"tilt.a", "tilt.alpha"}
