@@ -542,3 +542,20 @@ def test_read_only_file_is_not_replaced(tmp_path, capsys):
     assert cell.read_bytes() == before and out.read_text() == "kept"
     assert stat.S_IMODE(cell.stat().st_mode) == 0o444
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "kuka.dat"]  # no .bak
+
+
+def test_python_warning_is_one_line_without_source(capsys, monkeypatch):
+    import warnings
+
+    import robotcell.cli.export as export_cli
+
+    real = export_cli.export_cell
+
+    def noisy(*args, **kwargs):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(export_cli, "export_cell", noisy)
+    code, _, err = run(capsys, "export", "--cell", EXAMPLE, "--format", "kuka")
+    assert code == 0
+    assert err == "warning: RuntimeWarning: overflow encountered in multiply\n"

@@ -12,6 +12,7 @@ import importlib
 import importlib.util
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import click
@@ -103,16 +104,25 @@ def cli() -> None:
     """
 
 
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str,
+                      lineno: int, file: object = None, line: str | None = None) -> None:
+    """``warnings.showwarning`` for users: ``warning: <category>: <message>`` on stderr."""
+    click.echo(f"warning: {category.__name__}: {message}", err=True)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the CLI.
 
     Exit status: 0 on success; 2 for refused input (a bad option or file, geometry that does not
     determine the result), with ``error: ...`` on stderr; 1 when the user aborts, or for an
     unexpected failure, which is reported in one ``error:`` line with a request to report it
-    (never a traceback).
+    (never a traceback). A Python warning raised inside (e.g. numpy's overflow on absurd input)
+    is one ``warning:`` line, without the source file and line a developer would want.
     """
     try:
-        cli.main(args=argv, prog_name="robotcell", standalone_mode=False)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            cli.main(args=argv, prog_name="robotcell", standalone_mode=False)
     except click.exceptions.Abort:
         click.echo("aborted", err=True)
         sys.exit(1)
