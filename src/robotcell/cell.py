@@ -630,7 +630,7 @@ class Cell:
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
            table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
-           samples: int = 65) -> cellik.CellIKSolutions:
+           samples: int | None = None) -> cellik.CellIKSolutions:
         """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cellik.ik`.
 
         ``table``: the table angle ``(...)``, the positioner's axis values ``(..., n)``, or, for a
@@ -677,9 +677,10 @@ class Cell:
     def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                 table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
                 q_start: ArrayLike | None = None, max_step: float = cellik.MAX_STEP,
-                samples: int = 33) -> cellik.CellPath:
+                samples: int = 33, track_motion: str = "fixed") -> cellik.CellPath:
         """A continuous trajectory through targets; see :func:`robotcell.cellik.ik_path`."""
-        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples)
+        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples,
+                              track_motion)
 
     # -- files ------------------------------------------------------------------------------------
     @classmethod

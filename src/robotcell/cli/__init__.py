@@ -34,6 +34,8 @@ COMMANDS = {
     "report": "robotcell.cli.report:report",
     "demo": "robotcell.cli.demo:demo",
     "identify": "robotcell.cli.identify:identify",
+    "reach": "robotcell.cli.reach:reach",
+    "sweep": "robotcell.cli.sweep:sweep_cmd",
 }
 
 
