@@ -559,3 +559,16 @@ def test_python_warning_is_one_line_without_source(capsys, monkeypatch):
     code, _, err = run(capsys, "export", "--cell", EXAMPLE, "--format", "kuka")
     assert code == 0
     assert err == "warning: RuntimeWarning: overflow encountered in multiply\n"
+
+
+@pytest.mark.parametrize("option", ["-o", "--html"])
+def test_reach_and_sweep_outputs_checked_before_work(tmp_path, capsys, poses_csv, option):
+    code, out, err = run(capsys, "reach", poses_csv, "--cell", EXAMPLE, "--tool", "pointer",
+                         option, tmp_path / "nodir" / "reach.out")
+    assert code == 2 and "the folder" in err and "does not exist" in err
+    code, out, err = run(capsys, "reach", poses_csv, "--cell", EXAMPLE, "--tool", "pointer",
+                         option, tmp_path)
+    assert code == 2 and "it is a folder" in err and "Traceback" not in out + err
+    code, out, err = run(capsys, "sweep", "--cell", EXAMPLE, "--targets", poses_csv, "--layouts",
+                         tmp_path / "l.yaml", "-o", tmp_path / "nodir" / "sweep.csv")
+    assert code == 2 and "the folder" in err and "Traceback" not in out + err
