@@ -12,7 +12,7 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import write_csv
+from robotcell.cli.common import check_output, write_csv, write_output
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.poseformats import FORMATS
@@ -73,9 +73,9 @@ def load_targets(path: str, fmt: str, table_deg: float, choose_table: bool
 @target_options
 @click.option("--track", "track_mm", type=float, default=None,
               help="Track position (mm) for every target (default: chosen per target).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="CSV to write (default: standard output).")
-@click.option("--html", "html_path", type=click.Path(dir_okay=False), default=None,
+@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+              help="CSV to write, atomically (default: standard output).")
+@click.option("--html", "html_path", type=click.Path(), default=None, callback=check_output,
               help="Self-contained HTML page with the map (default: next to -o, .html).")
 def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
           table_deg: float, choose_table: bool, track_mm: float | None, output: str | None,
@@ -109,7 +109,7 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
     if html_path:
         page = reach_html(rm, T[:, :3, 3], title=f"Reachability: {Path(targets).name} in "
                           f"{cell.name}", frame=frame)
-        Path(html_path).write_text(page, encoding="utf-8")
+        write_output(html_path, page)
     n_ok = int(np.count_nonzero(rm.reachable))
     margin = math.degrees(float(np.nanmin(rm.limit_margin))) if n_ok else float("nan")
     click.echo(f"{n_ok} of {rm.reachable.size} targets reachable, mean score "

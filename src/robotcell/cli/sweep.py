@@ -10,7 +10,7 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import format_table, write_csv
+from robotcell.cli.common import check_output, format_table, write_csv
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
 from robotcell.errors import InputError
@@ -46,8 +46,8 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
               help="Run on a Dask cluster, e.g. tcp://10.0.0.5:8786 (pip install "
                    "'robotcell[dask]').")
 @click.option("--top", type=int, default=10, show_default=True, help="Layouts to print.")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="CSV of every layout, ranked.")
+@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+              help="CSV of every layout, ranked (written atomically).")
 def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool: str | None,
               fmt: str, table_deg: float, choose_table: bool, workers: int | None,
               scheduler: str | None, top: int, output: str | None) -> None:
