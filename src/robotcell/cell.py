@@ -7,7 +7,9 @@ files). Every calibrated quantity carries its :class:`Provenance`.
 
 :meth:`Cell.save` writes atomically: a temporary file in the same directory, flushed and
 fsynced, then ``os.replace``; the previous file is kept as ``<name>.bak``. A process that dies
-during a save leaves either the old or the new file, never a partial one.
+during a save leaves either the old or the new file, never a partial one. The file and its
+``.bak`` keep the permissions the file had (see :mod:`robotcell.fileio`, which also gives the
+encoding rule of :meth:`Cell.load`).
 
 Coupled kinematics (TCP pose in any frame given the arm joints, the track position and the table
 angle) are in :mod:`robotcell.coupled`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call them.
@@ -25,8 +27,6 @@ import datetime as _dt
 import math
 import os
 import re
-import shutil
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -38,6 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell import axischain, cellik, coupled
 from robotcell.coupled import RESERVED_FRAMES
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_copy, atomic_write, check_destination, read_text
 from robotcell.modelfile import load_robot, robot_from_dict, robot_to_dict
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.robot import Joint, Robot
@@ -629,7 +630,7 @@ class Cell:
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
            table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
-           samples: int = 65) -> cellik.CellIKSolutions:
+           samples: int | None = None) -> cellik.CellIKSolutions:
         """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cellik.ik`.
 
         ``table``: the table angle ``(...)``, the positioner's axis values ``(..., n)``, or, for a
@@ -676,9 +677,10 @@ class Cell:
     def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                 table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
                 q_start: ArrayLike | None = None, max_step: float = cellik.MAX_STEP,
-                samples: int = 33) -> cellik.CellPath:
+                samples: int = 33, track_motion: str = "fixed") -> cellik.CellPath:
         """A continuous trajectory through targets; see :func:`robotcell.cellik.ik_path`."""
-        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples)
+        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples,
+                              track_motion)
 
     # -- files ------------------------------------------------------------------------------------
     @classmethod
@@ -702,14 +704,11 @@ class Cell:
             file and the key.
         """
         p = Path(path)
-        if not p.is_file():
-            raise InputError(f"cell file {str(path)!r} does not exist")
+        text = read_text(p, "cell file")
         try:
-            data = yaml.safe_load(p.read_text(encoding="utf-8"))
+            data = yaml.safe_load(text)
         except yaml.YAMLError as exc:
             raise InputError(f"{path}: not valid YAML: {exc}") from None
-        except UnicodeDecodeError:
-            raise InputError(f"{path}: not a text file (expected UTF-8 YAML)") from None
         return cell_from_dict(data, str(path), p.resolve().parent)
 
     def save(self, path: str | Path) -> None:
@@ -718,7 +717,8 @@ class Cell:
         The text is written to a temporary file in the same directory, flushed and fsynced, then
         moved over ``path`` with ``os.replace``; the old file is first copied (the same way) to
         ``<path>.bak``. If the process dies at any point, ``path`` holds either the old or the new
-        content in full.
+        content in full. Both keep the permissions of the file replaced (a new file gets
+        ``0o666`` less the umask).
 
         Parameters
         ----------
@@ -728,9 +728,10 @@ class Cell:
         p = Path(path)
         text = _HEADER + yaml.safe_dump(cell_to_dict(self, p.resolve().parent), sort_keys=False,
                                         default_flow_style=None, width=100)
+        check_destination(p)  # a read-only file is refused before the backup is made
         if p.exists():
-            _atomic_copy(p, p.with_name(p.name + ".bak"))
-        _atomic_write(p, text)
+            atomic_copy(p, p.with_name(p.name + ".bak"))
+        atomic_write(p, text)
 
 
 _HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z, a, b, c} with\n"
@@ -754,45 +755,6 @@ def _unique_numbers(numbers: dict[str, int | None], what: str) -> None:
         if n in seen:
             raise InputError(f"{what}s {seen[n]!r} and {name!r} have the same number {n}")
         seen[n] = name
-
-
-# -- atomic writes --------------------------------------------------------------------------------
-def _fsync_dir(directory: Path) -> None:
-    try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:  # platforms without directory handles
-        return
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _atomic_write(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    _fsync_dir(path.parent)
-
-
-def _atomic_copy(src: Path, dst: Path) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
-    try:
-        with os.fdopen(fd, "wb") as out, src.open("rb") as inp:
-            shutil.copyfileobj(inp, out)
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(tmp, dst)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 # -- file content <-> Cell ------------------------------------------------------------------------

@@ -18,6 +18,7 @@ worst touch is best.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -31,11 +32,12 @@ from scipy.spatial.transform import Rotation
 from robotcell.cell import Cell, Turntable
 from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_write
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.robot import Robot
 from robotcell.transforms import invert, make_pose, rot_z, transform_points
 
-__all__ = ["PROCEDURES", "Touches", "simulate"]
+__all__ = ["MAX_TOUCHES", "PROCEDURES", "Touches", "check_counts", "simulate"]
 
 #: Procedures that can be simulated, with what they calibrate.
 PROCEDURES = {
@@ -50,6 +52,12 @@ PROCEDURES = {
 
 #: Candidate track positions when the track position of a procedure is chosen.
 TRACK_SAMPLES = 25
+
+#: Most touches one simulation places (memory of the configuration search grows with them).
+MAX_TOUCHES = 200
+
+#: Fewest touches each procedure's calibration accepts, as ``robotcell calibrate`` checks them.
+MIN_TOUCHES = {"turntable": 3, "track": 3}
 
 
 def _down_orientations() -> NDArray[np.float64]:
@@ -166,13 +174,20 @@ class Touches:
         return kw
 
     def write_csv(self, out: str | Path | TextIO) -> None:
-        """Write the measurement CSV to a path or an open text stream."""
+        """Write the measurement CSV to an open text stream, or to a path atomically.
+
+        Raises
+        ------
+        InputError
+            The path cannot be written (missing folder, a folder, no permission).
+        """
         header, rows = self.columns()
         if hasattr(out, "write"):
             _write(out, header, rows)
             return
-        with Path(out).open("w", newline="", encoding="utf-8") as fh:
-            _write(fh, header, rows)
+        buf = io.StringIO(newline="")
+        _write(buf, header, rows)
+        atomic_write(out, buf.getvalue())
 
 
 def _write(fh: TextIO, header: list[str], rows: list[list[str]]) -> None:
@@ -221,6 +236,9 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
     e : ndarray, shape (N,)
         Track positions (m).
     """
+    if len(labels) > MAX_TOUCHES:
+        raise InputError(f"{len(labels)} touches asked for; a simulation places at most "
+                         f"{MAX_TOUCHES}")
     robot = cell.robot
     if robot.n_joints != 6:
         raise InputError(f"simulated touches need a six-axis arm; {robot.name} has "
@@ -274,7 +292,11 @@ def _usual_configuration(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.flo
 
 
 def _rng(seed: int | np.random.Generator | None) -> np.random.Generator:
-    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise InputError(f"seed must be a whole number >= 0, got {seed}")
+    return np.random.default_rng(seed)
 
 
 def _tool_name(cell: Cell, tool: str | None) -> str:
@@ -300,6 +322,20 @@ def _frame_name(cell: Cell, frame: str | None, parents: tuple[str, ...], what: s
         raise InputError(f"frame {frame!r} is carried by {cell.frames[frame].parent}; the {what} "
                          f"procedure touches frames carried by {' or '.join(parents)}")
     return frame
+
+
+def check_counts(design: dict[str, Any]) -> None:
+    """Refuse ``touches``, ``positions`` or ``repeats`` above :data:`MAX_TOUCHES` up front.
+
+    Raises
+    ------
+    InputError
+        A count that would place more touches than a simulation places.
+    """
+    for key in ("touches", "positions", "repeats"):
+        if isinstance(design.get(key), (int, np.integer)) and design[key] > MAX_TOUCHES:
+            raise InputError(f"{key} {design[key]}: a simulation places at most {MAX_TOUCHES} "
+                             "touches")
 
 
 def _check_noise(noise: float) -> float:
@@ -398,6 +434,8 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                          f"along {t.axis}")
     if positions < 2:
         raise InputError(f"each reference point needs at least 2 track positions, got {positions}")
+    if not (math.isfinite(travel) and travel > 0):
+        raise InputError(f"travel must be a positive length (m), got {travel}")
     tname = _tool_name(cell, tool)
     u = t.direction
     o = t.T_L_R0[:3, 3]
@@ -416,6 +454,10 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
     offsets = np.linspace(-travel / 2, travel / 2, positions) / t.scale
     e_all = np.clip(centre[:, None] + offsets, t.lower, t.upper)
     point = np.repeat(np.arange(len(refs)), positions)
+    if len(point) < MIN_TOUCHES["track"]:
+        raise InputError(f"the track calibration needs at least {MIN_TOUCHES['track']} touches; "
+                         f"{len(refs)} reference point(s) x {positions} positions give "
+                         f"{len(point)}: add positions or reference points")
     e_all = e_all.ravel()
     for k in range(len(refs)):
         if np.ptp(e_all[point == k]) < 0.05:
@@ -472,10 +514,19 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
                radius: float = 0.3, height: float = 0.05) -> Touches:
     _one_axis_table(cell)
     tname = _tool_name(cell, tool)
-    if not radius > 0:
+    if not (math.isfinite(radius) and radius > 0):
         raise InputError(f"radius must be positive (m), got {radius}")
+    if not math.isfinite(height):
+        raise InputError(f"height must be a finite length (m), got {height}")
+    least = MIN_TOUCHES["turntable"]
+    if angles is None and touches < least:
+        raise InputError(f"the turntable calibration needs at least {least} table angles "
+                         f"(touches), got {touches}")
     th = _table_angles(cell, angles, touches)
     n = len(th)
+    if n < least:
+        raise InputError(f"the turntable calibration needs at least {least} table angles, "
+                         f"got {n}")
     p_B = np.array([radius, 0.0, height])
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -633,6 +684,7 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
     if procedure not in _SIMULATORS:
         raise InputError(f"unknown procedure {procedure!r}; choose from {', '.join(PROCEDURES)}")
     noise = _check_noise(noise)
+    check_counts(design)
     try:
         return _SIMULATORS[procedure](cell, _rng(seed), noise, tool, track, **design)
     except TypeError as exc:

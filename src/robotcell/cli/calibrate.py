@@ -27,7 +27,7 @@ from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cellcal.touches import POSE_COLUMNS, line_labels, repeat_notes
-from robotcell.cli.common import parse_numbers, read_csv
+from robotcell.cli.common import check_output, parse_numbers, read_csv, write_output
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import pose_from_vendor
@@ -69,12 +69,26 @@ def calibrate() -> None:
     """
 
 
+#: Key of ``click.Context.meta`` under which ``-o FILE`` is kept for :func:`emit`.
+OUTPUT_KEY = "robotcell.calibrate.output"
+
+
+def _keep_output(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+    ctx.meta[OUTPUT_KEY] = check_output(ctx, param, value)
+
+
 def measurement_options(func: Callable) -> Callable:
-    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json,
+    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o,
     --accept-poor."""
     func = click.option("--accept-poor", is_flag=True,
                         help="Write and exit 0 even when the verdict is poor (default: a poor "
                              "result exits with status 3 and changes no file).")(func)
+    func = click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+                        expose_value=False, callback=_keep_output,
+                        help="Also write the result to FILE, atomically and only when the run "
+                             "succeeds: the JSON object with --json, else the report. Use it "
+                             "instead of '--json > FILE', which empties FILE when a run is "
+                             "refused.")(func)
     func = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
                         help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
@@ -186,8 +200,9 @@ def sigma_m(sigma_mm: float | None) -> float | None:
     """``--sigma`` in mm to metres, refusing non-positive values."""
     if sigma_mm is None:
         return None
-    if not sigma_mm > 0:
-        raise InputError(f"--sigma must be a positive number of millimetres, got {sigma_mm}")
+    if not 0 < sigma_mm <= 1000:
+        raise InputError(f"--sigma must be a positive number of millimetres (at most 1000), got "
+                         f"{sigma_mm}")
     return sigma_mm * 1e-3
 
 
@@ -202,11 +217,19 @@ def echo_note(note: str) -> None:
 
 
 def emit(result: CalibrationResult, as_json: bool) -> None:
-    """Print a result: the terminal report, or one JSON object with ``--json``."""
-    if as_json:
-        click.echo(json.dumps(result.to_json(), indent=2))
-    else:
-        click.echo(result.summary())
+    """Print a result: the terminal report, or one JSON object with ``--json``.
+
+    With ``-o FILE`` the terminal shows the report and FILE gets the JSON object (``--json``) or
+    the report, written atomically.
+    """
+    output = click.get_current_context().meta.get(OUTPUT_KEY)
+    text = json.dumps(result.to_json(), indent=2) if as_json else result.summary()
+    if output is None:
+        click.echo(text)
+        return
+    click.echo(result.summary())
+    write_output(output, text + "\n")
+    click.echo(f"wrote {output}", err=True)
 
 
 class PoorCalibration(click.ClickException):
@@ -271,7 +294,7 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     require_name(name, target, "tool")
     prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     cell, label = cell_of(target)
     out = cellcal.tcp(cell, cols, name, robot=None if cell else model, world_mode=world_mode,
                       sigma=prior, source=measurements, cell_label=label, on_note=echo_note)
@@ -316,7 +339,8 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
                          "CELL.yaml")
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track", "nominal_x",
+                                                        "nominal_y", "nominal_z"])
     cell, label = cell_of(target)
     out = cellcal.frame(cell, cols, name, parent=parent, robot=None if cell else model,
                         tool=T_tool, sigma=prior, source=measurements, cell_label=label,
@@ -348,7 +372,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     refuse_track_column(cols, measurements, "is not used by 'calibrate external-tcp': touch the "
                         "fixed tool with the track at one position and remove the column")
     p = tcp_positions(cols, measurements, model, T_tool)

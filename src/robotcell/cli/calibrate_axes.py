@@ -10,12 +10,14 @@ turntable, positioner and workpiece.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import click
 import numpy as np
 
 from robotcell import cellcal
+from robotcell.cellcal.touches import POSE_COLUMNS
 from robotcell.cli.calibrate import (
     CellTarget,
     cell_of,
@@ -30,6 +32,7 @@ from robotcell.cli.calibrate import (
 )
 from robotcell.cli.common import parse_numbers, read_csv
 from robotcell.errors import InputError
+from robotcell.fileio import read_text
 from robotcell.transforms import validate_pose
 
 
@@ -69,7 +72,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     refs = np.array([parse_numbers(r, "--reference", 3) for r in references]).reshape(-1, 3) * 1e-3
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
     cell, label = cell_of(target)
     out = cellcal.track(cell, cols, references=refs, axis=axis, roll=roll,
                         robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
@@ -101,12 +104,12 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
 
     \b
     Examples:
-      robotcell calibrate turntable table.csv --json > turntable.json
+      robotcell calibrate turntable table.csv --json -o turntable.json
       robotcell calibrate turntable table.csv --cell cell.yaml --tool pointer
     """
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "track"])
     cell, label = cell_of(target)
     out = cellcal.turntable(cell, cols, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
@@ -136,11 +139,11 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     \b
     Examples:
       robotcell calibrate positioner touches.csv --cell cell.yaml --tool pointer
-      robotcell calibrate positioner touches.csv --json > positioner.json
+      robotcell calibrate positioner touches.csv --robot kuka_kr16 --json -o positioner.json
     """
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "e2", "track"])
     cell, label = cell_of(target)
     out = cellcal.positioner(cell, cols, robot=None if cell else model, tool=T_tool,
                              sigma=sigma_m(sigma), source=measurements, cell_label=label,
@@ -161,8 +164,8 @@ def _load_turntable(path: str) -> cellcal.TurntablePose:
     if not p.is_file():
         raise InputError(f"{path}: no such file")
     try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        data = json.loads(read_text(p))
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise InputError(f"{path}: not JSON ({exc}); pass the --json output of "
                          "'robotcell calibrate turntable'") from None
     if not isinstance(data, dict) or data.get("procedure") != "turntable" or "matrix" not in data:
@@ -178,17 +181,37 @@ def _load_turntable(path: str) -> cellcal.TurntablePose:
     T = validate_pose(T, f"{path}: matrix")
     sigma = data.get("sigma") if isinstance(data.get("sigma"), dict) else {}
     frame = "world" if any(str(k).startswith("T_world_B") for k in [*data, *sigma]) else "robot"
-    cov = data.get("T_world_B_covariance_mm_rad" if frame == "world" else "T_R_B_covariance_mm_rad")
+    key = "T_world_B_covariance_mm_rad" if frame == "world" else "T_R_B_covariance_mm_rad"
+    cov = data.get(key)
     if cov is not None:
-        cov = np.array(cov, dtype=float)
-        if cov.shape != (6, 6) or not np.all(np.isfinite(cov)):
-            cov = None
-        else:
-            to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
-            cov = cov * np.outer(to_si, to_si)
+        cov = _covariance(cov, f"{path}: {key!r}")
+        to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+        cov = cov * np.outer(to_si, to_si)
     noise = data.get("noise_sigma_mm")
+    if noise is not None and (isinstance(noise, bool) or not isinstance(noise, (int, float))
+                              or not math.isfinite(noise) or noise < 0):
+        raise InputError(f"{path}: 'noise_sigma_mm' must be a number of millimetres >= 0, got "
+                         f"{noise!r}; pass the unchanged --json output of 'robotcell calibrate "
+                         "turntable'")
     return cellcal.TurntablePose(T, cov, float(noise) * 1e-3 if noise is not None else None,
                                  frame, path)
+
+
+def _covariance(value: object, where: str) -> np.ndarray:
+    """A 6x6 symmetric positive semi-definite covariance (mm, rad) from JSON, or refused."""
+    advice = "; pass the unchanged --json output of 'robotcell calibrate turntable'"
+    try:
+        cov = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where} must be a 6x6 array of numbers{advice}") from None
+    if cov.shape != (6, 6) or not np.all(np.isfinite(cov)):
+        raise InputError(f"{where} must be a 6x6 array of finite numbers, got shape "
+                         f"{cov.shape}{advice}")
+    scale = max(float(np.abs(cov).max()), 1e-300)
+    if np.abs(cov - cov.T).max() > 1e-9 * scale or np.linalg.eigvalsh(cov).min() < -1e-9 * scale:
+        raise InputError(f"{where} is not a covariance (symmetric, no negative variance)"
+                         f"{advice}")
+    return cov
 
 
 @click.command("workpiece")
@@ -223,7 +246,7 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     require_name(name, target, "frame")
     model, T_tool = robot_and_tool(robot, tool, target)
     given = None if turntable_json is None else _load_turntable(turntable_json)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
     cell, label = cell_of(target)
     out = cellcal.workpiece(cell, cols, name, turntable=given, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,

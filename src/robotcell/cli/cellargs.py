@@ -23,7 +23,7 @@ from robotcell.errors import InputError
 from robotcell.poseformats import pose_from_vendor
 
 __all__ = ["NORMAL_UP", "PROGRESS_MIN", "cell_tool", "check_normal_up", "chunks", "row_values",
-           "table_angles", "table_option", "table_rows", "track_values"]
+           "table_angles", "table_columns", "table_option", "table_rows", "track_values"]
 
 #: ``ik --cell --table normal-up``: the positioner turns each target's surface normal up.
 NORMAL_UP = "normal-up"
@@ -131,6 +131,14 @@ def check_normal_up(cell: Cell, frame: str) -> str:
         raise InputError(f"--table normal-up needs the target in a frame carried by the "
                          f"positioner (--frame {carried or 'NAME'}), got --frame {frame}")
     return "normal_up"
+
+
+def table_columns(cell: Cell) -> tuple[tuple[int, ...], list[str]]:
+    """Trailing shape of the table values and their batch columns: ``table``, or ``e1..en``."""
+    pos = cell.turntable
+    if isinstance(pos, Positioner):
+        return (pos.n_axes,), [f"e{i + 1}" for i in range(pos.n_axes)]
+    return (), ["table"]
 
 
 def table_rows(cell: Cell, cols: dict, option: NDArray[np.float64] | float, n: int

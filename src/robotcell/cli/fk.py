@@ -13,11 +13,12 @@ from robotcell.cli.cellargs import (
     cell_tool,
     row_values,
     table_angles,
+    table_columns,
     table_option,
     table_rows,
     track_values,
 )
-from robotcell.cli.common import parse_numbers, read_csv, require_columns, write_csv
+from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
 from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
@@ -43,7 +44,9 @@ def tool_option(text: str | None) -> np.ndarray | None:
 @click.argument("robot", required=False)
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
-@click.option("--output", "output_path", type=click.Path(), help="CSV to write (default: standard output).")
+@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+              help="CSV to write, atomically: the poses of --input, or one row for --joints "
+                   "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,
               help="Pose format of the result.")
 @click.option("--tool", "tool", help="TCP in the flange frame X,Y,Z,A,B,C (mm, deg, KUKA convention); "
@@ -94,12 +97,15 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
         T = r.fk(q, tool=T_tool)
         if not r.within_limits(q):
             click.echo("warning: joint values outside the robot's limits", err=True)
+        if output_path is not None:
+            _write_poses(T[None], fmt, output_path)
+            return
         if fmt == "matrix":
             click.echo("T_R_TCP (translation in mm):")
         _echo_pose(T, fmt)
         return
-    cols = read_csv(input_path)
     names = [f"a{i}" for i in range(1, r.n_joints + 1)]
+    cols = read_csv(input_path, known=names)
     q = joints_to_si(r, require_columns(cols, names, input_path))
     T = r.fk(q, tool=T_tool)
     outside = int(np.count_nonzero(~r.within_limits(q)))
@@ -147,17 +153,17 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
         q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
         e, th = track_values(cell, track_mm), table_angles(cell, table_option(cell, table_deg))
     else:
-        cols = read_csv(input_path)
-        q = joints_to_si(r, require_columns(cols, [f"a{i}" for i in range(1, r.n_joints + 1)],
-                                           input_path))
+        names = [f"a{i}" for i in range(1, r.n_joints + 1)]
+        cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
+        q = joints_to_si(r, require_columns(cols, names, input_path))
         e = track_values(cell, row_values(cols, "track", track_mm, len(q)))
         th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)))
     T = cell.fk(q, e, th, T_tool, frame)
     outside = int(np.count_nonzero(~r.within_limits(q)))
     if outside:
         click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
-    if joints is not None:
+    if joints is not None and output_path is None:
         click.echo(f"{cell.name}: TCP in frame {frame!r} ({fmt}, mm, deg)")
         _echo_pose(T, fmt)
         return
-    _write_poses(T, fmt, output_path)
+    _write_poses(T.reshape(-1, 4, 4), fmt, output_path)

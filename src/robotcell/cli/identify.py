@@ -8,6 +8,7 @@ import sys
 
 import click
 
+from robotcell.cli.common import check_output
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
@@ -19,7 +20,8 @@ from robotcell.modelfile import load_robot, save_robot
 @click.argument("measurements", type=click.Path())
 @click.option("--robot", "robot", help="Nominal model: library name or model file. Without it the "
               "circle point analysis builds the start model (rows moving one joint at a time).")
-@click.option("-o", "--output", "output", type=click.Path(), help="Write the identified model file (YAML).")
+@click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
+              help="Write the identified model file (YAML), atomically.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of the report.")
 @click.option("--j23-factor", "j23", type=float, help="J2/J3 coupling k: q3_model = J3 + k * J2 "
               "(FANUC: -1). The report says whether the data support it.")

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
-import sys
 from typing import TextIO
 
 import click
@@ -18,11 +18,19 @@ from robotcell.cli.cellargs import (
     chunks,
     row_values,
     table_angles,
+    table_columns,
     table_option,
     table_rows,
     track_values,
 )
-from robotcell.cli.common import format_table, parse_numbers, read_csv, require_columns
+from robotcell.cli.common import (
+    check_output,
+    format_table,
+    parse_numbers,
+    read_csv,
+    require_columns,
+    write_output,
+)
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
@@ -59,7 +67,9 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 @click.argument("robot", required=False)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
-@click.option("--output", "output_path", type=click.Path(), help="CSV to write (default: standard output).")
+@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+              help="File to write, atomically: the CSV of --input, or the table of --pose "
+                   "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,
               help="Pose format of --pose / --input.")
 @click.option("--all", "show_all", is_flag=True, help="Also list unreachable and out-of-limit branches.")
@@ -140,7 +150,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         if ref is not None:
             q, found, branch = nearest(r, sol, ref)
             if not found:
-                raise click.ClickException("no valid solution (unreachable or outside the joint limits)")
+                raise InputError("no valid solution (unreachable or outside the joint limits)")
             q, valid, reach, ks = q[None], np.array([True]), np.array([True]), [int(branch)]
         else:
             q, valid, reach = sol.q, sol.valid, sol.reachable
@@ -160,13 +170,13 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
                 row.append(flags[row_i] if reach[row_i] else "-")
             rows.append(row)
         if not rows:
-            raise click.ClickException("no valid solution (unreachable or outside the joint limits); "
-                                       "--all lists every branch")
-        click.echo(f"{r.name}, {solver.method} solver, controller axis values in degrees")
-        click.echo(format_table(headers, rows))
+            raise InputError("no valid solution (unreachable or outside the joint limits); "
+                             "--all lists every branch")
+        write_output(output_path, f"{r.name}, {solver.method} solver, controller axis values in "
+                     f"degrees\n{format_table(headers, rows)}\n")
         return
-    cols = read_csv(input_path)
     names = [f.lower() for f in FORMATS[fmt].fields]
+    cols = read_csv(input_path, known=names)
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     sol = solver.solve(T, T_tool)
     axes = [f"a{i}" for i in range(1, n + 1)]
@@ -190,11 +200,9 @@ def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[obje
     none = int(np.count_nonzero(~valid.any(axis=1)))
     if none:
         click.echo(f"warning: {none} pose(s) without a valid solution", err=True)
-    if output_path:
-        with open(output_path, "w", newline="", encoding="utf-8") as fh:
-            _write(fh, header, out_rows)
-    else:
-        _write(sys.stdout, header, out_rows)
+    buf = io.StringIO(newline="")
+    _write(buf, header, out_rows)
+    write_output(output_path, buf.getvalue())
 
 
 def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
@@ -207,14 +215,6 @@ def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
         s, t = kuka_status_turn(robot, qq)
         return ["status", "turn"], np.column_stack([s, t])
     return ["cf1", "cf4", "cf6", "cfx"], np.atleast_2d(abb_confdata(robot, qq))
-
-
-def _table_columns(cell: Cell) -> tuple[tuple[int, ...], list[str]]:
-    """Trailing shape of the table values and their batch columns: ``table``, or ``e1..en``."""
-    pos = cell.turntable
-    if isinstance(pos, Positioner):
-        return (pos.n_axes,), [f"e{i + 1}" for i in range(pos.n_axes)]
-    return (), ["table"]
 
 
 def _table_text(cell: Cell, values: np.ndarray, chosen: bool) -> str:
@@ -271,12 +271,12 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
         how = "chosen" if track_mm is None else "given"
         where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
         where += _table_text(cell, sol.table, table_deg == NORMAL_UP)
-        click.echo(f"{cell.name}: {r.name}, {sol.method} solver, target in frame {frame!r}{where}; "
-                   "angles in degrees")
-        click.echo(format_table(headers, rows))
+        write_output(output_path, f"{cell.name}: {r.name}, {sol.method} solver, target in frame "
+                     f"{frame!r}{where}; angles in degrees\n{format_table(headers, rows)}\n")
         return
-    cols = read_csv(input_path)
     names = [f.lower() for f in FORMATS[fmt].fields]
+    n_table, table_names = table_columns(cell)
+    cols = read_csv(input_path, known=[*names, "track", *table_names])
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     n = len(T)
     e = track_values(cell, row_values(cols, "track", track_mm, n))
@@ -290,7 +290,6 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     valid = np.concatenate([p.valid for p in parts])
     reach = np.concatenate([p.reachable for p in parts])
     track = np.concatenate([np.broadcast_to(p.track, p.valid.shape[:-1]) for p in parts]) * 1e3
-    n_table, table_names = _table_columns(cell)
     table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1] + n_table)
                             for p in parts]).reshape(n, -1) * deg
     method = parts[0].method
