@@ -3,8 +3,9 @@
 Run: ``python benchmarks/bench_ik.py``. Prints the machine, the batched analytic IK time per pose
 (all 8 solutions, including input validation, joint-limit and 2*pi handling) with its ratio to
 EAIK's batched C++ solver on one thread: measured in the same run when EAIK is installed
-(``pip install EAIK``), otherwise against its published 4.7 us/pose (REFERENCES.md); J2/J3-coupled
-arms against the same arm without its coupling, timed alternately in the same run; and the
+(``pip install EAIK``), otherwise against 4.7 us/pose measured on a 2-core machine
+(docs/references.md); J2/J3-coupled arms against the same arm without its coupling, timed
+alternately in the same run; and the
 convergence of numeric IK for a 7-axis robot on a linear track over reachable random targets.
 """
 
@@ -25,7 +26,7 @@ from robotcell.ik import TrackRobot, solve, solve_numeric
 from robotcell.modelfile import load_robot
 from robotcell.transforms import make_pose, rot_x, rot_z
 
-EAIK_US_PER_POSE = 4.7  # all 8 solutions, batched C++, one thread (REFERENCES.md)
+EAIK_US_PER_POSE = 4.7  # all 8 solutions, batched C++, one thread (docs/references.md)
 N_POSES = 100_000
 N_TARGETS = 1000
 

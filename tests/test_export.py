@@ -110,7 +110,7 @@ def test_abb_quaternion_of_known_rotations():
             ) in text
     m = re.search(r"wobjdata w1:=\[FALSE,TRUE,\"\",\[\[[^]]*\],\[([^]]*)\]\]", text)
     q = [float(v) for v in m.group(1).split(",")]
-    # REFERENCES.md: KUKA (A, B, C) = (30, 20, 10) is ABB q = [0.951549, 0.038135, 0.189308, 0.239298].
+    # docs/references.md: KUKA (A, B, C) = (30, 20, 10) is ABB q = [0.951549, 0.038135, 0.189308, 0.239298].
     np.testing.assert_allclose(q, [0.951549, 0.038135, 0.189308, 0.239298], atol=1e-6)
     assert abs(np.linalg.norm(q) - 1) < 1e-9
 
@@ -118,7 +118,7 @@ def test_abb_quaternion_of_known_rotations():
 def test_fanuc_and_yaskawa_angles_of_a_known_rotation():
     cell = Cell(robot=ROBOT, robot_model="kuka_kr16",
                 frames={"f": Frame(pose_from_vendor([100, 200, 300, 30, 20, 10], "kuka"))})
-    # R = Rz(30) Ry(20) Rx(10): FANUC W, P, R = 10, 20, 30 (REFERENCES.md), and YASKAWA the same.
+    # R = Rz(30) Ry(20) Rx(10): FANUC W, P, R = 10, 20, 30 (docs/references.md), and YASKAWA the same.
     fanuc = export_cell(cell, "fanuc")
     assert ("UFRAME[1]  X 100.000000  Y 200.000000  Z 300.000000  W 10.000000000  P 20.000000000  "
             "R 30.000000000  ! f") in fanuc

@@ -74,7 +74,7 @@ def test_errors(capsys, tmp_path):
     code, _, err = run(["ik", "kuka_kr16"], capsys)
     assert code == 2 and "give exactly one of --pose" in err
     code, _, err = run(["ik", "kuka_kr16", "--pose", "9000,0,0,0,0,0"], capsys)
-    assert code == 1 and "no valid solution" in err
+    assert code == 2 and err.startswith("error: no valid solution")
     bad = tmp_path / "bad.csv"
     bad.write_text("x,y,z,a,b\n1,2,3,4,5\n")
     code, _, err = run(["ik", "kuka_kr16", "--input", str(bad)], capsys)

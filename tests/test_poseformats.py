@@ -5,8 +5,8 @@ from scipy.spatial.transform import Rotation
 from robotcell import FORMATS, InputError, pose_from_vendor, pose_to_vendor
 from robotcell.transforms import rot_x, rot_y, rot_z
 
-# Reference values from shared/REFERENCES.md (Roboception rc_visard pose formats; ABB RAPID
-# `orient`; RoboDK "Reference frames" for Staubli), checked there numerically.
+# Reference values from docs/references.md (Roboception rc_visard pose formats; ABB RAPID
+# `orient`; RoboDK "Reference frames" for Staubli), the worked example there.
 KUKA_ABC = [30.0, 20.0, 10.0]
 FANUC_WPR = [10.0, 20.0, 30.0]
 ABB_Q = [0.951549, 0.038135, 0.189308, 0.239298]

@@ -1,4 +1,4 @@
-"""The robot cell: robot, linear track, turntable, tools and frames, and its YAML file.
+"""The robot cell: robot, linear track, turntable or positioner, tools and frames, and its file.
 
 A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the schema); a
 :class:`Cell` holds the same content in SI units. Poses in the file are mappings
@@ -7,10 +7,18 @@ files). Every calibrated quantity carries its :class:`Provenance`.
 
 :meth:`Cell.save` writes atomically: a temporary file in the same directory, flushed and
 fsynced, then ``os.replace``; the previous file is kept as ``<name>.bak``. A process that dies
-during a save leaves either the old or the new file, never a partial one.
+during a save leaves either the old or the new file, never a partial one. The file and its
+``.bak`` keep the permissions the file had (see :mod:`robotcell.fileio`, which also gives the
+encoding rule of :meth:`Cell.load`).
 
 Coupled kinematics (TCP pose in any frame given the arm joints, the track position and the table
 angle) are in :mod:`robotcell.coupled`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call them.
+
+External axes that carry the work are a :class:`Turntable` (one axis, the lecture's ``R_T_B
+Rz(theta)``) or a :class:`Positioner`: a chain of 1-3 revolute axes written as a DH
+:class:`~robotcell.robot.Robot` whose ``base`` is the root pose, the form an identified chain
+takes. Both offer the same kinematic interface (:attr:`Turntable.chain`, ``T_root_P``,
+``axis_values``, ``within_limits``), which is all coupled kinematics and the exports use.
 """
 
 from __future__ import annotations
@@ -19,8 +27,6 @@ import datetime as _dt
 import math
 import os
 import re
-import shutil
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -29,15 +35,17 @@ import numpy as np
 import yaml
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell import cellik, coupled
+from robotcell import axischain, cellik, coupled
 from robotcell.coupled import RESERVED_FRAMES
 from robotcell.errors import InputError
-from robotcell.modelfile import load_robot
+from robotcell.fileio import atomic_copy, atomic_write, check_destination, read_text
+from robotcell.modelfile import load_robot, robot_from_dict, robot_to_dict
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.robot import Robot
-from robotcell.transforms import validate_pose
+from robotcell.robot import Joint, Robot
+from robotcell.transforms import finite_array, validate_pose
 
-__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "Provenance", "Tool", "Track", "Turntable"]
+__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool", "Track",
+           "Turntable"]
 
 #: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
 #: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
@@ -205,6 +213,145 @@ class Turntable:
         arr = np.asarray(theta, dtype=float)
         return (arr >= self.lower) & (arr <= self.upper)
 
+    # -- the interface shared with Positioner ----------------------------------------------------
+    n_axes = 1
+
+    @property
+    def T_parent_root(self) -> NDArray[np.float64]:
+        """Pose of the root frame B in the parent (metres): ``T_parent_B``."""
+        return self.T_parent_B
+
+    @property
+    def chain(self) -> Robot:
+        """The table as a 1-axis DH chain: base ``T_parent_B``, one revolute joint about Z_B."""
+        return Robot(self.name, (Joint("revolute", lower=self.lower, upper=self.upper,
+                                       name=f"{self.name}_axis"),), base=self.T_parent_B)
+
+    def axis_values(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """Table angles as an array of shape ``(...)`` (radians), refusing NaN and infinity."""
+        return finite_array(theta, "table angle")
+
+    def batch_shape(self, theta: NDArray[np.float64]) -> tuple[int, ...]:
+        """Batch shape of table angles: their shape."""
+        return theta.shape
+
+    def T_root_P(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """The table's turn ``Rz(theta)``, shape ``(..., 4, 4)``: frames on the table move with it."""
+        return coupled.table_pose(theta)
+
+
+@dataclass
+class Positioner:
+    """A positioner: a chain of 1-3 revolute axes carrying the work (tilt-rotate, L, drop-centre).
+
+    ``T_parent_P(v) = chain.fk(v)`` with the chain's ``base`` the root pose ``T_parent_0`` and its
+    ``flange`` the plate frame P on the last axis, which carries the frames with parent
+    ``turntable``. Axis values ``v`` have shape ``(..., n)``, radians, as the controller counts
+    them (``sign`` and offsets of the DH table apply). A turntable is the 1-axis case with
+    ``a = alpha = d = theta = 0``.
+
+    Attributes
+    ----------
+    chain : Robot
+        The axes as a DH chain (standard or modified), base = root pose in the parent (metres),
+        limits on each axis (radians); e.g. the result of a kinematic identification.
+    parent : {"world", "robot"}
+        ``world``: fixed in the cell; ``robot``: fixed to the robot base R (moves with a track).
+    name : str
+        Name of the mechanical unit (KUKA ``MACHINE_DEF`` name, ABB mechanical unit).
+    provenance : Provenance
+    """
+
+    chain: Robot
+    parent: Literal["world", "robot"] = "world"
+    name: str = "positioner"
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.chain, Robot):
+            raise InputError("positioner chain must be a robotcell.Robot (a DH chain)")
+        if not 1 <= self.chain.n_joints <= 3 or np.any(self.chain.prismatic):
+            raise InputError(f"a positioner is a chain of 1 to 3 revolute axes, got "
+                             f"{self.chain.n_joints} axes "
+                             f"({', '.join(j.type for j in self.chain.joints)})")
+        if self.parent not in ("world", "robot"):
+            raise InputError(f"positioner parent must be 'world' or 'robot', got {self.parent!r}")
+        self._axes = self.chain.with_base(np.eye(4))
+
+    @property
+    def n_axes(self) -> int:
+        """Number of axes (1 to 3)."""
+        return self.chain.n_joints
+
+    @property
+    def T_parent_root(self) -> NDArray[np.float64]:
+        """Pose of the root frame (frame 0 of the chain) in the parent (metres)."""
+        return self.chain.base
+
+    @property
+    def lower(self) -> NDArray[np.float64]:
+        """Lower axis limits, shape ``(n,)`` (radians)."""
+        return self.chain.lower
+
+    @property
+    def upper(self) -> NDArray[np.float64]:
+        """Upper axis limits, shape ``(n,)`` (radians)."""
+        return self.chain.upper
+
+    def axis_values(self, values: ArrayLike) -> NDArray[np.float64]:
+        """Axis values as an array of shape ``(..., n)`` (radians).
+
+        A single number is every axis of a 1-axis positioner; of a longer chain only 0 (every
+        axis at 0, the default of the kinematic functions) is taken, any other is refused.
+        """
+        v = finite_array(values, "positioner axis value")
+        if v.ndim == 0:
+            if self.n_axes > 1 and v != 0:
+                raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give one "
+                                 f"value per axis, shape (..., {self.n_axes}), not the single "
+                                 f"value {float(v):g} rad")
+            return np.broadcast_to(v, (self.n_axes,))
+        if v.shape[-1] != self.n_axes:
+            raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give its axis "
+                             f"values with shape (..., {self.n_axes}), got {v.shape}")
+        return v
+
+    def batch_shape(self, values: NDArray[np.float64]) -> tuple[int, ...]:
+        """Batch shape of axis values ``(..., n)``: ``(...)``."""
+        return values.shape[:-1]
+
+    def T_root_P(self, values: ArrayLike) -> NDArray[np.float64]:
+        """Pose of the plate P in the root at axis values ``(..., n)``, shape ``(..., 4, 4)``."""
+        return self._axes.fk(self.axis_values(values), np.eye(4))
+
+    def within_limits(self, values: ArrayLike) -> NDArray[np.bool_]:
+        """Whether axis values ``(..., n)`` are all within their limits, shape ``(...)``."""
+        v = self.axis_values(values)
+        return np.all((v >= self.lower) & (v <= self.upper), axis=-1)
+
+    def normal_up(self, normal: ArrayLike, T_world_parent: ArrayLike | None = None
+                  ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Axis values of a 2-axis positioner that turn a plate direction straight up.
+
+        Parameters
+        ----------
+        normal : array_like, shape (..., 3)
+            Direction in the plate frame P (e.g. a weld's surface normal).
+        T_world_parent : array_like, shape (..., 4, 4), optional
+            Pose of the positioner's parent in the world (the robot base for ``parent="robot"``);
+            default the world itself.
+
+        Returns
+        -------
+        values : ndarray, shape (..., 2, 2)
+            Up to two solutions (v_1, v_2), radians (NaN where none).
+        valid : ndarray of bool, shape (..., 2)
+            Solution exists and lies within the axis limits.
+        """
+        T = np.eye(4) if T_world_parent is None else np.asarray(T_world_parent, dtype=float)
+        R = T[..., :3, :3] @ self.chain.base[:3, :3]
+        return axischain.normal_up(self.chain, R, normal)
+
 
 @dataclass
 class Tool:
@@ -291,7 +438,9 @@ class Cell:
     T_world_R : ndarray, shape (4, 4)
         Pose of the robot base in the world for a cell without track (metres).
     track : Track or None
-    turntable : Turntable or None
+    turntable : Turntable or Positioner or None
+        What carries the work: a one-axis turntable or a positioner chain of 1-3 axes (also
+        :attr:`positioner`). Frames with parent ``turntable`` are carried by its last axis.
     tools : dict of str to Tool
     frames : dict of str to Frame
     name : str
@@ -301,7 +450,7 @@ class Cell:
     robot_model: str
     T_world_R: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     track: Track | None = None
-    turntable: Turntable | None = None
+    turntable: Turntable | Positioner | None = None
     tools: dict[str, Tool] = field(default_factory=dict)
     frames: dict[str, Frame] = field(default_factory=dict)
     name: str = "cell"
@@ -318,6 +467,11 @@ class Cell:
             self._check_parent(name, fr)
         _unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
         _unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
+
+    @property
+    def positioner(self) -> Turntable | Positioner | None:
+        """The external axes carrying the work (the same object as :attr:`turntable`)."""
+        return self.turntable
 
     def _check_parent(self, name: str, fr: Frame) -> None:
         if fr.parent == "turntable" and self.turntable is None:
@@ -429,9 +583,34 @@ class Cell:
         -------
         Turntable
         """
-        if self.turntable is None:
-            raise InputError("the cell has no turntable to update")
+        if not isinstance(self.turntable, Turntable):
+            raise InputError("the cell has no turntable to update" if self.turntable is None else
+                             "the cell's positioner is an axis chain: use update_positioner")
         self.turntable = replace(self.turntable, provenance=provenance, **changes)
+        return self.turntable
+
+    def update_positioner(self, provenance: Provenance, chain: Robot) -> Positioner:
+        """Write a calibrated positioner chain into the cell, keeping its parent and name.
+
+        The hook of the positioner calibration (:func:`robotcell.identification.calibrate_positioner`
+        returns the identified chain as a :class:`~robotcell.robot.Robot`): a turntable becomes a
+        :class:`Positioner` with that chain.
+
+        Parameters
+        ----------
+        provenance : Provenance
+        chain : Robot
+            1-3 revolute axes; base = root pose in the parent (metres), limits (radians).
+
+        Returns
+        -------
+        Positioner
+        """
+        old = self.turntable
+        if old is None:
+            raise InputError("the cell has no positioner to update")
+        self.turntable = Positioner(chain, parent=old.parent, name=old.name,
+                                    provenance=provenance)
         return self.turntable
 
     # -- kinematics -----------------------------------------------------------------------------
@@ -442,21 +621,66 @@ class Cell:
 
     def fk(self, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
            tool: str | ArrayLike | None = None, frame: str = "world") -> NDArray[np.float64]:
-        """TCP pose in a frame of the cell; see :func:`robotcell.coupled.fk`."""
+        """TCP pose in a frame of the cell; see :func:`robotcell.coupled.fk`.
+
+        ``table`` is the table angle ``(...)`` of a turntable, or the axis values ``(..., n)`` of
+        a positioner chain (radians).
+        """
         return coupled.fk(self, q, track, table, tool, frame)
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
-           table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
-           samples: int = 65) -> cellik.CellIKSolutions:
-        """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cellik.ik`."""
-        return cellik.ik(self, T, frame, track, table, tool, samples)
+           table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
+           samples: int | None = None) -> cellik.CellIKSolutions:
+        """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cellik.ik`.
+
+        ``table``: the table angle ``(...)``, the positioner's axis values ``(..., n)``, or, for a
+        2-axis positioner and targets in a frame it carries, ``"normal_up"``: the axis values
+        that turn each target's surface normal (its ``-Z``: the tool's Z points into the surface)
+        straight up, the welding position (:meth:`Positioner.normal_up`; of its two solutions,
+        per target, the one within the axis limits where the arm has more valid branches).
+        """
+        if not isinstance(table, str):
+            return cellik.ik(self, T, frame, track, table, tool, samples)
+        values, ok = self._normal_up(T, frame, track)
+        sols = [cellik.ik(self, T, frame, track, np.where(ok[..., k, None], values[..., k, :], 0.0),
+                          tool, samples) for k in range(2)]
+        counts = np.stack([np.where(ok[..., k], s.count, -1) for k, s in enumerate(sols)])
+        second = counts[1] > counts[0]
+
+        def pick(a: NDArray, b: NDArray) -> NDArray:
+            return np.where(second.reshape(second.shape + (1,) * (a.ndim - second.ndim)), b, a)
+
+        first, other = sols
+        return cellik.CellIKSolutions(
+            pick(first.q, other.q), pick(first.valid, other.valid),
+            pick(first.reachable, other.reachable), pick(first.track, other.track),
+            pick(first.table, other.table), first.method)
+
+    def _normal_up(self, T: ArrayLike, frame: str, track: ArrayLike | None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Positioner axis values turning the targets' -Z up, for :meth:`ik`."""
+        pos = self.turntable
+        if not isinstance(pos, Positioner) or pos.n_axes != 2:
+            raise InputError("table='normal_up' needs a positioner of 2 axes")
+        if frame not in self.frames or self.frames[frame].parent != "turntable":
+            raise InputError(f"table='normal_up' needs targets in a frame carried by the "
+                             f"positioner, got frame {frame!r}")
+        T_P = self.frames[frame].pose @ validate_pose(T, "target pose")
+        parent = (np.eye(4) if pos.parent == "world"
+                  else coupled.robot_pose(self, 0.0 if track is None else track))
+        values, valid = pos.normal_up(-T_P[..., :3, 2], parent)
+        if not np.all(np.any(valid, axis=-1)):
+            raise InputError("the positioner cannot turn every target's normal up within its "
+                             "axis limits")
+        return values, valid
 
     def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                 table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
                 q_start: ArrayLike | None = None, max_step: float = cellik.MAX_STEP,
-                samples: int = 33) -> cellik.CellPath:
+                samples: int = 33, track_motion: str = "fixed") -> cellik.CellPath:
         """A continuous trajectory through targets; see :func:`robotcell.cellik.ik_path`."""
-        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples)
+        return cellik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples,
+                              track_motion)
 
     # -- files ------------------------------------------------------------------------------------
     @classmethod
@@ -480,14 +704,11 @@ class Cell:
             file and the key.
         """
         p = Path(path)
-        if not p.is_file():
-            raise InputError(f"cell file {str(path)!r} does not exist")
+        text = read_text(p, "cell file")
         try:
-            data = yaml.safe_load(p.read_text(encoding="utf-8"))
+            data = yaml.safe_load(text)
         except yaml.YAMLError as exc:
             raise InputError(f"{path}: not valid YAML: {exc}") from None
-        except UnicodeDecodeError:
-            raise InputError(f"{path}: not a text file (expected UTF-8 YAML)") from None
         return cell_from_dict(data, str(path), p.resolve().parent)
 
     def save(self, path: str | Path) -> None:
@@ -496,7 +717,8 @@ class Cell:
         The text is written to a temporary file in the same directory, flushed and fsynced, then
         moved over ``path`` with ``os.replace``; the old file is first copied (the same way) to
         ``<path>.bak``. If the process dies at any point, ``path`` holds either the old or the new
-        content in full.
+        content in full. Both keep the permissions of the file replaced (a new file gets
+        ``0o666`` less the umask).
 
         Parameters
         ----------
@@ -506,9 +728,10 @@ class Cell:
         p = Path(path)
         text = _HEADER + yaml.safe_dump(cell_to_dict(self, p.resolve().parent), sort_keys=False,
                                         default_flow_style=None, width=100)
+        check_destination(p)  # a read-only file is refused before the backup is made
         if p.exists():
-            _atomic_copy(p, p.with_name(p.name + ".bak"))
-        _atomic_write(p, text)
+            atomic_copy(p, p.with_name(p.name + ".bak"))
+        atomic_write(p, text)
 
 
 _HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z, a, b, c} with\n"
@@ -532,45 +755,6 @@ def _unique_numbers(numbers: dict[str, int | None], what: str) -> None:
         if n in seen:
             raise InputError(f"{what}s {seen[n]!r} and {name!r} have the same number {n}")
         seen[n] = name
-
-
-# -- atomic writes --------------------------------------------------------------------------------
-def _fsync_dir(directory: Path) -> None:
-    try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:  # platforms without directory handles
-        return
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _atomic_write(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    _fsync_dir(path.parent)
-
-
-def _atomic_copy(src: Path, dst: Path) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
-    try:
-        with os.fdopen(fd, "wb") as out, src.open("rb") as inp:
-            shutil.copyfileobj(inp, out)
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(tmp, dst)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 # -- file content <-> Cell ------------------------------------------------------------------------
@@ -664,8 +848,8 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
     Cell
     """
     rd = _Reader(origin)
-    top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "tools", "frames"},
-                     ("robot",)) if isinstance(data, dict) else None
+    top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "positioner", "tools",
+                                "frames"}, ("robot",)) if isinstance(data, dict) else None
     if top is None:
         raise InputError(f"{origin}: a cell file must be a YAML mapping with keys robot, tools, "
                          "frames, ...")
@@ -717,6 +901,11 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
             lower=lo, upper=hi, name=rd.string(t.get("name", "turntable"), "turntable.name"),
             provenance=rd.provenance(t.get("provenance"), "turntable.provenance"),
         )
+    if top.get("positioner") is not None:
+        if "turntable" in kwargs:
+            raise rd.fail("positioner", "and key 'turntable' both describe the axes carrying the "
+                          "work; keep one (a turntable is a positioner of one axis)")
+        kwargs["turntable"] = _positioner_from_dict(rd, top["positioner"])
     tools: dict[str, Tool] = {}
     for name, td in rd.mapping(top.get("tools") or {}, "tools", set(top.get("tools") or {})).items():
         key = f"tools.{name}"
@@ -755,6 +944,47 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
         return Cell(tools=tools, frames=frames, **kwargs)
     except InputError as exc:
         raise InputError(f"{origin}: {exc}") from None
+
+
+_AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "sign", "min", "max"}
+
+
+def _positioner_from_dict(rd: _Reader, value: Any) -> Positioner:
+    """The ``positioner`` section: root frame, DH axes (mm, deg), plate, limits."""
+    p = rd.mapping(value, "positioner", {"name", "parent", "frame", "convention", "axes", "plate",
+                                         "provenance"}, ("axes",))
+    parent = p.get("parent", "world")
+    if parent not in ("world", "robot"):
+        raise rd.fail("positioner.parent", f"must be world or robot, got {parent!r}")
+    axes = p["axes"]
+    if not isinstance(axes, list) or not 1 <= len(axes) <= 3:
+        raise rd.fail("positioner.axes", "must be a list of 1 to 3 axes {a, alpha, d, theta, "
+                      "sign, min, max} (mm, deg)")
+    for i, ax in enumerate(axes, start=1):
+        rd.mapping(ax, f"positioner.axes[{i}]", _AXIS_KEYS)
+    name = rd.string(p.get("name", "positioner"), "positioner.name")
+    model: dict[str, Any] = {"name": name, "convention": p.get("convention", "standard"),
+                             "joints": [{"type": "revolute", **ax} for ax in axes],
+                             "base": rd.mapping(p.get("frame", {}), "positioner.frame",
+                                                set(_POSE_KEYS)),
+                             "flange": rd.mapping(p.get("plate", {}), "positioner.plate",
+                                                  set(_POSE_KEYS))}
+    chain = robot_from_dict(model, f"{rd.origin}: positioner")
+    return Positioner(chain, parent=parent, name=name,
+                      provenance=rd.provenance(p.get("provenance"), "positioner.provenance"))
+
+
+def _positioner_dict(pos: Positioner) -> dict[str, Any]:
+    """The ``positioner`` section of ``pos`` (mm, deg)."""
+    out: dict[str, Any] = {"name": pos.name, "parent": pos.parent,
+                           "frame": _pose_dict(pos.chain.base),
+                           "convention": pos.chain.convention}
+    out["axes"] = [{k: _clean(v) if isinstance(v, float) else v for k, v in j.items()
+                    if k != "type"} for j in robot_to_dict(pos.chain)["joints"]]
+    if not np.allclose(pos.chain.flange, np.eye(4), atol=0):
+        out["plate"] = _pose_dict(pos.chain.flange)
+    out["provenance"] = _prov_dict(pos.provenance)
+    return out
 
 
 def _named(rd: _Reader, name: Any, key: str, what: str) -> None:
@@ -817,7 +1047,9 @@ def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
             td["max"] = _clean(t.upper * 1e3)
         td["provenance"] = _prov_dict(t.provenance)
         data["track"] = td
-    if cell.turntable is not None:
+    if isinstance(cell.turntable, Positioner):
+        data["positioner"] = _positioner_dict(cell.turntable)
+    elif cell.turntable is not None:
         b = cell.turntable
         bd: dict[str, Any] = {"name": b.name, "parent": b.parent, "frame": _pose_dict(b.T_parent_B)}
         if math.isfinite(b.lower):

@@ -8,14 +8,18 @@ becomes a target of the arm with
 
 (:mod:`robotcell.coupled` for ``T_world_X``). The track position ``e`` is given, or chosen: the
 value within the track limits where the arm reaches the target with the largest manipulability
-(:meth:`robotcell.ik.TrackRobot.ik`). Then every analytic branch of the arm is returned.
+(:func:`choose_track_value`: closed form for an ortho-parallel arm, see
+:mod:`robotcell.ik.trackchoice`). Then every analytic branch of the arm is returned.
 
 :func:`ik_path` solves a sequence of targets (e.g. the TCP holding a point of a workpiece while
 the table turns) as one continuous joint trajectory: it keeps one analytic branch (one arm
 configuration: shoulder, elbow, wrist) along the whole path, unwraps the revolute joints so that
 no joint jumps by a turn, fits the whole trajectory inside the joint limits, and refuses a path
 on which every configuration would flip (cross a singularity) or leave the limits, naming where
-and why. Vectorised over the path: one batched IK call per candidate track value.
+and why. Vectorised over the path: one batched IK call per candidate track value. With
+``track_motion="moving"`` the track follows the path smoothly instead of standing still, and
+:func:`split_path` cuts a path that cannot be followed in one piece into continuous segments,
+naming each break (out of reach, a joint limit, a singularity).
 """
 
 from __future__ import annotations
@@ -23,22 +27,30 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.coupled import RESERVED_FRAMES, frame_pose, robot_pose, tool_pose
+from robotcell.coupled import (
+    RESERVED_FRAMES,
+    broadcast_table,
+    frame_pose,
+    robot_pose,
+    table_batch,
+    table_values,
+    tool_pose,
+)
+from robotcell.coupled import CellModel as Cell  # what is read of a robotcell.cell.Cell
 from robotcell.errors import InputError
+from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.limits import TWO_PI
-from robotcell.ik.track import TrackRobot
+from robotcell.ik.track import TrackChoice, TrackRobot
+from robotcell.ik.trackchoice import choose_track, scan_track
 from robotcell.robot import Robot
 from robotcell.transforms import finite_array, invert, validate_pose
 
-if TYPE_CHECKING:
-    from robotcell.cell import Cell
-
-__all__ = ["CellIKSolutions", "CellPath", "depends_on_track", "ik", "ik_path"]
+__all__ = ["CellIKSolutions", "CellPath", "PathBreak", "PathSplit", "choose_track_value",
+           "depends_on_track", "ik", "ik_path", "split_path"]
 
 #: Largest joint change between two consecutive targets of a path that still counts as
 #: continuous (rad). A configuration that passes a singularity (wrist flip, stretched elbow)
@@ -143,7 +155,7 @@ def depends_on_track(cell: Cell, frame: str) -> bool:
 
 
 def _limits_ok(cell: Cell, e: NDArray[np.float64], th: NDArray[np.float64]) -> NDArray[np.bool_]:
-    ok = np.ones(np.broadcast_shapes(e.shape, th.shape), dtype=bool)
+    ok = np.ones(np.broadcast_shapes(e.shape, table_batch(cell, th)), dtype=bool)
     if cell.track is not None:
         ok &= cell.track.within_limits(e)
     if cell.turntable is not None:
@@ -167,9 +179,41 @@ def _check_track_choice(cell: Cell, frame: str) -> None:
                          "fix the track position; give the track position")
 
 
+def choose_track_value(track: TrackRobot, T_L: NDArray[np.float64], tool: ArrayLike | None,
+                       samples: int | None = None, prefer: ArrayLike | None = None
+                       ) -> TrackChoice:
+    """Track value per target and the arm's solutions there, vectorised over targets.
+
+    For an ortho-parallel arm: :func:`robotcell.ik.trackchoice.choose_track` (closed-form
+    interval of the track value, closed-form manipulability scanned inside it, one analytic
+    solve; under 10 us per target in batches, docs/performance.md). Other arms (UR type): the
+    sampled search of :meth:`robotcell.ik.TrackRobot.ik` (``prefer`` is ignored there).
+
+    Parameters
+    ----------
+    track : TrackRobot
+    T_L : ndarray, shape (..., 4, 4)
+        Targets ``T_L_TCP`` in the track frame (m).
+    tool : array_like, shape (4, 4), optional
+        ``T_F_TCP`` (m).
+    samples : int, optional
+        Track values per search stage (default 24, or 65 for the sampled search).
+    prefer : array_like, shape (...), optional
+        Preferred track values (m; e.g. the previous target's on a path).
+
+    Returns
+    -------
+    TrackChoice
+        Track values in metres of motion (divide by the track's scale for controller values).
+    """
+    if analytic_solver(track.arm).method == "opw":
+        return choose_track(track, T_L, tool=tool, samples=samples or 24, prefer=prefer)
+    return track.ik(T_L, samples=samples or 65, tool=tool)
+
+
 def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
        table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
-       samples: int = 65) -> CellIKSolutions:
+       samples: int | None = None) -> CellIKSolutions:
     """Every arm solution for TCP targets given in a frame of the cell.
 
     Parameters
@@ -182,13 +226,15 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
     track : array_like, shape (...), optional
         Track position (m). Default: 0 without a track; with a track, chosen per target where
         the arm reaches it with the largest manipulability (needs the track limits; refused for
-        frames that move with the track).
-    table : array_like, shape (...)
-        Table angle (rad) at which the target is given; must be 0 without turntable.
+        frames that move with the track; see :func:`choose_track_value`).
+    table : array_like, shape (...) or (..., n)
+        Table angle (rad) at which the target is given, or a positioner's axis values; must be
+        0 without turntable.
     tool : str or array_like of shape (4, 4), optional
         A tool of the cell by name, or ``T_F_TCP`` (m); default: the robot model's tool.
-    samples : int
-        Track values per search stage when the track position is chosen.
+    samples : int, optional
+        Track values per search stage when the track position is chosen (default 24 for the
+        closed-form scan of an ortho-parallel arm, 65 for the sampled search of other arms).
 
     Returns
     -------
@@ -208,26 +254,26 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
     >>> sol.q[sol.valid]                                                          # doctest: +SKIP
     """
     arr = validate_pose(T, "target pose")
-    th = finite_array(table, "table angle")
+    th = table_values(cell, table)
     T_tool = tool_pose(cell, tool)
     if track is None and cell.track is not None:
         _check_track_choice(cell, frame)
-        batch = np.broadcast_shapes(arr.shape[:-2], th.shape)
+        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th))
         T_world = frame_pose(cell, frame, 0.0, th) @ arr
         T_L = invert(cell.track.T_world_L) @ np.broadcast_to(T_world, batch + (4, 4))
-        choice = _track_robot(cell).ik(T_L, samples=samples, tool=T_tool)
+        choice = choose_track_value(_track_robot(cell), T_L, T_tool, samples)
         e = choice.track / cell.track.scale
         q = choice.solutions.q[..., 1:]
         valid, reachable = choice.solutions.valid, choice.solutions.reachable
         method = choice.solutions.method
     else:
         e = finite_array(0.0 if track is None else track, "track position")
-        batch = np.broadcast_shapes(arr.shape[:-2], th.shape, e.shape)
+        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th), e.shape)
         e = np.broadcast_to(e, batch)
         T_world = frame_pose(cell, frame, e, th) @ arr
         sol = cell.robot.ik(invert(robot_pose(cell, e)) @ T_world, tool=T_tool)
         q, valid, reachable, method = sol.q, sol.valid, sol.reachable, sol.method
-    th = np.broadcast_to(th, batch)
+    th = broadcast_table(cell, th, batch)
     valid = valid & _limits_ok(cell, e, th)[..., None]
     return CellIKSolutions(q, valid, reachable, np.array(e, dtype=float), np.array(th), method)
 
@@ -235,9 +281,9 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
 def _path_inputs(cell: Cell, T: ArrayLike, table: ArrayLike, track: ArrayLike | None
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
     arr = validate_pose(T, "path targets")
-    th = finite_array(table, "table angle")
+    th = table_values(cell, table)
     e = None if track is None else finite_array(track, "track position")
-    shapes = [arr.shape[:-2], th.shape] + ([] if e is None else [e.shape])
+    shapes = [arr.shape[:-2], table_batch(cell, th)] + ([] if e is None else [e.shape])
     try:
         batch = np.broadcast_shapes(*shapes)
     except ValueError:
@@ -247,7 +293,7 @@ def _path_inputs(cell: Cell, T: ArrayLike, table: ArrayLike, track: ArrayLike | 
         raise InputError(f"a path needs a sequence of at least 2 targets (shape (N, 4, 4) or a "
                          f"sequence of table angles), got batch shape {batch}")
     arr = np.broadcast_to(arr, batch + (4, 4))
-    th = np.broadcast_to(th, batch)
+    th = broadcast_table(cell, th, batch)
     return arr, th, None if e is None else np.broadcast_to(e, batch)
 
 
@@ -281,51 +327,127 @@ def _fit_limits(q: NDArray[np.float64], rev: NDArray[np.bool_], lo: NDArray[np.f
     return q + np.where(rev, k, 0.0)[:, None] * TWO_PI
 
 
-def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
-            table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
-            q_start: ArrayLike | None = None, max_step: float = MAX_STEP,
-            samples: int = 33) -> CellPath:
-    """A continuous joint trajectory through a sequence of targets, with no configuration flip.
+#: Track motions of :func:`ik_path`.
+TRACK_MOTIONS = ("fixed", "moving")
 
-    The targets are solved together for every branch; a branch is kept when it reaches every
-    target, its unwrapped trajectory fits the joint limits (shifted by whole turns where a joint
-    has more than one turn of range), and no joint moves more than ``max_step`` between two
-    consecutive targets. Among the kept branches the one nearest to ``q_start`` at the first
-    target wins, or else the one with the largest smallest manipulability along the path.
+#: Targets of the moving average that smooths a moving track (:func:`ik_path`).
+TRACK_WINDOW = 9
 
-    Parameters
+#: A moving track stays, at each target, where the arm has at least this fraction of the best
+#: manipulability it has there over the track.
+TRACK_KEEP = 0.5
+
+
+@dataclass(frozen=True)
+class PathBreak:
+    """A place where a path must break.
+
+    Attributes
     ----------
-    cell : Cell
-    T : array_like, shape (N, 4, 4) or (4, 4)
-        Targets ``T_X_TCP`` in frame ``frame`` (m); one pose is held while the table turns.
-    frame : str
-        Frame of the targets (see :func:`ik`).
-    track : array_like, shape (N,) or (), optional
-        Track positions (m). Default: 0 without a track; with a track, one position for the
-        whole path, chosen on ``samples`` values over the track limits to maximise the smallest
-        manipulability along the path.
-    table : array_like, shape (N,) or ()
-        Table angles (rad) at the targets.
-    tool : str or array_like of shape (4, 4), optional
-        A tool of the cell by name, or ``T_F_TCP`` (m).
-    q_start : array_like, shape (n,), optional
-        Current arm configuration (rad): the path starts in the configuration nearest to it.
-    max_step : float
-        Largest joint change between consecutive targets (rad); sample the path more finely
-        when the motion between targets is larger.
-    samples : int
-        Candidate track positions when the track position is chosen (>= 2).
-
-    Returns
-    -------
-    CellPath
-
-    Raises
-    ------
-    InputError
-        Fewer than 2 targets, mismatched lengths, or no branch that follows the whole path; the
-        message gives, per branch, the first target where it fails and why.
+    index : int
+        Target (0-based) that no configuration of the preceding segment reaches continuously.
+    kind : str
+        ``"reach"`` (out of reach, or track/table outside its limits), ``"limit"`` (an arm axis
+        leaves its limits) or ``"singularity"`` (the configuration flips: an axis jumps by more
+        than ``max_step``).
+    message : str
+        The cause in words, naming the branch and the axis (degrees).
     """
+
+    index: int
+    kind: str
+    message: str
+
+
+@dataclass(frozen=True)
+class PathSplit:
+    """A path cut into segments that each can be followed continuously.
+
+    Attributes
+    ----------
+    segments : list of (int, int)
+        ``(start, stop)`` target ranges (Python slices, 0-based): each is one continuous
+        trajectory (solve it with :func:`ik_path` on ``T[start:stop]``).
+    breaks : list of PathBreak
+        Where and why the path breaks, in order.
+    track : ndarray, shape (N,)
+        Track position used at each target of a segment (m; 0 without track; NaN at a target
+        no configuration reaches).
+    """
+
+    segments: list[tuple[int, int]]
+    breaks: list[PathBreak]
+    track: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class _PathSolutions:
+    """Every branch along a path, for K track candidates: arrays (K, N, 8[, n])."""
+
+    q: NDArray[np.float64]
+    reach: NDArray[np.bool_]
+    inside: NDArray[np.bool_]
+    smooth: NDArray[np.bool_]
+    ee: NDArray[np.float64]  # (K, N) track positions
+
+    @property
+    def ok(self) -> NDArray[np.bool_]:
+        return self.reach & self.inside & self.smooth
+
+
+def _moving_track(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArray[np.float64],
+                  T_tool: NDArray[np.float64] | None, samples: int) -> NDArray[np.float64]:
+    """A smooth track trajectory (N,) (m) along a path: the moving average of the per-target
+    choice over :data:`TRACK_WINDOW` targets, kept where the arm has at least
+    :data:`TRACK_KEEP` of its best manipulability at each target."""
+    from scipy.ndimage import uniform_filter1d
+
+    t = _track_robot(cell)
+    T_L = invert(cell.track.T_world_L) @ frame_pose(cell, frame, 0.0, th) @ arr
+    choice = choose_track_value(t, T_L, T_tool, max(samples, 3))
+    x = choice.track
+    found = choice.solutions.valid.any(axis=-1)
+    if np.any(found) and not np.all(found):  # bridge unreachable targets from their neighbours
+        idx = np.arange(x.size)
+        x = np.interp(idx, idx[found], x[found])
+    if analytic_solver(t.arm).method == "opw":
+        scan = scan_track(t, T_L, T_tool, max(samples, 3))
+        m = scan.manipulability
+        keep = m >= TRACK_KEEP * m.max(axis=1, keepdims=True)
+        keep &= m > 0
+        lo = np.where(keep, scan.x, np.inf).min(axis=1)
+        hi = np.where(keep, scan.x, -np.inf).max(axis=1)
+        lo, hi = np.minimum(lo, x), np.maximum(hi, x)
+    else:
+        lo = hi = x
+    smooth = uniform_filter1d(x, size=min(TRACK_WINDOW, x.size), mode="nearest")
+    return np.clip(smooth, lo, hi) / cell.track.scale
+
+
+def _path_solutions(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArray[np.float64],
+                    ee: NDArray[np.float64], T_tool: NDArray[np.float64] | None,
+                    q_start: NDArray[np.float64] | None, max_step: float) -> _PathSolutions:
+    """Every branch along the path for track trajectories ``ee`` (K, N): unwrapped, shifted by
+    whole turns into the limits (one turn count per joint for the whole path), and checked."""
+    robot = cell.robot
+    T_world = frame_pose(cell, frame, ee, th) @ arr
+    sol = robot.ik(invert(robot_pose(cell, ee)) @ T_world, tool=T_tool)  # (K, N, 8, n)
+    rev = ~robot.prismatic
+    q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
+    reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
+    inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
+    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
+        inside &= robot.coupling.within_interaction(q)
+    step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
+    first = np.ones((step.shape[0], 1, step.shape[2]), dtype=bool)
+    smooth = np.concatenate([first, step <= max_step], axis=1)
+    return _PathSolutions(q, reach, inside, smooth, ee)
+
+
+def _path_setup(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None, table: ArrayLike,
+                tool: str | ArrayLike | None, q_start: ArrayLike | None, max_step: float,
+                samples: int, track_motion: str):
+    """Validated inputs of a path and its track candidates ``ee`` (K, N)."""
     arr, th, e = _path_inputs(cell, T, table, track)
     n_pts = arr.shape[0]
     T_tool = tool_pose(cell, tool)
@@ -340,33 +462,85 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
                              f"got {q_start.shape}")
     if not max_step > 0:
         raise InputError(f"max_step must be positive (rad), got {max_step}")
-    if e is None and cell.track is not None:
+    if track_motion not in TRACK_MOTIONS:
+        raise InputError(f"track_motion must be one of {', '.join(TRACK_MOTIONS)}, "
+                         f"got {track_motion!r}")
+    chosen = e is None and cell.track is not None
+    if chosen:
         _check_track_choice(cell, frame)
         if samples < 2:
             raise InputError(f"samples must be at least 2, got {samples}")
-        t = _track_robot(cell)
-        cand = np.linspace(t.lower, t.upper, samples) / cell.track.scale
+        if track_motion == "moving":
+            ee = _moving_track(cell, frame, arr, th, T_tool, samples)[None, :]
+        else:
+            t = _track_robot(cell)
+            cand = np.linspace(t.lower, t.upper, samples) / cell.track.scale
+            ee = np.broadcast_to(cand[:, None], (cand.size, n_pts))
     else:
-        cand = np.zeros(1) if e is None else None
-    if cand is not None:
-        ee = np.broadcast_to(cand[:, None], (cand.size, n_pts))  # (K, N)
-    else:
-        ee = e[None, :]
-    T_world = frame_pose(cell, frame, ee, th) @ arr
-    sol = robot.ik(invert(robot_pose(cell, ee)) @ T_world, tool=T_tool)  # (K, N, 8, n)
-    rev = ~robot.prismatic
-    q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
-    reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
-    inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
-    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
-        inside &= robot.coupling.within_interaction(q)
-    step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
-    smooth = np.concatenate([np.ones_like(step[:, :1], dtype=bool), step <= max_step], axis=1)
-    ok = reach & inside & smooth
-    feasible = np.all(ok, axis=1)                                           # (K, 8)
+        ee = np.zeros((1, n_pts)) if e is None else np.array(e, dtype=float)[None, :]
+    return arr, th, ee, T_tool, q_start, chosen
+
+
+def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+            table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
+            q_start: ArrayLike | None = None, max_step: float = MAX_STEP,
+            samples: int = 33, track_motion: str = "fixed") -> CellPath:
+    """A continuous joint trajectory through a sequence of targets, with no configuration flip.
+
+    The targets are solved together for every branch; a branch is kept when it reaches every
+    target, its unwrapped trajectory fits the joint limits (shifted by whole turns where a joint
+    has more than one turn of range; one turn count per joint for the whole path), and no joint
+    moves more than ``max_step`` between two consecutive targets. Among the kept branches the
+    one nearest to ``q_start`` at the first target wins, or else the one with the largest
+    smallest manipulability along the path.
+
+    Parameters
+    ----------
+    cell : Cell
+    T : array_like, shape (N, 4, 4) or (4, 4)
+        Targets ``T_X_TCP`` in frame ``frame`` (m); one pose is held while the table turns.
+    frame : str
+        Frame of the targets (see :func:`ik`).
+    track : array_like, shape (N,) or (), optional
+        Track positions (m). Default: 0 without a track; with a track, chosen (see
+        ``track_motion``).
+    table : array_like, shape (N,) or ()
+        Table angles (rad) at the targets.
+    tool : str or array_like of shape (4, 4), optional
+        A tool of the cell by name, or ``T_F_TCP`` (m).
+    q_start : array_like, shape (n,), optional
+        Current arm configuration (rad): the path starts in the configuration nearest to it.
+    max_step : float
+        Largest joint change between consecutive targets (rad); sample the path more finely
+        when the motion between targets is larger.
+    samples : int
+        Candidate track positions when the track position is chosen (>= 2).
+    track_motion : {"fixed", "moving"}
+        How a chosen track position moves: ``fixed``, one position for the whole path, chosen
+        on ``samples`` values over the track limits to maximise the smallest manipulability
+        along the path; ``moving``, the track follows the path smoothly: the per-target choice
+        of :func:`choose_track_value`, averaged over :data:`TRACK_WINDOW` consecutive targets
+        and kept where the arm has at least :data:`TRACK_KEEP` of its best manipulability.
+
+    Returns
+    -------
+    CellPath
+
+    Raises
+    ------
+    InputError
+        Fewer than 2 targets, mismatched lengths, or no branch that follows the whole path; the
+        message gives, per branch, the first target where it fails and why
+        (:func:`split_path` cuts such a path into segments instead).
+    """
+    arr, th, ee, T_tool, q_start, chosen = _path_setup(cell, T, frame, track, table, tool,
+                                                       q_start, max_step, samples, track_motion)
+    robot = cell.robot
+    ps = _path_solutions(cell, frame, arr, th, ee, T_tool, q_start, max_step)
+    q = ps.q
+    feasible = np.all(ps.ok, axis=1)                                        # (K, 8)
     if not np.any(feasible):
-        raise InputError(_path_failure(q, robot, reach, inside, smooth,
-                                       cand is not None and e is None))
+        raise InputError(_path_failure(ps, robot, chosen and track_motion == "fixed"))
     qz = np.where(feasible[:, None, :, None], q, 0.0)
     manip = np.abs(np.linalg.det(robot.jacobian(qz, tool=T_tool)))          # (K, N, 8)
     worst = np.where(feasible, manip.min(axis=1), -np.inf)                  # (K, 8)
@@ -384,26 +558,110 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
                     manipulability=float(worst[k, b]))
 
 
-def _path_failure(q: NDArray[np.float64], robot: Robot, reach: NDArray[np.bool_],
-                  inside: NDArray[np.bool_], smooth: NDArray[np.bool_], track_chosen: bool) -> str:
+def split_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+               table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
+               max_step: float = MAX_STEP, samples: int = 33,
+               track_motion: str = "moving") -> PathSplit:
+    """Cut a path into the fewest continuous segments, greedily, and say where and why it breaks.
+
+    From the first target, the branch and track candidate that follow the path furthest (as
+    :func:`ik_path` checks it: reach, joint limits with one turn count per segment, no joint
+    step above ``max_step``) make a segment; the target where that branch fails starts the
+    next one, or is skipped when no branch reaches it at all.
+
+    Parameters
+    ----------
+    cell, T, frame, track, table, tool, max_step, samples
+        As for :func:`ik_path`.
+    track_motion : {"fixed", "moving"}
+        As for :func:`ik_path`; here the default is ``moving``.
+
+    Returns
+    -------
+    PathSplit
+    """
+    arr, th, ee, T_tool, _, _ = _path_setup(cell, T, frame, track, table, tool, None,
+                                            max_step, samples, track_motion)
+    robot = cell.robot
+    n_pts = arr.shape[0]
+    segments: list[tuple[int, int]] = []
+    breaks: list[PathBreak] = []
+    used = np.full(n_pts, np.nan)
+    start = 0
+    while start < n_pts:
+        ps = _path_solutions(cell, frame, arr[start:], th[start:], ee[:, start:], T_tool, None,
+                             max_step)
+        ok = ps.ok
+        run = np.where(np.all(ok, axis=1), ok.shape[1], np.argmin(ok, axis=1))  # (K, 8)
+        k, b = np.unravel_index(np.argmax(run), run.shape)
+        length = int(run[k, b])
+        if length == 0:  # no configuration reaches this target within the limits
+            gap = _break(ps, robot, int(k), int(b), 0, start, max_step)
+            if breaks and breaks[-1].index == start:  # the previous segment ended here
+                breaks[-1] = gap
+            else:
+                breaks.append(gap)
+            start += 1
+            continue
+        segments.append((start, start + length))
+        used[start:start + length] = ee[k, start:start + length]
+        if start + length < n_pts:
+            breaks.append(_break(ps, robot, int(k), int(b), length, start, max_step))
+        start += length
+    return PathSplit(segments, breaks, used)
+
+
+def _break(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int, offset: int,
+           max_step: float) -> PathBreak:
+    """Why the path breaks at index ``i`` after following branch ``b`` (candidate ``k``).
+
+    ``reach`` when no configuration reaches the target; ``limit`` when every configuration that
+    reaches it is outside the joint limits; else ``singularity``: the target is reached, but only
+    in a configuration that is not continuous with the previous one (a flip).
+    """
+    where = f"target {offset + i + 1}"
+    usable = ps.reach[k, i] & ps.inside[k, i]
+    if not ps.reach[k, i].any():
+        return PathBreak(offset + i, "reach", f"{where}: out of reach (or track/table outside "
+                         "its limits) in every configuration")
+    if not usable.any():
+        why = _failure_cause(ps, robot, k, int(np.argmax(ps.reach[k, i])), i)[1]
+        return PathBreak(offset + i, "limit", f"{where}: every configuration that reaches it "
+                         f"is outside the limits, e.g. {why}")
+    jump = np.where(usable[:, None], np.abs(ps.q[k, i] - ps.q[k, i - 1, b]), np.inf)  # (8, n)
+    b2, j = np.unravel_index(np.argmin(jump.max(axis=1)), (8, 1))
+    j = int(np.argmax(jump[b2]))
+    step = float(jump[b2, j])
+    how = (f"axis {j + 1} would jump by {math.degrees(step):.0f} deg (a flip)" if step > max_step
+           else "the arm changes configuration through a singular one (det J = 0)")
+    return PathBreak(offset + i, "singularity",
+                     f"{where}: {BRANCH_NAMES[b]}: {_failure_cause(ps, robot, k, b, i)[1]}; "
+                     f"the target is reached in {BRANCH_NAMES[b2]}, but {how}")
+
+
+def _failure_cause(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int) -> tuple[str, str]:
+    """Kind and words of the failure of branch ``b`` (candidate ``k``) at path index ``i``."""
+    qi = ps.q[k, i, b]
+    if not ps.reach[k, i, b]:
+        return "reach", "out of reach (or track/table outside its limits)"
+    if not ps.inside[k, i, b]:
+        j = int(np.argmax((qi < robot.lower) | (qi > robot.upper)))
+        return "limit", f"axis {j + 1} leaves its limits ({math.degrees(qi[j]):.1f} deg)"
+    j = int(np.argmax(np.abs(qi - ps.q[k, i - 1, b])))
+    jump = math.degrees(abs(qi[j] - ps.q[k, i - 1, b, j]))
+    return "singularity", (f"axis {j + 1} jumps by {jump:.0f} deg (the configuration passes a "
+                           "singularity)")
+
+
+def _path_failure(ps: _PathSolutions, robot: Robot, track_chosen: bool) -> str:
     """Why no branch follows the path: the first failing target per branch (best track value)."""
-    ok = reach & inside & smooth
+    ok = ps.ok
     first_fail = np.where(np.all(ok, axis=1), ok.shape[1], np.argmin(ok, axis=1))  # (K, 8)
     k = int(np.argmax(first_fail.max(axis=1)))  # the track candidate where branches get furthest
     lines = []
     for b in range(8):
         i = int(first_fail[k, b])
-        qi = q[k, i, b]
-        if not reach[k, i, b]:
-            why = "out of reach (or track/table outside its limits)"
-        elif not inside[k, i, b]:
-            j = int(np.argmax((qi < robot.lower) | (qi > robot.upper)))
-            why = f"axis {j + 1} leaves its limits ({math.degrees(qi[j]):.1f} deg)"
-        else:
-            j = int(np.argmax(np.abs(qi - q[k, i - 1, b])))
-            why = (f"axis {j + 1} jumps by {math.degrees(abs(qi[j] - q[k, i - 1, b, j])):.0f} deg "
-                   "(the configuration passes a singularity)")
-        lines.append(f"{BRANCH_NAMES[b]}: target {i + 1}: {why}")
+        lines.append(f"{BRANCH_NAMES[b]}: target {i + 1}: {_failure_cause(ps, robot, k, b, i)[1]}")
     where = " at the best track position" if track_chosen else ""
     return ("no arm configuration follows the whole path without a flip" + where + "; "
             + "; ".join(lines) + ". Move the path towards the middle of the arm's reach, choose "

@@ -8,9 +8,10 @@ from its layout position, a workpiece clamped off its nominal place. The demo
 
 1. writes the nominal cell file and simulates every touch-up procedure in the true cell
    (joint values within every limit, touch-up error ``noise``);
-2. calibrates the cell in order, each step with the cell as calibrated so far, through the same
-   commands a technician types: ``robotcell calibrate tcp``, ``track``, ``turntable``,
-   ``workpiece`` with ``--cell``;
+2. calibrates the cell in order, each step with the cell as calibrated so far, by the library
+   calls of :mod:`robotcell.cellcal` that the commands a technician types (``robotcell calibrate
+   tcp``, ``track``, ``turntable``, ``workpiece`` with ``--cell``) make, printing each command;
+   the library never drives the command line, which keeps the import direction cli -> library;
 3. compares every calibrated value with the truth, in units of its reported 1-sigma;
 4. writes an HTML report per calibration and the controller exports (KUKA, ABB, FANUC,
    YASKAWA).
@@ -18,8 +19,6 @@ from its layout position, a workpiece clamped off its nominal place. The demo
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
 import shlex
@@ -32,13 +31,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell import cellcal
 from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
-from robotcell.errors import RobotcellError
+from robotcell.errors import InputError, RobotcellError
 from robotcell.export import EXPORT_FORMATS, export_cell
 from robotcell.modelfile import load_robot
 from robotcell.plan import pose_error
 from robotcell.poseformats import pose_from_vendor
 from robotcell.simulate import simulate
+from robotcell.tables import read_csv
 
 __all__ = ["DEMO_NOISE", "Comparison", "demo_cells", "run_demo"]
 
@@ -126,16 +127,6 @@ def _sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
             math.radians(float(np.linalg.norm(r))) if r is not None else math.nan)
 
 
-def _run_cli(args: list[str]) -> tuple[str, str]:
-    """Run a robotcell command in this process; return its stdout and stderr."""
-    from robotcell.cli import cli  # the CLI imports this module lazily, never the other way
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        cli.main(args=args, prog_name="robotcell", standalone_mode=False)
-    return out.getvalue(), err.getvalue()
-
-
 def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
              echo: Callable[[str], None] = print) -> list[Comparison]:
     """Run the demo, writing every file into ``folder``.
@@ -171,29 +162,45 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
          f"  true cell (the virtual hardware): {truth_file}\n"
          f"  touch-up error {noise * 1e3:g} mm (1-sigma per coordinate), seed {seed}\n")
     rng = np.random.default_rng(seed)
-    steps = [
-        ("tcp", ["--name", "torch"], {"tool": "torch"}),
-        ("track", ["--tool", "torch"], {"tool": "torch"}),
-        ("turntable", ["--tool", "torch"], {"tool": "torch"}),
+    # procedure, options of the command, keywords of the library call, of the simulation
+    steps: list[tuple[str, list[str], dict[str, Any], dict[str, Any]]] = [
+        # Enough touches for the verdict to see a wrong one (docs/calibration.md, "Verdict").
+        ("tcp", ["--name", "torch"], {"name": "torch"}, {"tool": "torch", "touches": 6}),
+        ("track", ["--tool", "torch"], {"tool": "torch"}, {"tool": "torch"}),
+        ("turntable", ["--tool", "torch"], {"tool": "torch"}, {"tool": "torch"}),
         ("workpiece", ["--tool", "torch", "--name", "part", "--turntable", "turntable.json"],
-         {"tool": "torch", "frame": "part"}),
+         {"tool": "torch", "name": "part"}, {"tool": "torch", "frame": "part", "repeats": 3}),
     ]
     results: dict[str, dict[str, Any]] = {}
-    for procedure, extra, kw in steps:
-        touches = simulate(truth, procedure, noise=noise, seed=rng, **kw)
+    cell = Cell.load(cell_file)
+    turntable: cellcal.TurntablePose | None = None
+    for procedure, extra, kw, design in steps:
+        touches = simulate(truth, procedure, noise=noise, seed=rng, **design)
         csv_path = out / f"{procedure}.csv"
         touches.write_csv(csv_path)
         args = (["calibrate", procedure, str(csv_path), "--cell", str(cell_file), "--json"]
                 + [str(out / a) if a.endswith(".json") else a for a in extra] + touches.options)
         echo(f"{procedure}: simulated {len(touches.q)} touches -> {csv_path.name}")
         echo("  $ robotcell " + shlex.join(args))
-        stdout, _ = _run_cli(args)
-        results[procedure] = json.loads(stdout)
-        (out / f"{procedure}.json").write_text(stdout, encoding="utf-8")
+        if procedure == "workpiece":
+            kw["turntable"] = turntable
+        done = getattr(cellcal, procedure)(cell, read_csv(csv_path), source=str(csv_path),
+                                            cell_label=str(cell_file), **kw, **touches.keywords())
+        verdict = done.result.verdict
+        if verdict.level == "poor":  # the command refuses to write it (exit 3); so does the demo
+            raise InputError(f"{procedure}: poor calibration, nothing written: "
+                             f"{'; '.join(verdict.reasons)}; try a smaller --noise")
+        if procedure == "turntable":
+            turntable = cellcal.TurntablePose.from_result(done.result, str(out / "turntable.json"))
+        done.cell.save(cell_file)
+        cell = Cell.load(cell_file)  # the next command reads the file, rounded as written
+        results[procedure] = done.result.to_json()
+        (out / f"{procedure}.json").write_text(json.dumps(results[procedure], indent=2) + "\n",
+                                               encoding="utf-8")
         r = results[procedure]
         echo(f"  RMS {r['rms_mm']:.3f} mm, max {r['max_mm']:.3f} mm, condition "
-             f"{r['condition']:.1f}; cell file updated")
-    calibrated = Cell.load(cell_file)
+             f"{r['condition']:.1f}; cell file updated\n  {verdict.line()}")
+    calibrated = Cell.load(cell_file)  # as the file holds it (rounded to 1e-10 mm, deg)
     comparisons = _compare(calibrated, truth, results)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
     echo(_comparison_table(comparisons))
@@ -224,8 +231,8 @@ def _compare(calibrated: Cell, truth: Cell,
 
 
 def _comparison_table(rows: list[Comparison]) -> str:
-    from robotcell.tables import format_table
     from robotcell.poseformats import pose_to_vendor
+    from robotcell.tables import format_table
 
     body = []
     for c in rows:

@@ -27,6 +27,7 @@ import yaml
 
 from robotcell.coupling import Coupling
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_write, read_text
 from robotcell.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.robot import Joint, Robot
 
@@ -74,7 +75,7 @@ def load_robot(name_or_path: str | Path) -> Robot:
     if path.suffix.lower() in (".yaml", ".yml") or path.exists():
         if not path.is_file():
             raise InputError(f"robot model file {text!r} does not exist")
-        return _load_file(path.read_text(encoding="utf-8"), str(path))
+        return _load_file(read_text(path, "robot model file"), str(path))
     lib = _library_dir() / f"{text}.yaml"
     if lib.is_file():
         return _load_file(lib.read_text(encoding="utf-8"), f"library robot {text!r}")
@@ -381,14 +382,22 @@ def _ik_seed_to_dict(seed: Robot) -> str | dict[str, Any]:
 
 
 def _clean(v: Any) -> Any:
-    if isinstance(v, float):
-        r = round(float(v), 9)  # float(): numpy scalars are floats yaml cannot write
+    """A plain Python int or float (YAML cannot write numpy scalars), rounded to 9 decimals."""
+    if isinstance(v, (float, np.floating)):
+        r = round(float(v), 9)
         return int(r) if r == int(r) and abs(r) < 1e15 else r
+    if isinstance(v, np.integer):
+        return int(v)
     return v
 
 
 def save_robot(robot: Robot, path: str | Path) -> None:
-    """Write ``robot`` as a YAML model file (millimetres and degrees)."""
-    Path(path).write_text(
-        yaml.safe_dump(robot_to_dict(robot), sort_keys=False, default_flow_style=None), encoding="utf-8"
-    )
+    """Write ``robot`` as a YAML model file (millimetres and degrees), atomically.
+
+    Raises
+    ------
+    InputError
+        The file cannot be written (missing folder, a folder, no permission).
+    """
+    atomic_write(path, yaml.safe_dump(robot_to_dict(robot), sort_keys=False,
+                                      default_flow_style=None))

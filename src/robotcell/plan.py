@@ -33,7 +33,7 @@ from robotcell.calibration.workpiece import calibrate_workpiece
 from robotcell.cell import Cell
 from robotcell.coupled import robot_pose, tool_pose
 from robotcell.errors import InputError, RobotcellError
-from robotcell.simulate import Touches, simulate
+from robotcell.simulate import Touches, check_counts, simulate
 
 __all__ = ["DESIGNS", "LEVER", "Candidate", "MonteCarlo", "Plan", "calibrate_touches",
            "plan", "pose_error", "predicted_sigma"]
@@ -270,6 +270,7 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
         raise InputError(f"noise must be a positive number (m), got {noise}")
     if runs < 0:
         raise InputError(f"runs must be >= 0, got {runs}")
+    check_counts(common)
     wrap = progress or (lambda items, label: items)
     candidates = []
     for design in wrap(designs if designs is not None else DESIGNS[procedure],

@@ -25,6 +25,7 @@ import numpy as np
 from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_write, read_text
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 
@@ -43,15 +44,62 @@ def load_result(path: str | Path) -> dict[str, Any]:
     if not p.is_file():
         raise InputError(f"{path}: no such file")
     try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
+        data = json.loads(read_text(p))
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise InputError(f"{path}: not valid JSON ({exc}); give the output of "
                          "'robotcell calibrate ... --json'") from None
     missing = [k for k in _REQUIRED if not isinstance(data, dict) or k not in data]
     if missing:
         raise InputError(f"{path}: not a calibration result (missing {', '.join(missing)}); give "
                          "the output of 'robotcell calibrate ... --json'")
+    bad = _malformed(data)
+    if bad:
+        raise InputError(f"{path}: not a calibration result: {bad}; give the unchanged output "
+                         "of 'robotcell calibrate ... --json'")
     return data
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _is_points(v: Any, n: int | None) -> bool:
+    """A list of ``n`` (any number when None) lists of 3 finite numbers."""
+    return (isinstance(v, list) and (n is None or len(v) == n)
+            and all(isinstance(p, list) and len(p) == 3 and all(map(_is_number, p)) for p in v))
+
+
+def _malformed(data: dict[str, Any]) -> str | None:
+    """What is wrong with the fields of a result that the report uses, or None."""
+    if not isinstance(data["procedure"], str):
+        return "'procedure' must be a text"
+    res = data["residuals_mm"]
+    if not isinstance(res, list) or not all(map(_is_number, res)):
+        return "'residuals_mm' must be a list of numbers"
+    n = len(res)
+    for key in ("rms_mm", "max_mm"):
+        if not _is_number(data[key]):
+            return f"{key!r} must be a number"
+    for key in ("warnings", "undetermined"):
+        v = data.get(key, [])
+        if (v is not None or key == "warnings") and (
+                not isinstance(v, list) or not all(isinstance(w, str) for w in v)):
+            return f"{key!r} must be a list of texts"
+    checks = {
+        "condition": lambda v: _is_number(v),
+        "labels": lambda v: isinstance(v, list) and len(v) == n
+        and all(isinstance(x, (str, int)) for x in v),
+        "residuals_xyz_mm": lambda v: _is_points(v, n),
+        "points_mm": lambda v: _is_points(v, None),
+        "pivot_mm": lambda v: _is_points([v], 1),
+        "sigma": lambda v: isinstance(v, dict),
+        "matrix": lambda v: isinstance(v, list) and len(v) == 4
+        and all(isinstance(r, list) and len(r) == 4 and all(map(_is_number, r)) for r in v),
+    }
+    for key, ok in checks.items():
+        if data.get(key) is not None and not ok(data[key]):
+            return f"{key!r} has the wrong type or size"
+    return None
 
 
 def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
@@ -287,5 +335,5 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
 <table><tr><th>touch</th><th>|residual|</th><th>x, y, z</th></tr>{touches}</table>
 </body></html>
 """
-    out.write_text(page, encoding="utf-8")
+    atomic_write(out, page)
     return [out]

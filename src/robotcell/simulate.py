@@ -18,6 +18,7 @@ worst touch is best.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -28,14 +29,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.cell import Cell
+from robotcell.cell import Cell, Turntable
 from robotcell.coupled import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_write
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.robot import Robot
 from robotcell.transforms import invert, make_pose, rot_z, transform_points
 
-__all__ = ["PROCEDURES", "Touches", "simulate"]
+__all__ = ["MAX_TOUCHES", "PROCEDURES", "Touches", "check_counts", "simulate"]
 
 #: Procedures that can be simulated, with what they calibrate.
 PROCEDURES = {
@@ -44,10 +46,18 @@ PROCEDURES = {
     "track": "the robot's linear track (touches of known reference points)",
     "turntable": "the turntable's root frame (one point on the table at several angles)",
     "workpiece": "a workpiece frame on the turntable (3-point at any table angles)",
+    "positioner": "a 2-axis positioner's axis chain (one point on the table at several "
+                  "(tilt, rotate) values)",
 }
 
 #: Candidate track positions when the track position of a procedure is chosen.
 TRACK_SAMPLES = 25
+
+#: Most touches one simulation places (memory of the configuration search grows with them).
+MAX_TOUCHES = 200
+
+#: Fewest touches each procedure's calibration accepts, as ``robotcell calibrate`` checks them.
+MIN_TOUCHES = {"turntable": 3, "track": 3}
 
 
 def _down_orientations() -> NDArray[np.float64]:
@@ -79,7 +89,8 @@ class Touches:
     track : ndarray, shape (N,), or None
         Robot's track position at each touch (m); None in a cell without track.
     table : ndarray, shape (N,), or None
-        Table angle at each touch (rad), for turntable and workpiece.
+        Table angle at each touch (rad), for turntable and workpiece; shape (N, 2), the
+        positioner's axis values (rad, CSV columns ``e1``, ``e2``), for positioner.
     roles : list of str, or None
         Value of the CSV column ``point`` per touch.
     truth : dict of str to Any
@@ -118,8 +129,9 @@ class Touches:
             header.append("e1")
             cols.append([f"{v * 1e3:.3f}" for v in self.track])
         elif self.table is not None:
-            header.append("e1")
-            cols.append([f"{math.degrees(v):.4f}" for v in self.table])
+            values = self.table.reshape(len(self.q), -1)
+            header += [f"e{i + 1}" for i in range(values.shape[1])]
+            cols += [[f"{math.degrees(v):.4f}" for v in values[:, i]] for i in range(values.shape[1])]
         if self.track is not None and self.procedure not in ("track", "tcp"):
             header.append("track")
             cols.append([f"{v * 1e3:.3f}" for v in self.track])
@@ -128,14 +140,54 @@ class Touches:
             cols.append(list(self.roles))
         return header, [list(r) for r in zip(*cols)]
 
+    def to_table(self) -> dict[str, Any]:
+        """The measurement table as :func:`robotcell.tables.read_csv` reads the CSV (mm, deg).
+
+        Returns
+        -------
+        dict
+            Column name to a float array (or a list of strings), the input of
+            :mod:`robotcell.cellcal`.
+        """
+        from robotcell.cellcal.touches import load_table
+
+        header, rows = self.columns()
+        return load_table(dict(zip(header, map(list, zip(*rows)))))[0]
+
+    def keywords(self) -> dict[str, Any]:
+        """The :mod:`robotcell.cellcal` keywords equal to :attr:`options` (SI, same rounding).
+
+        Returns
+        -------
+        dict
+            ``references`` (list of (3,) arrays, m) and ``height`` (m), where the options have
+            them.
+        """
+        kw: dict[str, Any] = {}
+        for opt in self.options:
+            key, value = opt.lstrip("-").split("=")
+            numbers = np.array([float(v) for v in value.split(",")]) * 1e-3
+            if key == "reference":
+                kw.setdefault("references", []).append(numbers)
+            else:
+                kw[key] = float(numbers[0])
+        return kw
+
     def write_csv(self, out: str | Path | TextIO) -> None:
-        """Write the measurement CSV to a path or an open text stream."""
+        """Write the measurement CSV to an open text stream, or to a path atomically.
+
+        Raises
+        ------
+        InputError
+            The path cannot be written (missing folder, a folder, no permission).
+        """
         header, rows = self.columns()
         if hasattr(out, "write"):
             _write(out, header, rows)
             return
-        with Path(out).open("w", newline="", encoding="utf-8") as fh:
-            _write(fh, header, rows)
+        buf = io.StringIO(newline="")
+        _write(buf, header, rows)
+        atomic_write(out, buf.getvalue())
 
 
 def _write(fh: TextIO, header: list[str], rows: list[list[str]]) -> None:
@@ -184,6 +236,9 @@ def _reach(cell: Cell, targets: Callable[[NDArray[np.float64]], NDArray[np.float
     e : ndarray, shape (N,)
         Track positions (m).
     """
+    if len(labels) > MAX_TOUCHES:
+        raise InputError(f"{len(labels)} touches asked for; a simulation places at most "
+                         f"{MAX_TOUCHES}")
     robot = cell.robot
     if robot.n_joints != 6:
         raise InputError(f"simulated touches need a six-axis arm; {robot.name} has "
@@ -237,7 +292,11 @@ def _usual_configuration(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.flo
 
 
 def _rng(seed: int | np.random.Generator | None) -> np.random.Generator:
-    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise InputError(f"seed must be a whole number >= 0, got {seed}")
+    return np.random.default_rng(seed)
 
 
 def _tool_name(cell: Cell, tool: str | None) -> str:
@@ -263,6 +322,20 @@ def _frame_name(cell: Cell, frame: str | None, parents: tuple[str, ...], what: s
         raise InputError(f"frame {frame!r} is carried by {cell.frames[frame].parent}; the {what} "
                          f"procedure touches frames carried by {' or '.join(parents)}")
     return frame
+
+
+def check_counts(design: dict[str, Any]) -> None:
+    """Refuse ``touches``, ``positions`` or ``repeats`` above :data:`MAX_TOUCHES` up front.
+
+    Raises
+    ------
+    InputError
+        A count that would place more touches than a simulation places.
+    """
+    for key in ("touches", "positions", "repeats"):
+        if isinstance(design.get(key), (int, np.integer)) and design[key] > MAX_TOUCHES:
+            raise InputError(f"{key} {design[key]}: a simulation places at most {MAX_TOUCHES} "
+                             "touches")
 
 
 def _check_noise(noise: float) -> float:
@@ -361,6 +434,8 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                          f"along {t.axis}")
     if positions < 2:
         raise InputError(f"each reference point needs at least 2 track positions, got {positions}")
+    if not (math.isfinite(travel) and travel > 0):
+        raise InputError(f"travel must be a positive length (m), got {travel}")
     tname = _tool_name(cell, tool)
     u = t.direction
     o = t.T_L_R0[:3, 3]
@@ -379,6 +454,10 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
     offsets = np.linspace(-travel / 2, travel / 2, positions) / t.scale
     e_all = np.clip(centre[:, None] + offsets, t.lower, t.upper)
     point = np.repeat(np.arange(len(refs)), positions)
+    if len(point) < MIN_TOUCHES["track"]:
+        raise InputError(f"the track calibration needs at least {MIN_TOUCHES['track']} touches; "
+                         f"{len(refs)} reference point(s) x {positions} positions give "
+                         f"{len(point)}: add positions or reference points")
     e_all = e_all.ravel()
     for k in range(len(refs)):
         if np.ptp(e_all[point == k]) < 0.05:
@@ -396,6 +475,16 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
     return Touches("track", q, e, None, [str(p + 1) for p in point],
                    truth={"T_L_R": t.T_L_R0.copy(), "scale": t.scale, "references": refs},
                    options=options, tool=tname, noise=noise)
+
+
+def _one_axis_table(cell: Cell) -> None:
+    """Refuse a cell without a one-axis turntable (the turntable and workpiece procedures)."""
+    if cell.turntable is None:
+        raise InputError("the cell has no turntable")
+    if not isinstance(cell.turntable, Turntable):
+        raise InputError(f"the cell's positioner {cell.turntable.name!r} is a chain of "
+                         f"{cell.turntable.n_axes} axes; the simulation of the turntable and "
+                         "workpiece procedures needs a one-axis turntable")
 
 
 def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.float64]:
@@ -423,13 +512,21 @@ def _table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.fl
 def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                track: float | None, touches: int = 6, angles: ArrayLike | None = None,
                radius: float = 0.3, height: float = 0.05) -> Touches:
-    if cell.turntable is None:
-        raise InputError("the cell has no turntable")
+    _one_axis_table(cell)
     tname = _tool_name(cell, tool)
-    if not radius > 0:
+    if not (math.isfinite(radius) and radius > 0):
         raise InputError(f"radius must be positive (m), got {radius}")
+    if not math.isfinite(height):
+        raise InputError(f"height must be a finite length (m), got {height}")
+    least = MIN_TOUCHES["turntable"]
+    if angles is None and touches < least:
+        raise InputError(f"the turntable calibration needs at least {least} table angles "
+                         f"(touches), got {touches}")
     th = _table_angles(cell, angles, touches)
     n = len(th)
+    if n < least:
+        raise InputError(f"the turntable calibration needs at least {least} table angles, "
+                         f"got {n}")
     p_B = np.array([radius, 0.0, height])
 
     def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -450,8 +547,7 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
 def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
                track: float | None, frame: str | None = None, size: float = 0.15,
                repeats: int = 2, angles: ArrayLike | None = None) -> Touches:
-    if cell.turntable is None:
-        raise InputError("the cell has no turntable")
+    _one_axis_table(cell)
     name = _frame_name(cell, frame, ("turntable",), "workpiece")
     tname = _tool_name(cell, tool)
     p_W, roles = _three_point(size, repeats)
@@ -480,8 +576,60 @@ def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
                    tool=tname, noise=noise)
 
 
+def _positioner_values(lower: float, upper: float, values: ArrayLike | None,
+                       default: NDArray[np.float64], what: str) -> NDArray[np.float64]:
+    """Values of one positioner axis (rad): ``values`` checked, else ``default`` clipped."""
+    if values is None:
+        return np.unique(np.clip(default, lower, upper))
+    v = np.atleast_1d(np.asarray(values, dtype=float))
+    if v.ndim != 1 or not np.all(np.isfinite(v)):
+        raise InputError(f"{what} values must be a list of finite numbers (rad)")
+    out = (v < lower) | (v > upper)
+    if np.any(out):
+        raise InputError(f"{what} value(s) {', '.join(f'{math.degrees(x):g}' for x in v[out])} deg "
+                         f"are outside the axis limits [{math.degrees(lower):g}, "
+                         f"{math.degrees(upper):g}] deg")
+    return v
+
+
+def _positioner(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
+                track: float | None, tilts: ArrayLike | None = None,
+                rotates: ArrayLike | None = None, radius: float = 0.2,
+                height: float = 0.0) -> Touches:
+    pos = cell.turntable
+    if pos is None or pos.n_axes != 2:
+        raise InputError("the positioner procedure needs a cell with a positioner of 2 axes "
+                         "(tilt, rotate)")
+    tname = _tool_name(cell, tool)
+    if not radius > 0:
+        raise InputError(f"radius must be positive (m), got {radius}")
+    t = _positioner_values(pos.lower[0], pos.upper[0], tilts, np.radians([-30.0, 0.0, 30.0]),
+                           "tilt")
+    r = _positioner_values(pos.lower[1], pos.upper[1], rotates,
+                           np.radians([0.0, 90.0, 180.0, 270.0]), "rotate")
+    if len(t) < 2 or len(r) < 3:
+        raise InputError(f"the positioner calibration needs at least 2 tilt and 3 rotate values, "
+                         f"got {len(t)} and {len(r)}")
+    v = np.stack(np.meshgrid(t, r, indexing="ij"), axis=-1).reshape(-1, 2)  # (n, 2)
+    n = len(v)
+    p_P = np.array([radius, 0.0, height])
+
+    def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
+        T_wP = frame_pose(cell, "turntable", Ek) @ pos.T_root_P(v)             # (K, n, 4, 4)
+        p_w = transform_points(T_wP, p_P)                                    # (K, n, 3)
+        return make_pose(DOWN[None, None], p_w[:, :, None])
+
+    E = _candidate_tracks(cell, track, n)
+    labels = [f"touch {i + 1} ({math.degrees(a):.0f}, {math.degrees(b):.0f} deg)"
+              for i, (a, b) in enumerate(v)]
+    q, e = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
+    return Touches("positioner", q, e if cell.track is not None else None, v, None,
+                   truth={"chain": pos.chain, "parent": pos.parent, "point": p_P},
+                   tool=tname, noise=noise)
+
+
 _SIMULATORS = {"tcp": _tcp, "frame": _frame, "track": _track, "turntable": _turntable,
-               "workpiece": _workpiece}
+               "workpiece": _workpiece, "positioner": _positioner}
 
 
 def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
@@ -493,7 +641,7 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
     ----------
     cell : Cell
         The virtual cell: its values are the truth the touches are made in.
-    procedure : {"tcp", "frame", "track", "turntable", "workpiece"}
+    procedure : {"tcp", "frame", "track", "turntable", "workpiece", "positioner"}
     noise : float
         Touch-up error, 1-sigma per coordinate (m); 0 for exact touches.
     seed : int or numpy.random.Generator, optional
@@ -517,7 +665,11 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
           spread of the track positions per point);
         - ``turntable``: ``touches`` (6), ``angles`` (default evenly around the turn),
           ``radius`` (0.3) and ``height`` (0.05) of the touched point on ``X_B``;
-        - ``workpiece``: ``frame`` (name), ``size`` (0.15), ``repeats`` (2), ``angles``.
+        - ``workpiece``: ``frame`` (name), ``size`` (0.15), ``repeats`` (2), ``angles``;
+        - ``positioner`` (2 axes): every combination of ``tilts`` (default -30, 0, 30 deg,
+          clipped to the limits) and ``rotates`` (default 0, 90, 180, 270 deg, clipped) of the
+          point ``(radius, 0, height)`` (0.2, 0.0) in the plate frame P; ``table`` holds the
+          axis values, shape (N, 2).
 
     Returns
     -------
@@ -532,6 +684,7 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
     if procedure not in _SIMULATORS:
         raise InputError(f"unknown procedure {procedure!r}; choose from {', '.join(PROCEDURES)}")
     noise = _check_noise(noise)
+    check_counts(design)
     try:
         return _SIMULATORS[procedure](cell, _rng(seed), noise, tool, track, **design)
     except TypeError as exc:

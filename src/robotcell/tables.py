@@ -8,33 +8,70 @@ share these readers and writers.
 from __future__ import annotations
 
 import csv
-from collections.abc import Sequence
+import difflib
+import io
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TextIO
 
 import numpy as np
 
 from robotcell.errors import InputError
+from robotcell.fileio import atomic_write, read_text
 
-__all__ = ["format_table", "read_csv", "require_columns", "write_csv"]
+__all__ = ["MAX_ABS_VALUE", "NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
+           "write_csv"]
+
+
+#: Largest magnitude of a number in a table or an option (mm, deg): a float64 of 1e15 resolves
+#: only 0.125 mm, so a larger value cannot be a measurement; it is a typing error.
+MAX_ABS_VALUE = 1e15
+
+#: Columns every reader accepts and ignores: free text beside the measurements.
+NOTE_COLUMNS = ("note", "notes", "comment", "comments", "remark", "remarks", "description")
 
 
 def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     """Read a CSV file with a header into columns.
 
     Numeric columns become float arrays; a column with any non-numeric entry stays a list of
-    strings. Column names are lower-cased and stripped.
+    strings. Column names are lower-cased and stripped. Files as spreadsheets save them are
+    read:
+
+    - the encoding follows :func:`robotcell.fileio.read_text` (UTF-8 with or without a
+      byte-order mark; otherwise Windows-1252 / Latin-1);
+    - the separator is ``,``, or ``;`` when the header line holds semicolons and no comma (the
+      "CSV" of a spreadsheet in a European locale). In a semicolon-separated file a number may
+      use a decimal comma (``1234,5``); a number with both ``.`` and ``,`` (a thousands
+      separator) is refused with a message that names the dialect.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+
+    Returns
+    -------
+    dict of str to ndarray or list of str
+        Column name -> values, one per data line (blank lines skipped).
 
     Raises
     ------
     InputError
-        Missing file, empty file, ragged rows, or an empty cell.
+        Missing or binary file, empty file, ragged rows, an empty cell, NaN or infinity, a number
+        beyond :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
     """
     p = Path(path)
     if not p.is_file():
-        raise InputError(f"{path}: no such file")
-    with p.open(newline="", encoding="utf-8") as fh:
-        rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+        raise InputError(f"{path}: no such file" + (" (it is a folder)" if p.is_dir() else ""))
+    text = read_text(p)
+    first = next((ln for ln in text.splitlines() if ln.strip()), "")
+    semicolon = ";" in first and "," not in first
+    reader = csv.reader(io.StringIO(text, newline=""), delimiter=";" if semicolon else ",")
+    try:
+        rows = [r for r in reader if any(c.strip() for c in r)]
+    except csv.Error as exc:
+        raise InputError(f"{path}: not a valid CSV file ({exc})") from None
     if len(rows) < 2:
         raise InputError(f"{path}: needs a header line and at least one data line")
     header = [h.strip().lower() for h in rows[0]]
@@ -43,7 +80,12 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     cols: dict[str, list[str]] = {h: [] for h in header}
     for lineno, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
-            raise InputError(f"{path}: line {lineno} has {len(row)} values, header has {len(header)}")
+            hint = ""
+            if not semicolon and len(row) > len(header):
+                hint = (" (decimal commas in a comma-separated file? Save it with ';' as the "
+                        "separator, or write numbers with a decimal point)")
+            raise InputError(f"{path}: line {lineno} has {len(row)} values, header has "
+                             f"{len(header)}{hint}")
         for h, cell in zip(header, row):
             cell = cell.strip()
             if cell == "":
@@ -51,14 +93,70 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
             cols[h].append(cell)
     out: dict[str, np.ndarray | list[str]] = {}
     for h, cells in cols.items():
-        try:
-            arr = np.array([float(c) for c in cells])
-        except ValueError:
+        values = [_number(c, semicolon) for c in cells]
+        if any(v is None for v in values):
+            if semicolon and h not in NOTE_COLUMNS:
+                _refuse_thousands(cells, h, path)
             out[h] = cells
             continue
+        arr = np.array(values, dtype=float)
         if not np.all(np.isfinite(arr)):
             raise InputError(f"{path}: column '{h}' contains NaN or infinite values")
+        huge = np.flatnonzero(np.abs(arr) > MAX_ABS_VALUE)
+        if huge.size:
+            raise InputError(f"{path}: line {huge[0] + 2}: column '{h}' has {cells[huge[0]]}, "
+                             f"beyond {MAX_ABS_VALUE:.0e} in size: no "
+                             "measurement in mm or deg is that large; correct the typing error")
         out[h] = arr
+    return out
+
+
+def _number(cell: str, decimal_comma: bool) -> float | None:
+    """``cell`` as a float (a decimal comma allowed when ``decimal_comma``), or None."""
+    if decimal_comma and "," in cell and "." not in cell and cell.count(",") == 1:
+        cell = cell.replace(",", ".")
+    try:
+        return float(cell)
+    except ValueError:
+        return None
+
+
+def _refuse_thousands(cells: list[str], column: str, path: str | Path) -> None:
+    """Refuse a number with both ``.`` and ``,`` in a semicolon-separated file."""
+    for c in cells:
+        if "," in c and "." in c and _number(c.replace(".", "").replace(",", ""), False) is not None:
+            raise InputError(f"{path}: column '{column}' has {c!r}: this file is semicolon-"
+                             "separated with decimal commas (European locale), and a number may "
+                             "not carry a thousands separator; write it as "
+                             f"{c.replace('.', '')!r} or save the file with ',' as the separator "
+                             "and '.' as the decimal mark")
+
+
+def unknown_columns(cols: dict, known: Iterable[str]) -> list[str]:
+    """The column names of ``cols`` that are neither in ``known`` nor a note column.
+
+    A reader states the columns it uses; a column it does not know (a misspelt ``piont``) would
+    otherwise be ignored silently. The note columns (:data:`NOTE_COLUMNS`) are always accepted.
+
+    Parameters
+    ----------
+    cols : dict
+        Columns from :func:`read_csv`.
+    known : iterable of str
+        Lower-case names the reader uses.
+
+    Returns
+    -------
+    list of str
+        Unknown names, each followed by `` (did you mean 'point'?)`` when a known name is close.
+    """
+    known = list(known)
+    out = []
+    for name in cols:
+        if name in known or name in NOTE_COLUMNS:
+            continue
+        close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+        out.append(f"{name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
     return out
 
 
@@ -75,12 +173,17 @@ def require_columns(cols: dict, names: Sequence[str], path: str | Path) -> np.nd
 
 def write_csv(path: str | Path | TextIO, header: Sequence[str], rows: np.ndarray,
               decimals: int = 6) -> None:
-    """Write an ``(N, len(header))`` array as CSV with fixed decimals to a path or open stream."""
+    """Write an ``(N, len(header))`` array as CSV with fixed decimals to a path or open stream.
+
+    A path is written atomically (:func:`robotcell.fileio.atomic_write`): a failed run leaves
+    the file as it was.
+    """
     if hasattr(path, "write"):
         _write_rows(path, header, rows, decimals)
         return
-    with Path(path).open("w", newline="", encoding="utf-8") as fh:
-        _write_rows(fh, header, rows, decimals)
+    buf = io.StringIO(newline="")
+    _write_rows(buf, header, rows, decimals)
+    atomic_write(path, buf.getvalue())
 
 
 def _write_rows(fh: TextIO, header: Sequence[str], rows: np.ndarray, decimals: int) -> None:

@@ -10,7 +10,9 @@ from __future__ import annotations
 import ast
 import importlib
 import importlib.util
+import os
 import sys
+import warnings
 from pathlib import Path
 
 import click
@@ -32,6 +34,8 @@ COMMANDS = {
     "report": "robotcell.cli.report:report",
     "demo": "robotcell.cli.demo:demo",
     "identify": "robotcell.cli.identify:identify",
+    "reach": "robotcell.cli.reach:reach",
+    "sweep": "robotcell.cli.sweep:sweep_cmd",
 }
 
 
@@ -102,18 +106,48 @@ def cli() -> None:
     """
 
 
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str,
+                      lineno: int, file: object = None, line: str | None = None) -> None:
+    """``warnings.showwarning`` for users: ``warning: <category>: <message>`` on stderr."""
+    click.echo(f"warning: {category.__name__}: {message}", err=True)
+
+
 def main(argv: list[str] | None = None) -> None:
-    """Entry point: run the CLI; refused input exits with status 2 and the reason on stderr."""
+    """Entry point: run the CLI.
+
+    Exit status: 0 on success; 2 for refused input (a bad option or file, geometry that does not
+    determine the result), with ``error: ...`` on stderr; 1 when the user aborts, or for an
+    unexpected failure, which is reported in one ``error:`` line with a request to report it
+    (never a traceback). A Python warning raised inside (e.g. numpy's overflow on absurd input)
+    is one ``warning:`` line, without the source file and line a developer would want.
+    """
     try:
-        cli.main(args=argv, prog_name="robotcell", standalone_mode=False)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            cli.main(args=argv, prog_name="robotcell", standalone_mode=False)
     except click.exceptions.Abort:
         click.echo("aborted", err=True)
         sys.exit(1)
+    except click.UsageError as exc:
+        if exc.ctx is not None:
+            click.echo(f"{exc.ctx.get_usage()}\nTry '{exc.ctx.command_path} --help' for help.",
+                       err=True)
+        click.echo(f"error: {exc.format_message()}", err=True)
+        sys.exit(2)
     except click.ClickException as exc:
-        exc.show()
+        click.echo(f"error: {exc.format_message()}", err=True)
         sys.exit(exc.exit_code)
     except RobotcellError as exc:
         click.echo(f"error: {exc}", err=True)
         sys.exit(2)
     except click.exceptions.Exit as exc:
         sys.exit(exc.exit_code)
+    except BrokenPipeError:
+        # The reader of stdout went away (``robotcell ... | head``): stop quietly.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        sys.exit(1)
+    except Exception as exc:  # noqa: BLE001 - the safety net: a message, never a traceback
+        click.echo(f"error: unexpected {type(exc).__name__}: {exc}\n"
+                   "This is a defect of robotcell, not of your input: please report it with "
+                   "the command line and the input files.", err=True)
+        sys.exit(1)

@@ -3,7 +3,9 @@
 Every subcommand reads a CSV (mm, deg; see docs/calibration.md), prints a report in mm/deg or,
 with ``--json``, one JSON object, and exits with status 2 and the reason on stderr when the input
 is refused. With ``--cell CELL.yaml`` (tcp, frame, track, turntable, workpiece) the result is
-written into the cell file through :class:`CellTarget`; notes about the update go to stderr.
+written into the cell file: the command parses its options, makes one call of
+:mod:`robotcell.cellcal` (which returns the result and the updated cell), prints its notes on
+stderr and saves the cell through :class:`CellTarget`.
 Subcommands of other modules are listed in ``REGISTERED`` at the bottom of this file and imported
 only when used.
 """
@@ -15,29 +17,21 @@ import importlib.util
 import json
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
 import click
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.calibration.measurements import (
-    check_count,
-    flange_poses,
-    nominal_points,
-    point_roles,
-    repeated_rows,
-    tcp_positions,
-    track_column,
-)
+from robotcell import cellcal
+from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
-from robotcell.cell import NAME_RE, Cell, Provenance
-from robotcell.cli.common import parse_numbers, read_csv
+from robotcell.cell import NAME_RE, Cell
+from robotcell.cellcal.touches import POSE_COLUMNS, line_labels, repeat_notes
+from robotcell.cli.common import check_output, parse_numbers, read_csv, write_output
 from robotcell.errors import InputError
 from robotcell.modelfile import load_robot
-from robotcell.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.poseformats import pose_from_vendor
 from robotcell.robot import Robot
-from robotcell.transforms import transform_points
 
 
 class CalibrateGroup(click.Group):
@@ -75,12 +69,26 @@ def calibrate() -> None:
     """
 
 
+#: Key of ``click.Context.meta`` under which ``-o FILE`` is kept for :func:`emit`.
+OUTPUT_KEY = "robotcell.calibrate.output"
+
+
+def _keep_output(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+    ctx.meta[OUTPUT_KEY] = check_output(ctx, param, value)
+
+
 def measurement_options(func: Callable) -> Callable:
-    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json,
+    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o,
     --accept-poor."""
     func = click.option("--accept-poor", is_flag=True,
                         help="Write and exit 0 even when the verdict is poor (default: a poor "
                              "result exits with status 3 and changes no file).")(func)
+    func = click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+                        expose_value=False, callback=_keep_output,
+                        help="Also write the result to FILE, atomically and only when the run "
+                             "succeeds: the JSON object with --json, else the report. Use it "
+                             "instead of '--json > FILE', which empties FILE when a run is "
+                             "refused.")(func)
     func = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
                         help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
@@ -112,7 +120,7 @@ class CellTarget:
     path : str
         The cell file as the user named it (used in messages).
     cell : Cell
-        Its content; updated in place, then written back by :meth:`save`.
+        Its content; a calibration returns an updated copy, written back by :meth:`save`.
     """
 
     path: str
@@ -139,42 +147,16 @@ class CellTarget:
                              "give one of them or X,Y,Z,A,B,C in mm/deg")
         return self.cell.tools[name].T_F_TCP
 
-    def track_positions(self, cols: dict, source: str) -> NDArray[np.float64] | None:
-        """Column ``track`` (m), or None; refused with non-zero values in a cell without track."""
-        e = track_column(cols, source)
-        if self.cell.track is None and e is not None and np.any(e != 0):
-            raise InputError(f"{source}: column 'track' has non-zero values, but the cell "
-                             f"{self.path} has no track; remove the column or add the track to "
-                             "the cell file")
-        return e
-
-    def robot_in_world(self, cols: dict, source: str, n: int) -> NDArray[np.float64]:
-        """``T_world_R`` at each of ``n`` touches, shape (n, 4, 4), from column ``track``."""
-        e = self.track_positions(cols, source)
-        if e is None:
-            if self.cell.track is not None:
-                raise InputError(
-                    f"{source}: missing column 'track' (track position of the robot at each "
-                    f"touch, mm): the robot of {self.path} is on a track, and the touches are "
-                    "mapped to the world through it; add the column (0 where the track did not "
-                    "move)")
-            e = np.zeros(n)
-        return self.cell.frame_pose("robot", track=e)
-
-    def save(self, what: str) -> None:
-        """Write the cell file and say on stderr what was updated."""
+    def save(self, cell: Cell, what: str, notes: tuple[str, ...] = ()) -> None:
+        """Write ``cell`` into the cell file; say on stderr ``notes`` and what was updated."""
+        for note in notes:
+            echo_note(note)
+        self.cell = cell
         try:
             self.cell.save(self.path)
         except OSError as exc:
             raise InputError(f"cannot write {self.path}: {exc}") from None
         click.echo(f"updated {self.path}: {what} (previous version: {self.path}.bak)", err=True)
-
-
-def cell_provenance(source: str, result: CalibrationResult, n: int, measurements: str
-                    ) -> Provenance:
-    """Provenance of a calibration read from ``measurements`` with ``n`` touches."""
-    return Provenance.now(source, rms_mm=result.rms * 1e3,
-                          note=f"{n} touches from {Path(measurements).name}")
 
 
 def require_name(name: str | None, target: CellTarget | None, what: str) -> None:
@@ -218,17 +200,36 @@ def sigma_m(sigma_mm: float | None) -> float | None:
     """``--sigma`` in mm to metres, refusing non-positive values."""
     if sigma_mm is None:
         return None
-    if not sigma_mm > 0:
-        raise InputError(f"--sigma must be a positive number of millimetres, got {sigma_mm}")
+    if not 0 < sigma_mm <= 1000:
+        raise InputError(f"--sigma must be a positive number of millimetres (at most 1000), got "
+                         f"{sigma_mm}")
     return sigma_mm * 1e-3
 
 
+def cell_of(target: CellTarget | None) -> tuple[Cell | None, str | None]:
+    """The cell of ``--cell`` and its name for messages (None, None without it)."""
+    return (None, None) if target is None else (target.cell, target.path)
+
+
+def echo_note(note: str) -> None:
+    """Print a note of a calibration on stderr."""
+    click.echo(note, err=True)
+
+
 def emit(result: CalibrationResult, as_json: bool) -> None:
-    """Print a result: the terminal report, or one JSON object with ``--json``."""
-    if as_json:
-        click.echo(json.dumps(result.to_json(), indent=2))
-    else:
-        click.echo(result.summary())
+    """Print a result: the terminal report, or one JSON object with ``--json``.
+
+    With ``-o FILE`` the terminal shows the report and FILE gets the JSON object (``--json``) or
+    the report, written atomically.
+    """
+    output = click.get_current_context().meta.get(OUTPUT_KEY)
+    text = json.dumps(result.to_json(), indent=2) if as_json else result.summary()
+    if output is None:
+        click.echo(text)
+        return
+    click.echo(result.summary())
+    write_output(output, text + "\n")
+    click.echo(f"wrote {output}", err=True)
 
 
 class PoorCalibration(click.ClickException):
@@ -256,50 +257,6 @@ def gate(result: CalibrationResult, as_json: bool, accept_poor: bool) -> None:
     click.echo(json.dumps(result.to_json(), indent=2) if as_json else result.summary())
     raise PoorCalibration(f"poor calibration, nothing written: {'; '.join(v.reasons)}. Fix the "
                           "measurements, or pass --accept-poor to use the result anyway")
-
-
-def raw_rows(cols: dict, names: list[str]) -> np.ndarray:
-    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note."""
-    use = [n for n in names if n in cols and isinstance(cols[n], np.ndarray)]
-    return np.stack([cols[n] for n in use], axis=1)
-
-
-def note_repeats(cols: dict, names: list[str], source: str) -> None:
-    """Say on stderr which rows are identical (they are used, each as a measurement)."""
-    for note in repeated_rows(raw_rows(cols, names), source):
-        click.echo(f"note: {note}", err=True)
-
-
-def _line_labels(roles: list[str]) -> list[str]:
-    return [f"line {i + 2} ({r})" for i, r in enumerate(roles)]
-
-
-POSE_COLUMNS = ["x", "y", "z", "a", "b", "c"] + [f"a{i}" for i in range(1, 10)]
-
-
-NO_CELL_TRACK = ("needs --cell CELL.yaml, which says where the track is; remove the column or "
-                 "pass --cell")
-
-
-def _write_tool(target: CellTarget, name: str, result: CalibrationResult, prov: Provenance) -> None:
-    """Set tool ``name`` from a TCP result; an unmeasured orientation is kept, and said so."""
-    if "T_F_TCP" in result.values:
-        target.cell.set_tool(name, result.values["T_F_TCP"], prov)
-        return
-    T = np.eye(4)
-    old = target.cell.tools.get(name)
-    advice = "ABC 2-point or ABC World touches measure it"
-    if old is not None:
-        T[:3, :3] = old.T_F_TCP[:3, :3]
-        abc = ", ".join(f"{v:.3f}" for v in pose_to_vendor(old.T_F_TCP, "kuka")[3:] + 0.0)
-        click.echo(f"note: the touches do not measure the tool orientation: kept the orientation "
-                   f"of tool {name!r} in {target.path} (A,B,C = {abc} deg); {advice}", err=True)
-    else:
-        click.echo(f"note: the touches do not measure the tool orientation and {target.path} has "
-                   f"no tool {name!r} yet: its orientation is the flange's (A,B,C = 0, 0, 0 deg); "
-                   f"{advice}", err=True)
-    T[:3, 3] = result.values["tcp"]
-    target.cell.set_tool(name, T, prov)
 
 
 @calibrate.command("tcp")
@@ -330,8 +287,6 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
       robotcell calibrate tcp joints.csv --robot kuka_kr16
       robotcell calibrate tcp joints.csv --cell cell.yaml --name torch
     """
-    from robotcell.calibration.tcp import calibrate_tool
-
     if tool is not None:
         raise InputError("--tool is not used by 'calibrate tcp': the flange poses are computed "
                          "without a tool; give only --robot")
@@ -339,49 +294,14 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     require_name(name, target, "tool")
     prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None, target)
-    cols = read_csv(measurements)
-    T = flange_poses(cols, measurements, model)
-    roles = [str(r).strip().lower() for r in cols["point"]] if "point" in cols else ["tcp"] * len(T)
-    bad = sorted(set(roles) - {"tcp", "-x", "xy", "world"})
-    if bad:
-        raise InputError(f"{measurements}: column 'point' must hold tcp, -x, xy or world; "
-                         f"found {', '.join(bad)}")
-    note_repeats(cols, POSE_COLUMNS + ["track"], measurements)
-    check_count(roles.count("tcp"), 3, "touches of the reference point (point=tcp)", measurements)
-    if target is None:
-        refuse_track_column(cols, measurements, NO_CELL_TRACK)
-    else:
-        e = target.track_positions(cols, measurements)
-        if e is not None and target.cell.track is not None:
-            T = target.cell.frame_pose("robot", track=e) @ T
-            click.echo("note: the flange poses were mapped to the world through column 'track': "
-                       "the reference point (pivot) is in world coordinates, and ABC World "
-                       "alignments refer to the world axes", err=True)
-    r = np.array(roles)
-    labels = _line_labels(roles)
-    order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
-    result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
-                            world_mode=world_mode, prior_sigma=prior,
-                            labels=[labels[i] for i in order])
-    gate(result, as_json, accept_poor)
-    if target is not None and name is not None:
-        _write_tool(target, name, result, cell_provenance("tcp", result, len(T), measurements))
-        target.save(f"tool {name!r}")
-    emit(result, as_json)
-
-
-def _frame_parent(target: CellTarget, name: str | None, parent: str | None) -> str:
-    """Parent of the frame to write: ``--parent``, else the existing frame's, else world."""
-    if parent is not None:
-        return parent
-    old = target.cell.frames.get(name)
-    if old is None:
-        return "world"
-    if old.parent == "turntable":
-        raise InputError(f"frame {name!r} of {target.path} is carried by the turntable: "
-                         "calibrate it with 'robotcell calibrate workpiece', or pass --parent "
-                         "world or --parent robot to replace it by a frame fixed there")
-    return old.parent
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
+    cell, label = cell_of(target)
+    out = cellcal.tcp(cell, cols, name, robot=None if cell else model, world_mode=world_mode,
+                      sigma=prior, source=measurements, cell_label=label, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
+    if out.cell is not None:
+        target.save(out.cell, out.item, out.update_notes)
+    emit(out.result, as_json)
 
 
 @calibrate.command("frame")
@@ -412,8 +332,6 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
       robotcell calibrate frame touches.csv
       robotcell calibrate frame joints.csv --cell cell.yaml --name fixture --tool torch
     """
-    from robotcell.calibration.frame import frame_3point, frame_npoint
-
     target = CellTarget.open(cell_path, robot)
     require_name(name, target, "frame")
     if target is None and parent is not None:
@@ -421,37 +339,16 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
                          "CELL.yaml")
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements)
-    p = tcp_positions(cols, measurements, model, T_tool)
-    note_repeats(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y", "nominal_z"],
-                 measurements)
-    in_world = False
-    if target is None:
-        refuse_track_column(cols, measurements, NO_CELL_TRACK)
-    else:
-        parent = _frame_parent(target, name, parent)
-        if parent == "world":
-            p = transform_points(target.robot_in_world(cols, measurements, len(p)), p)
-            in_world = True
-        else:
-            target.track_positions(cols, measurements)
-    if "nominal_x" in cols:
-        check_count(len(p), 3, "points", measurements)
-        q = nominal_points(cols, measurements)
-        result = frame_npoint(p, q, prior, [f"line {i + 2}" for i in range(len(p))])
-    else:
-        roles = point_roles(cols, measurements)
-        result = frame_3point(p, roles, prior, _line_labels(roles))
-    gate(result, as_json, accept_poor)
-    if target is not None and name is not None:
-        key = f"T_world_{name}" if in_world else "T_R_W"
-        if in_world:
-            result = result.renamed("T_R_W", key)
-        target.cell.update_frame(name, result.values[key],
-                                 cell_provenance("frame", result, len(p), measurements),
-                                 parent=parent)
-        target.save(f"frame {name!r} (parent {parent})")
-    emit(result, as_json)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track", "nominal_x",
+                                                        "nominal_y", "nominal_z"])
+    cell, label = cell_of(target)
+    out = cellcal.frame(cell, cols, name, parent=parent, robot=None if cell else model,
+                        tool=T_tool, sigma=prior, source=measurements, cell_label=label,
+                        on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
+    if out.cell is not None:
+        target.save(out.cell, out.item, out.update_notes)
+    emit(out.result, as_json)
 
 
 @calibrate.command("external-tcp")
@@ -475,7 +372,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
-    cols = read_csv(measurements)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     refuse_track_column(cols, measurements, "is not used by 'calibrate external-tcp': touch the "
                         "fixed tool with the track at one position and remove the column")
     p = tcp_positions(cols, measurements, model, T_tool)
@@ -483,8 +380,9 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
         roles = [str(v).strip().lower() for v in cols["point"]]
     else:
         roles = ["tcp"] * len(p)
-    note_repeats(cols, POSE_COLUMNS, measurements)
-    result = external_tcp(p, roles, prior, _line_labels(roles))
+    for note in repeat_notes(cols, POSE_COLUMNS, measurements):
+        echo_note(note)
+    result = external_tcp(p, roles, prior, line_labels(len(roles), roles))
     gate(result, as_json, accept_poor)
     emit(result, as_json)
 
@@ -493,11 +391,12 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
 # A module listed here is imported only when its subcommand is used; an entry whose module does
 # not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m, gate, emit, and for --cell cell_option, CellTarget and the helpers around it, from this
+# sigma_m, gate, emit, and for --cell cell_option, CellTarget, cell_of and echo_note, from this
 # module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",
+    "positioner": "robotcell.cli.calibrate_axes:positioner",
     "workpiece": "robotcell.cli.calibrate_axes:workpiece",
 }
 # ------------------------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ import math
 
 import click
 
-from robotcell.cell import Cell, Provenance
+from robotcell.cell import Cell, Provenance, Turntable
 from robotcell.cli.common import format_table
 from robotcell.poseformats import pose_to_vendor
 
@@ -57,10 +57,17 @@ def show(path: str) -> None:
         click.echo(f"track {t.name}: {t.lower * 1e3:g} .. {t.upper * 1e3:g} mm, scale {t.scale:g}")
     else:
         rows.append(_row("robot", "robot R (world)", None, c.T_world_R, Provenance("nominal")))
-    if c.turntable is not None:
+    if isinstance(c.turntable, Turntable):
         b = c.turntable
         rows.append(_row(b.name, f"turntable B ({b.parent})", None, b.T_parent_B, b.provenance))
         click.echo(f"turntable {b.name}: {math.degrees(b.lower):g} .. {math.degrees(b.upper):g} deg")
+    elif c.turntable is not None:
+        p = c.turntable
+        rows.append(_row(p.name, f"positioner root ({p.parent})", None, p.T_parent_root,
+                         p.provenance))
+        limits = ", ".join(f"{j.name} {math.degrees(j.lower):g} .. {math.degrees(j.upper):g}"
+                           for j in p.chain.joints)
+        click.echo(f"positioner {p.name}: {p.n_axes} axes, {limits} deg")
     for name, tool in c.tools.items():
         rows.append(_row(name, "tool (flange)", tool.number, tool.T_F_TCP, tool.provenance))
     for name, fr in c.frames.items():

@@ -1,4 +1,5 @@
-"""Helpers shared by the CLI commands: number lists; CSV files and tables (from ``robotcell.tables``).
+"""Helpers shared by the CLI commands: number lists; CSV files and tables (from ``robotcell.tables``);
+output files (written atomically, from ``robotcell.fileio``).
 
 Every file the CLI reads or writes is CSV with a header, lengths in millimetres and angles in
 degrees.
@@ -7,11 +8,18 @@ degrees.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
+from pathlib import Path
 
+import click
+
+from robotcell import tables
 from robotcell.errors import InputError
-from robotcell.tables import format_table, read_csv, require_columns, write_csv
+from robotcell.fileio import atomic_write, check_destination
+from robotcell.tables import format_table, require_columns, write_csv
 
-__all__ = ["format_table", "parse_numbers", "read_csv", "require_columns", "write_csv"]
+__all__ = ["check_not_folder", "check_output", "format_table", "parse_numbers", "read_csv", "require_columns",
+           "write_csv", "write_output"]
 
 
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:
@@ -25,4 +33,44 @@ def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]
         raise InputError(f"{what} needs {count} comma-separated values, got {len(values)}")
     if not all(math.isfinite(v) for v in values):
         raise InputError(f"{what} contains NaN or infinite values")
+    if any(abs(v) > tables.MAX_ABS_VALUE for v in values):
+        raise InputError(f"{what} has a value beyond {tables.MAX_ABS_VALUE:.0e} in size: no "
+                         "length in mm or angle in deg is that large")
     return values
+
+
+def read_csv(path: str, known: Iterable[str] | None = None) -> dict:
+    """:func:`robotcell.tables.read_csv`, warning on stderr about columns not in ``known``.
+
+    ``known`` lists the columns the command uses; any other column (except a note column) is
+    named in a ``warning:`` line, with the closest known name, since it is otherwise ignored.
+    """
+    cols = tables.read_csv(path)
+    if known is not None:
+        unknown = tables.unknown_columns(cols, known)
+        if unknown:
+            click.echo(f"warning: {path}: column(s) {', '.join(unknown)} not used by this command "
+                       "and ignored; check the spelling", err=True)
+    return cols
+
+
+def check_output(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """Callback of an output option: refuse a missing folder or a folder before any work."""
+    if value is not None:
+        check_destination(value)
+    return value
+
+
+def check_not_folder(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """Callback of an output option whose missing folder is created: refuse a folder."""
+    if value is not None and Path(value).is_dir():
+        raise InputError(f"cannot write {value!r}: it is a folder; give a file name")
+    return value
+
+
+def write_output(path: str | None, text: str) -> None:
+    """Write ``text`` to ``path`` atomically (see :mod:`robotcell.fileio`), or to stdout."""
+    if path is None:
+        click.echo(text, nl=False)
+    else:
+        atomic_write(path, text)

@@ -2,21 +2,20 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
 from robotcell.cell import Cell
-from robotcell.export import EXPORT_FORMATS, export_cell
+from robotcell.cli.common import check_output, write_output
+from robotcell.export import WRITE_FORMATS, export_cell
 
 
 @click.command()
 @click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file (YAML, mm/deg).")
-@click.option("--format", "fmt", required=True, type=click.Choice(list(EXPORT_FORMATS)),
+@click.option("--format", "fmt", required=True, type=click.Choice(list(WRITE_FORMATS)),
               help="Controller format.")
-@click.option("-o", "--output", "output", type=click.Path(dir_okay=False),
-              help="File to write (default: standard output).")
+@click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
+              help="File to write, atomically (default: standard output).")
 def export(cell_path: str, fmt: str, output: str | None) -> None:
     """Write what to paste into the controller: tools, bases/work objects/user frames and the
     placement of the robot, the track and the turntable (mm, deg; see docs/export.md).
@@ -26,6 +25,8 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     abb      RAPID module: tooldata, wobjdata, base frames as pose
     fanuc    UTOOL/UFRAME values for Direct Entry (X Y Z W P R)
     yaskawa  TOOL/UFRAME values for the pendant (X Y Z Rx Ry Rz)
+    urdf     the calibrated cell as a URDF tree for ROS tools (m, rad): robot, track and
+             turntable joints, tools and frames as fixed links
 
     \b
     Examples:
@@ -33,8 +34,6 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
       robotcell export --cell cell.yaml --format abb -o cell_frames.mod
     """
     text = export_cell(Cell.load(cell_path), fmt)
-    if output is None:
-        click.echo(text, nl=False)
-    else:
-        Path(output).write_text(text, encoding="utf-8")
+    write_output(output, text)
+    if output is not None:
         click.echo(f"wrote {output}", err=True)

@@ -9,6 +9,7 @@ import sys
 import click
 import numpy as np
 
+from robotcell.cli.common import check_not_folder, check_output
 from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
@@ -88,8 +89,9 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
 @click.argument("measurements", type=click.Path(), required=False)
 @click.option("--robot", "robot", help="Nominal model: library name or model file. Without it the "
               "circle point analysis builds the start model (rows moving one joint at a time).")
-@click.option("-o", "--output", "output", type=click.Path(), help="Write the identified model file "
-              "(YAML); with --propose, the proposed configurations (CSV).")
+@click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
+              help="Write the identified model file (YAML), atomically; with --propose, the "
+              "proposed configurations (CSV).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of the report.")
 @click.option("--j23-factor", "j23", type=float, help="J2/J3 coupling k: q3_model = J3 + k * J2 "
               "(FANUC: -1). The report says whether the data support it.")
@@ -103,7 +105,7 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
 @click.option("--force", "force", is_flag=True, help="Write -o even when the verdict is poor.")
 @click.option("--folds", "folds", type=int, help="Also K-fold cross-validate: every row predicted "
               "by the models identified without it (mean, RMS, max before and after).")
-@click.option("--report", "report", type=click.Path(dir_okay=False), help="Also write a "
+@click.option("--report", "report", type=click.Path(), callback=check_not_folder, help="Also write a "
               "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
 @click.option("--offsets-for", "offsets_for", type=click.Choice(["kuka", "abb"]), help="Also print "
               "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "

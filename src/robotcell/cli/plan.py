@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from robotcell.cell import Cell
-from robotcell.cli.common import format_table
+from robotcell.cli.common import check_output, format_table
 from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
 from robotcell.errors import InputError
 from robotcell.plan import DESIGNS, LEVER, Candidate
@@ -44,14 +44,14 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
 @click.command()
 @click.argument("procedure", type=click.Choice(list(DESIGNS)))
 @cell_options
-@click.option("--runs", type=int, default=100, show_default=True,
+@click.option("--runs", type=click.IntRange(min=0), default=100, show_default=True,
               help="Monte Carlo runs at the best design (0: none).")
 @click.option("--max-size", type=float, default=None, metavar="MM",
               help="frame/workpiece: largest triangle that fits on the part (mm).")
 @click.option("--max-radius", type=float, default=None, metavar="MM",
               help="turntable: largest distance of a touchable point from the axis (mm).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="Write the proposed touches (exact joint values to teach) as CSV.")
+@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+              help="Write the proposed touches (exact joint values to teach) as CSV, atomically.")
 def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
          frame: str | None, track_mm: float | None, touches: int | None, repeats: int | None,
          runs: int, max_size: float | None, max_radius: float | None,

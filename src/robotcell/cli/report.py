@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import click
 
+from robotcell.cli.common import check_not_folder
 from robotcell.report import load_result, verdict, write_report
 
 
 @click.command()
 @click.argument("result", type=click.Path())
 @click.option("-o", "--output", default="report.html", show_default=True, type=click.Path(),
+              callback=check_not_folder,
               help="HTML file to write; its figures are embedded, nothing else is written.")
 def report(result: str, output: str) -> None:
     """Write a self-contained HTML report, figures embedded, for a calibration result.
@@ -18,7 +20,7 @@ def report(result: str, output: str) -> None:
 
     \b
     Example:
-      robotcell calibrate frame base.csv --json > base.json
+      robotcell calibrate frame base.csv --json -o base.json
       robotcell report base.json -o base.html
     """
     data = load_result(result)

@@ -6,18 +6,31 @@ The design options (mm, deg) shared with ``robotcell plan`` are defined here.
 from __future__ import annotations
 
 import math
+import shlex
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import parse_numbers
+from robotcell.cli.common import check_output, parse_numbers
 from robotcell.errors import InputError
 from robotcell.simulate import PROCEDURES, Touches
 from robotcell.simulate import simulate as simulate_touches
+
+
+def _mm(option: str, positive: bool = False) -> Callable[[float], float]:
+    """Converter of a length option: mm to m, refusing (in mm) what the option cannot be."""
+    def convert(value: float) -> float:
+        if not math.isfinite(value) or (positive and value <= 0):
+            kind = "a positive" if positive else "a finite"
+            raise InputError(f"--{option} must be {kind} number of millimetres, got {value:g}")
+        return value * 1e-3
+    return convert
+
 
 #: Design options: CLI name -> (keyword of simulate, procedures it applies to, converter to SI).
 DESIGN_OPTIONS: dict[str, tuple[str, tuple[str, ...], Callable[[Any], Any]]] = {
@@ -25,16 +38,18 @@ DESIGN_OPTIONS: dict[str, tuple[str, tuple[str, ...], Callable[[Any], Any]]] = {
     "tilt": ("tilt", ("tcp",), math.radians),
     "point": ("point", ("tcp",), lambda v: np.array(parse_numbers(v, "--point", 3)) * 1e-3),
     "orientation": ("orientation", ("tcp",), bool),
-    "size": ("size", ("frame", "workpiece"), lambda v: v * 1e-3),
+    "size": ("size", ("frame", "workpiece"), _mm("size", positive=True)),
     "repeats": ("repeats", ("frame", "workpiece"), int),
     "reference": ("references", ("track",),
                   lambda v: np.array([parse_numbers(r, "--reference", 3) for r in v]) * 1e-3),
     "positions": ("positions", ("track",), int),
-    "travel": ("travel", ("track",), lambda v: v * 1e-3),
+    "travel": ("travel", ("track",), _mm("travel", positive=True)),
     "angles": ("angles", ("turntable", "workpiece"),
                lambda v: np.radians(parse_numbers(v, "--angles"))),
-    "radius": ("radius", ("turntable",), lambda v: v * 1e-3),
-    "height": ("height", ("turntable",), lambda v: v * 1e-3),
+    "radius": ("radius", ("turntable", "positioner"), _mm("radius", positive=True)),
+    "height": ("height", ("turntable", "positioner"), _mm("height")),
+    "tilts": ("tilts", ("positioner",), lambda v: np.radians(parse_numbers(v, "--tilts"))),
+    "rotates": ("rotates", ("positioner",), lambda v: np.radians(parse_numbers(v, "--rotates"))),
 }
 
 
@@ -45,7 +60,8 @@ def cell_options(func: Callable) -> Callable:
                      help="The virtual cell (YAML, mm/deg): its values are the truth."),
         click.option("--noise", type=float, default=0.1, show_default=True, metavar="MM",
                      help="Touch-up error, 1-sigma per coordinate (mm)."),
-        click.option("--seed", type=int, default=None, help="Seed of the touch-up errors."),
+        click.option("--seed", type=click.IntRange(min=0), default=None,
+                     help="Seed of the touch-up errors (a whole number >= 0)."),
         click.option("--tool", default=None, metavar="NAME",
                      help="Tool of the cell that touches (tcp: the tool to calibrate); needed "
                           "when the cell has several."),
@@ -87,9 +103,17 @@ def design_options(func: Callable) -> Callable:
                      help="turntable: table angles (deg; default evenly around the turn); "
                           "workpiece: one per touch."),
         click.option("--radius", type=float, default=None, metavar="MM",
-                     help="turntable: distance of the touched point from the axis (300)."),
+                     help="turntable: distance of the touched point from the axis (300); "
+                          "positioner: from the plate origin along its X (200)."),
         click.option("--height", type=float, default=None, metavar="MM",
-                     help="turntable: height of the touched point above the root frame (50)."),
+                     help="turntable: height of the touched point above the root frame (50); "
+                          "positioner: above the plate (0)."),
+        click.option("--tilts", default=None, metavar="A,B,...",
+                     help="positioner: values of axis 1, tilt (deg; -30,0,30 within the limits); "
+                          "every combination with --rotates is touched."),
+        click.option("--rotates", default=None, metavar="A,B,...",
+                     help="positioner: values of axis 2, rotate (deg; 0,90,180,270 within the "
+                          "limits)."),
     ]
     for opt in reversed(opts):
         func = opt(func)
@@ -120,8 +144,14 @@ def common_keywords(procedure: str, tool: str | None, frame: str | None,
                              "workpiece)")
         kw["frame"] = frame
     if track_mm is not None:
-        kw["track"] = track_mm * 1e-3
+        kw["track"] = _mm("track")(track_mm)
     return kw
+
+
+def working_copy(cell_path: str) -> str:
+    """Name of the copy of a virtual cell to calibrate into: ``cell.yaml`` -> ``cell_calibrated.yaml``."""
+    p = Path(cell_path)
+    return str(p.with_name(f"{p.stem}_calibrated{p.suffix or '.yaml'}"))
 
 
 def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
@@ -142,8 +172,8 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
 @click.argument("procedure", type=click.Choice(list(PROCEDURES)))
 @cell_options
 @design_options
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
-              help="CSV file to write (default: standard output).")
+@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+              help="CSV file to write, atomically (default: standard output).")
 def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
              frame: str | None, track_mm: float | None, output: str | None,
              **design: Any) -> None:
@@ -151,14 +181,16 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
 
     Writes the measurement CSV that 'robotcell calibrate PROCEDURE' reads: joint values
     a1..a6 (deg) that really reach the touched points within every limit, with the touch-up
-    error --noise; e1 (track mm or table deg), track (mm, robot's track position), point.
-    The command line that calibrates the file is printed on stderr. Procedures: tcp, frame,
-    track, turntable, workpiece.
+    error --noise; e1 (track mm or table deg; positioner: e1, e2 = tilt, rotate deg), track
+    (mm, robot's track position), point. The command line that calibrates the file is printed
+    on stderr. Procedures: tcp, frame, track, turntable, workpiece, positioner (a 2-axis
+    positioner: one point on the plate at every combination of --tilts and --rotates).
 
     \b
     Examples:
       robotcell simulate turntable --cell cell.yaml --noise 0.1 -o turntable.csv
       robotcell simulate tcp --cell cell.yaml --tool torch --tilt 40 --seed 1 -o tcp.csv
+      robotcell simulate positioner --cell truth.yaml --tool pointer --noise 0.1 -o touches.csv
     """
     if not (math.isfinite(noise) and noise >= 0):
         raise InputError(f"--noise must be a number of millimetres >= 0, got {noise}")
@@ -173,5 +205,8 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
     click.echo(f"simulated {len(t.q)} touches for '{procedure}' with a touch-up error of "
                f"{noise:g} mm (1-sigma per coordinate)"
                + (f"; wrote {output}" if output else ""), err=True)
-    click.echo("calibrate them (on a copy of the cell file: --cell updates it) with:\n  "
-               + calibrate_hint(t, output or "FILE.csv", cell_path), err=True)
+    copy = working_copy(cell_path)
+    click.echo(f"calibrate them on a copy of the cell file ({cell_path} is the truth to compare "
+               f"with, and --cell updates the file it is given):\n"
+               f"  cp {shlex.quote(cell_path)} {shlex.quote(copy)}\n  "
+               + calibrate_hint(t, output or "FILE.csv", copy), err=True)

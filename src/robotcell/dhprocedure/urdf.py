@@ -26,6 +26,7 @@ from robotcell.dh import Convention
 from robotcell.dhprocedure.axes import AxisChain
 from robotcell.dhprocedure.procedure import DHDerivation, dh_from_axes
 from robotcell.errors import InputError, RobotcellError
+from robotcell.fileio import read_text
 from robotcell.transforms import make_pose
 
 __all__ = ["UrdfChain", "UrdfJoint", "dh_from_urdf", "read_urdf"]
@@ -257,7 +258,7 @@ def _text(source: str | Path) -> tuple[str, str]:
     p = Path(s)
     if not p.is_file():
         raise InputError(f"URDF file {s!r} does not exist")
-    return p.read_text(encoding="utf-8"), s
+    return read_text(p, "URDF file"), s
 
 
 def _path(model: Any, start: str, tip: str | None, origin: str) -> list[Any]:

@@ -1,6 +1,7 @@
 """Controller exports: what a user pastes into a KUKA, ABB, FANUC or YASKAWA controller.
 
-``export_cell(cell, "kuka")`` returns the text; ``parse_export(text, "kuka")`` reads it back into
+``export_cell(cell, "kuka")`` returns the text (``"urdf"``: the cell as a URDF kinematic tree, for
+ROS tools, not a controller format); ``parse_export(text, "kuka")`` reads it back into
 :class:`~robotcell.export.common.ControllerData` (poses in metres). Formats, units, reference
 frames and sources: ``docs/export.md``.
 """
@@ -11,27 +12,30 @@ from types import ModuleType
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.export import abb, fanuc, kuka, yaskawa
+from robotcell.export import abb, fanuc, kuka, urdf, yaskawa
 from robotcell.export.common import ControllerData, Slot
 
-__all__ = ["EXPORT_FORMATS", "ControllerData", "Slot", "export_cell", "parse_export"]
+__all__ = ["EXPORT_FORMATS", "WRITE_FORMATS", "ControllerData", "Slot", "export_cell", "parse_export"]
 
 #: format name -> module with ``export(cell) -> str`` and ``parse(text) -> ControllerData``
 EXPORT_FORMATS: dict[str, ModuleType] = {"kuka": kuka, "abb": abb, "fanuc": fanuc,
                                          "yaskawa": yaskawa}
 
+#: every format :func:`export_cell` writes: the controller formats and ``urdf``
+WRITE_FORMATS: dict[str, ModuleType] = {**EXPORT_FORMATS, "urdf": urdf}
 
-def _module(fmt: str) -> ModuleType:
+
+def _module(fmt: str, formats: dict[str, ModuleType] = EXPORT_FORMATS) -> ModuleType:
     try:
-        return EXPORT_FORMATS[fmt.lower()]
+        return formats[fmt.lower()]
     except KeyError:
         raise InputError(f"unknown export format {fmt!r}; choose one of: "
-                         f"{', '.join(EXPORT_FORMATS)}") from None
+                         f"{', '.join(formats)}") from None
 
 
 def export_cell(cell: Cell, fmt: str) -> str:
-    """Controller text for ``cell`` in format ``fmt`` (``kuka``, ``abb``, ``fanuc``, ``yaskawa``)."""
-    return _module(fmt).export(cell)
+    """Text for ``cell`` in format ``fmt`` (``kuka``, ``abb``, ``fanuc``, ``yaskawa``, ``urdf``)."""
+    return _module(fmt, WRITE_FORMATS).export(cell)
 
 
 def parse_export(text: str, fmt: str) -> ControllerData:

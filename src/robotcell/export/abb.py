@@ -93,6 +93,14 @@ def format_data(data: ControllerData, cell_name: str) -> str:
         L.append(f"    ! system parameters, Motion > Single {unit} > base frame (in world, "
                  "z on the table axis):")
         L.append(f"    CONST pose {unit}_base:={pose_text(data.turntable.pose)};")
+        if data.positioner_frames:
+            L.append(f"    ! {unit} axes, not read by RAPID (the unit's kinematic model in the system "
+                     "parameters holds them): each axis frame, z on the axis, in the previous at "
+                     "axis 0, then the plate")
+            *axes, plate = data.positioner_frames
+            for i, T in enumerate(axes, start=1):
+                L.append(f"    CONST pose {unit}_axis{i}:={pose_text(T)};")
+            L.append(f"    CONST pose {unit}_plate:={pose_text(plate)};")
     if data.robot is not None:
         L.append("    ! system parameters, Motion > Robot > base frame (in world):")
         L.append(f"    CONST pose robot_base:={pose_text(data.robot.pose)};")
@@ -175,6 +183,10 @@ def parse(text: str) -> ControllerData:
     for name, T in poses.items():
         if name.endswith("_base") and name != "robot_base":
             data.turntable = Slot(name[: -len("_base")], None, T)
+            axes = [poses[f"{name[:-5]}_axis{i}"] for i in (1, 2, 3)
+                    if f"{name[:-5]}_axis{i}" in poses]
+            if axes and f"{name[:-5]}_plate" in poses:
+                data.positioner_frames = [*axes, poses[f"{name[:-5]}_plate"]]
         elif name.endswith("_root") and name[:-5] + "_robot" in poses:
             data.track_root = Slot(name[:-5], None, T)
             data.track_robot = Slot(name[:-5], None, poses[name[:-5] + "_robot"])

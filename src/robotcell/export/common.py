@@ -17,7 +17,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.cell import Cell
+from robotcell.axischain import axis_frames
+from robotcell.cell import Cell, Positioner
 from robotcell.errors import InputError
 from robotcell.transforms import invert, make_pose, rot_y
 
@@ -79,7 +80,14 @@ class ControllerData:
     track_scale : float
         Track displacement per unit of the controller's track value.
     turntable : Slot or None
-        Turntable root B in the reference frame (Z on the axis).
+        Turntable root B in the reference frame (Z on the axis); for a positioner chain its root
+        (frame 0 of the chain).
+    positioner_frames : list of ndarray, shape (4, 4) each
+        For a positioner chain of n axes, the n + 1 frames of KUKA's external kinematics
+        (``TA1KR``, ``TA2A1``, ``TA3A2``, ``TFLA3``): the pose of each axis frame (Z on the axis)
+        in the previous one at axis value 0, then the plate in the last axis frame
+        (:func:`robotcell.axischain.axis_frames`); empty for a one-axis turntable, whose frames
+        are null.
     skipped : list of str
         Frames the controller cannot hold (fixed to a robot that moves on a track).
     """
@@ -91,6 +99,7 @@ class ControllerData:
     track_robot: Slot | None = None
     track_scale: float = 1.0
     turntable: Slot | None = None
+    positioner_frames: list[NDArray[np.float64]] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
 
 
@@ -104,6 +113,27 @@ def track_root_rotation(axis: str) -> NDArray[np.float64]:
     if axis == "y":
         return make_pose(np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]]))
     return np.eye(4)
+
+
+#: Half a turn about X: turns Z of an axis frame round, ``Rx(pi) Rz(q) Rx(pi) = Rz(-q)``.
+_FLIP = np.diag([1.0, -1.0, -1.0, 1.0])
+
+
+def positive_z_frames(frames: list[NDArray[np.float64]], signs: list[float]
+                      ) -> list[NDArray[np.float64]]:
+    """Axis frames whose +Z turns the way the controller's axis value counts.
+
+    ``frames`` are ``pre_1 .. pre_n, post`` of :func:`robotcell.axischain.axis_frames`, where
+    joint ``i`` turns by ``sign_i q_i`` about Z. For ``sign_i = -1`` the frame of axis ``i`` is
+    turned half round X (``pre_i Rx(pi)``) and the next frame compensates (``Rx(pi) pre_{i+1}``),
+    so that every axis turns by ``+q_i`` about its Z, as KUKA's external kinematics count.
+    """
+    out = [np.array(F, dtype=float) for F in frames]
+    for i, s in enumerate(signs):
+        if s < 0:
+            out[i] = out[i] @ _FLIP
+            out[i + 1] = _FLIP @ out[i + 1]
+    return out
 
 
 def _numbers(names: list[str], given: list[int | None]) -> list[int]:
@@ -152,6 +182,10 @@ def collect(cell: Cell, reference: Literal["world", "robot"]) -> ControllerData:
                              "robot; controller exports need it fixed in the world")
         data.turntable = Slot(cell.turntable.name, None,
                               T_ref_world @ cell.frame_pose("turntable", 0.0))
+        if isinstance(cell.turntable, Positioner):
+            pre, post = axis_frames(cell.turntable.chain)
+            data.positioner_frames = positive_z_frames(
+                [*pre, post], [j.sign for j in cell.turntable.chain.joints])
     nums = _numbers(list(cell.frames), [f.number for f in cell.frames.values()])
     for (name, fr), n in zip(cell.frames.items(), nums):
         if fr.parent == "turntable":
@@ -191,8 +225,9 @@ def parse_float(text: str, where: str) -> float:
 def flatten_table(data: ControllerData) -> list[Slot]:
     """Frames for controllers without frames on a turntable: everything as fixed user frames.
 
-    Frames on the turntable become their pose at table axis 0 in the reference frame, and the
-    turntable root B itself becomes one more frame (the next free number) named after the unit.
+    Frames on the turntable become their pose at table axis 0 in the reference frame (on a
+    positioner chain: at every axis 0, through its axis frames), and the turntable root B itself
+    becomes one more frame (the next free number) named after the unit.
 
     Parameters
     ----------
@@ -204,10 +239,11 @@ def flatten_table(data: ControllerData) -> list[Slot]:
         Fixed frames, sorted by number.
     """
     out = []
+    plate = np.linalg.multi_dot([np.eye(4), np.eye(4), *data.positioner_frames])
     for s in data.frames:
         if s.on_table:
             assert data.turntable is not None
-            out.append(Slot(s.name, s.number, data.turntable.pose @ s.pose))
+            out.append(Slot(s.name, s.number, data.turntable.pose @ plate @ s.pose))
         else:
             out.append(s)
     if data.turntable is not None:

@@ -14,6 +14,10 @@ Written (see ``docs/export.md`` for sources and the paste locations):
   (ROBROOT kinematic ``#ERSYS``), ``$ERSYSROOT`` (the unit's root in ``$WORLD``, +Z along the
   motion, as for every frame of KUKA external kinematics), ``$ET1_TA1KR`` (null frame) and
   ``$ET1_TFLA3`` (robot base on the carriage at E1 = 0).
+- For a positioner chain (``#EASYS`` with 1-3 axes, ``ET2`` next to a linear unit, else ``ET1``):
+  ``$ETk_TA1KR``, ``$ETk_TA2A1``, ``$ETk_TA3A2`` (each axis frame, +Z on the axis, in the
+  previous one at axis value 0; null frames for missing axes) and ``$ETk_TFLA3`` (the plate, the
+  kinematic's flange, in the last axis frame), after ``MACHINE_DEF[m].ROOT``.
 
 Poses: X, Y, Z in mm (6 decimals), A, B, C in degrees (9 decimals), ``R = Rz(A) Ry(B) Rx(C)``.
 """
@@ -42,6 +46,8 @@ __all__ = ["MACHINE_INDEX", "export", "format_data", "parse"]
 #: ``MACHINE_DEF`` index of the turntable (``MACHINE_DEF[1]`` is the robot).
 MACHINE_INDEX = 2
 _KEYS = ("X", "Y", "Z", "A", "B", "C")
+#: Frames of a KUKA external kinematic, root to flange.
+_ET_FRAMES = ("TA1KR", "TA2A1", "TA3A2", "TFLA3")
 
 
 def frame_text(T: np.ndarray) -> str:
@@ -98,6 +104,18 @@ def format_data(data: ControllerData, cell_name: str) -> str:
         if abs(data.track_scale - 1.0) > 1e-12:
             L.append(f"; track scale {data.track_scale:.9f}: E1 moves the robot by scale * E1; "
                      "correct the gear ratio of E1 in the machine data by this factor")
+    if data.positioner_frames and data.turntable is not None:
+        k = 2 if data.track_root is not None else 1
+        frames = data.positioner_frames
+        n = len(frames) - 1
+        null = np.eye(4)
+        chain = [*frames[:n], *[null] * (3 - n)]
+        L.append(f"; positioner {data.turntable.name}: external base kinematic "
+                 f"$EX_KIN={{ET{k} #EASYS,...}} with {n} axes; +Z on each axis")
+        L.append(f"; chain: MACHINE_DEF[{MACHINE_INDEX}].ROOT : $ET{k}_TA1KR : Rot(Z, axis 1) : "
+                 f"$ET{k}_TA2A1 : Rot(Z, axis 2) : $ET{k}_TA3A2 : Rot(Z, axis 3) : $ET{k}_TFLA3")
+        for key, T in zip(_ET_FRAMES, [*chain, frames[n]]):
+            L.append(f"$ET{k}_{key}={frame_text(T)}")
     for name in data.skipped:
         L.append(f"; frame {name!r} moves with the robot on the track: no KUKA base holds it")
     return "\n".join(L) + "\n"
@@ -115,8 +133,8 @@ _LINE_RE = {
     "name": re.compile(r'^\s*(TOOL_NAME|BASE_NAME)\[(\d+),\]\s*=\s*"([^"]*)"', re.IGNORECASE),
     "machine": re.compile(r'^\s*MACHINE_DEF\[(\d+)\]\s*=\s*\{\s*NAME\[\]\s*"([^"]*)".*?ROOT\s*'
                           + _FRAME_RE + r".*?MECH_TYPE\s*#(\w+)", re.IGNORECASE),
-    "var": re.compile(r"^\s*\$(ROBROOT|ERSYSROOT|ET1_TA1KR|ET1_TFLA3)\s*=\s*" + _FRAME_RE,
-                      re.IGNORECASE),
+    "var": re.compile(r"^\s*\$(ROBROOT|ERSYSROOT|ET\d_TA1KR|ET\d_TA2A1|ET\d_TA3A2|ET\d_TFLA3)"
+                      r"\s*=\s*" + _FRAME_RE, re.IGNORECASE),
 }
 
 
@@ -179,4 +197,7 @@ def parse(text: str) -> ControllerData:
     if "ERSYSROOT" in ersys:
         data.track_root = Slot("track", None, ersys["ERSYSROOT"] @ ersys.get("ET1_TA1KR", np.eye(4)))
         data.track_robot = Slot("track", None, ersys.get("ET1_TFLA3", np.eye(4)))
+    k = 2 if "ERSYSROOT" in ersys else 1
+    if f"ET{k}_TFLA3" in ersys:
+        data.positioner_frames = [ersys.get(f"ET{k}_{key}", np.eye(4)) for key in _ET_FRAMES]
     return data

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.fileio import atomic_write
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.report import _CSS, _SCRIPT, _fmt, _png
@@ -91,7 +92,7 @@ def write_identification_report(
     ----------
     result : IdentificationResult
     path : str or Path
-        The HTML file to write; nothing else is written.
+        The HTML file to write (atomically; a missing folder is created); nothing else is written.
     cross_validation : CrossValidation, optional
         Held-out errors (:func:`~robotcell.identification.cross_validate`).
     observability : (float, ndarray), optional
@@ -172,5 +173,5 @@ def write_identification_report(
 <h2>Errors per row (mm)</h2>{per_row}
 </body></html>
 """
-    out.write_text(page, encoding="utf-8")
+    atomic_write(out, page)
     return out

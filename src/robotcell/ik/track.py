@@ -157,13 +157,7 @@ class TrackRobot:
         -------
         TrackChoice
         """
-        if not (math.isfinite(self.lower) and math.isfinite(self.upper)):
-            raise InputError("choosing the track value needs finite track limits (lower, upper)")
-        if self.arm.n_joints != 6:
-            raise InputError(f"choosing the track value needs a six-axis arm; {self.arm.name} has "
-                             f"{self.arm.n_joints} axes: give the track value (ik_at)")
-        if samples < 3:
-            raise InputError(f"samples must be at least 3, got {samples}")
+        self.check_choice(samples)
         arr = validate_pose(T, "target pose")
         batch = arr.shape[:-2]
         flat = arr.reshape(-1, 1, 4, 4)
@@ -174,6 +168,16 @@ class TrackRobot:
         x, score = self._best(flat, fine, tool)
         sol = self.ik_at(arr, x.reshape(batch), tool)
         return TrackChoice(sol, x.reshape(batch), score.reshape(batch))
+
+    def check_choice(self, samples: int) -> None:
+        """Refuse to choose the track value without finite limits or with fewer than 3 samples."""
+        if not (math.isfinite(self.lower) and math.isfinite(self.upper)):
+            raise InputError("choosing the track value needs finite track limits (lower, upper)")
+        if self.arm.n_joints != 6:
+            raise InputError(f"choosing the track value needs a six-axis arm; {self.arm.name} has "
+                             f"{self.arm.n_joints} axes: give the track value (ik_at)")
+        if samples < 3:
+            raise InputError(f"samples must be at least 3, got {samples}")
 
     def _best(self, T: NDArray[np.float64], grid: NDArray[np.float64],
               tool: ArrayLike | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

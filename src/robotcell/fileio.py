@@ -1,0 +1,223 @@
+"""Reading text files as people have them, and writing output files atomically.
+
+**Reading.** Every text file robotcell reads (measurement CSV, cell file, robot model file) goes
+through :func:`read_text`, with one rule for the encoding:
+
+1. A UTF-8 byte-order mark (what spreadsheet programs write with "CSV UTF-8") is dropped, and the
+   text is decoded as UTF-8.
+2. Anything else that is not valid UTF-8 is decoded as Windows-1252 (the "ANSI" code page of
+   Western-European Windows, a superset of Latin-1's printable characters); the five bytes that
+   Windows-1252 leaves undefined are read as Latin-1. A note column with ``Öffnung`` or ``pièce``
+   saved by an older spreadsheet is therefore read, not refused; numbers are ASCII in every one
+   of these encodings, so they are never changed by the choice.
+
+A file holding NUL characters is not text, and a UTF-16 file (its byte-order mark; what "Unicode
+text" saves) is not read: both are refused with :class:`~robotcell.errors.InputError`.
+
+**Writing.** :func:`atomic_write` writes a temporary file in the destination's folder, flushes and
+fsyncs it, gives it the permissions of the file it replaces (or the usual ones of a new file,
+``0o666`` less the umask), then moves it over the destination with ``os.replace``. A file without
+write permission for its owner is refused, not replaced. A run that
+fails before the write leaves nothing behind, and one that dies during it leaves the old file or
+the new one in full, never a partial or empty file. A missing folder, or a destination that is a
+folder, is refused with :class:`~robotcell.errors.InputError` naming it.
+"""
+
+from __future__ import annotations
+
+import codecs
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import BinaryIO
+
+from robotcell.errors import InputError
+
+__all__ = ["atomic_copy", "atomic_write", "check_destination", "decode_text", "read_text"]
+
+
+def _as_latin1(exc: UnicodeError) -> tuple[str, int]:
+    """Codec error handler: a byte that Windows-1252 leaves undefined, read as Latin-1."""
+    if not isinstance(exc, UnicodeDecodeError):
+        raise exc
+    return exc.object[exc.start:exc.end].decode("latin-1"), exc.end
+
+
+_LATIN1_FALLBACK = "robotcell-latin1"
+codecs.register_error(_LATIN1_FALLBACK, _as_latin1)
+
+
+def decode_text(data: bytes, origin: str) -> str:
+    """Decode the bytes of a text file by the rule of this module.
+
+    Parameters
+    ----------
+    data : bytes
+        Content of the file.
+    origin : str
+        Name of the file, for messages.
+
+    Returns
+    -------
+    str
+        The text, without a byte-order mark.
+
+    Raises
+    ------
+    InputError
+        Binary content (NUL characters), or UTF-16 text.
+    """
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        raise InputError(f"{origin}: not a text file robotcell reads (it starts with a UTF-16 "
+                         "mark, as 'Unicode text' is saved); save it as UTF-8 (\"CSV UTF-8\")")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = data.decode("cp1252", errors=_LATIN1_FALLBACK)
+    if "\x00" in text:
+        raise InputError(f"{origin}: not a text file (it holds NUL characters); give the text "
+                         "file (CSV, YAML, URDF, JSON), saved as UTF-8")
+    return text
+
+
+def read_text(path: str | Path, what: str = "file") -> str:
+    """Read a text file by the encoding rule of this module.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    what : str
+        What the file is, for the message when it does not exist (``"cell file"``).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    InputError
+        Missing or unreadable file, or binary content.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{what} {str(path)!r} does not exist"
+                         + (" (it is a folder)" if p.is_dir() else ""))
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+    return decode_text(data, str(path))
+
+
+def check_destination(path: str | Path) -> Path:
+    """``path`` as a Path whose folder exists and which is neither a folder nor read-only.
+
+    A file without write permission for its owner is refused: ``os.replace`` would go over it,
+    so the owner's protection is respected instead.
+
+    Raises
+    ------
+    InputError
+        ``path`` is a folder or a read-only file, or its folder does not exist.
+    """
+    p = Path(path)
+    if str(path) == "" or p.is_dir():
+        raise InputError(f"cannot write {str(path)!r}: it is a folder; give a file name")
+    folder = p.parent
+    if not folder.is_dir():
+        raise InputError(f"cannot write {path}: the folder {str(folder)!r} does not exist; "
+                         "create it first")
+    if p.exists() and not p.stat().st_mode & 0o200:
+        raise InputError(f"cannot write {path}: the file is read-only (mode "
+                         f"{p.stat().st_mode & 0o777:o}); make it writable or write to another "
+                         "file")
+    return p
+
+
+def _new_file_mode() -> int:
+    """Permissions of a newly created file: ``0o666`` less the process umask."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:  # platforms without directory handles
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _atomic(dst: Path, write: Callable[[BinaryIO], object], mode: int, what: str) -> None:
+    """Write ``dst`` through a temporary file in its folder, then ``os.replace`` it over ``dst``."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
+    except OSError as exc:
+        raise InputError(f"{what}: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, dst)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"{what}: {exc.strerror or exc}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    _fsync_dir(dst.parent)
+
+
+def atomic_write(path: str | Path, content: str | bytes) -> None:
+    """Write ``content`` to ``path`` atomically, keeping the permissions of the file replaced.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination file; its folder must exist.
+    content : str or bytes
+        Text (written as UTF-8, newlines as given) or bytes.
+
+    Raises
+    ------
+    InputError
+        The folder does not exist, ``path`` is a folder or a read-only file, or the file cannot
+        be written (the message names the file and the system's reason).
+    """
+    p = check_destination(path)
+    data = content.encode("utf-8") if isinstance(content, str) else content
+    mode = (p.stat().st_mode & 0o7777) if p.exists() else _new_file_mode()
+    _atomic(p, lambda fh: fh.write(data), mode, f"cannot write {path}")
+
+
+def atomic_copy(src: str | Path, dst: str | Path) -> None:
+    """Copy ``src`` to ``dst`` atomically; ``dst`` gets the permissions of ``src``.
+
+    Raises
+    ------
+    InputError
+        ``src`` cannot be read or ``dst`` cannot be written.
+    """
+    s, d = Path(src), check_destination(dst)
+    what = f"cannot copy {src} to {dst}"
+    try:
+        mode = s.stat().st_mode & 0o7777
+    except OSError as exc:
+        raise InputError(f"{what}: {exc.strerror or exc}") from None
+
+    def copy(fh: BinaryIO) -> None:
+        with s.open("rb") as inp:
+            shutil.copyfileobj(inp, fh)
+
+    _atomic(d, copy, mode, what)

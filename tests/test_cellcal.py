@@ -1,0 +1,155 @@
+"""Calibrating into a cell from Python (``robotcell.cellcal``) and its CLI caller.
+
+The CLI's ``calibrate ... --cell`` and the library call on the same measurements write the same
+cell file, byte for byte, and print the same JSON result.
+"""
+
+import json
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from robotcell import cellcal
+from robotcell.cell import Cell, Frame, Provenance, cell_to_dict
+from robotcell.demo import demo_cells
+from robotcell.errors import InputError
+from robotcell.simulate import simulate
+from robotcell.tables import read_csv
+
+STAMP = "2026-01-02T03:04:05+00:00"
+
+
+@pytest.fixture
+def fixed_time(monkeypatch):
+    """Provenance.now stamps every calibration with the same time, so files compare byte-wise."""
+    def now(cls, source, rms_mm=None, note=""):
+        return cls(source=source, time=STAMP, rms_mm=rms_mm, note=note)
+
+    monkeypatch.setattr(Provenance, "now", classmethod(now))
+
+
+# procedure, CLI arguments besides the file, library keywords, simulation keywords
+STEPS = [
+    ("tcp", ["--name", "torch"], {"name": "torch"}, {"tool": "torch"}),
+    ("track", ["--tool", "torch"], {"tool": "torch"}, {"tool": "torch"}),
+    ("turntable", ["--tool", "torch"], {"tool": "torch"}, {"tool": "torch"}),
+    ("workpiece", ["--tool", "torch", "--name", "part"], {"tool": "torch", "name": "part"},
+     {"tool": "torch", "frame": "part"}),
+    ("frame", ["--tool", "torch", "--name", "fixture"], {"tool": "torch", "name": "fixture"},
+     {"tool": "torch", "frame": "fixture"}),
+]
+
+
+def test_cli_cell_results_equal_the_library_call_byte_for_byte(tmp_path, capsys, fixed_time):
+    truth, nominal = demo_cells()
+    truth.frames["fixture"] = Frame(np.array(truth.frames["part"].pose), parent="world", number=2)
+    nominal.update_frame("fixture", truth.frames["fixture"].pose, Provenance(), parent="world",
+                         number=2)
+    (tmp_path / "cli").mkdir()
+    (tmp_path / "lib").mkdir()
+    cli_file, lib_file = tmp_path / "cli" / "cell.yaml", tmp_path / "lib" / "cell.yaml"
+    nominal.save(cli_file)
+    nominal.save(lib_file)
+    rng = np.random.default_rng(5)
+    for procedure, args, lib_kw, sim_kw in STEPS:
+        touches = simulate(truth, procedure, noise=1e-4, seed=rng, **sim_kw)
+        csv = tmp_path / f"{procedure}.csv"
+        touches.write_csv(csv)
+        code, out, err = run(capsys, "calibrate", procedure, csv, "--cell", cli_file, "--json",
+                             *args, *touches.options)
+        assert code == 0, err
+        before = Cell.load(lib_file)
+        content = cell_to_dict(before)
+        call = getattr(cellcal, procedure)
+        got = call(before, read_csv(csv), source=str(csv),
+                   **lib_kw, **touches.keywords())
+        got.cell.save(lib_file)
+        assert cli_file.read_bytes() == lib_file.read_bytes(), procedure
+        assert json.loads(out) == got.result.to_json(), procedure
+        assert f"updated {cli_file}: {got.item}" in err
+        assert all(note in err for note in (n.replace("cell 'demo_kr16_track_turntable'",
+                                                       str(cli_file))
+                                            for n in got.notes + got.update_notes))
+        assert got.provenance.source == procedure and got.provenance.time == STAMP
+        # the cell given is not changed: the result is a new cell
+        assert got.cell is not before and cell_to_dict(before) == content
+        assert cell_to_dict(got.cell) != content
+    assert (tmp_path / "cli" / "cell.yaml.bak").read_bytes() == \
+        (tmp_path / "lib" / "cell.yaml.bak").read_bytes()
+
+
+def test_library_call_returns_a_new_cell_and_leaves_the_given_one(tmp_path):
+    truth, nominal = demo_cells()
+    touches = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch")
+    old = nominal.tools["torch"].T_F_TCP.copy()
+    got = cellcal.tcp(nominal, touches.to_table(), "torch", time=STAMP)
+    assert np.array_equal(nominal.tools["torch"].T_F_TCP, old)
+    assert nominal.tools["torch"].provenance.source == "nominal"
+    tool = got.cell.tools["torch"]
+    assert np.linalg.norm(tool.T_F_TCP[:3, 3] - truth.tools["torch"].T_F_TCP[:3, 3]) < 1e-3
+    assert tool.provenance == Provenance("tcp", STAMP, got.result.rms * 1e3,
+                                         f"{len(touches.q)} touches from measurements")
+    assert got.item == "tool 'torch'" and tool.number == 1 and tool.mass == 3.2
+
+
+def test_library_without_a_name_or_a_cell_writes_nothing():
+    truth, nominal = demo_cells()
+    touches = simulate(truth, "turntable", noise=1e-4, seed=3, tool="torch")
+    got = cellcal.turntable(nominal, touches.to_table(), tool="torch")
+    assert got.cell is not None and "T_world_B" in got.result.values
+    tcp = simulate(truth, "tcp", noise=1e-4, seed=3, tool="torch")
+    plain = cellcal.tcp(None, {k: v for k, v in tcp.to_table().items()}, robot=nominal.robot)
+    assert plain.cell is None and plain.item == "" and "T_F_TCP" in plain.result.values
+
+
+def test_workpiece_takes_the_turntable_result_and_propagates_its_uncertainty():
+    truth, nominal = demo_cells()
+    rng = np.random.default_rng(4)
+    tt = cellcal.turntable(nominal, simulate(truth, "turntable", noise=1e-4, seed=rng,
+                                             tool="torch").to_table(), tool="torch",
+                           height=-0.05)
+    wp_touches = simulate(truth, "workpiece", noise=1e-4, seed=rng, tool="torch", frame="part")
+    with_tt = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch",
+                                turntable=tt.result)
+    without = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch")
+    assert with_tt.notes == ()
+    assert "does not include the turntable's uncertainty" in without.notes[0]
+    s_with = np.linalg.norm(with_tt.result.sigma["T_B_W_position"])
+    s_without = np.linalg.norm(without.result.sigma["T_B_W_position"])
+    assert s_with > s_without
+    assert with_tt.cell.frames["part"].parent == "turntable"
+
+
+def test_library_errors_name_the_cause():
+    truth, nominal = demo_cells()
+    table = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch").to_table()
+    with pytest.raises(InputError, match=r"measurements: column 'track' \(track position of each "
+                                         r"touch\) needs --cell CELL.yaml \(in Python: a Cell\)"):
+        cellcal.frame(None, {**table, "track": np.ones(len(table["a1"])) * 1000,
+                             "point": ["origin"] * len(table["a1"])}, robot=nominal.robot)
+    with pytest.raises(InputError, match=r"give a cell or a robot, not both"):
+        cellcal.tcp(nominal, table, robot=nominal.robot)
+    n = len(table["a1"])
+    with pytest.raises(InputError, match=rf"the columns have different lengths \[1, {n}\]"):
+        cellcal.tcp(nominal, {**table, "point": ["tcp"]})
+    with pytest.raises(InputError, match=r"tool 'torch' names a tool of a cell, but no cell"):
+        cellcal.frame(None, table, tool="torch", robot=nominal.robot)
+    bare = Cell(robot=nominal.robot, robot_model="kuka_kr16")
+    with pytest.raises(InputError, match=r"cell 'cell' has no turntable; add a 'turntable'"):
+        cellcal.turntable(bare, table)
+    with pytest.raises(InputError, match=r"cell 'cell' has no track to calibrate"):
+        cellcal.track(bare, table, roll="zero")
+
+
+def test_notes_reach_on_note_before_a_refusal():
+    truth, nominal = demo_cells()
+    table = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch").to_table()
+    rows = [0, 0, 1]  # a copied line: two of the three orientations are the same
+    short = {k: (np.asarray(v)[rows] if isinstance(v, np.ndarray) else [v[i] for i in rows])
+             for k, v in table.items()}
+    seen = []
+    with pytest.raises(InputError, match=r"flange orientations of the touches are too similar"):
+        cellcal.tcp(nominal, short, "torch", on_note=seen.append)
+    assert len(seen) == 1 and seen[0].startswith("note: measurements: line 2, line 3 are "
+                                                 "identical")

@@ -1,0 +1,128 @@
+"""Reachability map: library and ``robotcell reach``."""
+
+import base64
+import csv
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from robotcell import InputError
+from robotcell.cell import Cell
+from robotcell.reach import LIMIT_REF, manipulability_scale, reach_map, read_targets
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
+CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
+SEAM = EXAMPLES / "seam_part.csv"
+
+
+def test_reach_map_of_the_example_seam_reproduces_every_target():
+    cell = Cell.load(CELL)
+    T, table = read_targets(SEAM)
+    rm = reach_map(cell, T, frame="part", tool="torch", table=table)
+    assert rm.reachable.all()
+    back = cell.fk(rm.q, track=rm.track, table=rm.table, tool="torch", frame="part")
+    assert np.allclose(back, T, atol=1e-9)
+    assert np.all(cell.robot.within_limits(rm.q))
+    assert np.all((rm.track >= cell.track.lower) & (rm.track <= cell.track.upper))
+    assert np.allclose(rm.track_margin, np.minimum(rm.track - cell.track.lower,
+                                                   cell.track.upper - rm.track))
+    gap = np.minimum(rm.q - cell.robot.lower, cell.robot.upper - rm.q).min(axis=1)
+    assert np.allclose(rm.limit_margin, gap)
+    det = np.abs(np.linalg.det(cell.robot.jacobian(rm.q, tool=cell.tools["torch"].T_F_TCP)))
+    assert np.allclose(rm.manipulability, det)
+    expect = (np.minimum(1, det / manipulability_scale(cell.robot))
+              * np.minimum(1, gap / LIMIT_REF))
+    assert np.allclose(rm.score, expect)
+    assert np.all((rm.score > 0) & (rm.score <= 1))
+
+
+def test_unreachable_targets_score_zero_and_have_no_axis_values():
+    cell = Cell.load(CELL)
+    T = np.tile(np.eye(4), (3, 1, 1))
+    T[:, :3, 3] = [[3.0, 0.0, 1.2], [3.0, 9.0, 1.0], [50.0, 0.0, 1.0]]  # reachable, beside, beyond
+    rm = reach_map(cell, T, tool="torch")
+    assert rm.reachable.tolist() == [True, False, False]
+    assert np.all(np.isnan(rm.q[1:])) and np.all(rm.score[1:] == 0)
+    assert rm.branch[1] == -1 and np.isnan(rm.track[1])
+    assert rm.fraction == pytest.approx(1 / 3)
+    # at a given track position only that one is tried
+    rm = reach_map(cell, T[:1], tool="torch", track=0.0)
+    assert not rm.reachable[0] and rm.track[0] == 0.0
+
+
+def test_cli_writes_csv_and_a_self_contained_html_map(capsys, tmp_path):
+    out = tmp_path / "reach.csv"
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--tool",
+                       "torch", "-o", out)
+    assert code == 0, err
+    assert "36 of 36 targets reachable" in err
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 36 and rows[0]["reachable"] == "1.000000"
+    cell = Cell.load(CELL)
+    T, table = read_targets(SEAM)
+    rm = reach_map(cell, T, frame="part", tool="torch", table=table)
+    assert float(rows[5]["track_mm"]) == pytest.approx(rm.track[5] * 1e3, abs=1e-6)
+    assert float(rows[5]["a2_deg"]) == pytest.approx(math.degrees(rm.q[5, 1]), abs=1e-6)
+    assert float(rows[5]["table_deg"]) == pytest.approx(math.degrees(table[5]), abs=1e-6)
+    page = (tmp_path / "reach.html").read_text()
+    assert "36 of 36 targets reachable" in page and "<img" in page
+    png = base64.b64decode(re.search(r'data:image/png;base64,([^"]+)"', page).group(1))
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def test_cli_errors(capsys, tmp_path):
+    bad = tmp_path / "t.csv"
+    bad.write_text("x,y,z\n1,2,3\n")
+    code, _, err = run(capsys, "reach", "--cell", CELL, bad)
+    assert code == 2 and "missing column(s) a, b, c" in err
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "robot")
+    assert code == 2 and "moves with the track" in err
+    with pytest.raises(InputError, match="unknown frame"):
+        reach_map(Cell.load(CELL), np.eye(4)[None], frame="nowhere")
+
+
+def test_chosen_table_angle_reaches_and_scores_at_least_as_well_as_zero(capsys, tmp_path):
+    cell = Cell.load(CELL)
+    rng = np.random.default_rng(5)
+    q = rng.uniform(cell.robot.lower, cell.robot.upper, (40, 6)) * 0.7
+    T = cell.fk(q, track=rng.uniform(1.5, 4.5, 40), table=rng.uniform(-3, 3, 40), tool="torch",
+                frame="part")
+    chosen = reach_map(cell, T, frame="part", tool="torch", table=None)
+    at_zero = reach_map(cell, T, frame="part", tool="torch", table=0.0)
+    assert chosen.reachable.sum() > at_zero.reachable.sum()
+    assert np.all(chosen.score >= at_zero.score - 1e-12)  # 0 is one of the candidate angles
+    ok = chosen.reachable
+    back = cell.fk(chosen.q[ok], track=chosen.track[ok], table=chosen.table[ok], tool="torch",
+                   frame="part")
+    assert np.allclose(back, T[ok], atol=1e-9)
+    deg = np.degrees(chosen.table)
+    assert np.allclose(np.round(deg / 10) * 10, deg, atol=1e-9)  # one of the 36 candidates
+    with pytest.raises(InputError, match="needs a turntable"):
+        reach_map(Cell(robot=cell.robot, robot_model="kuka_kr16"), T[:1], table=None)
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part",
+                       "--choose-table")
+    assert code == 2 and "leave it out to --choose-table" in err
+
+
+def test_progress_in_blocks_gives_the_same_map(capsys, tmp_path, monkeypatch):
+    import robotcell.cli.progress as cli_progress
+    from robotcell import reach
+
+    cell = Cell.load(CELL)
+    T, table = read_targets(SEAM)
+    whole = reach_map(cell, T, frame="part", tool="torch", table=table)
+    monkeypatch.setattr(reach, "BLOCK", 10)
+    calls = []
+    blocks = reach_map(cell, T, frame="part", tool="torch", table=table,
+                       progress=lambda d, n: calls.append((d, n)))
+    assert calls == [(10, 36), (20, 36), (30, 36), (36, 36)]
+    for name in ("reachable", "q", "track", "table", "score", "branch"):
+        assert np.array_equal(getattr(blocks, name), getattr(whole, name), equal_nan=True)
+    monkeypatch.setattr(cli_progress, "PROGRESS_AFTER", 0.0)
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--tool",
+                       "torch", "-o", tmp_path / "r.csv")
+    assert code == 0 and err.startswith("targets")  # the bar (plain text off a terminal)
