@@ -33,6 +33,14 @@ def kr16_truth():
     return nominal, ch, x, rng
 
 
+def tracker_csv(kr16_truth, tmp_path, n):
+    """``n`` simulated rows of the KR 16 truth written as the CLI's CSV; (measurements, path)."""
+    nominal, ch, x, rng = kr16_truth
+    meas = measure(ch, x, configurations(nominal, n, rng), rng, NOISE)
+    write_csv(tmp_path / "tracker.csv", meas)
+    return meas, tmp_path / "tracker.csv"
+
+
 def test_identify_json_and_model_file(kr16_truth, tmp_path, capsys):
     nominal, ch, x, rng = kr16_truth
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
@@ -182,10 +190,7 @@ def test_identify_positioner_with_quaternions(tmp_path, capsys):
 
 
 def test_identified_model_file_in_fk_and_ik(kr16_truth, tmp_path, capsys):
-    nominal, ch, x, rng = kr16_truth
-    meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
-    csv = tmp_path / "tracker.csv"
-    write_csv(csv, meas)
+    _, csv = tracker_csv(kr16_truth, tmp_path, 40)
     out = tmp_path / "kr16_identified.yaml"
     code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out, "--accuracy", "0.02")
     assert code == 0, stderr
@@ -244,10 +249,8 @@ def test_propose_refusals(args, message, capsys):
 
 @pytest.mark.parametrize("vendor,unit,scale", [("kuka", "deg", 180 / math.pi), ("abb", "rad", 1.0)])
 def test_joint_offsets_for_controllers(kr16_truth, tmp_path, capsys, vendor, unit, scale):
-    nominal, ch, x, rng = kr16_truth
-    meas = measure(ch, x, configurations(nominal, 50, rng), rng, NOISE)
-    csv = tmp_path / "tracker.csv"
-    write_csv(csv, meas)
+    nominal, ch, x, _ = kr16_truth
+    _, csv = tracker_csv(kr16_truth, tmp_path, 50)
     code, stdout, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--accuracy", "0.02",
                                "--json", "--offsets-for", vendor)
     assert code == 0, stderr
