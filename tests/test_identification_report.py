@@ -69,3 +69,22 @@ def test_report_renders_in_headless_chromium(report_page, tmp_path, capsys):
     banner = [0xD8, 0xF3, 0xDC] if 'verdict good' in made.read_text() else [0xFF, 0xF3, 0xBF]
     colour = np.all(np.abs(img - np.array(banner) / 255) < 0.02, axis=-1).sum()
     assert blue > 300 and colour > 5000
+
+
+def test_report_of_pose_measurements_and_a_coupling(tmp_path, capsys):
+    # The real UR10 set (6D probe): orientation errors in the page; a stated J2/J3 factor on a
+    # synthetic arm: the check with and without it.
+    data = Path(__file__).resolve().parents[1] / "examples" / "identification"
+    page = tmp_path / "ur10.html"
+    code, _, stderr = run(capsys, "identify", data / "ipa_ur10_random_poses.csv", "--robot",
+                          data / "ur10_cb3.yaml", "--accuracy", "0.5", "--folds", "3", "--report", page)
+    assert code == 0, stderr
+    assert "orientation mean (deg)" in page.read_text()
+    rng = np.random.default_rng(23)
+    nominal = load_robot("kuka_kr16")
+    ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng, coupling=-1.0)
+    write_csv(tmp_path / "f.csv", measure(ch, x, configurations(nominal, 40, rng), rng, NOISE))
+    code, _, stderr = run(capsys, "identify", tmp_path / "f.csv", "--robot", "kuka_kr16", "--j23-factor",
+                          "-1", "--accuracy", "0.02", "--folds", "3", "--report", tmp_path / "f.html")
+    assert code == 0, stderr
+    assert "J2/J3 coupling</h2><p>k = -1:" in (tmp_path / "f.html").read_text()

@@ -1,7 +1,8 @@
 """HTML report of a kinematic identification: one self-contained page, figures embedded.
 
 The page (``robotcell identify ... --report FILE.html``) shows the verdict, the position error of
-the nominal and the identified model (mean, RMS, max; per row and as a histogram), the K-fold
+the nominal and the identified model (mean, RMS, max; per row and as a histogram; the orientation
+error with pose measurements; the J2/J3 check with a stated coupling), the K-fold
 cross-validated error, the parameters held and why, every parameter with its 1-sigma and the
 largest correlations, and the observability index O1 of the measured configurations against
 random ones. Figures are PNG ``data:`` URIs made with the helpers of :mod:`robotcell.report`
@@ -114,6 +115,16 @@ def write_identification_report(
     errors = _table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
                     [["nominal (base and targets fitted)", *_stats(all0)],
                      ["identified", *_stats(all1)]])
+    if result.rotation_residuals is not None:
+        r0 = np.degrees(np.linalg.norm(result.rotation_residuals_before, axis=-1))
+        r1 = np.degrees(np.linalg.norm(result.rotation_residuals, axis=-1))
+        errors += _table(["model", "orientation mean (deg)", "RMS (deg)", "max (deg)"],
+                         [["nominal (base and target fitted)", *_stats(r0)], ["identified", *_stats(r1)]])
+    extra = ""
+    if result.coupling_check:
+        c = result.coupling_check
+        extra = (f"<h2>J2/J3 coupling</h2><p>k = {c['k']:g}: RMS {c['rms_with_mm']:.4f} mm with it, "
+                 f"{c['rms_without_mm']:.4f} mm without; {html.escape(c['verdict'])}.</p>")
     fig_fit = _figure_errors(e0, e1, "Position error on the measured rows (largest target per row)")
     per_row = _table(["row", "nominal (mm)", "identified (mm)", "outlier"],
                      [[lab, float(a), float(b), "yes" if i in result.outliers else ""]
@@ -164,7 +175,7 @@ def write_identification_report(
 <h2>Position error before and after identification</h2>{errors}
 <p>Condition number {result.condition:.1f}, redundancy {result.dof}, variance factor
 {result.variance_factor:.3f} (1 when the stated accuracy is right).</p>
-<figure><img src="{fig_fit}" alt="errors before and after"></figure>
+<figure><img src="{fig_fit}" alt="errors before and after"></figure>{extra}
 <h2>Cross-validation</h2>{cv_html}
 <h2>Parameters held at their nominal value, and why</h2>{fixed}
 <h2>Parameters (mm, deg) with 1-sigma</h2>{params}
