@@ -17,8 +17,8 @@ from identification_helpers import (
 
 from robotcell import load_robot, save_robot
 from robotcell.identification import Measurements
-from robotcell.robot import Joint, Robot
-from robotcell.transforms import make_pose, rot_y
+from robotcell.kinematics.robot import Joint, Robot
+from robotcell.kinematics.transforms import make_pose, rot_y
 
 NOISE = 0.02e-3
 

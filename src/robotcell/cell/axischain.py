@@ -1,4 +1,4 @@
-"""Kinematics of a chain of joint axes given as a DH :class:`~robotcell.robot.Robot`.
+"""Kinematics of a chain of joint axes given as a DH :class:`~robotcell.kinematics.robot.Robot`.
 
 Two things the exports and the positioner need beyond the chain's FK:
 
@@ -17,10 +17,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.dh import link_transform
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
-from robotcell.robot import Robot
+from robotcell.kinematics.dh import link_transform
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["axis_frames", "normal_up"]
 

@@ -6,7 +6,7 @@ becomes a target of the arm with
 
     T_world_TCP = T_world_X(e, theta) T_X_TCP,      T_R_TCP = T_world_R(e)^-1 T_world_TCP,
 
-(:mod:`robotcell.coupled` for ``T_world_X``). The track position ``e`` is given, or chosen: the
+(:mod:`robotcell.cell.kinematics` for ``T_world_X``). The track position ``e`` is given, or chosen: the
 value within the track limits where the arm reaches the target with the largest manipulability
 (:func:`choose_track_value`: closed form for an ortho-parallel arm, see
 :mod:`robotcell.ik.trackchoice`). Then every analytic branch of the arm is returned.
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.coupled import (
+from robotcell.cell.kinematics import (
     RESERVED_FRAMES,
     broadcast_table,
     frame_pose,
@@ -40,14 +40,14 @@ from robotcell.coupled import (
     table_values,
     tool_pose,
 )
-from robotcell.coupled import CellModel as Cell  # what is read of a robotcell.cell.Cell
+from robotcell.cell.kinematics import CellModel as Cell  # what is read of a robotcell.cell.Cell
 from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.track import TrackChoice, TrackRobot
 from robotcell.ik.trackchoice import choose_track, scan_track
-from robotcell.robot import Robot
-from robotcell.transforms import finite_array, invert, validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import finite_array, invert, validate_pose
 
 __all__ = ["CellIKSolutions", "CellPath", "PathBreak", "PathSplit", "choose_track_value",
            "depends_on_track", "ik", "ik_path", "split_path"]
@@ -134,7 +134,7 @@ def depends_on_track(cell: Cell, frame: str) -> bool:
     ----------
     cell : Cell
     frame : str
-        A frame name accepted by :func:`robotcell.coupled.frame_pose`.
+        A frame name accepted by :func:`robotcell.cell.kinematics.frame_pose`.
 
     Returns
     -------

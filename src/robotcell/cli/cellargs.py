@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from robotcell.cell import Cell, Track, Turntable
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
-from robotcell.poseformats import pose_from_vendor
+from robotcell.io.poseformats import pose_from_vendor
 
 __all__ = ["PROGRESS_MIN", "cell_tool", "chunks", "row_values", "table_angles", "track_values"]
 

@@ -13,7 +13,7 @@ from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
 from robotcell.identification.validation import cross_validate
-from robotcell.modelfile import load_robot, save_robot
+from robotcell.kinematics.models import load_robot, save_robot
 
 
 @click.command()

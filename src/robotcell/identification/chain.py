@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.robot import Robot
-from robotcell.transforms import make_pose, rot_x, rot_y, rot_z
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import make_pose, rot_x, rot_y, rot_z
 
 __all__ = ["PARALLEL_TOL", "Chain", "Op"]
 

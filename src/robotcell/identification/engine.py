@@ -37,7 +37,7 @@ from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import Chain
 from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult, Parameter
-from robotcell.robot import Robot
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["identify", "identify_with_coupling"]
 

@@ -14,8 +14,8 @@ from numpy.typing import ArrayLike
 
 from robotcell.ik import solve, solve_numeric
 from robotcell.ik.result import IKSolutions
-from robotcell.robot import Robot
-from robotcell.transforms import validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["solve_identified"]
 

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
-from robotcell.transforms import validate_pose
+from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["FORMATS", "PoseFormat", "pose_from_vendor", "pose_to_vendor"]
 

@@ -17,7 +17,7 @@ from typing import TextIO
 import numpy as np
 
 from robotcell.errors import InputError
-from robotcell.fileio import atomic_write, read_text
+from robotcell.io.fileio import atomic_write, read_text
 
 __all__ = ["MAX_ABS_VALUE", "NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
            "write_csv"]
@@ -38,7 +38,7 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     strings. Column names are lower-cased and stripped. Files as spreadsheets save them are
     read:
 
-    - the encoding follows :func:`robotcell.fileio.read_text` (UTF-8 with or without a
+    - the encoding follows :func:`robotcell.io.fileio.read_text` (UTF-8 with or without a
       byte-order mark; otherwise Windows-1252 / Latin-1);
     - the separator is ``,``, or ``;`` when the header line holds semicolons and no comma (the
       "CSV" of a spreadsheet in a European locale). In a semicolon-separated file a number may
@@ -175,7 +175,7 @@ def write_csv(path: str | Path | TextIO, header: Sequence[str], rows: np.ndarray
               decimals: int = 6) -> None:
     """Write an ``(N, len(header))`` array as CSV with fixed decimals to a path or open stream.
 
-    A path is written atomically (:func:`robotcell.fileio.atomic_write`): a failed run leaves
+    A path is written atomically (:func:`robotcell.io.fileio.atomic_write`): a failed run leaves
     the file as it was.
     """
     if hasattr(path, "write"):

@@ -24,11 +24,11 @@ from typing import Any
 import numpy as np
 import yaml
 
-from robotcell.coupling import Coupling
 from robotcell.errors import InputError
-from robotcell.fileio import atomic_write, read_text
-from robotcell.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.robot import Joint, Robot
+from robotcell.io.fileio import atomic_write, read_text
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.robot import Joint, Robot
 
 __all__ = ["list_robots", "load_robot", "robot_from_dict", "robot_to_dict", "save_robot"]
 

@@ -3,7 +3,7 @@
 ``T_R_TCP(q) = T_R_0 · T_0_1(q_1) ··· T_{n-1,n}(q_n) · T_n_F · T_F_TCP`` with the base transform
 ``T_R_0``, the DH chain, the flange transform ``T_n_F`` and the tool ``T_F_TCP``. Joint values are
 controller axis values (see ``docs/conventions.md``): the DH variable is ``sign * q + offset``.
-A robot with a :class:`~robotcell.coupling.Coupling` (parallel linkage, passive joints) maps its
+A robot with a :class:`~robotcell.kinematics.coupling.Coupling` (parallel linkage, passive joints) maps its
 controller values to the chain's joint values first, ``q_model = C q + offset``; every method
 takes and returns controller values.
 """
@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.coupling import Coupling
-from robotcell.dh import Chain, Convention
 from robotcell.errors import InputError
-from robotcell.transforms import validate_pose
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.dh import Chain, Convention
+from robotcell.kinematics.transforms import validate_pose
 
 if TYPE_CHECKING:
     from robotcell.ik.result import IKSolutions

@@ -9,7 +9,7 @@ from its layout position, a workpiece clamped off its nominal place. The demo
 1. writes the nominal cell file and simulates every touch-up procedure in the true cell
    (joint values within every limit, touch-up error ``noise``);
 2. calibrates the cell in order, each step with the cell as calibrated so far, by the library
-   calls of :mod:`robotcell.cellcal` that the commands a technician types (``robotcell calibrate
+   calls of :mod:`robotcell.cell.calibrate` that the commands a technician types (``robotcell calibrate
    tcp``, ``track``, ``turntable``, ``workpiece`` with ``--cell``) make, printing each command;
    the library never drives the command line, which keeps the import direction cli -> library;
 3. compares every calibrated value with the truth, in units of its reported 1-sigma;
@@ -31,15 +31,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell import cellcal
 from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
+from robotcell.cell import calibrate as cellcal
 from robotcell.errors import InputError, RobotcellError
-from robotcell.export import EXPORT_FORMATS, export_cell
-from robotcell.modelfile import load_robot
-from robotcell.plan import pose_error
-from robotcell.poseformats import pose_from_vendor
-from robotcell.simulate import simulate
-from robotcell.tables import read_csv
+from robotcell.io.export import EXPORT_FORMATS, export_cell
+from robotcell.io.poseformats import pose_from_vendor
+from robotcell.io.tables import read_csv
+from robotcell.kinematics.models import load_robot
+from robotcell.studies.plan import pose_error
+from robotcell.studies.simulate import simulate
 
 __all__ = ["DEMO_NOISE", "Comparison", "demo_cells", "run_demo"]
 
@@ -230,8 +230,8 @@ def _compare(calibrated: Cell, truth: Cell,
 
 
 def _comparison_table(rows: list[Comparison]) -> str:
-    from robotcell.poseformats import pose_to_vendor
-    from robotcell.tables import format_table
+    from robotcell.io.poseformats import pose_to_vendor
+    from robotcell.io.tables import format_table
 
     body = []
     for c in rows:

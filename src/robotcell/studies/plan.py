@@ -31,9 +31,9 @@ from robotcell.calibration.track import calibrate_track
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.calibration.workpiece import calibrate_workpiece
 from robotcell.cell import Cell
-from robotcell.coupled import robot_pose, tool_pose
+from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.errors import InputError, RobotcellError
-from robotcell.simulate import Touches, check_counts, simulate
+from robotcell.studies.simulate import Touches, check_counts, simulate
 
 __all__ = ["DESIGNS", "LEVER", "Candidate", "MonteCarlo", "Plan", "calibrate_touches",
            "plan", "pose_error", "predicted_sigma"]
@@ -44,7 +44,7 @@ Progress = Callable[[Sized, str], Iterable[Any]]
 #: Distance from the frame origin at which rotation uncertainty is weighed against position (m).
 LEVER = 0.5
 
-#: Candidate designs per procedure: keyword arguments of :func:`robotcell.simulate.simulate`
+#: Candidate designs per procedure: keyword arguments of :func:`robotcell.studies.simulate.simulate`
 #: (SI units); the number of touches stays as the user asks.
 DESIGNS: dict[str, list[dict[str, Any]]] = {
     "tcp": [{"tilt": math.radians(t)} for t in (10, 20, 30, 40, 50, 60)],
@@ -252,7 +252,7 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
     designs : list of dict, optional
         Candidate designs instead of :data:`DESIGNS`.
     **common
-        Keywords of :func:`robotcell.simulate.simulate` fixed for every candidate (``tool``,
+        Keywords of :func:`robotcell.studies.simulate.simulate` fixed for every candidate (``tool``,
         ``frame``, ``track``, ``touches``, ``repeats``, ``references``, ``height``, ...).
 
     Returns

@@ -2,7 +2,7 @@
 far from its joint limits and from singular configurations.
 
 Every target ``T_X_TCP`` (in a frame X of the cell, at a table angle) is solved by
-:func:`robotcell.cellik.ik`, which chooses the track position when the cell has a track and none
+:func:`robotcell.cell.ik.ik`, which chooses the track position when the cell has a track and none
 is given. Among the valid arm configurations the one with the best score is kept. Per target:
 
 - ``limit_margin``: the smallest distance of any arm axis to its limits (rad; m for a prismatic
@@ -35,14 +35,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.cellik import ik
-from robotcell.coupled import tool_pose
+from robotcell.cell.ik import ik
+from robotcell.cell.kinematics import tool_pose
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.trackchoice import arm_manipulability
-from robotcell.poseformats import FORMATS, pose_from_vendor
-from robotcell.robot import Robot
-from robotcell.tables import read_csv, require_columns
+from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.tables import read_csv, require_columns
+from robotcell.kinematics.robot import Robot
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
@@ -151,7 +151,7 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
     T : array_like, shape (N, 4, 4)
         Targets ``T_X_TCP`` in frame ``frame`` (m).
     frame : str
-        Frame of the targets (see :func:`robotcell.coupled.frame_pose`).
+        Frame of the targets (see :func:`robotcell.cell.kinematics.frame_pose`).
     tool : str or array_like of shape (4, 4), optional
         A tool of the cell by name, or ``T_F_TCP`` (m).
     table : array_like of shape (N,) or (), or None
@@ -159,7 +159,7 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
         spread over one turn (or over the table's limits when they span less), the one where
         the target gets the best score.
     track : array_like, shape (N,) or (), optional
-        Track positions (m); default: chosen per target (:func:`robotcell.cellik.ik`).
+        Track positions (m); default: chosen per target (:func:`robotcell.cell.ik.ik`).
     table_samples : int
         Candidate table angles when ``table`` is None (10 deg apart by default).
     progress : callable, optional
@@ -304,7 +304,7 @@ def read_targets(path: str | Path, fmt: str = "kuka"
     ----------
     path : str or Path
     fmt : str
-        A pose format of :data:`robotcell.poseformats.FORMATS` (``kuka``: ``x,y,z,a,b,c``).
+        A pose format of :data:`robotcell.io.poseformats.FORMATS` (``kuka``: ``x,y,z,a,b,c``).
 
     Returns
     -------

@@ -30,12 +30,12 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.cell import Cell, Turntable
-from robotcell.coupled import frame_pose, robot_pose, tool_pose
+from robotcell.cell.kinematics import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
-from robotcell.fileio import atomic_write
 from robotcell.ik import analytic_solver, arm_sides
-from robotcell.robot import Robot
-from robotcell.transforms import invert, make_pose, rot_z, transform_points
+from robotcell.io.fileio import atomic_write
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
 
 __all__ = ["MAX_TOUCHES", "PROCEDURES", "Touches", "check_counts", "simulate"]
 
@@ -137,21 +137,21 @@ class Touches:
         return header, [list(r) for r in zip(*cols)]
 
     def to_table(self) -> dict[str, Any]:
-        """The measurement table as :func:`robotcell.tables.read_csv` reads the CSV (mm, deg).
+        """The measurement table as :func:`robotcell.io.tables.read_csv` reads the CSV (mm, deg).
 
         Returns
         -------
         dict
             Column name to a float array (or a list of strings), the input of
-            :mod:`robotcell.cellcal`.
+            :mod:`robotcell.cell.calibrate`.
         """
-        from robotcell.cellcal.touches import load_table
+        from robotcell.cell.calibrate.touches import load_table
 
         header, rows = self.columns()
         return load_table(dict(zip(header, map(list, zip(*rows)))))[0]
 
     def keywords(self) -> dict[str, Any]:
-        """The :mod:`robotcell.cellcal` keywords equal to :attr:`options` (SI, same rounding).
+        """The :mod:`robotcell.cell.calibrate` keywords equal to :attr:`options` (SI, same rounding).
 
         Returns
         -------

@@ -16,7 +16,7 @@ Components: ``robot``, ``track`` (the same as ``robot`` in a cell with a track),
 or the name of a frame of the cell. ``x, y, z`` move the component along the axes of its parent
 frame; ``a, b, c`` turn it about its own origin by ``Rz(a) Ry(b) Rx(c)`` in its own frame.
 
-Each layout is scored by :func:`robotcell.reach.reach_map` on the same targets: the fraction of
+Each layout is scored by :func:`robotcell.studies.reach.reach_map` on the same targets: the fraction of
 reachable targets, the mean score (0 for an unreachable target) and the smallest score. Layouts
 rank by reachable fraction, then mean score, then their order in the grid.
 
@@ -43,8 +43,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
-from robotcell.reach import reach_map
-from robotcell.transforms import make_pose
+from robotcell.kinematics.transforms import make_pose
+from robotcell.studies.reach import reach_map
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
@@ -89,7 +89,7 @@ class LayoutScore:
     fraction : float
         Fraction of the targets that are reachable.
     mean_score : float
-        Mean of :attr:`robotcell.reach.ReachMap.score` over all targets (0 for unreachable).
+        Mean of :attr:`robotcell.studies.reach.ReachMap.score` over all targets (0 for unreachable).
     min_score : float
         Smallest score over all targets.
     """
@@ -246,7 +246,7 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
     layouts : list of Layout
         From :func:`read_layouts`.
     frame, tool, table
-        As for :func:`robotcell.reach.reach_map` (table angles in rad; None: chosen per
+        As for :func:`robotcell.studies.reach.reach_map` (table angles in rad; None: chosen per
         target).
     executor : concurrent.futures.Executor, optional
         Runs one task per layout (e.g. ``ProcessPoolExecutor(4)`` or

@@ -2,7 +2,7 @@
 
 Each function takes a :class:`~robotcell.cell.Cell` (or None for a plain calibration in the robot
 base), a measurement table (column name to values in the units of the measurement CSV, mm and
-deg, as :func:`robotcell.tables.read_csv` returns it; or the CSV's path) and the procedure's
+deg, as :func:`robotcell.io.tables.read_csv` returns it; or the CSV's path) and the procedure's
 options in SI units. It maps the touches into the frames of the cell (through column ``track``
 when the robot is on a track), runs the estimator of :mod:`robotcell.calibration` and returns a
 :class:`CellCalibration`: the :class:`~robotcell.calibration.result.CalibrationResult`, a new
@@ -39,7 +39,7 @@ from robotcell.calibration.measurements import (
 )
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import Cell, Positioner, Provenance, Turntable
-from robotcell.cellcal.touches import (
+from robotcell.cell.calibrate.touches import (
     POSE_COLUMNS,
     Table,
     line_labels,
@@ -50,10 +50,10 @@ from robotcell.cellcal.touches import (
     track_positions,
 )
 from robotcell.errors import InputError
-from robotcell.poseformats import pose_to_vendor
-from robotcell.robot import Robot
-from robotcell.tables import require_columns
-from robotcell.transforms import invert, transform_points, validate_pose
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.io.tables import require_columns
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import invert, transform_points, validate_pose
 
 __all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "positioner",
            "positioner_touches", "tcp", "track", "turntable", "workpiece"]
@@ -499,7 +499,7 @@ def _cell_turntable(cell: Cell, label: str) -> Turntable:
         raise InputError(f"the positioner {cell.turntable.name!r} of {label} is a chain of "
                          f"{cell.turntable.n_axes} axes: the turntable procedure is for a "
                          "one-axis turntable; a positioner chain is calibrated by "
-                         "robotcell.cellcal.positioner (robotcell.identification."
+                         "robotcell.cell.calibrate.positioner (robotcell.identification."
                          "calibrate_positioner)")
     return cell.turntable
 

@@ -3,7 +3,7 @@
 The mapping that turns touches taken in a cell into the robot base and world frames: column
 ``track`` (the robot's track position at each touch, mm) gives ``T_world_R`` per touch through the
 cell's track (:func:`robot_in_world`). Tables are mappings of column name to values in the units
-of the measurement CSV (mm, deg), as :func:`robotcell.tables.read_csv` returns them.
+of the measurement CSV (mm, deg), as :func:`robotcell.io.tables.read_csv` returns them.
 """
 
 from __future__ import annotations
@@ -17,10 +17,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.measurements import repeated_rows, track_column
 from robotcell.cell import Cell
-from robotcell.coupled import tool_pose
+from robotcell.cell.kinematics import tool_pose
 from robotcell.errors import InputError
-from robotcell.tables import read_csv
-from robotcell.transforms import validate_pose
+from robotcell.io.tables import read_csv
+from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["POSE_COLUMNS", "Table", "line_labels", "load_table", "raw_rows", "repeat_notes",
            "robot_in_world", "tool_transform", "track_positions"]

@@ -2,7 +2,7 @@
 
 ``export_cell(cell, "kuka")`` returns the text (``"urdf"``: the cell as a URDF kinematic tree, for
 ROS tools, not a controller format); ``parse_export(text, "kuka")`` reads it back into
-:class:`~robotcell.export.common.ControllerData` (poses in metres). Formats, units, reference
+:class:`~robotcell.io.export.common.ControllerData` (poses in metres). Formats, units, reference
 frames and sources: ``docs/export.md``.
 """
 
@@ -12,8 +12,8 @@ from types import ModuleType
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.export import abb, fanuc, kuka, urdf, yaskawa
-from robotcell.export.common import ControllerData, Slot
+from robotcell.io.export import abb, fanuc, kuka, urdf, yaskawa
+from robotcell.io.export.common import ControllerData, Slot
 
 __all__ = ["EXPORT_FORMATS", "WRITE_FORMATS", "ControllerData", "Slot", "export_cell", "parse_export"]
 

@@ -17,10 +17,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.axischain import axis_frames
 from robotcell.cell import Cell, Positioner
+from robotcell.cell.axischain import axis_frames
 from robotcell.errors import InputError
-from robotcell.transforms import invert, make_pose, rot_y
+from robotcell.kinematics.transforms import invert, make_pose, rot_y
 
 __all__ = ["ControllerData", "Slot", "collect", "fmt_num", "track_root_rotation"]
 
@@ -86,7 +86,7 @@ class ControllerData:
         For a positioner chain of n axes, the n + 1 frames of KUKA's external kinematics
         (``TA1KR``, ``TA2A1``, ``TA3A2``, ``TFLA3``): the pose of each axis frame (Z on the axis)
         in the previous one at axis value 0, then the plate in the last axis frame
-        (:func:`robotcell.axischain.axis_frames`); empty for a one-axis turntable, whose frames
+        (:func:`robotcell.cell.axischain.axis_frames`); empty for a one-axis turntable, whose frames
         are null.
     skipped : list of str
         Frames the controller cannot hold (fixed to a robot that moves on a track).
@@ -123,7 +123,7 @@ def positive_z_frames(frames: list[NDArray[np.float64]], signs: list[float]
                       ) -> list[NDArray[np.float64]]:
     """Axis frames whose +Z turns the way the controller's axis value counts.
 
-    ``frames`` are ``pre_1 .. pre_n, post`` of :func:`robotcell.axischain.axis_frames`, where
+    ``frames`` are ``pre_1 .. pre_n, post`` of :func:`robotcell.cell.axischain.axis_frames`, where
     joint ``i`` turns by ``sign_i q_i`` about Z. For ``sign_i = -1`` the frame of axis ``i`` is
     turned half round X (``pre_i Rx(pi)``) and the next frame compensates (``Rx(pi) pre_{i+1}``),
     so that every axis turns by ``+q_i`` about its Z, as KUKA's external kinematics count.

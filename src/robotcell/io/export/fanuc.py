@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.export.common import (
+from robotcell.io.export.common import (
     ControllerData,
     Slot,
     collect,
@@ -22,7 +22,7 @@ from robotcell.export.common import (
     listing_line,
     parse_listing,
 )
-from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
+from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 
 __all__ = ["export", "format_data", "parse"]
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.export.common import (
+from robotcell.io.export.common import (
     DEG_DECIMALS,
     MM_DECIMALS,
     ControllerData,
@@ -39,7 +39,7 @@ from robotcell.export.common import (
     fmt_num,
     parse_float,
 )
-from robotcell.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 
 __all__ = ["MACHINE_INDEX", "export", "format_data", "parse"]
 

@@ -9,7 +9,7 @@ ROS tools (RViz, MoveIt, tf) and the Robotics Toolbox then see the calibrated ce
   position 0; without a track a fixed joint places ``base_link`` at ``T_world_R``;
 - the arm's DH chain: revolute (or prismatic) joints ``<name>`` (the model's joint names, else
   ``joint_1..n``) moving the links ``link_1..n``; each joint's origin holds the constant part of
-  the DH link before it (:func:`robotcell.axischain.axis_frames`), so its axis is the DH joint
+  the DH link before it (:func:`robotcell.cell.axischain.axis_frames`), so its axis is the DH joint
   axis; then ``flange`` fixed at the rest of the chain;
 - the turntable: ``turntable_root`` (B) fixed in ``world`` or ``base_link`` at ``T_parent_B``, a
   revolute joint ``turntable_axis`` about its Z moving ``turntable_link_1`` and the fixed link
@@ -38,9 +38,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.axischain import axis_frames
 from robotcell.cell import Cell, Turntable
-from robotcell.robot import Robot
+from robotcell.cell.axischain import axis_frames
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["chain_elements", "export", "urdf_origin"]
 
