@@ -44,13 +44,13 @@ def test_old_path_is_the_new_module_and_warns(old):
 def test_from_imports_and_monkeypatching_see_one_module(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
-        from robotcell.cell import Cell
         from robotcell.cellik import CellIKSolutions
         from robotcell.export import kuka
         from robotcell.modelfile import load_robot
     import robotcell.cell.ik
     import robotcell.io.export.kuka
     import robotcell.kinematics.models
+    from robotcell.cell import Cell
 
     assert CellIKSolutions is robotcell.cell.ik.CellIKSolutions
     assert kuka is robotcell.io.export.kuka

@@ -408,7 +408,7 @@ def test_refuses_unknown_procedure_and_bad_noise():
     cell = fixed_cell()
     with pytest.raises(InputError, match=r"unknown procedure 'dh'; choose from tcp, frame, track"):
         simulate(cell, "dh")
-    assert set(PROCEDURES) == {"tcp", "frame", "track", "turntable", "workpiece"}
+    assert set(PROCEDURES) == {"tcp", "frame", "track", "turntable", "workpiece", "positioner"}
     for noise in (-1e-4, math.nan, math.inf):
         with pytest.raises(InputError, match=r"noise must be a finite number >= 0 \(m\)"):
             simulate(cell, "tcp", noise=noise)

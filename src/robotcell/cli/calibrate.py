@@ -396,6 +396,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",
+    "positioner": "robotcell.cli.calibrate_axes:positioner",
     "workpiece": "robotcell.cli.calibrate_axes:workpiece",
 }
 # ------------------------------------------------------------------------------------------------

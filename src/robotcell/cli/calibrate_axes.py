@@ -1,9 +1,10 @@
-"""``robotcell calibrate track | turntable | workpiece``: external-axis calibration from CSV.
+"""``robotcell calibrate track | turntable | positioner | workpiece``: external axes from CSV.
 
 Registered in :data:`robotcell.cli.calibrate.REGISTERED`. CSV columns: ``x,y,z`` (mm, TCP in the
 robot base) or ``a1..a6`` with ``--robot``/``--tool``; ``e1`` = track position (mm) or table angle
-(deg); ``point`` as described per command; with ``--cell``, ``track`` = track position of the
-robot at each touch (mm) for the turntable and workpiece.
+(deg); ``e1,e2`` = tilt, rotate (deg) of a 2-axis positioner; ``point`` as described per
+command; with ``--cell``, ``track`` = track position of the robot at each touch (mm) for the
+turntable, positioner and workpiece.
 """
 
 from __future__ import annotations
@@ -113,6 +114,40 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     out = cellcal.turntable(cell, cols, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
                             cell_label=label, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
+    if out.cell is not None:
+        target.save(out.cell, out.item, out.update_notes)
+    emit(out.result, as_json)
+
+
+@click.command("positioner")
+@click.argument("measurements", type=click.Path(dir_okay=False))
+@cell_option
+@measurement_options
+def positioner(measurements: str, cell_path: str | None, robot: str | None, tool: str | None,
+               sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+    """2-axis (tilt-rotate) positioner: both axis lines, common normal, zeros, root frame.
+
+    \b
+    Rows: TCP touches of one point on the table at combinations of tilt e1 and rotate e2 (deg);
+    e.g. 3 tilt values by 4 rotate values, spread over the axis ranges (12 touches).
+    With --cell the cell's chain is the start and the calibrated chain is written into the cell
+    file (its 'positioner' section); the values are in the positioner's parent frame (the world,
+    mapped through column track (mm) in a cell with a track). Without --cell they are in the
+    robot base, and each axis needs at least 3 touches that move it alone.
+
+    \b
+    Examples:
+      robotcell calibrate positioner touches.csv --cell cell.yaml --tool pointer
+      robotcell calibrate positioner touches.csv --robot kuka_kr16 --json -o positioner.json
+    """
+    target = CellTarget.open(cell_path, robot)
+    model, T_tool = robot_and_tool(robot, tool, target)
+    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "e2", "track"])
+    cell, label = cell_of(target)
+    out = cellcal.positioner(cell, cols, robot=None if cell else model, tool=T_tool,
+                             sigma=sigma_m(sigma), source=measurements, cell_label=label,
+                             on_note=echo_note)
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)

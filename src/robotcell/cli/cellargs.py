@@ -2,7 +2,9 @@
 
 The commands call :meth:`robotcell.cell.Cell.ik` and :meth:`robotcell.cell.Cell.fk`; this module
 only turns the command line's vendor units into their SI arguments and refuses values outside
-the cell's limits with a message naming the value and the limits.
+the cell's limits with a message naming the value and the limits. The table is a turntable's
+angle, or one value per axis of a positioner chain (``--table 30,90``, batch columns
+``e1..en``), as in the calibration CSV files.
 """
 
 from __future__ import annotations
@@ -15,12 +17,16 @@ import click
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.cell import Cell, Track, Turntable
+from robotcell.cell import Cell, Positioner, Track, Turntable
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 
-__all__ = ["PROGRESS_MIN", "cell_tool", "chunks", "row_values", "table_angles", "track_values"]
+__all__ = ["NORMAL_UP", "PROGRESS_MIN", "cell_tool", "check_normal_up", "chunks", "row_values",
+           "table_angles", "table_columns", "table_option", "table_rows", "track_values"]
+
+#: ``ik --cell --table normal-up``: the positioner turns each target's surface normal up.
+NORMAL_UP = "normal-up"
 
 #: Batches of at least this many poses show a progress bar on stderr.
 PROGRESS_MIN = 2000
@@ -68,9 +74,95 @@ def track_values(cell: Cell, mm: NDArray[np.float64] | float | None
 
 
 def table_angles(cell: Cell, deg: NDArray[np.float64] | float) -> NDArray[np.float64]:
-    """Table angles in rad from deg, checked against the cell's turntable and its limits."""
-    return _checked(np.radians(np.asarray(deg, dtype=float)), 180.0 / math.pi, "deg",
-                    cell.turntable, "table angle", "table")
+    """Table angles in rad from deg, checked against the cell's turntable and its limits.
+
+    For a positioner chain ``deg`` holds the axis values, shape ``(..., n)`` (0: every axis at 0),
+    each checked against its axis's limits.
+    """
+    pos = cell.turntable
+    if not isinstance(pos, Positioner):
+        return _checked(np.radians(np.asarray(deg, dtype=float)), 180.0 / math.pi, "deg",
+                        cell.turntable, "table angle", "table")
+    v = np.radians(np.asarray(deg, dtype=float))
+    if v.ndim == 0 and v == 0:
+        v = np.zeros(pos.n_axes)
+    if v.ndim == 0 or v.shape[-1] != pos.n_axes:
+        raise InputError(f"positioner {pos.name!r} has {pos.n_axes} axes: give one value per "
+                         f"axis (deg), e.g. --table {','.join(['0'] * pos.n_axes)}")
+    bad = (v < pos.lower) | (v > pos.upper)
+    if np.any(bad):
+        i = int(np.nonzero(bad)[-1][0])
+        first = math.degrees(float(v[bad][0]))
+        name = pos.chain.joints[i].name or f"e{i + 1}"
+        raise InputError(f"positioner axis {name} value {first:g} deg is outside its limits "
+                         f"[{math.degrees(pos.lower[i]):g}, {math.degrees(pos.upper[i]):g}] deg")
+    return v
+
+
+def table_option(cell: Cell, text: str | None) -> NDArray[np.float64] | float:
+    """``--table`` (deg): a turntable angle, or one comma-separated value per positioner axis.
+
+    Without it 0 (the turntable, or every positioner axis, at 0).
+    """
+    if text is None:
+        return 0.0
+    pos = cell.turntable
+    n = pos.n_axes if isinstance(pos, Positioner) else 1
+    values = parse_numbers(text, "--table")
+    if pos is None and len(values) != 1:
+        raise InputError("the cell has no table; leave out --table (or the table column)")
+    if len(values) != n:
+        what = (f"positioner {pos.name!r} has {n} axes" if isinstance(pos, Positioner)
+                else "a turntable has one angle")
+        raise InputError(f"--table: {what}: give {n} comma-separated value(s) (deg), got "
+                         f"{len(values)} ({text!r})")
+    return np.array(values) if isinstance(pos, Positioner) else values[0]
+
+
+def check_normal_up(cell: Cell, frame: str) -> str:
+    """``--table normal-up``: refused unless a 2-axis positioner carries ``frame``; the value of
+    ``table`` for :meth:`Cell.ik` (``"normal_up"``)."""
+    pos = cell.turntable
+    if not isinstance(pos, Positioner) or pos.n_axes != 2:
+        raise InputError("--table normal-up needs a positioner of 2 axes (tilt, rotate); give "
+                         "the table angle in deg instead")
+    if frame not in cell.frames or cell.frames[frame].parent != "turntable":
+        carried = ", ".join(k for k, f in cell.frames.items() if f.parent == "turntable")
+        raise InputError(f"--table normal-up needs the target in a frame carried by the "
+                         f"positioner (--frame {carried or 'NAME'}), got --frame {frame}")
+    return "normal_up"
+
+
+def table_columns(cell: Cell) -> tuple[tuple[int, ...], list[str]]:
+    """Trailing shape of the table values and their batch columns: ``table``, or ``e1..en``."""
+    pos = cell.turntable
+    if isinstance(pos, Positioner):
+        return (pos.n_axes,), [f"e{i + 1}" for i in range(pos.n_axes)]
+    return (), ["table"]
+
+
+def table_rows(cell: Cell, cols: dict, option: NDArray[np.float64] | float, n: int
+               ) -> NDArray[np.float64]:
+    """Per-row table values of a batch file (deg), else the option's value for every row.
+
+    A turntable reads column ``table``; a positioner chain columns ``e1..en`` (one per axis,
+    as in the calibration CSV), shape ``(rows, n_axes)``.
+    """
+    pos = cell.turntable
+    if not isinstance(pos, Positioner):
+        return row_values(cols, "table", float(option), n)
+    names = [f"e{i + 1}" for i in range(pos.n_axes)]
+    if "table" in cols:
+        raise InputError(f"column 'table' holds a turntable angle; positioner {pos.name!r} has "
+                         f"{pos.n_axes} axes: give columns {', '.join(names)} (deg)")
+    given = [c for c in names if c in cols]
+    if not given:
+        return np.broadcast_to(np.asarray(option, dtype=float), (n, pos.n_axes))
+    if len(given) != len(names):
+        missing = ", ".join(c for c in names if c not in cols)
+        raise InputError(f"positioner {pos.name!r} has {pos.n_axes} axes: missing column(s) "
+                         f"{missing} (deg)")
+    return np.column_stack([row_values(cols, c, None, n) for c in names])
 
 
 def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[np.float64] | None:

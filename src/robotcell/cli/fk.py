@@ -9,7 +9,15 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.cellargs import cell_tool, row_values, table_angles, track_values
+from robotcell.cli.cellargs import (
+    cell_tool,
+    row_values,
+    table_angles,
+    table_columns,
+    table_option,
+    table_rows,
+    track_values,
+)
 from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
@@ -49,19 +57,21 @@ def tool_option(text: str | None) -> np.ndarray | None:
               help="--cell: frame of the result (world, track, robot, turntable or a frame of the cell).")
 @click.option("--track", "track_mm", type=float, default=0.0, metavar="MM",
               help="--cell: track position (mm).")
-@click.option("--table", "table_deg", type=float, default=0.0, metavar="DEG",
-              help="--cell: turntable angle (deg).")
+@click.option("--table", "table_deg", default=None, metavar="DEG[,DEG...]",
+              help="--cell: turntable angle (deg), or one value per positioner axis, e.g. 30,90 "
+                   "(deg); default 0.")
 def fk(robot: str | None, joints: str | None, input_path: str | None, output_path: str | None,
        fmt: str, tool: str | None, cell_path: str | None, frame: str, track_mm: float,
-       table_deg: float) -> None:
+       table_deg: str | None) -> None:
     """Forward kinematics: pose of the TCP in the robot base frame.
 
     ROBOT is a library name (see 'robotcell robots') or a model file.
 
     With --cell CELL.yaml instead of ROBOT: joints plus track position (--track, mm) and table
-    angle (--table, deg) give the TCP pose in a frame of the cell (--frame). A batch file may hold
-    per-row columns track and table. Refused with exit status 2: unknown frame or tool, track or
-    table outside their limits.
+    angle (--table, deg; for a positioner one value per axis, --table 30,90) give the TCP pose
+    in a frame of the cell (--frame). A batch file may hold per-row columns track and table
+    (positioner: e1,e2,...). Refused with exit status 2: unknown frame or tool, track or table
+    outside their limits, a --table with the wrong number of values.
 
     \b
     Examples:
@@ -69,6 +79,7 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
       robotcell fk ur5e --joints 0,-90,90,0,90,0 --format ur
       robotcell fk abb_irb2400 --input joints.csv --output poses.csv --format abb
       robotcell fk --cell cell.yaml --joints 0,-90,90,0,45,0 --track 1500 --tool torch --frame part
+      robotcell fk --cell positioner.yaml --joints 0,-90,90,0,45,0 --table 30,90 --frame part
     """
     if cell_path is not None:
         if robot is not None:
@@ -130,7 +141,8 @@ def _write_poses(T: np.ndarray, fmt: str, output_path: str | None) -> None:
 
 
 def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_path: str | None,
-             fmt: str, tool: str | None, frame: str, track_mm: float, table_deg: float) -> None:
+             fmt: str, tool: str | None, frame: str, track_mm: float, table_deg: str | None
+             ) -> None:
     """``robotcell fk --cell``: :meth:`Cell.fk` for one configuration or a batch (mm, deg)."""
     cell = Cell.load(cell_path)
     r = cell.robot
@@ -139,13 +151,13 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
         raise InputError("give exactly one of --joints a1,a2,... or --input joints.csv")
     if joints is not None:
         q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
-        e, th = track_values(cell, track_mm), table_angles(cell, table_deg)
+        e, th = track_values(cell, track_mm), table_angles(cell, table_option(cell, table_deg))
     else:
         names = [f"a{i}" for i in range(1, r.n_joints + 1)]
-        cols = read_csv(input_path, known=[*names, "track", "table"])
+        cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
         q = joints_to_si(r, require_columns(cols, names, input_path))
         e = track_values(cell, row_values(cols, "track", track_mm, len(q)))
-        th = table_angles(cell, row_values(cols, "table", table_deg, len(q)))
+        th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)))
     T = cell.fk(q, e, th, T_tool, frame)
     outside = int(np.count_nonzero(~r.within_limits(q)))
     if outside:

@@ -10,8 +10,19 @@ from typing import TextIO
 import click
 import numpy as np
 
-from robotcell.cell import Cell
-from robotcell.cli.cellargs import cell_tool, chunks, row_values, table_angles, track_values
+from robotcell.cell import Cell, Positioner
+from robotcell.cli.cellargs import (
+    NORMAL_UP,
+    cell_tool,
+    check_normal_up,
+    chunks,
+    row_values,
+    table_angles,
+    table_columns,
+    table_option,
+    table_rows,
+    track_values,
+)
 from robotcell.cli.common import (
     check_output,
     format_table,
@@ -71,11 +82,13 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
               help="--cell: frame of the target (world, track, robot, turntable or a frame of the cell).")
 @click.option("--track", "track_mm", type=float, metavar="MM",
               help="--cell: track position (mm); chosen per pose when omitted in a cell with a track.")
-@click.option("--table", "table_deg", type=float, default=0.0, metavar="DEG",
-              help="--cell: turntable angle (deg) at which the target is given.")
+@click.option("--table", "table_deg", default=None, metavar="DEG[,DEG...]",
+              help="--cell: turntable angle (deg) at which the target is given, or one value "
+                   "per positioner axis (e.g. 30,90); 'normal-up': a 2-axis positioner turns "
+                   "each target's surface normal (its -Z) straight up. Default 0.")
 def ik(robot: str | None, pose: str | None, input_path: str | None, output_path: str | None, fmt: str,
        show_all: bool, near: str | None, tool: str | None, cell_path: str | None, frame: str,
-       track_mm: float | None, table_deg: float) -> None:
+       track_mm: float | None, table_deg: str | None) -> None:
     """Inverse kinematics: every arm configuration that reaches a TCP pose.
 
     ROBOT is a library name (see 'robotcell robots') or a model file with an ortho-parallel
@@ -97,9 +110,12 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
     at a table angle (--table), for a track position (--track, chosen per pose where the arm
     reaches best when omitted); the output adds track (mm) and table (deg) and, for --format
     kuka/abb, the configuration flags (batch columns status,turn or cf1,cf4,cf6,cfx). A batch
-    file may hold per-row columns track and table. Batches of 2000 poses or more show a progress
+    file may hold per-row columns track and table. On a positioner chain --table takes one
+    value per axis (deg) and the table columns are e1,e2,...; --table normal-up lets a 2-axis
+    positioner turn each target's normal (-Z of a target in a frame it carries) up, the welding
+    position, and reports the values chosen. Batches of 2000 poses or more show a progress
     bar on stderr. Refused with exit status 2: unknown frame or tool, track or table outside
-    their limits, no valid solution for --pose.
+    their limits, a --table with the wrong number of values, no valid solution for --pose.
 
     \b
     Examples:
@@ -108,6 +124,8 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
       robotcell ik ur5e --pose 0.5,0.1,0.4,0,3.1416,0 --format ur --near 0,-90,90,-90,-90,0
       robotcell ik kuka_kr16 --input poses.csv --output joints.csv
       robotcell ik --cell cell.yaml --frame part --table 90 --tool torch --pose 0,0,50,0,180,0
+      robotcell ik --cell positioner.yaml --frame part --table normal-up --tool torch \\
+          --pose 50,0,0,0,180,0
     """
     if cell_path is not None:
         if robot is not None:
@@ -199,9 +217,21 @@ def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
     return ["cf1", "cf4", "cf6", "cfx"], np.atleast_2d(abb_confdata(robot, qq))
 
 
+def _table_text(cell: Cell, values: np.ndarray, chosen: bool) -> str:
+    """``, table 90 deg`` or ``, positioner E1, E2 30, 90 deg (normal up)`` for the headline."""
+    pos = cell.turntable
+    if pos is None:
+        return ""
+    if not isinstance(pos, Positioner):
+        return f", table {float(values) * 180.0 / math.pi:g} deg"
+    names = ", ".join(j.name or f"e{i + 1}" for i, j in enumerate(pos.chain.joints))
+    v = ", ".join(f"{x:.4f}" for x in np.degrees(np.ravel(values)) + 0.0)
+    return f", positioner {names} {v} deg" + (" (chosen: normal up)" if chosen else "")
+
+
 def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_path: str | None,
              fmt: str, show_all: bool, near: str | None, tool: str | None, frame: str,
-             track_mm: float | None, table_deg: float) -> None:
+             track_mm: float | None, table_deg: str | None) -> None:
     """``robotcell ik --cell``: :meth:`Cell.ik` for one pose or a batch (mm, deg)."""
     cell = Cell.load(cell_path)
     r = cell.robot
@@ -212,7 +242,9 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     ref = None if near is None else np.radians(parse_numbers(near, "--near", r.n_joints))
     if pose is not None:
         T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
-        sol = cell.ik(T, frame, track_values(cell, track_mm), table_angles(cell, table_deg), T_tool)
+        th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
+              else table_angles(cell, table_option(cell, table_deg)))
+        sol = cell.ik(T, frame, track_values(cell, track_mm), th, T_tool)
         valid = sol.valid
         if ref is not None:
             q, found, branch = nearest(r, IKSolutions(sol.q, valid, sol.reachable, sol.method), ref)
@@ -238,38 +270,44 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
             rows.append(row)
         how = "chosen" if track_mm is None else "given"
         where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
-        where += f", table {float(sol.table) * deg:g} deg" if cell.turntable is not None else ""
+        where += _table_text(cell, sol.table, table_deg == NORMAL_UP)
         write_output(output_path, f"{cell.name}: {r.name}, {sol.method} solver, target in frame "
                      f"{frame!r}{where}; angles in degrees\n{format_table(headers, rows)}\n")
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
-    cols = read_csv(input_path, known=[*names, "track", "table"])
+    n_table, table_names = table_columns(cell)
+    cols = read_csv(input_path, known=[*names, "track", *table_names])
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     n = len(T)
     e = track_values(cell, row_values(cols, "track", track_mm, n))
-    th = table_angles(cell, row_values(cols, "table", table_deg, n))
+    th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
+          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n)))
     parts = []
     for sl in chunks(n, "ik"):
-        parts.append(cell.ik(T[sl], frame, None if e is None else e[sl], th[sl], T_tool))
+        parts.append(cell.ik(T[sl], frame, None if e is None else e[sl],
+                             th if isinstance(th, str) else th[sl], T_tool))
     q = np.concatenate([p.q for p in parts])
     valid = np.concatenate([p.valid for p in parts])
     reach = np.concatenate([p.reachable for p in parts])
     track = np.concatenate([np.broadcast_to(p.track, p.valid.shape[:-1]) for p in parts]) * 1e3
-    table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1]) for p in parts]) * deg
+    table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1] + n_table)
+                            for p in parts]).reshape(n, -1) * deg
     method = parts[0].method
     axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
     if ref is not None:
         qn, found, _ = nearest(r, IKSolutions(q, valid, reach, method), ref)
         names_f, flags = _cell_flag_columns(r, method, fmt, qn)
-        header = ["pose", "found", "track", "table", *axes, *names_f]
-        out_rows = [[i, int(found[i]), track[i], table[i], *(qn[i] * deg).tolist(),
+        header = ["pose", "found", "track", *table_names, *axes, *names_f]
+        out_rows = [[i, int(found[i]), track[i], *table[i].tolist(), *(qn[i] * deg).tolist(),
                      *(flags[i].tolist() if found[i] else ["-"] * len(names_f))] for i in range(n)]
     else:
         idx = [(i, k) for i in range(n) for k in range(8)] if show_all else list(zip(*np.nonzero(valid)))
         sel = np.array([q[i, k] for i, k in idx]).reshape(-1, r.n_joints)
         names_f, flags = _cell_flag_columns(r, method, fmt, sel)
-        header = ["pose", "branch", *(["valid"] if show_all else []), "track", "table", *axes, *names_f]
-        out_rows = [[int(i), int(k), *([int(valid[i, k])] if show_all else []), track[i], table[i],
+        header = ["pose", "branch", *(["valid"] if show_all else []), "track", *table_names, *axes,
+                  *names_f]
+        out_rows = [[int(i), int(k), *([int(valid[i, k])] if show_all else []), track[i],
+                     *table[i].tolist(),
                      *(sel[j] * deg).tolist(), *(flags[j].tolist() if reach[i, k] else ["-"] * len(names_f))]
                     for j, (i, k) in enumerate(idx)]
     _finish_batch(valid, header, out_rows, output_path)

@@ -46,8 +46,10 @@ DESIGN_OPTIONS: dict[str, tuple[str, tuple[str, ...], Callable[[Any], Any]]] = {
     "travel": ("travel", ("track",), _mm("travel", positive=True)),
     "angles": ("angles", ("turntable", "workpiece"),
                lambda v: np.radians(parse_numbers(v, "--angles"))),
-    "radius": ("radius", ("turntable",), _mm("radius", positive=True)),
-    "height": ("height", ("turntable",), _mm("height")),
+    "radius": ("radius", ("turntable", "positioner"), _mm("radius", positive=True)),
+    "height": ("height", ("turntable", "positioner"), _mm("height")),
+    "tilts": ("tilts", ("positioner",), lambda v: np.radians(parse_numbers(v, "--tilts"))),
+    "rotates": ("rotates", ("positioner",), lambda v: np.radians(parse_numbers(v, "--rotates"))),
 }
 
 
@@ -101,9 +103,17 @@ def design_options(func: Callable) -> Callable:
                      help="turntable: table angles (deg; default evenly around the turn); "
                           "workpiece: one per touch."),
         click.option("--radius", type=float, default=None, metavar="MM",
-                     help="turntable: distance of the touched point from the axis (300)."),
+                     help="turntable: distance of the touched point from the axis (300); "
+                          "positioner: from the plate origin along its X (200)."),
         click.option("--height", type=float, default=None, metavar="MM",
-                     help="turntable: height of the touched point above the root frame (50)."),
+                     help="turntable: height of the touched point above the root frame (50); "
+                          "positioner: above the plate (0)."),
+        click.option("--tilts", default=None, metavar="A,B,...",
+                     help="positioner: values of axis 1, tilt (deg; -30,0,30 within the limits); "
+                          "every combination with --rotates is touched."),
+        click.option("--rotates", default=None, metavar="A,B,...",
+                     help="positioner: values of axis 2, rotate (deg; 0,90,180,270 within the "
+                          "limits)."),
     ]
     for opt in reversed(opts):
         func = opt(func)
@@ -171,14 +181,16 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
 
     Writes the measurement CSV that 'robotcell calibrate PROCEDURE' reads: joint values
     a1..a6 (deg) that really reach the touched points within every limit, with the touch-up
-    error --noise; e1 (track mm or table deg), track (mm, robot's track position), point.
-    The command line that calibrates the file is printed on stderr. Procedures: tcp, frame,
-    track, turntable, workpiece.
+    error --noise; e1 (track mm or table deg; positioner: e1, e2 = tilt, rotate deg), track
+    (mm, robot's track position), point. The command line that calibrates the file is printed
+    on stderr. Procedures: tcp, frame, track, turntable, workpiece, positioner (a 2-axis
+    positioner: one point on the plate at every combination of --tilts and --rotates).
 
     \b
     Examples:
       robotcell simulate turntable --cell cell.yaml --noise 0.1 -o turntable.csv
       robotcell simulate tcp --cell cell.yaml --tool torch --tilt 40 --seed 1 -o tcp.csv
+      robotcell simulate positioner --cell truth.yaml --tool pointer --noise 0.1 -o touches.csv
     """
     if not (math.isfinite(noise) and noise >= 0):
         raise InputError(f"--noise must be a number of millimetres >= 0, got {noise}")

@@ -164,11 +164,12 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     rng = np.random.default_rng(seed)
     # procedure, options of the command, keywords of the library call, of the simulation
     steps: list[tuple[str, list[str], dict[str, Any], dict[str, Any]]] = [
-        ("tcp", ["--name", "torch"], {"name": "torch"}, {"tool": "torch"}),
+        # Enough touches for the verdict to see a wrong one (docs/calibration.md, "Verdict").
+        ("tcp", ["--name", "torch"], {"name": "torch"}, {"tool": "torch", "touches": 6}),
         ("track", ["--tool", "torch"], {"tool": "torch"}, {"tool": "torch"}),
         ("turntable", ["--tool", "torch"], {"tool": "torch"}, {"tool": "torch"}),
         ("workpiece", ["--tool", "torch", "--name", "part", "--turntable", "turntable.json"],
-         {"tool": "torch", "name": "part"}, {"tool": "torch", "frame": "part"}),
+         {"tool": "torch", "name": "part"}, {"tool": "torch", "frame": "part", "repeats": 3}),
     ]
     results: dict[str, dict[str, Any]] = {}
     cell = Cell.load(cell_file)
@@ -198,7 +199,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
                                                encoding="utf-8")
         r = results[procedure]
         echo(f"  RMS {r['rms_mm']:.3f} mm, max {r['max_mm']:.3f} mm, condition "
-             f"{r['condition']:.1f}; cell file updated")
+             f"{r['condition']:.1f}; cell file updated\n  {verdict.line()}")
     calibrated = Cell.load(cell_file)  # as the file holds it (rounded to 1e-10 mm, deg)
     comparisons = _compare(calibrated, truth, results)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")

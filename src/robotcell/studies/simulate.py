@@ -46,6 +46,8 @@ PROCEDURES = {
     "track": "the robot's linear track (touches of known reference points)",
     "turntable": "the turntable's root frame (one point on the table at several angles)",
     "workpiece": "a workpiece frame on the turntable (3-point at any table angles)",
+    "positioner": "a 2-axis positioner's axis chain (one point on the table at several "
+                  "(tilt, rotate) values)",
 }
 
 #: Candidate track positions when the track position of a procedure is chosen.
@@ -87,7 +89,8 @@ class Touches:
     track : ndarray, shape (N,), or None
         Robot's track position at each touch (m); None in a cell without track.
     table : ndarray, shape (N,), or None
-        Table angle at each touch (rad), for turntable and workpiece.
+        Table angle at each touch (rad), for turntable and workpiece; shape (N, 2), the
+        positioner's axis values (rad, CSV columns ``e1``, ``e2``), for positioner.
     roles : list of str, or None
         Value of the CSV column ``point`` per touch.
     truth : dict of str to Any
@@ -126,8 +129,9 @@ class Touches:
             header.append("e1")
             cols.append([f"{v * 1e3:.3f}" for v in self.track])
         elif self.table is not None:
-            header.append("e1")
-            cols.append([f"{math.degrees(v):.4f}" for v in self.table])
+            values = self.table.reshape(len(self.q), -1)
+            header += [f"e{i + 1}" for i in range(values.shape[1])]
+            cols += [[f"{math.degrees(v):.4f}" for v in values[:, i]] for i in range(values.shape[1])]
         if self.track is not None and self.procedure not in ("track", "tcp"):
             header.append("track")
             cols.append([f"{v * 1e3:.3f}" for v in self.track])
@@ -572,8 +576,60 @@ def _workpiece(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
                    tool=tname, noise=noise)
 
 
+def _positioner_values(lower: float, upper: float, values: ArrayLike | None,
+                       default: NDArray[np.float64], what: str) -> NDArray[np.float64]:
+    """Values of one positioner axis (rad): ``values`` checked, else ``default`` clipped."""
+    if values is None:
+        return np.unique(np.clip(default, lower, upper))
+    v = np.atleast_1d(np.asarray(values, dtype=float))
+    if v.ndim != 1 or not np.all(np.isfinite(v)):
+        raise InputError(f"{what} values must be a list of finite numbers (rad)")
+    out = (v < lower) | (v > upper)
+    if np.any(out):
+        raise InputError(f"{what} value(s) {', '.join(f'{math.degrees(x):g}' for x in v[out])} deg "
+                         f"are outside the axis limits [{math.degrees(lower):g}, "
+                         f"{math.degrees(upper):g}] deg")
+    return v
+
+
+def _positioner(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
+                track: float | None, tilts: ArrayLike | None = None,
+                rotates: ArrayLike | None = None, radius: float = 0.2,
+                height: float = 0.0) -> Touches:
+    pos = cell.turntable
+    if pos is None or pos.n_axes != 2:
+        raise InputError("the positioner procedure needs a cell with a positioner of 2 axes "
+                         "(tilt, rotate)")
+    tname = _tool_name(cell, tool)
+    if not radius > 0:
+        raise InputError(f"radius must be positive (m), got {radius}")
+    t = _positioner_values(pos.lower[0], pos.upper[0], tilts, np.radians([-30.0, 0.0, 30.0]),
+                           "tilt")
+    r = _positioner_values(pos.lower[1], pos.upper[1], rotates,
+                           np.radians([0.0, 90.0, 180.0, 270.0]), "rotate")
+    if len(t) < 2 or len(r) < 3:
+        raise InputError(f"the positioner calibration needs at least 2 tilt and 3 rotate values, "
+                         f"got {len(t)} and {len(r)}")
+    v = np.stack(np.meshgrid(t, r, indexing="ij"), axis=-1).reshape(-1, 2)  # (n, 2)
+    n = len(v)
+    p_P = np.array([radius, 0.0, height])
+
+    def targets(Ek: NDArray[np.float64]) -> NDArray[np.float64]:
+        T_wP = frame_pose(cell, "turntable", Ek) @ pos.T_root_P(v)             # (K, n, 4, 4)
+        p_w = transform_points(T_wP, p_P)                                    # (K, n, 3)
+        return make_pose(DOWN[None, None], p_w[:, :, None])
+
+    E = _candidate_tracks(cell, track, n)
+    labels = [f"touch {i + 1} ({math.degrees(a):.0f}, {math.degrees(b):.0f} deg)"
+              for i, (a, b) in enumerate(v)]
+    q, e = _reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
+    return Touches("positioner", q, e if cell.track is not None else None, v, None,
+                   truth={"chain": pos.chain, "parent": pos.parent, "point": p_P},
+                   tool=tname, noise=noise)
+
+
 _SIMULATORS = {"tcp": _tcp, "frame": _frame, "track": _track, "turntable": _turntable,
-               "workpiece": _workpiece}
+               "workpiece": _workpiece, "positioner": _positioner}
 
 
 def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
@@ -585,7 +641,7 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
     ----------
     cell : Cell
         The virtual cell: its values are the truth the touches are made in.
-    procedure : {"tcp", "frame", "track", "turntable", "workpiece"}
+    procedure : {"tcp", "frame", "track", "turntable", "workpiece", "positioner"}
     noise : float
         Touch-up error, 1-sigma per coordinate (m); 0 for exact touches.
     seed : int or numpy.random.Generator, optional
@@ -609,7 +665,11 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
           spread of the track positions per point);
         - ``turntable``: ``touches`` (6), ``angles`` (default evenly around the turn),
           ``radius`` (0.3) and ``height`` (0.05) of the touched point on ``X_B``;
-        - ``workpiece``: ``frame`` (name), ``size`` (0.15), ``repeats`` (2), ``angles``.
+        - ``workpiece``: ``frame`` (name), ``size`` (0.15), ``repeats`` (2), ``angles``;
+        - ``positioner`` (2 axes): every combination of ``tilts`` (default -30, 0, 30 deg,
+          clipped to the limits) and ``rotates`` (default 0, 90, 180, 270 deg, clipped) of the
+          point ``(radius, 0, height)`` (0.2, 0.0) in the plate frame P; ``table`` holds the
+          axis values, shape (N, 2).
 
     Returns
     -------

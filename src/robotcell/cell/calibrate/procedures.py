@@ -21,6 +21,7 @@ writes the identified chain with :meth:`Cell.update_positioner`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -49,7 +50,7 @@ from robotcell.cell.calibrate.touches import (
     tool_transform,
     track_positions,
 )
-from robotcell.errors import InputError
+from robotcell.errors import IllPosedError, InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import require_columns
 from robotcell.kinematics.robot import Robot
@@ -559,11 +560,29 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
     return values, f
 
 
-def positioner(cell: Cell, measurements: Table | str | Path, *,
-               tool: str | ArrayLike | None = None, sigma: float | None = None,
-               source: str | None = None, cell_label: str | None = None,
-               time: str | None = None, on_note: Callable[[str], None] | None = None
-               ) -> CellCalibration:
+def _check_alone(values: NDArray[np.float64], source: str) -> None:
+    """Refuse touches in which no 3 rows turn one axis alone over 10 deg (no start without a cell).
+
+    ``values`` (N, 2) are tilt and rotate (rad); the circle point analysis that starts the fit
+    without a nominal chain needs such a group per axis.
+    """
+    for k, name in enumerate(("e1 (tilt)", "e2 (rotate)")):
+        other = np.round(values[:, 1 - k], 9)
+        if not any(len(np.unique(np.round(values[other == o, k], 9))) >= 3
+                   and np.ptp(values[other == o, k]) >= math.radians(10.0) * 0.999
+                   for o in np.unique(other)):
+            raise IllPosedError(
+                f"{source}: no 3 touches turn {name} alone over 10 deg or more; without --cell "
+                "(in Python: a Cell) the positioner calibration starts from the circles of such "
+                "touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give the cell with the "
+                "positioner's nominal chain")
+
+
+def positioner(cell: Cell | None, measurements: Table | str | Path, *,
+               robot: Robot | None = None, tool: str | ArrayLike | None = None,
+               sigma: float | None = None, source: str | None = None,
+               cell_label: str | None = None, time: str | None = None,
+               on_note: Callable[[str], None] | None = None) -> CellCalibration:
     """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
 
     The touches (:func:`positioner_touches`) go to
@@ -574,11 +593,15 @@ def positioner(cell: Cell, measurements: Table | str | Path, *,
 
     Parameters
     ----------
-    cell : Cell
-        A cell with a positioner of 2 axes.
+    cell : Cell or None
+        A cell with a positioner of 2 axes. None: a plain calibration in the robot base, started
+        from the circle point analysis of the touches (which then need, for each axis, at least
+        3 that move that axis alone, e.g. a grid of 3 tilt by 4 rotate values); nothing written.
     measurements : mapping or str or Path
         As for :func:`positioner_touches`: one point on the table touched at several (tilt,
         rotate) values ``e1``, ``e2`` (deg).
+    robot : Robot, optional
+        Robot model for joint values when no cell is given.
     tool, sigma, source, cell_label, time, on_note
         As for :func:`frame`.
 
@@ -586,24 +609,37 @@ def positioner(cell: Cell, measurements: Table | str | Path, *,
     -------
     CellCalibration
         ``result`` is the positioner calibration's (procedure ``positioner-2axis``, values in
-        the positioner's parent frame).
+        the positioner's parent frame: ``T_world_B`` instead of ``T_R_B`` for a positioner in
+        the world; in the robot base without a cell).
     """
     from robotcell.identification import calibrate_positioner
 
     label = _label(cell, cell_label)
+    cols, source = load_table(measurements, source)
+    notes = _Notes(on_note)
+    if cell is None:
+        _refuse_track_column(cols, source, _NO_CELL_TRACK)
+        points = tcp_positions(cols, source, robot, tool_transform(None, tool))
+        values = np.radians(require_columns(cols, ["e1", "e2"], source))
+        notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2"], source))
+        _check_alone(values, source)
+        done = calibrate_positioner(values, points, prior_sigma=sigma,
+                                    labels=line_labels(len(points)))
+        return CellCalibration(done.result, notes=tuple(notes))
     pos = cell.turntable
     if pos is None or pos.n_axes != 2:
         raise InputError(f"{label} has no positioner of 2 axes (tilt, rotate) to calibrate")
-    cols, source = load_table(measurements, source)
-    notes = _Notes(on_note)
+    if robot is not None:
+        raise InputError("the robot is the cell's: give a cell or a robot, not both")
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2", "track"], source))
     values, points = positioner_touches(cell, cols, tool=tool, source=source, cell_label=label)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
                                 labels=line_labels(len(points)))
-    prov = _provenance("positioner", done.result, len(points), source, time)
+    result = done.result.renamed("T_R_B", "T_world_B") if pos.parent == "world" else done.result
+    prov = _provenance("positioner", result, len(points), source, time)
     new = _copy(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
-    return CellCalibration(done.result, new, f"positioner {pos.name!r} (axes, root)", prov,
+    return CellCalibration(result, new, f"positioner {pos.name!r} (axes, root)", prov,
                            tuple(notes))
 
 
