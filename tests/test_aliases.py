@@ -2,6 +2,7 @@
 object as the new path, with a DeprecationWarning naming the new path."""
 
 import importlib
+import importlib.util
 import subprocess
 import sys
 import warnings
@@ -78,3 +79,36 @@ def test_old_submodule_attributes_in_a_fresh_process():
             "import robotcell.kinematics.dh\n"
             "assert robotcell.dh is robotcell.kinematics.dh\n")
     subprocess.run([sys.executable, "-c", code], env={"PYTHONPATH": SRC}, check=True, timeout=120)
+
+
+ROOT = Path(__file__).resolve().parents[1]
+_SPEC = importlib.util.spec_from_file_location("relayout_imports",
+                                               ROOT / "tools" / "relayout_imports.py")
+_TOOL = importlib.util.module_from_spec(_SPEC)
+_SPEC.loader.exec_module(_TOOL)
+rewrite = _TOOL.rewrite
+
+#: the only files that may name an old path: the alias table, its test, and the notes on it
+MAY_NAME_OLD = {"src/robotcell/_aliases.py", "tests/test_aliases.py", "docs/conventions.md",
+                "src/robotcell/__init__.py", "tools/relayout_imports.py"}
+
+
+def test_rewrite_maps_old_paths_only():
+    text = ("from robotcell import cellcal\nfrom robotcell.robot import Robot\n"
+            "import robotcell.export.kuka  # src/robotcell/cellik.py, robotcell/export/urdf.py\n"
+            "robotcell.robots robotcell.dhprocedure robotcell.cli.export robotcell.cell.ik\n")
+    assert rewrite(text) == (
+        "from robotcell.cell import calibrate as cellcal\n"
+        "from robotcell.kinematics.robot import Robot\n"
+        "import robotcell.io.export.kuka  # src/robotcell/cell/ik.py, robotcell/io/export/urdf.py\n"
+        "robotcell.robots robotcell.dhprocedure robotcell.cli.export robotcell.cell.ik\n")
+
+
+def test_no_file_of_the_repository_uses_an_old_path():
+    files = [p for d in ("src", "tests", "benchmarks", "docs", "examples", "tools")
+             for p in (ROOT / d).rglob("*") if p.suffix in (".py", ".md", ".yaml")]
+    files.append(ROOT / "README.md")
+    old = sorted(str(p.relative_to(ROOT)) for p in files
+                 if str(p.relative_to(ROOT)) not in MAY_NAME_OLD
+                 and rewrite(p.read_text(encoding="utf-8")) != p.read_text(encoding="utf-8"))
+    assert not old, f"old module paths in {old}: run python tools/relayout_imports.py FILE..."

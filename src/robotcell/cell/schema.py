@@ -47,23 +47,12 @@ _HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z,
 
 
 def load_cell(path: str | Path) -> Cell:
-    """Read a cell file.
+    """Read a cell file (millimetres, degrees) into a :class:`Cell`: what :meth:`Cell.load` does.
 
     Parameters
     ----------
     path : str or Path
-        YAML cell file (millimetres, degrees). A robot model path inside it is resolved
-        against the file's directory.
-
-    Returns
-    -------
-    Cell
-
-    Raises
-    ------
-    InputError
-        Missing or unreadable file, invalid YAML, or invalid content; the message names the
-        file and the key.
+        YAML cell file; a robot model path inside it is resolved against the file's directory.
     """
     p = Path(path)
     text = read_text(p, "cell file")
@@ -75,20 +64,14 @@ def load_cell(path: str | Path) -> Cell:
 
 
 def save_cell(cell: Cell, path: str | Path) -> None:
-    """Write a cell file atomically, keeping the previous version as ``<path>.bak``.
-
-    The text is written to a temporary file in the same directory, flushed and fsynced, then
-    moved over ``path`` with ``os.replace``; the old file is first copied (the same way) to
-    ``<path>.bak``. If the process dies at any point, ``path`` holds either the old or the new
-    content in full. Both keep the permissions of the file replaced (a new file gets
-    ``0o666`` less the umask).
+    """Write ``cell`` to a cell file atomically with a ``.bak``: what :meth:`Cell.save` does.
 
     Parameters
     ----------
     cell : Cell
-        The cell to write (SI units; written in millimetres and degrees).
+        The cell (SI units), written in millimetres and degrees.
     path : str or Path
-        Destination. A robot model file is written relative to its directory.
+        Destination; a robot model file is written relative to its directory.
     """
     p = Path(path)
     text = _HEADER + yaml.safe_dump(cell_to_dict(cell, p.resolve().parent), sort_keys=False,
