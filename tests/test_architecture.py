@@ -179,7 +179,8 @@ def test_imports_go_down_the_layers(name):
     assert not up, f"{name} (layer {layer(name)}) imports {up} from a layer above"
 
 
-@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith("robotcell.calibration")))
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if n.startswith("robotcell.calibration")))
 def test_calibration_estimators_know_no_files(name):
     # arrays in, results out: no file reading or writing, no YAML, no paths
     bad = sorted(t for t in ALL_IMPORTS[name]

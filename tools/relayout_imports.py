@@ -16,7 +16,8 @@ from pathlib import Path
 
 from robotcell._aliases import ALIASES
 
-OLD = {old.removeprefix("robotcell."): new.removeprefix("robotcell.") for old, new in ALIASES.items()}
+OLD = {old.removeprefix("robotcell."): new.removeprefix("robotcell.")
+       for old, new in ALIASES.items()}
 _ALT = "|".join(sorted(OLD, key=len, reverse=True))
 DOTTED = re.compile(rf"(?<![\w.])robotcell\.({_ALT})\b(?!\.py)")
 SLASHED = re.compile(rf"(?<![\w.])robotcell/({_ALT})(\.py\b|/)")

@@ -25,5 +25,5 @@ from robotcell.cell.model import (
 )
 from robotcell.cell.schema import cell_from_dict, cell_to_dict
 
-__all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool", "Track",
-           "Turntable", "cell_from_dict", "cell_to_dict"]
+__all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool",
+           "Track", "Turntable", "cell_from_dict", "cell_to_dict"]

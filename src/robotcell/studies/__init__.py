@@ -4,5 +4,6 @@
 - :mod:`robotcell.studies.plan`: planning a calibration (which touches, checked by Monte Carlo);
 - :mod:`robotcell.studies.demo`: the end-to-end demo;
 - :mod:`robotcell.studies.reach`: reach maps of a cell;
-- :mod:`robotcell.studies.sweep`: layout sweeps (robot, track, turntable or part placed over a grid).
+- :mod:`robotcell.studies.sweep`: layout sweeps (robot, track, turntable or part placed over a
+  grid).
 """
