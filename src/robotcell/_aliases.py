@@ -13,7 +13,6 @@ it. The finder imports nothing until an old path is imported.
 from __future__ import annotations
 
 import importlib
-import importlib.abc
 import importlib.machinery
 import sys
 import warnings
@@ -54,8 +53,8 @@ def new_name(old: str) -> str | None:
     return None
 
 
-class _AliasLoader(importlib.abc.Loader):
-    """Gives the module of the new path for an old path."""
+class _AliasLoader:
+    """Gives the module of the new path for an old path (an import loader, PEP 451)."""
 
     def __init__(self, new: str) -> None:
         self.new = new
@@ -71,8 +70,12 @@ class _AliasLoader(importlib.abc.Loader):
         module.__spec__ = self._spec
 
 
-class AliasFinder(importlib.abc.MetaPathFinder):
-    """Finds the old module paths of :data:`ALIASES` (and their submodules)."""
+class AliasFinder:
+    """Finds the old module paths of :data:`ALIASES` (and their submodules).
+
+    A meta path finder (PEP 451); it does not subclass :mod:`importlib.abc`, whose import costs
+    ``import robotcell`` as much again.
+    """
 
     def find_spec(self, fullname: str, path: object = None,
                   target: object = None) -> importlib.machinery.ModuleSpec | None:
