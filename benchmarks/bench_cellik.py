@@ -6,7 +6,7 @@ prints the time per target of
 
 - the sampled search (:meth:`robotcell.ik.TrackRobot.ik`: 2 x 65 track values, the full analytic
   IK and the Jacobian's determinant at each; the method ``Cell.ik`` used before), and
-- the fast choice (:func:`robotcell.cellik.ik`: closed-form interval, closed-form manipulability
+- the fast choice (:func:`robotcell.cell.ik.ik`: closed-form interval, closed-form manipulability
   scanned inside it, one analytic solve),
 
 both in this run on the same targets, interleaved, best of 3 rounds each, as wall time and as
@@ -27,9 +27,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from machine import describe
 
 from robotcell.cell import Cell
-from robotcell.cellik import _track_robot
+from robotcell.cell.ik import _track_robot
 from robotcell.ik.trackchoice import arm_manipulability
-from robotcell.transforms import invert
+from robotcell.kinematics.transforms import invert
 
 CELL = Path(__file__).parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 N_SAME = 300      # targets solved by both methods

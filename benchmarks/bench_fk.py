@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from machine import describe
 
 from robotcell import load_robot
-from robotcell.dh import link_transform
+from robotcell.kinematics.dh import link_transform
 
 
 def plain_numpy_chain(robot, q):

@@ -23,7 +23,7 @@ from identification_helpers import configurations, measure, perturbed, truth_cha
 from machine import describe
 
 from robotcell.identification import identify
-from robotcell.modelfile import load_robot
+from robotcell.kinematics.models import load_robot
 
 N_CONFIGS, N_REFLECTORS, NOISE, REPEATS = 100, 3, 0.02e-3, 7
 

@@ -19,7 +19,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from machine import describe
 
 from robotcell.cell import Cell
-from robotcell.sweep import read_layouts, sweep
+from robotcell.studies.sweep import read_layouts, sweep
 
 CELL = Path(__file__).parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 N_TARGETS = 10_000

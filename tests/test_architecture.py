@@ -95,17 +95,18 @@ def test_the_graph_sees_every_module_and_its_imports():
     # a guard that the parser does what the tests below rely on
     assert "robotcell.cell" in MODULES and "robotcell.cli.calibrate" in MODULES
     assert "click" in GRAPH["robotcell.cli.calibrate"]
-    assert "robotcell.cellcal" in GRAPH["robotcell.cli.calibrate"]
-    assert "robotcell.coupled" in GRAPH["robotcell.cell"]
+    assert "robotcell.cell.calibrate" in GRAPH["robotcell.cli.calibrate"]
+    assert "robotcell.cell.kinematics" in GRAPH["robotcell.cell"]
     # TYPE_CHECKING imports are edges; imports inside functions only for the CLI rule
-    assert "robotcell.ik.result" in GRAPH["robotcell.robot"]
-    assert "robotcell.ik" not in GRAPH["robotcell.robot"]
-    assert "robotcell.ik" in ALL_IMPORTS["robotcell.robot"]
+    assert "robotcell.ik.result" in GRAPH["robotcell.kinematics.robot"]
+    assert "robotcell.ik" not in GRAPH["robotcell.kinematics.robot"]
+    assert "robotcell.ik" in ALL_IMPORTS["robotcell.kinematics.robot"]
 
 
 def test_find_cycle_finds_a_cycle():
-    graph = {"robotcell.cell": {"robotcell.coupled"}, "robotcell.coupled": {"robotcell.cell"}}
-    assert find_cycle(graph) == ["robotcell.cell", "robotcell.coupled", "robotcell.cell"]
+    graph = {"robotcell.cell": {"robotcell.cell.kinematics"},
+             "robotcell.cell.kinematics": {"robotcell.cell"}}
+    assert find_cycle(graph) == ["robotcell.cell", "robotcell.cell.kinematics", "robotcell.cell"]
 
 
 def test_no_import_cycle():
@@ -118,3 +119,73 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
     bad = sorted(t for t in ALL_IMPORTS[name]
                  if t in ("click", "robotcell.cli") or t.startswith(("click.", "robotcell.cli.")))
     assert not bad, f"{name} imports {bad}"
+
+
+#: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
+#: package's ``__init__``, ``errors``, ``report`` (one concept, one module) and ``_aliases``.
+CONCEPTS = {"kinematics", "ik", "dhprocedure", "calibration", "identification", "cell", "io",
+            "studies", "cli", "robots"}
+TOP_MODULES = {"__init__.py", "errors.py", "report.py", "_aliases.py"}
+
+
+def test_the_top_level_holds_only_the_concept_packages():
+    entries = {p.name for p in PACKAGE.iterdir() if p.name != "__pycache__"}
+    assert entries == CONCEPTS | TOP_MODULES
+    # every concept is a package (robots/ is package data: YAML models and URDFs)
+    for name in CONCEPTS - {"robots"}:
+        assert (PACKAGE / name / "__init__.py").is_file(), name
+
+
+#: The layers, bottom first: a module imports only modules of its own layer or of lower layers
+#: (a module belongs to the longest prefix listed). The vendor-boundary helpers of ``io`` (files,
+#: tables, pose formats) and the pose algebra sit under the kinematics, which reads model files;
+#: the controller exports of ``io`` sit over the cell they export; reports of results sit with the
+#: estimators whose results they show. Imports inside functions
+#: (``Robot.ik`` offers the solvers of :mod:`robotcell.ik`) do not count, as for cycles.
+LAYERS = [
+    {"robotcell.errors", "robotcell.kinematics.transforms", "robotcell.io.fileio",
+     "robotcell.io.tables", "robotcell.io.poseformats", "robotcell.ik.result"},
+    {"robotcell.kinematics", "robotcell.ik"},
+    {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification",
+     "robotcell.report"},
+    {"robotcell.cell"},
+    {"robotcell.io.export"},
+    {"robotcell.studies"},
+    {"robotcell.cli"},
+]
+
+
+def layer(module: str) -> int:
+    """Index in :data:`LAYERS` of the longest prefix of ``module``."""
+    best = (-1, -1)
+    for i, prefixes in enumerate(LAYERS):
+        for p in prefixes:
+            if (module == p or module.startswith(p + ".")) and len(p) > best[0]:
+                best = (len(p), i)
+    assert best[1] >= 0, f"{module} is in no layer"
+    return best[1]
+
+
+def test_every_module_is_in_a_layer():
+    assert layer("robotcell.io.export.kuka") == 4 and layer("robotcell.io.tables") == 0
+    assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 6
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if n not in ("robotcell", "robotcell._aliases")))
+def test_imports_go_down_the_layers(name):
+    up = sorted(t for t in internal(GRAPH[name]) - {"robotcell._aliases"}
+                if layer(t) > layer(name))
+    assert not up, f"{name} (layer {layer(name)}) imports {up} from a layer above"
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if n.startswith("robotcell.calibration")))
+def test_calibration_estimators_know_no_files(name):
+    # arrays in, results out: no file reading or writing, no YAML, no paths
+    bad = sorted(t for t in ALL_IMPORTS[name]
+                 if t in ("pathlib", "os", "io", "yaml", "csv", "json", "robotcell.io.fileio"))
+    tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
+    calls = {n.func.id for n in ast.walk(tree)
+             if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+    assert not bad and "open" not in calls, f"{name} imports {bad} or calls open()"

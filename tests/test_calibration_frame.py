@@ -6,7 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell import IllPosedError, InputError
 from robotcell.calibration import external_tcp, frame_3point, frame_npoint
-from robotcell.transforms import transform_points
+from robotcell.kinematics.transforms import transform_points
 
 R_TRUE = Rotation.from_euler("ZYX", [40, 5, -3], degrees=True).as_matrix()
 O_TRUE = np.array([1.2, -0.3, 0.4])

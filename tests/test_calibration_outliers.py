@@ -27,7 +27,7 @@ import robotcell.calibration.track as track_mod
 import robotcell.calibration.turntable as turntable_mod
 import robotcell.calibration.workpiece as workpiece_mod
 from robotcell.calibration.fitting import touch_statistics
-from robotcell.transforms import make_pose, rot_z, transform_points
+from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 
 RATE = 0.0027  # the documented false-alarm rate per touch (3 sigma)
 NOISE = 1e-4

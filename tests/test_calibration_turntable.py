@@ -6,7 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell import IllPosedError, InputError
 from robotcell.calibration.turntable import angular_spread, calibrate_turntable
-from robotcell.transforms import make_pose, rot_z
+from robotcell.kinematics.transforms import make_pose, rot_z
 
 SIGMA = 1e-4
 THETA = np.radians([0.0, 60.0, 130.0, 200.0, 270.0, 320.0])

@@ -26,11 +26,11 @@ from robotcell.calibration.verdict import (
     verdict,
 )
 from robotcell.cell import Cell, Tool, Track, Turntable
-from robotcell.modelfile import load_robot
-from robotcell.poseformats import pose_to_vendor
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.kinematics.models import load_robot
+from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 from robotcell.report import verdict as report_verdict
 from robotcell.report import write_report
-from robotcell.transforms import make_pose, rot_z, transform_points
 
 NOISE = 1e-4  # m per coordinate
 TCP = np.array([0.01, -0.02, 0.2])

@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 from robotcell import IllPosedError, InputError
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.calibration.workpiece import calibrate_workpiece, table_points, workpiece_pose
-from robotcell.transforms import make_pose, rot_z
+from robotcell.kinematics.transforms import make_pose, rot_z
 
 SIGMA = 1e-4
 T_R_B = make_pose(Rotation.from_rotvec([0.02, -0.01, 0.7]).as_matrix(), [1.2, 0.3, 0.4])

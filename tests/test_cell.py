@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import yaml
 
-import robotcell.cell as cellmod
+import robotcell.cell.schema as cellmod
 from robotcell import InputError, load_robot, pose_from_vendor, save_robot
 from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
 

@@ -1,4 +1,4 @@
-"""Calibrating into a cell from Python (``robotcell.cellcal``) and its CLI caller.
+"""Calibrating into a cell from Python (``robotcell.cell.calibrate``) and its CLI caller.
 
 The CLI's ``calibrate ... --cell`` and the library call on the same measurements write the same
 cell file, byte for byte, and print the same JSON result.
@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from cli_helpers import run
 
-from robotcell import cellcal
 from robotcell.cell import Cell, Frame, Provenance, cell_to_dict
-from robotcell.demo import demo_cells
+from robotcell.cell import calibrate as cellcal
 from robotcell.errors import InputError
-from robotcell.simulate import simulate
-from robotcell.tables import read_csv
+from robotcell.io.tables import read_csv
+from robotcell.studies.demo import demo_cells
+from robotcell.studies.simulate import simulate
 
 STAMP = "2026-01-02T03:04:05+00:00"
 

@@ -10,7 +10,7 @@ from robotcell import InputError, load_robot
 from robotcell.cell import Cell, Frame, Tool, Track, Turntable
 from robotcell.ik import kuka_status_turn
 from robotcell.ik.limits import TWO_PI
-from robotcell.transforms import make_pose
+from robotcell.kinematics.transforms import make_pose
 
 ROBOT = load_robot("kuka_kr16")
 TORCH = make_pose(Rotation.from_euler("y", 45, degrees=True).as_matrix(), [0.3125, -0.0012, 0.095])

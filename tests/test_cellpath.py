@@ -9,8 +9,8 @@ from scipy.spatial.transform import Rotation
 from test_cellik import track_cell
 
 from robotcell import InputError
-from robotcell.cellik import TRACK_WINDOW, split_path
-from robotcell.transforms import make_pose
+from robotcell.cell.ik import TRACK_WINDOW, split_path
+from robotcell.kinematics.transforms import make_pose
 
 DOWN = Rotation.from_euler("y", 180, degrees=True).as_matrix()  # torch pointing down
 

@@ -8,7 +8,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from robotcell import load_robot, pose_from_vendor, pose_to_vendor
-from robotcell.transforms import transform_points
+from robotcell.kinematics.transforms import transform_points
 
 T_TRUE = pose_from_vendor([1100, -250, 420, 35, 4, -2], "kuka")
 

@@ -8,7 +8,7 @@ from cli_helpers import run
 from scipy.spatial.transform import Rotation
 
 from robotcell.calibration.workpiece import workpiece_pose
-from robotcell.transforms import make_pose, rot_z
+from robotcell.kinematics.transforms import make_pose, rot_z
 
 Q = Rotation.from_rotvec([0.01, -0.02, 0.03]).as_matrix()
 REF = np.array([1.5, 0.8, 0.3])

@@ -12,8 +12,8 @@ from cli_helpers import run
 from robotcell.cell import Cell
 from robotcell.ik import abb_confdata, kuka_status_turn
 from robotcell.ik.limits import wrap_to_pi
-from robotcell.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.tables import read_csv
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.tables import read_csv
 
 CELL = Path(__file__).parent.parent / "examples" / "cell_kr16_track_turntable.yaml"
 

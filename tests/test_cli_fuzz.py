@@ -23,7 +23,7 @@ import pytest
 from cli_helpers import run
 
 from robotcell import pose_from_vendor, pose_to_vendor
-from robotcell.transforms import rot_z
+from robotcell.kinematics.transforms import rot_z
 
 SEED = int(os.environ.get("ROBOTCELL_FUZZ_SEED", "2026"))
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"

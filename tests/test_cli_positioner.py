@@ -304,9 +304,9 @@ def test_example_positioner_cell_levels_the_plate_at_zero():
 
 
 def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, monkeypatch):
-    from robotcell import cellcal
     from robotcell.cell import Provenance
-    from robotcell.tables import read_csv
+    from robotcell.cell import calibrate as cellcal
+    from robotcell.io.tables import read_csv
 
     stamp = "2026-01-02T03:04:05+00:00"
     monkeypatch.setattr(Provenance, "now", classmethod(
@@ -368,7 +368,7 @@ def test_positioner_in_a_track_cell_reads_the_track_column(tmp_path, capsys):
 
 
 def test_simulated_positioner_touches_reach_the_point_within_the_limits():
-    from robotcell.simulate import simulate
+    from robotcell.studies.simulate import simulate
 
     cell = Cell.load(EXAMPLE)
     t = simulate(cell, "positioner", noise=0.0, seed=1, tool="pointer", radius=0.15)

@@ -10,7 +10,6 @@ from cli_helpers import run
 from scipy.spatial.transform import Rotation
 
 from robotcell import load_robot
-from robotcell.coupling import Coupling
 from robotcell.errors import InputError
 from robotcell.ik import (
     TrackRobot,
@@ -24,8 +23,9 @@ from robotcell.ik import (
     solve_numeric,
 )
 from robotcell.ik.limits import wrap_to_pi
-from robotcell.modelfile import robot_from_dict, robot_to_dict, save_robot
-from robotcell.transforms import make_pose, rot_z
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.models import robot_from_dict, robot_to_dict, save_robot
+from robotcell.kinematics.transforms import make_pose, rot_z
 
 COUPLED = ["fanuc_lrmate200id", "fanuc_m20ia", "abb_irb2400", "abb_irb460"]
 
@@ -374,7 +374,7 @@ def test_robots_show_prints_the_interaction_limit(tmp_path, capsys):
 
 def test_palletizer_in_a_cell_is_refused_where_six_axes_are_needed():
     from robotcell.cell import Cell, Track
-    from robotcell.cellik import ik_path
+    from robotcell.cell.ik import ik_path
 
     robot = load_robot("abb_irb460")
     cell = Cell(robot=robot, robot_model="abb_irb460",
@@ -391,7 +391,7 @@ def test_palletizer_in_a_cell_is_refused_where_six_axes_are_needed():
 
 def test_simulated_touches_need_a_six_axis_arm():
     from robotcell.cell import Cell, Tool
-    from robotcell.simulate import simulate
+    from robotcell.studies.simulate import simulate
 
     robot = load_robot("abb_irb460")
     cell = Cell(robot=robot, robot_model="abb_irb460", tools={"gripper": Tool(make_pose(np.eye(3), [0, 0, 0.2]))})

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from robotcell import InputError, Joint, Robot, make_pose, rot_x
-from robotcell.dh import link_transform
+from robotcell.kinematics.dh import link_transform
 
 
 def test_link_transform_matches_lecture_matrix():

@@ -8,7 +8,7 @@ import pytest
 import robotcell as rc
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError, InputError
-from robotcell.transforms import make_pose
+from robotcell.kinematics.transforms import make_pose
 
 TOL = 1e-9
 

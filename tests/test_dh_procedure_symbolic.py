@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import robotcell as rc
-from robotcell.dh import link_transform
 from robotcell.dhprocedure.symbolic import symbolic_arm, symbolic_link
 from robotcell.errors import InputError, RobotcellError
+from robotcell.kinematics.dh import link_transform
 
 sp = pytest.importorskip("sympy")
 

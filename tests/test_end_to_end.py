@@ -15,11 +15,11 @@ from cli_helpers import run
 
 from robotcell import load_robot
 from robotcell.cell import Cell, Frame, Tool, Turntable
-from robotcell.demo import EXPORT_FILES, demo_cells
-from robotcell.export import EXPORT_FORMATS, parse_export
-from robotcell.export.common import collect, flatten_table
-from robotcell.plan import pose_error
-from robotcell.poseformats import pose_from_vendor
+from robotcell.io.export import EXPORT_FORMATS, parse_export
+from robotcell.io.export.common import collect, flatten_table
+from robotcell.io.poseformats import pose_from_vendor
+from robotcell.studies.demo import EXPORT_FILES, demo_cells
+from robotcell.studies.plan import pose_error
 
 #: Controller reference frame of each export (see docs/export.md).
 REFERENCE = {"kuka": "world", "abb": "world", "fanuc": "robot", "yaskawa": "robot"}

@@ -18,9 +18,9 @@ from test_positioner import tilt_rotate
 
 from robotcell import load_robot, pose_from_vendor
 from robotcell.cell import Cell, Frame, Positioner, Tool, Turntable
-from robotcell.demo import demo_cells
-from robotcell.export import export_cell
-from robotcell.export.urdf import urdf_origin
+from robotcell.io.export import export_cell
+from robotcell.io.export.urdf import urdf_origin
+from robotcell.studies.demo import demo_cells
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "cell_kr16_track_turntable.yaml"
 TOL = 1e-9

@@ -15,8 +15,8 @@ import pytest
 from cli_helpers import run
 
 from robotcell import InputError, load_robot, pose_from_vendor
-from robotcell.fileio import atomic_copy, atomic_write, read_text
-from robotcell.tables import read_csv, unknown_columns
+from robotcell.io.fileio import atomic_copy, atomic_write, read_text
+from robotcell.io.tables import read_csv, unknown_columns
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "cell_kr16_track_turntable.yaml"
@@ -206,7 +206,7 @@ def test_output_written_atomically_with_permissions_kept(tmp_path, capsys, joint
 
 
 def _turntable_csv(tmp_path):
-    from robotcell.transforms import rot_z
+    from robotcell.kinematics.transforms import rot_z
 
     T = pose_from_vendor([2000, 900, 200, 90, 0.2, -0.1], "kuka")
     theta = np.radians([0.0, 60.0, 120.0, 180.0, 240.0, 300.0])

@@ -18,9 +18,9 @@ from identification_helpers import (
 
 from robotcell import load_robot, save_robot
 from robotcell.identification import Measurements
-from robotcell.poseformats import pose_to_vendor
-from robotcell.robot import Joint, Robot
-from robotcell.transforms import make_pose, rot_y
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.kinematics.robot import Joint, Robot
+from robotcell.kinematics.transforms import make_pose, rot_y
 
 NOISE = 0.02e-3
 

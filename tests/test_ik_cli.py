@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from robotcell.cli import main
-from robotcell.modelfile import load_robot
-from robotcell.poseformats import pose_to_vendor
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.kinematics.models import load_robot
 
 
 def run(argv, capsys):

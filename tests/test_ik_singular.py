@@ -14,17 +14,17 @@ import math
 import numpy as np
 import pytest
 
-from robotcell.dh import link_transform
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, solve
 from robotcell.ik.limits import TWO_PI, wrap_to_pi
 from robotcell.ik.opw import opw_fk
 from robotcell.ik.result import REACH_TOL
 from robotcell.ik.ur import ur_fk_frames
-from robotcell.modelfile import list_robots, load_robot
-from robotcell.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.robot import Robot
-from robotcell.transforms import rot_z
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.kinematics.dh import link_transform
+from robotcell.kinematics.models import list_robots, load_robot
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import rot_z
 
 ANALYTIC = [n for n in list_robots() if n != "stanford_arm"]
 N_RANDOM = 10_000

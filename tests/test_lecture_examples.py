@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.calibration.track import calibrate_track
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.calibration.workpiece import calibrate_workpiece
-from robotcell.transforms import invert, make_pose, rot_z
+from robotcell.kinematics.transforms import invert, make_pose, rot_z
 
 Q_TRUE = Rotation.from_rotvec([0.01, -0.02, 0.03]).as_matrix()  # L_Q_R, a small mounting error
 REF_L = np.array([1.5, 0.8, 0.3])  # the fixed reference point r, in L

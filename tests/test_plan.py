@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from robotcell import InputError
-from robotcell.demo import demo_cells
-from robotcell.plan import DESIGNS, LEVER, plan
+from robotcell.studies.demo import demo_cells
+from robotcell.studies.plan import DESIGNS, LEVER, plan
 
 TRUTH, _ = demo_cells()
 

@@ -3,7 +3,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from robotcell import FORMATS, InputError, pose_from_vendor, pose_to_vendor
-from robotcell.transforms import rot_x, rot_y, rot_z
+from robotcell.kinematics.transforms import rot_x, rot_y, rot_z
 
 # Reference values from docs/references.md (Roboception rc_visard pose formats; ABB RAPID
 # `orient`; RoboDK "Reference frames" for Staubli), the worked example there.

@@ -14,11 +14,11 @@ import pytest
 
 from robotcell import make_pose, rot_x, rot_y, rot_z
 from robotcell.cell import Cell, Frame, Positioner, Provenance, Tool, Turntable
-from robotcell.demo import demo_cells
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import InputError
-from robotcell.modelfile import load_robot
-from robotcell.poseformats import pose_from_vendor
+from robotcell.io.poseformats import pose_from_vendor
+from robotcell.kinematics.models import load_robot
+from robotcell.studies.demo import demo_cells
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = Path(__file__).resolve().parent / "data"
@@ -215,7 +215,7 @@ def test_positioner_errors_name_the_cause(tmp_path):
 @pytest.mark.parametrize("convention, signs", [("standard", [1, 1]), ("modified", [1, -1]),
                                                ("standard", [-1, -1])])
 def test_kuka_and_abb_exports_hold_the_axis_chain(fmt, convention, signs):
-    from robotcell.export import export_cell, parse_export
+    from robotcell.io.export import export_cell, parse_export
 
     chain = dh_from_axes(AXES, convention, signs=signs).robot
     cell = tilt_rotate()
@@ -237,7 +237,7 @@ def test_kuka_and_abb_exports_hold_the_axis_chain(fmt, convention, signs):
 
 
 def test_kuka_positioner_next_to_a_linear_unit_is_et2():
-    from robotcell.export import export_cell
+    from robotcell.io.export import export_cell
 
     truth, _ = demo_cells()
     chain = dh_from_axes(AXES, "standard").robot
@@ -249,8 +249,8 @@ def test_kuka_positioner_next_to_a_linear_unit_is_et2():
 
 
 def test_one_axis_procedures_refuse_a_positioner_chain():
-    from robotcell import cellcal
-    from robotcell.simulate import simulate
+    from robotcell.cell import calibrate as cellcal
+    from robotcell.studies.simulate import simulate
 
     cell = tilt_rotate()
     with pytest.raises(InputError, match=r"positioner 'DKP_2' is a chain of 2 axes; the "
@@ -260,13 +260,13 @@ def test_one_axis_procedures_refuse_a_positioner_chain():
              "e1": [0.0, 90.0, 180.0]}
     with pytest.raises(InputError, match=r"the turntable procedure is for a one-axis turntable; "
                                          r"a positioner chain is calibrated by "
-                                         r"robotcell.cellcal.positioner"):
+                                         r"robotcell.cell.calibrate.positioner"):
         cellcal.turntable(cell, table)
 
 
 @pytest.mark.parametrize("fmt", ["fanuc", "yaskawa"])
 def test_fanuc_and_yaskawa_write_frames_on_a_positioner_at_axis_zero(fmt):
-    from robotcell.export import export_cell, parse_export
+    from robotcell.io.export import export_cell, parse_export
 
     cell = tilt_rotate("modified")
     part = next(s for s in parse_export(export_cell(cell, fmt), fmt).frames if s.name == "part")
@@ -296,7 +296,7 @@ def test_ik_path_follows_the_positioner_axes():
 
 
 def test_positioner_touches_map_a_touched_point_into_the_parent_frame():
-    from robotcell import cellcal
+    from robotcell.cell import calibrate as cellcal
 
     cell = tilt_rotate()
     v = np.radians([[0.0, 0.0], [30.0, 90.0], [-20.0, 200.0], [10.0, -45.0]])
@@ -312,7 +312,7 @@ def test_positioner_touches_map_a_touched_point_into_the_parent_frame():
 
 
 def test_positioner_calibration_into_the_cell_recovers_the_true_chain(tmp_path):
-    from robotcell import cellcal
+    from robotcell.cell import calibrate as cellcal
 
     true_axes = AxisChain(points=AXES.points + [[0.002, -0.001, 0.003], [0.001, 0.002, 0.0]],
                           directions=AXES.directions + [[0.0, 0.0, 0.004], [0.003, -0.002, 0.0]],
@@ -349,7 +349,7 @@ def test_positioner_calibration_into_the_cell_recovers_the_true_chain(tmp_path):
 
 
 def test_workpiece_on_a_positioner_chain_is_touched_into_its_plate():
-    from robotcell import cellcal
+    from robotcell.cell import calibrate as cellcal
 
     cell = tilt_rotate("modified")
     p_W = np.array([[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]] * 2, dtype=float)  # origin, x, xy

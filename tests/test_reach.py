@@ -12,7 +12,7 @@ from cli_helpers import run
 
 from robotcell import InputError
 from robotcell.cell import Cell
-from robotcell.reach import LIMIT_REF, manipulability_scale, reach_map, read_targets
+from robotcell.studies.reach import LIMIT_REF, manipulability_scale, reach_map, read_targets
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
@@ -110,7 +110,7 @@ def test_chosen_table_angle_reaches_and_scores_at_least_as_well_as_zero(capsys, 
 
 def test_progress_in_blocks_gives_the_same_map(capsys, tmp_path, monkeypatch):
     import robotcell.cli.progress as cli_progress
-    from robotcell import reach
+    from robotcell.studies import reach
 
     cell = Cell.load(CELL)
     T, table = read_targets(SEAM)

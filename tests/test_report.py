@@ -15,8 +15,8 @@ from robotcell import InputError
 from robotcell.calibration.frame import frame_npoint
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.cli import main
+from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 from robotcell.report import load_result, verdict, write_report
-from robotcell.transforms import make_pose, rot_z, transform_points
 
 
 def frame_result(seed=0, outlier=False, size=0.004):

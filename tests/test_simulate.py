@@ -17,8 +17,8 @@ from robotcell.calibration.track import calibrate_track
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.calibration.workpiece import calibrate_workpiece
 from robotcell.cell import Cell, Frame, Tool, Track, Turntable
-from robotcell.simulate import PROCEDURES, simulate
-from robotcell.transforms import rot_z
+from robotcell.kinematics.transforms import rot_z
+from robotcell.studies.simulate import PROCEDURES, simulate
 
 ROBOT = load_robot("kuka_kr16")
 NOISE = 1e-4

@@ -12,8 +12,8 @@ from cli_helpers import run
 import robotcell.cli.progress as cli_progress
 from robotcell import InputError
 from robotcell.cell import Cell
-from robotcell.reach import reach_map, read_targets
-from robotcell.sweep import apply_layout, read_layouts, sweep
+from robotcell.studies.reach import reach_map, read_targets
+from robotcell.studies.sweep import apply_layout, read_layouts, sweep
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
@@ -165,6 +165,6 @@ def test_reach_and_sweep_with_a_two_axis_positioner(capsys, tmp_path):
     ranked = sweep(cell, T, layouts, frame="part", tool="torch", table=v)
     assert ranked[0].index == 0 and ranked[0].fraction == 1.0    # as built: every target
     assert all(r.fraction < 1.0 for r in ranked if r.layout.values["turntable.x"] == 2000)
-    from robotcell.reach import reach_html
+    from robotcell.studies.reach import reach_html
     page = reach_html(rm, T[:, :3, 3], frame="part")
     assert "30 of 30 targets reachable" in page

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from robotcell import InputError, load_robot
-from robotcell.cellik import choose_track_value
+from robotcell.cell.ik import choose_track_value
 from robotcell.ik import TrackRobot, analytic_solver
 from robotcell.ik.trackchoice import (
     arm_manipulability,
@@ -13,7 +13,7 @@ from robotcell.ik.trackchoice import (
     scan_track,
     track_interval,
 )
-from robotcell.transforms import make_pose, rot_x, rot_z
+from robotcell.kinematics.transforms import make_pose, rot_x, rot_z
 
 ARM = load_robot("kuka_kr16")
 
@@ -137,8 +137,8 @@ def test_errors():
 def test_cell_ik_choice_matches_the_sampled_search_in_a_frame_on_the_table():
     from test_cellik import track_cell
 
-    from robotcell.cellik import _track_robot
-    from robotcell.transforms import invert
+    from robotcell.cell.ik import _track_robot
+    from robotcell.kinematics.transforms import invert
 
     cell = track_cell()
     rng = np.random.default_rng(6)

@@ -3,7 +3,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from robotcell import InputError, check_pose, compose, invert, make_pose, rot_x, rot_y, rot_z
-from robotcell.transforms import transform_points, validate_pose
+from robotcell.kinematics.transforms import transform_points, validate_pose
 
 
 def random_poses(rng, n):

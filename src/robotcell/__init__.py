@@ -4,6 +4,10 @@ Conventions (pose naming ``T_a_b``, units, array shapes) are in ``docs/conventio
 
 The public names below are imported on first use (PEP 562), so ``import robotcell`` and the
 command line's ``--version`` and ``--help`` do not pay for numpy and scipy.
+
+The modules live in concept packages (``docs/conventions.md``, "Layout"); the old top-level
+module paths (``robotcell.transforms``, ``robotcell.cellik``, ...) still import, with a
+DeprecationWarning, for one release (:mod:`robotcell._aliases`).
 """
 
 from __future__ import annotations
@@ -11,14 +15,17 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from robotcell import _aliases
 from robotcell.errors import IllPosedError, InputError, RobotcellError
 
+_aliases.install()
+
 if TYPE_CHECKING:
-    from robotcell.coupling import Coupling
-    from robotcell.modelfile import list_robots, load_robot, robot_from_dict, save_robot
-    from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
-    from robotcell.robot import Joint, Robot
-    from robotcell.transforms import (
+    from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
+    from robotcell.kinematics.coupling import Coupling
+    from robotcell.kinematics.models import list_robots, load_robot, robot_from_dict, save_robot
+    from robotcell.kinematics.robot import Joint, Robot
+    from robotcell.kinematics.transforms import (
         check_pose,
         compose,
         invert,
@@ -34,16 +41,17 @@ __version__ = "0.1.0"
 
 #: public name -> module that defines it, imported on first access
 _LAZY = {
-    "Coupling": "robotcell.coupling",
+    "Coupling": "robotcell.kinematics.coupling",
     **dict.fromkeys(["list_robots", "load_robot", "robot_from_dict", "save_robot"],
-                    "robotcell.modelfile"),
-    **dict.fromkeys(["FORMATS", "pose_from_vendor", "pose_to_vendor"], "robotcell.poseformats"),
-    **dict.fromkeys(["Joint", "Robot"], "robotcell.robot"),
+                    "robotcell.kinematics.models"),
+    **dict.fromkeys(["FORMATS", "pose_from_vendor", "pose_to_vendor"], "robotcell.io.poseformats"),
+    **dict.fromkeys(["Joint", "Robot"], "robotcell.kinematics.robot"),
     **dict.fromkeys(["check_pose", "compose", "invert", "make_pose", "rot_x", "rot_y", "rot_z",
-                     "transform_points", "validate_pose"], "robotcell.transforms"),
+                     "transform_points", "validate_pose"], "robotcell.kinematics.transforms"),
 }
 #: Submodules that ``import robotcell`` used to load as a side effect, still reachable as
-#: attributes (``robotcell.transforms``) and loaded on first access.
+#: attributes (``robotcell.transforms``, deprecated: :mod:`robotcell._aliases`) and loaded on
+#: first access.
 _SUBMODULES = {"coupling", "dh", "modelfile", "poseformats", "robot", "transforms"}
 
 __all__ = [

@@ -25,7 +25,7 @@ import numpy as np
 from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
-from robotcell.fileio import atomic_write, read_text
+from robotcell.io.fileio import atomic_write, read_text
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 

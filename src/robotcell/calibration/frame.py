@@ -21,7 +21,7 @@ from robotcell.calibration.fitting import (
 )
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
-from robotcell.transforms import as_points
+from robotcell.kinematics.transforms import as_points
 
 __all__ = ["external_tcp", "frame_3point", "frame_npoint"]
 

@@ -14,7 +14,7 @@ degrees. Column names are case-insensitive.
 - ``nominal_x, nominal_y, nominal_z``: known coordinates of a touched point in the frame being
   calibrated (mm), for N-point frames.
 
-Columns come from :func:`robotcell.cli.common.read_csv` (lower-cased names; numeric columns as
+Columns come from :func:`robotcell.io.tables.read_csv` (lower-cased names; numeric columns as
 float arrays, others as lists of strings).
 """
 
@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.errors import InputError
-from robotcell.poseformats import pose_from_vendor
-from robotcell.robot import Robot
+from robotcell.io.poseformats import pose_from_vendor
+from robotcell.kinematics.robot import Robot
 
 __all__ = [
     "MM_LOOKS_LIKE_M",

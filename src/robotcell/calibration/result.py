@@ -23,8 +23,8 @@ from robotcell.calibration.verdict import (
 )
 from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
-from robotcell.poseformats import pose_to_vendor
-from robotcell.tables import format_table
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.io.tables import format_table
 
 __all__ = ["CalibrationResult", "pose_fields", "to_jsonable"]
 

@@ -23,7 +23,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.calibration.fitting import fit, nearest_rotation, outlier_warnings, perturb_rotation
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
-from robotcell.transforms import validate_pose
+from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["ABC_WORLD_5D", "ABC_WORLD_6D", "calibrate_tool"]
 

@@ -38,7 +38,7 @@ from robotcell.calibration.fitting import (
 from robotcell.calibration.propagate import propagate
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult
 from robotcell.errors import IllPosedError, InputError
-from robotcell.transforms import as_points, make_pose
+from robotcell.kinematics.transforms import as_points, make_pose
 
 __all__ = ["TRACK_AXES", "calibrate_track", "zero_roll_rotation"]
 

@@ -25,7 +25,7 @@ from robotcell.calibration.fitting import fit, outlier_warnings, perturb_rotatio
 from robotcell.calibration.propagate import propagate
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
-from robotcell.transforms import as_points, make_pose, rot_z
+from robotcell.kinematics.transforms import as_points, make_pose, rot_z
 
 __all__ = ["angular_spread", "calibrate_turntable"]
 

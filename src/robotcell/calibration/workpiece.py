@@ -25,7 +25,7 @@ from robotcell.calibration.fitting import fit, outlier_warnings, perturb_pose
 from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
-from robotcell.transforms import as_points, invert, make_pose, rot_z, validate_pose
+from robotcell.kinematics.transforms import as_points, invert, make_pose, rot_z, validate_pose
 
 __all__ = ["ROLES", "calibrate_workpiece", "table_points", "workpiece_pose"]
 

@@ -4,7 +4,7 @@ Every subcommand reads a CSV (mm, deg; see docs/calibration.md), prints a report
 with ``--json``, one JSON object, and exits with status 2 and the reason on stderr when the input
 is refused. With ``--cell CELL.yaml`` (tcp, frame, track, turntable, workpiece) the result is
 written into the cell file: the command parses its options, makes one call of
-:mod:`robotcell.cellcal` (which returns the result and the updated cell), prints its notes on
+:mod:`robotcell.cell.calibrate` (which returns the result and the updated cell), prints its notes on
 stderr and saves the cell through :class:`CellTarget`.
 Subcommands of other modules are listed in ``REGISTERED`` at the bottom of this file and imported
 only when used.
@@ -22,16 +22,16 @@ import click
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell import cellcal
 from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
-from robotcell.cellcal.touches import POSE_COLUMNS, line_labels, repeat_notes
+from robotcell.cell import calibrate as cellcal
+from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
 from robotcell.cli.common import check_output, parse_numbers, read_csv, write_output
 from robotcell.errors import InputError
-from robotcell.modelfile import load_robot
-from robotcell.poseformats import pose_from_vendor
-from robotcell.robot import Robot
+from robotcell.io.poseformats import pose_from_vendor
+from robotcell.kinematics.models import load_robot
+from robotcell.kinematics.robot import Robot
 
 
 class CalibrateGroup(click.Group):

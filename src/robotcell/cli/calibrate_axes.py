@@ -16,8 +16,8 @@ from pathlib import Path
 import click
 import numpy as np
 
-from robotcell import cellcal
-from robotcell.cellcal.touches import POSE_COLUMNS
+from robotcell.cell import calibrate as cellcal
+from robotcell.cell.calibrate.touches import POSE_COLUMNS
 from robotcell.cli.calibrate import (
     CellTarget,
     cell_of,
@@ -32,8 +32,8 @@ from robotcell.cli.calibrate import (
 )
 from robotcell.cli.common import parse_numbers, read_csv
 from robotcell.errors import InputError
-from robotcell.fileio import read_text
-from robotcell.transforms import validate_pose
+from robotcell.io.fileio import read_text
+from robotcell.kinematics.transforms import validate_pose
 
 
 @click.command("track")

@@ -8,7 +8,7 @@ import click
 
 from robotcell.cell import Cell, Provenance, Turntable
 from robotcell.cli.common import format_table
-from robotcell.poseformats import pose_to_vendor
+from robotcell.io.poseformats import pose_to_vendor
 
 
 def _prov(p: Provenance) -> str:

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from robotcell.cell import Cell, Positioner, Track, Turntable
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
-from robotcell.poseformats import pose_from_vendor
+from robotcell.io.poseformats import pose_from_vendor
 
 __all__ = ["NORMAL_UP", "PROGRESS_MIN", "cell_tool", "check_normal_up", "chunks", "row_values",
            "table_angles", "table_columns", "table_option", "table_rows", "track_values"]

@@ -1,5 +1,5 @@
-"""Helpers shared by the CLI commands: number lists; CSV files and tables (from ``robotcell.tables``);
-output files (written atomically, from ``robotcell.fileio``).
+"""Helpers shared by the CLI commands: number lists; CSV files and tables (from ``robotcell.io.tables``);
+output files (written atomically, from ``robotcell.io.fileio``).
 
 Every file the CLI reads or writes is CSV with a header, lengths in millimetres and angles in
 degrees.
@@ -13,10 +13,10 @@ from pathlib import Path
 
 import click
 
-from robotcell import tables
 from robotcell.errors import InputError
-from robotcell.fileio import atomic_write, check_destination
-from robotcell.tables import format_table, require_columns, write_csv
+from robotcell.io import tables
+from robotcell.io.fileio import atomic_write, check_destination
+from robotcell.io.tables import format_table, require_columns, write_csv
 
 __all__ = ["check_not_folder", "check_output", "format_table", "parse_numbers", "read_csv", "require_columns",
            "write_csv", "write_output"]
@@ -40,7 +40,7 @@ def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]
 
 
 def read_csv(path: str, known: Iterable[str] | None = None) -> dict:
-    """:func:`robotcell.tables.read_csv`, warning on stderr about columns not in ``known``.
+    """:func:`robotcell.io.tables.read_csv`, warning on stderr about columns not in ``known``.
 
     ``known`` lists the columns the command uses; any other column (except a note column) is
     named in a ``warning:`` line, with the closest known name, since it is otherwise ignored.
@@ -69,7 +69,7 @@ def check_not_folder(ctx: click.Context, param: click.Parameter, value: str | No
 
 
 def write_output(path: str | None, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (see :mod:`robotcell.fileio`), or to stdout."""
+    """Write ``text`` to ``path`` atomically (see :mod:`robotcell.io.fileio`), or to stdout."""
     if path is None:
         click.echo(text, nl=False)
     else:

@@ -6,8 +6,8 @@ import math
 
 import click
 
-from robotcell.demo import DEMO_NOISE, run_demo
 from robotcell.errors import InputError
+from robotcell.studies.demo import DEMO_NOISE, run_demo
 
 
 @click.command()

@@ -18,9 +18,9 @@ from robotcell.dhprocedure import (
     dh_from_urdf,
     symbolic_arm,
 )
-from robotcell.modelfile import load_robot, save_robot
-from robotcell.poseformats import pose_to_vendor
-from robotcell.robot import Joint, Robot
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.kinematics.models import load_robot, save_robot
+from robotcell.kinematics.robot import Joint, Robot
 
 _CONVENTION = click.Choice(["standard", "modified"])
 

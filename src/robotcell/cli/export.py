@@ -6,7 +6,7 @@ import click
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_output, write_output
-from robotcell.export import WRITE_FORMATS, export_cell
+from robotcell.io.export import WRITE_FORMATS, export_cell
 
 
 @click.command()

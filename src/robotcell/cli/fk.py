@@ -20,9 +20,9 @@ from robotcell.cli.cellargs import (
 )
 from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
 from robotcell.errors import InputError
-from robotcell.modelfile import load_robot
-from robotcell.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
-from robotcell.robot import Robot
+from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
+from robotcell.kinematics.models import load_robot
+from robotcell.kinematics.robot import Robot
 
 FORMAT_CHOICES = [*FORMATS, "matrix"]
 

@@ -21,9 +21,9 @@ from robotcell.identification.validation import (
     cross_validate,
     select_configurations,
 )
-from robotcell.modelfile import load_robot, save_robot
-from robotcell.robot import Robot
-from robotcell.tables import format_table, write_csv
+from robotcell.io.tables import format_table, write_csv
+from robotcell.kinematics.models import load_robot, save_robot
+from robotcell.kinematics.robot import Robot
 
 
 def _offsets(result, vendor: str) -> dict:

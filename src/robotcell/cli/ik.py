@@ -34,9 +34,9 @@ from robotcell.cli.common import (
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
-from robotcell.modelfile import load_robot
-from robotcell.poseformats import FORMATS, pose_from_vendor
-from robotcell.robot import Robot
+from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.kinematics.models import load_robot
+from robotcell.kinematics.robot import Robot
 
 BRANCHES = ["front up", "front up flip", "front down", "front down flip",
             "back up", "back up flip", "back down", "back down flip"]

@@ -13,8 +13,8 @@ from robotcell.cell import Cell
 from robotcell.cli.common import check_output, format_table
 from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
 from robotcell.errors import InputError
-from robotcell.plan import DESIGNS, LEVER, Candidate
-from robotcell.plan import plan as make_plan
+from robotcell.studies.plan import DESIGNS, LEVER, Candidate
+from robotcell.studies.plan import plan as make_plan
 
 
 def _design_text(design: dict[str, Any]) -> str:

@@ -15,8 +15,8 @@ from robotcell.cell import Cell
 from robotcell.cli.common import check_output, write_csv, write_output
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
-from robotcell.poseformats import FORMATS
-from robotcell.reach import ReachMap, reach_html, reach_map, read_targets
+from robotcell.io.poseformats import FORMATS
+from robotcell.studies.reach import ReachMap, reach_html, reach_map, read_targets
 
 
 def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:

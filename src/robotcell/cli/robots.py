@@ -8,9 +8,9 @@ import click
 import numpy as np
 
 from robotcell.cli.common import format_table
-from robotcell.modelfile import list_robots, load_robot
-from robotcell.poseformats import pose_to_vendor
-from robotcell.robot import Robot
+from robotcell.io.poseformats import pose_to_vendor
+from robotcell.kinematics.models import list_robots, load_robot
+from robotcell.kinematics.robot import Robot
 
 
 @click.group(invoke_without_command=True)

@@ -18,8 +18,8 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.common import check_output, parse_numbers
 from robotcell.errors import InputError
-from robotcell.simulate import PROCEDURES, Touches
-from robotcell.simulate import simulate as simulate_touches
+from robotcell.studies.simulate import PROCEDURES, Touches
+from robotcell.studies.simulate import simulate as simulate_touches
 
 
 def _mm(option: str, positive: bool = False) -> Callable[[float], float]:

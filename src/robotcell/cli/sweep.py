@@ -14,7 +14,7 @@ from robotcell.cli.common import check_output, format_table, write_csv
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
 from robotcell.errors import InputError
-from robotcell.sweep import read_layouts, sweep
+from robotcell.studies.sweep import read_layouts, sweep
 
 
 def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> Executor | None:

@@ -21,10 +21,10 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.dh import Convention
 from robotcell.errors import InputError
-from robotcell.robot import Robot
-from robotcell.transforms import make_pose, rot_x
+from robotcell.kinematics.dh import Convention
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import make_pose, rot_x
 
 __all__ = ["convert_convention"]
 

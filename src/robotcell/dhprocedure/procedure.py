@@ -38,11 +38,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.dh import Convention
 from robotcell.dhprocedure.axes import AxisChain
 from robotcell.errors import IllPosedError, InputError
-from robotcell.robot import Joint, Robot
-from robotcell.transforms import invert, make_pose
+from robotcell.kinematics.dh import Convention
+from robotcell.kinematics.robot import Joint, Robot
+from robotcell.kinematics.transforms import invert, make_pose
 
 __all__ = ["DHDerivation", "FrameNote", "dh_from_axes"]
 

@@ -13,9 +13,9 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from robotcell.dh import Convention
 from robotcell.errors import InputError, RobotcellError
-from robotcell.robot import Robot
+from robotcell.kinematics.dh import Convention
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["SymbolicArm", "symbolic_arm", "symbolic_link"]
 

@@ -22,12 +22,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.dh import Convention
 from robotcell.dhprocedure.axes import AxisChain
 from robotcell.dhprocedure.procedure import DHDerivation, dh_from_axes
 from robotcell.errors import InputError, RobotcellError
-from robotcell.fileio import read_text
-from robotcell.transforms import make_pose
+from robotcell.io.fileio import read_text
+from robotcell.kinematics.dh import Convention
+from robotcell.kinematics.transforms import make_pose
 
 __all__ = ["UrdfChain", "UrdfJoint", "dh_from_urdf", "read_urdf"]
 

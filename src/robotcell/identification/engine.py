@@ -32,7 +32,6 @@ from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from robotcell.calibration.fitting import kabsch, scaled_condition
-from robotcell.coupling import Coupling
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import COMPLIANT_JOINTS, Chain
@@ -41,7 +40,8 @@ from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult, Parameter
 from robotcell.ik import analytic_solver
 from robotcell.ik.seeded import SeededSolver
-from robotcell.robot import Robot
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["identify", "identify_with_coupling"]
 

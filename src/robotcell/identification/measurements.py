@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
-from robotcell.tables import read_csv, require_columns
+from robotcell.io.tables import read_csv, require_columns
 
 __all__ = ["Measurements", "read_measurements"]
 

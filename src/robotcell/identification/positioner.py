@@ -34,8 +34,8 @@ from robotcell.identification.circles import start_model
 from robotcell.identification.engine import identify
 from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult
-from robotcell.robot import Robot
-from robotcell.transforms import as_points
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import as_points
 
 __all__ = ["PositionerCalibration", "calibrate_positioner"]
 

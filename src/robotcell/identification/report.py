@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.fileio import atomic_write
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
+from robotcell.io.fileio import atomic_write
 from robotcell.report import _CSS, _SCRIPT, _fmt, _png
 
 __all__ = ["write_identification_report"]

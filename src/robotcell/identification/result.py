@@ -11,8 +11,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
 from robotcell.calibration.result import CONDITION_LIMIT, to_jsonable
-from robotcell.robot import Robot
-from robotcell.tables import format_table
+from robotcell.io.tables import format_table
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["IdentificationResult", "Parameter"]
 

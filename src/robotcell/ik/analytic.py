@@ -1,11 +1,11 @@
-"""Batched analytic inverse kinematics of a :class:`~robotcell.robot.Robot`.
+"""Batched analytic inverse kinematics of a :class:`~robotcell.kinematics.robot.Robot`.
 
 :func:`solve` recognises the structure of the model once (cached per robot object) and returns
 all 8 solutions of every pose: ortho-parallel arms with a spherical wrist through
 :mod:`robotcell.ik.opw`, Universal-Robots-type arms through :mod:`robotcell.ik.ur`, and all 4
 solutions of 4-axis palletizers through :mod:`robotcell.ik.palletizer`.
 
-A robot with a joint coupling (:mod:`robotcell.coupling`) is solved on its uncoupled model; the
+A robot with a joint coupling (:mod:`robotcell.kinematics.coupling`) is solved on its uncoupled model; the
 model solutions are mapped to controller values right after the kernel, and the 2*pi rule, the
 joint limits and the interaction limits are then applied to the controller values, as the pendant
 shows them. Robots without a coupling skip the mapping.
@@ -35,8 +35,8 @@ from robotcell.ik.palletizer import (
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.seeded import SeededSolver
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
-from robotcell.robot import Robot
-from robotcell.transforms import finite_array, invert, validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import finite_array, invert, validate_pose
 
 __all__ = ["AnalyticSolver", "analytic_solver", "solve"]
 

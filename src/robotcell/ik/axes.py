@@ -7,7 +7,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.robot import Robot
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["AXIS_TOL", "angle_deg", "closest_point", "joint_axes", "line_distance"]
 

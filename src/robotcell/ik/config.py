@@ -39,7 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.opw import OPWParameters
-from robotcell.robot import Robot
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["abb_confdata", "arm_sides", "kuka_status_turn"]
 

@@ -1,6 +1,6 @@
 """Numeric inverse kinematics for any chain: damped least squares with Levenberg-Marquardt damping.
 
-Works for every :class:`~robotcell.robot.Robot` (prismatic joints, 7 or more axes, calibrated
+Works for every :class:`~robotcell.kinematics.robot.Robot` (prismatic joints, 7 or more axes, calibrated
 models whose axes are no longer exactly parallel). For a batch of targets it iterates all
 unconverged targets together:
 
@@ -26,8 +26,8 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
 from robotcell.ik.result import NumericIKResult
-from robotcell.robot import Robot
-from robotcell.transforms import validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["solve_numeric"]
 

@@ -38,8 +38,8 @@ from robotcell.ik.axes import (
 )
 from robotcell.ik.limits import TWO_PI, wrap_to_pi
 from robotcell.ik.result import REACH_TOL
-from robotcell.robot import Robot
-from robotcell.transforms import invert, rot_y, rot_z
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import invert, rot_y, rot_z
 
 __all__ = ["OPWParameters", "clamp_circular", "opw_fk", "opw_kernel", "opw_parameters", "opw_problems",
            "reach_distance"]

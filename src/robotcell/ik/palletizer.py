@@ -29,7 +29,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.errors import InputError
 from robotcell.ik.axes import AXIS_TOL
 from robotcell.ik.limits import wrap_to_pi
-from robotcell.robot import Robot
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["PalletizerParameters", "palletizer_kernel", "palletizer_parameters", "palletizer_problems"]
 

@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.ik.numeric import solve_numeric
 from robotcell.ik.result import IKSolutions
-from robotcell.robot import Robot
-from robotcell.transforms import validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["SEEDED_TOL", "SeededSolver"]
 

@@ -16,7 +16,7 @@ from robotcell.errors import InputError
 from robotcell.ik.config import abb_confdata, kuka_status_turn
 from robotcell.ik.limits import TWO_PI, shift_into_interval
 from robotcell.ik.result import IKSolutions
-from robotcell.robot import Robot
+from robotcell.kinematics.robot import Robot
 
 __all__ = ["nearest", "select_abb", "select_kuka"]
 

@@ -14,7 +14,7 @@ the lecture; KUKA external axes move along their Z.
 
 :meth:`TrackRobot.as_robot` writes the same system as one 7-joint DH chain whose first, prismatic
 joint slides along ``u`` (a DH frame placed at the track), for numeric IK or anything that takes a
-:class:`~robotcell.robot.Robot`.
+:class:`~robotcell.kinematics.robot.Robot`.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.ik.analytic import solve
 from robotcell.ik.result import IKSolutions
-from robotcell.robot import Joint, Robot
-from robotcell.transforms import invert, make_pose, rot_x, validate_pose
+from robotcell.kinematics.robot import Joint, Robot
+from robotcell.kinematics.transforms import invert, make_pose, rot_x, validate_pose
 
 __all__ = ["TrackChoice", "TrackRobot"]
 

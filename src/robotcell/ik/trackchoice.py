@@ -52,8 +52,8 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.opw import OPWParameters
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.track import TrackChoice, TrackRobot
-from robotcell.robot import Robot
-from robotcell.transforms import invert, validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import invert, validate_pose
 
 __all__ = ["TrackScan", "arm_manipulability", "choose_track", "manipulability", "scan_track",
            "track_interval"]

@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.dh import link_transform
 from robotcell.errors import InputError
 from robotcell.ik.axes import (
     AXIS_TOL,
@@ -43,8 +42,9 @@ from robotcell.ik.axes import (
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.ik.opw import ROUND, _controller_angle, reach_distance
 from robotcell.ik.result import REACH_TOL
-from robotcell.robot import Robot
-from robotcell.transforms import invert
+from robotcell.kinematics.dh import link_transform
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import invert
 
 __all__ = ["URParameters", "ur_fk", "ur_kernel", "ur_parameters", "ur_problems"]
 

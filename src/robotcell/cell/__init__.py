@@ -1,0 +1,29 @@
+"""The robot cell: its data model, its file, coupled kinematics, and calibrating into it.
+
+- :mod:`robotcell.cell.model`: :class:`Cell`, :class:`Tool`, :class:`Frame`, :class:`Track`,
+  :class:`Turntable`, :class:`Positioner`, :class:`Provenance` (SI units);
+- :mod:`robotcell.cell.schema`: the YAML cell file (millimetres, degrees), its reader and writer,
+  and the atomic save with ``.bak``;
+- :mod:`robotcell.cell.kinematics`: coupled forward kinematics (arm, track, positioner, frames);
+- :mod:`robotcell.cell.ik`: inverse kinematics and paths in the cell;
+- :mod:`robotcell.cell.axischain`: the kinematic chain of a positioner's axes;
+- :mod:`robotcell.cell.calibrate`: calibration procedures that write their result into a cell.
+
+``from robotcell.cell import Cell`` gives the names below.
+"""
+
+from robotcell.cell.kinematics import RESERVED_FRAMES
+from robotcell.cell.model import (
+    NAME_RE,
+    Cell,
+    Frame,
+    Positioner,
+    Provenance,
+    Tool,
+    Track,
+    Turntable,
+)
+from robotcell.cell.schema import cell_from_dict, cell_to_dict
+
+__all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool",
+           "Track", "Turntable", "cell_from_dict", "cell_to_dict"]

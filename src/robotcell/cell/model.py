@@ -1,0 +1,737 @@
+"""The robot cell: robot, linear track, turntable or positioner, tools and frames.
+
+A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the schema); a
+:class:`Cell` holds the same content in SI units. Poses in the file are mappings
+``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention, as in robot model
+files). Every calibrated quantity carries its :class:`Provenance`.
+
+The file (YAML schema, reader, writer, atomic save with ``.bak``) is :mod:`robotcell.cell.schema`;
+:meth:`Cell.load` and :meth:`Cell.save` call it. :meth:`Cell.save` writes atomically: a process
+that dies during a save leaves either the old or the new file, never a partial one.
+
+Coupled kinematics (TCP pose in any frame given the arm joints, the track position and the table
+angle) are in :mod:`robotcell.cell.kinematics`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call them.
+
+External axes that carry the work are a :class:`Turntable` (one axis, the lecture's ``R_T_B
+Rz(theta)``) or a :class:`Positioner`: a chain of 1-3 revolute axes written as a DH
+:class:`~robotcell.kinematics.robot.Robot` whose ``base`` is the root pose, the form an identified chain
+takes. Both offer the same kinematic interface (:attr:`Turntable.chain`, ``T_root_P``,
+``axis_values``, ``within_limits``), which is all coupled kinematics and the exports use.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import re
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.cell import axischain, kinematics
+from robotcell.cell import ik as cell_ik
+from robotcell.cell.kinematics import RESERVED_FRAMES
+from robotcell.errors import InputError
+from robotcell.kinematics.robot import Joint, Robot
+from robotcell.kinematics.transforms import finite_array, validate_pose
+
+__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool", "Track",
+           "Turntable"]
+
+#: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
+#: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
+NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,23}$")
+
+
+# -- provenance -----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Provenance:
+    """Where a calibrated value comes from.
+
+    Attributes
+    ----------
+    source : str
+        ``"nominal"`` (design value), ``"manual"`` (typed in) or the calibration procedure that
+        produced the value (``"tcp"``, ``"frame"``, ``"track"``, ``"turntable"``,
+        ``"workpiece"``, ...).
+    time : str or None
+        When it was produced, ISO 8601 (``2025-03-14T09:30:00+01:00``).
+    rms_mm : float or None
+        Residual RMS of the calibration (mm).
+    note : str
+        Free text (operator, number of points, instrument).
+    """
+
+    source: str = "nominal"
+    time: str | None = None
+    rms_mm: float | None = None
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.source, str) or not self.source.strip():
+            raise InputError("provenance source must be a non-empty string")
+        if self.time is not None:
+            _iso_time(self.time, "provenance time")
+        if self.rms_mm is not None and not (math.isfinite(self.rms_mm) and self.rms_mm >= 0):
+            raise InputError(f"provenance rms_mm must be a finite number >= 0, got {self.rms_mm}")
+
+    @classmethod
+    def now(cls, source: str, rms_mm: float | None = None, note: str = "") -> Provenance:
+        """Provenance stamped with the current local time (ISO 8601, seconds, with UTC offset)."""
+        stamp = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
+        return cls(source=source, time=stamp, rms_mm=rms_mm, note=note)
+
+
+def _iso_time(value: str, where: str) -> str:
+    try:
+        _dt.datetime.fromisoformat(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{where} must be an ISO 8601 time like 2025-03-14T09:30:00+01:00, "
+                         f"got {value!r}") from None
+    return value
+
+
+# -- components -----------------------------------------------------------------------------------
+def _pose(T: ArrayLike, name: str) -> NDArray[np.float64]:
+    arr = validate_pose(T, name)
+    if arr.shape != (4, 4):
+        raise InputError(f"{name} must be a single pose of shape (4, 4), got {arr.shape}")
+    return arr.copy()
+
+
+def _limits(lower: float, upper: float, what: str) -> None:
+    if not (isinstance(lower, (int, float)) and isinstance(upper, (int, float))):
+        raise InputError(f"{what} limits must be numbers")
+    if not lower < upper:
+        raise InputError(f"{what}: lower limit {lower} must be below upper limit {upper}")
+
+
+@dataclass
+class Track:
+    """A linear track carrying the robot.
+
+    ``T_L_R(e) = T_L_R0`` with its translation moved by ``e * scale * axis``: the lecture's
+    ``p = x + L_Q_R f`` with ``x = e * scale * axis`` and ``L_Q_R`` the rotation of ``T_L_R0``.
+
+    Attributes
+    ----------
+    T_world_L : ndarray, shape (4, 4)
+        Pose of the track frame L in the world (metres).
+    T_L_R0 : ndarray, shape (4, 4)
+        Pose of the robot base R in L at track position 0 (metres); its rotation is the
+        lecture's alignment error ``L_Q_R``, its translation the mounting offset.
+    axis : {"x", "y", "z"}
+        Axis of L the robot moves along (``x`` in the lecture; KUKA's linear units use ``z``).
+    scale : float
+        Displacement per unit of the controller's track value (1 for a true encoder).
+    lower, upper : float
+        Limits of the controller's track value (metres).
+    name : str
+        Name of the mechanical unit (used by controller exports, e.g. ABB ``TRACK_1``).
+    provenance : Provenance
+    """
+
+    T_world_L: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    T_L_R0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    axis: Literal["x", "y", "z"] = "x"
+    scale: float = 1.0
+    lower: float = -math.inf
+    upper: float = math.inf
+    name: str = "track"
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_world_L = _pose(self.T_world_L, "track T_world_L")
+        self.T_L_R0 = _pose(self.T_L_R0, "track T_L_R0")
+        if self.axis not in ("x", "y", "z"):
+            raise InputError(f"track axis must be 'x', 'y' or 'z', got {self.axis!r}")
+        if not (math.isfinite(self.scale) and self.scale > 0):
+            raise InputError(f"track scale must be a finite number > 0, got {self.scale}")
+        _limits(self.lower, self.upper, "track")
+
+    @property
+    def direction(self) -> NDArray[np.float64]:
+        """Unit vector of the motion in L, shape ``(3,)``."""
+        return np.eye(3)["xyz".index(self.axis)]
+
+    def T_L_R(self, e: ArrayLike) -> NDArray[np.float64]:
+        """Pose of the robot base in L at track positions ``e`` (shape ``(...)``, metres)."""
+        return kinematics.track_pose(self.T_L_R0, self.direction * self.scale, e)
+
+    def within_limits(self, e: ArrayLike) -> NDArray[np.bool_]:
+        """Whether track positions ``e`` (shape ``(...)``, metres) are within the limits."""
+        arr = np.asarray(e, dtype=float)
+        return (arr >= self.lower) & (arr <= self.upper)
+
+
+@dataclass
+class Turntable:
+    """A one-axis turntable (rotary positioner).
+
+    ``T_parent_W(theta) = T_parent_B Rz(theta) T_B_W`` for a frame W carried by the table: the
+    lecture's ``R_T_W(theta) = R_T_B Rz(theta) B_T_W``. Positive table values turn about +Z_B.
+
+    Attributes
+    ----------
+    T_parent_B : ndarray, shape (4, 4)
+        Pose of the table root frame B (origin on the axis, Z along it) in its parent (metres).
+    parent : {"world", "robot"}
+        ``world``: fixed in the cell; ``robot``: fixed to the robot base R (moves with a track).
+    lower, upper : float
+        Limits of the table angle (radians).
+    name : str
+        Name of the mechanical unit (KUKA ``MACHINE_DEF`` name, ABB ``ufmec``).
+    provenance : Provenance
+    """
+
+    T_parent_B: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    parent: Literal["world", "robot"] = "world"
+    lower: float = -math.inf
+    upper: float = math.inf
+    name: str = "turntable"
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_parent_B = _pose(self.T_parent_B, "turntable T_parent_B")
+        if self.parent not in ("world", "robot"):
+            raise InputError(f"turntable parent must be 'world' or 'robot', got {self.parent!r}")
+        _limits(self.lower, self.upper, "turntable")
+
+    def within_limits(self, theta: ArrayLike) -> NDArray[np.bool_]:
+        """Whether table angles ``theta`` (shape ``(...)``, radians) are within the limits."""
+        arr = np.asarray(theta, dtype=float)
+        return (arr >= self.lower) & (arr <= self.upper)
+
+    # -- the interface shared with Positioner ----------------------------------------------------
+    n_axes = 1
+
+    @property
+    def T_parent_root(self) -> NDArray[np.float64]:
+        """Pose of the root frame B in the parent (metres): ``T_parent_B``."""
+        return self.T_parent_B
+
+    @property
+    def chain(self) -> Robot:
+        """The table as a 1-axis DH chain: base ``T_parent_B``, one revolute joint about Z_B."""
+        return Robot(self.name, (Joint("revolute", lower=self.lower, upper=self.upper,
+                                       name=f"{self.name}_axis"),), base=self.T_parent_B)
+
+    def axis_values(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """Table angles as an array of shape ``(...)`` (radians), refusing NaN and infinity."""
+        return finite_array(theta, "table angle")
+
+    def batch_shape(self, theta: NDArray[np.float64]) -> tuple[int, ...]:
+        """Batch shape of table angles: their shape."""
+        return theta.shape
+
+    def T_root_P(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """The table's turn ``Rz(theta)``, shape ``(..., 4, 4)``: frames on the table move with it."""
+        return kinematics.table_pose(theta)
+
+
+@dataclass
+class Positioner:
+    """A positioner: a chain of 1-3 revolute axes carrying the work (tilt-rotate, L, drop-centre).
+
+    ``T_parent_P(v) = chain.fk(v)`` with the chain's ``base`` the root pose ``T_parent_0`` and its
+    ``flange`` the plate frame P on the last axis, which carries the frames with parent
+    ``turntable``. Axis values ``v`` have shape ``(..., n)``, radians, as the controller counts
+    them (``sign`` and offsets of the DH table apply). A turntable is the 1-axis case with
+    ``a = alpha = d = theta = 0``.
+
+    Attributes
+    ----------
+    chain : Robot
+        The axes as a DH chain (standard or modified), base = root pose in the parent (metres),
+        limits on each axis (radians); e.g. the result of a kinematic identification.
+    parent : {"world", "robot"}
+        ``world``: fixed in the cell; ``robot``: fixed to the robot base R (moves with a track).
+    name : str
+        Name of the mechanical unit (KUKA ``MACHINE_DEF`` name, ABB mechanical unit).
+    provenance : Provenance
+    """
+
+    chain: Robot
+    parent: Literal["world", "robot"] = "world"
+    name: str = "positioner"
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.chain, Robot):
+            raise InputError("positioner chain must be a robotcell.Robot (a DH chain)")
+        if not 1 <= self.chain.n_joints <= 3 or np.any(self.chain.prismatic):
+            raise InputError(f"a positioner is a chain of 1 to 3 revolute axes, got "
+                             f"{self.chain.n_joints} axes "
+                             f"({', '.join(j.type for j in self.chain.joints)})")
+        if self.parent not in ("world", "robot"):
+            raise InputError(f"positioner parent must be 'world' or 'robot', got {self.parent!r}")
+        self._axes = self.chain.with_base(np.eye(4))
+
+    @property
+    def n_axes(self) -> int:
+        """Number of axes (1 to 3)."""
+        return self.chain.n_joints
+
+    @property
+    def T_parent_root(self) -> NDArray[np.float64]:
+        """Pose of the root frame (frame 0 of the chain) in the parent (metres)."""
+        return self.chain.base
+
+    @property
+    def lower(self) -> NDArray[np.float64]:
+        """Lower axis limits, shape ``(n,)`` (radians)."""
+        return self.chain.lower
+
+    @property
+    def upper(self) -> NDArray[np.float64]:
+        """Upper axis limits, shape ``(n,)`` (radians)."""
+        return self.chain.upper
+
+    def axis_values(self, values: ArrayLike) -> NDArray[np.float64]:
+        """Axis values as an array of shape ``(..., n)`` (radians).
+
+        A single number is every axis of a 1-axis positioner; of a longer chain only 0 (every
+        axis at 0, the default of the kinematic functions) is taken, any other is refused.
+        """
+        v = finite_array(values, "positioner axis value")
+        if v.ndim == 0:
+            if self.n_axes > 1 and v != 0:
+                raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give one "
+                                 f"value per axis, shape (..., {self.n_axes}), not the single "
+                                 f"value {float(v):g} rad")
+            return np.broadcast_to(v, (self.n_axes,))
+        if v.shape[-1] != self.n_axes:
+            raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give its axis "
+                             f"values with shape (..., {self.n_axes}), got {v.shape}")
+        return v
+
+    def batch_shape(self, values: NDArray[np.float64]) -> tuple[int, ...]:
+        """Batch shape of axis values ``(..., n)``: ``(...)``."""
+        return values.shape[:-1]
+
+    def T_root_P(self, values: ArrayLike) -> NDArray[np.float64]:
+        """Pose of the plate P in the root at axis values ``(..., n)``, shape ``(..., 4, 4)``."""
+        return self._axes.fk(self.axis_values(values), np.eye(4))
+
+    def within_limits(self, values: ArrayLike) -> NDArray[np.bool_]:
+        """Whether axis values ``(..., n)`` are all within their limits, shape ``(...)``."""
+        v = self.axis_values(values)
+        return np.all((v >= self.lower) & (v <= self.upper), axis=-1)
+
+    def normal_up(self, normal: ArrayLike, T_world_parent: ArrayLike | None = None
+                  ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Axis values of a 2-axis positioner that turn a plate direction straight up.
+
+        Parameters
+        ----------
+        normal : array_like, shape (..., 3)
+            Direction in the plate frame P (e.g. a weld's surface normal).
+        T_world_parent : array_like, shape (..., 4, 4), optional
+            Pose of the positioner's parent in the world (the robot base for ``parent="robot"``);
+            default the world itself.
+
+        Returns
+        -------
+        values : ndarray, shape (..., 2, 2)
+            Up to two solutions (v_1, v_2), radians (NaN where none).
+        valid : ndarray of bool, shape (..., 2)
+            Solution exists and lies within the axis limits.
+        """
+        T = np.eye(4) if T_world_parent is None else np.asarray(T_world_parent, dtype=float)
+        R = T[..., :3, :3] @ self.chain.base[:3, :3]
+        return axischain.normal_up(self.chain, R, normal)
+
+
+@dataclass
+class Tool:
+    """A tool on the robot flange.
+
+    Attributes
+    ----------
+    T_F_TCP : ndarray, shape (4, 4)
+        Pose of the TCP in the flange frame F of the cell's robot model (metres).
+    number : int or None
+        Controller slot (KUKA ``TOOL_DATA[n]``, Fanuc ``UTOOL[n]``); None: numbered in file order.
+    mass : float or None
+        Mass of the tool (kg), for controllers that need load data (ABB ``tload``).
+    cog : ndarray, shape (3,), or None
+        Centre of gravity in the flange frame (metres).
+    provenance : Provenance
+    """
+
+    T_F_TCP: NDArray[np.float64]
+    number: int | None = None
+    mass: float | None = None
+    cog: NDArray[np.float64] | None = None
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_F_TCP = _pose(self.T_F_TCP, "tool T_F_TCP")
+        _check_number(self.number, "tool number")
+        if self.mass is not None and not (math.isfinite(self.mass) and self.mass > 0):
+            raise InputError(f"tool mass must be a finite number > 0 (kg), got {self.mass}")
+        if self.cog is not None:
+            cog = np.asarray(self.cog, dtype=float)
+            if cog.shape != (3,) or not np.all(np.isfinite(cog)):
+                raise InputError(f"tool cog must be 3 finite numbers, got {self.cog!r}")
+            self.cog = cog
+
+
+@dataclass
+class Frame:
+    """A named frame of the cell: a fixture, a base, a workpiece.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (4, 4)
+        Pose of the frame in its parent (metres): ``T_world_X``, ``T_R_X`` or ``T_B_X`` (for a
+        frame on the turntable, at table angle 0).
+    parent : {"world", "robot", "turntable"}
+        What carries the frame: nothing (fixed in the world), the robot base (moves with the
+        track), or the turntable (turns with it).
+    number : int or None
+        Controller slot (KUKA ``BASE_DATA[n]``, Fanuc ``UFRAME[n]``); None: numbered in order.
+    provenance : Provenance
+    """
+
+    pose: NDArray[np.float64]
+    parent: Literal["world", "robot", "turntable"] = "world"
+    number: int | None = None
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.pose = _pose(self.pose, "frame pose")
+        if self.parent not in ("world", "robot", "turntable"):
+            raise InputError(f"frame parent must be 'world', 'robot' or 'turntable', "
+                             f"got {self.parent!r}")
+        _check_number(self.number, "frame number")
+
+
+def _check_number(n: Any, what: str) -> None:
+    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
+        raise InputError(f"{what} must be an integer >= 1, got {n!r}")
+
+
+# -- the cell -------------------------------------------------------------------------------------
+@dataclass
+class Cell:
+    """A robot cell in SI units.
+
+    Attributes
+    ----------
+    robot : Robot
+        The arm. Its default tool applies when :meth:`fk` gets no tool.
+    robot_model : str
+        How the cell file names the robot: a library name, or the path of a model file (absolute,
+        or relative to the working directory).
+    T_world_R : ndarray, shape (4, 4)
+        Pose of the robot base in the world for a cell without track (metres).
+    track : Track or None
+    turntable : Turntable or Positioner or None
+        What carries the work: a one-axis turntable or a positioner chain of 1-3 axes (also
+        :attr:`positioner`). Frames with parent ``turntable`` are carried by its last axis.
+    tools : dict of str to Tool
+    frames : dict of str to Frame
+    name : str
+    """
+
+    robot: Robot
+    robot_model: str
+    T_world_R: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    track: Track | None = None
+    turntable: Turntable | Positioner | None = None
+    tools: dict[str, Tool] = field(default_factory=dict)
+    frames: dict[str, Frame] = field(default_factory=dict)
+    name: str = "cell"
+
+    def __post_init__(self) -> None:
+        self.T_world_R = _pose(self.T_world_R, "robot T_world_R")
+        if self.track is not None and not np.allclose(self.T_world_R, np.eye(4), atol=0):
+            raise InputError("a robot on a track is placed by the track (track frame and "
+                             "robot_at_zero); do not give the robot a frame as well")
+        for name in self.tools:
+            _check_name(name, "tool")
+        for name, fr in self.frames.items():
+            _check_name(name, "frame")
+            self._check_parent(name, fr)
+        _unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
+        _unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
+
+    @property
+    def positioner(self) -> Turntable | Positioner | None:
+        """The external axes carrying the work (the same object as :attr:`turntable`)."""
+        return self.turntable
+
+    def _check_parent(self, name: str, fr: Frame) -> None:
+        if fr.parent == "turntable" and self.turntable is None:
+            raise InputError(f"frame {name!r} is carried by the turntable, but the cell has none")
+
+    # -- editing (used by calibration commands) -------------------------------------------------
+    def set_tool(self, name: str, T_F_TCP: ArrayLike, provenance: Provenance,
+                 number: int | None = None, mass: float | None = None,
+                 cog: ArrayLike | None = None) -> Tool:
+        """Add or replace a tool; an existing tool keeps its number and load unless given.
+
+        Parameters
+        ----------
+        name : str
+            Tool name (letter, then letters, digits, ``_``; at most 24 characters).
+        T_F_TCP : array_like, shape (4, 4)
+            Pose of the TCP in the flange frame (metres).
+        provenance : Provenance
+        number : int, optional
+            Controller slot.
+        mass : float, optional
+            Tool mass (kg).
+        cog : array_like, shape (3,), optional
+            Centre of gravity in the flange frame (metres).
+
+        Returns
+        -------
+        Tool
+        """
+        _check_name(name, "tool")
+        old = self.tools.get(name)
+        tool = Tool(
+            T_F_TCP=np.asarray(T_F_TCP, dtype=float),
+            number=number if number is not None else (old.number if old else None),
+            mass=mass if mass is not None else (old.mass if old else None),
+            cog=np.asarray(cog, dtype=float) if cog is not None else (old.cog if old else None),
+            provenance=provenance,
+        )
+        _unique_numbers({**{k: t.number for k, t in self.tools.items()}, name: tool.number}, "tool")
+        self.tools[name] = tool
+        return tool
+
+    def update_frame(self, name: str, pose: ArrayLike, provenance: Provenance,
+                     parent: Literal["world", "robot", "turntable"] | None = None,
+                     number: int | None = None) -> Frame:
+        """Add or replace a frame; an existing frame keeps its parent and number unless given.
+
+        Parameters
+        ----------
+        name : str
+            Frame name (not one of ``world``, ``track``, ``L``, ``robot``, ``R``,
+            ``turntable``, ``B``).
+        pose : array_like, shape (4, 4)
+            Pose of the frame in its parent (metres); in B at table angle 0 for a frame on the
+            turntable.
+        provenance : Provenance
+        parent : {"world", "robot", "turntable"}, optional
+            Default: the existing frame's parent, else ``world``.
+        number : int, optional
+            Controller slot.
+
+        Returns
+        -------
+        Frame
+        """
+        _check_name(name, "frame")
+        old = self.frames.get(name)
+        fr = Frame(
+            pose=np.asarray(pose, dtype=float),
+            parent=parent or (old.parent if old else "world"),
+            number=number if number is not None else (old.number if old else None),
+            provenance=provenance,
+        )
+        self._check_parent(name, fr)
+        _unique_numbers({**{k: f.number for k, f in self.frames.items()}, name: fr.number}, "frame")
+        self.frames[name] = fr
+        return fr
+
+    def update_track(self, provenance: Provenance, **changes: Any) -> Track:
+        """Replace fields of the track (``T_world_L``, ``T_L_R0``, ``axis``, ``scale``, ...).
+
+        Parameters
+        ----------
+        provenance : Provenance
+            Provenance of the new track calibration.
+        **changes
+            :class:`Track` attributes to change (SI units).
+
+        Returns
+        -------
+        Track
+        """
+        if self.track is None:
+            raise InputError("the cell has no track to update")
+        self.track = replace(self.track, provenance=provenance, **changes)
+        return self.track
+
+    def update_turntable(self, provenance: Provenance, **changes: Any) -> Turntable:
+        """Replace fields of the turntable (``T_parent_B``, ``parent``, limits, ``name``).
+
+        Parameters
+        ----------
+        provenance : Provenance
+            Provenance of the new turntable calibration.
+        **changes
+            :class:`Turntable` attributes to change (SI units).
+
+        Returns
+        -------
+        Turntable
+        """
+        if not isinstance(self.turntable, Turntable):
+            raise InputError("the cell has no turntable to update" if self.turntable is None else
+                             "the cell's positioner is an axis chain: use update_positioner")
+        self.turntable = replace(self.turntable, provenance=provenance, **changes)
+        return self.turntable
+
+    def update_positioner(self, provenance: Provenance, chain: Robot) -> Positioner:
+        """Write a calibrated positioner chain into the cell, keeping its parent and name.
+
+        The hook of the positioner calibration (:func:`robotcell.identification.calibrate_positioner`
+        returns the identified chain as a :class:`~robotcell.kinematics.robot.Robot`): a turntable becomes a
+        :class:`Positioner` with that chain.
+
+        Parameters
+        ----------
+        provenance : Provenance
+        chain : Robot
+            1-3 revolute axes; base = root pose in the parent (metres), limits (radians).
+
+        Returns
+        -------
+        Positioner
+        """
+        old = self.turntable
+        if old is None:
+            raise InputError("the cell has no positioner to update")
+        self.turntable = Positioner(chain, parent=old.parent, name=old.name,
+                                    provenance=provenance)
+        return self.turntable
+
+    # -- kinematics -----------------------------------------------------------------------------
+    def frame_pose(self, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
+                   ) -> NDArray[np.float64]:
+        """Pose of a frame of the cell in the world; see :func:`robotcell.cell.kinematics.frame_pose`."""
+        return kinematics.frame_pose(self, name, track, table)
+
+    def fk(self, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
+           tool: str | ArrayLike | None = None, frame: str = "world") -> NDArray[np.float64]:
+        """TCP pose in a frame of the cell; see :func:`robotcell.cell.kinematics.fk`.
+
+        ``table`` is the table angle ``(...)`` of a turntable, or the axis values ``(..., n)`` of
+        a positioner chain (radians).
+        """
+        return kinematics.fk(self, q, track, table, tool, frame)
+
+    def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+           table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
+           samples: int | None = None) -> cell_ik.CellIKSolutions:
+        """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cell.ik.ik`.
+
+        ``table``: the table angle ``(...)``, the positioner's axis values ``(..., n)``, or, for a
+        2-axis positioner and targets in a frame it carries, ``"normal_up"``: the axis values
+        that turn each target's surface normal (its ``-Z``: the tool's Z points into the surface)
+        straight up, the welding position (:meth:`Positioner.normal_up`; of its two solutions,
+        per target, the one within the axis limits where the arm has more valid branches).
+        """
+        if not isinstance(table, str):
+            return cell_ik.ik(self, T, frame, track, table, tool, samples)
+        values, ok = self._normal_up(T, frame, track)
+        sols = [cell_ik.ik(self, T, frame, track, np.where(ok[..., k, None], values[..., k, :], 0.0),
+                          tool, samples) for k in range(2)]
+        counts = np.stack([np.where(ok[..., k], s.count, -1) for k, s in enumerate(sols)])
+        second = counts[1] > counts[0]
+
+        def pick(a: NDArray, b: NDArray) -> NDArray:
+            return np.where(second.reshape(second.shape + (1,) * (a.ndim - second.ndim)), b, a)
+
+        first, other = sols
+        return cell_ik.CellIKSolutions(
+            pick(first.q, other.q), pick(first.valid, other.valid),
+            pick(first.reachable, other.reachable), pick(first.track, other.track),
+            pick(first.table, other.table), first.method)
+
+    def _normal_up(self, T: ArrayLike, frame: str, track: ArrayLike | None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Positioner axis values turning the targets' -Z up, for :meth:`ik`."""
+        pos = self.turntable
+        if not isinstance(pos, Positioner) or pos.n_axes != 2:
+            raise InputError("table='normal_up' needs a positioner of 2 axes")
+        if frame not in self.frames or self.frames[frame].parent != "turntable":
+            raise InputError(f"table='normal_up' needs targets in a frame carried by the "
+                             f"positioner, got frame {frame!r}")
+        T_P = self.frames[frame].pose @ validate_pose(T, "target pose")
+        parent = (np.eye(4) if pos.parent == "world"
+                  else kinematics.robot_pose(self, 0.0 if track is None else track))
+        values, valid = pos.normal_up(-T_P[..., :3, 2], parent)
+        if not np.all(np.any(valid, axis=-1)):
+            raise InputError("the positioner cannot turn every target's normal up within its "
+                             "axis limits")
+        return values, valid
+
+    def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+                table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
+                q_start: ArrayLike | None = None, max_step: float = cell_ik.MAX_STEP,
+                samples: int = 33, track_motion: str = "fixed") -> cell_ik.CellPath:
+        """A continuous trajectory through targets; see :func:`robotcell.cell.ik.ik_path`."""
+        return cell_ik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples,
+                              track_motion)
+
+    # -- files ------------------------------------------------------------------------------------
+    @classmethod
+    def load(cls, path: str | Path) -> Cell:
+        """Read a cell file.
+
+        Parameters
+        ----------
+        path : str or Path
+            YAML cell file (millimetres, degrees). A robot model path inside it is resolved
+            against the file's directory.
+
+        Returns
+        -------
+        Cell
+
+        Raises
+        ------
+        InputError
+            Missing or unreadable file, invalid YAML, or invalid content; the message names the
+            file and the key.
+        """
+        from robotcell.cell.schema import load_cell  # the schema builds on this module
+
+        return load_cell(path)
+
+    def save(self, path: str | Path) -> None:
+        """Write the cell file atomically, keeping the previous version as ``<path>.bak``.
+
+        The text is written to a temporary file in the same directory, flushed and fsynced, then
+        moved over ``path`` with ``os.replace``; the old file is first copied (the same way) to
+        ``<path>.bak``. If the process dies at any point, ``path`` holds either the old or the new
+        content in full. Both keep the permissions of the file replaced (a new file gets
+        ``0o666`` less the umask).
+
+        Parameters
+        ----------
+        path : str or Path
+            Destination. A robot model file is written relative to its directory.
+        """
+        from robotcell.cell.schema import save_cell  # the schema builds on this module
+
+        save_cell(self, path)
+
+
+def _check_name(name: Any, what: str) -> None:
+    if not isinstance(name, str) or not NAME_RE.match(name):
+        raise InputError(f"{what} name {name!r} is invalid: use a letter, then letters, digits "
+                         "or '_', at most 24 characters")
+    if what == "frame" and name in RESERVED_FRAMES:
+        raise InputError(f"frame name {name!r} is reserved (reserved: "
+                         f"{', '.join(sorted(RESERVED_FRAMES))})")
+
+
+def _unique_numbers(numbers: dict[str, int | None], what: str) -> None:
+    seen: dict[int, str] = {}
+    for name, n in numbers.items():
+        if n is None:
+            continue
+        if n in seen:
+            raise InputError(f"{what}s {seen[n]!r} and {name!r} have the same number {n}")
+        seen[n] = name

@@ -1,0 +1,409 @@
+"""The cell file: its YAML schema, the reader and the writer, and the atomic save.
+
+A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the schema); the
+:class:`~robotcell.cell.model.Cell` it is read into holds the same content in SI units. Poses in
+the file are mappings ``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention,
+as in robot model files).
+
+:func:`save_cell` (what :meth:`Cell.save <robotcell.cell.model.Cell.save>` calls) writes
+atomically: a temporary file in the same directory, flushed and fsynced, then ``os.replace``; the
+previous file is kept as ``<name>.bak``. The file and its ``.bak`` keep the permissions the file
+had (see :mod:`robotcell.io.fileio`, which also gives the encoding rule of :func:`load_cell`).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from numpy.typing import NDArray
+
+from robotcell.cell.model import (
+    Cell,
+    Frame,
+    Positioner,
+    Provenance,
+    Tool,
+    Track,
+    Turntable,
+    _check_name,
+)
+from robotcell.errors import InputError
+from robotcell.io.fileio import atomic_copy, atomic_write, check_destination, read_text
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.kinematics.models import load_robot, robot_from_dict, robot_to_dict
+
+__all__ = ["cell_from_dict", "cell_to_dict", "load_cell", "save_cell"]
+
+_POSE_KEYS = ("x", "y", "z", "a", "b", "c")
+
+_HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z, a, b, c} with\n"
+           "# R = Rz(a) Ry(b) Rx(c). Schema: docs/cell.md\n")
+
+
+def load_cell(path: str | Path) -> Cell:
+    """Read a cell file (millimetres, degrees) into a :class:`Cell`: what :meth:`Cell.load` does.
+
+    Parameters
+    ----------
+    path : str or Path
+        YAML cell file; a robot model path inside it is resolved against the file's directory.
+    """
+    p = Path(path)
+    text = read_text(p, "cell file")
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise InputError(f"{path}: not valid YAML: {exc}") from None
+    return cell_from_dict(data, str(path), p.resolve().parent)
+
+
+def save_cell(cell: Cell, path: str | Path) -> None:
+    """Write ``cell`` to a cell file atomically with a ``.bak``: what :meth:`Cell.save` does.
+
+    Parameters
+    ----------
+    cell : Cell
+        The cell (SI units), written in millimetres and degrees.
+    path : str or Path
+        Destination; a robot model file is written relative to its directory.
+    """
+    p = Path(path)
+    text = _HEADER + yaml.safe_dump(cell_to_dict(cell, p.resolve().parent), sort_keys=False,
+                                    default_flow_style=None, width=100)
+    check_destination(p)  # a read-only file is refused before the backup is made
+    if p.exists():
+        atomic_copy(p, p.with_name(p.name + ".bak"))
+    atomic_write(p, text)
+
+
+# -- file content <-> Cell ------------------------------------------------------------------------
+class _Reader:
+    """Typed access to the parsed YAML with errors naming the file and the key."""
+
+    def __init__(self, origin: str):
+        self.origin = origin
+
+    def fail(self, key: str, msg: str) -> InputError:
+        return InputError(f"{self.origin}: key '{key}' {msg}")
+
+    def mapping(self, value: Any, key: str, allowed: set[str], required: tuple[str, ...] = ()
+                ) -> dict:
+        if not isinstance(value, dict):
+            raise self.fail(key, f"must be a mapping, got {type(value).__name__}")
+        unknown = set(value) - allowed
+        if unknown:
+            raise self.fail(key, f"has unknown key(s) {sorted(map(str, unknown))}; "
+                            f"allowed: {sorted(allowed)}")
+        for r in required:
+            if r not in value:
+                raise self.fail(f"{key}.{r}" if key else r, "is missing")
+        return value
+
+    def number(self, value: Any, key: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(key, f"must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise self.fail(key, f"must be finite, got {value!r}")
+        return float(value)
+
+    def string(self, value: Any, key: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(key, f"must be a non-empty string, got {value!r}")
+        return value
+
+    def pose(self, value: Any, key: str) -> NDArray[np.float64]:
+        m = self.mapping(value, key, set(_POSE_KEYS))
+        v = [self.number(m.get(k, 0), f"{key}.{k}") for k in _POSE_KEYS]
+        return pose_from_vendor(v, "kuka")
+
+    def provenance(self, value: Any, key: str) -> Provenance:
+        if value is None:
+            return Provenance()
+        m = self.mapping(value, key, {"source", "time", "rms_mm", "note"}, ("source",))
+        time = m.get("time")
+        if isinstance(time, (_dt.datetime, _dt.date)):  # YAML reads unquoted timestamps
+            time = time.isoformat()
+        try:
+            return Provenance(
+                source=self.string(m["source"], f"{key}.source"),
+                time=time,
+                rms_mm=None if m.get("rms_mm") is None else self.number(m["rms_mm"], f"{key}.rms_mm"),
+                note=str(m.get("note", "")),
+            )
+        except InputError as exc:
+            raise self.fail(key, f"is invalid: {str(exc).lstrip()}") from None
+
+    def limits(self, m: dict, key: str, scale: float) -> tuple[float, float]:
+        lo = self.number(m["min"], f"{key}.min") * scale if "min" in m else -math.inf
+        hi = self.number(m["max"], f"{key}.max") * scale if "max" in m else math.inf
+        if not lo < hi:
+            raise self.fail(f"{key}.min", f"({m.get('min')}) must be below {key}.max ({m.get('max')})")
+        return lo, hi
+
+    def integer(self, value: Any, key: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise self.fail(key, f"must be an integer >= 1, got {value!r}")
+        return value
+
+
+def _is_model_path(text: str) -> bool:
+    return text.lower().endswith((".yaml", ".yml")) or "/" in text or os.sep in text
+
+
+def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> Cell:
+    """Build a cell from the parsed content of a cell file.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed YAML (millimetres, degrees).
+    origin : str
+        What to call the source in error messages (a file name).
+    base_dir : str or Path
+        Directory against which a relative robot model path is resolved.
+
+    Returns
+    -------
+    Cell
+    """
+    rd = _Reader(origin)
+    top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "positioner", "tools",
+                                "frames"}, ("robot",)) if isinstance(data, dict) else None
+    if top is None:
+        raise InputError(f"{origin}: a cell file must be a YAML mapping with keys robot, tools, "
+                         "frames, ...")
+    rob = rd.mapping(top["robot"], "robot", {"model", "frame"}, ("model",))
+    model = rd.string(rob["model"], "robot.model")
+    if _is_model_path(model):
+        model_path = Path(model) if Path(model).is_absolute() else Path(base_dir) / model
+        if not model_path.is_file():
+            raise rd.fail("robot.model", f"names model file {str(model_path)!r}, which does not exist")
+        model = str(model_path)
+    try:
+        robot = load_robot(model)
+    except InputError as exc:
+        raise rd.fail("robot.model", f"is invalid: {exc}") from None
+    kwargs: dict[str, Any] = {"robot": robot, "robot_model": model}
+    if "frame" in rob:
+        kwargs["T_world_R"] = rd.pose(rob["frame"], "robot.frame")
+    if "name" in top:
+        kwargs["name"] = rd.string(top["name"], "name")
+    if top.get("track") is not None:
+        t = rd.mapping(top["track"], "track", {"name", "frame", "robot_at_zero", "axis", "scale",
+                                               "min", "max", "provenance"})
+        if "frame" in rob:
+            raise rd.fail("robot.frame", "must be omitted when the cell has a track: the track "
+                          "places the robot (track.frame and track.robot_at_zero)")
+        axis = t.get("axis", "x")
+        if axis not in ("x", "y", "z"):
+            raise rd.fail("track.axis", f"must be x, y or z, got {axis!r}")
+        lo, hi = rd.limits(t, "track", 1e-3)
+        scale = rd.number(t.get("scale", 1.0), "track.scale")
+        if scale <= 0:
+            raise rd.fail("track.scale", f"must be > 0, got {scale}")
+        kwargs["track"] = Track(
+            T_world_L=rd.pose(t.get("frame", {}), "track.frame"),
+            T_L_R0=rd.pose(t.get("robot_at_zero", {}), "track.robot_at_zero"),
+            axis=axis, scale=scale, lower=lo, upper=hi,
+            name=rd.string(t.get("name", "track"), "track.name"),
+            provenance=rd.provenance(t.get("provenance"), "track.provenance"),
+        )
+    if top.get("turntable") is not None:
+        t = rd.mapping(top["turntable"], "turntable", {"name", "frame", "parent", "min", "max",
+                                                       "provenance"})
+        parent = t.get("parent", "world")
+        if parent not in ("world", "robot"):
+            raise rd.fail("turntable.parent", f"must be world or robot, got {parent!r}")
+        lo, hi = rd.limits(t, "turntable", math.pi / 180)
+        kwargs["turntable"] = Turntable(
+            T_parent_B=rd.pose(t.get("frame", {}), "turntable.frame"), parent=parent,
+            lower=lo, upper=hi, name=rd.string(t.get("name", "turntable"), "turntable.name"),
+            provenance=rd.provenance(t.get("provenance"), "turntable.provenance"),
+        )
+    if top.get("positioner") is not None:
+        if "turntable" in kwargs:
+            raise rd.fail("positioner", "and key 'turntable' both describe the axes carrying the "
+                          "work; keep one (a turntable is a positioner of one axis)")
+        kwargs["turntable"] = _positioner_from_dict(rd, top["positioner"])
+    tools: dict[str, Tool] = {}
+    for name, td in rd.mapping(top.get("tools") or {}, "tools", set(top.get("tools") or {})).items():
+        key = f"tools.{name}"
+        _named(rd, name, key, "tool")
+        td = rd.mapping(td, key, {"number", "frame", "mass", "cog", "provenance"}, ("frame",))
+        cog = td.get("cog")
+        if cog is not None and (not isinstance(cog, list) or len(cog) != 3):
+            raise rd.fail(f"{key}.cog", f"must be a list [x, y, z] in mm, got {cog!r}")
+        mass = rd.number(td["mass"], f"{key}.mass") if "mass" in td else None
+        if mass is not None and mass <= 0:
+            raise rd.fail(f"{key}.mass", f"must be > 0 kg, got {td['mass']}")
+        tools[name] = Tool(
+            T_F_TCP=rd.pose(td["frame"], f"{key}.frame"),
+            number=rd.integer(td["number"], f"{key}.number") if "number" in td else None,
+            mass=mass,
+            cog=None if cog is None else np.array(
+                [rd.number(v, f"{key}.cog[{i}]") for i, v in enumerate(cog)]) * 1e-3,
+            provenance=rd.provenance(td.get("provenance"), f"{key}.provenance"),
+        )
+    frames: dict[str, Frame] = {}
+    for name, fd in rd.mapping(top.get("frames") or {}, "frames", set(top.get("frames") or {})).items():
+        key = f"frames.{name}"
+        _named(rd, name, key, "frame")
+        fd = rd.mapping(fd, key, {"number", "parent", "frame", "provenance"}, ("frame",))
+        parent = fd.get("parent", "world")
+        if parent not in ("world", "robot", "turntable"):
+            raise rd.fail(f"{key}.parent", f"must be world, robot or turntable, got {parent!r}")
+        if parent == "turntable" and "turntable" not in kwargs:
+            raise rd.fail(f"{key}.parent", "is turntable, but the cell has no turntable")
+        frames[name] = Frame(
+            pose=rd.pose(fd["frame"], f"{key}.frame"), parent=parent,
+            number=rd.integer(fd["number"], f"{key}.number") if "number" in fd else None,
+            provenance=rd.provenance(fd.get("provenance"), f"{key}.provenance"),
+        )
+    try:
+        return Cell(tools=tools, frames=frames, **kwargs)
+    except InputError as exc:
+        raise InputError(f"{origin}: {exc}") from None
+
+
+_AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "sign", "min", "max"}
+
+
+def _positioner_from_dict(rd: _Reader, value: Any) -> Positioner:
+    """The ``positioner`` section: root frame, DH axes (mm, deg), plate, limits."""
+    p = rd.mapping(value, "positioner", {"name", "parent", "frame", "convention", "axes", "plate",
+                                         "provenance"}, ("axes",))
+    parent = p.get("parent", "world")
+    if parent not in ("world", "robot"):
+        raise rd.fail("positioner.parent", f"must be world or robot, got {parent!r}")
+    axes = p["axes"]
+    if not isinstance(axes, list) or not 1 <= len(axes) <= 3:
+        raise rd.fail("positioner.axes", "must be a list of 1 to 3 axes {a, alpha, d, theta, "
+                      "sign, min, max} (mm, deg)")
+    for i, ax in enumerate(axes, start=1):
+        rd.mapping(ax, f"positioner.axes[{i}]", _AXIS_KEYS)
+    name = rd.string(p.get("name", "positioner"), "positioner.name")
+    model: dict[str, Any] = {"name": name, "convention": p.get("convention", "standard"),
+                             "joints": [{"type": "revolute", **ax} for ax in axes],
+                             "base": rd.mapping(p.get("frame", {}), "positioner.frame",
+                                                set(_POSE_KEYS)),
+                             "flange": rd.mapping(p.get("plate", {}), "positioner.plate",
+                                                  set(_POSE_KEYS))}
+    chain = robot_from_dict(model, f"{rd.origin}: positioner")
+    return Positioner(chain, parent=parent, name=name,
+                      provenance=rd.provenance(p.get("provenance"), "positioner.provenance"))
+
+
+def _positioner_dict(pos: Positioner) -> dict[str, Any]:
+    """The ``positioner`` section of ``pos`` (mm, deg)."""
+    out: dict[str, Any] = {"name": pos.name, "parent": pos.parent,
+                           "frame": _pose_dict(pos.chain.base),
+                           "convention": pos.chain.convention}
+    out["axes"] = [{k: _clean(v) if isinstance(v, float) else v for k, v in j.items()
+                    if k != "type"} for j in robot_to_dict(pos.chain)["joints"]]
+    if not np.allclose(pos.chain.flange, np.eye(4), atol=0):
+        out["plate"] = _pose_dict(pos.chain.flange)
+    out["provenance"] = _prov_dict(pos.provenance)
+    return out
+
+
+def _named(rd: _Reader, name: Any, key: str, what: str) -> None:
+    try:
+        _check_name(name, what)
+    except InputError as exc:
+        raise rd.fail(key, f"is not a valid name: {exc}") from None
+
+
+def _clean(v: float) -> float | int:
+    # 10 decimals of mm or deg: 1e-10 mm, or 2e-12 rad (1e-11 mm at 6 m), far below any
+    # measurement, and a file a person can read (90 rather than 89.99999999999999).
+    r = round(float(v), 10) + 0.0
+    return int(r) if r == int(r) and abs(r) < 1e15 else r
+
+
+def _pose_dict(T: NDArray[np.float64]) -> dict[str, float | int]:
+    return {k: _clean(v) for k, v in zip(_POSE_KEYS, pose_to_vendor(T, "kuka"))}
+
+
+def _prov_dict(p: Provenance) -> dict[str, Any]:
+    out: dict[str, Any] = {"source": p.source}
+    if p.time is not None:
+        out["time"] = p.time
+    if p.rms_mm is not None:
+        out["rms_mm"] = p.rms_mm
+    if p.note:
+        out["note"] = p.note
+    return out
+
+
+def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
+    """The cell-file content of ``cell`` (millimetres, degrees).
+
+    Parameters
+    ----------
+    cell : Cell
+    base_dir : str or Path
+        Directory of the file to be written; a robot model path is written relative to it.
+
+    Returns
+    -------
+    dict
+    """
+    model = cell.robot_model
+    if _is_model_path(model):
+        model = os.path.relpath(Path(model).resolve(), Path(base_dir).resolve())
+    rob: dict[str, Any] = {"model": model}
+    if not np.allclose(cell.T_world_R, np.eye(4), atol=0):
+        rob["frame"] = _pose_dict(cell.T_world_R)
+    data: dict[str, Any] = {"name": cell.name, "robot": rob}
+    if cell.track is not None:
+        t = cell.track
+        td: dict[str, Any] = {"name": t.name, "frame": _pose_dict(t.T_world_L),
+                              "robot_at_zero": _pose_dict(t.T_L_R0), "axis": t.axis,
+                              "scale": _clean(t.scale)}
+        if math.isfinite(t.lower):
+            td["min"] = _clean(t.lower * 1e3)
+        if math.isfinite(t.upper):
+            td["max"] = _clean(t.upper * 1e3)
+        td["provenance"] = _prov_dict(t.provenance)
+        data["track"] = td
+    if isinstance(cell.turntable, Positioner):
+        data["positioner"] = _positioner_dict(cell.turntable)
+    elif cell.turntable is not None:
+        b = cell.turntable
+        bd: dict[str, Any] = {"name": b.name, "parent": b.parent, "frame": _pose_dict(b.T_parent_B)}
+        if math.isfinite(b.lower):
+            bd["min"] = _clean(math.degrees(b.lower))
+        if math.isfinite(b.upper):
+            bd["max"] = _clean(math.degrees(b.upper))
+        bd["provenance"] = _prov_dict(b.provenance)
+        data["turntable"] = bd
+    tools: dict[str, Any] = {}
+    for name, tool in cell.tools.items():
+        entry: dict[str, Any] = {}
+        if tool.number is not None:
+            entry["number"] = tool.number
+        entry["frame"] = _pose_dict(tool.T_F_TCP)
+        if tool.mass is not None:
+            entry["mass"] = _clean(tool.mass)
+        if tool.cog is not None:
+            entry["cog"] = [_clean(v * 1e3) for v in tool.cog]
+        entry["provenance"] = _prov_dict(tool.provenance)
+        tools[name] = entry
+    data["tools"] = tools
+    frames: dict[str, Any] = {}
+    for name, fr in cell.frames.items():
+        entry = {}
+        if fr.number is not None:
+            entry["number"] = fr.number
+        entry["parent"] = fr.parent
+        entry["frame"] = _pose_dict(fr.pose)
+        entry["provenance"] = _prov_dict(fr.provenance)
+        frames[name] = entry
+    data["frames"] = frames
+    return data

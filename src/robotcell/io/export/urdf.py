@@ -1,0 +1,174 @@
+"""URDF of a calibrated cell: robot, track, turntable, tools and frames as one kinematic tree.
+
+ROS tools (RViz, MoveIt, tf) and the Robotics Toolbox then see the calibrated cell. The tree
+(``docs/export.md``, "URDF"):
+
+- ``world``; the track frame ``track`` (L) fixed in it, a prismatic joint ``track_axis`` moving
+  the link ``track_carriage`` along the track axis (its Z, origin at the robot base at position
+  0), and the robot base ``base_link`` (R) fixed on the carriage so that it is at ``T_L_R0`` at
+  position 0; without a track a fixed joint places ``base_link`` at ``T_world_R``;
+- the arm's DH chain: revolute (or prismatic) joints ``<name>`` (the model's joint names, else
+  ``joint_1..n``) moving the links ``link_1..n``; each joint's origin holds the constant part of
+  the DH link before it (:func:`robotcell.cell.axischain.axis_frames`), so its axis is the DH joint
+  axis; then ``flange`` fixed at the rest of the chain;
+- the turntable: ``turntable_root`` (B) fixed in ``world`` or ``base_link`` at ``T_parent_B``, a
+  revolute joint ``turntable_axis`` about its Z moving ``turntable_link_1`` and the fixed link
+  ``turntable`` that carries the frames; a positioner chain the same way, with the joints
+  ``turntable_axis_1..n`` and the links ``turntable_link_1..n``, ``turntable`` at its plate;
+- every tool of the cell as a fixed link ``tool_<name>`` on the flange at ``T_F_TCP``, every frame
+  as a fixed link ``frame_<name>`` on its parent (``world``, ``base_link`` or ``turntable``).
+
+Every moving joint turns about or slides along the Z axis of its frame (``axis`` ``0 0 1`` or
+``0 0 -1``), the form every URDF reader takes without a change of frame.
+
+Joint values of the URDF are the controller's in SI units (rad, m): a DH joint's sign is the
+direction of its URDF axis, its constant offset part of the next origin. The track joint's value
+is the carriage's displacement (m), the controller value times the track's ``scale`` (a URDF
+joint cannot scale its value). Lengths in metres, angles in radians, as URDF prescribes; every
+number is written with all its digits (``repr``), so the tree reproduces the cell's poses exactly.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+import xml.etree.ElementTree as ET
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.cell import Cell, Turntable
+from robotcell.cell.axischain import axis_frames
+from robotcell.kinematics.robot import Robot
+
+__all__ = ["chain_elements", "export", "urdf_origin"]
+
+
+def _num(v: float) -> str:
+    return repr(float(v) + 0.0)
+
+
+def urdf_origin(T: NDArray[np.float64]) -> dict[str, str]:
+    """Attributes ``xyz`` (m) and ``rpy`` (rad) of a URDF ``<origin>`` for the pose ``T``.
+
+    URDF's ``rpy`` is the fixed-axis roll, pitch, yaw: ``R = Rz(yaw) Ry(pitch) Rx(roll)``, which
+    is scipy's extrinsic ``"xyz"``.
+    """
+    with warnings.catch_warnings():  # gimbal lock: scipy's split of the outer angles is exact
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")
+    return {"xyz": " ".join(_num(v) for v in T[:3, 3]), "rpy": " ".join(_num(v) for v in rpy)}
+
+
+#: Rotations that turn Z onto the track axis x, y or z (as ``T_L_J`` of the track joint).
+_Z_TO = {"x": Rotation.from_euler("y", 90, degrees=True).as_matrix(),
+         "y": Rotation.from_euler("x", -90, degrees=True).as_matrix(),
+         "z": np.eye(3)}
+
+
+def _link(root: ET.Element, name: str) -> None:
+    ET.SubElement(root, "link", name=name)
+
+
+def _joint(root: ET.Element, name: str, kind: str, parent: str, child: str,
+           T: NDArray[np.float64], axis: NDArray[np.float64] | None = None,
+           lower: float = -math.inf, upper: float = math.inf) -> None:
+    if kind == "revolute" and not (math.isfinite(lower) and math.isfinite(upper)):
+        kind = "continuous"
+    j = ET.SubElement(root, "joint", name=name, type=kind)
+    ET.SubElement(j, "parent", link=parent)
+    ET.SubElement(j, "child", link=child)
+    ET.SubElement(j, "origin", urdf_origin(T))
+    if axis is not None:
+        ET.SubElement(j, "axis", xyz=" ".join(_num(v) for v in axis))
+    if kind in ("revolute", "prismatic"):
+        # URDF needs finite limits on these joints; an open side becomes a bound far outside
+        # any cell (1e6 m or rad). effort and velocity are not known to the cell: 0.
+        lo = lower if math.isfinite(lower) else -1e6
+        hi = upper if math.isfinite(upper) else 1e6
+        ET.SubElement(j, "limit", lower=_num(lo), upper=_num(hi), effort="0", velocity="0")
+
+
+def chain_elements(root: ET.Element, robot: Robot, parent: str, prefix: str, end: str,
+                   names: list[str] | None = None) -> None:
+    """Add the DH chain of ``robot`` under link ``parent``, ending in the fixed link ``end``.
+
+    Parameters
+    ----------
+    root : xml.etree.ElementTree.Element
+        The ``<robot>`` element.
+    robot : Robot
+        A DH chain; ``robot.base`` places frame 0 in ``parent``, ``robot.flange`` places ``end``
+        on the last DH frame.
+    parent : str
+        Link the chain is fixed to.
+    prefix : str
+        Prefix of the moving links ``<prefix>link_1..n``.
+    end : str
+        Name of the link at the chain's flange.
+    names : list of str, optional
+        Joint names; default the model's, else ``<prefix>joint_1..n``.
+    """
+    names = names or [j.name or f"{prefix}joint_{i + 1}" for i, j in enumerate(robot.joints)]
+    pre, post = axis_frames(robot)
+    last = parent
+    for i, j in enumerate(robot.joints):
+        child = f"{prefix}link_{i + 1}"
+        _link(root, child)
+        _joint(root, names[i], j.type, last, child, robot.base @ pre[i] if i == 0 else pre[i],
+               np.array([0.0, 0.0, j.sign]), j.lower, j.upper)
+        last = child
+    _link(root, end)
+    _joint(root, f"{end}_fixed", "fixed", last, end, post)
+
+
+def export(cell: Cell) -> str:
+    """URDF text of ``cell`` (metres, radians; see the module docstring for the tree).
+
+    Parameters
+    ----------
+    cell : Cell
+
+    Returns
+    -------
+    str
+        ``<?xml ...?>`` and one ``<robot name=CELL_NAME>`` element.
+    """
+    root = ET.Element("robot", name=cell.name)
+    _link(root, "world")
+    _link(root, "base_link")
+    if cell.track is not None:
+        t = cell.track
+        _link(root, "track")
+        _joint(root, "track_frame", "fixed", "world", "track", t.T_world_L)
+        T_L_J = np.eye(4)  # the joint frame: at the robot base at position 0, Z along the motion
+        T_L_J[:3, :3] = _Z_TO[t.axis]
+        T_L_J[:3, 3] = t.T_L_R0[:3, 3]
+        _link(root, "track_carriage")
+        _joint(root, "track_axis", "prismatic", "track", "track_carriage", T_L_J,
+               np.array([0.0, 0.0, 1.0]), t.lower * t.scale, t.upper * t.scale)
+        _joint(root, "robot_on_track", "fixed", "track_carriage", "base_link",
+               np.linalg.solve(T_L_J, t.T_L_R0))
+    else:
+        _joint(root, "robot_frame", "fixed", "world", "base_link", cell.T_world_R)
+    chain_elements(root, cell.robot, "base_link", "", "flange")
+    if cell.turntable is not None:
+        b = cell.turntable
+        _link(root, "turntable_root")
+        _joint(root, "turntable_frame", "fixed", "world" if b.parent == "world" else "base_link",
+               "turntable_root", b.T_parent_root)
+        names = (["turntable_axis"] if isinstance(b, Turntable)
+                 else [f"turntable_axis_{i + 1}" for i in range(b.n_axes)])
+        chain_elements(root, b.chain.with_base(np.eye(4)), "turntable_root", "turntable_",
+                       "turntable", names)
+    for name, tool in cell.tools.items():
+        _link(root, f"tool_{name}")
+        _joint(root, f"tool_{name}_fixed", "fixed", "flange", f"tool_{name}", tool.T_F_TCP)
+    parents = {"world": "world", "robot": "base_link", "turntable": "turntable"}
+    for name, fr in cell.frames.items():
+        _link(root, f"frame_{name}")
+        _joint(root, f"frame_{name}_fixed", "fixed", parents[fr.parent], f"frame_{name}",
+               fr.pose)
+    ET.indent(root)
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

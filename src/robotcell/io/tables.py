@@ -1,0 +1,209 @@
+"""Tables of measurements and results: CSV files with a header, and plain-text tables.
+
+Every file robotcell reads or writes as a table is CSV with a header, lengths in millimetres and
+angles in degrees (the vendor boundary, see ``docs/conventions.md``). The library and the CLI
+share these readers and writers.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import io
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import TextIO
+
+import numpy as np
+
+from robotcell.errors import InputError
+from robotcell.io.fileio import atomic_write, read_text
+
+__all__ = ["MAX_ABS_VALUE", "NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
+           "write_csv"]
+
+
+#: Largest magnitude of a number in a table or an option (mm, deg): a float64 of 1e15 resolves
+#: only 0.125 mm, so a larger value cannot be a measurement; it is a typing error.
+MAX_ABS_VALUE = 1e15
+
+#: Columns every reader accepts and ignores: free text beside the measurements.
+NOTE_COLUMNS = ("note", "notes", "comment", "comments", "remark", "remarks", "description")
+
+
+def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
+    """Read a CSV file with a header into columns.
+
+    Numeric columns become float arrays; a column with any non-numeric entry stays a list of
+    strings. Column names are lower-cased and stripped. Files as spreadsheets save them are
+    read:
+
+    - the encoding follows :func:`robotcell.io.fileio.read_text` (UTF-8 with or without a
+      byte-order mark; otherwise Windows-1252 / Latin-1);
+    - the separator is ``,``, or ``;`` when the header line holds semicolons and no comma (the
+      "CSV" of a spreadsheet in a European locale). In a semicolon-separated file a number may
+      use a decimal comma (``1234,5``); a number with both ``.`` and ``,`` (a thousands
+      separator) is refused with a message that names the dialect.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+
+    Returns
+    -------
+    dict of str to ndarray or list of str
+        Column name -> values, one per data line (blank lines skipped).
+
+    Raises
+    ------
+    InputError
+        Missing or binary file, empty file, ragged rows, an empty cell, NaN or infinity, a number
+        beyond :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{path}: no such file" + (" (it is a folder)" if p.is_dir() else ""))
+    text = read_text(p)
+    first = next((ln for ln in text.splitlines() if ln.strip()), "")
+    semicolon = ";" in first and "," not in first
+    reader = csv.reader(io.StringIO(text, newline=""), delimiter=";" if semicolon else ",")
+    try:
+        rows = [r for r in reader if any(c.strip() for c in r)]
+    except csv.Error as exc:
+        raise InputError(f"{path}: not a valid CSV file ({exc})") from None
+    if len(rows) < 2:
+        raise InputError(f"{path}: needs a header line and at least one data line")
+    header = [h.strip().lower() for h in rows[0]]
+    if len(set(header)) != len(header):
+        raise InputError(f"{path}: repeated column name in header {header}")
+    cols: dict[str, list[str]] = {h: [] for h in header}
+    for lineno, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            hint = ""
+            if not semicolon and len(row) > len(header):
+                hint = (" (decimal commas in a comma-separated file? Save it with ';' as the "
+                        "separator, or write numbers with a decimal point)")
+            raise InputError(f"{path}: line {lineno} has {len(row)} values, header has "
+                             f"{len(header)}{hint}")
+        for h, cell in zip(header, row):
+            cell = cell.strip()
+            if cell == "":
+                raise InputError(f"{path}: line {lineno}: empty value in column '{h}'")
+            cols[h].append(cell)
+    out: dict[str, np.ndarray | list[str]] = {}
+    for h, cells in cols.items():
+        values = [_number(c, semicolon) for c in cells]
+        if any(v is None for v in values):
+            if semicolon and h not in NOTE_COLUMNS:
+                _refuse_thousands(cells, h, path)
+            out[h] = cells
+            continue
+        arr = np.array(values, dtype=float)
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"{path}: column '{h}' contains NaN or infinite values")
+        huge = np.flatnonzero(np.abs(arr) > MAX_ABS_VALUE)
+        if huge.size:
+            raise InputError(f"{path}: line {huge[0] + 2}: column '{h}' has {cells[huge[0]]}, "
+                             f"beyond {MAX_ABS_VALUE:.0e} in size: no "
+                             "measurement in mm or deg is that large; correct the typing error")
+        out[h] = arr
+    return out
+
+
+def _number(cell: str, decimal_comma: bool) -> float | None:
+    """``cell`` as a float (a decimal comma allowed when ``decimal_comma``), or None."""
+    if decimal_comma and "," in cell and "." not in cell and cell.count(",") == 1:
+        cell = cell.replace(",", ".")
+    try:
+        return float(cell)
+    except ValueError:
+        return None
+
+
+def _refuse_thousands(cells: list[str], column: str, path: str | Path) -> None:
+    """Refuse a number with both ``.`` and ``,`` in a semicolon-separated file."""
+    for c in cells:
+        if "," in c and "." in c and _number(c.replace(".", "").replace(",", ""), False) is not None:
+            raise InputError(f"{path}: column '{column}' has {c!r}: this file is semicolon-"
+                             "separated with decimal commas (European locale), and a number may "
+                             "not carry a thousands separator; write it as "
+                             f"{c.replace('.', '')!r} or save the file with ',' as the separator "
+                             "and '.' as the decimal mark")
+
+
+def unknown_columns(cols: dict, known: Iterable[str]) -> list[str]:
+    """The column names of ``cols`` that are neither in ``known`` nor a note column.
+
+    A reader states the columns it uses; a column it does not know (a misspelt ``piont``) would
+    otherwise be ignored silently. The note columns (:data:`NOTE_COLUMNS`) are always accepted.
+
+    Parameters
+    ----------
+    cols : dict
+        Columns from :func:`read_csv`.
+    known : iterable of str
+        Lower-case names the reader uses.
+
+    Returns
+    -------
+    list of str
+        Unknown names, each followed by `` (did you mean 'point'?)`` when a known name is close.
+    """
+    known = list(known)
+    out = []
+    for name in cols:
+        if name in known or name in NOTE_COLUMNS:
+            continue
+        close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+        out.append(f"{name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+    return out
+
+
+def require_columns(cols: dict, names: Sequence[str], path: str | Path) -> np.ndarray:
+    """Stack numeric columns ``names`` into an ``(N, len(names))`` array, or raise naming the gap."""
+    missing = [n for n in names if n not in cols]
+    if missing:
+        raise InputError(f"{path}: missing column(s) {', '.join(missing)} (have: {', '.join(cols)})")
+    for n in names:
+        if not isinstance(cols[n], np.ndarray):
+            raise InputError(f"{path}: column '{n}' must be numeric")
+    return np.stack([cols[n] for n in names], axis=1)
+
+
+def write_csv(path: str | Path | TextIO, header: Sequence[str], rows: np.ndarray,
+              decimals: int = 6) -> None:
+    """Write an ``(N, len(header))`` array as CSV with fixed decimals to a path or open stream.
+
+    A path is written atomically (:func:`robotcell.io.fileio.atomic_write`): a failed run leaves
+    the file as it was.
+    """
+    if hasattr(path, "write"):
+        _write_rows(path, header, rows, decimals)
+        return
+    buf = io.StringIO(newline="")
+    _write_rows(buf, header, rows, decimals)
+    atomic_write(path, buf.getvalue())
+
+
+def _write_rows(fh: TextIO, header: Sequence[str], rows: np.ndarray, decimals: int) -> None:
+    w = csv.writer(fh, lineterminator="\n")
+    w.writerow(header)
+    for r in np.atleast_2d(rows):
+        w.writerow([f"{v:.{decimals}f}" for v in r])
+
+
+def format_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
+    """A plain-text table with right-aligned columns; floats with 3 decimals."""
+    def cell(v: object) -> str:
+        if isinstance(v, float):
+            return f"{v:.3f}"
+        return str(v)
+
+    body = [[cell(v) for v in r] for r in rows]
+    widths = [max(len(str(h)), *(len(r[i]) for r in body)) if body else len(str(h))
+              for i, h in enumerate(headers)]
+    lines = ["  ".join(str(h).rjust(w) for h, w in zip(headers, widths))]
+    lines.append("  ".join("-" * w for w in widths))
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in body]
+    return "\n".join(lines)

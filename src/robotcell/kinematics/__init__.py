@@ -1,0 +1,10 @@
+"""Kinematics of one robot: poses and rotations, DH chains, the robot, joint coupling, model files.
+
+- :mod:`robotcell.kinematics.transforms`: homogeneous poses ``(..., 4, 4)`` and rotations;
+- :mod:`robotcell.kinematics.dh`: Denavit-Hartenberg link transforms and chains;
+- :mod:`robotcell.kinematics.robot`: :class:`~robotcell.kinematics.robot.Robot` (FK, Jacobian);
+- :mod:`robotcell.kinematics.coupling`: linear coupling of motor and DH joint values (J2/J3);
+- :mod:`robotcell.kinematics.models`: robot model files and the robot library.
+
+Inverse kinematics is the package :mod:`robotcell.ik`, which builds on this one.
+"""

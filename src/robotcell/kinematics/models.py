@@ -1,0 +1,403 @@
+"""Robot model files (YAML) and the built-in robot library.
+
+A model file is written by hand in the vendor's units (see ``docs/models.md``)::
+
+    name: my_robot
+    convention: standard        # or: modified
+    units: {length: mm, angle: deg}
+    joints:
+      - {type: revolute,  a: 25, alpha: -90, d: 400, theta: 0,  min: -170, max: 170}
+      - {type: prismatic, a: 0,  alpha: 0,   d: 0,   theta: 90, min: 0,    max: 1500}
+    coupling: {j23_factor: 1}   # optional: q_model = C q_controller + offset
+    ik_seed: kuka_kr16          # optional: nominal model whose analytic IK seeds this one's
+
+The loader converts to SI and reports any problem with the file, the joint and the key.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from robotcell.errors import InputError
+from robotcell.io.fileio import atomic_write, read_text
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.robot import Joint, Robot
+
+__all__ = ["list_robots", "load_robot", "robot_from_dict", "robot_to_dict", "save_robot"]
+
+_LENGTH = {"mm": 1e-3, "m": 1.0}
+_ANGLE = {"deg": math.pi / 180, "rad": 1.0}
+_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name", "passive", "mass", "com"}
+_COUPLING_KEYS = {"j23_factor", "matrix", "offset", "interaction"}
+_POSE_KEYS = {"x", "y", "z", "a", "b", "c"}
+_TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
+             "source", "verified", "verification", "coupling", "ik_seed"}
+
+
+def _library_dir():
+    return resources.files("robotcell") / "robots"
+
+
+def list_robots() -> list[str]:
+    """Names of the robots in the built-in library, sorted."""
+    return sorted(p.name[:-5] for p in _library_dir().iterdir() if p.name.endswith(".yaml"))
+
+
+def load_robot(name_or_path: str | Path) -> Robot:
+    """Load a robot from the built-in library or from a YAML model file.
+
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A library name (``kuka_kr16``, ``ur5e``; see :func:`list_robots`) or the path of a model
+        file.
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    InputError
+        Unknown name (the closest library names are offered), unreadable file, or a file whose
+        content is invalid (the message names the file, the joint and the key).
+    """
+    text = str(name_or_path)
+    path = Path(text)
+    if path.suffix.lower() in (".yaml", ".yml") or path.exists():
+        if not path.is_file():
+            raise InputError(f"robot model file {text!r} does not exist")
+        return _load_file(read_text(path, "robot model file"), str(path))
+    lib = _library_dir() / f"{text}.yaml"
+    if lib.is_file():
+        return _load_file(lib.read_text(encoding="utf-8"), f"library robot {text!r}")
+    close = difflib.get_close_matches(text.lower(), list_robots(), n=3, cutoff=0.4)
+    hint = f"; did you mean {', '.join(close)}?" if close else "; run 'robotcell robots' for the list"
+    raise InputError(f"unknown robot {text!r} (neither a library name nor a model file){hint}")
+
+
+def _load_file(text: str, origin: str) -> Robot:
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise InputError(f"{origin}: not valid YAML: {exc}") from None
+    return robot_from_dict(data, origin)
+
+
+def _number(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{where} must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise InputError(f"{where} must be finite, got {value!r}")
+    return float(value)
+
+
+def _pose(value: Any, where: str, lscale: float, ascale: float) -> np.ndarray:
+    if not isinstance(value, dict):
+        raise InputError(f"{where} must be a mapping with keys x, y, z, a, b, c")
+    unknown = set(value) - _POSE_KEYS
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: x, y, z, a, b, c")
+    v = [_number(value.get(k, 0.0), f"{where}: key '{k}'") for k in ("x", "y", "z", "a", "b", "c")]
+    # KUKA ABC convention; convert the file's units to mm / deg first.
+    v = [x * lscale * 1e3 for x in v[:3]] + [math.degrees(x * ascale) for x in v[3:]]
+    return pose_from_vendor(v, "kuka")
+
+
+def robot_from_dict(data: Any, origin: str = "model") -> Robot:
+    """Build a robot from the parsed content of a model file.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed YAML (file units).
+    origin : str
+        What to call the source in error messages (a file name).
+
+    Returns
+    -------
+    Robot
+    """
+    if not isinstance(data, dict):
+        raise InputError(f"{origin}: a model file must be a YAML mapping with keys name, joints, ...")
+    unknown = set(data) - _TOP_KEYS
+    if unknown:
+        raise InputError(f"{origin}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_TOP_KEYS)}")
+    for key in ("name", "joints"):
+        if key not in data:
+            raise InputError(f"{origin}: missing key '{key}'")
+    units = data.get("units", {"length": "mm", "angle": "deg"})
+    if not isinstance(units, dict):
+        raise InputError(f"{origin}: key 'units' must be a mapping like {{length: mm, angle: deg}}")
+    lunit, aunit = units.get("length", "mm"), units.get("angle", "deg")
+    if lunit not in _LENGTH:
+        raise InputError(f"{origin}: units.length must be 'mm' or 'm', got {lunit!r}")
+    if aunit not in _ANGLE:
+        raise InputError(f"{origin}: units.angle must be 'deg' or 'rad', got {aunit!r}")
+    ls, as_ = _LENGTH[lunit], _ANGLE[aunit]
+    joints_data = data["joints"]
+    if not isinstance(joints_data, list) or not joints_data:
+        raise InputError(f"{origin}: key 'joints' must be a non-empty list")
+    joints = []
+    for i, jd in enumerate(joints_data, start=1):
+        where = f"{origin}: joint {i}"
+        if not isinstance(jd, dict):
+            raise InputError(f"{where} must be a mapping with keys type, a, alpha, d, theta")
+        unknown = set(jd) - _JOINT_KEYS
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_JOINT_KEYS)}")
+        for key in ("type", "a", "alpha", "d", "theta"):
+            if key not in jd:
+                raise InputError(f"{where}: missing key '{key}'")
+        jtype = jd["type"]
+        if jtype not in ("revolute", "prismatic"):
+            raise InputError(f"{where}: key 'type' must be 'revolute' or 'prismatic', got {jtype!r}")
+        qscale = ls if jtype == "prismatic" else as_
+        sign = _number(jd.get("sign", 1), f"{where}: key 'sign'")
+        if sign not in (1.0, -1.0):
+            raise InputError(f"{where}: key 'sign' must be +1 or -1, got {jd['sign']!r}")
+        lo = _number(jd["min"], f"{where}: key 'min'") * qscale if "min" in jd else -math.inf
+        hi = _number(jd["max"], f"{where}: key 'max'") * qscale if "max" in jd else math.inf
+        if not lo < hi:
+            raise InputError(f"{where}: key 'min' ({jd.get('min')}) must be below key 'max' ({jd.get('max')})")
+        passive = jd.get("passive", False)
+        if not isinstance(passive, bool):
+            raise InputError(f"{where}: key 'passive' must be true or false, got {passive!r}")
+        if passive and ("min" in jd or "max" in jd):
+            raise InputError(f"{where}: a passive joint has no limits of its own (remove 'min', 'max'); "
+                             "state limits on the controller axes or under coupling.interaction")
+        mass = _number(jd.get("mass", 0.0), f"{where}: key 'mass'")
+        if mass < 0:
+            raise InputError(f"{where}: key 'mass' must be >= 0 (kg), got {jd['mass']!r}")
+        com = jd.get("com", [0.0, 0.0, 0.0])
+        if not isinstance(com, list) or len(com) != 3:
+            raise InputError(f"{where}: key 'com' must be [x, y, z], the centre of mass in the "
+                             "link's DH frame (file length unit)")
+        joints.append(Joint(
+            mass=mass, com=tuple(_number(v, f"{where}: key 'com'") * ls for v in com),
+            type=jtype,
+            a=_number(jd["a"], f"{where}: key 'a'") * ls,
+            alpha=_number(jd["alpha"], f"{where}: key 'alpha'") * as_,
+            d=_number(jd["d"], f"{where}: key 'd'") * ls,
+            theta=_number(jd["theta"], f"{where}: key 'theta'") * as_,
+            sign=sign, lower=lo, upper=hi, name=str(jd.get("name", f"P{i}" if passive else f"A{i}")),
+            passive=passive,
+        ))
+    kwargs: dict[str, Any] = {}
+    if "coupling" in data:
+        kwargs["coupling"] = _coupling(data["coupling"], joints, origin, ls, as_)
+    elif any(j.passive for j in joints):
+        raise InputError(f"{origin}: passive joints need key 'coupling' with a 'matrix' that says "
+                         "how they move")
+    if "ik_seed" in data:
+        kwargs["ik_seed"] = _ik_seed(data["ik_seed"], origin)
+    for key in ("base", "flange", "tool"):
+        if key in data:
+            kwargs[key] = _pose(data[key], f"{origin}: key '{key}'", ls, as_)
+    if "home" in data:
+        home = data["home"]
+        axes = [j for j in joints if not j.passive]
+        if not isinstance(home, list) or len(home) != len(axes):
+            raise InputError(f"{origin}: key 'home' must be a list of {len(axes)} joint values (one per controller axis)")
+        kwargs["home"] = np.array([
+            _number(v, f"{origin}: key 'home' value {k}") * (ls if j.prismatic else as_)
+            for k, (v, j) in enumerate(zip(home, axes), start=1)
+        ])
+    convention = data.get("convention", "standard")
+    if convention not in ("standard", "modified"):
+        raise InputError(f"{origin}: key 'convention' must be 'standard' or 'modified', got {convention!r}")
+    verified = data.get("verified", False)
+    if not isinstance(verified, bool):
+        raise InputError(f"{origin}: key 'verified' must be true or false, got {verified!r}")
+    try:
+        return Robot(
+            name=str(data["name"]), joints=tuple(joints), convention=convention,
+            title=str(data.get("title", data["name"])), source=str(data.get("source", "")),
+            verified=verified, verification=str(data.get("verification", "")), **kwargs,
+        )
+    except InputError as exc:
+        raise InputError(f"{origin}: {exc}") from None
+
+
+def _ik_seed(value: Any, origin: str) -> Robot:
+    """Parse key ``ik_seed``: a library name or a nested model (mapping)."""
+    where = f"{origin}: key 'ik_seed'"
+    if isinstance(value, str):
+        if value not in list_robots():
+            raise InputError(f"{where}: {value!r} is not a library robot; give a library name or "
+                             "the nominal model itself as a nested mapping (name, joints, ...)")
+        return load_robot(value)
+    if isinstance(value, dict):
+        return robot_from_dict(value, where)
+    raise InputError(f"{where} must be a library robot name or a nested model mapping")
+
+
+def _coupling(value: Any, joints: list[Joint], origin: str, ls: float, as_: float) -> Coupling:
+    """Parse key ``coupling`` (file units) into a :class:`Coupling` in SI units."""
+    where = f"{origin}: key 'coupling'"
+    if not isinstance(value, dict):
+        raise InputError(f"{where} must be a mapping with j23_factor, or matrix (and offset, interaction)")
+    unknown = set(value) - _COUPLING_KEYS
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_COUPLING_KEYS)}")
+    if ("j23_factor" in value) == ("matrix" in value):
+        raise InputError(f"{where} needs exactly one of 'j23_factor' or 'matrix'")
+    axes = [j for j in joints if not j.passive]
+    m, n = len(joints), len(axes)
+    # Scale of each joint's file unit in SI: C_SI[i, j] = C_file[i, j] * s_model[i] / s_axis[j].
+    s_model = np.array([ls if j.prismatic else as_ for j in joints])
+    s_axis = np.array([ls if j.prismatic else as_ for j in axes])
+    if "j23_factor" in value:
+        k = _number(value["j23_factor"], f"{where}.j23_factor")
+        if m != n or m < 3:
+            raise InputError(f"{where}.j23_factor needs at least 3 joints and no passive joint")
+        if joints[1].prismatic != joints[2].prismatic:
+            raise InputError(f"{where}.j23_factor couples joints 2 and 3, which must be of one type")
+        C = np.eye(m)
+        C[2, 1] = k
+    else:
+        rows = value["matrix"]
+        if (not isinstance(rows, list) or len(rows) != m
+                or not all(isinstance(r, list) and len(r) == n for r in rows)):
+            raise InputError(f"{where}.matrix must be {m} rows (one per joint) of {n} numbers (one "
+                             f"per controller axis, i.e. per joint that is not passive)")
+        C = np.array([[_number(v, f"{where}.matrix row {i} value {c}") for c, v in enumerate(r, start=1)]
+                      for i, r in enumerate(rows, start=1)])
+        C = C * s_model[:, None] / s_axis[None, :]
+    off = value.get("offset")
+    if off is not None:
+        if not isinstance(off, list) or len(off) != m:
+            raise InputError(f"{where}.offset must be a list of {m} numbers (one per joint)")
+        off = np.array([_number(v, f"{where}.offset value {i}") for i, v in enumerate(off, start=1)]) * s_model
+    A, lo, hi = [], [], []
+    limits = value.get("interaction", [])
+    if not isinstance(limits, list):
+        raise InputError(f"{where}.interaction must be a list of {{coefficients: [...], min: .., max: ..}}")
+    for i, lim in enumerate(limits, start=1):
+        w = f"{where}.interaction {i}"
+        if not isinstance(lim, dict) or set(lim) - {"coefficients", "min", "max"} or "coefficients" not in lim:
+            raise InputError(f"{w} must be a mapping with keys coefficients, min, max")
+        co = lim["coefficients"]
+        if not isinstance(co, list) or len(co) != n:
+            raise InputError(f"{w}: coefficients must be {n} numbers, one per controller axis")
+        a = np.array([_number(v, f"{w}: coefficient {c}") for c, v in enumerate(co, start=1)])
+        used = {axes[c].prismatic for c in np.flatnonzero(a)}
+        if len(used) != 1:
+            raise InputError(f"{w}: coefficients must be nonzero on axes of one type (all revolute or "
+                             "all prismatic), so that min and max have one unit")
+        scale = ls if used.pop() else as_
+        A.append(a * scale / s_axis)
+        lo.append(_number(lim["min"], f"{w}: key 'min'") * scale if "min" in lim else -math.inf)
+        hi.append(_number(lim["max"], f"{w}: key 'max'") * scale if "max" in lim else math.inf)
+    try:
+        return Coupling(C, off, np.array(A).reshape(-1, n), np.array(lo), np.array(hi))
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _coupling_to_dict(robot: Robot) -> dict[str, Any]:
+    """Key ``coupling`` of a model file (mm, deg) for ``robot.coupling``."""
+    c = robot.coupling
+    assert c is not None
+    k = c.j23_factor
+    s_model = np.array([1e3 if j.prismatic else 180 / math.pi for j in robot.joints])
+    s_axis = np.array([1e3 if j.prismatic else 180 / math.pi for j in robot.axes])
+    out: dict[str, Any]
+    if k is not None:
+        out = {"j23_factor": _clean(k)}
+    else:
+        C = c.matrix * s_model[:, None] / s_axis[None, :]
+        out = {"matrix": [[_clean(float(v)) for v in row] for row in C]}
+        if np.any(c.offset):
+            out["offset"] = [_clean(float(v)) for v in c.offset * s_model]
+    limits = []
+    for a, lo, hi in zip(c.interaction, c.interaction_lower, c.interaction_upper):
+        scale = 1e3 if robot.axes[int(np.flatnonzero(a)[0])].prismatic else 180 / math.pi
+        lim: dict[str, Any] = {"coefficients": [_clean(float(v)) for v in a * s_axis / scale]}
+        if math.isfinite(lo):
+            lim["min"] = _clean(float(lo * scale))
+        if math.isfinite(hi):
+            lim["max"] = _clean(float(hi * scale))
+        limits.append(lim)
+    if limits:
+        out["interaction"] = limits
+    return out
+
+
+def robot_to_dict(robot: Robot) -> dict[str, Any]:
+    """The model-file content of ``robot`` (millimetres and degrees)."""
+    joints = []
+    for j in robot.joints:
+        qs = 1e3 if j.prismatic else 180 / math.pi
+        entry: dict[str, Any] = {
+            "name": j.name, "type": j.type, "a": j.a * 1e3, "alpha": math.degrees(j.alpha),
+            "d": j.d * 1e3, "theta": math.degrees(j.theta), "sign": int(j.sign),
+        }
+        if math.isfinite(j.lower):
+            entry["min"] = j.lower * qs
+        if math.isfinite(j.upper) and not j.passive:
+            entry["max"] = j.upper * qs
+        if j.passive:
+            entry.pop("min", None)
+            entry["passive"] = True
+        if j.mass > 0:
+            entry["mass"] = j.mass
+            entry["com"] = [_clean(v * 1e3) for v in j.com]
+        joints.append({k: _clean(v) for k, v in entry.items()})
+    data: dict[str, Any] = {
+        "name": robot.name, "title": robot.title, "convention": robot.convention,
+        "units": {"length": "mm", "angle": "deg"}, "joints": joints,
+    }
+    for key in ("base", "flange", "tool"):
+        T = getattr(robot, key)
+        if not np.allclose(T, np.eye(4), atol=1e-15):
+            data[key] = dict(zip("xyzabc", (_clean(v) for v in pose_to_vendor(T, "kuka"))))
+    if robot.coupling is not None:
+        data["coupling"] = _coupling_to_dict(robot)
+    if robot.ik_seed is not None:
+        data["ik_seed"] = _ik_seed_to_dict(robot.ik_seed)
+    if robot.home is not None:
+        data["home"] = [
+            _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.axes)
+        ]
+    data.update(source=robot.source, verified=robot.verified, verification=robot.verification)
+    return data
+
+
+def _ik_seed_to_dict(seed: Robot) -> str | dict[str, Any]:
+    """Key ``ik_seed``: the library name when the seed is that library model, else the model."""
+    data = robot_to_dict(seed)
+    data.pop("ik_seed", None)
+    if seed.name in list_robots() and robot_to_dict(load_robot(seed.name)) == data:
+        return seed.name
+    return data
+
+
+def _clean(v: Any) -> Any:
+    """A plain Python int or float (YAML cannot write numpy scalars), rounded to 9 decimals."""
+    if isinstance(v, (float, np.floating)):
+        r = round(float(v), 9)
+        return int(r) if r == int(r) and abs(r) < 1e15 else r
+    if isinstance(v, np.integer):
+        return int(v)
+    return v
+
+
+def save_robot(robot: Robot, path: str | Path) -> None:
+    """Write ``robot`` as a YAML model file (millimetres and degrees), atomically.
+
+    Raises
+    ------
+    InputError
+        The file cannot be written (missing folder, a folder, no permission).
+    """
+    atomic_write(path, yaml.safe_dump(robot_to_dict(robot), sort_keys=False,
+                                      default_flow_style=None))

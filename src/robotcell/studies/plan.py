@@ -1,0 +1,327 @@
+"""Planning a calibration: which touches give the smallest uncertainty, checked by Monte Carlo.
+
+For a virtual cell (its values taken as the truth) and a touch-up accuracy ``noise``, each
+candidate touch design of a procedure (:data:`DESIGNS`: tool tilt, size of the 3-point
+triangle, track travel, table angles and radius) is simulated without error, and the
+calibration of those exact touches with ``prior_sigma = noise`` gives the *predicted*
+uncertainty (first-order propagation, the same covariance every calibration reports). The design
+with the smallest predicted uncertainty of the calibrated pose wins. A Monte Carlo run then
+repeats simulate-with-error and calibrate ``runs`` times at that design and compares the spread
+of the actual errors with the prediction.
+
+The figure of merit of a pose is ``sqrt(|sigma_position|^2 + (LEVER * |sigma_rotation|)^2)``:
+the 1-sigma error of a point ``LEVER`` from the frame's origin, in metres.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sized
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.calibration.frame import frame_3point
+from robotcell.calibration.result import CalibrationResult
+from robotcell.calibration.tcp import calibrate_tool
+from robotcell.calibration.track import calibrate_track
+from robotcell.calibration.turntable import calibrate_turntable
+from robotcell.calibration.workpiece import calibrate_workpiece
+from robotcell.cell import Cell
+from robotcell.cell.kinematics import robot_pose, tool_pose
+from robotcell.errors import InputError, RobotcellError
+from robotcell.studies.simulate import Touches, check_counts, simulate
+
+__all__ = ["DESIGNS", "LEVER", "Candidate", "MonteCarlo", "Plan", "calibrate_touches",
+           "plan", "pose_error", "predicted_sigma"]
+
+#: ``progress(items, label)``: wraps a sized iterable (e.g. in a progress bar) and yields its items.
+Progress = Callable[[Sized, str], Iterable[Any]]
+
+#: Distance from the frame origin at which rotation uncertainty is weighed against position (m).
+LEVER = 0.5
+
+#: Candidate designs per procedure: keyword arguments of :func:`robotcell.studies.simulate.simulate`
+#: (SI units); the number of touches stays as the user asks.
+DESIGNS: dict[str, list[dict[str, Any]]] = {
+    "tcp": [{"tilt": math.radians(t)} for t in (10, 20, 30, 40, 50, 60)],
+    "frame": [{"size": s} for s in (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)],
+    "track": [{"travel": t} for t in (0.1, 0.25, 0.5, 1.0, 1.5, 2.0)],
+    "turntable": [{"span": math.radians(s), "radius": r} for s in (60, 120, 180, 270, 360)
+                  for r in (0.1, 0.2, 0.3, 0.4)],
+    "workpiece": [{"size": s} for s in (0.05, 0.1, 0.15, 0.2, 0.3, 0.4)],
+}
+
+#: The key of the calibrated pose in each procedure's result values.
+POSE_KEY = {"tcp": "T_F_TCP", "frame": "T_R_W", "track": "T_L_R", "turntable": "T_R_B",
+            "workpiece": "T_B_W"}
+
+
+def _design_to_simulation(procedure: str, design: dict[str, Any]) -> dict[str, Any]:
+    """Turn a planning design into :func:`simulate` keywords (table spans into angle lists)."""
+    out = dict(design)
+    if procedure == "turntable" and "span" in out:
+        span = out.pop("span")
+        n = out.pop("touches", 6)
+        full = span >= 2 * math.pi - 1e-9
+        out["angles"] = np.linspace(-span / 2, span / 2, n, endpoint=not full)
+    return out
+
+
+def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = None
+                      ) -> CalibrationResult:
+    """Calibrate simulated touches with the library, the cell giving robot, tool and axes.
+
+    TCP positions come from the recorded joint values through the cell's robot and the tool
+    that touched. Frame and turntable touches are mapped into the parent frame of what they
+    calibrate (world, or the robot base for items carried by it), so the pose in the result is
+    expressed in that parent (under the procedure's usual key, e.g. ``T_R_B``).
+
+    Parameters
+    ----------
+    cell : Cell
+        The cell as known at calibration time (e.g. with an already calibrated tool).
+    touches : Touches
+    prior_sigma : float, optional
+        Touch-up accuracy (m) used for the uncertainties instead of the residuals.
+
+    Returns
+    -------
+    CalibrationResult
+    """
+    robot = cell.robot
+    if touches.procedure == "tcp":
+        F = robot.fk(touches.q, np.eye(4))
+        r = np.array(touches.roles)
+        return calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=prior_sigma)
+    T_R_TCP = robot.fk(touches.q, tool_pose(cell, touches.tool))
+    e = np.zeros(len(touches.q)) if touches.track is None else touches.track
+    if touches.procedure == "track":
+        pt = np.array([int(p) - 1 for p in touches.roles])
+        refs = touches.truth["references"]
+        t = cell.track
+        assert t is not None
+        return calibrate_track(e, T_R_TCP[:, :3, 3], references=refs, point=pt, axis=t.axis,
+                               prior_sigma=prior_sigma)
+    parent = touches.truth["parent"]
+    if parent == "turntable":
+        parent = cell.turntable.parent if cell.turntable is not None else "world"
+    T_P_R = np.eye(4) if parent == "robot" else robot_pose(cell, e)
+    f = (T_P_R @ T_R_TCP)[..., :3, 3]
+    if touches.procedure == "frame":
+        return frame_3point(f, touches.roles, prior_sigma)
+    if touches.procedure == "turntable":
+        return calibrate_turntable(touches.table, f, height=-touches.truth["height"],
+                                   prior_sigma=prior_sigma)
+    assert cell.turntable is not None
+    return calibrate_workpiece(touches.table, f, touches.roles, cell.turntable.T_parent_B,
+                               prior_sigma=prior_sigma)
+
+
+def _pose_sigma(result: CalibrationResult, key: str) -> tuple[float, float]:
+    """Lengths of the 1-sigma position (m) and rotation (rad) vectors of a pose in a result."""
+    sp = np.asarray(result.sigma.get(key + "_position", np.full(3, np.nan)), dtype=float)
+    sr = np.asarray(result.sigma.get(key + "_rotation", np.zeros(3)), dtype=float)
+    return float(np.linalg.norm(sp)), float(np.linalg.norm(sr))
+
+
+def predicted_sigma(result: CalibrationResult, procedure: str) -> tuple[float, float, float]:
+    """Predicted 1-sigma of the calibrated pose: position (m), rotation (rad), merit (m).
+
+    For a tool calibrated without orientation the TCP position alone counts.
+    """
+    key = POSE_KEY[procedure]
+    if key in result.values:
+        sp, sr = _pose_sigma(result, key)
+    else:
+        sp, sr = float(np.linalg.norm(result.sigma["tcp"])), 0.0
+    return sp, sr, math.hypot(sp, LEVER * sr)
+
+
+def pose_error(T_est: NDArray[np.float64], T_true: NDArray[np.float64]) -> tuple[float, float]:
+    """Position (m) and rotation (rad) error of an estimated pose against the truth."""
+    dp = float(np.linalg.norm(T_est[:3, 3] - T_true[:3, 3]))
+    dr = float(np.linalg.norm(Rotation.from_matrix(T_est[:3, :3] @ T_true[:3, :3].T).as_rotvec()))
+    return dp, dr
+
+
+def _true_pose(touches: Touches) -> NDArray[np.float64]:
+    """The truth, in the frame :func:`calibrate_touches` expresses the result in."""
+    return touches.truth[{"tcp": "T_F_TCP", "track": "T_L_R"}.get(touches.procedure, "pose")]
+
+
+@dataclass
+class Candidate:
+    """One touch design and its predicted uncertainty.
+
+    Attributes
+    ----------
+    design : dict
+        Keywords of the design (SI units), see :data:`DESIGNS`.
+    position : float
+        Predicted 1-sigma of the calibrated position (m); NaN when the design is not feasible.
+    rotation : float
+        Predicted 1-sigma of the calibrated rotation (rad).
+    merit : float
+        ``sqrt(position^2 + (LEVER * rotation)^2)`` (m); infinite when not feasible.
+    condition : float
+        Condition number of the calibration at this design.
+    reason : str
+        Why the design is not feasible (unreachable touches, ill-posed geometry), else empty.
+    """
+
+    design: dict[str, Any]
+    position: float = math.nan
+    rotation: float = math.nan
+    merit: float = math.inf
+    condition: float = math.nan
+    reason: str = ""
+
+
+@dataclass
+class MonteCarlo:
+    """Monte Carlo check of a design: actual errors over repeated simulated calibrations.
+
+    Attributes
+    ----------
+    runs : int
+    position_rms, rotation_rms : float
+        RMS over the runs of the length of the position error (m) and of the rotation error
+        (rad) of the calibrated pose against the truth.
+    position_predicted, rotation_predicted : float
+        Predicted 1-sigma lengths (m, rad); for Gaussian errors the RMS lengths above should be
+        close to these.
+    failures : int
+        Runs whose calibration refused the data (an outlier can make the geometry ill-posed).
+    """
+
+    runs: int
+    position_rms: float
+    rotation_rms: float
+    position_predicted: float
+    rotation_predicted: float
+    failures: int = 0
+
+
+@dataclass
+class Plan:
+    """The proposed touches of a procedure, the candidates compared, and the Monte Carlo check.
+
+    Attributes
+    ----------
+    procedure : str
+    noise : float
+        Touch-up accuracy assumed (m, 1-sigma per coordinate).
+    best : Candidate
+    candidates : list of Candidate
+    touches : Touches
+        The proposed touches (exact, without touch-up error): joint values to teach.
+    monte_carlo : MonteCarlo or None
+    """
+
+    procedure: str
+    noise: float
+    best: Candidate
+    candidates: list[Candidate]
+    touches: Touches
+    monte_carlo: MonteCarlo | None = None
+
+
+def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
+         seed: int | None = 0, progress: Progress | None = None,
+         designs: list[dict[str, Any]] | None = None, **common: Any) -> Plan:
+    """Propose the touches of a procedure that minimise the predicted uncertainty.
+
+    Parameters
+    ----------
+    cell : Cell
+        Virtual cell whose values are taken as the truth.
+    procedure : {"tcp", "frame", "track", "turntable", "workpiece"}
+    noise : float
+        Touch-up accuracy, 1-sigma per coordinate (m); > 0.
+    runs : int
+        Monte Carlo runs at the best design (0: none).
+    seed : int, optional
+        Seed of the Monte Carlo touch-up errors.
+    progress : callable, optional
+        ``progress(items, label)`` wraps the candidates and then the Monte Carlo runs, e.g. in
+        a progress bar; it must yield the items.
+    designs : list of dict, optional
+        Candidate designs instead of :data:`DESIGNS`.
+    **common
+        Keywords of :func:`robotcell.studies.simulate.simulate` fixed for every candidate (``tool``,
+        ``frame``, ``track``, ``touches``, ``repeats``, ``references``, ``height``, ...).
+
+    Returns
+    -------
+    Plan
+
+    Raises
+    ------
+    InputError
+        Unknown procedure, non-positive noise, no feasible design.
+    """
+    if procedure not in DESIGNS:
+        raise InputError(f"unknown procedure {procedure!r}; choose from {', '.join(DESIGNS)}")
+    if not (math.isfinite(noise) and noise > 0):
+        raise InputError(f"noise must be a positive number (m), got {noise}")
+    if runs < 0:
+        raise InputError(f"runs must be >= 0, got {runs}")
+    check_counts(common)
+    wrap = progress or (lambda items, label: items)
+    candidates = []
+    for design in wrap(designs if designs is not None else DESIGNS[procedure],
+                       f"predicting {procedure} designs"):
+        cand = Candidate(dict(design))
+        kw = _design_to_simulation(procedure, {**common, **design})
+        try:
+            exact = simulate(cell, procedure, noise=0.0, **kw)
+            res = calibrate_touches(cell, exact, prior_sigma=noise)
+        except RobotcellError as exc:
+            cand.reason = str(exc)
+        else:
+            cand.position, cand.rotation, cand.merit = predicted_sigma(res, procedure)
+            cand.condition = res.condition
+        candidates.append(cand)
+    feasible = [c for c in candidates if math.isfinite(c.merit)]
+    if not feasible:
+        reasons = "; ".join(sorted({c.reason for c in candidates}))
+        raise InputError(f"no candidate {procedure} design can be carried out in this cell: {reasons}")
+    best = min(feasible, key=lambda c: c.merit)
+    kw = _design_to_simulation(procedure, {**common, **best.design})
+    touches = simulate(cell, procedure, noise=0.0, **kw)
+    mc = None
+    if runs:
+        if cell.track is not None and procedure != "track":
+            kw["track"] = float(touches.track[0])  # where the robot stands, as planned
+        mc = _monte_carlo(cell, procedure, noise, runs, seed, progress, kw, best)
+    return Plan(procedure, noise, best, candidates, touches, mc)
+
+
+def _monte_carlo(cell: Cell, procedure: str, noise: float, runs: int, seed: int | None,
+                 progress: Progress | None,
+                 kw: dict[str, Any], best: Candidate) -> MonteCarlo:
+    rng = np.random.default_rng(seed)
+    dp, dr = [], []
+    failures = 0
+    key = POSE_KEY[procedure]
+    wrap = progress or (lambda items, label: items)
+    for _ in wrap(range(runs), f"Monte Carlo, {runs} runs"):
+        t = simulate(cell, procedure, noise=noise, seed=rng, **kw)
+        try:
+            res = calibrate_touches(cell, t)
+        except RobotcellError:
+            failures += 1
+            continue
+        T_true = _true_pose(t)
+        if key in res.values:
+            p, r = pose_error(res.values[key], T_true)
+        else:
+            p, r = float(np.linalg.norm(res.values["tcp"] - T_true[:3, 3])), 0.0
+        dp.append(p)
+        dr.append(r)
+    rms = (lambda v: float(np.sqrt(np.mean(np.square(v)))) if v else math.nan)
+    return MonteCarlo(runs, rms(dp), rms(dr), best.position, best.rotation, failures)

@@ -1,0 +1,322 @@
+"""Reachability map of a cell: can the robot reach every target, with which axis values, and how
+far from its joint limits and from singular configurations.
+
+Every target ``T_X_TCP`` (in a frame X of the cell, at a table angle) is solved by
+:func:`robotcell.cell.ik.ik`, which chooses the track position when the cell has a track and none
+is given. Among the valid arm configurations the one with the best score is kept. Per target:
+
+- ``limit_margin``: the smallest distance of any arm axis to its limits (rad; m for a prismatic
+  axis),
+- ``manipulability``: ``|det J|`` of the arm (Yoshikawa 1985; m^3 for a six-axis arm), zero at a
+  singular configuration,
+- ``score`` in ``[0, 1]``: ``min(1, manipulability / scale) * min(1, limit_margin / LIMIT_REF)``
+  with ``scale`` the largest ``|det J|`` of the arm over :data:`SCALE_SAMPLES` random
+  configurations within its limits (:func:`manipulability_scale`); 0 when unreachable. So a
+  target scores 1 when the arm is as far from singularities as it gets and every axis is at least
+  :data:`LIMIT_REF` from its limits.
+
+:func:`reach_html` draws the map (targets coloured by score; track and table along the targets)
+into a self-contained HTML page (the figure embedded as a PNG data URI); matplotlib is imported
+only there.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+import weakref
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.cell.ik import ik
+from robotcell.cell.kinematics import tool_pose
+from robotcell.errors import InputError
+from robotcell.ik.limits import TWO_PI
+from robotcell.ik.trackchoice import arm_manipulability
+from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.tables import read_csv, require_columns
+from robotcell.kinematics.robot import Robot
+
+if TYPE_CHECKING:
+    from robotcell.cell import Cell
+
+__all__ = ["LIMIT_REF", "ReachMap", "manipulability_scale", "reach_html", "reach_map",
+           "read_targets"]
+
+#: Distance to the joint limits (rad) from which a target counts as fully clear of them.
+LIMIT_REF = math.radians(10.0)
+#: Targets per block when :func:`reach_map` reports progress.
+BLOCK = 2000
+#: Random configurations that set the manipulability scale of an arm.
+SCALE_SAMPLES = 4096
+
+_SCALES: weakref.WeakKeyDictionary[Robot, float] = weakref.WeakKeyDictionary()
+
+
+def manipulability_scale(robot: Robot) -> float:
+    """The largest ``|det J|`` of ``robot`` over :data:`SCALE_SAMPLES` seeded random
+    configurations within its limits (revolute axes within ``[-pi, pi]``); m^3 for a 6R arm."""
+    scale = _SCALES.get(robot)
+    if scale is None:
+        rng = np.random.default_rng(0)
+        lo = np.maximum(robot.lower, -math.pi)
+        hi = np.minimum(robot.upper, math.pi)
+        q = rng.uniform(lo, hi, (SCALE_SAMPLES, robot.n_joints))
+        scale = float(np.max(np.abs(np.linalg.det(robot.jacobian(q)))))
+        _SCALES[robot] = scale
+    return scale
+
+
+@dataclass(frozen=True)
+class ReachMap:
+    """Reachability of a batch of targets.
+
+    Attributes
+    ----------
+    reachable : ndarray of bool, shape (N,)
+        Some arm configuration reaches the target within every limit.
+    q : ndarray, shape (N, n)
+        Arm axis values of the best configuration (rad; NaN where unreachable).
+    branch : ndarray of int, shape (N,)
+        Its analytic branch (``4 * shoulder + 2 * elbow + wrist``; -1 where unreachable).
+    track : ndarray, shape (N,)
+        Track position (m; chosen unless given, NaN where chosen and unreachable; 0 without
+        track).
+    table : ndarray, shape (N,) or (N, n)
+        Table angle (rad; 0 without turntable), or a positioner's axis values.
+    limit_margin : ndarray, shape (N,)
+        Smallest distance of an arm axis to its limits (rad; NaN where unreachable).
+    track_margin : ndarray, shape (N,)
+        Distance of the track position to the nearer track limit (m; inf without track
+        limits, NaN without a track position).
+    manipulability : ndarray, shape (N,)
+        ``|det J|`` of the arm (m^3 for a six-axis arm; 0 where unreachable).
+    score : ndarray, shape (N,)
+        In ``[0, 1]``, see the module docstring.
+    """
+
+    reachable: NDArray[np.bool_]
+    q: NDArray[np.float64]
+    branch: NDArray[np.int_]
+    track: NDArray[np.float64]
+    table: NDArray[np.float64]
+    limit_margin: NDArray[np.float64]
+    track_margin: NDArray[np.float64]
+    manipulability: NDArray[np.float64]
+    score: NDArray[np.float64]
+
+    @property
+    def fraction(self) -> float:
+        """Fraction of the targets that are reachable."""
+        return float(np.mean(self.reachable)) if self.reachable.size else 0.0
+
+
+def _rows(v: ArrayLike | None, sl: slice, n: int) -> ArrayLike | None:
+    """Rows ``sl`` of a per-target value given as a scalar or an array of length ``n``."""
+    if v is None or np.ndim(v) == 0:
+        return v
+    return np.broadcast_to(np.asarray(v, dtype=float), (n,))[sl]
+
+
+def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:
+    """Table angles (rad) to choose from: one turn, or the limits when they span less."""
+    tt = cell.turntable
+    if tt is None or tt.n_axes != 1 or np.ndim(tt.lower) != 0:
+        raise InputError("choosing the table angle needs a turntable (one axis) in the cell; "
+                         "give a positioner's axis values")
+    if samples < 2:
+        raise InputError(f"table_samples must be at least 2, got {samples}")
+    if tt.upper - tt.lower >= TWO_PI:
+        mid = 0.5 * (tt.lower + tt.upper)
+        return mid + np.linspace(-math.pi, math.pi, samples, endpoint=False)
+    return np.linspace(tt.lower, tt.upper, samples)
+
+
+def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayLike | None = None,
+              table: ArrayLike | None = 0.0, track: ArrayLike | None = None,
+              table_samples: int = 36,
+              progress: Callable[[int, int], None] | None = None) -> ReachMap:
+    """Score every target: reachable or not, axis values, limit margin, manipulability.
+
+    Parameters
+    ----------
+    cell : Cell
+    T : array_like, shape (N, 4, 4)
+        Targets ``T_X_TCP`` in frame ``frame`` (m).
+    frame : str
+        Frame of the targets (see :func:`robotcell.cell.kinematics.frame_pose`).
+    tool : str or array_like of shape (4, 4), optional
+        A tool of the cell by name, or ``T_F_TCP`` (m).
+    table : array_like of shape (N,) or (), or None
+        Table angles (rad). None: chosen per target among ``table_samples`` angles evenly
+        spread over one turn (or over the table's limits when they span less), the one where
+        the target gets the best score.
+    track : array_like, shape (N,) or (), optional
+        Track positions (m); default: chosen per target (:func:`robotcell.cell.ik.ik`).
+    table_samples : int
+        Candidate table angles when ``table`` is None (10 deg apart by default).
+    progress : callable, optional
+        With it, the targets are solved in blocks of :data:`BLOCK` and ``progress(done, total)``
+        is called after each.
+
+    Returns
+    -------
+    ReachMap
+    """
+    arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
+    if progress is not None:
+        n = arr.shape[0]
+        parts = []
+        for s in range(0, n, BLOCK):
+            sl = slice(s, s + BLOCK)
+            parts.append(reach_map(cell, arr[sl], frame, tool, _rows(table, sl, n),
+                                   _rows(track, sl, n), table_samples))
+            progress(min(s + BLOCK, n), n)
+        return ReachMap(*(np.concatenate([getattr(p, f.name) for p in parts])
+                          for f in fields(ReachMap)))
+    if table is None:
+        grid = _table_grid(cell, table_samples)
+        arr = np.broadcast_to(arr[:, None], (arr.shape[0], grid.size, 4, 4))
+        table = np.broadcast_to(grid, arr.shape[:2])
+    sol = ik(cell, arr, frame=frame, track=track, table=table, tool=tool)
+    robot = cell.robot
+    T_tool = tool_pose(cell, tool)
+    n = arr.shape[0]
+    valid = sol.valid.reshape(n, -1)                                    # (N, M * 8)
+    q_all = sol.q.reshape(n, valid.shape[1], -1)
+    q = np.where(valid[..., None], q_all, 0.0)
+    if sol.method == "opw":  # closed form; |det J| does not depend on the tool
+        manip = np.where(valid, arm_manipulability(robot, q), 0.0)
+    else:
+        manip = np.where(valid, np.abs(np.linalg.det(robot.jacobian(q, tool=T_tool))), 0.0)
+    lo, hi = robot.lower, robot.upper
+    with np.errstate(invalid="ignore"):
+        gap = np.minimum(np.where(np.isfinite(lo), q - lo, np.inf),
+                         np.where(np.isfinite(hi), hi - q, np.inf)).min(axis=-1)
+    score = (np.minimum(1.0, manip / manipulability_scale(robot))
+             * np.minimum(1.0, gap / LIMIT_REF))
+    score = np.where(valid, score, -1.0)
+    best = np.argmax(score, axis=-1)
+    rows = np.arange(n)
+    ok = valid[rows, best]
+    e = np.broadcast_to(sol.track, sol.valid.shape[:-1]).reshape(n, -1)[rows, best // 8]
+    tab = np.asarray(sol.table)
+    extra = tab.shape[sol.valid.ndim - 1:]  # () for a turntable, (n,) for a positioner's axes
+    th = np.broadcast_to(tab, sol.valid.shape[:-1] + extra).reshape((n, -1) + extra)[rows,
+                                                                                    best // 8]
+    e = np.array(e, dtype=float)
+    if track is None and cell.track is not None:
+        e = np.where(ok, e, np.nan)  # no track position was chosen for an unreachable target
+    if cell.track is not None:
+        e_margin = np.minimum(e - cell.track.lower, cell.track.upper - e)
+    else:
+        e_margin = np.full(ok.shape, np.inf)
+    return ReachMap(
+        reachable=ok,
+        q=np.where(ok[:, None], q_all[rows, best], np.nan),
+        branch=np.where(ok, best % 8, -1),
+        track=e,
+        table=np.array(th, dtype=float),
+        limit_margin=np.where(ok, gap[rows, best], np.nan),
+        track_margin=e_margin,
+        manipulability=np.where(ok, manip[rows, best], 0.0),
+        score=np.where(ok, score[rows, best], 0.0),
+    )
+
+
+def reach_html(rm: ReachMap, points: ArrayLike, title: str = "Reachability map",
+               frame: str = "world") -> str:
+    """A self-contained HTML page of a reachability map.
+
+    Parameters
+    ----------
+    rm : ReachMap
+    points : array_like, shape (N, 3)
+        Target positions in their frame (m); drawn in millimetres.
+    title : str
+    frame : str
+        Name of the targets' frame, for the axis labels.
+
+    Returns
+    -------
+    str
+        HTML with the figure embedded as a PNG data URI: the targets seen from above and from
+        the side, coloured by score (unreachable ones as red crosses), and the track position
+        (mm) and table angle (deg) along the targets.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    p = np.asarray(points, dtype=float).reshape(-1, 3) * 1e3
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+    ok = rm.reachable
+    for ax, (i, j) in zip(axes[:2], ((0, 1), (0, 2))):
+        sc = ax.scatter(p[ok, i], p[ok, j], c=rm.score[ok], cmap="viridis", vmin=0, vmax=1, s=14)
+        ax.scatter(p[~ok, i], p[~ok, j], marker="x", color="red", s=18, label="unreachable")
+        ax.set_xlabel(f"{'xyz'[i]} in {frame} (mm)")
+        ax.set_ylabel(f"{'xyz'[j]} in {frame} (mm)")
+        ax.set_aspect("equal", adjustable="datalim")
+        if np.any(~ok):
+            ax.legend(loc="best")
+    axes[0].set_title("from above")
+    axes[1].set_title("from the side")
+    fig.colorbar(sc, ax=axes[1], label="score (1: clear of limits and singularities)")
+    idx = np.arange(ok.size) + 1
+    ax = axes[2]
+    ax.plot(idx, rm.track * 1e3, color="tab:blue", marker=".", label="track (mm)")
+    ax.set_xlabel("target")
+    ax.set_ylabel("track position (mm)", color="tab:blue")
+    ax2 = ax.twinx()
+    ax2.plot(idx, np.degrees(rm.table), marker=".", color="tab:orange" if rm.table.ndim == 1
+             else None)
+    ax2.set_ylabel("table / positioner axes (deg)", color="tab:orange")
+    ax.set_title("external axes along the targets")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    png = base64.b64encode(buf.getvalue()).decode("ascii")
+    n, n_ok = ok.size, int(np.count_nonzero(ok))
+    mean = float(np.mean(rm.score)) if n else 0.0
+    margin = np.degrees(np.nanmin(rm.limit_margin)) if n_ok else float("nan")
+    summary = (f"{n_ok} of {n} targets reachable ({100.0 * n_ok / max(n, 1):.1f} %); mean score "
+               f"{mean:.3f}; smallest distance to a joint limit {margin:.1f} deg")
+    return ("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">"
+            f"<title>{html.escape(title)}</title></head><body>\n"
+            f"<h1>{html.escape(title)}</h1>\n<p>{html.escape(summary)}</p>\n"
+            f"<img alt=\"reachability map\" src=\"data:image/png;base64,{png}\">\n"
+            "</body></html>\n")
+
+
+def read_targets(path: str | Path, fmt: str = "kuka"
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+    """Targets from a CSV file: the pose columns of ``fmt`` (mm, deg), optional ``table`` (deg).
+
+    Parameters
+    ----------
+    path : str or Path
+    fmt : str
+        A pose format of :data:`robotcell.io.poseformats.FORMATS` (``kuka``: ``x,y,z,a,b,c``).
+
+    Returns
+    -------
+    T : ndarray, shape (N, 4, 4)
+        Target poses (m).
+    table : ndarray, shape (N,), or None
+        Table angles (rad) from a column ``table``, if there is one.
+    """
+    cols = read_csv(path)
+    names = [f.lower() for f in FORMATS[fmt].fields]
+    T = pose_from_vendor(require_columns(cols, names, path), fmt)
+    table = None
+    if "table" in cols:
+        table = np.radians(require_columns(cols, ["table"], path)[:, 0])
+    return T, table

@@ -1,0 +1,280 @@
+"""Layout sweep: place the robot, track, turntable or part over a grid, score each layout on the
+targets, rank the layouts.
+
+A layout file (YAML, millimetres and degrees) lists, per component, offsets from the cell
+file's placement; the sweep takes every combination (the Cartesian product)::
+
+    robot:               # on a track the whole track moves; else the robot base
+      y: [-300, -150, 0]             # values (mm)
+    turntable:
+      x: {from: -200, to: 200, steps: 5}   # evenly spaced, ends included (mm)
+      a: [0, 90]                     # deg
+    part:                # a frame of the cell
+      z: [0, 50]
+
+Components: ``robot``, ``track`` (the same as ``robot`` in a cell with a track), ``turntable``
+or the name of a frame of the cell. ``x, y, z`` move the component along the axes of its parent
+frame; ``a, b, c`` turn it about its own origin by ``Rz(a) Ry(b) Rx(c)`` in its own frame.
+
+Each layout is scored by :func:`robotcell.studies.reach.reach_map` on the same targets: the fraction of
+reachable targets, the mean score (0 for an unreachable target) and the smallest score. Layouts
+rank by reachable fraction, then mean score, then their order in the grid.
+
+:func:`sweep` runs the layouts on any :class:`concurrent.futures.Executor`: serially without one,
+a :class:`~concurrent.futures.ProcessPoolExecutor` on one machine, or a cluster's executor, e.g.
+Dask's ``distributed.Client(address).get_executor()``. Every task is a pure function of the cell,
+one layout and the targets, so the ranking does not depend on where it ran.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+from collections.abc import Callable
+from concurrent.futures import Executor, as_completed
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import yaml
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.errors import InputError
+from robotcell.kinematics.transforms import make_pose
+from robotcell.studies.reach import reach_map
+
+if TYPE_CHECKING:
+    from robotcell.cell import Cell
+
+__all__ = ["Layout", "LayoutScore", "apply_layout", "evaluate_layout", "read_layouts", "sweep"]
+
+_AXES = ("x", "y", "z", "a", "b", "c")
+
+
+@dataclass(frozen=True)
+class Layout:
+    """One placement of the cell's components, as offsets from the cell file.
+
+    Attributes
+    ----------
+    offsets : dict of str to tuple of 6 floats
+        Per component: ``(x, y, z)`` in metres along the parent's axes and ``(a, b, c)`` in
+        radians about its own origin (``Rz(a) Ry(b) Rx(c)``).
+    values : dict of str to float
+        The varied parameters as in the layout file (``"robot.y"`` -> mm, ``"turntable.a"`` ->
+        deg), for reports.
+    """
+
+    offsets: dict[str, tuple[float, ...]]
+    values: dict[str, float]
+
+    @property
+    def label(self) -> str:
+        """``robot.y=-150 turntable.a=90`` (mm, deg)."""
+        return " ".join(f"{k}={v:g}" for k, v in self.values.items()) or "as in the cell file"
+
+
+@dataclass(frozen=True)
+class LayoutScore:
+    """Score of one layout on the targets.
+
+    Attributes
+    ----------
+    index : int
+        Position of the layout in the grid (0-based).
+    layout : Layout
+    fraction : float
+        Fraction of the targets that are reachable.
+    mean_score : float
+        Mean of :attr:`robotcell.studies.reach.ReachMap.score` over all targets (0 for unreachable).
+    min_score : float
+        Smallest score over all targets.
+    """
+
+    index: int
+    layout: Layout
+    fraction: float
+    mean_score: float
+    min_score: float
+
+    @property
+    def key(self) -> tuple[float, float, int]:
+        """Sort key: best first."""
+        return (-self.fraction, -self.mean_score, self.index)
+
+
+def _values(spec: Any, where: str) -> list[float]:
+    if isinstance(spec, dict):
+        if set(spec) != {"from", "to", "steps"}:
+            raise InputError(f"{where}: a range needs exactly the keys from, to, steps; got "
+                             f"{sorted(spec)}")
+        steps = spec["steps"]
+        if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
+            raise InputError(f"{where}: steps must be a whole number >= 1, got {steps!r}")
+        vals = np.linspace(float(spec["from"]), float(spec["to"]), steps).tolist()
+    elif isinstance(spec, list) and spec:
+        vals = spec
+    elif isinstance(spec, (int, float)) and not isinstance(spec, bool):
+        vals = [spec]
+    else:
+        raise InputError(f"{where}: give a list of numbers or {{from, to, steps}}, got {spec!r}")
+    try:
+        out = [float(v) for v in vals]
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: values must be numbers, got {vals!r}") from None
+    if not all(math.isfinite(v) for v in out):
+        raise InputError(f"{where}: values must be finite numbers")
+    return out
+
+
+def read_layouts(source: str | Path | dict) -> list[Layout]:
+    """The grid of layouts of a layout file (see the module docstring).
+
+    Parameters
+    ----------
+    source : str or Path or dict
+        Path of the YAML file, or its content.
+
+    Returns
+    -------
+    list of Layout
+        Every combination, the last listed parameter varying fastest.
+
+    Raises
+    ------
+    InputError
+        Unreadable file, unknown axis, or values that are not numbers.
+    """
+    where = "layouts"
+    if isinstance(source, dict):
+        data = source
+    else:
+        where = str(source)
+        try:
+            data = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+        except OSError as exc:
+            raise InputError(f"{source}: cannot read ({exc.strerror})") from None
+        except yaml.YAMLError as exc:
+            raise InputError(f"{source}: not valid YAML ({exc})") from None
+    if not isinstance(data, dict) or not data:
+        raise InputError(f"{where}: expected a mapping of components (robot, track, turntable "
+                         "or a frame) to offsets")
+    params: list[tuple[str, str, list[float]]] = []
+    for comp, axes in data.items():
+        if not isinstance(axes, dict) or not axes:
+            raise InputError(f"{where}: {comp}: expected a mapping of x, y, z, a, b, c to values")
+        for ax, spec in axes.items():
+            if ax not in _AXES:
+                raise InputError(f"{where}: {comp}: unknown axis {ax!r}; use x, y, z (mm) or "
+                                 "a, b, c (deg)")
+            params.append((str(comp), ax, _values(spec, f"{where}: {comp}.{ax}")))
+    layouts = []
+    for combo in itertools.product(*(p[2] for p in params)):
+        offsets: dict[str, list[float]] = {}
+        values = {}
+        for (comp, ax, _), v in zip(params, combo):
+            off = offsets.setdefault(comp, [0.0] * 6)
+            i = _AXES.index(ax)
+            off[i] = v * 1e-3 if i < 3 else math.radians(v)
+            values[f"{comp}.{ax}"] = v
+        layouts.append(Layout({k: tuple(v) for k, v in offsets.items()}, values))
+    return layouts
+
+
+def _moved(T: NDArray[np.float64], off: tuple[float, ...]) -> NDArray[np.float64]:
+    R = Rotation.from_euler("ZYX", off[3:]).as_matrix()
+    out = T @ make_pose(R, [0.0, 0.0, 0.0])
+    out[:3, 3] += off[:3]
+    return out
+
+
+def apply_layout(cell: Cell, layout: Layout) -> Cell:
+    """A copy of ``cell`` with its components moved by ``layout`` (the input is unchanged).
+
+    Raises
+    ------
+    InputError
+        A component the cell does not have.
+    """
+    new = copy.copy(cell)
+    new.frames = dict(cell.frames)
+    for comp, off in layout.offsets.items():
+        if comp in ("robot", "track") and cell.track is not None:
+            new.track = replace(new.track, T_world_L=_moved(new.track.T_world_L, off))
+        elif comp == "robot":
+            new.T_world_R = _moved(new.T_world_R, off)
+        elif comp == "turntable" and cell.turntable is not None:
+            tt = new.turntable
+            if hasattr(tt, "T_parent_B"):
+                new.turntable = replace(tt, T_parent_B=_moved(tt.T_parent_B, off))
+            else:  # a positioner chain: its base is the root pose
+                new.turntable = replace(tt, chain=tt.chain.with_base(_moved(tt.chain.base, off)))
+        elif comp in cell.frames:
+            fr = new.frames[comp]
+            new.frames[comp] = replace(fr, pose=_moved(fr.pose, off))
+        else:
+            known = ["robot"] + (["track"] if cell.track else []) + (
+                ["turntable"] if cell.turntable else []) + sorted(cell.frames)
+            raise InputError(f"the layout moves {comp!r}, which the cell does not have; it has: "
+                             f"{', '.join(known)}")
+    return new
+
+
+def evaluate_layout(cell: Cell, layout: Layout, index: int, T: NDArray[np.float64], frame: str,
+                    tool: str | ArrayLike | None, table: ArrayLike | None) -> LayoutScore:
+    """Score one layout on the targets (a pure function: the unit of work of :func:`sweep`)."""
+    rm = reach_map(apply_layout(cell, layout), T, frame=frame, tool=tool, table=table)
+    score = rm.score
+    return LayoutScore(index, layout, rm.fraction, float(np.mean(score)) if score.size else 0.0,
+                       float(np.min(score)) if score.size else 0.0)
+
+
+def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
+          tool: str | ArrayLike | None = None, table: ArrayLike | None = 0.0,
+          executor: Executor | None = None,
+          progress: Callable[[int, int], None] | None = None) -> list[LayoutScore]:
+    """Score every layout on the targets and rank them, best first.
+
+    Parameters
+    ----------
+    cell : Cell
+    T : array_like, shape (N, 4, 4)
+        Targets ``T_X_TCP`` in frame ``frame`` (m).
+    layouts : list of Layout
+        From :func:`read_layouts`.
+    frame, tool, table
+        As for :func:`robotcell.studies.reach.reach_map` (table angles in rad; None: chosen per
+        target).
+    executor : concurrent.futures.Executor, optional
+        Runs one task per layout (e.g. ``ProcessPoolExecutor(4)`` or
+        ``distributed.Client(address).get_executor()``); default: serially in this process.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each finished layout.
+
+    Returns
+    -------
+    list of LayoutScore
+        Sorted by :attr:`LayoutScore.key`.
+    """
+    arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
+    table = None if table is None else np.asarray(table, dtype=float)
+    if layouts:  # refuse a component the cell lacks before sending work anywhere
+        apply_layout(cell, layouts[0])
+    total = len(layouts)
+    results: list[LayoutScore] = []
+    if executor is None:
+        for i, lay in enumerate(layouts):
+            results.append(evaluate_layout(cell, lay, i, arr, frame, tool, table))
+            if progress:
+                progress(i + 1, total)
+    else:
+        futures = [executor.submit(evaluate_layout, cell, lay, i, arr, frame, tool, table)
+                   for i, lay in enumerate(layouts)]
+        for done, fut in enumerate(as_completed(futures), start=1):
+            results.append(fut.result())
+            if progress:
+                progress(done, total)
+    return sorted(results, key=lambda r: r.key)
