@@ -127,7 +127,7 @@ def test_cli_errors(capsys, tmp_path, monkeypatch):
     assert code == 2 and "pip install 'robotcell[dask]'" in err
     code, _, err = run(capsys, "sweep", "--cell", CELL, "--targets", SEAM, "--layouts",
                        tmp_path / "none.yaml")
-    assert code == 2 and "cannot read" in err
+    assert code == 2 and "does not exist" in err
 
 
 def test_cli_runs_on_a_dask_scheduler_by_address(capsys, tmp_path):

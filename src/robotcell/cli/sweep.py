@@ -25,8 +25,9 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
             raise InputError("--scheduler needs Dask: pip install 'robotcell[dask]'") from None
         try:
             client = stack.enter_context(Client(scheduler, timeout="10s"))
-        except OSError as exc:
-            raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+        except Exception as exc:  # noqa: BLE001 - whatever answers there, it is no scheduler
+            raise InputError(f"cannot reach a Dask scheduler at {scheduler} ({exc}); give the "
+                             "address 'dask scheduler' prints, e.g. tcp://HOST:8786") from None
         return client.get_executor()
     n = (os.cpu_count() or 1) if workers is None else workers
     if n < 1:

@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
+from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import make_pose
 from robotcell.studies.reach import reach_map
 
@@ -52,6 +53,8 @@ if TYPE_CHECKING:
 __all__ = ["Layout", "LayoutScore", "apply_layout", "evaluate_layout", "read_layouts", "sweep"]
 
 _AXES = ("x", "y", "z", "a", "b", "c")
+#: Largest grid a layout file may span: each layout is one reach map of every target.
+MAX_LAYOUTS = 100_000
 
 
 @dataclass(frozen=True)
@@ -112,8 +115,9 @@ def _values(spec: Any, where: str) -> list[float]:
             raise InputError(f"{where}: a range needs exactly the keys from, to, steps; got "
                              f"{sorted(spec)}")
         steps = spec["steps"]
-        if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
-            raise InputError(f"{where}: steps must be a whole number >= 1, got {steps!r}")
+        if not isinstance(steps, int) or isinstance(steps, bool) or not 1 <= steps <= MAX_LAYOUTS:
+            raise InputError(f"{where}: steps must be a whole number from 1 to {MAX_LAYOUTS}, "
+                             f"got {steps!r}")
         vals = np.linspace(float(spec["from"]), float(spec["to"]), steps).tolist()
     elif isinstance(spec, list) and spec:
         vals = spec
@@ -154,9 +158,7 @@ def read_layouts(source: str | Path | dict) -> list[Layout]:
     else:
         where = str(source)
         try:
-            data = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise InputError(f"{source}: cannot read ({exc.strerror})") from None
+            data = yaml.safe_load(read_text(source, "layout file"))
         except yaml.YAMLError as exc:
             raise InputError(f"{source}: not valid YAML ({exc})") from None
     if not isinstance(data, dict) or not data:
@@ -171,6 +173,10 @@ def read_layouts(source: str | Path | dict) -> list[Layout]:
                 raise InputError(f"{where}: {comp}: unknown axis {ax!r}; use x, y, z (mm) or "
                                  "a, b, c (deg)")
             params.append((str(comp), ax, _values(spec, f"{where}: {comp}.{ax}")))
+    count = math.prod(len(p[2]) for p in params)
+    if count > MAX_LAYOUTS:
+        raise InputError(f"{where}: {count} layouts (every combination) is more than "
+                         f"{MAX_LAYOUTS}; use fewer values or steps, or split the sweep")
     layouts = []
     for combo in itertools.product(*(p[2] for p in params)):
         offsets: dict[str, list[float]] = {}
