@@ -52,14 +52,22 @@ def _print_offsets(offsets: dict, vendor: str) -> None:
     click.echo(format_table(head, rows))
 
 
+#: Random configurations within the joint limits that --propose picks from.
+_CANDIDATES = 1000
+
+
 def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int, accuracy: float,
              angle_accuracy: float, output: str | None, as_json: bool) -> None:
     """``--propose N``: write the selected configurations (deg, mm) and print O1 against random."""
     if n < 1 or targets < 1:
         raise InputError(f"--propose and --targets must be positive, got {n} and {targets}")
+    if n >= _CANDIDATES:
+        raise InputError(f"--propose {n}: at most {_CANDIDATES - 1} configurations (they are "
+                         f"picked from {_CANDIDATES} random candidates)")
     if orientation and targets != 1:
         raise InputError("--orientation goes with one target per configuration (--targets 1)")
     sel = select_configurations(nominal, n, n_targets=targets, pose=orientation, seed=seed,
+                                n_candidates=_CANDIDATES,
                                 point_sigma=accuracy * 1e-3, angle_sigma=math.radians(angle_accuracy))
     q = np.where(nominal.prismatic, sel.q * 1e3, np.degrees(sel.q))
     header = [f"a{i}" for i in range(1, nominal.n_joints + 1)]
@@ -147,6 +155,9 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
       robotcell identify tracker.csv --robot fanuc_m20ia --j23-factor -1 --json
       robotcell identify --propose 30 --robot kuka_kr16 --targets 3 -o to_measure.csv
     """
+    for name, value in (("--accuracy", accuracy), ("--angle-accuracy", angle_accuracy)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{name} must be a positive number, got {value}")
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
