@@ -139,7 +139,8 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     \b
     Examples:
       robotcell calibrate positioner touches.csv --cell cell.yaml --tool pointer
-      robotcell calibrate positioner touches.csv --robot kuka_kr16 --json -o positioner.json
+      robotcell calibrate positioner touches.csv --robot kuka_kr16 --tool 250,0,0,0,0,0 \\
+          --json -o positioner.json
     """
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)

@@ -123,7 +123,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
       robotcell ik abb_irb2400 --pose 940,0,1455,0.7071068,0,0.7071068,0 --format abb --all
       robotcell ik ur5e --pose 0.5,0.1,0.4,0,3.1416,0 --format ur --near 0,-90,90,-90,-90,0
       robotcell ik kuka_kr16 --input poses.csv --output joints.csv
-      robotcell ik --cell cell.yaml --frame part --table 90 --tool torch --pose 0,0,50,0,180,0
+      robotcell ik --cell cell.yaml --frame part --table 150 --tool torch --pose 0,0,50,0,180,0
       robotcell ik --cell positioner.yaml --frame part --table normal-up --tool torch \\
           --pose 50,0,0,0,180,0
     """

@@ -68,8 +68,9 @@ def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: s
 
     \b
     Examples:
-      robotcell plan turntable --cell cell.yaml --noise 0.1 --max-radius 350
-      robotcell plan frame --cell cell.yaml --frame fixture --max-size 300 -o frame_touches.csv
+      robotcell plan turntable --cell cell.yaml --tool pointer --noise 0.1 --max-radius 350
+      robotcell plan frame --cell cell.yaml --tool pointer --frame fixture --max-size 300 \\
+          -o frame_touches.csv
     """
     if not (math.isfinite(noise) and noise > 0):
         raise InputError(f"--noise must be a positive number of millimetres, got {noise}")

@@ -188,7 +188,7 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
 
     \b
     Examples:
-      robotcell simulate turntable --cell cell.yaml --noise 0.1 -o turntable.csv
+      robotcell simulate turntable --cell cell.yaml --tool pointer --noise 0.1 -o turntable.csv
       robotcell simulate tcp --cell cell.yaml --tool torch --tilt 40 --seed 1 -o tcp.csv
       robotcell simulate positioner --cell truth.yaml --tool pointer --noise 0.1 -o touches.csv
     """
