@@ -26,14 +26,19 @@ from robotcell import pose_from_vendor, pose_to_vendor
 from robotcell.kinematics.transforms import rot_z
 
 SEED = int(os.environ.get("ROBOTCELL_FUZZ_SEED", "2026"))
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLE = EXAMPLES / "cell_kr16_track_turntable.yaml"
+POSITIONER = EXAMPLES / "cell_kr16_positioner.yaml"
+SEAM = EXAMPLES / "seam_part.csv"
 
 #: Exit statuses the CLI documents (README, "Files and exit status"; 3 = poor calibration).
 DOCUMENTED = {0, 2, 3}
 
-#: Cases per command: 1,030 in all.
+#: Cases per command: 1,490 in all.
 CASES = {"tcp": 120, "frame": 120, "track": 110, "turntable": 110, "workpiece": 100,
-         "fk": 110, "ik": 100, "export": 90, "cell-show": 90, "report": 80}
+         "fk": 110, "ik": 100, "export": 90, "cell-show": 90, "report": 80,
+         "identify": 50, "reach": 60, "sweep": 40, "positioner": 50, "simulate-positioner": 50,
+         "fk-cell": 50, "ik-cell": 50, "urdf": 60}
 
 
 # -- valid inputs (mm, deg) -----------------------------------------------------------------------
@@ -114,6 +119,25 @@ def _poses_csv(rng: np.random.Generator) -> str:
     q = np.radians(rng.uniform([-60, -100, 40, -90, -60, -90], [60, -50, 110, 90, 60, 90], (4, 6)))
     v = pose_to_vendor(robot.fk(q), "kuka")
     return _csv(["x", "y", "z", "a", "b", "c"], [list(map(float, r)) for r in v])
+
+
+def _tracker_csv(rng: np.random.Generator) -> str:
+    """20 exact tracker rows of the nominal KR 16: a1..a6 (deg), x, y, z (mm)."""
+    from robotcell import load_robot
+
+    robot = load_robot("kuka_kr16")
+    q = np.radians(rng.uniform([-60, -100, 40, -90, -60, -90], [60, -50, 110, 90, 60, 90], (20, 6)))
+    xyz = (robot.fk(q) @ [0.05, 0.02, 0.1, 1.0])[:, :3] * 1e3 + [2000.0, 500.0, 0.0]
+    return _csv([f"a{i}" for i in range(1, 7)] + ["x", "y", "z"],
+                [list(map(float, r)) for r in np.hstack([np.degrees(q), xyz])])
+
+
+def _cell_joints_csv(rng: np.random.Generator, positioner: bool) -> str:
+    q = rng.uniform([-60, -100, 40, -90, -60, -90], [60, -50, 110, 90, 60, 90], (4, 6))
+    ext = rng.uniform([-30, 0], [30, 180], (4, 2)) if positioner else rng.uniform(0, 6000, (4, 1))
+    names = ["e1", "e2"] if positioner else ["track"]
+    return _csv([f"a{i}" for i in range(1, 7)] + names,
+                [list(map(float, r)) for r in np.hstack([q, ext])])
 
 
 # -- mutations ------------------------------------------------------------------------------------
@@ -312,10 +336,87 @@ def _case(command: str, rng: np.random.Generator, tmp: Path, good: dict[str, Pat
             fmt = str(rng.choice(["kuka", "abb", "fanuc", "yaskawa"]))
             return ["export", "--cell", str(path), "--format", fmt, "-o", str(out)], what, out
         return ["cell", "show", str(path)], what, None
+    if command in CELL_COMMANDS:
+        return _cell_case(command, rng, tmp, good, out)
     content, what = mutate_json(good["turntable.json"].read_text(), rng)
     path = _write(tmp / "r.json", content)
     html = tmp / "out" / "r.html"
     return ["report", str(path), "-o", str(html)], what, html
+
+
+#: The commands of the cell studies and identification, cased in :func:`_cell_case`.
+CELL_COMMANDS = ("identify", "reach", "sweep", "positioner", "simulate-positioner", "fk-cell",
+                 "ik-cell", "urdf")
+
+
+def _mutated(valid: str, rng: np.random.Generator, tmp: Path, name: str) -> tuple[Path, str]:
+    """``valid`` (a CSV when ``name`` ends so, else YAML) mutated, written to ``tmp/name``."""
+    content, what = (mutate_csv if name.endswith(".csv") else mutate_text)(valid, rng)
+    return _write(tmp / name, content), f"{name}: {what}"
+
+
+def _cell_case(command: str, rng: np.random.Generator, tmp: Path, good: dict[str, Path],
+               out: Path) -> tuple[list[str], str, Path | None]:
+    """A mutated case of one of :data:`CELL_COMMANDS`: mostly the data file, sometimes the cell
+    file or an option."""
+    cell_text = (POSITIONER if command in ("positioner", "simulate-positioner") else EXAMPLE
+                 ).read_text(encoding="utf-8")
+    cell, what = _write(tmp / "cell.yaml", cell_text), "valid cell"
+    if command in ("simulate-positioner", "urdf") or rng.random() < 0.15:
+        cell, what = _mutated(cell_text, rng, tmp, "cell.yaml")
+    bad = str(rng.choice(BAD_FLOATS))
+    if command == "identify":
+        path, what = _mutated(_tracker_csv(rng), rng, tmp, "tracker.csv")
+        opts = [str(rng.choice(["--accuracy", "--folds", "--j23-factor"])), bad] \
+            if rng.random() < 0.2 else []
+        if rng.random() < 0.1:
+            return (["identify", "--propose", str(rng.choice(["0", "-1", "2", "5000", "abc"])),
+                     "--robot", "kuka_kr16", "-o", str(out)], "--propose", out)
+        return ["identify", str(path), "--robot", "kuka_kr16", "-o", str(out), *opts], what, out
+    if command in ("reach", "sweep"):
+        path, w = _mutated(SEAM.read_text(encoding="utf-8"), rng, tmp, "seam.csv")
+        what += "; " + w
+        if command == "reach":
+            return (["reach", "--cell", str(cell), str(path), "--frame", "part", "--tool", "torch",
+                     "-o", str(out)], what, out)
+        layouts = "robot:\n  y: [-300, 0]\nturntable:\n  a: {from: 0, to: 90, steps: 2}\n"
+        lay = _write(tmp / "layouts.yaml", layouts)
+        if rng.random() < 0.5:
+            lay, w = _mutated(layouts, rng, tmp, "layouts.yaml")
+            what += "; " + w
+        workers = str(rng.choice(["0", "-1", "abc"])) if rng.random() < 0.1 else "1"
+        return (["sweep", "--cell", str(cell), "--targets", str(path), "--layouts", str(lay),
+                 "--frame", "part", "--tool", "torch", "--workers", workers, "-o", str(out)],
+                what, out)
+    if command == "positioner":
+        path, what = _mutated(good["positioner.csv"].read_text(encoding="utf-8"), rng, tmp,
+                              "touches.csv")
+        if rng.random() < 0.5:
+            return (["calibrate", "positioner", str(path), "--cell", str(cell), "--tool",
+                     "pointer"], what, None)
+        return (["calibrate", "positioner", str(path), "--robot", "kuka_kr16", "--tool",
+                 "250,0,0,0,0,0", "--json", "-o", str(out)], what, out)
+    if command == "simulate-positioner":
+        opts = []
+        if rng.random() < 0.3:
+            opt = str(rng.choice(["--tilts", "--rotates", "--noise", "--radius", "--height"]))
+            opts = [opt, str(rng.choice([bad, "0", "10,20", "500", "0,0,0"]))]
+        return (["simulate", "positioner", "--cell", str(cell), "--tool", "pointer", "--seed",
+                 "1", "-o", str(out), *opts], what + " " + " ".join(opts), out)
+    if command in ("fk-cell", "ik-cell"):
+        positioner = rng.random() < 0.5
+        if positioner:
+            cell = _write(tmp / "cell.yaml", POSITIONER.read_text(encoding="utf-8"))
+        if command == "fk-cell":
+            path, what = _mutated(_cell_joints_csv(rng, positioner), rng, tmp, "joints.csv")
+            return (["fk", "--cell", str(cell), "--input", str(path), "--frame", "part",
+                     "--tool", "torch", "-o", str(out)], what, out)
+        path, what = _mutated(_poses_csv(rng), rng, tmp, "poses.csv")
+        table = str(rng.choice(["normal-up", "10,20", "10", bad])) if positioner else \
+            str(rng.choice(["150", "90", bad]))
+        return (["ik", "--cell", str(cell), "--input", str(path), "--frame", "part", "--tool",
+                 "torch", "--table", table, "-o", str(out)], f"{what} --table {table}", out)
+    return ["export", "--cell", str(cell), "--format", "urdf", "-o", str(out)], what, out
 
 
 def _write(path: Path, content: bytes | str) -> Path:
@@ -328,15 +429,20 @@ def _write(path: Path, content: bytes | str) -> Path:
 
 @pytest.fixture(scope="module")
 def good(tmp_path_factory) -> dict[str, Path]:
-    """A valid turntable result (the --json output), for workpiece and report."""
+    """A valid turntable result (the --json output), for workpiece and report; positioner
+    touches simulated in the example positioner cell."""
     from robotcell.calibration.turntable import calibrate_turntable
+    from robotcell.cell import Cell
+    from robotcell.studies.simulate import simulate
 
     d = tmp_path_factory.mktemp("good")
     f, th = _turntable_rows(np.random.default_rng(SEED))
     result = calibrate_turntable(np.radians(th), f * 1e-3)
     path = d / "turntable.json"
     path.write_text(json.dumps(result.to_json()))
-    return {"turntable.json": path}
+    touches = d / "positioner.csv"
+    simulate(Cell.load(POSITIONER), "positioner", seed=SEED, tool="pointer").write_csv(touches)
+    return {"turntable.json": path, "positioner.csv": touches}
 
 
 @pytest.mark.parametrize("command", list(CASES))

@@ -158,6 +158,8 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     for name, value in (("--accuracy", accuracy), ("--angle-accuracy", angle_accuracy)):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"{name} must be a positive number, got {value}")
+    if j23 is not None and not math.isfinite(j23):
+        raise InputError(f"--j23-factor must be a finite number, got {j23}")
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
