@@ -1,7 +1,8 @@
 """Fuzz test of the CLI: mutated copies of valid inputs never give a traceback.
 
 Every case starts from a valid input of one of the main commands (calibrate tcp, frame, track,
-turntable, workpiece; fk; ik; export; report; cell show), applies one or two seeded mutations
+turntable, workpiece, positioner; fk; ik; fk/ik --cell; export, also --format urdf; report; cell
+show; identify, also --propose; reach; sweep, serial; simulate positioner), applies one or two seeded mutations
 (truncation, wrong types, huge values, NaN, other encodings, swapped or misspelt columns, empty
 files, binary junk, European CSV, ...) and runs the command in process. Each run must end with a
 documented exit status: 0 (done), 2 (refused input, with ``error:`` on stderr) or 3 (a poor
