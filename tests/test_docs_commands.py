@@ -26,6 +26,9 @@ FILES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 BLOCK = re.compile(r"^[ \t]*```([\w-]*)[ \t]*\n(.*?)^[ \t]*```[ \t]*$", re.DOTALL | re.MULTILINE)
 TRACK_CELL = "examples/cell_kr16_track_turntable.yaml"
 POSITIONER_CELL = "examples/cell_kr16_positioner.yaml"
+#: An inline command (`robotcell ...` in the prose), and what makes one a synopsis, not a command.
+INLINE = re.compile(r"`(robotcell [^`]+)`")
+PLACEHOLDER = re.compile(r"\.\.\.|[|\[]|\b[A-Z]{3,}\b|\b[A-Z](,[A-Z])+\b")
 
 #: Commands left out, with why (matched against the start of the command line).
 LEFT_OUT = {
@@ -67,6 +70,8 @@ LEFT_OUT = {
     "robotcell report base.json": "the --json of a pendant-position frame run",
     "robotcell dh symbolic": "needs the 'symbolic' extra (sympy), 4-6 s each "
                              "(tests/test_dh_procedure_symbolic.py)",
+    "robotcell identify --compliance#": "names an option in the prose, not a command",
+    "robotcell fk --cell#": "names an option in the prose, not a command",
     "robotcell identify fanuc.csv": "no simulated FANUC set in the docs (test_identification_cli)",
 }
 
@@ -90,6 +95,11 @@ def commands() -> list[tuple[str, int, str]]:
                 i += 1
                 if line.startswith("robotcell "):
                     found.append((path.name, first + start, line.split(" #")[0].strip()))
+        prose = BLOCK.sub(lambda m: "\n" * m.group(0).count("\n"), text)
+        for m in INLINE.finditer(prose):
+            command = " ".join(m.group(1).split())
+            if ("--" in command or "." in command) and not PLACEHOLDER.search(command):
+                found.append((path.name, prose.count("\n", 0, m.start()) + 1, command))
     return found
 
 
