@@ -1,13 +1,16 @@
-"""Every ``robotcell`` shell command of README.md and docs/*.md runs as documented.
+"""Every ``robotcell`` shell command of README.md, docs/*.md and the --help texts runs as
+documented.
 
 The commands are taken from the ```sh, ```console and plain ``` blocks (a line that starts with
-``robotcell``, backslash continuations joined, ``#`` comments dropped) and run in process, in
-order, in a fresh folder that holds a copy of ``examples/``, as a user who runs them from the root
-of the repository. The input files a command names are made the way the docs say: ``cell.yaml``
-is a copy of the example cell (of the positioner cell for positioner commands), touch files come
-from ``robotcell simulate``, ``joints.csv`` from ``identify --propose``, ``poses.csv`` from ``fk
---input``, ``tracker.csv`` from the block of docs/identification.md that simulates it. Each command
-must exit 0 without a traceback and write the files it names.
+``robotcell``, backslash continuations joined, ``#`` comments dropped), from the concrete inline
+commands of the prose (not the synopses with placeholders) and from the examples of every
+command's --help. They run in process, in order, in a fresh folder that holds a copy of
+``examples/``, as a user who runs them from the root of the repository. The input files a command
+names are made the way the docs say: ``cell.yaml`` is a copy of the example cell (of the
+positioner cell for positioner commands), touch files come from ``robotcell simulate``,
+``joints.csv`` from ``identify --propose``, ``poses.csv`` from ``fk --input``, ``tracker.csv``
+from the block of docs/identification.md that simulates it. Each command must exit 0 without a
+traceback and write the files it names. ``LEFT_OUT`` lists the commands not run, and why.
 """
 
 from __future__ import annotations
