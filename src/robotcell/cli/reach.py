@@ -57,15 +57,10 @@ def target_options(f: Callable[..., None]) -> Callable[..., None]:
     return f
 
 
-def load_targets(path: str, fmt: str, table_deg: float, choose_table: bool, axes: int = 1
+def load_targets(path: str, fmt: str, table_deg: float, choose_table: bool
                  ) -> tuple[np.ndarray, np.ndarray | None]:
-    """Targets (m) and table angles (rad; None: to be chosen) from the targets file; ``axes``:
-    of the cell's turntable or positioner (one table angle is for a one-axis table only)."""
+    """Targets (m) and table angles (rad; None: to be chosen) from the targets file."""
     T, table = read_targets(path, fmt)
-    if axes > 1 and (table is not None or table_deg != 0):
-        raise InputError(f"the cell's positioner has {axes} axes, which stand at 0 from the "
-                         "command line: give no 'table' column and no --table (in Python, "
-                         "reach_map(..., table=...) takes one value per axis)")
     if choose_table:
         if table is not None:
             raise InputError(f"{path} has a 'table' column; leave it out to --choose-table")
@@ -102,8 +97,7 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
       robotcell reach --cell cell.yaml seam.csv --tool torch --html reach.html
     """
     cell = Cell.load(cell_path)
-    T, th = load_targets(targets, fmt, table_deg, choose_table,
-                         cell.turntable.n_axes if cell.turntable else 1)
+    T, th = load_targets(targets, fmt, table_deg, choose_table)
     track = None if track_mm is None else track_mm * 1e-3
     with ExitStack() as stack:
         rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,

@@ -67,8 +67,7 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
     cell = Cell.load(cell_path)
-    T, th = load_targets(targets, fmt, table_deg, choose_table,
-                         cell.turntable.n_axes if cell.turntable else 1)
+    T, th = load_targets(targets, fmt, table_deg, choose_table)
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
