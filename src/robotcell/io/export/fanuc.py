@@ -38,17 +38,5 @@ def export(cell: Cell) -> str:
 
 
 def parse(text: str) -> ControllerData:
-    """Read a listing written by :func:`export` back into :class:`ControllerData`.
-
-    Parameters
-    ----------
-    text : str
-        Listing lines; ``!`` comment lines are ignored.
-
-    Returns
-    -------
-    ControllerData
-        ``tools`` from ``UTOOL`` lines, ``frames`` (all fixed, in WORLD) from ``UFRAME`` lines;
-        poses in metres.
-    """
+    """Read a listing written by :func:`export` back: tools, and frames fixed in WORLD (metres)."""
     return parse_pendant_listing(text, LISTING)

@@ -41,17 +41,5 @@ def export(cell: Cell) -> str:
 
 
 def parse(text: str) -> ControllerData:
-    """Read a listing written by :func:`export` back into :class:`ControllerData`.
-
-    Parameters
-    ----------
-    text : str
-        Listing lines; ``'`` comment lines are ignored.
-
-    Returns
-    -------
-    ControllerData
-        ``tools`` from ``TOOL`` lines, ``frames`` (all fixed, in base coordinates) from
-        ``UFRAME`` lines; poses in metres.
-    """
+    """Read a listing written by :func:`export` back (tools, frames in base coordinates; m)."""
     return parse_pendant_listing(text, LISTING)
