@@ -57,13 +57,6 @@ def axis_frames(robot: Robot) -> tuple[NDArray[np.float64], NDArray[np.float64]]
     return S, np.array(robot.flange, dtype=float)
 
 
-def _rot_z(phi: NDArray[np.float64]) -> NDArray[np.float64]:
-    c, s = np.cos(phi), np.sin(phi)
-    R = np.zeros(phi.shape + (3, 3))
-    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
-    return R
-
-
 def _angle_about(k: NDArray[np.float64], u: NDArray[np.float64], v: NDArray[np.float64]
                  ) -> NDArray[np.float64]:
     """Angle turning ``u`` onto ``v`` about the unit axis ``k`` (Paden-Kahan subproblem 1)."""
