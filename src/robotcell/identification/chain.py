@@ -51,7 +51,6 @@ COMPLIANT_JOINTS = (1, 2)
 
 #: Consecutive nominal axes closer than this to parallel (radians) get a Hayati ``beta``.
 PARALLEL_TOL = math.radians(1.0)
-_KINDS = ("tx", "ty", "tz", "rx", "ry", "rz")
 
 
 @dataclass(frozen=True)
