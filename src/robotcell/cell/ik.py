@@ -435,9 +435,7 @@ def _path_solutions(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArra
     rev = ~robot.prismatic
     q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
     reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
-    inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
-    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
-        inside &= robot.coupling.within_interaction(q)
+    inside = robot._inside(q)  # (K, N, 8); interaction limits (e.g. FANUC J2/J3) too
     step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
     first = np.ones((step.shape[0], 1, step.shape[2]), dtype=bool)
     smooth = np.concatenate([first, step <= max_step], axis=1)

@@ -104,7 +104,7 @@ class SeededSolver:
                                 tol_orientation=self.tol, max_iterations=100, restarts=0, tool=tool_T)
             q[idx], reach[idx], err[idx] = num.q, num.success, num.position_error
         q[~reach] = np.nan
-        valid = reach & self.robot.within_limits(np.nan_to_num(q))
+        valid = reach & self.robot._inside(q)
         batch = arr.shape[:-2]
         return IKSolutions(q.reshape(batch + (nb, n)), valid.reshape(batch + (nb,)),
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))

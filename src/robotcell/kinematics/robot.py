@@ -253,10 +253,13 @@ class Robot:
         -------
         ndarray of bool, shape (...)
         """
-        arr = self._joints(q)
-        ok = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
+        return self._inside(self._joints(q), tol)
+
+    def _inside(self, q: NDArray[np.float64], tol: float = 0.0) -> NDArray[np.bool_]:
+        """:meth:`within_limits` of unchecked values ``(..., n)``: NaN values are outside."""
+        ok = np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
         if self.coupling is not None:
-            ok &= self.coupling.within_interaction(arr, tol)
+            ok &= self.coupling.within_interaction(q, tol)
         return ok
 
     def model_values(self, q: ArrayLike) -> NDArray[np.float64]:
