@@ -136,7 +136,7 @@ def positive_z_frames(frames: list[NDArray[np.float64]], signs: list[float]
     return out
 
 
-def _numbers(names: list[str], given: list[int | None]) -> list[int]:
+def _numbers(given: list[int | None]) -> list[int]:
     """Explicit numbers, then the lowest free numbers for the others, in order."""
     used = {n for n in given if n is not None}
     out, nxt = [], 1
@@ -172,7 +172,7 @@ def collect(cell: Cell, reference: Literal["world", "robot"]) -> ControllerData:
     data = ControllerData()
     T_world_ref = np.eye(4) if reference == "world" else cell.frame_pose("robot", 0.0)
     T_ref_world = invert(T_world_ref)
-    nums = _numbers(list(cell.tools), [t.number for t in cell.tools.values()])
+    nums = _numbers([t.number for t in cell.tools.values()])
     for (name, tool), n in zip(cell.tools.items(), nums):
         data.tools.append(Slot(name, n, tool.T_F_TCP.copy(), mass=tool.mass,
                                cog=None if tool.cog is None else tool.cog.copy()))
@@ -186,7 +186,7 @@ def collect(cell: Cell, reference: Literal["world", "robot"]) -> ControllerData:
             pre, post = axis_frames(cell.turntable.chain)
             data.positioner_frames = positive_z_frames(
                 [*pre, post], [j.sign for j in cell.turntable.chain.joints])
-    nums = _numbers(list(cell.frames), [f.number for f in cell.frames.values()])
+    nums = _numbers([f.number for f in cell.frames.values()])
     for (name, fr), n in zip(cell.frames.items(), nums):
         if fr.parent == "turntable":
             data.frames.append(Slot(name, n, fr.pose.copy(), on_table=True))
