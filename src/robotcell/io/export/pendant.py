@@ -70,11 +70,6 @@ class PendantListing:
     track: str
     table_axis: str
 
-    @property
-    def fields(self) -> tuple[str, ...]:
-        """The six field names of a pose."""
-        return FORMATS[self.vendor].fields
-
 
 def listing_line(key: str, number: int, values: NDArray[np.float64], fields: tuple[str, ...],
                  comment: str, name: str) -> str:
@@ -158,7 +153,7 @@ def format_listing(data: ControllerData, cell_name: str, style: PendantListing) 
         Tool lines, then user frame lines (frames on the turntable at axis 0 and the turntable
         root as one more frame), lengths in mm and angles in deg, one per line.
     """
-    c, fields = style.comment, style.fields
+    c, fields = style.comment, FORMATS[style.vendor].fields
 
     def line(key: str, s: Slot) -> str:
         return listing_line(key, s.number, pose_to_vendor(s.pose, style.vendor), fields, c, s.name)
@@ -204,7 +199,8 @@ def parse_pendant_listing(text: str, style: PendantListing) -> ControllerData:
     data = ControllerData()
     seen: set[tuple[str, int]] = set()
     keys = (style.tool_key, "UFRAME")
-    for key, n, values, name in parse_listing(text, keys, style.fields, style.comment):
+    fields = FORMATS[style.vendor].fields
+    for key, n, values, name in parse_listing(text, keys, fields, style.comment):
         if (key, n) in seen:
             raise InputError(f"{key}[{n}] appears twice")
         seen.add((key, n))
