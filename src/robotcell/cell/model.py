@@ -643,10 +643,12 @@ class Cell:
             return np.where(second.reshape(second.shape + (1,) * (a.ndim - second.ndim)), b, a)
 
         first, other = sols
+        err = (None if first.reach_error is None or other.reach_error is None
+               else pick(first.reach_error, other.reach_error))
         return cell_ik.CellIKSolutions(
             pick(first.q, other.q), pick(first.valid, other.valid),
             pick(first.reachable, other.reachable), pick(first.track, other.track),
-            pick(first.table, other.table), first.method)
+            pick(first.table, other.table), first.method, err)
 
     def _normal_up(self, T: ArrayLike, frame: str, track: ArrayLike | None
                    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
