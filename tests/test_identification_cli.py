@@ -156,7 +156,7 @@ def test_identify_refuses_bad_csv(tmp_path, capsys, content, message):
     code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16")
     assert code == 2
     # an unknown column (b1) is named in a warning line before the error
-    assert re.search(r"^error:", stderr, re.M) and message in stderr
+    assert re.search(r"^error:", stderr, re.MULTILINE) and message in stderr
     assert "Traceback" not in stderr
 
 
@@ -273,7 +273,7 @@ def test_joint_offsets_for_controllers(kr16_truth, tmp_path, capsys, vendor, uni
 
 
 def test_identify_names_an_unknown_column_in_a_warning(kr16_truth, tmp_path, capsys):
-    meas, path = tracker_csv(kr16_truth, tmp_path, 30)
+    _, path = tracker_csv(kr16_truth, tmp_path, 30)
     lines = path.read_text().splitlines()
     good = [lines[0] + ",note"] + [f"{line},ok" for line in lines[1:]]
     path.write_text("\n".join(good) + "\n")
