@@ -76,9 +76,10 @@ def test_collinear_points_refused_with_cause_and_fix():
     line = transform_points(T_TRUE, [[0, 0, 0], [0.4, 0, 0], [0.2, 0.001, 0]])
     with pytest.raises(IllPosedError, match=r"collinear \(all on one line\).*add points well away"):
         frame_npoint(line, [[0, 0, 0], [0.4, 0, 0], [0.8, 0, 0]])
-    close = transform_points(T_TRUE, [[0, 0, 0], [0.005, 0, 0], [0.1, 0.3, 0]])
-    with pytest.raises(IllPosedError, match="too close to define a direction"):
-        frame_3point(close, ROLES)
+    same = transform_points(T_TRUE, [[0, 0, 0], [0.0, 0, 0], [0.1, 0.3, 0]])
+    with pytest.raises(IllPosedError, match=r"\+X touch is at the origin touch, so it defines no "
+                       "direction; touch a point on \\+X at least 100 mm"):
+        frame_3point(same, ROLES)
     with pytest.raises(IllPosedError, match="at least 3 points"):
         frame_npoint(line[:2], [[0, 0, 0], [0.4, 0, 0]])
     with pytest.raises(InputError, match="missing xy"):

@@ -134,8 +134,12 @@ def test_abc_2point_refusals():
         calibrate_tool(touches, axis, on_axis)
     too_close = [pose_for(design(rng, 1)[0], TCP + R_TOOL @ [-0.002, 0, 0])]
     plane = [pose_for(design(rng, 1)[0], TCP + R_TOOL @ [0.03, 0.08, 0])]
-    with pytest.raises(IllPosedError, match="at least 50 mm"):
-        calibrate_tool(touches, too_close, plane)
+    r = calibrate_tool(touches, too_close, plane)  # 2 mm: computed, with a warning
+    assert any("only 2.0 mm from the TCP" in w for w in r.warnings)
+    at_tcp = [pose_for(design(rng, 1)[0], TCP)]
+    with pytest.raises(IllPosedError, match="at the TCP, so they define no tool direction; move the "
+                       "tool back along its axis, at least 50 mm"):
+        calibrate_tool(touches, at_tcp, plane)
     world = [np.eye(4)]
     with pytest.raises(InputError, match="not both"):
         calibrate_tool(touches, axis, plane, world)

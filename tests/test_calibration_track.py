@@ -178,8 +178,11 @@ def test_refusals():
         calibrate_track(e, cell.touches(REF, e))
     with pytest.raises(InputError, match="not in the track's length unit"):
         calibrate_track(E * 1e3, f)  # track values in mm passed as metres
-    on_axis = np.array([0.8, 0.01, 0.0])
-    with pytest.raises(IllPosedError, match="from the track axis"):
+    near_axis = np.array([0.8, 0.01, 0.0])
+    r = calibrate_track(E, cell.touches(near_axis, E), references=[near_axis])
+    assert any("only 10.0 mm from the track axis" in w for w in r.warnings)
+    on_axis = np.array([0.8, 0.0, 0.0])
+    with pytest.raises(IllPosedError, match="lies on the track axis.*at least 50 mm off"):
         calibrate_track(E, cell.touches(on_axis, E), references=[on_axis])
     pair = [REF, REF + [0.5, 0.0, 0.0]]
     with pytest.raises(IllPosedError, match="one line parallel to the track axis"):

@@ -104,8 +104,10 @@ def test_refusals():
     with pytest.raises(IllPosedError, match=r"only 2 distinct table angle\(s\) \(modulo 360 deg\): "
                        "a circle needs 3"):
         calibrate_turntable(theta, touches(T, theta))
-    with pytest.raises(IllPosedError, match="from the table axis"):
-        calibrate_turntable(THETA, touches(T, THETA, radius=0.002))
+    r = calibrate_turntable(THETA, touches(T, THETA, radius=0.002))  # computed, with a warning
+    assert any("only 2.0 mm from the table axis" in w for w in r.warnings)
+    with pytest.raises(IllPosedError, match="does not move when the table turns .* at least 50 mm"):
+        calibrate_turntable(THETA, touches(T, THETA, radius=0.0))
     with pytest.raises(InputError, match="matching TCP positions"):
         calibrate_turntable(THETA[:-1], f)
     with pytest.raises(InputError, match="NaN"):

@@ -116,11 +116,17 @@ def test_refusals():
     with pytest.raises(InputError, match="must be origin, x or xy; found z"):
         calibrate_workpiece(theta, f, ["origin", "x", "z"], T_R_B)
     near = touch(roles, theta, [[0, 0, 0], [-0.145, 0, 0], [0, 0, 0]])
-    with pytest.raises(IllPosedError, match=r"\+X point is only 5.0 mm from the origin"):
-        calibrate_workpiece(theta, near, roles, T_R_B)
+    r = calibrate_workpiece(theta, near, roles, T_R_B)  # 5 mm: computed, with a warning
+    assert any(r"+X point is only 5.0 mm from the origin" in w for w in r.warnings)
+    at_origin = touch(roles, theta, [[0, 0, 0], [-0.15, 0, 0], [0, 0, 0]])
+    with pytest.raises(IllPosedError, match=r"\+X point is at the origin, so it defines no direction"):
+        calibrate_workpiece(theta, at_origin, roles, T_R_B)
     collinear = touch(roles, theta, [[0, 0, 0], [0, 0, 0], [0.0, -0.115, 0]])
-    with pytest.raises(IllPosedError, match="nearly collinear"):
-        calibrate_workpiece(theta, collinear, roles, T_R_B)
+    r = calibrate_workpiece(theta, collinear, roles, T_R_B)
+    assert any("nearly collinear" in w for w in r.warnings)
+    on_axis = touch(roles, theta, [[0, 0, 0], [0, 0, 0], [0.0, -0.12, 0]])
+    with pytest.raises(IllPosedError, match="lies on the X axis .* collinear.*not determined"):
+        calibrate_workpiece(theta, on_axis, roles, T_R_B)
     bad = T_R_B.copy()
     bad[:3, 0] *= -1.0
     with pytest.raises(InputError, match="T_R_B"):

@@ -166,3 +166,52 @@ def test_long_batch_shows_progress_on_stderr(tmp_path, capsys):
     assert code == 0
     assert "ik" in err and stdout == ""
     assert out.read_text().startswith("pose,branch,track,table,a1,")
+
+
+def test_ik_cell_carries_and_prints_the_reach_error_of_a_rounded_target(tmp_path, capsys):
+    """A target 0.3 um outside the stretched elbow's reach is solved at the boundary; Cell.ik
+    reports the distance per branch as the arm's IK does, and ik --cell prints it in mm."""
+    from robotcell.ik import opw_parameters, solve
+
+    cell = Cell.load(CELL)
+    r = cell.robot
+    p = opw_parameters(r)
+    a3 = p.signs[2] * (-np.arctan2(p.a2, p.c3) - p.offsets[2])  # A3 of the stretched elbow
+    q = np.array([0.3, -0.5, a3, 0.2, 0.7, 0.5])
+    T_R = r.fk(q)
+    T_R[:3, 3] *= 1 + 2e-7  # rounded outward by a fraction of a micrometre
+    arm = solve(r, T_R)
+    T_W = cell.frame_pose("robot", track=1.0) @ T_R
+    sol = cell.ik(T_W, track=1.0)
+    assert sol.reach_error is not None and sol.reach_error.shape == (8,)
+    np.testing.assert_allclose(sol.reach_error, arm.reach_error, rtol=1e-6, atol=1e-12)
+    k = int(np.nanargmin(np.abs(sol.q - q).sum(axis=-1)))
+    assert sol.valid[k] and 1e-7 < sol.reach_error[k] < 1e-6
+    chosen = cell.ik(np.stack([T_W, T_W]))  # the track chosen: one value per target and branch
+    assert chosen.reach_error.shape == (2, 8)
+    pose = ",".join(repr(float(v)) for v in pose_to_vendor(T_W, "kuka"))
+    code, out, err = run(capsys, "ik", "--cell", CELL, "--track", "1000", "--pose", pose)
+    assert code == 0, err
+    assert "reach error mm" in out
+    row = next(line for line in out.splitlines() if line.lstrip().startswith(f"{k} "))
+    assert float(row.split()[-1]) == pytest.approx(sol.reach_error[k] * 1e3, rel=1e-3)
+    inside = ",".join(repr(float(v)) for v in pose_to_vendor(
+        cell.frame_pose("robot", track=1.0) @ r.fk([0.1, -1.2, 1.4, 0.3, 0.6, 0.2]), "kuka"))
+    code, out, err = run(capsys, "ik", "--cell", CELL, "--track", "1000", "--pose", inside)
+    assert code == 0 and "reach error" not in out, err  # inside the reach: no column
+    poses = tmp_path / "p.csv"
+    poses.write_text("x,y,z,a,b,c\n" + pose + "\n" + inside + "\n")
+    code, out, err = run(capsys, "ik", "--cell", CELL, "--track", "1000", "--input", poses)
+    assert code == 0, err
+    rows = read_csv_text(out)
+    assert "reach_error_mm" in rows[0]
+    first = [float(x["reach_error_mm"]) for x in rows if x["pose"] == "0" and x["branch"] == str(k)]
+    assert first == [pytest.approx(sol.reach_error[k] * 1e3, rel=1e-3)]
+    assert all(float(x["reach_error_mm"]) == 0.0 for x in rows if x["pose"] == "1")
+
+
+def read_csv_text(text: str) -> list[dict]:
+    import csv
+    import io
+
+    return list(csv.DictReader(io.StringIO(text)))

@@ -155,7 +155,8 @@ def test_identify_refuses_bad_csv(tmp_path, capsys, content, message):
     csv.write_text(content)
     code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16")
     assert code == 2
-    assert stderr.startswith("error:") and message in stderr
+    # an unknown column (b1) is named in a warning line before the error
+    assert re.search(r"^error:", stderr, re.MULTILINE) and message in stderr
     assert "Traceback" not in stderr
 
 
@@ -269,3 +270,19 @@ def test_joint_offsets_for_controllers(kr16_truth, tmp_path, capsys, vendor, uni
     assert code == 0 and ("$MAMES[i]" in stdout if vendor == "kuka" else "no MOC.cfg line" in stdout)
     code, _, stderr = run(capsys, "identify", csv, "--offsets-for", vendor)
     assert code == 2 and "--offsets-for needs --robot" in stderr
+
+
+def test_identify_names_an_unknown_column_in_a_warning(kr16_truth, tmp_path, capsys):
+    _, path = tracker_csv(kr16_truth, tmp_path, 30)
+    lines = path.read_text().splitlines()
+    good = [lines[0] + ",note"] + [f"{line},ok" for line in lines[1:]]
+    path.write_text("\n".join(good) + "\n")
+    code, _, err = run(capsys, "identify", path, "--robot", "kuka_kr16", "--json")
+    assert code == 0 and "warning" not in err  # every column is known (note: a note column)
+    head = lines[0].split(",")
+    head[head.index("z1")] = "zl"  # a misspelt target column is ignored: its target lacks z
+    typo = [",".join(head) + ",temp"] + [f"{line},20.5" for line in lines[1:]]
+    path.write_text("\n".join(typo) + "\n")
+    code, _, err = run(capsys, "identify", path, "--robot", "kuka_kr16", "--json")
+    assert code == 2 and "give the measured target as columns x,y,z" in err
+    assert "warning: " in err and "'zl'" in err and "'temp'" in err

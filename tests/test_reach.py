@@ -65,9 +65,18 @@ def test_cli_writes_csv_and_a_self_contained_html_map(capsys, tmp_path):
     cell = Cell.load(CELL)
     T, table = read_targets(SEAM)
     rm = reach_map(cell, T, frame="part", tool="torch", table=table)
-    assert float(rows[5]["track_mm"]) == pytest.approx(rm.track[5] * 1e3, abs=1e-6)
-    assert float(rows[5]["a2_deg"]) == pytest.approx(math.degrees(rm.q[5, 1]), abs=1e-6)
-    assert float(rows[5]["table_deg"]) == pytest.approx(math.degrees(table[5]), abs=1e-6)
+    assert float(rows[5]["track"]) == pytest.approx(rm.track[5] * 1e3, abs=1e-6)
+    assert float(rows[5]["a2"]) == pytest.approx(math.degrees(rm.q[5, 1]), abs=1e-6)
+    assert float(rows[5]["table"]) == pytest.approx(math.degrees(table[5]), abs=1e-6)
+    # The axis columns are those of fk --cell: the map goes back to the targets.
+    code, _, err = run(capsys, "fk", "--cell", CELL, "--input", out, "--frame", "part",
+                       "--tool", "torch", "-o", tmp_path / "back.csv")
+    assert code == 0, err
+    back = list(csv.DictReader((tmp_path / "back.csv").open()))
+    seam = list(csv.DictReader(SEAM.open()))
+    for k in "xyz":  # fk writes X,Y,Z; the seam has x,y,z (mm)
+        assert [float(b[k.upper()]) for b in back] == pytest.approx([float(t[k]) for t in seam],
+                                                                    abs=1e-4)
     page = (tmp_path / "reach.html").read_text()
     assert "36 of 36 targets reachable" in page and "<img" in page
     png = base64.b64decode(re.search(r'data:image/png;base64,([^"]+)"', page).group(1))
@@ -79,6 +88,12 @@ def test_cli_errors(capsys, tmp_path):
     bad.write_text("x,y,z\n1,2,3\n")
     code, _, err = run(capsys, "reach", "--cell", CELL, bad)
     assert code == 2 and "missing column(s) a, b, c" in err
+    typo = tmp_path / "typo.csv"
+    typo.write_text(SEAM.read_text().replace("table", "tabel"))
+    code, _, err = run(capsys, "reach", "--cell", CELL, typo, "--frame", "part", "--tool", "torch")
+    assert code == 0 and "warning: " in err and "'tabel' (did you mean 'table'?)" in err
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--track", "9000")
+    assert code == 2 and "track position 9000 mm is outside the track limits" in err
     code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "robot")
     assert code == 2 and "moves with the track" in err
     with pytest.raises(InputError, match="unknown frame"):

@@ -58,6 +58,14 @@ def test_calibrate_tcp_imports_what_it_needs_only(tmp_path, capsys):
     assert "scipy.stats" not in modules and "matplotlib" not in modules
     others = {t.split(":")[0] for name, t in COMMANDS.items() if name != "calibrate"}
     assert not modules & others
+    # A TCP calibration solves no IK: neither the IK package (which reading a cell's positioner
+    # chain used to import for a constant) nor the cell's coupled IK.
+    assert not {m for m in modules if m == "robotcell.ik" or m.startswith("robotcell.ik.")}
+    assert "robotcell.cell.ik" not in modules
+    # scipy: least_squares and Rotation (and what scipy.optimize imports itself); no sparse
+    # linear algebra of our own, no integration, interpolation or signal processing.
+    assert not modules & {"scipy.integrate", "scipy.interpolate", "scipy.signal", "scipy.ndimage",
+                          "scipy.io", "scipy.cluster", "scipy.odr"}
 
 
 def test_every_public_name_is_importable_as_before():

@@ -168,3 +168,40 @@ def test_reach_and_sweep_with_a_two_axis_positioner(capsys, tmp_path):
     from robotcell.studies.reach import reach_html
     page = reach_html(rm, T[:, :3, 3], frame="part")
     assert "30 of 30 targets reachable" in page
+
+
+def test_reach_cli_reads_and_writes_a_positioners_axes_as_fk_does(capsys, tmp_path):
+    """reach takes a positioner's values in columns e1..en (deg) and writes them back under the
+    same names, with track/table/a1..an as fk --cell and ik --cell name them."""
+    import csv
+
+    from test_positioner import tilt_rotate
+
+    from robotcell.io.poseformats import pose_to_vendor
+
+    cell = tilt_rotate()
+    path = tmp_path / "cell.yaml"
+    cell.save(path)
+    rng = np.random.default_rng(9)
+    q = rng.uniform(cell.robot.lower, cell.robot.upper, (6, 6)) * 0.6
+    v = np.column_stack([rng.uniform(-0.5, 0.5, 6), rng.uniform(-3, 3, 6)])
+    T = cell.fk(q, table=v, tool="torch", frame="part")
+    targets = tmp_path / "t.csv"
+    rows = np.column_stack([pose_to_vendor(T, "kuka"), np.degrees(v)])
+    targets.write_text("x,y,z,a,b,c,e1,e2\n" + "\n".join(",".join(f"{x:.9f}" for x in r)
+                                                          for r in rows) + "\n")
+    out = tmp_path / "reach.csv"
+    code, _, err = run(capsys, "reach", "--cell", path, targets, "--frame", "part", "--tool",
+                       "torch", "-o", out)
+    assert code == 0, err
+    got = list(csv.DictReader(out.open()))
+    assert list(got[0])[3:12] == ["track", "e1", "e2", "branch", "a1", "a2", "a3", "a4", "a5"]
+    assert np.allclose([[float(r["e1"]), float(r["e2"])] for r in got], np.degrees(v), atol=1e-6)
+    code, back, err = run(capsys, "fk", "--cell", path, "--input", out, "--frame", "part",
+                          "--tool", "torch")
+    assert code == 0, err
+    xyz = np.array([[float(x) for x in line.split(",")[:3]] for line in back.splitlines()[1:]])
+    assert np.allclose(xyz, T[:, :3, 3] * 1e3, atol=1e-4)
+    targets.write_text(targets.read_text().replace("e1,e2", "table,e2"))
+    code, _, err = run(capsys, "reach", "--cell", path, targets, "--frame", "part")
+    assert code == 2 and "column 'table' holds a turntable angle" in err

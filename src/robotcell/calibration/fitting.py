@@ -39,6 +39,12 @@ THREE_SIGMA_P = 0.9973
 #: Scaled-Jacobian condition number above which the parameters count as not determined.
 SINGULAR_CONDITION = 1e10
 
+#: Distance (m) below which two measured points coincide to rounding (1 nm; controllers print
+#: 1 um): geometry that needs them apart (a direction from one to the other, a radius) then
+#: determines nothing and is refused. Any larger distance is data: the fit computes the result and
+#: its uncertainty, and the verdict grades a weak design by its condition number.
+SAME_POINT = 1e-9
+
 
 @dataclass
 class Fit:
@@ -102,6 +108,7 @@ def fit(
     x0: ArrayLike,
     names: Sequence[str],
     prior_sigma: float | None = None,
+    advice: str = "take touches that differ in position and orientation in more directions",
 ) -> Fit:
     """Maximum-likelihood fit of a point model.
 
@@ -117,6 +124,9 @@ def fit(
     prior_sigma : float, optional
         Known measurement noise (metres per coordinate). When given it is used for the
         covariance; otherwise ``s^2 = SSR / dof`` is used, which needs ``dof > 0``.
+    advice : str
+        What to measure instead, ending the error raised when the data do not determine the
+        parameters.
 
     Returns
     -------
@@ -149,8 +159,7 @@ def fit(
         involved = [names[i] for i in order if abs(weak[i]) > 0.2 * abs(weak[order[0]])]
         raise IllPosedError(
             "the measurements do not determine " + ", ".join(involved)
-            + " (their combination is unobservable with these touches); "
-            "take touches that differ in position and orientation in more directions"
+            + f" (their combination is unobservable with these touches); {advice}"
         )
     dof = m - p
     if prior_sigma is not None:

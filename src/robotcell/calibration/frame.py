@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.fitting import (
+    SAME_POINT,
     fit,
     kabsch,
     outlier_warnings,
@@ -25,8 +26,6 @@ from robotcell.kinematics.transforms import as_points
 
 __all__ = ["external_tcp", "frame_3point", "frame_npoint"]
 
-#: Smallest distance (m) from the origin touch to the +X touch that defines a direction at all.
-MIN_X_DISTANCE = 0.010
 #: Below this distance (m) from origin to the +X touch a warning recommends spreading further.
 GOOD_X_DISTANCE = 0.100
 #: Sine of the angle between the +X line and the XY-plane touch (3-point), or ratio of the second
@@ -58,10 +57,10 @@ def _check_roles(p: NDArray[np.float64], roles: list[str]) -> None:
     o = p[r == "origin"].mean(axis=0)
     x = p[r == "x"].mean(axis=0) - o
     lx = np.linalg.norm(x)
-    if lx < MIN_X_DISTANCE:
+    if lx < SAME_POINT:
         raise IllPosedError(
-            f"the +X touch is {lx * 1e3:.1f} mm from the origin touch, too close to define a "
-            f"direction; touch a point on +X at least {GOOD_X_DISTANCE * 1e3:.0f} mm from the origin")
+            "the +X touch is at the origin touch, so it defines no direction; touch a point on +X "
+            f"at least {GOOD_X_DISTANCE * 1e3:.0f} mm from the origin")
     xy = p[r == "xy"].mean(axis=0) - o
     sin = np.linalg.norm(np.cross(x / lx, xy)) / max(np.linalg.norm(xy), 1e-12)
     if sin < COLLINEAR_SIN:
@@ -156,7 +155,9 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
     Raises
     ------
     IllPosedError
-        +X touch too close to the origin, or origin, +X and XY touches collinear.
+        +X touch at the origin, or origin, +X and XY touches collinear (both to rounding: the
+        direction or the rotation about X is then not determined). Short distances and nearly
+        collinear touches are computed, with a warning and a larger condition number.
     """
     p = as_points(points, "points").reshape(-1, 3)
     roles = [str(r).lower() for r in roles]

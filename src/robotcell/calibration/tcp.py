@@ -20,7 +20,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.calibration.fitting import fit, nearest_rotation, outlier_warnings, perturb_rotation
+from robotcell.calibration.fitting import (
+    SAME_POINT,
+    SINGULAR_CONDITION,
+    fit,
+    nearest_rotation,
+    outlier_warnings,
+    perturb_rotation,
+    scaled_condition,
+)
+from robotcell.calibration.frame import COLLINEAR_SIN, NEAR_COLLINEAR_SIN
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import validate_pose
@@ -32,16 +41,18 @@ ABC_WORLD_6D = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
 #: Tool +X in the world frame when aligned for ABC World 5D.
 ABC_WORLD_5D = np.array([0.0, 0.0, -1.0])
 
-#: Orientation spread (rad) about the least-varied direction below which the TCP is refused ...
-MIN_SPREAD = np.radians(2.0)
-#: ... and below which a warning asks for more varied orientations.
+#: Orientation spread (rad) about the least-varied direction below which a warning asks for more
+#: varied orientations. Touches that leave the TCP undetermined (one orientation, two, or all
+#: rotated about one axis) are refused by the fit's rank test, not by a spread threshold.
 GOOD_SPREAD = np.radians(15.0)
-#: Smallest distance (m) of the reference point from the TCP in an ABC 2-point touch.
-MIN_AXIS_DISTANCE = 0.010
-#: Sine of the angle between the -X touch and the XY touch below which they are collinear.
-COLLINEAR_SIN = 0.02
+#: Distance (m) of the reference point from the TCP in an ABC 2-point touch below which a warning
+#: asks to move the tool farther back (the tool direction's 1-sigma is about the touch noise
+#: divided by this distance).
+GOOD_AXIS_DISTANCE = 0.050
 
 ADVICE = "touch with orientations differing by at least 30-60 degrees about different axes"
+#: Ending of the error when the touches do not determine the TCP.
+SIMILAR = "the flange orientations of the touches are too similar: " + ADVICE
 
 
 def _poses(T: ArrayLike | None, name: str) -> NDArray[np.float64]:
@@ -134,8 +145,11 @@ def calibrate_tool(
     Raises
     ------
     IllPosedError
-        Fewer than 3 touches, orientations too similar, or ABC 2-point touches that do not define
-        a direction/plane.
+        Fewer than 3 touches, orientations that leave the TCP undetermined (one or two distinct
+        orientations, or all rotated about one axis: the fit's Jacobian is rank deficient), or ABC
+        2-point touches that define no direction (the reference point at the TCP to rounding) or
+        no plane (the XY touch on the X axis to rounding). Similar orientations and short
+        distances are computed, with a warning and a larger condition number.
     """
     T = _poses(touches, "touch flange poses")
     Ta = _poses(axis_touches, "ABC 2-point -X flange poses")
@@ -152,10 +166,6 @@ def calibrate_tool(
     if len(Ta) and len(Tw):
         raise InputError("give either ABC 2-point touches or ABC World alignments, not both")
     spread = orientation_spread(T[:, :3, :3])
-    if spread < MIN_SPREAD:
-        raise IllPosedError(f"the flange orientations of the touches are too similar (they differ by "
-                            f"{np.degrees(spread):.1f} deg in their least-varied direction), so the TCP "
-                            f"is not determined: {ADVICE}")
     n, na, nq = len(T), len(Ta), len(Tp)
     if labels is None:
         labels = ([f"{i + 1}" for i in range(n)] + [f"{n + i + 1} (-x)" for i in range(na)]
@@ -164,6 +174,9 @@ def calibrate_tool(
         raise InputError(f"labels has {len(labels)} entries for {n + na + nq} touches")
     # Linear start: [R_i, -I] [t; c] = -p_i.
     A = np.concatenate([T[:, :3, :3], np.broadcast_to(-np.eye(3), (n, 3, 3))], axis=2).reshape(-1, 6)
+    if scaled_condition(A) > SINGULAR_CONDITION:  # A is the Jacobian of the TCP touches, exactly
+        raise IllPosedError("the TCP is not determined (one or two distinct flange orientations, or "
+                            f"all rotated about one axis): {SIMILAR}")
     t0, c0 = np.split(np.linalg.lstsq(A, -T[:, :3, 3].ravel(), rcond=None)[0], 2)
     x0 = [t0, c0]
     R0 = np.eye(3)
@@ -171,16 +184,17 @@ def calibrate_tool(
         f_a = np.einsum("nji,nj->ni", Ta[:, :3, :3], c0 - Ta[:, :3, 3]) - t0
         f_p = np.einsum("nji,nj->ni", Tp[:, :3, :3], c0 - Tp[:, :3, 3]) - t0
         da = np.linalg.norm(f_a, axis=1)
-        if np.any(da < MIN_AXIS_DISTANCE):
-            raise IllPosedError(f"in a -X touch the reference point is only {da.min() * 1e3:.1f} mm from "
-                                "the TCP; move the tool back along its axis by at least 50 mm")
-        X = -(f_a / da[:, None]).mean(axis=0)
+        if da.max() < SAME_POINT:
+            raise IllPosedError("in the -X touches the reference point is at the TCP, so they define no "
+                                "tool direction; move the tool back along its axis, at least "
+                                f"{GOOD_AXIS_DISTANCE * 1e3:.0f} mm")
+        X = -f_a.sum(axis=0)
         X /= np.linalg.norm(X)
         w = f_p.mean(axis=0) - (f_p.mean(axis=0) @ X) * X
-        if np.linalg.norm(w) < COLLINEAR_SIN * np.linalg.norm(f_p.mean(axis=0)):
+        if np.linalg.norm(w) <= COLLINEAR_SIN * np.linalg.norm(f_p.mean(axis=0)):
             raise IllPosedError("the XY-plane touch lies on the tool's X axis (collinear with the -X "
-                                "touch): move the tool sideways so the reference point is off its axis "
-                                "on the tool's +Y side")
+                                "touch), so the rotation about X is not determined: move the tool "
+                                "sideways so the reference point is off its axis on the tool's +Y side")
         Y = w / np.linalg.norm(w)
         R0 = np.column_stack([X, Y, np.cross(X, Y)])
         x0 += [np.zeros(3), da, (f_p @ R0[:, :2]).ravel()]
@@ -205,7 +219,7 @@ def calibrate_tool(
                   "tool rotation about flange z"]
         names += [f"distance of touch {labels[n + i]} along -X" for i in range(na)]
         names += [f"{k} of touch {labels[n + na + i]}" for i in range(nq) for k in ("x", "y")]
-    res = fit(resid, x0, names, prior_sigma)
+    res = fit(resid, x0, names, prior_sigma, advice=SIMILAR)
     t, c = res.x[:3], res.x[3:6]
     values: dict = {"tcp": t, "pivot": c}
     sigma: dict = {"tcp": res.sigma[:3], "pivot": res.sigma[3:6]}
@@ -221,9 +235,19 @@ def calibrate_tool(
         if np.any(res.x[9:9 + na] <= 0):
             raise IllPosedError("in a -X touch the reference point lies on the tool's positive X side; "
                                 "the -X touch must move the tool back, against its tool direction")
-        if np.any(res.x[9 + na:].reshape(nq, 2)[:, 1] <= 0):
+        xy = res.x[9 + na:].reshape(nq, 2)
+        if np.any(xy[:, 1] <= 0):
             raise IllPosedError("the XY-plane touches lie on both sides of the tool's X axis; keep them "
                                 "all on the tool's positive Y side")
+        if res.x[9:9 + na].min() < GOOD_AXIS_DISTANCE:
+            warnings.append(f"in a -X touch the reference point is only {res.x[9:9 + na].min() * 1e3:.1f}"
+                            " mm from the TCP: the tool direction is poorly determined; move the tool "
+                            f"back along its axis by at least {GOOD_AXIS_DISTANCE * 1e3:.0f} mm")
+        sin_xy = np.min(xy[:, 1] / np.linalg.norm(xy, axis=1))
+        if sin_xy < NEAR_COLLINEAR_SIN:
+            warnings.append(f"an XY-plane touch is only {np.degrees(np.arcsin(sin_xy)):.1f} deg off the "
+                            "tool's X axis (nearly collinear): the rotation about X is poorly "
+                            "determined; move the tool sideways, toward its +Y side")
     elif len(Tw):
         R_tool, sigma_rot = _world_orientation(Tw[:, :3, :3], world_mode)
         if len(Tw) < 2:

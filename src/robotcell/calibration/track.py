@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.calibration.fitting import (
+    SAME_POINT,
     fit,
     kabsch,
     nearest_rotation,
@@ -52,6 +53,11 @@ SCALE_WARN = 0.02
 #: Travel (m) spanned by the touches below which a warning asks to spread them: the direction's
 #: uncertainty is about the touch noise divided by the travel.
 TRAVEL_WARN = 0.05
+
+#: Distance (m) of a single known reference point from the track axis, or spread of several
+#: across one line parallel to it, below which a warning is given: the rotation about the axis
+#: is then poorly determined (its 1-sigma is about the touch noise divided by this lever).
+LEVER_WARN = 0.05
 
 #: Scale outside ``[1 / SCALE_REFUSE, SCALE_REFUSE]`` means the data are not of one fixed point or
 #: the track values are not in the track's own length unit.
@@ -112,24 +118,34 @@ def _check_positions(e: NDArray[np.float64]) -> float:
     return travel
 
 
-def _check_references(refs: NDArray[np.float64], d: NDArray[np.float64], min_lever: float) -> None:
+def _check_references(refs: NDArray[np.float64], d: NDArray[np.float64]) -> list[str]:
+    """Refuse reference points that leave the roll undetermined; warnings for a short lever.
+
+    A single point on the track axis, or several on one line parallel to it (to rounding,
+    :data:`SAME_POINT`), cannot see the rotation about the axis. A short lever is computed.
+    """
     perp = refs - np.outer(refs @ d, d)
     if len(refs) == 1:
         lever = float(np.linalg.norm(perp[0]))
-        if lever < min_lever:
+        if lever < SAME_POINT:
             raise IllPosedError(
-                f"the reference point is only {lever * 1e3:.1f} mm from the track axis, so the "
-                "rotation about the axis stays undetermined; use a reference point at least "
-                f"{min_lever * 1e3:.0f} mm off the axis, or two known points"
-            )
-        return
-    spread = max(float(np.linalg.norm(p - q)) for p in perp for q in perp)
-    if spread < min_lever:
-        raise IllPosedError(
-            f"the reference points lie on one line parallel to the track axis (within "
-            f"{spread * 1e3:.1f} mm), so the rotation about the axis stays undetermined; add a "
-            f"point at least {min_lever * 1e3:.0f} mm off that line"
-        )
+                "the reference point lies on the track axis, so the rotation about the axis stays "
+                f"undetermined; use a reference point at least {LEVER_WARN * 1e3:.0f} mm off the "
+                "axis, or two known points")
+        what = f"the reference point is only {lever * 1e3:.1f} mm from the track axis"
+    else:
+        lever = max(float(np.linalg.norm(p - q)) for p in perp for q in perp)
+        if lever < SAME_POINT:
+            raise IllPosedError(
+                "the reference points lie on one line parallel to the track axis, so the rotation "
+                f"about the axis stays undetermined; add a point at least {LEVER_WARN * 1e3:.0f} mm "
+                "off that line")
+        what = (f"the reference points lie within {lever * 1e3:.1f} mm of one line parallel to "
+                "the track axis")
+    if lever < LEVER_WARN:
+        return [(f"{what}: the rotation about the axis is poorly determined; use a point at "
+                 f"least {LEVER_WARN * 1e3:.0f} mm off it")]
+    return []
 
 
 def _fit_unknown_point(e: NDArray[np.float64], f: NDArray[np.float64], prior: float | None):
@@ -186,7 +202,6 @@ def calibrate_track(
     roll: str | None = None,
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
-    min_lever: float = 0.05,
 ) -> CalibrationResult:
     """Calibrate a linear track from TCP touches of fixed reference points.
 
@@ -218,9 +233,6 @@ def calibrate_track(
     prior_sigma : float, optional
         Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
         the residuals.
-    min_lever : float
-        Smallest distance of a single known point from the track axis, or of two known points from
-        one line parallel to it (metres).
 
     Returns
     -------
@@ -240,7 +252,8 @@ def calibrate_track(
         or a scale so far from 1 that the data cannot be touches of one fixed point in the track's
         length unit.
     IllPosedError
-        All touches at one track position, reference points on the axis, or touches that do not
+        All touches at one track position, reference points on the axis (to rounding; a short
+        lever is computed with a warning below :data:`LEVER_WARN`), or touches that do not
         determine the parameters (see :func:`robotcell.calibration.fit`). Repeated track
         positions are data: they are averaged by the fit.
     """
@@ -281,13 +294,11 @@ def calibrate_track(
             raise InputError(f"reference point(s) {', '.join(str(u + 1) for u in unused)} were "
                              "never touched; drop them or add their touches")
     travel = _check_positions(e)
-    if refs is not None:
-        _check_references(refs, d, min_lever)
+    warnings: list[str] = [] if refs is None else _check_references(refs, d)
 
     values: dict = {}
     sigma: dict = {}
     undetermined: list[str] = []
-    warnings: list[str] = []
     if refs is None:
         res, e_mean = _fit_unknown_point(e, f, prior_sigma)
 

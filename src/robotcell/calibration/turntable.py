@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.fitting import fit, outlier_warnings, perturb_rotation
+from robotcell.calibration.fitting import SAME_POINT, fit, outlier_warnings, perturb_rotation
 from robotcell.calibration.propagate import propagate
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
@@ -31,6 +31,8 @@ __all__ = ["angular_spread", "calibrate_turntable"]
 
 #: Angular spread of the touches below which a warning is given (radians).
 SPREAD_WARN = np.radians(90.0)
+#: Radius (m) of the reference point below which a warning asks for a point nearer the rim.
+RADIUS_WARN = 0.05
 
 
 def angular_spread(theta: ArrayLike) -> float:
@@ -67,16 +69,20 @@ def _check_angles(theta: NDArray[np.float64]) -> float:
     return angular_spread(theta)
 
 
-def _linear_start(theta: NDArray[np.float64], f: NDArray[np.float64], min_radius: float):
-    """Linear LS for ``f = b' + u cos + v sin``; returns ``(b', R0, r0)``."""
+def _linear_start(theta: NDArray[np.float64], f: NDArray[np.float64]):
+    """Linear LS for ``f = b' + u cos + v sin``; returns ``(b', R0, r0)``.
+
+    Refuses a point on the axis to rounding (:data:`SAME_POINT`): it does not move, so the axis
+    direction and the angle zero are not determined.
+    """
     A = np.stack([np.ones_like(theta), np.cos(theta), np.sin(theta)], axis=1)
     (b, u, v), *_ = np.linalg.lstsq(A, f, rcond=None)
     r0 = 0.5 * (np.linalg.norm(u) + np.linalg.norm(v))
-    if r0 < min_radius:
+    if r0 < SAME_POINT:
         raise IllPosedError(
-            f"the reference point is only {r0 * 1e3:.1f} mm from the table axis, so the axis "
-            "direction and the angle zero are not determined; touch a point at least "
-            f"{min_radius * 1e3:.0f} mm from the axis, ideally near the rim"
+            "the reference point does not move when the table turns (it lies on the table axis), "
+            "so the axis direction and the angle zero are not determined; touch a point at least "
+            f"{RADIUS_WARN * 1e3:.0f} mm from the axis, ideally near the rim"
         )
     x = u / np.linalg.norm(u)
     z = np.cross(u, v)
@@ -92,7 +98,6 @@ def calibrate_turntable(
     height: float = 0.0,
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
-    min_radius: float = 0.01,
 ) -> CalibrationResult:
     """Calibrate the root frame B of a turntable from touches of one point on the table.
 
@@ -114,8 +119,6 @@ def calibrate_turntable(
     prior_sigma : float, optional
         Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
         the residuals.
-    min_radius : float
-        Smallest distance of the reference point from the axis (metres).
 
     Returns
     -------
@@ -135,8 +138,9 @@ def calibrate_turntable(
     InputError
         Wrong shapes, NaN, fewer than 3 touches.
     IllPosedError
-        Fewer than 3 distinct angles, a reference point on the axis, or touches that do not
-        determine the parameters (see :func:`robotcell.calibration.fit`).
+        Fewer than 3 distinct angles, a reference point on the axis (to rounding), or touches that
+        do not determine the parameters (see :func:`robotcell.calibration.fit`). A point near the
+        axis is computed, with a warning below :data:`RADIUS_WARN` and a larger condition number.
     """
     f = as_points(f, "TCP positions")
     theta = np.asarray(theta, dtype=float)
@@ -151,7 +155,7 @@ def calibrate_turntable(
                          "more let a wrong touch be singled out)")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
     spread = _check_angles(theta)
-    b_plane, R0, r0 = _linear_start(theta, f, min_radius)
+    b_plane, R0, r0 = _linear_start(theta, f)
     rot_theta = rot_z(theta)
 
     def unpack(x: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
@@ -186,6 +190,10 @@ def calibrate_turntable(
         warnings.append(f"the touches span only {np.degrees(spread):.0f} deg of table rotation; "
                         "spread them over at least 90 deg (ideally around the full turn) for a "
                         "well-determined axis")
+    if radius < RADIUS_WARN:
+        warnings.append(f"the reference point is only {radius * 1e3:.1f} mm from the table axis: the "
+                        "axis direction and the angle zero are poorly determined; touch a point at "
+                        f"least {RADIUS_WARN * 1e3:.0f} mm from the axis, ideally near the rim")
     if tilt > np.pi / 2:
         warnings.append("Z_B points downward in the robot base: positive table angles turn the "
                         "table clockwise seen from above; check the axis sign in the controller's "

@@ -21,7 +21,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.fitting import fit, outlier_warnings, perturb_pose
+from robotcell.calibration.fitting import SAME_POINT, fit, outlier_warnings, perturb_pose
+from robotcell.calibration.frame import GOOD_X_DISTANCE, NEAR_COLLINEAR_SIN
 from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
 from robotcell.errors import IllPosedError, InputError
@@ -81,27 +82,37 @@ def workpiece_pose(T_R_B: ArrayLike, T_B_W: ArrayLike, theta: ArrayLike) -> NDAr
     return T_R_B @ turn @ T_B_W
 
 
-def _start_frame(p: NDArray[np.float64], roles: NDArray[np.str_], min_distance: float):
-    """3-point construction from the mean point of each role; refuses collinear points."""
+def _start_frame(p: NDArray[np.float64], roles: NDArray[np.str_]):
+    """3-point construction from the mean point of each role; warnings for a weak layout.
+
+    Refuses only points that coincide or are collinear to rounding (:data:`SAME_POINT`): the
+    direction of X or the rotation about it is then not determined.
+    """
     o, px, pxy = (p[roles == r].mean(axis=0) for r in ROLES)
     u = px - o
-    if np.linalg.norm(u) < min_distance:
+    lx = float(np.linalg.norm(u))
+    if lx < SAME_POINT:
         raise IllPosedError(
-            f"the +X point is only {np.linalg.norm(u) * 1e3:.1f} mm from the origin; touch a point "
-            f"on +X at least {min_distance * 1e3:.0f} mm away (farther is more accurate)"
-        )
-    x = u / np.linalg.norm(u)
+            "the +X point is at the origin, so it defines no direction; touch a point on +X at "
+            f"least {GOOD_X_DISTANCE * 1e3:.0f} mm from the origin (farther is more accurate)")
+    x = u / lx
     v = pxy - o
-    off_axis = v - (v @ x) * x
-    if np.linalg.norm(off_axis) < min_distance:
+    off = float(np.linalg.norm(v - (v @ x) * x))
+    if off < SAME_POINT:
         raise IllPosedError(
-            f"the XY-plane point is only {np.linalg.norm(off_axis) * 1e3:.1f} mm from the X axis "
-            "(the three points are nearly collinear); touch a point with positive Y at least "
-            f"{min_distance * 1e3:.0f} mm from the X axis"
-        )
+            "the XY-plane point lies on the X axis (the three points are collinear), so the rotation "
+            "about X is not determined; touch a point with positive Y well away from the X axis")
+    warnings = []
+    if lx < GOOD_X_DISTANCE:
+        warnings.append(f"the +X point is only {lx * 1e3:.1f} mm from the origin: the direction of X "
+                        f"is sensitive to touch errors; touch at least {GOOD_X_DISTANCE * 1e3:.0f} "
+                        "mm away")
+    if off < NEAR_COLLINEAR_SIN * np.linalg.norm(v):
+        warnings.append(f"the XY-plane point is only {off * 1e3:.1f} mm from the X axis (nearly "
+                        "collinear): the rotation about X is poorly determined; touch it near +Y")
     z = np.cross(x, v)
     z /= np.linalg.norm(z)
-    return make_pose(np.stack([x, np.cross(z, x), z], axis=1), o)
+    return make_pose(np.stack([x, np.cross(z, x), z], axis=1), o), warnings
 
 
 def _feature_points(T: NDArray[np.float64], roles: NDArray[np.str_],
@@ -130,7 +141,6 @@ def calibrate_workpiece(
     noise_sigma: float | None = None,
     prior_sigma: float | None = None,
     labels: Sequence[str] | None = None,
-    min_distance: float = 0.01,
 ) -> CalibrationResult:
     """Calibrate the workpiece frame ``T_B_W`` on a calibrated turntable.
 
@@ -157,9 +167,6 @@ def calibrate_workpiece(
         (overrides ``noise_sigma`` and the estimate from the residuals).
     labels : sequence of str, optional
         Name of each touch (default ``"1".."N"``).
-    min_distance : float
-        Smallest distance of the +X point from the origin and of the XY point from the X axis
-        (metres).
 
     Returns
     -------
@@ -175,7 +182,9 @@ def calibrate_workpiece(
     InputError
         Wrong shapes, NaN, unknown or missing roles, an invalid ``T_R_B``.
     IllPosedError
-        +X point too close to the origin, XY point too close to the X axis.
+        +X point at the origin, XY point on the X axis (both to rounding), or touches that do not
+        determine the frame (see :func:`robotcell.calibration.fit`). Points close together are
+        computed, with a warning and a larger condition number.
     """
     f = as_points(f, "TCP positions")
     theta = np.asarray(theta, dtype=float)
@@ -204,7 +213,7 @@ def calibrate_workpiece(
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
 
     p = table_points(T_R_B, theta, f)
-    T0 = _start_frame(p, roles, min_distance)
+    T0, warnings = _start_frame(p, roles)
     back = rot_z(theta) @ T_R_B[:3, :3]
 
     def residuals(x: NDArray[np.float64], t: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
@@ -226,7 +235,6 @@ def calibrate_workpiece(
         prior_sigma = noise_sigma
     res = fit(residuals, x0, names, prior_sigma=prior_sigma)
     cov = res.covariance
-    warnings = []
     undetermined = []
     if cov_t is not None:
         t0 = np.concatenate([T_R_B[:3, 3], np.zeros(3)])

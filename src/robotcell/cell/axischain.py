@@ -18,7 +18,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
-from robotcell.ik.limits import TWO_PI
 from robotcell.kinematics.dh import link_transform
 from robotcell.kinematics.robot import Robot
 
@@ -55,13 +54,6 @@ def axis_frames(robot: Robot) -> tuple[NDArray[np.float64], NDArray[np.float64]]
         pre = np.concatenate([np.eye(4)[None], S[:-1]])
         return pre, S[-1] @ robot.flange
     return S, np.array(robot.flange, dtype=float)
-
-
-def _rot_z(phi: NDArray[np.float64]) -> NDArray[np.float64]:
-    c, s = np.cos(phi), np.sin(phi)
-    R = np.zeros(phi.shape + (3, 3))
-    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
-    return R
 
 
 def _angle_about(k: NDArray[np.float64], u: NDArray[np.float64], v: NDArray[np.float64]
@@ -141,10 +133,12 @@ def normal_up(chain: Robot, R_world_0: ArrayLike, normal: ArrayLike,
     values = out * signs
     values[~exists] = np.nan
     # a whole turn more or less where that brings a value inside its limits
-    lo, hi = chain.lower, chain.upper
-    shift = np.where(values < lo, np.ceil((lo - values) / TWO_PI),
-                     np.where(values > hi, -np.ceil((values - hi) / TWO_PI), 0.0))
-    values = values + np.nan_to_num(shift) * TWO_PI
+    # (2 pi written out: importing robotcell.ik.limits would load the whole IK package into
+    # every command that reads a cell file)
+    lo, hi, turn = chain.lower, chain.upper, 2.0 * np.pi
+    shift = np.where(values < lo, np.ceil((lo - values) / turn),
+                     np.where(values > hi, -np.ceil((values - hi) / turn), 0.0))
+    values = values + np.nan_to_num(shift) * turn
     with np.errstate(invalid="ignore"):
         valid = np.all((values >= lo) & (values <= hi), axis=-1)
     return values, valid

@@ -82,6 +82,12 @@ class CellIKSolutions:
         Table angle of the solutions (rad; 0 in a cell without turntable).
     method : str
         Analytic method of the arm (``"opw"`` or ``"ur"``).
+    reach_error : ndarray, shape (..., 8), optional
+        Distance (m) by which the target lies outside the branch's reach, as
+        :attr:`robotcell.ik.IKSolutions.reach_error`: 0 inside up to rounding; up to
+        :data:`robotcell.ik.result.REACH_TOL` (1 um) a rounded target is solved at the boundary
+        of the reach (``reachable`` True) and its TCP misses the target by this distance. None
+        when the arm's solver gives no distance.
     """
 
     q: NDArray[np.float64]
@@ -90,6 +96,7 @@ class CellIKSolutions:
     track: NDArray[np.float64]
     table: NDArray[np.float64]
     method: str
+    reach_error: NDArray[np.float64] | None = None
 
     @property
     def count(self) -> NDArray[np.int_]:
@@ -265,7 +272,7 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         e = choice.track / cell.track.scale
         q = choice.solutions.q[..., 1:]
         valid, reachable = choice.solutions.valid, choice.solutions.reachable
-        method = choice.solutions.method
+        method, reach_error = choice.solutions.method, choice.solutions.reach_error
     else:
         e = finite_array(0.0 if track is None else track, "track position")
         batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th), e.shape)
@@ -273,9 +280,11 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         T_world = frame_pose(cell, frame, e, th) @ arr
         sol = cell.robot.ik(invert(robot_pose(cell, e)) @ T_world, tool=T_tool)
         q, valid, reachable, method = sol.q, sol.valid, sol.reachable, sol.method
+        reach_error = sol.reach_error
     th = broadcast_table(cell, th, batch)
     valid = valid & _limits_ok(cell, e, th)[..., None]
-    return CellIKSolutions(q, valid, reachable, np.array(e, dtype=float), np.array(th), method)
+    return CellIKSolutions(q, valid, reachable, np.array(e, dtype=float), np.array(th), method,
+                           None if reach_error is None else np.array(reach_error, dtype=float))
 
 
 def _path_inputs(cell: Cell, T: ArrayLike, table: ArrayLike, track: ArrayLike | None
@@ -435,9 +444,7 @@ def _path_solutions(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArra
     rev = ~robot.prismatic
     q = _fit_limits(_unwrapped(rev, sol.q), rev, robot.lower, robot.upper, q_start)
     reach = sol.reachable & _limits_ok(cell, ee, th)[..., None]             # (K, N, 8)
-    inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)       # (K, N, 8)
-    if robot.coupling is not None:  # interaction limits (e.g. FANUC J2/J3) are limits too
-        inside &= robot.coupling.within_interaction(q)
+    inside = robot._inside(q)  # (K, N, 8); interaction limits (e.g. FANUC J2/J3) too
     step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
     first = np.ones((step.shape[0], 1, step.shape[2]), dtype=bool)
     smooth = np.concatenate([first, step <= max_step], axis=1)

@@ -26,17 +26,19 @@ import math
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell import axischain, kinematics
-from robotcell.cell import ik as cell_ik
 from robotcell.cell.kinematics import RESERVED_FRAMES
 from robotcell.errors import InputError
 from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import finite_array, validate_pose
+
+if TYPE_CHECKING:
+    from robotcell.cell.ik import CellIKSolutions, CellPath
 
 __all__ = ["RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool", "Track",
            "Turntable"]
@@ -622,7 +624,7 @@ class Cell:
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
            table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
-           samples: int | None = None) -> cell_ik.CellIKSolutions:
+           samples: int | None = None) -> CellIKSolutions:
         """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cell.ik.ik`.
 
         ``table``: the table angle ``(...)``, the positioner's axis values ``(..., n)``, or, for a
@@ -631,6 +633,8 @@ class Cell:
         straight up, the welding position (:meth:`Positioner.normal_up`; of its two solutions,
         per target, the one within the axis limits where the arm has more valid branches).
         """
+        from robotcell.cell import ik as cell_ik  # the IK package only for commands that solve IK
+
         if not isinstance(table, str):
             return cell_ik.ik(self, T, frame, track, table, tool, samples)
         values, ok = self._normal_up(T, frame, track)
@@ -643,10 +647,12 @@ class Cell:
             return np.where(second.reshape(second.shape + (1,) * (a.ndim - second.ndim)), b, a)
 
         first, other = sols
+        err = (None if first.reach_error is None or other.reach_error is None
+               else pick(first.reach_error, other.reach_error))
         return cell_ik.CellIKSolutions(
             pick(first.q, other.q), pick(first.valid, other.valid),
             pick(first.reachable, other.reachable), pick(first.track, other.track),
-            pick(first.table, other.table), first.method)
+            pick(first.table, other.table), first.method, err)
 
     def _normal_up(self, T: ArrayLike, frame: str, track: ArrayLike | None
                    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
@@ -668,11 +674,15 @@ class Cell:
 
     def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                 table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
-                q_start: ArrayLike | None = None, max_step: float = cell_ik.MAX_STEP,
-                samples: int = 33, track_motion: str = "fixed") -> cell_ik.CellPath:
-        """A continuous trajectory through targets; see :func:`robotcell.cell.ik.ik_path`."""
-        return cell_ik.ik_path(self, T, frame, track, table, tool, q_start, max_step, samples,
-                              track_motion)
+                q_start: ArrayLike | None = None, max_step: float | None = None,
+                samples: int = 33, track_motion: str = "fixed") -> CellPath:
+        """A continuous trajectory through targets; see :func:`robotcell.cell.ik.ik_path`
+        (``max_step`` None: its default, :data:`robotcell.cell.ik.MAX_STEP`, rad)."""
+        from robotcell.cell import ik as cell_ik
+
+        return cell_ik.ik_path(self, T, frame, track, table, tool, q_start,
+                               cell_ik.MAX_STEP if max_step is None else max_step, samples,
+                               track_motion)
 
     # -- files ------------------------------------------------------------------------------------
     @classmethod

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 
 import click
 import numpy as np
 
-from robotcell.cli.common import check_not_folder, check_output
+from robotcell.cli.common import check_not_folder, check_output, read_csv, warn_unknown_columns
 from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
@@ -24,6 +25,17 @@ from robotcell.identification.validation import (
 from robotcell.io.tables import format_table, write_csv
 from robotcell.kinematics.models import load_robot, save_robot
 from robotcell.kinematics.robot import Robot
+
+#: Columns of a measurement CSV (docs/identification.md): joints ``a1..aN``, one target ``x,y,z``
+#: or several ``x1,y1,z1,...``, an orientation ``qw,qx,qy,qz``.
+MEASUREMENT_COLUMN = re.compile(r"a\d+|[xyz]\d*|q[wxyz]")
+
+
+def _check_columns(path: str) -> None:
+    """Name the columns of a measurement CSV that identify does not use, in a warning."""
+    cols = read_csv(path)
+    warn_unknown_columns(path, cols, [*(c for c in cols if MEASUREMENT_COLUMN.fullmatch(c)),
+                                      "x", "y", "z", "qw", "qx", "qy", "qz"])
 
 
 def _offsets(result, vendor: str) -> dict:
@@ -172,6 +184,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     if offsets_for is not None and robot is None:
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
+    _check_columns(measurements)
     options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale,
                "compliance": compliance}
     if robot is not None:

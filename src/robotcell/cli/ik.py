@@ -205,6 +205,14 @@ def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[obje
     write_output(output_path, buf.getvalue())
 
 
+def _reach_error_mm(reach_error: np.ndarray | None, reachable: np.ndarray) -> np.ndarray | None:
+    """``reach_error`` in mm where a branch reaches (solved at the boundary), else 0; None
+    when the solver gives no distance."""
+    if reach_error is None:
+        return None
+    return np.where(reachable, np.nan_to_num(reach_error, posinf=0.0) * 1e3, 0.0)
+
+
 def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
                        ) -> tuple[list[str], np.ndarray]:
     """Batch columns of the configuration flags (KUKA status,turn; ABB cf1..cfx) per row of q."""
@@ -256,9 +264,13 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
             raise InputError(f"no valid solution for the target in frame {frame!r}: out of reach, "
                              "or outside the joint, track or table limits (--all lists every branch)")
         flags = _flags(r, sol.method, fmt, qs) if ks else None
+        off = _reach_error_mm(sol.reach_error, sol.reachable)
+        off_shown = off is not None and bool(np.any(off[ks] > 0))
         headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
         if flags is not None:
             headers.append("S/T" if fmt == "kuka" else "confdata")
+        if off_shown:
+            headers.append("reach error mm")
         rows = []
         for i, k in enumerate(ks):
             state = "yes" if valid[k] else ("limits" if sol.reachable[k] else "unreachable")
@@ -267,6 +279,8 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
             row = [f"{k} {BRANCHES[k]}", *vals, state]
             if flags is not None:
                 row.append(flags[i] if sol.reachable[k] else "-")
+            if off_shown:
+                row.append(f"{off[k]:.6f}" if sol.reachable[k] else "-")
             rows.append(row)
         how = "chosen" if track_mm is None else "given"
         where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
@@ -289,17 +303,20 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     q = np.concatenate([p.q for p in parts])
     valid = np.concatenate([p.valid for p in parts])
     reach = np.concatenate([p.reachable for p in parts])
+    off = (None if any(p.reach_error is None for p in parts)
+           else _reach_error_mm(np.concatenate([p.reach_error for p in parts]), reach))
     track = np.concatenate([np.broadcast_to(p.track, p.valid.shape[:-1]) for p in parts]) * 1e3
     table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1] + n_table)
                             for p in parts]).reshape(n, -1) * deg
     method = parts[0].method
     axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
     if ref is not None:
-        qn, found, _ = nearest(r, IKSolutions(q, valid, reach, method), ref)
+        qn, found, branch = nearest(r, IKSolutions(q, valid, reach, method), ref)
         names_f, flags = _cell_flag_columns(r, method, fmt, qn)
         header = ["pose", "found", "track", *table_names, *axes, *names_f]
         out_rows = [[i, int(found[i]), track[i], *table[i].tolist(), *(qn[i] * deg).tolist(),
                      *(flags[i].tolist() if found[i] else ["-"] * len(names_f))] for i in range(n)]
+        shown = [(i, int(branch[i])) if found[i] else None for i in range(n)]
     else:
         idx = [(i, k) for i in range(n) for k in range(8)] if show_all else list(zip(*np.nonzero(valid)))
         sel = np.array([q[i, k] for i, k in idx]).reshape(-1, r.n_joints)
@@ -310,4 +327,9 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
                      *table[i].tolist(),
                      *(sel[j] * deg).tolist(), *(flags[j].tolist() if reach[i, k] else ["-"] * len(names_f))]
                     for j, (i, k) in enumerate(idx)]
+        shown = [(int(i), int(k)) for i, k in idx]
+    if off is not None and any(s is not None and off[s] > 0 for s in shown):
+        header.append("reach_error_mm")  # only when a target lies outside the reach (<= 1 um)
+        for row, s in zip(out_rows, shown):
+            row.append(0.0 if s is None else float(off[s]))
     _finish_batch(valid, header, out_rows, output_path)

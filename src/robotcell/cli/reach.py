@@ -12,24 +12,37 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import check_output, write_csv, write_output
+from robotcell.cli.cellargs import (
+    row_values,
+    table_angles,
+    table_columns,
+    table_option,
+    table_rows,
+    track_values,
+)
+from robotcell.cli.common import check_output, read_csv, write_csv, write_output
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
-from robotcell.io.poseformats import FORMATS
-from robotcell.studies.reach import ReachMap, reach_html, reach_map, read_targets
+from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.tables import require_columns
+from robotcell.studies.reach import ReachMap, reach_html, reach_map
 
 
-def reach_rows(rm: ReachMap, n_axes: int) -> tuple[list[str], np.ndarray]:
-    """CSV header and rows of a reachability map (mm, deg)."""
-    table = (["table_deg"] if rm.table.ndim == 1
-             else [f"table{i + 1}_deg" for i in range(rm.table.shape[1])])
-    header = ["target", "reachable", "score", "track_mm", *table, "branch",
-              *[f"a{i + 1}_deg" for i in range(n_axes)], "limit_margin_deg", "track_margin_mm",
-              "manipulability_m3"]
+def reach_rows(rm: ReachMap, cell: Cell) -> tuple[list[str], np.ndarray]:
+    """CSV header and rows of a reachability map (mm, deg).
+
+    The axis columns are named as ``fk --cell`` and ``ik --cell`` name them: ``track`` (mm),
+    ``table`` or a positioner's ``e1..en`` (deg), ``a1..an`` (deg), so the file can be fed to
+    ``robotcell fk --cell CELL --input``. ``track_margin_mm`` only for a cell with a track.
+    """
+    margin = ["track_margin_mm"] if cell.track is not None else []
+    header = ["target", "reachable", "score", "track", *table_columns(cell)[1], "branch",
+              *[f"a{i + 1}" for i in range(cell.robot.n_joints)], "limit_margin_deg",
+              *margin, "manipulability_m3"]
     rows = np.column_stack([
         np.arange(rm.reachable.size), rm.reachable.astype(float), rm.score, rm.track * 1e3,
         np.degrees(rm.table), rm.branch, np.degrees(rm.q), np.degrees(rm.limit_margin),
-        rm.track_margin * 1e3, rm.manipulability,
+        *([rm.track_margin * 1e3] if margin else []), rm.manipulability,
     ])
     return header, rows
 
@@ -47,8 +60,9 @@ def target_options(f: Callable[..., None]) -> Callable[..., None]:
                      help="Tool of the cell (default: the robot model's tool)."),
         click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka",
                      show_default=True, help="Pose columns of the targets file."),
-        click.option("--table", "table_deg", type=float, default=0.0, show_default=True,
-                     help="Table angle (deg) for targets without a 'table' column."),
+        click.option("--table", "table_deg", default=None, metavar="DEG[,DEG...]",
+                     help="Table angle (deg; a positioner: one value per axis) for targets "
+                          "without a 'table' (or e1..en) column; default 0."),
         click.option("--choose-table", is_flag=True,
                      help="Choose the table angle per target (36 angles over one turn, best "
                           "score)."),
@@ -57,15 +71,25 @@ def target_options(f: Callable[..., None]) -> Callable[..., None]:
     return f
 
 
-def load_targets(path: str, fmt: str, table_deg: float, choose_table: bool
-                 ) -> tuple[np.ndarray, np.ndarray | None]:
-    """Targets (m) and table angles (rad; None: to be chosen) from the targets file."""
-    T, table = read_targets(path, fmt)
+def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_table: bool,
+                 track_mm: float | None = None, track_column: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Targets (m), table angles (rad; None: to be chosen) and track positions (m; None: to be
+    chosen) from the targets file, with the columns of ``ik --cell``: the pose columns of
+    ``fmt``, ``track`` (mm, when ``track_column``), ``table`` or a positioner's ``e1..en``
+    (deg). A column the command does not use is named in a warning."""
+    names = [f.lower() for f in FORMATS[fmt].fields]
+    _, table_names = table_columns(cell)
+    cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
+    T = pose_from_vendor(require_columns(cols, names, path), fmt)
+    track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
+                         else track_mm)
     if choose_table:
-        if table is not None:
-            raise InputError(f"{path} has a 'table' column; leave it out to --choose-table")
-        return T, None
-    return T, np.radians(table_deg) if table is None else table
+        given = [c for c in table_names if c in cols]
+        if given:
+            raise InputError(f"{path} has a '{given[0]}' column; leave it out to --choose-table")
+        return T, None, track
+    return T, table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T))), track
 
 
 @click.command()
@@ -78,18 +102,19 @@ def load_targets(path: str, fmt: str, table_deg: float, choose_table: bool
 @click.option("--html", "html_path", type=click.Path(), default=None, callback=check_output,
               help="Self-contained HTML page with the map (default: next to -o, .html).")
 def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
-          table_deg: float, choose_table: bool, track_mm: float | None, output: str | None,
+          table_deg: str | None, choose_table: bool, track_mm: float | None, output: str | None,
           html_path: str | None) -> None:
     """Reachability map: can the robot reach every target, and how well.
 
     TARGETS is a CSV of poses in --frame with the columns of --format (kuka: x,y,z,a,b,c in mm
-    and deg) and optionally a column 'table' (deg). The track position is chosen per target
-    unless --track is given; the table angle too with --choose-table. Every target gets:
-    reachable (1/0), score (0..1: 1 when the arm is as far from singularities as it gets and
-    every axis is at least 10 deg from its limits), track_mm, table_deg, branch (0..7),
-    a1_deg.., limit_margin_deg (smallest distance of an axis to its limits), track_margin_mm and
-    manipulability_m3 (|det J|). Unreachable targets have nan axis values. A summary goes to
-    stderr.
+    and deg) and optionally 'track' (mm) and 'table' (deg; a positioner: e1..en), as for
+    'ik --cell'. The track position is chosen per target unless given; the table angle too
+    with --choose-table. Every target gets: reachable (1/0), score (0..1: 1 when the arm is as
+    far from singularities as it gets and every axis is at least 10 deg from its limits), track
+    (mm), table (deg; a positioner: e1..en), branch (0..7), a1.. (deg), limit_margin_deg
+    (smallest distance of an axis to its limits), track_margin_mm and manipulability_m3
+    (|det J|): the axis columns of 'fk --cell --input'. Unreachable targets have nan axis
+    values. A summary goes to stderr.
 
     \b
     Examples:
@@ -97,12 +122,11 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
       robotcell reach --cell cell.yaml seam.csv --tool torch --html reach.html
     """
     cell = Cell.load(cell_path)
-    T, th = load_targets(targets, fmt, table_deg, choose_table)
-    track = None if track_mm is None else track_mm * 1e-3
+    T, th, track = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
     with ExitStack() as stack:
         rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
                        progress=DeferredProgress(stack, "targets"))
-    header, rows = reach_rows(rm, cell.robot.n_joints)
+    header, rows = reach_rows(rm, cell)
     write_csv(output if output else sys.stdout, header, rows, 6)
     if html_path is None and output:
         html_path = str(Path(output).with_suffix(".html"))

@@ -38,7 +38,8 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
 @click.command()
 @target_options
 @click.option("--targets", "targets", required=True, type=click.Path(dir_okay=False),
-              help="CSV of target poses (columns of --format; optional 'table' in deg).")
+              help="CSV of target poses (columns of --format; optional 'table' in deg, a "
+                   "positioner's e1..en).")
 @click.option("--layouts", "layouts_path", required=True, type=click.Path(dir_okay=False),
               help="YAML of offsets per component (mm, deg); every combination is a layout.")
 @click.option("--workers", type=int, default=None,
@@ -50,7 +51,7 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
 @click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
               help="CSV of every layout, ranked (written atomically).")
 def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool: str | None,
-              fmt: str, table_deg: float, choose_table: bool, workers: int | None,
+              fmt: str, table_deg: str | None, choose_table: bool, workers: int | None,
               scheduler: str | None, top: int, output: str | None) -> None:
     """Rank layouts of the cell by how well the robot reaches the targets.
 
@@ -67,7 +68,7 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
     cell = Cell.load(cell_path)
-    T, th = load_targets(targets, fmt, table_deg, choose_table)
+    T, th, _ = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)

@@ -51,7 +51,6 @@ COMPLIANT_JOINTS = (1, 2)
 
 #: Consecutive nominal axes closer than this to parallel (radians) get a Hayati ``beta``.
 PARALLEL_TOL = math.radians(1.0)
-_KINDS = ("tx", "ty", "tz", "rx", "ry", "rz")
 
 
 @dataclass(frozen=True)
@@ -288,12 +287,11 @@ class Chain:
         """``d pts / d x``: shape (N, K, 3, P) (m per m or rad)."""
         N, K = pts.shape[:2]
         J = np.zeros((N, K, 3, len(self.names)))
-        qm = self.model_joints(x, q)
         for o, u, org in zip(self.ops, ev.axes, ev.origins):
             col = u[:, None, :] if o.kind[0] == "t" else np.cross(u[:, None, :], pts - org[:, None, :])
             J[..., o.param] += np.broadcast_to(col, (N, K, 3))
             if o.joint >= 0:
-                self._joint_terms(J, col, o, q, qm, x)
+                self._joint_terms(J, col, o, q, x)
         for k, idx in enumerate(self.target_params):
             J[:, k, :, idx] = np.moveaxis(ev.R, -1, 0)
         return J
@@ -303,16 +301,15 @@ class Chain:
         """Angular velocity of the target frame per parameter: shape (N, 3, P) (rad per m or rad)."""
         N = q.shape[0]
         W = np.zeros((N, 3, len(self.names)))
-        qm = self.model_joints(x, q)
         for o, u in zip(self.ops, ev.axes):
             if o.kind[0] == "t":
                 continue
             W[..., o.param] += u
             if o.joint >= 0:
-                self._joint_terms(W, u, o, q, qm, x)
+                self._joint_terms(W, u, o, q, x)
         return W
 
-    def _joint_terms(self, J, col, o: Op, q, qm, x) -> None:
+    def _joint_terms(self, J, col, o: Op, q, x) -> None:
         """Add the scale and coupling columns of a joint motion whose parameter column is ``col``."""
         extra = (slice(None),) + (None,) * (col.ndim - 1)
         j = o.joint

@@ -32,11 +32,11 @@ from robotcell.ik.palletizer import (
     palletizer_parameters,
     palletizer_problems,
 )
-from robotcell.ik.result import IKSolutions
+from robotcell.ik.result import IKSolutions, flat_reference
 from robotcell.ik.seeded import SeededSolver
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
 from robotcell.kinematics.robot import Robot
-from robotcell.kinematics.transforms import finite_array, invert, validate_pose
+from robotcell.kinematics.transforms import invert, validate_pose
 
 __all__ = ["AnalyticSolver", "analytic_solver", "solve"]
 
@@ -150,17 +150,7 @@ class AnalyticSolver:
         """
         arr = validate_pose(T, "target pose")
         tool_T = self.robot.tool if tool is None else validate_pose(tool, "tool")
-        ref = None
-        if q_ref is not None:
-            ref = finite_array(q_ref, "q_ref")
-            n_ref = self.robot.n_joints
-            if ref.ndim == 0 or ref.shape[-1] != n_ref:
-                raise InputError(f"q_ref must have shape (..., {n_ref}), got {ref.shape}")
-            try:
-                ref = np.broadcast_to(ref, arr.shape[:-2] + (n_ref,)).reshape(-1, n_ref)
-            except ValueError:
-                raise InputError(f"q_ref of shape {ref.shape} does not match the "
-                                 f"{arr.shape[:-2]} poses") from None
+        ref = flat_reference(q_ref, self.robot.n_joints, arr.shape[:-2])
         # T_O_end = T_O_R @ T_R_TCP @ T_TCP_end, with T_TCP_end = inv(T_end_n @ flange @ tool).
         T_tcp_end = invert(self.params.T_e_n @ self.robot.flange @ tool_T)
         batch = arr.shape[:-2]

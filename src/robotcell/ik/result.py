@@ -5,9 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["REACH_TOL", "IKSolutions", "NumericIKResult"]
+from robotcell.errors import InputError
+from robotcell.kinematics.transforms import finite_array
+
+__all__ = ["REACH_TOL", "IKSolutions", "NumericIKResult", "flat_reference"]
 
 #: A pose outside a branch's reach by at most this distance (m) is solved at the boundary of the
 #: reach, as controllers do with rounded poses; the distance is reported in
@@ -80,3 +83,37 @@ class NumericIKResult:
     orientation_error: NDArray[np.float64]
     iterations: NDArray[np.int_]
     restarts: NDArray[np.int_]
+
+
+def flat_reference(q_ref: ArrayLike | None, n: int, batch: tuple[int, ...]
+                   ) -> NDArray[np.float64] | None:
+    """The reference configuration of every pose of a batch, one row per pose.
+
+    Parameters
+    ----------
+    q_ref : array_like, shape (n,) or (..., n), or None
+        Reference configuration(s) (rad, m), broadcastable to the poses.
+    n : int
+        Number of axes.
+    batch : tuple of int
+        Batch shape of the poses.
+
+    Returns
+    -------
+    ndarray, shape (prod(batch), n), or None
+        None when ``q_ref`` is None.
+
+    Raises
+    ------
+    InputError
+        Non-finite values, or a shape that does not fit ``n`` axes or the poses.
+    """
+    if q_ref is None:
+        return None
+    ref = finite_array(q_ref, "q_ref")
+    if ref.ndim == 0 or ref.shape[-1] != n:
+        raise InputError(f"q_ref must have shape (..., {n}), got {ref.shape}")
+    try:
+        return np.broadcast_to(ref, batch + (n,)).reshape(-1, n)
+    except ValueError:
+        raise InputError(f"q_ref of shape {ref.shape} does not match the {batch} poses") from None

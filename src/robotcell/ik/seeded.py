@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.ik.numeric import solve_numeric
-from robotcell.ik.result import IKSolutions
+from robotcell.ik.result import IKSolutions, flat_reference
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import validate_pose
 
@@ -91,8 +91,7 @@ class SeededSolver:
         nb, n = self.branches, self.robot.n_joints
         q = seeds.q.reshape(-1, nb, seeds.q.shape[-1]).copy()
         reach = seeds.reachable.reshape(-1, nb).copy()
-        ref = None if q_ref is None else np.broadcast_to(
-            np.asarray(q_ref, dtype=float), arr.shape[:-2] + (q.shape[-1],)).reshape(-1, q.shape[-1])
+        ref = flat_reference(q_ref, q.shape[-1], arr.shape[:-2])
         self._edge_seeds(arr.reshape(-1, 4, 4), tool_T, ref, seeds, q, reach)
         if self.seed.robot.coupling is not None:  # seed values -> chain values -> ours
             q = self.seed.robot.coupling.to_model(q)
@@ -105,7 +104,7 @@ class SeededSolver:
                                 tol_orientation=self.tol, max_iterations=100, restarts=0, tool=tool_T)
             q[idx], reach[idx], err[idx] = num.q, num.success, num.position_error
         q[~reach] = np.nan
-        valid = reach & self.robot.within_limits(np.nan_to_num(q))
+        valid = reach & self.robot._inside(q)
         batch = arr.shape[:-2]
         return IKSolutions(q.reshape(batch + (nb, n)), valid.reshape(batch + (nb,)),
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))

@@ -100,12 +100,28 @@ def _number(value: Any, where: str) -> float:
     return float(value)
 
 
-def _pose(value: Any, where: str, lscale: float, ascale: float) -> np.ndarray:
+def _mapping(value: Any, where: str, allowed: set[str], not_mapping: str,
+             required: tuple[str, ...] = (), listed: str | None = None) -> dict:
+    """``value`` when it is a mapping with only ``allowed`` keys and every ``required`` one.
+
+    ``not_mapping`` is the message for a value that is not a mapping; ``listed`` the allowed keys
+    as the message names them (default: sorted).
+    """
     if not isinstance(value, dict):
-        raise InputError(f"{where} must be a mapping with keys x, y, z, a, b, c")
-    unknown = set(value) - _POSE_KEYS
+        raise InputError(not_mapping)
+    unknown = set(value) - allowed
     if unknown:
-        raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: x, y, z, a, b, c")
+        raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; "
+                         f"allowed: {listed or sorted(allowed)}")
+    for key in required:
+        if key not in value:
+            raise InputError(f"{where}: missing key '{key}'")
+    return value
+
+
+def _pose(value: Any, where: str, lscale: float, ascale: float) -> np.ndarray:
+    _mapping(value, where, _POSE_KEYS, f"{where} must be a mapping with keys x, y, z, a, b, c",
+             listed="x, y, z, a, b, c")
     v = [_number(value.get(k, 0.0), f"{where}: key '{k}'") for k in ("x", "y", "z", "a", "b", "c")]
     # KUKA ABC convention; convert the file's units to mm / deg first.
     v = [x * lscale * 1e3 for x in v[:3]] + [math.degrees(x * ascale) for x in v[3:]]
@@ -126,14 +142,9 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
     -------
     Robot
     """
-    if not isinstance(data, dict):
-        raise InputError(f"{origin}: a model file must be a YAML mapping with keys name, joints, ...")
-    unknown = set(data) - _TOP_KEYS
-    if unknown:
-        raise InputError(f"{origin}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_TOP_KEYS)}")
-    for key in ("name", "joints"):
-        if key not in data:
-            raise InputError(f"{origin}: missing key '{key}'")
+    _mapping(data, origin, _TOP_KEYS,
+             f"{origin}: a model file must be a YAML mapping with keys name, joints, ...",
+             ("name", "joints"))
     units = data.get("units", {"length": "mm", "angle": "deg"})
     if not isinstance(units, dict):
         raise InputError(f"{origin}: key 'units' must be a mapping like {{length: mm, angle: deg}}")
@@ -149,14 +160,9 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
     joints = []
     for i, jd in enumerate(joints_data, start=1):
         where = f"{origin}: joint {i}"
-        if not isinstance(jd, dict):
-            raise InputError(f"{where} must be a mapping with keys type, a, alpha, d, theta")
-        unknown = set(jd) - _JOINT_KEYS
-        if unknown:
-            raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_JOINT_KEYS)}")
-        for key in ("type", "a", "alpha", "d", "theta"):
-            if key not in jd:
-                raise InputError(f"{where}: missing key '{key}'")
+        _mapping(jd, where, _JOINT_KEYS,
+                 f"{where} must be a mapping with keys type, a, alpha, d, theta",
+                 ("type", "a", "alpha", "d", "theta"))
         jtype = jd["type"]
         if jtype not in ("revolute", "prismatic"):
             raise InputError(f"{where}: key 'type' must be 'revolute' or 'prismatic', got {jtype!r}")
@@ -243,11 +249,8 @@ def _ik_seed(value: Any, origin: str) -> Robot:
 def _coupling(value: Any, joints: list[Joint], origin: str, ls: float, as_: float) -> Coupling:
     """Parse key ``coupling`` (file units) into a :class:`Coupling` in SI units."""
     where = f"{origin}: key 'coupling'"
-    if not isinstance(value, dict):
-        raise InputError(f"{where} must be a mapping with j23_factor, or matrix (and offset, interaction)")
-    unknown = set(value) - _COUPLING_KEYS
-    if unknown:
-        raise InputError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(_COUPLING_KEYS)}")
+    _mapping(value, where, _COUPLING_KEYS,
+             f"{where} must be a mapping with j23_factor, or matrix (and offset, interaction)")
     if ("j23_factor" in value) == ("matrix" in value):
         raise InputError(f"{where} needs exactly one of 'j23_factor' or 'matrix'")
     axes = [j for j in joints if not j.passive]

@@ -153,9 +153,6 @@ class Robot:
         chain = Chain(self.convention, [j.a for j in js], [j.alpha for j in js], [j.d for j in js],
                       [j.theta for j in js], [j.prismatic for j in js], [j.sign for j in js])
         object.__setattr__(self, "_chain", chain)
-        self._set_tail()
-
-    def _set_tail(self) -> None:
         tail = self.flange @ self.tool
         object.__setattr__(self, "_tail", tail)
         # Start pose of the single-pose kernel, as columns; the tail is applied afterwards.
@@ -224,6 +221,10 @@ class Robot:
         return replace(self, base=new, ik_seed=seed)
 
     # -- validation -----------------------------------------------------------------------------
+    def _tail_for(self, tool: ArrayLike | None) -> NDArray[np.float64]:
+        """``T_n_TCP = T_n_F @ T_F_TCP`` for ``tool`` (the default tool when None), metres."""
+        return self._tail if tool is None else self.flange @ validate_pose(tool, "tool")
+
     def _joints(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
         try:
             arr = np.asarray(q, dtype=float)
@@ -252,10 +253,13 @@ class Robot:
         -------
         ndarray of bool, shape (...)
         """
-        arr = self._joints(q)
-        ok = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
+        return self._inside(self._joints(q), tol)
+
+    def _inside(self, q: NDArray[np.float64], tol: float = 0.0) -> NDArray[np.bool_]:
+        """:meth:`within_limits` of unchecked values ``(..., n)``: NaN values are outside."""
+        ok = np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
         if self.coupling is not None:
-            ok &= self.coupling.within_interaction(arr, tol)
+            ok &= self.coupling.within_interaction(q, tol)
         return ok
 
     def model_values(self, q: ArrayLike) -> NDArray[np.float64]:
@@ -297,10 +301,7 @@ class Robot:
         ndarray, shape (..., 4, 4)
             Pose of the TCP in the robot base frame (metres).
         """
-        if tool is None:
-            tail = self._tail
-        else:
-            tail = self.flange @ validate_pose(tool, "tool")
+        tail = self._tail_for(tool)
         # One pose: evaluate with Python floats, much cheaper than numpy calls on tiny arrays.
         if isinstance(q, (list, tuple)) or (isinstance(q, np.ndarray) and q.ndim == 1):
             vals = q.tolist() if isinstance(q, np.ndarray) else [float(v) for v in q]
@@ -316,10 +317,8 @@ class Robot:
                 ).reshape(4, 4)
             tc = self._tail_cols if tool is None else tail[:3, :].tolist()
             return _compose_cols(m, tc)
-        arr = self._joints(q)
+        arr = self.model_values(q)
         batch = arr.shape[:-1]
-        if self.coupling is not None:
-            arr = self.coupling.to_model(arr)
         T = self._chain.apply(self.base, arr.reshape(-1, len(self.joints)), tail=tail)
         return T.reshape(batch + (4, 4))
 
@@ -362,7 +361,7 @@ class Robot:
             coupling ``J_model @ C`` (chain rule).
         """
         F = self.frames(q)
-        tail = self._tail if tool is None else self.flange @ validate_pose(tool, "tool")
+        tail = self._tail_for(tool)
         p_e = (F[..., -1, :, :] @ tail)[..., :3, 3]
         # Joint i moves about Z_{i-1} (standard DH) or Z_i (modified DH).
         axes = F[..., :-1, :, :] if self.convention == "standard" else F[..., 1:, :, :]

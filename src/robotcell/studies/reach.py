@@ -119,10 +119,12 @@ class ReachMap:
 
 
 def _rows(v: ArrayLike | None, sl: slice, n: int) -> ArrayLike | None:
-    """Rows ``sl`` of a per-target value given as a scalar or an array of length ``n``."""
+    """Rows ``sl`` of a per-target value: a scalar, an array of length ``n``, or of shape
+    ``(n, k)`` (a positioner's axis values per target)."""
     if v is None or np.ndim(v) == 0:
         return v
-    return np.broadcast_to(np.asarray(v, dtype=float), (n,))[sl]
+    a = np.asarray(v, dtype=float)
+    return a[sl] if a.ndim and a.shape[0] == n else a
 
 
 def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:

@@ -629,8 +629,7 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
     pos = cell.turntable
     if pos is None or pos.n_axes != 2:
         raise InputError(f"{label} has no positioner of 2 axes (tilt, rotate) to calibrate")
-    if robot is not None:
-        raise InputError("the robot is the cell's: give a cell or a robot, not both")
+    _arm(cell, robot)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2", "track"], source))
     values, points = positioner_touches(cell, cols, tool=tool, source=source, cell_label=label)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,

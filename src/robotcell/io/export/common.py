@@ -136,7 +136,7 @@ def positive_z_frames(frames: list[NDArray[np.float64]], signs: list[float]
     return out
 
 
-def _numbers(names: list[str], given: list[int | None]) -> list[int]:
+def _numbers(given: list[int | None]) -> list[int]:
     """Explicit numbers, then the lowest free numbers for the others, in order."""
     used = {n for n in given if n is not None}
     out, nxt = [], 1
@@ -172,7 +172,7 @@ def collect(cell: Cell, reference: Literal["world", "robot"]) -> ControllerData:
     data = ControllerData()
     T_world_ref = np.eye(4) if reference == "world" else cell.frame_pose("robot", 0.0)
     T_ref_world = invert(T_world_ref)
-    nums = _numbers(list(cell.tools), [t.number for t in cell.tools.values()])
+    nums = _numbers([t.number for t in cell.tools.values()])
     for (name, tool), n in zip(cell.tools.items(), nums):
         data.tools.append(Slot(name, n, tool.T_F_TCP.copy(), mass=tool.mass,
                                cog=None if tool.cog is None else tool.cog.copy()))
@@ -186,7 +186,7 @@ def collect(cell: Cell, reference: Literal["world", "robot"]) -> ControllerData:
             pre, post = axis_frames(cell.turntable.chain)
             data.positioner_frames = positive_z_frames(
                 [*pre, post], [j.sign for j in cell.turntable.chain.joints])
-    nums = _numbers(list(cell.frames), [f.number for f in cell.frames.values()])
+    nums = _numbers([f.number for f in cell.frames.values()])
     for (name, fr), n in zip(cell.frames.items(), nums):
         if fr.parent == "turntable":
             data.frames.append(Slot(name, n, fr.pose.copy(), on_table=True))
@@ -254,67 +254,3 @@ def flatten_table(data: ControllerData) -> list[Slot]:
         out.append(Slot(data.turntable.name, n, data.turntable.pose.copy()))
     return sorted(out, key=lambda s: s.number or 0)
 
-
-def listing_line(key: str, number: int, values: NDArray[np.float64], fields: tuple[str, ...],
-                 comment: str, name: str) -> str:
-    """``KEY[n]  F1 v1  F2 v2 ...  <comment> name``: a pose as typed on a pendant screen.
-
-    Parameters
-    ----------
-    key : str
-        ``UTOOL``, ``UFRAME``, ``TOOL``, ...
-    number : int
-        Slot number.
-    values : ndarray, shape (6,)
-        Three lengths (mm) and three angles (deg).
-    fields : tuple of str
-        The six field names.
-    comment : str
-        The vendor's comment marker.
-    name : str
-        Name written after the comment marker.
-    """
-    vals = "  ".join(f"{f} {fmt_num(v, MM_DECIMALS if i < 3 else DEG_DECIMALS)}"
-                     for i, (f, v) in enumerate(zip(fields, values)))
-    return f"{key}[{number}]  {vals}  {comment} {name}"
-
-
-def parse_listing(text: str, keys: tuple[str, ...], fields: tuple[str, ...], comment: str
-                  ) -> list[tuple[str, int, list[float], str]]:
-    """Read lines written by :func:`listing_line`.
-
-    Parameters
-    ----------
-    text : str
-        The listing; lines starting with ``comment`` and blank lines are ignored.
-    keys : tuple of str
-        Accepted line keys.
-    fields : tuple of str
-        The six field names, in order.
-    comment : str
-        The vendor's comment marker.
-
-    Returns
-    -------
-    list of (key, number, values, name)
-        ``values`` are the six numbers as written (mm, deg).
-    """
-    head = re.compile(r"^\s*(" + "|".join(keys) + r")\[(\d+)\]\s+(.*)$", re.IGNORECASE)
-    out = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        where = f"line {lineno}"
-        stripped = line.strip()
-        if not stripped or stripped.startswith(comment):
-            continue
-        m = head.match(line)
-        if not m:
-            raise InputError(f"{where}: expected '<{'|'.join(keys)}>[n]  {fields[0]} ...', "
-                             f"got {stripped[:40]!r}")
-        body, _, name = m.group(3).partition(comment)
-        tok = body.split()
-        if len(tok) != 12 or [t.upper() for t in tok[0::2]] != [f.upper() for f in fields]:
-            raise InputError(f"{where}: expected the fields {' '.join(fields)} each followed by "
-                             "a number")
-        values = [parse_float(t, where) for t in tok[1::2]]
-        out.append((m.group(1).upper(), int(m.group(2)), values, name.strip()))
-    return out
