@@ -75,6 +75,7 @@ LEFT_OUT = {
                              "(tests/test_dh_procedure_symbolic.py)",
     "robotcell identify --compliance#": "names an option in the prose, not a command",
     "robotcell fk --cell#": "names an option in the prose, not a command",
+    "robotcell ik --cell#": "names an option in the prose, not a command",
     "robotcell identify fanuc.csv": "no simulated FANUC set in the docs (test_identification_cli)",
 }
 
