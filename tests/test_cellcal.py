@@ -142,6 +142,17 @@ def test_library_errors_name_the_cause():
         cellcal.track(bare, table, roll="zero")
 
 
+def test_joint_value_touches_in_a_cell_with_tools_need_the_tool_said():
+    """Without --tool the touches would be the flange's: refused, not a 'poor' fit to a bad cell."""
+    truth, nominal = demo_cells()
+    table = simulate(truth, "turntable", noise=1e-4, seed=3, tool="torch").to_table()
+    with pytest.raises(InputError, match=r"touches given as joint values: say which tool "
+                                         r"touched, --tool NAME \(the cell has: torch\)"):
+        cellcal.turntable(nominal, table)
+    flange = cellcal.turntable(nominal, table, tool=np.eye(4))  # said: the bare flange
+    assert flange.result.verdict.level == "poor"  # and the flange did not touch: the fit says so
+
+
 def test_notes_reach_on_note_before_a_refusal():
     truth, nominal = demo_cells()
     table = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch").to_table()

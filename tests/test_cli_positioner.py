@@ -153,6 +153,9 @@ def test_calibrate_positioner_refusals(tmp_path, capsys):
     code, _, err = run(capsys, "calibrate", "positioner", small, "--robot", "kuka_kr16")
     assert code == 2 and "no 3 touches turn e1 (tilt) alone over 10 deg or more" in err
     code, _, err = run(capsys, "calibrate", "positioner", small, "--cell", truth)
+    assert code == 2 and "say which tool touched, --tool NAME (the cell has: pointer" in err
+    code, _, err = run(capsys, "calibrate", "positioner", small, "--cell", truth, "--tool",
+                       "pointer")
     assert code == 2 and "3 rows give 9 measured coordinates for 7 identifiable unknowns" in err
     with_track = tmp_path / "track.csv"
     with_track.write_text("\n".join(r + (",track" if i == 0 else ",0")

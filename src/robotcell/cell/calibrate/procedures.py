@@ -343,7 +343,7 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
         raise InputError("the parent of a frame is a cell's notion; give the cell too")
     cols, source = load_table(measurements, source)
     label = _label(cell, cell_label)
-    p = tcp_positions(cols, source, _arm(cell, robot), tool_transform(cell, tool))
+    p = tcp_positions(cols, source, _arm(cell, robot), tool_transform(cell, tool, cols))
     notes = _Notes(on_note)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y", "nominal_z"],
                            source))
@@ -456,11 +456,10 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
     if cell is not None:
         axis = _cell_track_axis(cell, axis, refs, roll, label)  # type: ignore[assignment]
     model = _arm(cell, robot)
-    T_tool = tool_transform(cell, tool)
     cols, source = load_table(measurements, source)
     _refuse_track_column(cols, source, "is not used by 'calibrate track': its track "
                          "positions are column e1")
-    f = tcp_positions(cols, source, model, T_tool)
+    f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
     e = external_axis(cols, source, "track")
     check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
@@ -551,7 +550,7 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
         raise InputError(f"{label} has no positioner; add a 'positioner' section to the cell "
                          "file first")
     cols, source = load_table(measurements, source)
-    f = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool))
+    f = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
     n = cell.turntable.n_axes
     values = np.radians(require_columns(cols, [f"e{i + 1}" for i in range(n)], source))
     if cell.turntable.parent == "world":
@@ -671,9 +670,8 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     label = _label(cell, cell_label)
     parent = _cell_turntable(cell, label).parent if cell is not None else None
     model = _arm(cell, robot)
-    T_tool = tool_transform(cell, tool)
     cols, source = load_table(measurements, source)
-    f = tcp_positions(cols, source, model, T_tool)
+    f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
     theta = external_axis(cols, source, "table")
     check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
@@ -801,12 +799,11 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     if isinstance(turntable, CalibrationResult):
         turntable = TurntablePose.from_result(turntable)
     model = _arm(cell, robot)
-    T_tool = tool_transform(cell, tool)
     tt, where = _workpiece_turntable(cell, turntable, label)
     notes = _Notes(on_note)
     notes.add(where)
     cols, source = load_table(measurements, source)
-    f = tcp_positions(cols, source, model, T_tool)
+    f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
     theta = external_axis(cols, source, "workpiece")
     roles = point_roles(cols, source)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))

@@ -93,8 +93,19 @@ def line_labels(n: int, roles: Sequence[str] | None = None) -> list[str]:
     return [f"line {i + 2} ({r})" for i, r in enumerate(roles)]
 
 
-def tool_transform(cell: Cell | None, tool: str | ArrayLike | None) -> NDArray[np.float64] | None:
-    """``T_F_TCP`` (m) of the tool that touched: a tool of the cell by name, a pose, or None."""
+def tool_transform(cell: Cell | None, tool: str | ArrayLike | None,
+                   cols: Table | None = None) -> NDArray[np.float64] | None:
+    """``T_F_TCP`` (m) of the tool that touched: a tool of the cell by name, a pose, or None.
+
+    With ``cols``, the measurement columns: touches given as joint values in a cell that has
+    tools need the tool said, since the wrong tool (or none) moves every touch by its length,
+    which no fit can tell from a bad cell.
+    """
+    if (tool is None and cell is not None and cell.tools and cols is not None
+            and "a1" in cols and "x" not in cols):
+        known = ", ".join(sorted(cell.tools))
+        raise InputError(f"touches given as joint values: say which tool touched, --tool NAME "
+                         f"(the cell has: {known}), or --tool 0,0,0,0,0,0 for the bare flange")
     if isinstance(tool, str):
         if cell is None:
             raise InputError(f"tool {tool!r} names a tool of a cell, but no cell was given; give "
