@@ -21,8 +21,9 @@ import shutil
 from pathlib import Path
 
 import pytest
-import yaml
 from cli_helpers import run
+
+from robotcell.io.yamlfile import dump_yaml, parse_yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 FILES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
@@ -177,11 +178,11 @@ def prepare(capsys, argv: list[str]) -> None:
         proc, data = argv[1], argv[2]
         tool = argv[argv.index("--tool") + 1] if "--tool" in argv else "pointer"
         if tool not in ("torch", "pointer"):  # X,Y,Z,A,B,C: the pointer of the truth is that tool
-            cell = yaml.safe_load(Path(truth).read_text(encoding="utf-8"))
+            cell = parse_yaml(Path(truth).read_text(encoding="utf-8"), truth)
             x, y, z, a, b, c = map(float, tool.split(","))
             cell["tools"]["pointer"]["frame"] = {"x": x, "y": y, "z": z, "a": a, "b": b, "c": c}
             truth = "truth_tool.yaml"
-            Path(truth).write_text(yaml.safe_dump(cell), encoding="utf-8")
+            Path(truth).write_text(dump_yaml(cell), encoding="utf-8")
         extra = ["--tool", "torch" if proc == "tcp" or tool == "torch" else "pointer"]
         if proc in ("frame", "workpiece"):
             extra += ["--frame", "part" if proc == "workpiece" else "fixture"]

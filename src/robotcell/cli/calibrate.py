@@ -57,8 +57,8 @@ def calibrate() -> None:
     \b
     CSV with a header, lengths in mm, angles in deg. Positions as x,y,z (TCP in the robot base)
     or joint values a1..a6 with --robot and --tool. Report in mm/deg, or --json.
-    With --cell CELL.yaml the result is written into the cell file (CELL.yaml.bak keeps the
-    previous version). Exit status 2 when the measurements are refused, with the reason on stderr.
+    With --cell CELL.yaml the result is written into the cell file, keeping its comments and
+    layout (CELL.yaml.N.bak keeps the previous version; robotcell cell history lists them). Exit status 2 when the measurements are refused, with the reason on stderr.
     Every report ends with a verdict (good / check / poor); a poor result prints its report,
     exits with status 3 and writes nothing, unless --accept-poor is given.
 
@@ -106,8 +106,8 @@ def cell_option(func: Callable) -> Callable:
     """Option ``--cell CELL.yaml`` of the subcommands that can update a cell file."""
     return click.option(
         "--cell", "cell_path", default=None, metavar="CELL.yaml", type=click.Path(dir_okay=False),
-        help="Write the result into this cell file (atomically; the previous version is kept as "
-             "CELL.yaml.bak). Joint values a1..a6 then use the cell's robot, and --tool may name "
+        help="Write the result into this cell file (atomically, keeping its comments and "
+             "layout; the previous version is kept as CELL.yaml.N.bak). Joint values a1..a6 then use the cell's robot, and --tool may name "
              "a tool of the cell.")(func)
 
 
@@ -153,10 +153,11 @@ class CellTarget:
             echo_note(note)
         self.cell = cell
         try:
-            self.cell.save(self.path)
+            backup = self.cell.save(self.path)
         except OSError as exc:
             raise InputError(f"cannot write {self.path}: {exc}") from None
-        click.echo(f"updated {self.path}: {what} (previous version: {self.path}.bak)", err=True)
+        kept = f" (previous version: {backup})" if backup is not None else ""
+        click.echo(f"updated {self.path}: {what}{kept}", err=True)
 
 
 def require_name(name: str | None, target: CellTarget | None, what: str) -> None:
