@@ -140,7 +140,7 @@ def test_the_history_lists_every_version_with_its_provenance(tmp_path, capsys):
     for rms in (0.05, 0.04):
         cell = Cell.load(path)
         cell.set_tool("torch", cell.tools["torch"].T_F_TCP,
-                      Provenance("tcp", "2026-01-0%dT08:00:00+01:00" % (rms * 100), rms,
+                      Provenance("tcp", f"2026-01-0{round(rms * 100)}T08:00:00+01:00", rms,
                                  "touches.csv"))
         cell.save(path)
     versions = cell_history(path)

@@ -53,14 +53,14 @@ def test_ik_in_a_cell_names_the_tool(capsys):
 
 @pytest.mark.parametrize("argv,message", [
     (["identify", "--propose", "10", "--robot", "kuka_kr16", "-o", "{tmp}/x.json"],
-     "-o {tmp}/x.json: the name says JSON, but this writes the proposed configurations as CSV; "
-     "name it x.csv"),
+     ("-o {tmp}/x.json: the name says JSON, but this writes the proposed configurations as CSV; "
+     "name it x.csv")),
     (["identify", "{tmp}/tracker.csv", "--robot", "kuka_kr16", "-o", "{tmp}/x.json"],
-     "-o {tmp}/x.json: the name says JSON, but this writes the identified model file as YAML; "
-     "name it x.yaml"),
+     ("-o {tmp}/x.json: the name says JSON, but this writes the identified model file as YAML; "
+     "name it x.yaml")),
     (["calibrate", "tcp", "{tmp}/t.csv", "-o", "{tmp}/r.json"],
-     "-o {tmp}/r.json: the name says JSON, but this writes the report (add --json for the JSON "
-     "result) as text"),
+     ("-o {tmp}/r.json: the name says JSON, but this writes the report (add --json for the JSON "
+     "result) as text")),
     (["calibrate", "tcp", "{tmp}/t.csv", "--json", "-o", "{tmp}/r.yaml"],
      "the name says YAML, but this writes the result as JSON; name it r.json"),
     (["fk", "kuka_kr16", "--joints", JOINTS, "-o", "{tmp}/p.json"],

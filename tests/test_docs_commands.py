@@ -22,7 +22,6 @@ from pathlib import Path
 
 import pytest
 from cli_helpers import run
-
 from test_commissioning import readme_sequence
 
 from robotcell.io.yamlfile import dump_yaml, parse_yaml
