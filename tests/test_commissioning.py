@@ -48,6 +48,11 @@ def test_the_readme_and_the_guide_give_one_sequence():
              for what in ("calibrate tcp", "calibrate track", "calibrate turntable",
                           "calibrate frame", "calibrate workpiece", "export")]
     assert order == sorted(order)
+    # Where the inputs come from on a real cell is said beside the steps that need them.
+    guide = _section(ROOT / "docs" / "calibration.md", "## Commissioning a cell, step by step")
+    for said in ("**Where the `--reference` points come from:**", "**The sign of `--height`:**",
+                 "Columns `a1..a6`, `e1`", "`--height=-h`"):
+        assert said in guide
 
 
 def test_the_sequence_runs_in_order_on_the_files_each_step_writes(tmp_path, capsys,
