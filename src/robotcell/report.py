@@ -344,10 +344,12 @@ def _result_rows(result: dict[str, Any]) -> tuple[str, set[str], set[str]]:
     xyzabc = result.get("xyzabc")
     if xyzabc is None and _is_points(result.get("rotation"), 3) and _is_points(
             [result.get("offset_mm")], 1):  # the track: the robot base on the carriage
-        T = np.eye(4)
-        T[:3, :3], T[:3, 3] = result["rotation"], np.array(result["offset_mm"]) * 1e-3
-        xyzabc = pose_to_vendor(T, "kuka").tolist()
-        used |= {"rotation", "offset_mm"}
+        R = np.array(result["rotation"], dtype=float)
+        if np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, np.array(result["offset_mm"]) * 1e-3
+            xyzabc = pose_to_vendor(T, "kuka").tolist()
+            used |= {"rotation", "offset_mm"}
     if isinstance(xyzabc, list) and len(xyzabc) == 6:
         a, b = (("a", "b") if match is None else
                 (_FRAME_NAMES.get(match[1], match[1]), _FRAME_NAMES.get(match[2], match[2])))
@@ -440,8 +442,9 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
                  if k not in _SKIP and k not in used and k not in _QUALITY}
     internals.update({f"sigma.{k}": v for k, v in (result.get("sigma") or {}).items()
                       if k not in used_sigma})
-    internals.update({f"verdict.{k}": v for k, v in (result.get("verdict") or {}).items()
-                      if k not in ("level", "reasons")})
+    given = result.get("verdict")
+    internals.update({f"verdict.{k}": v for k, v in (given if isinstance(given, dict) else {})
+                      .items() if k not in ("level", "reasons")})
     appendix = "".join(f"<tr><th>{head(k)}</th><td>{_fmt(v)}</td></tr>"
                        for k, v in internals.items())
     labels = result.get("labels") or [str(i + 1) for i in range(len(result["residuals_mm"]))]
