@@ -8,11 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 import robotcell.cell.schema as cellmod
 from robotcell import InputError, load_robot, pose_from_vendor, save_robot
 from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
+from robotcell.io.yamlfile import parse_yaml
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 
@@ -67,22 +67,22 @@ def test_save_load_round_trip(tmp_path):
     assert text.startswith("# robotcell cell file") and "89.99999" not in text
 
 
-def test_save_keeps_previous_version_as_bak(tmp_path):
+def test_save_keeps_previous_version_as_numbered_backup(tmp_path):
     c = Cell.load(EXAMPLE)
     out = tmp_path / "cell.yaml"
-    c.save(out)
-    assert not (tmp_path / "cell.yaml.bak").exists()
+    assert c.save(out) is None
+    assert [p.name for p in tmp_path.iterdir()] == ["cell.yaml"]
     first = out.read_text()
     c.set_tool("torch", np.eye(4), Provenance.now("tcp", rms_mm=0.2))
-    c.save(out)
-    assert (tmp_path / "cell.yaml.bak").read_text() == first
+    assert c.save(out) == tmp_path / "cell.yaml.1.bak"
+    assert (tmp_path / "cell.yaml.1.bak").read_text() == first
     assert out.read_text() != first
     np.testing.assert_allclose(Cell.load(out).tools["torch"].T_F_TCP, np.eye(4))
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "cell.yaml.bak"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "cell.yaml.1.bak"]
 
 
 @pytest.mark.parametrize("mode", [0o664, 0o640, 0o600])
-def test_save_keeps_permissions_of_file_and_bak(tmp_path, mode):
+def test_save_keeps_permissions_of_file_and_backups(tmp_path, mode):
     out = tmp_path / "cell.yaml"
     Cell.load(EXAMPLE).save(out)
     os.chmod(out, mode)
@@ -90,9 +90,9 @@ def test_save_keeps_permissions_of_file_and_bak(tmp_path, mode):
     c.set_tool("torch", np.eye(4), Provenance("manual"))
     c.save(out)
     assert stat.S_IMODE(out.stat().st_mode) == mode
-    assert stat.S_IMODE((tmp_path / "cell.yaml.bak").stat().st_mode) == mode
-    c.save(out)  # the .bak replaced again keeps it too
-    assert stat.S_IMODE((tmp_path / "cell.yaml.bak").stat().st_mode) == mode
+    assert stat.S_IMODE((tmp_path / "cell.yaml.1.bak").stat().st_mode) == mode
+    c.save(out)  # the next backup keeps it too
+    assert stat.S_IMODE((tmp_path / "cell.yaml.2.bak").stat().st_mode) == mode
 
 
 def test_new_cell_file_gets_umask_permissions(tmp_path):
@@ -126,7 +126,7 @@ def test_failed_save_leaves_old_file_intact(tmp_path, monkeypatch, where):
         raise OSError("simulated crash")
 
     if where == "dump":
-        monkeypatch.setattr(cellmod.yaml, "safe_dump", boom)
+        monkeypatch.setattr(cellmod, "dump_yaml", boom)
     elif where == "fsync":
         real_fsync = os.fsync
         calls = []
@@ -174,7 +174,7 @@ def test_model_file_path_relative_to_cell_file(tmp_path, monkeypatch):
     other = tmp_path / "elsewhere" / "deeper"
     other.mkdir(parents=True)
     c.save(other / "copy.yaml")
-    data = yaml.safe_load((other / "copy.yaml").read_text())
+    data = parse_yaml((other / "copy.yaml").read_text(), "copy.yaml")
     assert data["robot"]["model"] == os.path.join("..", "..", "models", "my_kr16.yaml")
     d = Cell.load(other / "copy.yaml")
     np.testing.assert_allclose(d.robot.fk(q), robot.fk(q), atol=1e-12)

@@ -9,8 +9,9 @@ import threading
 from pathlib import Path
 
 import pytest
-import yaml
 from cli_helpers import run
+
+from robotcell.io.yamlfile import dump_yaml, parse_yaml
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CELL = str(EXAMPLES / "cell_kr16_track_turntable.yaml")
@@ -125,11 +126,11 @@ def test_missing_parts_and_bad_options(args, match, tmp_path, capsys):
 def test_a_singular_coupling_matrix(tmp_path, capsys):
     from importlib.resources import files
 
-    model = yaml.safe_load((files("robotcell") / "robots" / "kuka_kr16.yaml").read_text())
+    model = parse_yaml((files("robotcell") / "robots" / "kuka_kr16.yaml").read_text(), "kr16")
     eye = [[float(i == j) for j in range(6)] for i in range(6)]
     eye[2] = list(eye[1])  # axes 2 and 3 drive the same joint
     model["coupling"] = {"matrix": eye}
-    (tmp_path / "m.yaml").write_text(yaml.safe_dump(model))
+    (tmp_path / "m.yaml").write_text(dump_yaml(model))
     (tmp_path / "tracker.csv").write_text(TRACKER)
     cell = Path(CELL).read_text().replace("model: kuka_kr16", f"model: {tmp_path / 'm.yaml'}")
     (tmp_path / "cell.yaml").write_text(cell)

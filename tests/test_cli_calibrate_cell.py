@@ -67,7 +67,7 @@ def assert_pose_within(T, truth, sigma_pos_mm, sigma_rot_deg):
 
 
 def assert_updated(err, path, what, source, rms_mm, item):
-    assert f"updated {path}: {what}" in err and f"(previous version: {path}.bak)" in err
+    assert f"updated {path}: {what} (previous version: {path}." in err and ".bak)" in err
     assert item.provenance.source == source
     assert item.provenance.rms_mm == pytest.approx(rms_mm)
     assert item.provenance.time is not None
@@ -108,7 +108,7 @@ def test_tcp_from_joint_values_keeps_the_tool_orientation_and_a_bak(tmp_path, ca
     assert torch.number == 1 and torch.mass == pytest.approx(3.2)
     assert torch.provenance.note == "6 touches from tcp.csv"
     assert_updated(err, path, "tool 'torch'", "tcp", j["rms_mm"], torch)
-    assert (tmp_path / "cell.yaml.bak").read_text() == before
+    assert (tmp_path / "cell.yaml.1.bak").read_text() == before
     assert after.tools["pointer"].T_F_TCP == pytest.approx(cell.tools["pointer"].T_F_TCP)
 
 
@@ -456,7 +456,7 @@ def test_cell_refusals_exit_2_and_leave_the_cell_alone(tmp_path, capsys, args, m
     code, out, err = run(capsys, "calibrate", args[0], csv, "--cell", path, *args[1:])
     assert code == 2 and out == ""
     assert re.search(message, err), err
-    assert path.read_text() == before and not (tmp_path / "cell.yaml.bak").exists()
+    assert path.read_text() == before and not list(tmp_path.glob("cell.yaml.*bak"))
 
 
 def test_cells_without_track_or_turntable_are_refused(tmp_path, capsys):

@@ -242,7 +242,7 @@ def test_ik_table_values_and_batch_columns(tmp_path, capsys):
     code, out, err = run(capsys, "ik", "--cell", EXAMPLE, "--pose", "50,0,0,0,180,0", "--frame",
                          "part", "--tool", "torch", "--table", "10,20")
     assert code == 0, err
-    assert "positioner E1, E2 10.0000, 20.0000 deg; angles in degrees" in out
+    assert "positioner E1, E2 10.0000, 20.0000 deg; kuka_kr16, opw solver; angles in degrees" in out
     poses = tmp_path / "poses.csv"
     poses.write_text("x,y,z,a,b,c,e1,e2\n50,0,0,0,180,0,10,20\n20,10,0,0,180,0,-15,90\n")
     code, out, err = run(capsys, "ik", "--cell", EXAMPLE, "--input", poses, "--frame", "part",
@@ -321,6 +321,7 @@ def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, 
                "pointer", "-o", csv)[0] == 0
     cli_file, lib_file = tmp_path / "cli.yaml", tmp_path / "lib.yaml"
     shutil.copy(EXAMPLE, cli_file)
+    shutil.copy(EXAMPLE, lib_file)  # both update the file as written
     code, out, err = run(capsys, "calibrate", "positioner", csv, "--cell", cli_file, "--tool",
                          "pointer", "--json")
     assert code == 0, err

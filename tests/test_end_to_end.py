@@ -110,7 +110,7 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
     assert code == 0, err
     assert elapsed < 30
     assert "calibrated vs true cell" in out
-    for name in ["cell.yaml", "cell.yaml.bak", "truth.yaml", *EXPORT_FILES.values(),
+    for name in ["cell.yaml", *(f"cell.yaml.{i}.bak" for i in range(1, 5)), "truth.yaml", *EXPORT_FILES.values(),
                  *(f"{p}.{ext}" for p in ("tcp", "track", "turntable", "workpiece")
                    for ext in ("csv", "json")),
                  *(f"report_{p}.html" for p in ("tcp", "track", "turntable", "workpiece"))]:

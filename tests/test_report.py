@@ -1,6 +1,7 @@
 """HTML reports: verdicts, files, and the page as a real headless browser renders it."""
 
 import base64
+import html
 import json
 import os
 import re
@@ -90,8 +91,9 @@ def test_report_prints_small_numbers_with_their_units(tmp_path):
     assert "mm², mm·rad, rad²" in row
     assert f"{cov[5, 5]:.4g}" in row and "0.0000" not in row
     # The 1-sigma of the axis direction (order 1e-4 and below) is shown with its digits too.
-    sig = re.search(r"<tr><th>axis</th><td>(.*?)</td>", page.split("1-sigma uncertainty")[1]).group(1)
-    assert "0.0000" not in sig
+    sig = re.search(r"<tr><th>rotation axis Z_B \(unit vector X, Y, Z\)</th><td>.*?</td>"
+                    r"<td>(.*?)</td>", page).group(1)
+    assert "0.0000," not in sig and "(direction: " in sig
 
 
 def test_load_result_errors(tmp_path):
@@ -105,6 +107,15 @@ def test_load_result_errors(tmp_path):
     other.write_text(json.dumps({"procedure": "x"}))
     with pytest.raises(InputError, match=r"not a calibration result \(missing residuals_mm"):
         load_result(other)
+
+
+def main_exit(argv):
+    """Exit status of the command line with ``argv``."""
+    try:
+        main(argv)
+    except SystemExit as exc:
+        return exc.code or 0
+    return 0
 
 
 def test_report_command(tmp_path, capsys):
@@ -160,3 +171,64 @@ def test_report_renders_figures_in_headless_chromium(tmp_path):
     # The 3D view: its residual vectors are tab:orange (255, 127, 14), in no other figure.
     orange = np.all(np.abs(img - np.array([255, 127, 14]) / 255) < 0.06, axis=-1).sum()
     assert orange > 50
+
+
+def _result_table(page):
+    """(quantity, value, 1-sigma, unit) of every row of the page's result tables."""
+    rows = []
+    for table in re.findall(r'<table class="result">(.*?)</table>', page, re.DOTALL):
+        for row in re.findall(r"<tr>(.*?)</tr>", table, re.DOTALL)[1:]:
+            rows.append(tuple(re.sub(r"<[^>]+>", "", c) for c in
+                              re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", row, re.DOTALL)))
+    return rows
+
+
+def test_demo_reports_for_a_technician_in_headless_chromium(tmp_path, capsys):
+    """The demo's reports: each quantity named with its unit and 1-sigma, internals in an
+    appendix, 3D figures on equal axes with every magnified residual inside the plot."""
+    exe = _chromium()
+    assert main_exit(["demo", "-o", str(tmp_path / "demo")]) == 0
+    capsys.readouterr()
+    expected = {
+        "tcp": ("position of TCP in flange F (X, Y, Z)", "mm"),
+        "track": ("position of robot base R in track L (X, Y, Z)", "mm"),
+        "turntable": ("orientation of turntable B in world (A, B, C; R = Rz(A) Ry(B) Rx(C))",
+                      "deg"),
+        "workpiece": ("position of workpiece W in turntable B (X, Y, Z)", "mm"),
+    }
+    for procedure, (quantity, unit) in expected.items():
+        path = tmp_path / "demo" / f"report_{procedure}.html"
+        page = path.read_text()
+        rows = _result_table(page)
+        assert (quantity, unit) in {(r[0], r[3]) for r in rows}, procedure
+        # Every quantity has a unit column; the calibrated ones a 1-sigma beside the value.
+        result_rows = rows[:[r[0] for r in rows].index("touches")]
+        assert result_rows and all(len(r) == 4 for r in rows)
+        assert all(r[2] for r in result_rows if r[3] in ("mm", "deg")
+                   and not r[0].startswith(("origin above", "arc covered"))), procedure
+        # Internals only in the appendix, below the result.
+        main_part, appendix = page.split("<h2>Appendix: fit internals</h2>")
+        for internal in ("dof", "noise_source", "covariance"):
+            assert f"<th>{internal}" not in main_part
+        assert "<th>dof" in appendix and "<th>noise_source" in appendix
+        # The 3D figure: equal axes, the magnified residuals inside the limits.
+        geometry = json.loads(html.unescape(re.search(r'data-geometry="([^"]+)"', page)[1]))
+        limits = np.array(geometry["limits_mm"])
+        spans = limits[:, 1] - limits[:, 0]
+        np.testing.assert_allclose(spans, spans[0], rtol=1e-9)
+        if procedure != "workpiece":  # the workpiece result carries no measured points
+            low, high = np.array(geometry["tips_mm"])
+            assert np.all(low > limits[:, 0]) and np.all(high < limits[:, 1]), procedure
+            gain = geometry["gain"]
+            assert f"residual vectors magnified {gain:g} times" in page
+        # Rendered by a browser: not blank, the figures loaded.
+        url = path.resolve().as_uri()
+        dom = _run_chromium(exe, tmp_path, "--virtual-time-budget=5000", "--dump-dom",
+                            url).stdout
+        assert 'data-figures="loaded"' in dom, procedure
+        shot = tmp_path / f"{procedure}.png"
+        _run_chromium(exe, tmp_path, "--window-size=1000,2000", f"--screenshot={shot}", url)
+        import matplotlib.image
+
+        img = matplotlib.image.imread(shot)[..., :3]
+        assert img.std() > 0.05 and (img < 0.5).mean() > 0.005, procedure  # text and figures

@@ -108,12 +108,21 @@ def test_cli_ranks_writes_csv_and_shows_progress(capsys, tmp_path, monkeypatch):
     code, stdout, err = run(capsys, "sweep", "--cell", CELL, "--targets", SEAM, "--layouts", lay,
                             "--frame", "part", "--tool", "torch", "--workers", "1", "-o", out)
     assert code == 0, err
-    assert "6 layouts, 36 targets" in stdout and "robot.y=300" in stdout.splitlines()[3]
+    assert "all 6 layouts, scored on 36 targets" in stdout
+    assert "robot.y=300" in stdout.splitlines()[3]
     assert "layouts" in err  # the progress bar
     lines = out.read_text().splitlines()
     assert lines[0] == ("rank,layout,robot.y,turntable.a,reachable_fraction,mean_score,"
                         "min_score")
-    assert len(lines) == 7
+    assert len(lines) == 7 and lines[1].split(",")[0] == "1"  # ranks are integers
+    assert sorted(int(line.split(",")[1]) for line in lines[1:]) == list(range(6))
+    # The count printed is the count listed.
+    code, stdout, err = run(capsys, "sweep", "--cell", CELL, "--targets", SEAM, "--layouts", lay,
+                            "--frame", "part", "--tool", "torch", "--workers", "1", "--top", "4")
+    assert code == 0, err
+    head, *table = stdout.splitlines()
+    assert head.startswith("the best 4 of 6 layouts (--top N lists more, -o FILE writes all)")
+    assert len(table) == 2 + 4
 
 
 def test_cli_errors(capsys, tmp_path, monkeypatch):

@@ -26,6 +26,7 @@ from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, read_text
+from robotcell.io.poseformats import pose_to_vendor
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 
@@ -162,7 +163,21 @@ def _png(fig: Any) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def _figure_view(result: dict[str, Any]) -> str:
+def _nice_gain(gain: float) -> float:
+    """The largest 1, 2 or 5 times a power of ten not above ``gain`` (a factor easy to read)."""
+    if gain <= 0 or not math.isfinite(gain):
+        return 1.0
+    decade = 10.0 ** math.floor(math.log10(gain))
+    return max(m * decade for m in (1.0, 2.0, 5.0) if m * decade <= gain)
+
+
+def _figure_view(result: dict[str, Any]) -> tuple[str, dict[str, Any]]:
+    """The 3D view (PNG data URI) and its geometry: axis limits (mm), gain, residual tips.
+
+    The axes are equal (one cube, one scale on X, Y and Z), and the residual vectors are
+    magnified by a round factor that makes the longest a tenth of the scene; the limits
+    include every magnified residual, so none leaves the plot.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -181,31 +196,44 @@ def _figure_view(result: dict[str, Any]) -> str:
     cloud = [T[:3, 3] for _, T in frames]
     if anchor is not None:
         cloud += list(anchor)
-    cloud = np.array(cloud)
-    size = float(np.ptp(cloud, axis=0).max()) if len(cloud) > 1 else 100.0
-    size = max(size, 50.0)
+    size = max(float(np.ptp(np.array(cloud), axis=0).max()) if len(cloud) > 1 else 100.0, 50.0)
+    axis_len = 0.15 * size
     for label, T in frames:
-        L = 0.15 * size
         for k, color in enumerate(("tab:red", "tab:green", "tab:blue")):
-            ax.quiver(*T[:3, 3], *(T[:3, k] * L), color=color, linewidth=2)
+            ax.quiver(*T[:3, 3], *(T[:3, k] * axis_len), color=color, linewidth=2)
+            cloud.append(T[:3, 3] + T[:3, k] * axis_len)
         ax.text(*T[:3, 3], f" {label}", fontsize=9)
     gain = None
+    tips = np.empty((0, 3))
     if anchor is not None and len(res) == len(anchor) and len(res):
         ax.scatter(*anchor.T, color="black", s=18, label="measured points")
         longest = float(np.linalg.norm(res, axis=1).max())
-        gain = 0.1 * size / longest if longest > 0 else 1.0
+        gain = _nice_gain(0.1 * size / longest) if longest > 0 else 1.0
+        tips = anchor + res * gain
+        cloud += list(tips)
         ax.quiver(*anchor.T, *(res.T * gain), color="tab:orange", linewidth=1.5,
-                  label="residuals")
+                  label=f"residuals x {gain:g}")
         ax.legend(loc="upper left")
+    cloud_arr = np.array(cloud)
+    centre = (cloud_arr.min(axis=0) + cloud_arr.max(axis=0)) / 2
+    half = 0.55 * float(np.ptp(cloud_arr, axis=0).max())  # 10 % margin
+    limits = [[float(c - half), float(c + half)] for c in centre]
+    ax.set_xlim(*limits[0])
+    ax.set_ylim(*limits[1])
+    ax.set_zlim(*limits[2])
+    ax.set_box_aspect((1, 1, 1))
     ax.set_xlabel("X [mm]")
     ax.set_ylabel("Y [mm]")
     ax.set_zlabel("Z [mm]")
-    title = f"Frames and measured points (in {where}, mm)"
+    title = f"Frames and measured points (in {where}, mm, equal axes)"
     if gain is not None:
-        title += f"\nresidual vectors magnified {gain:.0f}x"
+        title += f"\nresidual vectors magnified {gain:g}x"
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    return _png(fig)
+    geometry = {"limits_mm": limits, "gain": gain,
+                "tips_mm": [tips.min(axis=0).tolist(), tips.max(axis=0).tolist()]
+                if len(tips) else None}
+    return _png(fig), geometry
 
 
 def _figure_residuals(result: dict[str, Any]) -> str:
@@ -254,8 +282,114 @@ def _fmt(v: Any) -> str:
 _UNITS = {"_covariance_mm_rad": "6x6 over the origin x, y, z (mm) and the rotation vector rx, ry, rz "
                                 "(rad): entries in mm², mm·rad, rad²"}
 
+#: Fields shown elsewhere in the page (verdict, residual table, lists).
 _SKIP = {"procedure", "residuals_mm", "residuals_xyz_mm", "labels", "points_mm", "warnings",
-         "undetermined", "next_step", "sigma", "verdict"}
+         "undetermined", "next_step", "sigma", "verdict", "xyzabc"}
+
+#: Result fields a technician reads, in the order shown: what each is and its unit. Its 1-sigma
+#: is ``sigma[field]``, or ``<field without unit>_sigma_deg`` (the angle of a unit vector).
+_QUANTITIES: dict[str, tuple[str, str]] = {
+    "tcp_mm": ("TCP in the flange frame (X, Y, Z)", "mm"),
+    "pivot_mm": ("reference tip in the robot base (X, Y, Z)", "mm"),
+    "direction": ("track direction in the robot base (unit vector X, Y, Z)", "1"),
+    "scale": ("track scale (measured / commanded travel)", "1"),
+    "offset_mm": ("carriage offset: robot base in L at track 0 (X, Y, Z)", "mm"),
+    "rotation_source": ("rotation of the robot on the carriage", ""),
+    "axis": ("rotation axis Z_B (unit vector X, Y, Z)", "1"),
+    "radius_mm": ("radius of the touched point about the axis", "mm"),
+    "tilt_deg": ("tilt of the axis from vertical", "deg"),
+    "height_mm": ("origin above the touched point (--height)", "mm"),
+    "spread_deg": ("arc covered by the touches", "deg"),
+    "normal_length_mm": ("length of the common normal of the two axes", "mm"),
+    "axis_angle_deg": ("angle between the two axes", "deg"),
+    "tilt_zero_deg": ("zero of the tilt axis", "deg"),
+    "rotate_zero_deg": ("zero of the rotate axis", "deg"),
+    "rotation_determined": ("orientation determined by the touches", ""),
+}
+
+#: How well the touches fit, in the order shown.
+_QUALITY: dict[str, tuple[str, str]] = {
+    "rms_mm": ("residual RMS", "mm"), "max_mm": ("largest residual", "mm"),
+    "mean_mm": ("mean residual", "mm"), "min_mm": ("smallest residual", "mm"),
+    "condition": ("condition number (below 100: the touches determine every quantity)", ""),
+}
+
+_DECIMALS = {"mm": 3, "deg": 4, "": 1}
+
+
+def _numbers(v: Any, unit: str) -> str:
+    """A value or list of values with the decimals of its unit (mm 3, deg 4, none 1, else 6)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, list)):
+        return _fmt(v)
+    values = v if isinstance(v, list) else [v]
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in values):
+        return _fmt(v)
+    d = _DECIMALS.get(unit, 6)
+    return ", ".join(_fmt(float(x)) if x != 0 and abs(x) < 10.0 ** -d else f"{x:.{d}f}"
+                     for x in values)
+
+
+def _row(name: str, value: str, sigma: str, unit: str) -> str:
+    return (f"<tr><th>{html.escape(name)}</th><td>{value}</td><td>{sigma}</td>"
+            f"<td>{html.escape(unit)}</td></tr>")
+
+
+def _result_rows(result: dict[str, Any]) -> tuple[str, set[str], set[str]]:
+    """Rows (quantity, value, 1-sigma, unit) of the result, and the fields and sigmas used."""
+    sigma = result.get("sigma") or {}
+    used: set[str] = set()
+    used_sigma: set[str] = set()
+    rows = []
+    match = next((m for m in map(_POSE_KEY.fullmatch, [*result, *sigma]) if m), None)
+    xyzabc = result.get("xyzabc")
+    if xyzabc is None and _is_points(result.get("rotation"), 3) and _is_points(
+            [result.get("offset_mm")], 1):  # the track: the robot base on the carriage
+        R = np.array(result["rotation"], dtype=float)
+        if np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, np.array(result["offset_mm"]) * 1e-3
+            xyzabc = pose_to_vendor(T, "kuka").tolist()
+            used |= {"rotation", "offset_mm"}
+    if isinstance(xyzabc, list) and len(xyzabc) == 6:
+        a, b = (("a", "b") if match is None else
+                (_FRAME_NAMES.get(match[1], match[1]), _FRAME_NAMES.get(match[2], match[2])))
+        key = None if match is None else f"T_{match[1]}_{match[2]}"
+        pos, rot = (sigma.get(f"{key}_position_mm"), sigma.get(f"{key}_rotation_deg"))
+        used_sigma |= {f"{key}_position_mm", f"{key}_rotation_deg"}
+        v = xyzabc
+        rows.append(_row(f"position of {b} in {a} (X, Y, Z)", _numbers(v[:3], "mm"),
+                         "not available" if pos is None else _numbers(pos, "mm"), "mm"))
+        rows.append(_row(f"orientation of {b} in {a} (A, B, C; R = Rz(A) Ry(B) Rx(C))",
+                         _numbers(v[3:], "deg"), "not available" if rot is None else
+                         f"{_numbers(rot, 'deg')} (about X, Y, Z of {a})", "deg"))
+        used |= {"matrix", "tcp_mm"}  # the TCP is the position of this pose
+    for field, (name, unit) in _QUANTITIES.items():
+        if field not in result or field in used:
+            continue
+        value = result[field]
+        if field == "axis" and isinstance(value, str):
+            name, unit = "axis of the track frame L along the rail", ""
+        angle = result.get(field.removesuffix("_mm").removesuffix("_deg") + "_sigma_deg")
+        if field in sigma:
+            err = _numbers(sigma[field], unit)
+            if angle is not None:
+                err += f" (direction: {_numbers(angle, 'deg')} deg)"
+        elif angle is not None:
+            err = f"{_numbers(angle, 'deg')} deg (direction)"
+        else:
+            err = ""
+        used |= {field, f"{field}_sigma_deg", field.removesuffix("_mm") + "_sigma_deg"}
+        used_sigma.add(field)
+        rows.append(_row(name, _numbers(value, unit), err, unit))
+    return "".join(rows), used, used_sigma
+
+
+def _quality_rows(result: dict[str, Any]) -> str:
+    rows = [_row("touches", str(len(result["residuals_mm"])), "", "")]
+    rows += [_row(name, _numbers(result[k], unit), "", unit)
+             for k, (name, unit) in _QUALITY.items() if result.get(k) is not None]
+    return "".join(rows)
+
 
 _CSS = """
 body { font-family: sans-serif; max-width: 960px; margin: 2em auto; color: #222; }
@@ -294,7 +428,7 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     where = _frames(result)[0]
-    view = _figure_view(result)
+    view, geometry = _figure_view(result)
     resid = _figure_residuals(result)
     grade, reasons = verdict(result)
     proc = html.escape(str(result["procedure"]))
@@ -303,10 +437,16 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
         units = [u for suffix, u in _UNITS.items() if key.endswith(suffix)]
         return html.escape(key) + "".join(f"<br><small>{html.escape(u)}</small>" for u in units)
 
-    rows = "".join(f"<tr><th>{head(k)}</th><td>{_fmt(v)}</td></tr>"
-                   for k, v in result.items() if k not in _SKIP)
-    sig = "".join(f"<tr><th>{html.escape(k)}</th><td>{_fmt(v)}</td></tr>"
-                  for k, v in (result.get("sigma") or {}).items())
+    quantities, used, used_sigma = _result_rows(result)
+    internals = {k: v for k, v in result.items()
+                 if k not in _SKIP and k not in used and k not in _QUALITY}
+    internals.update({f"sigma.{k}": v for k, v in (result.get("sigma") or {}).items()
+                      if k not in used_sigma})
+    given = result.get("verdict")
+    internals.update({f"verdict.{k}": v for k, v in (given if isinstance(given, dict) else {})
+                      .items() if k not in ("level", "reasons")})
+    appendix = "".join(f"<tr><th>{head(k)}</th><td>{_fmt(v)}</td></tr>"
+                       for k, v in internals.items())
     labels = result.get("labels") or [str(i + 1) for i in range(len(result["residuals_mm"]))]
     xyz = result.get("residuals_xyz_mm") or [[float("nan")] * 3] * len(labels)
     touches = "".join(
@@ -316,6 +456,8 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
         vals = result.get(key) or []
         return "<ul>" + "".join(f"<li>{html.escape(str(v))}</li>" for v in vals) + "</ul>" if vals else "<p>none</p>"
 
+    gain_text = ("" if geometry["gain"] is None else
+                 f"; residual vectors magnified {geometry['gain']:g} times")
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell report: {proc}</title>
 <style>{_CSS}</style><script>{_SCRIPT}</script></head>
@@ -323,16 +465,25 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
 <h1>Calibration report: {proc}</h1>
 <div class="verdict {grade}"><b>{grade.upper()}</b>: {html.escape('; '.join(reasons))}</div>
 <h2>Next step</h2><p>{html.escape(str(result.get('next_step') or ''))}</p>
-<h2>Result (mm, deg)</h2><table>{rows}</table>
-<h2>1-sigma uncertainty</h2><table>{sig or '<tr><td>not available</td></tr>'}</table>
+<h2>Result</h2>
+<table class="result"><tr><th>quantity</th><th>value</th><th>1-sigma</th><th>unit</th></tr>
+{quantities or '<tr><td colspan="4">no calibrated quantity</td></tr>'}</table>
+<h2>Fit quality</h2>
+<table class="result"><tr><th>quantity</th><th>value</th><th></th><th>unit</th></tr>
+{_quality_rows(result)}</table>
 <h2>Not determined by the measurements</h2>{items('undetermined')}
 <h2>Warnings</h2>{items('warnings')}
 <h2>Figures</h2>
-<figure><img src="{view}" alt="3D view of frames and measured points">
-<figcaption>Frames and measured points in the {html.escape(where)} frame (mm).</figcaption></figure>
+<figure class="view" data-geometry="{html.escape(json.dumps(geometry))}">
+<img src="{view}" alt="3D view of frames and measured points">
+<figcaption>Frames and measured points in the {html.escape(where)} frame (mm), on equal axes{gain_text}.</figcaption></figure>
 <figure><img src="{resid}" alt="residual per touch"></figure>
-<h2>Residuals per touch (mm)</h2>
-<table><tr><th>touch</th><th>|residual|</th><th>x, y, z</th></tr>{touches}</table>
+<h2>Residuals per touch</h2>
+<table><tr><th>touch</th><th>|residual| (mm)</th><th>x, y, z (mm)</th></tr>{touches}</table>
+<h2>Appendix: fit internals</h2>
+<p>For checking the computation (redundancy, noise estimate, covariance, matrices); the result
+above is all that is needed to use the calibration.</p>
+<table>{appendix}</table>
 </body></html>
 """
     atomic_write(out, page)

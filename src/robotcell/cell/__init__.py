@@ -3,7 +3,8 @@
 - :mod:`robotcell.cell.model`: :class:`Cell`, :class:`Tool`, :class:`Frame`, :class:`Track`,
   :class:`Turntable`, :class:`Positioner`, :class:`Provenance` (SI units);
 - :mod:`robotcell.cell.schema`: the YAML cell file (millimetres, degrees), its reader and writer,
-  and the atomic save with ``.bak``;
+  and the atomic save that keeps comments and layout;
+- :mod:`robotcell.cell.history`: the numbered backups of a cell file and its history;
 - :mod:`robotcell.cell.kinematics`: coupled forward kinematics (arm, track, positioner, frames);
 - :mod:`robotcell.cell.ik`: inverse kinematics and paths in the cell;
 - :mod:`robotcell.cell.axischain`: the kinematic chain of a positioner's axes;

@@ -5,9 +5,10 @@ A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the 
 ``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention, as in robot model
 files). Every calibrated quantity carries its :class:`Provenance`.
 
-The file (YAML schema, reader, writer, atomic save with ``.bak``) is :mod:`robotcell.cell.schema`;
-:meth:`Cell.load` and :meth:`Cell.save` call it. :meth:`Cell.save` writes atomically: a process
-that dies during a save leaves either the old or the new file, never a partial one.
+The file (YAML schema, reader, writer, atomic save with numbered backups) is
+:mod:`robotcell.cell.schema`; :meth:`Cell.load` and :meth:`Cell.save` call it. :meth:`Cell.save`
+writes atomically: a process that dies during a save leaves either the old or the new file,
+never a partial one.
 
 Coupled kinematics (TCP pose in any frame given the arm joints, the track position and the table
 angle) are in :mod:`robotcell.cell.kinematics`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call them.
@@ -709,23 +710,31 @@ class Cell:
 
         return load_cell(path)
 
-    def save(self, path: str | Path) -> None:
-        """Write the cell file atomically, keeping the previous version as ``<path>.bak``.
+    def save(self, path: str | Path) -> Path | None:
+        """Write the cell file atomically, keeping what the user wrote and every old version.
 
-        The text is written to a temporary file in the same directory, flushed and fsynced, then
-        moved over ``path`` with ``os.replace``; the old file is first copied (the same way) to
-        ``<path>.bak``. If the process dies at any point, ``path`` holds either the old or the new
-        content in full. Both keep the permissions of the file replaced (a new file gets
-        ``0o666`` less the umask).
+        An existing cell file is updated in place: only the values this cell changes are
+        rewritten, and its comments, key order and layout stay. The previous file is first
+        copied to the next numbered backup ``<path>.<N>.bak`` (none is ever overwritten;
+        ``robotcell cell history`` lists them). The text is written to a temporary file in the
+        same directory, flushed and fsynced, then moved over ``path`` with ``os.replace``: if
+        the process dies at any point, ``path`` holds either the old or the new content in
+        full. The file and its backups keep the permissions of the file replaced (a new file
+        gets ``0o666`` less the umask).
 
         Parameters
         ----------
         path : str or Path
             Destination. A robot model file is written relative to its directory.
+
+        Returns
+        -------
+        Path or None
+            The backup of the previous file, or None when there was no file.
         """
         from robotcell.cell.schema import save_cell  # the schema builds on this module
 
-        save_cell(self, path)
+        return save_cell(self, path)
 
 
 def _check_name(name: Any, what: str) -> None:

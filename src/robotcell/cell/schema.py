@@ -5,10 +5,14 @@ A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the 
 the file are mappings ``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention,
 as in robot model files).
 
-:func:`save_cell` (what :meth:`Cell.save <robotcell.cell.model.Cell.save>` calls) writes
-atomically: a temporary file in the same directory, flushed and fsynced, then ``os.replace``; the
-previous file is kept as ``<name>.bak``. The file and its ``.bak`` keep the permissions the file
-had (see :mod:`robotcell.io.fileio`, which also gives the encoding rule of :func:`load_cell`).
+:func:`save_cell` (what :meth:`Cell.save <robotcell.cell.model.Cell.save>` calls) updates an
+existing file as the user wrote it: the file is read as a round-trip YAML document
+(:mod:`robotcell.io.yamlfile`), the values the cell changed are put in place and the rest (comments,
+key order, layout, the spelling of unchanged numbers) stays as it was. It writes atomically: a
+temporary file in the same directory, flushed and fsynced, then ``os.replace``; the previous file
+is kept as a numbered backup ``<name>.<N>.bak`` that no later update overwrites
+(:mod:`robotcell.cell.history`). The file and its backups keep the permissions the file had (see
+:mod:`robotcell.io.fileio`, which also gives the encoding rule of :func:`load_cell`).
 """
 
 from __future__ import annotations
@@ -20,9 +24,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from numpy.typing import NDArray
 
+from robotcell.cell.history import keep_version
 from robotcell.cell.model import (
     Cell,
     Frame,
@@ -34,8 +38,9 @@ from robotcell.cell.model import (
     _check_name,
 )
 from robotcell.errors import InputError
-from robotcell.io.fileio import atomic_copy, atomic_write, check_destination, read_text
+from robotcell.io.fileio import atomic_write, check_destination, read_text
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.yamlfile import dump_yaml, parse_yaml, update_document
 from robotcell.kinematics.models import load_robot, robot_from_dict, robot_to_dict
 
 __all__ = ["cell_from_dict", "cell_to_dict", "load_cell", "save_cell"]
@@ -55,16 +60,18 @@ def load_cell(path: str | Path) -> Cell:
         YAML cell file; a robot model path inside it is resolved against the file's directory.
     """
     p = Path(path)
-    text = read_text(p, "cell file")
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise InputError(f"{path}: not valid YAML: {exc}") from None
+    data = parse_yaml(read_text(p, "cell file"), str(path))
     return cell_from_dict(data, str(path), p.resolve().parent)
 
 
-def save_cell(cell: Cell, path: str | Path) -> None:
-    """Write ``cell`` to a cell file atomically with a ``.bak``: what :meth:`Cell.save` does.
+def save_cell(cell: Cell, path: str | Path) -> Path | None:
+    """Write ``cell`` to a cell file atomically, keeping the file as the user wrote it.
+
+    An existing file that reads as a cell is updated in place: only the values that differ from
+    what the file says change, in their places; comments, key order, layout and keys this
+    writer does not use are kept. Another file is replaced whole. Either way the previous file is
+    first copied to the next numbered backup ``<name>.<N>.bak``, which no later save overwrites.
+    This is what :meth:`Cell.save` does.
 
     Parameters
     ----------
@@ -72,14 +79,38 @@ def save_cell(cell: Cell, path: str | Path) -> None:
         The cell (SI units), written in millimetres and degrees.
     path : str or Path
         Destination; a robot model file is written relative to its directory.
+
+    Returns
+    -------
+    Path or None
+        The backup of the previous file, or None when there was none.
     """
     p = Path(path)
-    text = _HEADER + yaml.safe_dump(cell_to_dict(cell, p.resolve().parent), sort_keys=False,
-                                    default_flow_style=None, width=100)
+    base = p.resolve().parent
+    new = cell_to_dict(cell, base)
     check_destination(p)  # a read-only file is refused before the backup is made
-    if p.exists():
-        atomic_copy(p, p.with_name(p.name + ".bak"))
+    written = _as_written(p, base) if p.is_file() else None
+    if written is None:
+        text = _HEADER + dump_yaml(new)
+    else:
+        doc, old = written
+        update_document(doc, old, new)
+        text = dump_yaml(doc)
+    backup = keep_version(p) if p.exists() else None
     atomic_write(p, text)
+    return backup
+
+
+def _as_written(path: Path, base: Path) -> tuple[Any, dict[str, Any]] | None:
+    """The file's round-trip document and what it says in this writer's spelling, or None.
+
+    None when the file does not read as a cell (it is then replaced whole; its backup keeps it).
+    """
+    try:
+        doc = parse_yaml(read_text(path, "cell file"), str(path))
+        return doc, cell_to_dict(cell_from_dict(doc, str(path), base), base)
+    except InputError:
+        return None
 
 
 # -- file content <-> Cell ------------------------------------------------------------------------

@@ -27,7 +27,7 @@ from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
-from robotcell.cli.common import check_output, parse_numbers, read_csv, write_output
+from robotcell.cli.common import check_kind, check_output, parse_numbers, read_csv, write_output
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.kinematics.models import load_robot
@@ -57,8 +57,8 @@ def calibrate() -> None:
     \b
     CSV with a header, lengths in mm, angles in deg. Positions as x,y,z (TCP in the robot base)
     or joint values a1..a6 with --robot and --tool. Report in mm/deg, or --json.
-    With --cell CELL.yaml the result is written into the cell file (CELL.yaml.bak keeps the
-    previous version). Exit status 2 when the measurements are refused, with the reason on stderr.
+    With --cell CELL.yaml the result is written into the cell file, keeping its comments and
+    layout (CELL.yaml.N.bak keeps the previous version; robotcell cell history lists them). Exit status 2 when the measurements are refused, with the reason on stderr.
     Every report ends with a verdict (good / check / poor); a poor result prints its report,
     exits with status 3 and writes nothing, unless --accept-poor is given.
 
@@ -73,8 +73,27 @@ def calibrate() -> None:
 OUTPUT_KEY = "robotcell.calibrate.output"
 
 
+#: Key of ``click.Context.meta`` under which ``--json`` is kept, to check the name of ``-o``.
+JSON_KEY = "robotcell.calibrate.json"
+
+
 def _keep_output(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
     ctx.meta[OUTPUT_KEY] = check_output(ctx, param, value)
+    _check_output_kind(ctx)
+
+
+def _keep_json(ctx: click.Context, param: click.Parameter, value: bool) -> bool:
+    ctx.meta[JSON_KEY] = value
+    _check_output_kind(ctx)
+    return value
+
+
+def _check_output_kind(ctx: click.Context) -> None:
+    """Once both -o and --json are parsed: -o FILE.json needs --json, and --json a JSON name."""
+    if OUTPUT_KEY in ctx.meta and JSON_KEY in ctx.meta:
+        as_json = ctx.meta[JSON_KEY]
+        check_kind(ctx.meta[OUTPUT_KEY], "JSON" if as_json else "text",
+                   "the result" if as_json else "the report (add --json for the JSON result)")
 
 
 def measurement_options(func: Callable) -> Callable:
@@ -89,7 +108,8 @@ def measurement_options(func: Callable) -> Callable:
                              "succeeds: the JSON object with --json, else the report. Use it "
                              "instead of '--json > FILE', which empties FILE when a run is "
                              "refused.")(func)
-    func = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")(func)
+    func = click.option("--json", "as_json", is_flag=True, callback=_keep_json,
+                        help="Print one JSON object (and write it to -o FILE).")(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
                         help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
                              "uncertainties instead of the residuals.")(func)
@@ -106,8 +126,8 @@ def cell_option(func: Callable) -> Callable:
     """Option ``--cell CELL.yaml`` of the subcommands that can update a cell file."""
     return click.option(
         "--cell", "cell_path", default=None, metavar="CELL.yaml", type=click.Path(dir_okay=False),
-        help="Write the result into this cell file (atomically; the previous version is kept as "
-             "CELL.yaml.bak). Joint values a1..a6 then use the cell's robot, and --tool may name "
+        help="Write the result into this cell file (atomically, keeping its comments and "
+             "layout; the previous version is kept as CELL.yaml.N.bak). Joint values a1..a6 then use the cell's robot, and --tool may name "
              "a tool of the cell.")(func)
 
 
@@ -153,10 +173,11 @@ class CellTarget:
             echo_note(note)
         self.cell = cell
         try:
-            self.cell.save(self.path)
+            backup = self.cell.save(self.path)
         except OSError as exc:
             raise InputError(f"cannot write {self.path}: {exc}") from None
-        click.echo(f"updated {self.path}: {what} (previous version: {self.path}.bak)", err=True)
+        kept = f" (previous version: {backup})" if backup is not None else ""
+        click.echo(f"updated {self.path}: {what}{kept}", err=True)
 
 
 def require_name(name: str | None, target: CellTarget | None, what: str) -> None:

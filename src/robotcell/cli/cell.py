@@ -1,4 +1,4 @@
-"""``robotcell cell``: inspect a cell file (mm, deg)."""
+"""``robotcell cell``: inspect a cell file (mm, deg) and the versions its updates kept."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import math
 import click
 
 from robotcell.cell import Cell, Provenance, Turntable
+from robotcell.cell.history import cell_history
 from robotcell.cli.common import format_table
 from robotcell.io.poseformats import pose_to_vendor
 
@@ -27,11 +28,12 @@ def _row(name: str, kind: str, number: object, T, p: Provenance) -> list[object]
 
 @click.group()
 def cell() -> None:
-    """Inspect cell files.
+    """Inspect cell files and their history.
 
     \b
-    Example:
+    Examples:
       robotcell cell show examples/cell_kr16_track_turntable.yaml
+      robotcell cell history cell.yaml
     """
 
 
@@ -73,3 +75,44 @@ def show(path: str) -> None:
     for name, fr in c.frames.items():
         rows.append(_row(name, f"frame ({fr.parent})", fr.number, fr.pose, fr.provenance))
     click.echo(format_table(head, rows))
+
+
+def _provenance_text(prov: dict) -> str:
+    """One line of a provenance mapping as written: source, time, RMS, note, other keys."""
+    if not prov:
+        return "no provenance recorded"
+    parts = [str(prov.get("source", "?"))]
+    if prov.get("time") is not None:
+        parts.append(str(prov["time"]))
+    if isinstance(prov.get("rms_mm"), (int, float)):
+        parts.append(f"rms {prov['rms_mm']:.3f} mm")
+    parts += [str(prov[k]) if k == "note" else f"{k} {prov[k]}"
+              for k in prov if k not in ("source", "time", "rms_mm")]
+    return ", ".join(parts)
+
+
+@cell.command()
+@click.argument("path", type=click.Path(dir_okay=False))
+def history(path: str) -> None:
+    """List the versions of a cell file that its updates kept, oldest first.
+
+    Every update (calibrate ... --cell, Cell.save) first copies the file to the next numbered
+    backup PATH.N.bak. For each version this prints the file, when it was written and the
+    provenance (procedure, time, residual RMS, note) of the items that changed from the version
+    before; the first version lists every item.
+
+    \b
+    Example:
+      robotcell cell history cell.yaml
+    """
+    versions = cell_history(path)
+    click.echo(f"{len(versions)} version(s) of {path}, oldest first:")
+    for v in versions:
+        name = f"{v.path} (current)" if v.number is None else str(v.path)
+        click.echo(f"{name}  written {v.modified}")
+        if v.error is not None:
+            click.echo(f"  not readable: {v.error}")
+        elif not v.changed:
+            click.echo("  no item changed its provenance")
+        for item in v.changed:
+            click.echo(f"  {item}: {_provenance_text(v.provenance[item])}")

@@ -22,8 +22,23 @@ from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 
-__all__ = ["NORMAL_UP", "PROGRESS_MIN", "cell_tool", "check_normal_up", "chunks", "row_values",
-           "table_angles", "table_columns", "table_option", "table_rows", "track_values"]
+__all__ = [
+    "NORMAL_UP",
+    "PROGRESS_MIN",
+    "batch_table",
+    "batch_track",
+    "cell_tool",
+    "check_normal_up",
+    "chunks",
+    "row_values",
+    "setup_text",
+    "table_angles",
+    "table_columns",
+    "table_option",
+    "table_rows",
+    "table_text",
+    "track_values",
+]
 
 #: ``ik --cell --table normal-up``: the positioner turns each target's surface normal up.
 NORMAL_UP = "normal-up"
@@ -185,3 +200,65 @@ def chunks(n: int, label: str) -> Iterator[slice]:
         for s in range(0, n, CHUNK):
             yield slice(s, min(s + CHUNK, n))
             bar.update(min(CHUNK, n - s))
+
+
+def table_text(cell: Cell, values: NDArray[np.float64] | float, chosen: bool = False) -> str:
+    """``, table 90 deg`` or ``, positioner E1, E2 30, 90 deg (normal up)`` for a headline.
+
+    ``values`` are radians: a scalar for a turntable, one per axis for a positioner; nothing
+    for a cell without either.
+    """
+    pos = cell.turntable
+    if pos is None:
+        return ""
+    if not isinstance(pos, Positioner):
+        return f", table {float(values) * 180.0 / math.pi:g} deg"
+    names = ", ".join(j.name or f"e{i + 1}" for i, j in enumerate(pos.chain.joints))
+    v = ", ".join(f"{x:.4f}" for x in np.degrees(np.ravel(values)) + 0.0)
+    return f", positioner {names} {v} deg" + (" (chosen: normal up)" if chosen else "")
+
+
+def setup_text(cell: Cell, tool: str | None, frame: str, track: str, table: str) -> str:
+    """What a result of ``fk``/``ik --cell`` assumed: tool, frame, track and table.
+
+    Parameters
+    ----------
+    cell : Cell
+    tool : str or None
+        ``--tool`` as given: a tool name, ``X,Y,Z,A,B,C``, or None for the bare flange.
+    frame : str
+        ``--frame``.
+    track, table : str
+        How the track position and the table were set, e.g. ``", track 1500 mm"`` (empty for
+        a cell without the axis).
+
+    Returns
+    -------
+    str
+        E.g. ``"kr16: TCP of tool 'torch' in frame 'part', track 0 mm (default), table 0 deg"``.
+    """
+    what = ("the bare flange (no --tool)" if tool is None else
+            f"tool {tool} (X,Y,Z,A,B,C)" if "," in tool else f"tool {tool!r}")
+    return f"{cell.name}: TCP of {what} in frame {frame!r}{track}{table}"
+
+
+def batch_track(cell: Cell, cols: dict, track_mm: float | None, default: str) -> str:
+    """How the rows of a batch file set the track, for :func:`setup_text`."""
+    if cell.track is None:
+        return ""
+    if "track" in cols:
+        return ", track from column 'track' (mm)"
+    return f", track {default}" if track_mm is None else f", track {track_mm:g} mm (given)"
+
+
+def batch_table(cell: Cell, cols: dict, table_deg: str | None) -> str:
+    """How the rows of a batch file set the table, for :func:`setup_text`."""
+    if cell.turntable is None:
+        return ""
+    names = table_columns(cell)[1]
+    if any(c in cols for c in names):
+        return f", table from column(s) {', '.join(names)} (deg)"
+    if table_deg == NORMAL_UP:
+        return ", positioner chosen per pose: normal up"
+    given = "0 (default)" if table_deg is None else f"{table_deg} (given)"
+    return f", table {given} deg"

@@ -8,7 +8,7 @@ degrees.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import click
@@ -18,8 +18,8 @@ from robotcell.io import tables
 from robotcell.io.fileio import atomic_write, check_destination
 from robotcell.io.tables import format_table, require_columns, write_csv
 
-__all__ = ["check_not_folder", "check_output", "format_table", "parse_numbers", "read_csv", "require_columns",
-           "write_csv", "write_output"]
+__all__ = ["check_kind", "check_not_folder", "check_output", "format_table", "output_of",
+           "parse_numbers", "read_csv", "require_columns", "write_csv", "write_output"]
 
 
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:
@@ -64,6 +64,50 @@ def check_output(ctx: click.Context, param: click.Parameter, value: str | None) 
     if value is not None:
         check_destination(value)
     return value
+
+
+#: File name endings that say what kind of file a name holds, and the ending of each kind.
+_KINDS = {".json": "JSON", ".yaml": "YAML", ".yml": "YAML", ".csv": "CSV", ".html": "HTML",
+          ".htm": "HTML", ".urdf": "URDF"}
+_ENDING = {"JSON": ".json", "YAML": ".yaml", "CSV": ".csv", "HTML": ".html", "URDF": ".urdf",
+           "text": ".txt"}
+
+
+def check_kind(path: str | None, kind: str, what: str, option: str = "-o") -> None:
+    """Refuse an output file whose name says another kind of file than the one written.
+
+    ``-o`` writes what the command produces; a name ending in ``.json`` for a YAML model file
+    (or ``.csv`` for a JSON result, ...) would mislead whoever opens it, so it is refused
+    before any work. A name with another ending (``.dat``, none) is taken as given.
+
+    Parameters
+    ----------
+    path : str or None
+        The output option's value.
+    kind : str
+        What is written: ``JSON``, ``YAML``, ``CSV``, ``HTML``, ``URDF`` or ``text``.
+    what : str
+        What the file holds, for the message (``"the identified model file"``).
+    option : str
+        The option, for the message.
+    """
+    if path is None:
+        return
+    named = _KINDS.get(Path(path).suffix.lower())
+    if named is not None and named != kind:
+        raise InputError(f"{option} {path}: the name says {named}, but this writes {what} as "
+                         f"{kind}; name it {Path(path).stem}{_ENDING[kind]}")
+
+
+def output_of(kind: str, what: str) -> Callable[[click.Context, click.Parameter, str | None],
+                                                str | None]:
+    """Callback of an output option that writes ``what`` as ``kind``: :func:`check_output`, and
+    :func:`check_kind` on the name, before any work."""
+    def callback(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+        checked = check_output(ctx, param, value)
+        check_kind(value, kind, what, param.opts[0])
+        return checked
+    return callback
 
 
 def check_not_folder(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:

@@ -9,7 +9,7 @@ import math
 
 import click
 
-from robotcell.cli.common import check_output, format_table, parse_numbers
+from robotcell.cli.common import format_table, output_of, parse_numbers
 from robotcell.dhprocedure import (
     AxisChain,
     DHDerivation,
@@ -47,7 +47,8 @@ def dh() -> None:
               help="Last link (default: the only leaf; needed when the tree branches).")
 @click.option("--signs", default=None,
               help="Sign corrections, one +1/-1 per joint: -1 points Z against the URDF axis.")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=click.Path(), default=None,
+              callback=output_of("YAML", "the model file"),
               help="Write the model file (YAML, mm/deg) here, atomically.")
 def from_urdf(file: str, convention: str, base_link: str | None, tip_link: str | None,
               signs: str | None, output: str | None) -> None:
@@ -73,7 +74,8 @@ def from_urdf(file: str, convention: str, base_link: str | None, tip_link: str |
 @dh.command()
 @click.argument("model")
 @click.option("--to", "target", type=_CONVENTION, required=True, help="Target convention.")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=click.Path(), default=None,
+              callback=output_of("YAML", "the model file"),
               help="Write the converted model file (YAML, mm/deg) here, atomically.")
 def convert(model: str, target: str, output: str | None) -> None:
     """Convert MODEL (library name or model file) between standard and modified DH.

@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from robotcell.cell import Cell
-from robotcell.cli.common import check_output, write_output
+from robotcell.cli.common import check_kind, check_output, write_output
 from robotcell.io.export import WRITE_FORMATS, export_cell
 
 
@@ -33,6 +33,7 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
       robotcell export --cell cell.yaml --format kuka
       robotcell export --cell cell.yaml --format abb -o cell_frames.mod
     """
+    check_kind(output, "URDF" if fmt == "urdf" else "text", f"the {fmt} export")
     text = export_cell(Cell.load(cell_path), fmt)
     write_output(output, text)
     if output is not None:

@@ -10,15 +10,25 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
+    batch_table,
+    batch_track,
     cell_tool,
     row_values,
+    setup_text,
     table_angles,
     table_columns,
     table_option,
     table_rows,
+    table_text,
     track_values,
 )
-from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
+from robotcell.cli.common import (
+    output_of,
+    parse_numbers,
+    read_csv,
+    require_columns,
+    write_csv,
+)
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 from robotcell.kinematics.models import load_robot
@@ -44,7 +54,8 @@ def tool_option(text: str | None) -> np.ndarray | None:
 @click.argument("robot", required=False)
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
-@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output_path", type=click.Path(),
+              callback=output_of("CSV", "the poses"),
               help="CSV to write, atomically: the poses of --input, or one row for --joints "
                    "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,
@@ -55,13 +66,13 @@ def tool_option(text: str | None) -> np.ndarray | None:
               help="Forward kinematics in a cell file (robot, track, turntable, tools, frames).")
 @click.option("--frame", "frame", default="world", show_default=True,
               help="--cell: frame of the result (world, track, robot, turntable or a frame of the cell).")
-@click.option("--track", "track_mm", type=float, default=0.0, metavar="MM",
-              help="--cell: track position (mm).")
+@click.option("--track", "track_mm", type=float, default=None, metavar="MM",
+              help="--cell: track position (mm); default 0, which the result says.")
 @click.option("--table", "table_deg", default=None, metavar="DEG[,DEG...]",
               help="--cell: turntable angle (deg), or one value per positioner axis, e.g. 30,90 "
                    "(deg); default 0.")
 def fk(robot: str | None, joints: str | None, input_path: str | None, output_path: str | None,
-       fmt: str, tool: str | None, cell_path: str | None, frame: str, track_mm: float,
+       fmt: str, tool: str | None, cell_path: str | None, frame: str, track_mm: float | None,
        table_deg: str | None) -> None:
     """Forward kinematics: pose of the TCP in the robot base frame.
 
@@ -70,7 +81,8 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
     With --cell CELL.yaml instead of ROBOT: joints plus track position (--track, mm) and table
     angle (--table, deg; for a positioner one value per axis, --table 30,90) give the TCP pose
     in a frame of the cell (--frame). A batch file may hold per-row columns track and table
-    (positioner: e1,e2,...). Refused with exit status 2: unknown frame or tool, track or table
+    (positioner: e1,e2,...). The result names the tool, frame, track position and table it
+    used (the defaults: the bare flange, world, track 0, table 0); for a batch on stderr. Refused with exit status 2: unknown frame or tool, track or table
     outside their limits, a --table with the wrong number of values.
 
     \b
@@ -141,29 +153,37 @@ def _write_poses(T: np.ndarray, fmt: str, output_path: str | None) -> None:
 
 
 def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_path: str | None,
-             fmt: str, tool: str | None, frame: str, track_mm: float, table_deg: str | None
-             ) -> None:
+             fmt: str, tool: str | None, frame: str, track_mm: float | None,
+             table_deg: str | None) -> None:
     """``robotcell fk --cell``: :meth:`Cell.fk` for one configuration or a batch (mm, deg)."""
     cell = Cell.load(cell_path)
     r = cell.robot
     T_tool = cell_tool(tool)
     if (joints is None) == (input_path is None):
         raise InputError("give exactly one of --joints a1,a2,... or --input joints.csv")
+    track = 0.0 if track_mm is None else track_mm
     if joints is not None:
         q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
-        e, th = track_values(cell, track_mm), table_angles(cell, table_option(cell, table_deg))
+        e, th = track_values(cell, track), table_angles(cell, table_option(cell, table_deg))
+        setup = setup_text(cell, tool, frame, "" if cell.track is None else
+                           f", track {track:g} mm" + (" (default)" if track_mm is None else ""),
+                           table_text(cell, th) + (" (default)" if table_deg is None and
+                                                   cell.turntable is not None else ""))
     else:
         names = [f"a{i}" for i in range(1, r.n_joints + 1)]
         cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
         q = joints_to_si(r, require_columns(cols, names, input_path))
-        e = track_values(cell, row_values(cols, "track", track_mm, len(q)))
+        e = track_values(cell, row_values(cols, "track", track, len(q)))
         th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)))
+        setup = setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "0 mm (default)"),
+                           batch_table(cell, cols, table_deg))
     T = cell.fk(q, e, th, T_tool, frame)
     outside = int(np.count_nonzero(~r.within_limits(q)))
     if outside:
         click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
     if joints is not None and output_path is None:
-        click.echo(f"{cell.name}: TCP in frame {frame!r} ({fmt}, mm, deg)")
+        click.echo(f"{setup} ({fmt}, mm, deg)")
         _echo_pose(T, fmt)
         return
+    click.echo(setup, err=True)
     _write_poses(T.reshape(-1, 4, 4), fmt, output_path)

@@ -10,7 +10,13 @@ import sys
 import click
 import numpy as np
 
-from robotcell.cli.common import check_not_folder, check_output, read_csv, warn_unknown_columns
+from robotcell.cli.common import (
+    check_kind,
+    check_not_folder,
+    check_output,
+    read_csv,
+    warn_unknown_columns,
+)
 from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
@@ -177,10 +183,12 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
         if robot is None:
             raise InputError("--propose needs --robot NOMINAL (library name or model file)")
+        check_kind(output, "CSV", "the proposed configurations")
         return _propose(load_robot(robot), propose, targets, orientation, seed, accuracy,
                         angle_accuracy, output, as_json)
     if measurements is None:
         raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
+    check_kind(output, "YAML", "the identified model file")
     if offsets_for is not None and robot is None:
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")

@@ -10,20 +10,25 @@ from typing import TextIO
 import click
 import numpy as np
 
-from robotcell.cell import Cell, Positioner
+from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
+    batch_table,
+    batch_track,
     cell_tool,
     check_normal_up,
     chunks,
     row_values,
+    setup_text,
     table_angles,
     table_columns,
     table_option,
     table_rows,
+    table_text,
     track_values,
 )
 from robotcell.cli.common import (
+    check_kind,
     check_output,
     format_table,
     parse_numbers,
@@ -127,6 +132,8 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
       robotcell ik --cell positioner.yaml --frame part --table normal-up --tool torch \\
           --pose 50,0,0,0,180,0
     """
+    check_kind(output_path, "text" if pose is not None else "CSV",
+               "the table of solutions" if pose is not None else "the joint values")
     if cell_path is not None:
         if robot is not None:
             raise InputError("give either ROBOT or --cell CELL.yaml, not both")
@@ -225,18 +232,6 @@ def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
     return ["cf1", "cf4", "cf6", "cfx"], np.atleast_2d(abb_confdata(robot, qq))
 
 
-def _table_text(cell: Cell, values: np.ndarray, chosen: bool) -> str:
-    """``, table 90 deg`` or ``, positioner E1, E2 30, 90 deg (normal up)`` for the headline."""
-    pos = cell.turntable
-    if pos is None:
-        return ""
-    if not isinstance(pos, Positioner):
-        return f", table {float(values) * 180.0 / math.pi:g} deg"
-    names = ", ".join(j.name or f"e{i + 1}" for i, j in enumerate(pos.chain.joints))
-    v = ", ".join(f"{x:.4f}" for x in np.degrees(np.ravel(values)) + 0.0)
-    return f", positioner {names} {v} deg" + (" (chosen: normal up)" if chosen else "")
-
-
 def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_path: str | None,
              fmt: str, show_all: bool, near: str | None, tool: str | None, frame: str,
              track_mm: float | None, table_deg: str | None) -> None:
@@ -283,10 +278,10 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
                 row.append(f"{off[k]:.6f}" if sol.reachable[k] else "-")
             rows.append(row)
         how = "chosen" if track_mm is None else "given"
-        where = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
-        where += _table_text(cell, sol.table, table_deg == NORMAL_UP)
-        write_output(output_path, f"{cell.name}: {r.name}, {sol.method} solver, target in frame "
-                     f"{frame!r}{where}; angles in degrees\n{format_table(headers, rows)}\n")
+        track = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
+        where = table_text(cell, sol.table, table_deg == NORMAL_UP)
+        write_output(output_path, f"{setup_text(cell, tool, frame, track, where)}; {r.name}, "
+                     f"{sol.method} solver; angles in degrees\n{format_table(headers, rows)}\n")
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
     n_table, table_names = table_columns(cell)
@@ -296,6 +291,8 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     e = track_values(cell, row_values(cols, "track", track_mm, n))
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
           else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n)))
+    click.echo(setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "chosen per pose"),
+                          batch_table(cell, cols, table_deg)), err=True)
     parts = []
     for sl in chunks(n, "ik"):
         parts.append(cell.ik(T[sl], frame, None if e is None else e[sl],

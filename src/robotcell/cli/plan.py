@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from robotcell.cell import Cell
-from robotcell.cli.common import check_output, format_table
+from robotcell.cli.common import format_table, output_of
 from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
 from robotcell.errors import InputError
 from robotcell.studies.plan import DESIGNS, LEVER, Candidate
@@ -50,7 +50,8 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
               help="frame/workpiece: largest triangle that fits on the part (mm).")
 @click.option("--max-radius", type=float, default=None, metavar="MM",
               help="turntable: largest distance of a touchable point from the axis (mm).")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=click.Path(), default=None,
+              callback=output_of("CSV", "the proposed touches"),
               help="Write the proposed touches (exact joint values to teach) as CSV, atomically.")
 def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
          frame: str | None, track_mm: float | None, touches: int | None, repeats: int | None,

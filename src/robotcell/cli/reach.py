@@ -20,31 +20,35 @@ from robotcell.cli.cellargs import (
     table_rows,
     track_values,
 )
-from robotcell.cli.common import check_output, read_csv, write_csv, write_output
+from robotcell.cli.common import output_of, read_csv, write_output
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
-from robotcell.io.tables import require_columns
+from robotcell.io.tables import require_columns, write_columns
 from robotcell.studies.reach import ReachMap, reach_html, reach_map
 
 
-def reach_rows(rm: ReachMap, cell: Cell) -> tuple[list[str], np.ndarray]:
-    """CSV header and rows of a reachability map (mm, deg).
+def reach_columns(rm: ReachMap, cell: Cell) -> dict[str, np.ndarray]:
+    """The CSV columns of a reachability map (mm, deg), each in its type.
 
     The axis columns are named as ``fk --cell`` and ``ik --cell`` name them: ``track`` (mm),
     ``table`` or a positioner's ``e1..en`` (deg), ``a1..an`` (deg), so the file can be fed to
-    ``robotcell fk --cell CELL --input``. ``track_margin_mm`` only for a cell with a track.
+    ``robotcell fk --cell CELL --input``. ``target`` and ``branch`` are integers, ``reachable``
+    is ``true``/``false``; ``track_margin_mm`` only for a cell with a track.
     """
-    margin = ["track_margin_mm"] if cell.track is not None else []
-    header = ["target", "reachable", "score", "track", *table_columns(cell)[1], "branch",
-              *[f"a{i + 1}" for i in range(cell.robot.n_joints)], "limit_margin_deg",
-              *margin, "manipulability_m3"]
-    rows = np.column_stack([
-        np.arange(rm.reachable.size), rm.reachable.astype(float), rm.score, rm.track * 1e3,
-        np.degrees(rm.table), rm.branch, np.degrees(rm.q), np.degrees(rm.limit_margin),
-        *([rm.track_margin * 1e3] if margin else []), rm.manipulability,
-    ])
-    return header, rows
+    table = np.degrees(rm.table).reshape(rm.reachable.size, -1)
+    columns: dict[str, np.ndarray] = {
+        "target": np.arange(rm.reachable.size), "reachable": rm.reachable.astype(bool),
+        "score": rm.score, "track": rm.track * 1e3,
+        **{name: table[:, i] for i, name in enumerate(table_columns(cell)[1])},
+        "branch": rm.branch.astype(int),
+        **{f"a{i + 1}": np.degrees(rm.q[:, i]) for i in range(cell.robot.n_joints)},
+        "limit_margin_deg": np.degrees(rm.limit_margin),
+    }
+    if cell.track is not None:
+        columns["track_margin_mm"] = rm.track_margin * 1e3
+    columns["manipulability_m3"] = rm.manipulability
+    return columns
 
 
 def target_options(f: Callable[..., None]) -> Callable[..., None]:
@@ -97,9 +101,11 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
 @target_options
 @click.option("--track", "track_mm", type=float, default=None,
               help="Track position (mm) for every target (default: chosen per target).")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=click.Path(), default=None,
+              callback=output_of("CSV", "the scores"),
               help="CSV to write, atomically (default: standard output).")
-@click.option("--html", "html_path", type=click.Path(), default=None, callback=check_output,
+@click.option("--html", "html_path", type=click.Path(), default=None,
+              callback=output_of("HTML", "the map"),
               help="Self-contained HTML page with the map (default: next to -o, .html).")
 def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
           table_deg: str | None, choose_table: bool, track_mm: float | None, output: str | None,
@@ -126,8 +132,7 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
     with ExitStack() as stack:
         rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
                        progress=DeferredProgress(stack, "targets"))
-    header, rows = reach_rows(rm, cell)
-    write_csv(output if output else sys.stdout, header, rows, 6)
+    write_columns(output if output else sys.stdout, reach_columns(rm, cell), 6)
     if html_path is None and output:
         html_path = str(Path(output).with_suffix(".html"))
     if html_path:

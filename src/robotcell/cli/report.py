@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from robotcell.cli.common import check_not_folder
+from robotcell.cli.common import check_kind, check_not_folder
 from robotcell.report import load_result, verdict, write_report
 
 
@@ -23,6 +23,7 @@ def report(result: str, output: str) -> None:
       robotcell calibrate frame base.csv --json -o base.json
       robotcell report base.json -o base.html
     """
+    check_kind(output, "HTML", "the report")
     data = load_result(result)
     files = write_report(data, output)
     grade, reasons = verdict(data)

@@ -16,7 +16,7 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import check_output, parse_numbers
+from robotcell.cli.common import output_of, parse_numbers
 from robotcell.errors import InputError
 from robotcell.studies.simulate import PROCEDURES, Touches
 from robotcell.studies.simulate import simulate as simulate_touches
@@ -172,7 +172,8 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
 @click.argument("procedure", type=click.Choice(list(PROCEDURES)))
 @cell_options
 @design_options
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=click.Path(), default=None,
+              callback=output_of("CSV", "the touches"),
               help="CSV file to write, atomically (default: standard output).")
 def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
              frame: str | None, track_mm: float | None, output: str | None,

@@ -10,10 +10,11 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import check_output, format_table, write_csv
+from robotcell.cli.common import format_table, output_of
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
 from robotcell.errors import InputError
+from robotcell.io.tables import write_columns
 from robotcell.studies.sweep import read_layouts, sweep
 
 
@@ -48,7 +49,8 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
               help="Run on a Dask cluster, e.g. tcp://10.0.0.5:8786 (pip install "
                    "'robotcell[dask]').")
 @click.option("--top", type=int, default=10, show_default=True, help="Layouts to print.")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=click.Path(), default=None,
+              callback=output_of("CSV", "the ranking"),
               help="CSV of every layout, ranked (written atomically).")
 def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool: str | None,
               fmt: str, table_deg: str | None, choose_table: bool, workers: int | None,
@@ -76,12 +78,18 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
                        progress=DeferredProgress(stack, "layouts"))
     names = list(layouts[0].values) if layouts else []
     if output:
-        rows = np.array([[rank + 1, r.index, *r.layout.values.values(), r.fraction,
-                          r.mean_score, r.min_score] for rank, r in enumerate(ranked)])
-        write_csv(output, ["rank", "layout", *names, "reachable_fraction", "mean_score",
-                           "min_score"], rows, 6)
+        write_columns(output, {
+            "rank": np.arange(1, len(ranked) + 1), "layout": np.array([r.index for r in ranked]),
+            **{n: np.array([r.layout.values[n] for r in ranked], dtype=float) for n in names},
+            "reachable_fraction": np.array([r.fraction for r in ranked]),
+            "mean_score": np.array([r.mean_score for r in ranked]),
+            "min_score": np.array([r.min_score for r in ranked])}, 6)
+    shown = ranked[:max(top, 0)]
     rows_out = [[rank + 1, r.layout.label, f"{100 * r.fraction:.1f}", f"{r.mean_score:.3f}",
-                 f"{r.min_score:.3f}"] for rank, r in enumerate(ranked[:max(top, 0)])]
-    click.echo(f"{len(ranked)} layouts, {len(T)} targets; offsets in mm and deg")
+                 f"{r.min_score:.3f}"] for rank, r in enumerate(shown)]
+    listed = (f"all {len(ranked)} layouts" if len(shown) == len(ranked) else
+              f"the best {len(shown)} of {len(ranked)} layouts (--top N lists more"
+              + (f", {output} has all" if output else ", -o FILE writes all") + ")")
+    click.echo(f"{listed}, scored on {len(T)} targets; offsets in mm and deg")
     click.echo(format_table(["rank", "layout", "reachable %", "mean score", "min score"],
                             rows_out))

@@ -10,17 +10,18 @@ from __future__ import annotations
 import csv
 import difflib
 import io
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TextIO
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, read_text
 
 __all__ = ["MAX_ABS_VALUE", "NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
-           "write_csv"]
+           "write_columns", "write_csv"]
 
 
 #: Largest magnitude of a number in a table or an option (mm, deg): a float64 of 1e15 resolves
@@ -176,21 +177,48 @@ def write_csv(path: str | Path | TextIO, header: Sequence[str], rows: np.ndarray
     """Write an ``(N, len(header))`` array as CSV with fixed decimals to a path or open stream.
 
     A path is written atomically (:func:`robotcell.io.fileio.atomic_write`): a failed run leaves
-    the file as it was.
+    the file as it was. Columns of other types: :func:`write_columns`.
     """
-    if hasattr(path, "write"):
-        _write_rows(path, header, rows, decimals)
-        return
+    table = np.atleast_2d(np.asarray(rows, dtype=float))
+    _write(path, list(header), [_formatted(c, decimals) for c in table.T], len(table))
+
+
+def write_columns(path: str | Path | TextIO, columns: Mapping[str, ArrayLike],
+                  decimals: int = 6) -> None:
+    """Write named columns as CSV, each in its type, to a path (atomically) or open stream.
+
+    Parameters
+    ----------
+    path : str, Path or text stream
+    columns : mapping of str to array_like, each of shape (N,)
+        Column name -> values. Booleans are written ``true``/``false``, integers as integers,
+        other numbers with ``decimals`` fixed decimals.
+    decimals : int
+    """
+    cells = [_formatted(np.asarray(v), decimals) for v in columns.values()]
+    _write(path, list(columns), cells, max((len(c) for c in cells), default=0))
+
+
+def _formatted(values: np.ndarray, decimals: int) -> list[str]:
+    """The CSV text of a column: ``true``/``false``, integers, or fixed decimals."""
+    if values.dtype == np.bool_:
+        return ["true" if v else "false" for v in values]
+    if np.issubdtype(values.dtype, np.integer):
+        return [str(int(v)) for v in values]
+    return [f"{v:.{decimals}f}" for v in values.astype(float)]
+
+
+def _write(path: str | Path | TextIO, header: list[str], cells: list[list[str]], n: int) -> None:
+    """Rows ``i < n`` of the formatted columns, to a stream or atomically to a path."""
     buf = io.StringIO(newline="")
-    _write_rows(buf, header, rows, decimals)
-    atomic_write(path, buf.getvalue())
-
-
-def _write_rows(fh: TextIO, header: Sequence[str], rows: np.ndarray, decimals: int) -> None:
-    w = csv.writer(fh, lineterminator="\n")
+    w = csv.writer(buf, lineterminator="\n")
     w.writerow(header)
-    for r in np.atleast_2d(rows):
-        w.writerow([f"{v:.{decimals}f}" for v in r])
+    for i in range(n):
+        w.writerow([c[i] for c in cells])
+    if isinstance(path, (str, Path)):
+        atomic_write(path, buf.getvalue())
+    else:
+        path.write(buf.getvalue())
 
 
 def format_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:

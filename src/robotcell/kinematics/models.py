@@ -23,11 +23,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, read_text
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.yamlfile import dump_yaml, parse_yaml
 from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.robot import Joint, Robot
 
@@ -85,11 +85,7 @@ def load_robot(name_or_path: str | Path) -> Robot:
 
 
 def _load_file(text: str, origin: str) -> Robot:
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise InputError(f"{origin}: not valid YAML: {exc}") from None
-    return robot_from_dict(data, origin)
+    return robot_from_dict(parse_yaml(text, origin), origin)
 
 
 def _number(value: Any, where: str) -> float:
@@ -402,5 +398,4 @@ def save_robot(robot: Robot, path: str | Path) -> None:
     InputError
         The file cannot be written (missing folder, a folder, no permission).
     """
-    atomic_write(path, yaml.safe_dump(robot_to_dict(robot), sort_keys=False,
-                                      default_flow_style=None))
+    atomic_write(path, dump_yaml(robot_to_dict(robot)))

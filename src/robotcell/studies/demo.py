@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
 from robotcell.cell import calibrate as cellcal
+from robotcell.cell.history import backups
 from robotcell.errors import InputError, RobotcellError
 from robotcell.io.export import EXPORT_FORMATS, export_cell
 from robotcell.io.poseformats import pose_from_vendor
@@ -153,7 +154,8 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     truth, nominal = demo_cells()
     cell_file = out / "cell.yaml"
     truth_file = out / "truth.yaml"
-    for stale in (cell_file, cell_file.with_name(cell_file.name + ".bak")):
+    for stale in (cell_file, truth_file, *(b for _, b in backups(cell_file)),
+                  *(b for _, b in backups(truth_file))):  # a run before in the same folder
         stale.unlink(missing_ok=True)
     nominal.save(cell_file)
     truth.save(truth_file)

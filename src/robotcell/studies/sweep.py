@@ -38,12 +38,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import yaml
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
+from robotcell.io.yamlfile import parse_yaml
 from robotcell.kinematics.transforms import make_pose
 from robotcell.studies.reach import reach_map
 
@@ -157,10 +157,7 @@ def read_layouts(source: str | Path | dict) -> list[Layout]:
         data = source
     else:
         where = str(source)
-        try:
-            data = yaml.safe_load(read_text(source, "layout file"))
-        except yaml.YAMLError as exc:
-            raise InputError(f"{source}: not valid YAML ({exc})") from None
+        data = parse_yaml(read_text(source, "layout file"), where)
     if not isinstance(data, dict) or not data:
         raise InputError(f"{where}: expected a mapping of components (robot, track, turntable "
                          "or a frame) to offsets")
