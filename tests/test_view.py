@@ -241,7 +241,7 @@ def test_page_of_a_scene_has_its_title(tmp_path):
 
 
 def test_public_names_are_imported_on_first_use():
-    import robotcell.view as view
+    from robotcell import view
 
     assert set(view.__all__) == set(view._LAZY) and set(view.__all__) <= set(dir(view))
     for name in view.__all__:

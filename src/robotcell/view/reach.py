@@ -98,7 +98,7 @@ def read_reach(path: str | Path, cell: Cell) -> ReachTable:
         Missing or non-numeric columns, a ``reachable`` other than 0 or 1, a score outside
         [0, 1], a reachable row without axis values; the message names the file and the row.
     """
-    cols = read_csv(path)
+    cols = read_csv(path, allow_nan=True)
     pos = cell.turntable
     tables = ([f"e{i + 1}" for i in range(pos.n_axes)] if isinstance(pos, Positioner)
               else ["table"])
@@ -106,10 +106,10 @@ def read_reach(path: str | Path, cell: Cell) -> ReachTable:
     data = require_columns(cols, ["reachable", "score", "track", *tables, *arms], path)
     flag, score = data[:, 0], data[:, 1]
     line = 2 + np.arange(len(data))  # file line of each row, after the header
-    bad = ~np.isin(flag, (0.0, 1.0))
+    bad = ~np.isin(flag, (0.0, 1.0))  # NaN too
     if np.any(bad):
         raise InputError(f"{path}: line {line[bad][0]}: 'reachable' must be 1 or 0")
-    bad = ~((score >= 0) & (score <= 1))
+    bad = ~((score >= 0) & (score <= 1))  # NaN too
     if np.any(bad):
         raise InputError(f"{path}: line {line[bad][0]}: 'score' must be within [0, 1]")
     reachable = flag == 1
@@ -121,8 +121,9 @@ def read_reach(path: str | Path, cell: Cell) -> ReachTable:
     k = len(tables)
     table = np.radians(axes[:, 1:1 + k])
     arm_scale = np.where(cell.robot.prismatic, 1e-3, np.pi / 180)
-    target = (np.asarray(cols["target"], dtype=int) if isinstance(cols.get("target"), np.ndarray)
-              else np.arange(len(data)))
+    given = cols.get("target")
+    ok = isinstance(given, np.ndarray) and bool(np.all(np.isfinite(given)))
+    target = given.astype(int) if ok else np.arange(len(data))
     return ReachTable(target, reachable, axes[:, 1 + k:] * arm_scale, axes[:, 0] * 1e-3,
                       table if isinstance(pos, Positioner) else table[:, 0], score)
 
