@@ -4,14 +4,33 @@ residuals, a path with the arm at each point on a slider, a reach map, on synthe
 import numpy as np
 import pytest
 from cli_helpers import run
-from view_helpers import EXAMPLE, assert_triad, figure_from_page, traces, triads, xyz
+from view_helpers import (
+    EXAMPLE,
+    _chromium,
+    assert_triad,
+    figure_from_page,
+    js_errors,
+    render,
+    traces,
+    triads,
+    xyz,
+)
 
 from robotcell import InputError, make_pose, rot_x, rot_z
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.cell import Cell
 from robotcell.kinematics.transforms import transform_points
 from robotcell.studies.reach import reach_map
-from robotcell.view import Scene, Step, Triads, cell_scene, page, path_scene, scene_figure
+from robotcell.view import (
+    Scene,
+    Step,
+    Triads,
+    cell_scene,
+    page,
+    path_scene,
+    scene_figure,
+    write_html,
+)
 from robotcell.view.reach import reach_points, read_reach
 from robotcell.view.shapes import (
     circle,
@@ -177,6 +196,18 @@ def test_path_scene_puts_the_arm_at_each_point_where_fk_does():
     assert moving == {"robot kuka_kr16: links", "robot kuka_kr16: flange F",
                       "turntable DKP_400_01: plate P", "turntable DKP_400_01: plate", "frames",
                       "TCP"}
+
+
+def test_browser_plays_the_path(tmp_path):
+    # the animation frames, the slider and the play button load with no JavaScript error
+    exe = _chromium()
+    cell = Cell.load(EXAMPLE)
+    path = seam(cell, n=6)
+    out = write_html(path_scene(cell, path.q, path.track, np.radians(150), tool="torch"),
+                     tmp_path / "path.html")
+    dom, console, _ = render(exe, out, tmp_path, screenshot=False)
+    assert 'data-scene="rendered"' in dom and "slider" in dom
+    assert not js_errors(console), console
 
 
 def test_path_scene_with_points_without_joint_values():

@@ -8,7 +8,7 @@ Run as a script, it writes the picture of the view that the README shows:
     python tests/view_helpers.py docs/view.png
 
 (the view of examples/cell_kr16_track_turntable.yaml rendered by Debian's Chromium, as the
-browser test renders it, cropped to the page).
+browser test renders it, cropped to the page, in 64 colours).
 """
 
 import json
@@ -77,7 +77,7 @@ def assert_triad(frame, T, tol=1e-6):
     np.testing.assert_allclose(tips, (T[:3, 3] * 1e3 + length * T[:3, :3].T), rtol=0, atol=tol)
 
 
-def render(exe, page, tmp_path, size=(1200, 900)):
+def render(exe, page, tmp_path, size=(1200, 900), screenshot=True):
     """Load ``page`` alone in an empty folder in headless Chromium (WebGL on SwiftShader).
 
     Returns
@@ -86,9 +86,9 @@ def render(exe, page, tmp_path, size=(1200, 900)):
         The DOM after the page's scripts ran.
     console : list of str
         The page's console messages (uncaught errors among them).
-    shot : Path
-        A screenshot, cropped to the page (headless Chromium's viewport is shorter than its
-        window; the rest of the image is blank).
+    shot : Path or None
+        A screenshot (when ``screenshot``), cropped to the page (headless Chromium's viewport is
+        shorter than its window; the rest of the image is blank).
     """
     alone = tmp_path / "alone"
     alone.mkdir(exist_ok=True)
@@ -97,6 +97,8 @@ def render(exe, page, tmp_path, size=(1200, 900)):
     run = _run_chromium(exe, tmp_path, *WEBGL, "--enable-logging=stderr", "--v=0",
                         "--virtual-time-budget=10000", "--dump-dom", url)
     console = [line for line in run.stderr.splitlines() if ":CONSOLE" in line]
+    if not screenshot:
+        return run.stdout, console, None
     shot = tmp_path / "shot.png"
     _run_chromium(exe, tmp_path, *WEBGL, "--hide-scrollbars", "--virtual-time-budget=10000",
                   f"--window-size={size[0]},{size[1]}", f"--screenshot={shot}", url)
@@ -135,7 +137,12 @@ def write_picture(png):
                 raise
         _, console, shot = render(_chromium(), page, Path(tmp), size=(1100, 800))
         assert not js_errors(console), console
-        shutil.copy(shot, png)
+        from PIL import Image  # matplotlib's own image library
+
+        # 64 colours (octree: it keeps the small areas of pure red, green and blue) are plenty
+        # for lines on white, and keep the file small
+        Image.open(shot).convert("RGB").quantize(64, method=Image.Quantize.FASTOCTREE).save(
+            png, optimize=True)
 
 
 if __name__ == "__main__":
