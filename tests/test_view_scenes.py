@@ -208,6 +208,11 @@ def test_browser_plays_the_path(tmp_path):
     dom, console, _ = render(exe, out, tmp_path, screenshot=False)
     assert 'data-scene="rendered"' in dom and "slider" in dom
     assert not js_errors(console), console
+    # a guard: the check sees an error thrown by a page
+    broken = tmp_path / "broken.html"
+    broken.write_text("<html><body><script>undefined_function();</script></body></html>")
+    _, console, _ = render(exe, broken, tmp_path, screenshot=False)
+    assert any("Uncaught ReferenceError" in m for m in js_errors(console)), console
 
 
 def test_path_scene_with_points_without_joint_values():

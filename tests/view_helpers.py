@@ -92,17 +92,15 @@ def render(exe, page, tmp_path, size=(1200, 900), screenshot=True):
     """
     alone = tmp_path / "alone"
     alone.mkdir(exist_ok=True)
-    copy = Path(shutil.copy(page, alone))
-    url = copy.resolve().as_uri()
+    url = Path(shutil.copy(page, alone)).resolve().as_uri()
+    shot = tmp_path / "shot.png" if screenshot else None
+    extra = ([f"--window-size={size[0]},{size[1]}", "--hide-scrollbars", f"--screenshot={shot}"]
+             if screenshot else [])
     run = _run_chromium(exe, tmp_path, *WEBGL, "--enable-logging=stderr", "--v=0",
-                        "--virtual-time-budget=10000", "--dump-dom", url)
+                        "--virtual-time-budget=8000", *extra, "--dump-dom", url)
     console = [line for line in run.stderr.splitlines() if ":CONSOLE" in line]
-    if not screenshot:
-        return run.stdout, console, None
-    shot = tmp_path / "shot.png"
-    _run_chromium(exe, tmp_path, *WEBGL, "--hide-scrollbars", "--virtual-time-budget=10000",
-                  f"--window-size={size[0]},{size[1]}", f"--screenshot={shot}", url)
-    crop(shot)
+    if screenshot:
+        crop(shot)
     return run.stdout, console, shot
 
 
