@@ -137,6 +137,13 @@ def test_scene_defaults_and_notes():
         cell_scene(cell, np.zeros(5))
     with pytest.raises(InputError, match="joints contains NaN"):
         cell_scene(cell, [0, 0, np.nan, 0, 0, 0])
+    with pytest.raises(InputError, match=r"track: give one track position \(m\), got shape \(2,\)"):
+        cell_scene(cell, track=[1.0, 2.0])
+    # a prismatic axis in mm (the Stanford arm's third)
+    from robotcell.view.cellscene import axes_text
+
+    assert axes_text(load_robot("stanford_arm"), [0.1, 0, 0.25, 0, 0, 0]) == (
+        "5.73 deg, 0 deg, 250.000 mm, 0 deg, 0 deg, 0 deg")
     bare = Cell(robot=cell.robot, robot_model="kuka_kr16")
     with pytest.raises(InputError, match="the cell has no track"):
         cell_scene(bare, track=1.0)

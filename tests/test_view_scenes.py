@@ -297,3 +297,15 @@ def test_reach_csv_errors(tmp_path):
     bad.write_text("target,reachable,score\n0,1,0.5\n")
     with pytest.raises(InputError, match="missing column"):
         read_reach(bad, cell)
+
+
+def test_arrow_heads_fit_their_arrows():
+    from robotcell.view import Arrows
+
+    arrows = Arrows("residuals", np.zeros((3, 3)), [[0.1, 0, 0], [0, 0.01, 0], [0, 0, 0]])
+    fig = scene_figure(Scene("arrows", [arrows])).to_plotly_json()
+    heads = traces(fig, "residuals", "heads")[0]
+    # one size (a quarter of the longest), at most half a short arrow, none on a zero arrow
+    np.testing.assert_allclose(np.column_stack([heads["u"], heads["v"], heads["w"]]),
+                               [[25.0, 0, 0], [0, 5.0, 0]], atol=1e-9)
+    np.testing.assert_allclose(xyz(heads), [[100.0, 0, 0], [0, 10.0, 0]], atol=1e-9)

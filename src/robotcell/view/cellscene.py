@@ -42,8 +42,8 @@ from robotcell.view.shapes import disk
 if TYPE_CHECKING:
     import plotly.graph_objects as go
 
-__all__ = ["cell_figure", "cell_items", "cell_scene", "degrees", "fixed_items", "frame_size",
-           "joint_values"]
+__all__ = ["axes_text", "cell_figure", "cell_items", "cell_scene", "degrees", "fixed_items",
+           "frame_size", "joint_values"]
 
 #: Margin of the drawn plate beyond the farthest frame it carries (m).
 PLATE_MARGIN = 0.1
@@ -75,6 +75,15 @@ def _triads(name: str, poses: list[NDArray[np.float64]], labels: list[str], hove
 def degrees(values: ArrayLike) -> str:
     """Angles (rad) as ``"10, -90.5"``: degrees to 3 decimals, without trailing zeros."""
     return ", ".join(f"{v:g}" for v in np.round(np.degrees(np.atleast_1d(values)), 3))
+
+
+def axes_text(robot: Robot, q: ArrayLike) -> str:
+    """Axis values (rad, m) as the pendant shows them: ``"0, -90, 90, 0, 0, 0 deg"``, or with
+    a unit per value (deg, mm) when the robot has a prismatic axis."""
+    if not np.any(robot.prismatic):
+        return f"{degrees(q)} deg"
+    return ", ".join(f"{v * 1e3:.3f} mm" if p else f"{degrees(v)} deg"
+                     for v, p in zip(np.asarray(q, dtype=float), robot.prismatic))
 
 
 def joint_values(robot: Robot, joints: ArrayLike | None) -> NDArray[np.float64]:
@@ -204,15 +213,19 @@ def cell_scene(cell: Cell, joints: ArrayLike | None = None, track: float = 0.0,
     Raises
     ------
     InputError
-        Joints of the wrong number, NaN, a track or table the cell does not have.
+        Joints of the wrong number, NaN, more than one track position, a track or table the
+        cell does not have.
     """
     q = joint_values(cell.robot, joints)
-    e = float(finite_array(track, "track"))
+    e_arr = finite_array(track, "track")
+    if e_arr.ndim:
+        raise InputError(f"track: give one track position (m), got shape {e_arr.shape}")
+    e = float(e_arr)
     th = cell.turntable.axis_values(table) if cell.turntable is not None else table
     cell.frame_pose("world", e, th)  # refuses a track or a table the cell does not have
     size = frame_size(cell.robot)
     items = fixed_items(cell, size) + cell_items(cell, q, e, th, size)
-    state = [f"axes {degrees(q)} deg"]
+    state = [f"axes {axes_text(cell.robot, q)}"]
     if cell.track is not None:
         state.append(f"track {e * 1e3:g} mm")
     if cell.turntable is not None:

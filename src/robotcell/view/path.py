@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.kinematics.transforms import as_points
-from robotcell.view.cellscene import cell_items, degrees, fixed_items, frame_size
+from robotcell.view.cellscene import axes_text, cell_items, fixed_items, frame_size
 from robotcell.view.scene import Item, Lines, Points, Scene, Step, Triads, pose_text
 from robotcell.view.shapes import OUTLIER_COLOR
 
@@ -121,7 +121,7 @@ def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLik
     shown = np.where(shown < 0, int(np.argmax(has_q)), shown)
     T_tcp = cell.fk(qq[shown], e[shown], th[shown], tool)
     tcp = [Triads("TCP", T, [f"point {lab}"], length=size, hover=[
-        f"<b>point {lab}</b><br>TCP in the world: {pose_text(T)[0]}<br>axes {degrees(qq[i])} deg"])
+        f"<b>point {lab}</b><br>TCP in the world: {pose_text(T)[0]}<br>axes {axes_text(cell.robot, qq[i])}"])
            for lab, T, i in zip(labs, T_tcp, shown)]
     at = [[*cell_items(cell, qq[i], e[i], th[i], size, detail=False, with_tools=False), t]
           for i, t in zip(shown, tcp)]

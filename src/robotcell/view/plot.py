@@ -84,15 +84,17 @@ def _traces(go: Any, item: Item) -> list[Any]:
                              marker=marker, **text, **_hover(item.hover), **_common(item, "points"))]
     if isinstance(item, Arrows):
         norms = np.linalg.norm(item.vectors, axis=1)
-        head = item.head * (float(norms.max()) if norms.size else 0.0)
-        unit = item.vectors / np.where(norms > 0, norms, 1.0)[:, None]
-        heads = {k: v for k, v in zip("uvw", _mm(unit * head).values())}
+        # heads of one size, but at most half their arrow; none on an arrow of length 0
+        head = np.minimum(item.head * (float(norms.max()) if norms.size else 0.0), 0.5 * norms)
+        some = norms > 0
+        cone = item.vectors[some] * (head[some] / norms[some])[:, None]
+        heads = {k: v for k, v in zip("uvw", _mm(cone).values())}
         shafts = go.Scatter3d(mode="lines", **_mm(_segments(item.origins, item.tips)),
                               line={"color": item.color, "width": item.width},
                               **_hover(None if item.hover is None
                                        else tuple(h for h in item.hover for _ in range(3))),
                               **_common(item, "shafts"))
-        cones = go.Cone(**_mm(item.tips), **heads, anchor="tip", sizemode="raw", sizeref=1.0,
+        cones = go.Cone(**_mm(item.tips[some]), **heads, anchor="tip", sizemode="raw", sizeref=1.0,
                         colorscale=[[0, item.color], [1, item.color]], showscale=False,
                         showlegend=False, hoverinfo="skip", **_common(item, "heads"))
         return [shafts, cones]

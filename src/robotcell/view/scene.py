@@ -160,7 +160,7 @@ class Arrows:
     width : float
         Shaft width (pixels).
     head : float
-        Length of the head as a fraction of the longest arrow.
+        Length of the heads as a fraction of the longest arrow (at most half their own arrow).
     hover : tuple of str or None
         Hover text per arrow.
     visible : bool
