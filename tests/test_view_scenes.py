@@ -263,7 +263,7 @@ def test_reach_map_read_back_from_the_csv_of_reach(tmp_path, capsys):
     # in the view: coloured by score, and a target the map could not reach is counted
     rows = out.read_text().splitlines()
     cells = rows[3].split(",")
-    cells[1:3] = ["0.000000", "0.000000"]
+    cells[1:3] = ["false" if cells[1] == "true" else "0", "0.000000"]  # as reach writes it
     cells[3:13] = ["nan"] * 10
     rows[3] = ",".join(cells)
     out.write_text("\n".join(rows) + "\n")
@@ -286,7 +286,9 @@ def test_reach_csv_errors(tmp_path):
     cell = Cell.load(EXAMPLE)
     bad = tmp_path / "bad.csv"
     head = "target,reachable,score,track,table,a1,a2,a3,a4,a5,a6\n"
-    for row, message in (("0,2,0.5,0,0,0,0,0,0,0,0", "line 2: 'reachable' must be 1 or 0"),
+    for row, message in (("0,2,0.5,0,0,0,0,0,0,0,0",
+                          "line 2: 'reachable' must be true or false \\(or 1 or 0\\), got '2.0'"),
+                         ("0,yes,0.5,0,0,0,0,0,0,0,0", "line 2: 'reachable' must be true or false"),
                          ("0,1,1.5,0,0,0,0,0,0,0,0", r"line 2: 'score' must be within \[0, 1\]"),
                          ("0,1,0.5,0,0,nan,0,0,0,0,0",
                           ("line 2: a reachable target needs finite values of track, table and "
@@ -297,6 +299,14 @@ def test_reach_csv_errors(tmp_path):
     bad.write_text("target,reachable,score\n0,1,0.5\n")
     with pytest.raises(InputError, match="missing column"):
         read_reach(bad, cell)
+    bad.write_text("target,score\n0,0.5\n")
+    with pytest.raises(InputError, match="missing column reachable"):
+        read_reach(bad, cell)
+    # true/false, as reach writes the column, and 1/0
+    for yes, no in (("true", "false"), ("1", "0")):
+        bad.write_text(f"{head}0,{yes},0.5,0,0,0,-90,90,0,0,0\n1,{no},0,nan,nan,nan,nan,nan,"
+                       "nan,nan,nan\n")
+        assert read_reach(bad, cell).reachable.tolist() == [True, False]
 
 
 def test_arrow_heads_fit_their_arrows():

@@ -77,13 +77,27 @@ class ReachTable:
     score: NDArray[np.float64]
 
 
+def _flags(cols: dict, path: str | Path) -> NDArray[np.bool_]:
+    """Column ``reachable``: ``true``/``false`` (as ``reach`` writes it) or 1/0."""
+    given = cols.get("reachable")
+    if given is None:
+        raise InputError(f"{path}: missing column reachable (have: {', '.join(cols)})")
+    words = ([str(w).strip().lower() for w in given] if isinstance(given, list)
+             else ["true" if v == 1 else "false" if v == 0 else str(v) for v in given])
+    bad = [i for i, w in enumerate(words) if w not in ("true", "false")]
+    if bad:
+        raise InputError(f"{path}: line {bad[0] + 2}: 'reachable' must be true or false (or "
+                         f"1 or 0), got {words[bad[0]]!r}")
+    return np.array([w == "true" for w in words])
+
+
 def read_reach(path: str | Path, cell: Cell) -> ReachTable:
     """Read the CSV that ``robotcell reach`` writes for ``cell`` (mm, deg).
 
     Parameters
     ----------
     path : str or Path
-        Columns ``reachable`` (1/0), ``score``, ``track`` (mm), ``table`` (deg; a positioner:
+        Columns ``reachable`` (``true``/``false``, or 1/0), ``score``, ``track`` (mm), ``table`` (deg; a positioner:
         ``e1..ek``), ``a1..an`` (deg; mm for a prismatic axis), optionally ``target``.
     cell : Cell
         The cell the map was made in.
@@ -95,7 +109,7 @@ def read_reach(path: str | Path, cell: Cell) -> ReachTable:
     Raises
     ------
     InputError
-        Missing or non-numeric columns, a ``reachable`` other than 0 or 1, a score outside
+        Missing or non-numeric columns, a ``reachable`` other than true or false, a score outside
         [0, 1], a reachable row without axis values; the message names the file and the row.
     """
     cols = read_csv(path, allow_nan=True)
@@ -103,17 +117,14 @@ def read_reach(path: str | Path, cell: Cell) -> ReachTable:
     tables = ([f"e{i + 1}" for i in range(pos.n_axes)] if isinstance(pos, Positioner)
               else ["table"])
     arms = [f"a{i + 1}" for i in range(cell.robot.n_joints)]
-    data = require_columns(cols, ["reachable", "score", "track", *tables, *arms], path)
-    flag, score = data[:, 0], data[:, 1]
+    reachable = _flags(cols, path)
+    data = require_columns(cols, ["score", "track", *tables, *arms], path)
+    score = data[:, 0]
     line = 2 + np.arange(len(data))  # file line of each row, after the header
-    bad = ~np.isin(flag, (0.0, 1.0))  # NaN too
-    if np.any(bad):
-        raise InputError(f"{path}: line {line[bad][0]}: 'reachable' must be 1 or 0")
     bad = ~((score >= 0) & (score <= 1))  # NaN too
     if np.any(bad):
         raise InputError(f"{path}: line {line[bad][0]}: 'score' must be within [0, 1]")
-    reachable = flag == 1
-    axes = data[:, 2:]
+    axes = data[:, 1:]
     bad = reachable & ~np.all(np.isfinite(axes), axis=1)
     if np.any(bad):
         raise InputError(f"{path}: line {line[bad][0]}: a reachable target needs finite values "
