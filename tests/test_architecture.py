@@ -124,7 +124,7 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
 #: package's ``__init__``, ``errors``, ``report`` (one concept, one module) and ``_aliases``.
 CONCEPTS = {"kinematics", "ik", "dhprocedure", "calibration", "identification", "cell", "io",
-            "studies", "cli", "robots"}
+            "studies", "view", "cli", "robots"}
 TOP_MODULES = {"__init__.py", "errors.py", "report.py", "_aliases.py"}
 
 
@@ -143,7 +143,9 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: (a module belongs to the longest prefix listed). The vendor-boundary helpers of ``io`` (files,
 #: tables, pose formats) and the pose algebra sit under the kinematics, which reads model files;
 #: the controller exports of ``io`` sit over the cell they export; reports of results sit with the
-#: estimators whose results they show. Imports inside functions
+#: estimators whose results they show, and with them the 3D scenes and their plotly drawing
+#: (``robotcell.view.scene``, ``.shapes``, ``.arm``, ``.plot``), which the reports will use; the
+#: view of a cell, its paths and reach maps sits over the exports. Imports inside functions
 #: (``Robot.ik`` offers the solvers of :mod:`robotcell.ik`) do not count, as for cycles.
 LAYERS = [
     {"robotcell.errors", "robotcell.kinematics.transforms", "robotcell.io.fileio",
@@ -151,9 +153,11 @@ LAYERS = [
      "robotcell.ik.result"},
     {"robotcell.kinematics", "robotcell.ik"},
     {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification",
-     "robotcell.report"},
+     "robotcell.report", "robotcell.view.scene", "robotcell.view.shapes", "robotcell.view.arm",
+     "robotcell.view.plot"},
     {"robotcell.cell"},
     {"robotcell.io.export"},
+    {"robotcell.view"},
     {"robotcell.studies"},
     {"robotcell.cli"},
 ]
@@ -172,7 +176,8 @@ def layer(module: str) -> int:
 
 def test_every_module_is_in_a_layer():
     assert layer("robotcell.io.export.kuka") == 4 and layer("robotcell.io.tables") == 0
-    assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 6
+    assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 7
+    assert layer("robotcell.view.plot") == 2 and layer("robotcell.view.cellscene") == 5
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES

@@ -12,13 +12,14 @@ import time
 
 import numpy as np
 from cli_helpers import run
+from view_helpers import figure_from_page, triads
 
-from robotcell import load_robot
+from robotcell import load_robot, make_pose
 from robotcell.cell import Cell, Frame, Tool, Turntable
 from robotcell.io.export import EXPORT_FORMATS, parse_export
 from robotcell.io.export.common import collect, flatten_table
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.studies.demo import EXPORT_FILES, demo_cells
+from robotcell.studies.demo import EXPORT_FILES, VIEW_TABLE, demo_cells
 from robotcell.studies.plan import pose_error
 
 #: Controller reference frame of each export (see docs/export.md).
@@ -113,10 +114,15 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
     for name in ["cell.yaml", *(f"cell.yaml.{i}.bak" for i in range(1, 5)), "truth.yaml", *EXPORT_FILES.values(),
                  *(f"{p}.{ext}" for p in ("tcp", "track", "turntable", "workpiece")
                    for ext in ("csv", "json")),
-                 *(f"report_{p}.html" for p in ("tcp", "track", "turntable", "workpiece"))]:
+                 *(f"report_{p}.html" for p in ("tcp", "track", "turntable", "workpiece")),
+                 "cell.html"]:
         assert (tmp_path / name).is_file(), name
     truth, nominal = demo_cells()
     cell = Cell.load(tmp_path / "cell.yaml")
+    # The 3D view shows the calibrated cell: the torch 50 mm above the part's origin.
+    view = figure_from_page((tmp_path / "cell.html").read_text(encoding="utf-8"))
+    above = cell.frame_pose("part", 0.0, VIEW_TABLE) @ make_pose(np.eye(3), [0, 0, 0.05])
+    np.testing.assert_allclose(triads(view, "tools")["torch"][0], above[:3, 3] * 1e3, atol=1e-6)
     # Every calibrated item carries its provenance.
     assert cell.tools["torch"].provenance.source == "tcp"
     assert cell.track.provenance.source == "track"

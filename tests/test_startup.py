@@ -34,7 +34,7 @@ def loaded_after(args):
     return set(json.loads(proc.stderr.strip().splitlines()[-1]))
 
 
-HEAVY = {"numpy", "scipy", "yaml", "matplotlib"}
+HEAVY = {"numpy", "scipy", "yaml", "matplotlib", "plotly"}
 
 
 @pytest.mark.parametrize("args", [[], ["--version"], ["--help"], ["-h"]],
@@ -54,8 +54,10 @@ def test_calibrate_tcp_imports_what_it_needs_only(tmp_path, capsys):
     assert code == 0, err
     modules = loaded_after(["calibrate", "tcp", str(csv), "--robot", "kuka_kr16"])
     assert "robotcell.calibration.tcp" in modules
-    # scipy.stats alone costs 0.2 s; matplotlib is for reports; no other command's module.
+    # scipy.stats alone costs 0.2 s; matplotlib is for reports, plotly for 3D views; no other
+    # command's module.
     assert "scipy.stats" not in modules and "matplotlib" not in modules
+    assert not {m for m in modules if m == "plotly" or m.startswith("plotly.")}
     others = {t.split(":")[0] for name, t in COMMANDS.items() if name != "calibrate"}
     assert not modules & others
     # A TCP calibration solves no IK: neither the IK package (which reading a cell's positioner
@@ -97,3 +99,12 @@ def test_help_lists_each_command_with_its_own_help():
         for limit in (45, 80):
             assert _help_command(name).get_short_help_str(limit) == \
                 real.get_short_help_str(limit), name
+
+
+def test_view_loads_plotly_only_to_draw():
+    # plotly (about 0.3 s to import) is loaded by the functions that draw, not by the command's
+    # module: its --help and a refused input do without it.
+    for args in (["view", "--help"], ["view", str(EXAMPLE), "--joints", "1,2", "-o", "x.html"]):
+        modules = loaded_after(args)
+        assert "robotcell.cli.view" in modules
+        assert not {m for m in modules if m == "plotly" or m.startswith("plotly.")}, args

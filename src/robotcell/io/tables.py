@@ -32,7 +32,7 @@ MAX_ABS_VALUE = 1e15
 NOTE_COLUMNS = ("note", "notes", "comment", "comments", "remark", "remarks", "description")
 
 
-def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
+def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray | list[str]]:
     """Read a CSV file with a header into columns.
 
     Numeric columns become float arrays; a column with any non-numeric entry stays a list of
@@ -50,6 +50,9 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     ----------
     path : str or Path
         The CSV file.
+    allow_nan : bool
+        Accept ``nan``: a value the file's writer did not have (``robotcell reach`` writes it
+        for the axes of an unreachable target). Infinity is refused all the same.
 
     Returns
     -------
@@ -101,7 +104,7 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
             out[h] = cells
             continue
         arr = np.array(values, dtype=float)
-        if not np.all(np.isfinite(arr)):
+        if np.any(np.isinf(arr) if allow_nan else ~np.isfinite(arr)):
             raise InputError(f"{path}: column '{h}' contains NaN or infinite values")
         huge = np.flatnonzero(np.abs(arr) > MAX_ABS_VALUE)
         if huge.size:

@@ -13,8 +13,8 @@ from its layout position, a workpiece clamped off its nominal place. The demo
    tcp``, ``track``, ``turntable``, ``workpiece`` with ``--cell``) make, printing each command;
    the library never drives the command line, which keeps the import direction cli -> library;
 3. compares every calibrated value with the truth, in units of its reported 1-sigma;
-4. writes an HTML report per calibration and the controller exports (KUKA, ABB, FANUC,
-   YASKAWA).
+4. writes an HTML report per calibration, the controller exports (KUKA, ABB, FANUC,
+   YASKAWA) and the interactive 3D view of the calibrated cell (``cell.html``).
 """
 
 from __future__ import annotations
@@ -39,8 +39,11 @@ from robotcell.io.export import EXPORT_FORMATS, export_cell
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.models import load_robot
+from robotcell.kinematics.transforms import make_pose, rot_y
 from robotcell.studies.plan import pose_error
 from robotcell.studies.simulate import simulate
+from robotcell.view.cellscene import cell_figure
+from robotcell.view.plot import write_html
 
 __all__ = ["DEMO_NOISE", "Comparison", "demo_cells", "run_demo"]
 
@@ -268,8 +271,24 @@ def _write_outputs(out: Path, cell: Cell, results: dict[str, dict[str, Any]],
         path = out / EXPORT_FILES[fmt]
         path.write_text(text, encoding="utf-8")
         echo(f"  {path.name}")
+    page = _write_view(out, cell)
+    echo(f"3D view of the calibrated cell (open it in a browser): {page.name}")
     prov = [f"{name}: {p.source} (rms {p.rms_mm:.3f} mm)" for name, p in _provenances(cell)]
     echo("cell file provenance: " + "; ".join(prov))
+
+
+#: Table angle of the demo's 3D view (rad).
+VIEW_TABLE = math.radians(30.0)
+
+
+def _write_view(out: Path, cell: Cell) -> Path:
+    """``cell.html``: the cell with the torch 50 mm above the part's origin, pointing down, at
+    table angle :data:`VIEW_TABLE` (the first valid IK solution; the track chosen by the IK)."""
+    target = make_pose(rot_y(math.pi), [0.0, 0.0, 0.05])
+    sol = cell.ik(target, frame="part", tool="torch", table=VIEW_TABLE)
+    q = sol.q[sol.valid][0]
+    fig = cell_figure(cell, q, float(sol.track), VIEW_TABLE)
+    return write_html(fig, out / "cell.html", title=f"{cell.name}: robotcell view")
 
 
 def _provenances(cell: Cell) -> list[tuple[str, Provenance]]:

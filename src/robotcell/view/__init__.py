@@ -1,0 +1,50 @@
+"""Interactive 3D views of a cell, of calibration data and of paths: one HTML file, no server.
+
+- :mod:`robotcell.view.scene`: what a view shows (items in SI units), independent of the
+  plotting library; :mod:`robotcell.view.shapes` and :mod:`robotcell.view.arm` build items
+  (touches, residual vectors, fitted circles and lines, plates; a DH chain's links and axes).
+- :mod:`robotcell.view.plot`: a scene as a plotly figure (mm), and as one self-contained page.
+- :mod:`robotcell.view.cellscene`: the view of a cell (:func:`cell_figure`);
+  :mod:`robotcell.view.path`: a path with the arm at each point, on a slider;
+  :mod:`robotcell.view.reach`: a reachability map in the cell.
+
+The names below are imported on first use (PEP 562): the scene and plotting modules sit below
+the cell in the layers (docs/conventions.md), with the calibration reports that use them, and
+importing them must not load the cell. plotly itself is imported only to draw.
+See docs/view.md.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from robotcell.view.cellscene import cell_figure, cell_scene
+    from robotcell.view.path import path_scene
+    from robotcell.view.plot import page, scene_figure, write_html
+    from robotcell.view.reach import read_reach
+    from robotcell.view.scene import Arrows, Lines, Mesh, Points, Scene, Step, Triads
+
+#: public name -> module that defines it
+_LAZY = {
+    **dict.fromkeys(["cell_figure", "cell_scene"], "robotcell.view.cellscene"),
+    "path_scene": "robotcell.view.path",
+    **dict.fromkeys(["page", "scene_figure", "write_html"], "robotcell.view.plot"),
+    "read_reach": "robotcell.view.reach",
+    **dict.fromkeys(["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads"],
+                    "robotcell.view.scene"),
+}
+
+__all__ = ["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads", "cell_figure",
+           "cell_scene", "page", "path_scene", "read_reach", "scene_figure", "write_html"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY])

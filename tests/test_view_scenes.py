@@ -1,0 +1,321 @@
+"""Scenes other than the cell's: calibration touches with the fitted geometry and magnified
+residuals, a path with the arm at each point on a slider, a reach map, on synthetic data."""
+
+import numpy as np
+import pytest
+from cli_helpers import run
+from view_helpers import (
+    EXAMPLE,
+    _chromium,
+    assert_triad,
+    figure_from_page,
+    js_errors,
+    render,
+    traces,
+    triads,
+    xyz,
+)
+
+from robotcell import InputError, make_pose, rot_x, rot_z
+from robotcell.calibration.turntable import calibrate_turntable
+from robotcell.cell import Cell
+from robotcell.kinematics.transforms import transform_points
+from robotcell.studies.reach import reach_map
+from robotcell.view import (
+    Scene,
+    Step,
+    Triads,
+    cell_scene,
+    page,
+    path_scene,
+    scene_figure,
+    write_html,
+)
+from robotcell.view.reach import reach_points, read_reach
+from robotcell.view.shapes import (
+    circle,
+    circle_points,
+    disk,
+    line_through,
+    magnification,
+    residual_arrows,
+    touches,
+)
+
+
+def turntable_touches(seed=0, outlier=3):
+    """A point on a turntable touched at 8 angles (m), 0.05 mm noise, one touch off by 2 mm."""
+    rng = np.random.default_rng(seed)
+    T_R_B = make_pose(rot_z(0.7) @ rot_x(0.01), [2.1, 1.3, 0.4])
+    theta = np.radians(np.arange(0, 360, 45))
+    f = transform_points(T_R_B, np.column_stack([0.3 * np.cos(theta), 0.3 * np.sin(theta),
+                                                 np.zeros(8)]))
+    f = f + rng.normal(0, 5e-5, f.shape)
+    f[outlier] += [0, 0, 0.002]
+    return theta, f, T_R_B
+
+
+def test_turntable_calibration_scene_shows_touches_circle_and_magnified_residuals():
+    theta, f, _ = turntable_touches()
+    res = calibrate_turntable(theta, f)
+    T, radius = res.values["T_R_B"], res.values["radius"]
+    outliers = np.array([f"touch {lab} is an outlier" in " ".join(res.warnings)
+                         for lab in res.labels])
+    assert outliers.tolist() == [k == 3 for k in range(8)]
+    factor = magnification(res.residuals, size=2 * radius)
+    arrows = residual_arrows(res.points, res.residuals, factor, res.labels)
+    scene = Scene("turntable", [*touches(res.points, res.labels, outliers),
+                                circle("fitted circle", T, radius), arrows,
+                                Triads("turntable B", T, ["B"], length=0.1)],
+                  notes=[f"residual vectors magnified {factor:g} x"], frame="robot base R")
+    fig = scene_figure(scene).to_plotly_json()
+    # each touch, the outlier apart
+    assert traces(fig, "touches")[0]["text"] == [str(k + 1) for k in range(8) if k != 3]
+    out = traces(fig, "touches (outliers)")[0]
+    assert out["text"] == ["4"] and out["marker"]["symbol"] == "x"
+    np.testing.assert_allclose(xyz(out)[0], res.points[3] * 1e3, atol=1e-6)
+    # the fitted circle goes through the point the fit predicts for each touch
+    ring = xyz(traces(fig, "fitted circle")[0]) * 1e-3
+    predicted = res.points - res.residuals
+    local = transform_points(np.linalg.inv(T), predicted)
+    np.testing.assert_allclose(np.hypot(local[:, 0], local[:, 1]), radius, atol=1e-12)
+    np.testing.assert_allclose(local[:, 2], 0, atol=1e-12)
+    gaps = np.linalg.norm(ring[:, None] - predicted[None], axis=-1).min(axis=0)
+    assert gaps.max() < radius * np.pi / 72  # within one segment of the drawn polygon
+    # residual vectors: from the predicted point, magnified by the stated factor
+    # the outlier's 1.3 mm, drawn at most a tenth of the 600 mm circle: 20 x (50 x would be 64 mm)
+    longest = np.linalg.norm(res.residuals, axis=1).max()
+    assert factor == 20.0 and 1.2e-3 < longest < 1.4e-3
+    shafts = xyz(traces(fig, f"residuals x {factor:g}", "shafts")[0])
+    np.testing.assert_allclose(shafts[0::3], predicted * 1e3, atol=1e-6)
+    np.testing.assert_allclose(shafts[1::3], (predicted + factor * res.residuals) * 1e3, atol=1e-6)
+    assert "magnified 20 x" in fig["layout"]["title"]["text"]
+    assert_triad(triads(fig, "turntable B")["B"], T)
+    assert fig["layout"]["scene"]["xaxis"]["title"]["text"] == "x in robot base R (mm)"
+
+
+def test_magnification_states_a_round_factor():
+    r = np.array([[0.0, 0.0, 3e-4], [1e-4, 0, 0]])  # longest 0.3 mm
+    assert magnification(r, size=1.0) == 200.0  # 0.1 m / 0.3 mm = 333 -> 200
+    assert magnification(r, size=0.45) == 100.0  # 150 -> 100
+    assert magnification(r, size=0.0015) == 1.0  # never drawn shorter than it is
+    assert magnification(np.zeros((2, 3)), size=1.0) == 1.0
+    assert magnification(r, size=0.015) == 5.0
+    with pytest.raises(InputError, match="size must be a length > 0"):
+        magnification(r, size=0.0)
+
+
+def test_shapes():
+    T = make_pose(rot_x(0.3), [1.0, 2.0, 3.0])
+    p = circle_points(T, 0.25, 12)
+    assert p.shape == (13, 3) and np.allclose(p[0], p[-1])
+    local = transform_points(np.linalg.inv(T), p)
+    np.testing.assert_allclose(np.linalg.norm(local[:, :2], axis=1), 0.25, atol=1e-12)
+    np.testing.assert_allclose(local[:, 2], 0, atol=1e-12)
+    plate = disk("plate", T, 0.25, n=12)
+    assert plate.faces.shape == (12, 3) and plate.vertices.shape == (13, 3)
+    # a fitted line spans the projections of its points, 10 % longer at each end
+    pts = np.array([[0.0, 0, 0], [1.0, 0.1, 0], [3.0, -0.1, 0]])
+    line = line_through("track", [0, 0, 0], [2, 0, 0], pts)
+    np.testing.assert_allclose(line.points, [[-0.3, 0, 0], [3.3, 0, 0]], atol=1e-12)
+    with pytest.raises(InputError, match="line direction must not be zero"):
+        line_through("track", [0, 0, 0], [0, 0, 0], pts)
+    with pytest.raises(InputError, match="radius must be a length > 0"):
+        circle("c", T, -1.0)
+    with pytest.raises(InputError, match="touches: 2 labels for 3 points"):
+        touches(pts, labels=["a", "b"])
+    with pytest.raises(InputError, match=r"outliers must be 3 booleans, got shape \(2,\)"):
+        touches(pts, outliers=[True, False])
+    with pytest.raises(InputError, match="residuals: 2 vectors for 3 touches"):
+        residual_arrows(pts, pts[:2], 10.0)
+    with pytest.raises(InputError, match="factor must be a length > 0"):
+        residual_arrows(pts, pts, 0.0)
+
+
+def test_scene_items_refuse_bad_geometry():
+    from robotcell.view import Arrows, Lines, Mesh, Points
+
+    with pytest.raises(InputError, match="links contains NaN"):
+        Lines("links", [[0, 0, 0], [np.nan, 1, 1]])  # a break is a whole row of NaN
+    Lines("links", [[0, 0, 0], [np.nan] * 3, [1, 1, 1]])
+    with pytest.raises(InputError, match="map: values must be 2 finite numbers"):
+        Points("map", np.zeros((2, 3)), values=[0.5])
+    with pytest.raises(InputError, match="axes: 1 origins for 2 vectors"):
+        Arrows("axes", np.zeros((1, 3)), np.ones((2, 3)))
+    with pytest.raises(InputError, match="plate: a face refers to a vertex that does not exist"):
+        Mesh("plate", np.zeros((3, 3)), [[0, 1, 3]])
+    with pytest.raises(InputError, match="frames: 1 texts for 2 elements"):
+        Triads("frames", np.stack([np.eye(4)] * 2), ["a"])
+    with pytest.raises(InputError, match="every step of a scene must hold the same kinds"):
+        Scene("s", steps=[Step("1", (Lines("a", np.zeros((2, 3))),)),
+                          Step("2", (Points("a", np.zeros((2, 3))),))])
+
+
+def seam(cell, n=12):
+    """A synthetic path: the torch along a line over the part, solved by the cell's IK."""
+    from robotcell import rot_y
+
+    x = np.linspace(-0.1, 0.1, n)
+    T = make_pose(rot_y(np.pi), np.column_stack([x, np.zeros(n), np.full(n, 0.01)]))
+    return cell.ik_path(T, frame="part", table=np.radians(150), tool="torch")
+
+
+def test_path_scene_puts_the_arm_at_each_point_where_fk_does():
+    cell = Cell.load(EXAMPLE)
+    path = seam(cell)
+    n = len(path.q)
+    table = np.radians(150 + np.linspace(0, 20, n))  # the table turns along the path
+    bad = np.zeros(n, bool)
+    bad[4] = True
+    reasons = [""] * n
+    reasons[4] = "A5 within 1 deg of its limit"
+    scene = path_scene(cell, path.q, path.track, table, tool="torch", bad=bad, reasons=reasons)
+    fig = scene_figure(scene)
+    data = figure_from_page(page(fig))
+    assert len(data["frames"]) == n
+    assert [s["label"] for s in data["layout"]["sliders"][0]["steps"]] == [str(k + 1) for k in range(n)]
+    # the marked point, with its reason
+    mark = traces(data, "bad points")[0]
+    assert mark["hovertext"] == ["<b>point 5</b>: A5 within 1 deg of its limit"]
+    tcp = cell.fk(path.q, path.track, table, tool="torch")
+    np.testing.assert_allclose(xyz(mark)[0], tcp[4, :3, 3] * 1e3, atol=1e-6)
+    np.testing.assert_allclose(xyz(traces(data, "TCP path")[0]), tcp[:, :3, 3] * 1e3, atol=1e-6)
+    # at each step, the TCP, the flange and the frames carried by the table are the cell's FK
+    first = {t["meta"]["item"] + ":" + t["meta"]["part"]: i for i, t in enumerate(data["data"])}
+    for k, frame in enumerate(data["frames"]):
+        step = {"data": [dict(data["data"][i], **t) for i, t in zip(frame["traces"], frame["data"])]}
+        assert_triad(triads(step, "TCP")[f"point {k + 1}"], tcp[k])
+        assert_triad(triads(step, "robot kuka_kr16: flange F")["flange F"],
+                     cell.fk(path.q[k], path.track[k], table[k], tool=np.eye(4)))
+        assert_triad(triads(step, "frames")["part"], cell.frame_pose("part", path.track[k], table[k]))
+    # what does not move is drawn once, outside the steps: the world axes, the robot base (the
+    # track stays where the path's IK put it)
+    assert np.ptp(path.track) == 0
+    moving = {data["data"][i]["meta"]["item"] for i in data["frames"][0]["traces"]}
+    assert "world:origins" in first and "robot R" not in moving
+    assert moving == {"robot kuka_kr16: links", "robot kuka_kr16: flange F",
+                      "turntable DKP_400_01: plate P", "turntable DKP_400_01: plate", "frames",
+                      "TCP"}
+
+
+def test_browser_plays_the_path(tmp_path):
+    # the animation frames, the slider and the play button load with no JavaScript error
+    exe = _chromium()
+    cell = Cell.load(EXAMPLE)
+    path = seam(cell, n=6)
+    out = write_html(path_scene(cell, path.q, path.track, np.radians(150), tool="torch"),
+                     tmp_path / "path.html")
+    dom, console, _ = render(exe, out, tmp_path, screenshot=False)
+    assert 'data-scene="rendered"' in dom and "slider" in dom
+    assert not js_errors(console), console
+    # a guard: the check sees an error thrown by a page
+    broken = tmp_path / "broken.html"
+    broken.write_text("<html><body><script>undefined_function();</script></body></html>")
+    _, console, _ = render(exe, broken, tmp_path, screenshot=False)
+    assert any("Uncaught ReferenceError" in m for m in js_errors(console)), console
+
+
+def test_path_scene_with_points_without_joint_values():
+    cell = Cell.load(EXAMPLE)
+    path = seam(cell, n=5)
+    q = path.q.copy()
+    q[2] = np.nan  # an unreachable target: no arm there
+    where = cell.fk(path.q, path.track, np.radians(150), tool="torch")[:, :3, 3]
+    bad = np.arange(5) == 2
+    reasons = ["", "", "unreachable: 40 mm beyond the arm's reach", "", ""]
+    with pytest.raises(InputError, match="point 3 has no joint values: give its position in points"):
+        path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad, reasons=reasons)
+    scene = path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad,
+                       reasons=reasons, points=where)
+    fig = scene_figure(scene).to_plotly_json()
+    np.testing.assert_allclose(xyz(traces(fig, "bad points")[0])[0], where[2] * 1e3, atol=1e-6)
+    # its step shows the arm of the point before it
+    assert scene.steps[2].items[-1].labels == ("point 3",)
+    np.testing.assert_array_equal(scene.steps[2].items[-1].poses, scene.steps[1].items[-1].poses)
+    with pytest.raises(InputError, match=r"q must have shape \(N, 6\)"):
+        path_scene(cell, q[:, :5])
+    with pytest.raises(InputError, match="no point of the path has joint values"):
+        path_scene(cell, np.full((2, 6), np.nan))
+    with pytest.raises(InputError, match=r"labels, bad and reasons need one entry per point \(5\)"):
+        path_scene(cell, path.q, path.track, labels=["a"])
+
+
+def test_reach_map_read_back_from_the_csv_of_reach(tmp_path, capsys):
+    seam_csv = EXAMPLE.with_name("seam_part.csv")
+    out = tmp_path / "reach.csv"
+    code, _, err = run(capsys, "reach", "--cell", EXAMPLE, seam_csv, "--frame", "part", "--tool",
+                       "torch", "-o", out)
+    assert code == 0, err
+    cell = Cell.load(EXAMPLE)
+    table = read_reach(out, cell)
+    # the same map in Python: each reachable target at the TCP its axis values give
+    from robotcell.studies.reach import read_targets
+
+    T, th = read_targets(seam_csv)
+    rm = reach_map(cell, T, frame="part", tool="torch", table=th)
+    assert np.array_equal(table.reachable, rm.reachable) and table.reachable.all()
+    mine = reach_points(cell, table, tool="torch")
+    np.testing.assert_allclose(mine.points, reach_points(cell, rm, tool="torch").points,
+                               atol=2e-9)  # the CSV has 6 decimals of mm and deg
+    target = cell.frame_pose("part", 0.0, th) @ T
+    np.testing.assert_allclose(mine.points, target[:, :3, 3], atol=2e-8)
+    np.testing.assert_allclose(mine.values, rm.score, atol=1e-6)
+    # in the view: coloured by score, and a target the map could not reach is counted
+    rows = out.read_text().splitlines()
+    cells = rows[3].split(",")
+    cells[1:3] = ["false" if cells[1] == "true" else "0", "0.000000"]  # as reach writes it
+    cells[3:13] = ["nan"] * 10
+    rows[3] = ",".join(cells)
+    out.write_text("\n".join(rows) + "\n")
+    scene = cell_scene(cell, reach=read_reach(out, cell), tool="torch")
+    assert scene.notes[-1] == ("reach map: each reachable target at its TCP in the world; 1 "
+                               "unreachable target(s) not drawn (no axis values)")
+    fig = scene_figure(scene).to_plotly_json()
+    points = traces(fig, "reach map")[0]
+    assert len(points["x"]) == len(T) - 1 and points["marker"]["cmax"] == 1
+    assert points["hovertext"][2].startswith("<b>target 3</b>: score")
+    # the command draws it
+    code, _, err = run(capsys, "view", EXAMPLE, "--reach", out, "--tool", "torch", "-o",
+                       tmp_path / "reach.html")
+    assert code == 0, err
+    text = (tmp_path / "reach.html").read_text(encoding="utf-8")
+    assert len(traces(figure_from_page(text), "reach map")[0]["x"]) == len(T) - 1
+
+
+def test_reach_csv_errors(tmp_path):
+    cell = Cell.load(EXAMPLE)
+    bad = tmp_path / "bad.csv"
+    head = "target,reachable,score,track,table,a1,a2,a3,a4,a5,a6\n"
+    for row, message in (("0,2,0.5,0,0,0,0,0,0,0,0",
+                          "line 2: 'reachable' must be true or false \\(or 1 or 0\\), got '2.0'"),
+                         ("0,yes,0.5,0,0,0,0,0,0,0,0", "line 2: 'reachable' must be true or false"),
+                         ("0,1,1.5,0,0,0,0,0,0,0,0", r"line 2: 'score' must be within \[0, 1\]"),
+                         ("0,1,0.5,0,0,nan,0,0,0,0,0",
+                          ("line 2: a reachable target needs finite values of track, table and "
+                           "a1..a6"))):
+        bad.write_text(head + row + "\n")
+        with pytest.raises(InputError, match=message):
+            read_reach(bad, cell)
+    bad.write_text("target,reachable,score\n0,1,0.5\n")
+    with pytest.raises(InputError, match="missing column"):
+        read_reach(bad, cell)
+    bad.write_text("target,score\n0,0.5\n")
+    with pytest.raises(InputError, match="missing column reachable"):
+        read_reach(bad, cell)
+    # true/false, as reach writes the column, and 1/0
+    for yes, no in (("true", "false"), ("1", "0")):
+        bad.write_text(f"{head}0,{yes},0.5,0,0,0,-90,90,0,0,0\n1,{no},0,nan,nan,nan,nan,nan,"
+                       "nan,nan,nan\n")
+        assert read_reach(bad, cell).reachable.tolist() == [True, False]
+
+
+def test_arrow_heads_fit_their_arrows():
+    from robotcell.view import Arrows
+
+    arrows = Arrows("residuals", np.zeros((3, 3)), [[0.1, 0, 0], [0, 0.01, 0], [0, 0, 0]])
+    fig = scene_figure(Scene("arrows", [arrows])).to_plotly_json()
+    heads = traces(fig, "residuals", "heads")[0]
+    # one size (a quarter of the longest), at most half a short arrow, none on a zero arrow
+    np.testing.assert_allclose(np.column_stack([heads["u"], heads["v"], heads["w"]]),
+                               [[25.0, 0, 0], [0, 5.0, 0]], atol=1e-9)
+    np.testing.assert_allclose(xyz(heads), [[100.0, 0, 0], [0, 10.0, 0]], atol=1e-9)
