@@ -35,6 +35,7 @@ from robotcell.ik.palletizer import (
 from robotcell.ik.result import IKSolutions, flat_reference
 from robotcell.ik.seeded import SeededSolver
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
+from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, validate_pose
 
@@ -120,7 +121,7 @@ class AnalyticSolver:
             ok = self._fold(sub)
             q[..., per] = sub
             f = q[..., fixed]
-            ok &= np.all((f >= lo) & (f <= hi), axis=-1)
+            ok &= np.all(within(f, lo, hi), axis=-1)
         else:
             ok = self._fold(q)
         if inter is not None:
