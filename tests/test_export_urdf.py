@@ -17,10 +17,12 @@ from cli_helpers import run
 from scipy.spatial.transform import Rotation
 from test_positioner import tilt_rotate
 
-from robotcell import load_robot, pose_from_vendor
+from robotcell import InputError, load_robot, pose_from_vendor
 from robotcell.cell import Cell, Frame, Positioner, Tool, Turntable
 from robotcell.io.export import export_cell
 from robotcell.io.export.urdf import urdf_origin
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.robot import Joint, Robot
 from robotcell.studies.demo import demo_cells
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "cell_kr16_track_turntable.yaml"
@@ -295,6 +297,17 @@ def test_coupled_joint_limits_hold_every_value_the_controller_reaches(kind):
             v = values[j.name]
             assert np.all((v >= j.limit.lower - 1e-12) & (v <= j.limit.upper + 1e-12)), j.name
             assert np.isclose(v.min(), j.limit.lower) and np.isclose(v.max(), j.limit.upper)
+
+
+def test_passive_joints_of_a_coupling_that_mimic_cannot_hold_are_refused():
+    # The joints with a motor move together (rows 1 and 2 of C equal); the passive one alone
+    # holds the second axis: no URDF joint could be the independent one.
+    joints = (Joint("revolute", a=0.3, name="A1"), Joint("revolute", a=0.2, name="A2"),
+              Joint("revolute", a=0.1, name="P", passive=True))
+    robot = Robot(name="odd", joints=joints, coupling=Coupling([[1, 0], [1, 0], [0, 1]]))
+    with pytest.raises(InputError, match="odd: the coupling of the joints with a motor is not "
+                                         "invertible, so the passive joints cannot be written"):
+        export_cell(Cell(robot=robot, robot_model="odd", name="odd"), "urdf")
 
 
 def test_urdf_origin_is_fixed_axis_roll_pitch_yaw():
