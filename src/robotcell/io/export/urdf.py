@@ -123,6 +123,12 @@ def chain_elements(root: ET.Element, robot: Robot, parent: str, prefix: str, end
         Name of the link at the chain's flange.
     names : list of str, optional
         Joint names; default the model's, else ``<prefix>joint_1..n``.
+
+    Notes
+    -----
+    With a coupling the joints take the model's values ``C q + offset`` and their limits are the
+    range of those over the controller's limits; a passive joint becomes mimic joints; XML
+    comments before the chain state the mapping (module docstring).
     """
     names = names or [j.name or f"{prefix}joint_{i + 1}" for i, j in enumerate(robot.joints)]
     pre, post = axis_frames(robot)
