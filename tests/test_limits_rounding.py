@@ -13,7 +13,7 @@ import pytest
 from test_cellik import track_cell
 from test_positioner import tilt_rotate
 
-from robotcell import load_robot
+from robotcell import InputError, load_robot
 from robotcell.ik import (
     IKSolutions,
     abb_confdata,
@@ -119,3 +119,15 @@ def test_cell_ik_at_the_track_limit():
     T = cell.fk([0.1, -1.4, 1.5, 0.3, 0.6, 0.2], track=cell.track.upper, tool="torch")
     assert cell.ik(T, track=e, tool="torch").valid.any()
     assert not cell.ik(T, track=cell.track.upper + BEYOND, tool="torch").valid.any()
+
+
+def test_simulated_positioner_values_at_the_limits():
+    from robotcell.studies.simulate import simulate
+
+    cell = tilt_rotate()
+    cell.turntable = replace(cell.turntable, chain=with_limits(cell.turntable.chain, 0, -0.5, 0.5))
+    touches = simulate(cell, "positioner", noise=0.0, seed=1, tool="torch",
+                       tilts=[-0.5 - ROUNDING, 0.0, 0.5 + ROUNDING])
+    assert len(touches.q) == 12
+    with pytest.raises(InputError, match=r"tilt value\(s\) 28.6479 deg are outside the axis limits"):
+        simulate(cell, "positioner", noise=0.0, seed=1, tool="torch", tilts=[0.0, 0.5 + 1e-6])
