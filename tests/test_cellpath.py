@@ -65,20 +65,42 @@ def test_split_path_reports_the_shoulder_singularity():
     assert dets[10] < 0.05 * dets.max()  # truly next to the singular configuration
 
 
-def test_split_path_reports_a_joint_limit():
-    cell = track_cell()
+def axis1_limited(cell, upper):
+    """``cell`` with axis 1 limited to +-``upper`` (rad)."""
     j1 = cell.robot.joints[0]
-    # Axis 1 limited to +-30 deg: the shoulder-back configurations (A1 + 180) are all outside.
-    cell.robot = replace(cell.robot, joints=(replace(j1, lower=-math.radians(30),
-                                                     upper=math.radians(30)),)
+    cell.robot = replace(cell.robot, joints=(replace(j1, lower=-upper, upper=upper),)
                          + cell.robot.joints[1:])
+    return cell
+
+
+def axis1_sweep(cell):
+    """Targets of A1 = 10 .. 50 deg in 2 deg steps (A1 = 30 deg at index 10), track at 2 m."""
     q = np.tile([0.0, -1.2, 1.6, 0.4, 0.6, 0.2], (21, 1))
-    q[:, 0] = np.radians(np.linspace(10, 50, 21))  # A1 passes its limit at 30 deg
-    T = cell.fk(q, track=2.0, tool="torch")
-    split = split_path(cell, T, track=2.0, tool="torch")
+    q[:, 0] = np.radians(np.linspace(10, 50, 21))
+    return cell.fk(q, track=2.0, tool="torch")
+
+
+def test_split_path_reports_a_joint_limit():
+    # Axis 1 limited to +-30 deg: the shoulder-back configurations (A1 + 180) are all outside.
+    cell = axis1_limited(track_cell(), math.radians(30))
+    split = split_path(cell, axis1_sweep(cell), track=2.0, tool="torch")
     assert split.segments == [(0, 11)]
     assert [b.kind for b in split.breaks] == ["limit"] * 10
     assert split.breaks[0].index == 11 and "axis 1" in split.breaks[0].message
+
+
+def test_split_path_counts_a_value_at_the_limit_up_to_rounding_as_inside():
+    # The IK of the target at 30 deg gives 30 deg plus or minus rounding (1e-14 rad on some
+    # machines): put the limit exactly 1e-14 rad below the value the IK returns here.
+    cell = track_cell()
+    T = axis1_sweep(cell)
+    sol = cell.ik(T, track=2.0, tool="torch")
+    a1 = sol.q[10, sol.valid[10], 0]
+    assert np.allclose(a1, math.radians(30), rtol=0, atol=1e-12)
+    cell = axis1_limited(cell, float(a1.max()) - 1e-14)
+    assert cell.robot.upper[0] < a1.max()   # the value is beyond the limit by rounding
+    split = split_path(cell, T, track=2.0, tool="torch")
+    assert split.segments == [(0, 11)] and split.breaks[0].index == 11
 
 
 def test_split_path_of_a_followable_path_is_one_segment():

@@ -7,7 +7,7 @@ import pytest
 
 import robotcell as rc
 from robotcell.dhprocedure import AxisChain, dh_from_axes
-from robotcell.errors import IllPosedError, InputError
+from robotcell.errors import InputError
 from robotcell.kinematics.transforms import make_pose
 
 TOL = 1e-9
@@ -50,8 +50,6 @@ def random_chain(rng, n):
         else:  # within 1e-13 of coincident: treated as coincident at tol 1e-9
             q, w = p + rng.normal() * z + 1e-13 * perp(rng, z), unit(z + 1e-13 * perp(rng, z))
         t = rng.choice(["revolute", "prismatic"])
-        if t == types[-1] == "prismatic" and case in ("parallel", "coincident", "coincident-ish"):
-            t = "revolute"
         pts.append(q)
         dirs.append(w)
         types.append(t)
@@ -184,11 +182,24 @@ def test_zero_direction_names_the_joint():
                   types=("revolute", "revolute"), names=("base", "elbow"))
 
 
-def test_coincident_prismatic_axes_name_both_joints():
-    chain = AxisChain(points=[[0, 0, 0], [0, 0, 1]], directions=[[0, 0, 1], [0, 0, -2]],
-                      types=("prismatic", "prismatic"), names=("Z1", "Z2"))
-    with pytest.raises(IllPosedError, match="joints Z1 and Z2 are both prismatic along parallel"):
-        dh_from_axes(chain)
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+@pytest.mark.parametrize("second", [[0.0, 0.0, 1.0], [0.3, -0.2, 1.0]])  # coincident, parallel
+def test_parallel_prismatic_axes_are_two_d_variables(convention, second):
+    # A gantry with a redundant vertical axis (Z1, then Z2 the other way along the same
+    # direction), then a rotary axis and a slide: legal, DH holds both as d along one Z.
+    chain = AxisChain(points=[[0, 0, 0], second, [0.5, 0, 0], [0.5, 0.1, 0]],
+                      directions=[[0, 0, 1], [0, 0, -2], [0, 0, 1], [1, 0, 0]],
+                      types=("prismatic", "prismatic", "revolute", "prismatic"),
+                      names=("Z1", "Z2", "C", "X"),
+                      flange=make_pose(None, [0.7, 0.1, -0.2]))
+    der = dh_from_axes(chain, convention)
+    assert [j.type for j in der.robot.joints] == ["prismatic", "prismatic", "revolute", "prismatic"]
+    q = np.random.default_rng(4).uniform(-1, 1, (50, 4))
+    dp, dr = pose_error(der.robot.fk(q), chain.fk(q))
+    assert dp < TOL and dr < TOL
+    # moving Z1 and Z2 by the same amount leaves the flange where it was
+    T = der.robot.fk(np.array([[0.2, 0.2, 0.3, 0.1], [0.0, 0.0, 0.3, 0.1]]))
+    assert np.allclose(T[0], T[1], atol=TOL)
 
 
 def test_bad_arguments():

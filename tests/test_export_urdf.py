@@ -7,6 +7,7 @@ by the Robotics Toolbox's own ``fkine``; both must equal ``Cell.fk`` / ``Cell.fr
 """
 
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -16,10 +17,12 @@ from cli_helpers import run
 from scipy.spatial.transform import Rotation
 from test_positioner import tilt_rotate
 
-from robotcell import load_robot, pose_from_vendor
+from robotcell import InputError, load_robot, pose_from_vendor
 from robotcell.cell import Cell, Frame, Positioner, Tool, Turntable
 from robotcell.io.export import export_cell
 from robotcell.io.export.urdf import urdf_origin
+from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.robot import Joint, Robot
 from robotcell.studies.demo import demo_cells
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "cell_kr16_track_turntable.yaml"
@@ -54,10 +57,32 @@ def vertical_track_cell():
     return cell
 
 
+def coupled_cell(model):
+    """A library arm with a J2/J3 coupling or a passive joint, placed in the world, with a tool
+    and a frame on its base."""
+    return Cell(robot=load_robot(model), robot_model=model, name=model,
+                T_world_R=pose_from_vendor([300, -200, 50, 30, 0, 0], "kuka"),
+                tools={"gripper": Tool(pose_from_vendor([10, -20, 250, 0, 30, 90], "kuka"))},
+                frames={"pallet": Frame(pose_from_vendor([1200, 300, -400, 90, 0, 0], "kuka"),
+                                        parent="robot")})
+
+
+def fanuc_on_track():
+    """The example cell's track and turntable with a FANUC M-20iA (J3 coupled to J2)."""
+    cell = Cell.load(EXAMPLE)
+    cell.robot, cell.robot_model = load_robot("fanuc_m20ia"), "fanuc_m20ia"
+    return cell
+
+
+#: Arms whose URDF joint values are not the controller's (docs/export.md, "URDF").
+COUPLED = {"fanuc_m20ia": lambda: coupled_cell("fanuc_m20ia"), "fanuc_on_track": fanuc_on_track,
+           "fanuc_lrmate200id": lambda: coupled_cell("fanuc_lrmate200id"),
+           "abb_irb2400": lambda: coupled_cell("abb_irb2400"),
+           "abb_irb460": lambda: coupled_cell("abb_irb460")}
 CELLS = {"track_turntable": lambda: Cell.load(EXAMPLE), "modified_dh": modified_cell,
          "prismatic": prismatic_cell, "demo_truth": lambda: demo_cells()[0],
          "vertical_track": vertical_track_cell, "positioner": tilt_rotate,
-         "positioner_modified": lambda: tilt_rotate("modified")}
+         "positioner_modified": lambda: tilt_rotate("modified"), **COUPLED}
 
 
 def random_values(cell, rng, n=20):
@@ -72,9 +97,11 @@ def random_values(cell, rng, n=20):
 
 
 def urdf_joint_values(cell, q, e, th):
-    """URDF joint name -> value: the arm's controller values, track displacement, table angle."""
-    names = [j.name for j in cell.robot.joints]
-    values = dict(zip(names, np.asarray(q).T))
+    """URDF joint name -> value, the documented mapping: the arm's model values ``C q + offset``
+    (the controller values without a coupling; FANUC J3 + J2, IRB 2400 axis3 - axis2; passive
+    joints follow their mimic elements), the track displacement, the table angles."""
+    qm = cell.robot.model_values(q)
+    values = {j.name: qm[..., i] for i, j in enumerate(cell.robot.joints) if not j.passive}
     if cell.track is not None:
         values["track_axis"] = e * cell.track.scale
     if isinstance(cell.turntable, Positioner):
@@ -92,9 +119,21 @@ def origin_matrix(origin):
     return T
 
 
+def with_mimics(model, values):
+    """``values`` completed by the values of the mimic joints, from their parsed ``<mimic>``."""
+    out = dict(values)
+    for j in model.joints:
+        if j.mimic is not None:
+            out[j.name] = (1.0 if j.mimic.multiplier is None else j.mimic.multiplier) \
+                * values[j.mimic.joint] + (j.mimic.offset or 0.0)
+    return out
+
+
 def parsed_fk(model, link, values):
-    """Pose of ``link`` in the root by the URDF definition, from urdf-parser-py's joints."""
+    """Pose of ``link`` in the root by the URDF definition, from urdf-parser-py's joints (mimic
+    joints from their ``<mimic>`` element)."""
     by_child = {j.child: j for j in model.joints}
+    values = with_mimics(model, values)
     T = np.eye(4)
     while link in by_child:
         j = by_child[link]
@@ -156,9 +195,10 @@ def test_robotics_toolbox_loads_it_and_its_fk_equals_the_cells(kind, tmp_path):
     robot = rtb.Robot(elinks, name=name)
     assert name == cell.name
     # the toolbox numbers its joints; each moving link is the child of one URDF joint
-    child_joint = {j.child: j.name for j in URDF.from_xml_string(path.read_bytes()).joints}
+    parsed = URDF.from_xml_string(path.read_bytes())
+    child_joint = {j.child: j.name for j in parsed.joints}
     q, e, th = random_values(cell, np.random.default_rng(2), n=5)
-    values = urdf_joint_values(cell, q, e, th)
+    values = with_mimics(parsed, urdf_joint_values(cell, q, e, th))  # the toolbox ignores <mimic>
     for i in range(len(q)):
         qv = np.zeros(robot.n)
         for link in robot.links:
@@ -167,6 +207,107 @@ def test_robotics_toolbox_loads_it_and_its_fk_equals_the_cells(kind, tmp_path):
         for target, pose in targets(cell):
             got = np.array(robot.fkine(qv, end=target).A)
             assert_same(got, pose(q[i], e[i], th[i]))
+
+
+def pinocchio_q(model, values):
+    """Pinocchio's configuration vector of URDF joint values (a continuous joint as cos, sin;
+    mimic joints are computed by pinocchio)."""
+    import pinocchio as pin
+
+    qv = pin.neutral(model)
+    for jid in range(1, model.njoints):
+        joint = model.joints[jid]
+        if joint.shortname() == "JointModelMimic":
+            continue
+        v = values[model.names[jid]]
+        qv[joint.idx_q:joint.idx_q + joint.nq] = [math.cos(v), math.sin(v)] if joint.nq == 2 else v
+    return qv
+
+
+@pytest.mark.parametrize("kind", CELLS)
+def test_pinocchio_loads_it_with_its_mimic_joints_and_its_fk_equals_the_cells(kind):
+    import pinocchio as pin
+
+    cell = CELLS[kind]()
+    model = pin.buildModelFromXML(export_cell(cell, "urdf"), mimic=True)
+    data = model.createData()
+    q, e, th = random_values(cell, np.random.default_rng(3), n=10)
+    values = urdf_joint_values(cell, q, e, th)
+    for i in range(len(q)):
+        pin.framesForwardKinematics(model, data, pinocchio_q(model, {k: v[i] for k, v in values.items()}))
+        for link, pose in targets(cell):
+            assert_same(data.oMf[model.getFrameId(link)].homogeneous, pose(q[i], e[i], th[i]))
+
+
+def test_pinocchio_places_the_m20ia_as_robotcell_with_j3_plus_j2():
+    # controller (0, 30, 0, 0, 0, 0) deg: the flange at (1480.0, 0, 934.2) mm in robotcell; the
+    # URDF's J3 takes J3 + J2 = 30 deg (fed the controller's 0, the flange ends 500 mm lower).
+    import pinocchio as pin
+
+    cell = coupled_cell("fanuc_m20ia")
+    cell.T_world_R = np.eye(4)
+    q = np.radians([0, 30, 0, 0, 0, 0])
+    want = cell.fk(q, tool=np.eye(4))
+    assert np.allclose(want[:3, 3] * 1e3, [1480.0, 0, 934.2], atol=0.05)
+    model = pin.buildModelFromXML(export_cell(cell, "urdf"), mimic=True)
+    data = model.createData()
+    values = dict(zip([f"J{i}" for i in range(1, 7)], q))
+    values["J3"] = q[2] + q[1]
+    pin.framesForwardKinematics(model, data, pinocchio_q(model, values))
+    assert_same(data.oMf[model.getFrameId("flange")].homogeneous, want)
+
+
+@pytest.mark.parametrize("kind, lines", [
+    ("fanuc_m20ia", ["J3 = J3 + J2 of the controller"]),
+    ("fanuc_lrmate200id", ["J3 = J3 + J2 of the controller"]),
+    ("abb_irb2400", ["J3 = J3 - J2 of the controller"]),
+    ("abb_irb460", ["A3 = A3 - A2 of the controller",
+                    ("P is passive: P = -A3 of the controller = -A2 - A3 of this file "
+                     "(mimic joints P, P_2)")]),
+])
+def test_the_file_states_the_joint_mapping_and_the_passive_joint_mimics(kind, lines):
+    from urdf_parser_py.urdf import URDF
+
+    text = export_cell(COUPLED[kind](), "urdf")
+    comments = [c.strip() for c in re.findall(r"<!--(.*?)-->", text)]
+    assert any(c.startswith("Joint values of the arm: its model's joint values") for c in comments)
+    assert [c for c in comments if not c.startswith("Joint values")] == lines
+    mimic = {j.name: j.mimic for j in URDF.from_xml_string(text.encode()).joints if j.mimic}
+    if kind == "abb_irb460":
+        assert {k: (m.joint, m.multiplier) for k, m in mimic.items()} == {"P": ("A2", -1.0),
+                                                                          "P_2": ("A3", -1.0)}
+    else:
+        assert not mimic
+
+
+@pytest.mark.parametrize("kind", COUPLED)
+def test_coupled_joint_limits_hold_every_value_the_controller_reaches(kind):
+    # A URDF limit bounds the joint's own value: for J3 + J2 it is the range over the controller's
+    # limits of J2 and J3 (the controller's box is stricter and not expressible in URDF).
+    from urdf_parser_py.urdf import URDF
+
+    cell = COUPLED[kind]()
+    model = URDF.from_xml_string(export_cell(cell, "urdf").encode())
+    lo, hi = cell.robot.lower, cell.robot.upper
+    corners = np.array(np.meshgrid(*zip(lo, hi))).reshape(len(lo), -1).T
+    q = np.vstack([corners, random_values(cell, np.random.default_rng(4), n=200)[0]])
+    values = with_mimics(model, urdf_joint_values(cell, q, np.zeros(len(q)), np.zeros(len(q))))
+    for j in model.joints:
+        if j.child.startswith("link_") and j.limit is not None:  # the arm's joints
+            v = values[j.name]
+            assert np.all((v >= j.limit.lower - 1e-12) & (v <= j.limit.upper + 1e-12)), j.name
+            assert np.isclose(v.min(), j.limit.lower) and np.isclose(v.max(), j.limit.upper)
+
+
+def test_passive_joints_of_a_coupling_that_mimic_cannot_hold_are_refused():
+    # The joints with a motor move together (rows 1 and 2 of C equal); the passive one alone
+    # holds the second axis: no URDF joint could be the independent one.
+    joints = (Joint("revolute", a=0.3, name="A1"), Joint("revolute", a=0.2, name="A2"),
+              Joint("revolute", a=0.1, name="P", passive=True))
+    robot = Robot(name="odd", joints=joints, coupling=Coupling([[1, 0], [1, 0], [0, 1]]))
+    with pytest.raises(InputError, match="odd: the coupling of the joints with a motor is not "
+                                         "invertible, so the passive joints cannot be written"):
+        export_cell(Cell(robot=robot, robot_model="odd", name="odd"), "urdf")
 
 
 def test_urdf_origin_is_fixed_axis_roll_pitch_yaw():

@@ -254,6 +254,8 @@ def test_refused_input():
         identify(nominal, Measurements(np.zeros((5, 5)), np.zeros((5, 3))))
     with pytest.raises(InputError, match="point_sigma must be a positive number"):
         identify(nominal, Measurements(q, np.zeros((5, 3))), point_sigma=0.0)
+    with pytest.raises(InputError, match=r"max_sigma_angle must be a positive number \(math.inf"):
+        identify(nominal, Measurements(q, np.zeros((5, 3))), max_sigma_angle=0.0)
     with pytest.raises(IllPosedError, match="measure at least"):
         rng = np.random.default_rng(0)
         identify(nominal, Measurements(rng.uniform(-1, 1, (5, 6)), rng.uniform(-1, 1, (5, 3))))

@@ -142,6 +142,39 @@ def test_identify_j23_factor_report(tmp_path, capsys):
     assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 0.05e-3
 
 
+def test_identify_without_nominal_groups_rows_in_model_values_of_a_coupled_arm(tmp_path, capsys):
+    # A FANUC arm (pendant J3 = forearm to the horizontal, chain J3 = J3 + J2) whose rows move one
+    # joint of the chain at a time: moving J2 alone means J3 = -J2 on the pendant.
+    rng = np.random.default_rng(24)
+    nominal = load_robot("fanuc_m20ia")
+    ch, x = truth_chain(perturbed(nominal, rng), 1, False, rng)
+    model_rows = np.concatenate([one_joint_rows(nominal, span_deg=40),
+                                 nominal.model_values(configurations(nominal, 40, rng))])
+    pendant = model_rows.copy()
+    pendant[:, 2] -= model_rows[:, 1]
+    meas = measure(ch, x, pendant, rng, NOISE)
+    write_csv(tmp_path / "fanuc.csv", meas)
+    code, stdout, stderr = run(capsys, "identify", tmp_path / "fanuc.csv", "--j23-factor", "1",
+                               "--json", "--accuracy", "0.02", "-o", tmp_path / "fanuc.yaml")
+    assert code == 0, stderr
+    data = json.loads(stdout)
+    assert data["coupling_check"]["supported"]
+    # the reference: the same rows converted to the chain's values by hand, no coupling
+    write_csv(tmp_path / "model.csv", Measurements(model_rows, meas.points))
+    code, ref, stderr = run(capsys, "identify", tmp_path / "model.csv", "--json", "--accuracy", "0.02")
+    assert code == 0, stderr
+    ref = json.loads(ref)
+    assert data["rms_after_mm"] == pytest.approx(ref["rms_after_mm"], rel=0.02)
+    floor = math.sqrt(3) * NOISE  # RMS of the 3-D noise (m)
+    assert data["rms_after_mm"] < 1.1 * floor * 1e3
+    # the model file takes the pendant's values
+    assert "coupling: {j23_factor: 1}" in (tmp_path / "fanuc.yaml").read_text()
+    base = np.array(data["base"])
+    base[:3, 3] /= 1e3
+    pred = (base @ load_robot(tmp_path / "fanuc.yaml").fk(meas.q))[:, :3, 3]
+    assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 1.1 * floor
+
+
 @pytest.mark.parametrize("content,message", [
     ("a1,a2,x,y,z\n0,0,1,2,3\n", "6 joints"),
     ("a1,a2,a3,a4,a5,a6,x,y\n0,0,0,0,0,0,1,2\n", "x,y,z"),

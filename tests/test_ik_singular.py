@@ -301,6 +301,53 @@ def test_reach_error_is_the_distance_outside_reach(name):
             assert ang[k] < 1e-12
 
 
+# UR3e / UR10e configurations (rad, elbow stretched to within 1e-9 rad) whose poses another branch
+# missed by 0.02 to 0.8 um, solved at the boundary of its reach and returned valid, although
+# the pose is exactly reachable.
+UR_EXTRA_BRANCH = {
+    "ur3e": [[-1.7754770978528043, -1.5674255677229796, 8.766843935286329e-10, 1.5671560547012948,
+              2.3329795733156145, 1.0350261880543883],
+             [1.7387063255188488, -1.7351917231379221, 1.0719605996372576e-09, -1.4063794719343636,
+              0.8312513506686781, 1.9657712859280476]],
+    "ur10e": [[-1.3032243538635981, -0.8412605751451552, 3.326088148972903e-10, -1.5721424045174326,
+               -1.4398573429550101, -2.1420434433789515],
+              [-1.8911280685637049, -3.120367095025993, -4.883081477984455e-10, -1.5728946912961486,
+               -1.5731279547919612, -0.24847102940014176]],
+}
+
+
+@pytest.mark.parametrize("name", sorted(UR_EXTRA_BRANCH))
+def test_no_valid_branch_misses_a_reachable_pose(name):
+    """A branch at the boundary of its reach is no solution (not valid) of a pose another valid
+    branch reaches exactly (within 1 nm); poses out of reach by rounding keep their boundary
+    branches (test_reach_error_is_the_distance_outside_reach)."""
+    robot = load_robot(name)
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-math.pi, math.pi, (3000, 6))
+    q[:, 2] = rng.normal(0.0, 1e-9, len(q))  # stretched elbow: where boundary branches appear
+    q = np.vstack([UR_EXTRA_BRANCH[name], q])
+    T = robot.fk(q)
+    sol = robot.ik(T)
+    pos, ang = pose_errors(robot, sol, T)
+    assert np.all(pos[sol.valid] <= 1e-9), pos[sol.valid].max()
+    assert np.all(ang[sol.valid] <= 1e-9)
+    assert found(sol, q).all()
+    # the branches left out still say by how much they miss
+    missed = (sol.reach_error > 1e-9) & (sol.reach_error <= REACH_TOL)
+    assert missed[:2].any(axis=-1).all() and not np.any(sol.valid & missed)
+    # Out of reach by rounding: the wrist-2 point 0.5 um inside the cylinder of radius d4 about
+    # axis 1, which no branch reaches; the boundary branches stay valid, off by 0.5 um.
+    q0 = families(robot, rng, 5)["shoulder d4"]
+    T0 = robot.fk(q0)
+    p5 = robot.frames(q0)[:, 5, :2, 3]
+    T0[:, :2, 3] -= 0.5e-6 * p5 / np.linalg.norm(p5, axis=-1, keepdims=True)
+    sol = robot.ik(T0)
+    pos, _ = pose_errors(robot, sol, T0)
+    assert sol.valid.any(axis=-1).all()
+    np.testing.assert_allclose(sol.reach_error[sol.valid], 0.5e-6, rtol=1e-3)
+    np.testing.assert_allclose(pos[sol.valid], 0.5e-6, rtol=1e-3)
+
+
 def test_q_ref_shape_is_checked():
     robot = load_robot("kuka_kr16")
     T = robot.fk(np.zeros((3, 6)))

@@ -197,8 +197,8 @@ URDF_CHAINS = {
     # abb_irb120_support/urdf/irb120_3_58_macro.xacro; tool0 = link_6 @ Ry(90)
     "abb_irb120": (abb_chain((0, 0, 0), (0, 0, 0.29), (0, 0, 0.27), (0, 0, 0.07), (0.302, 0, 0),
                              (0.072, 0, 0)), None, hom(ry(PI / 2))),
-    # abb_irb2400_support/urdf/irb2400_macro.xacro (its tool0 predates REP-199;
-    # ABB tool0 = link_6 @ Ry(90))
+    # abb_irb2400_support/urdf/irb2400_macro.xacro (1.3.1): joint_6-tool0 rpy (0, pi/2, 0),
+    # the ABB tool0 (since ros-industrial/abb commit 41966cf, issue #32)
     "abb_irb2400": (abb_chain((0, 0, 0), (0.1, 0, 0.615), (0, 0, 0.705), (0.258, 0, 0.135),
                               (0.497, 0, 0), (0.085, 0, 0)), None, hom(ry(PI / 2))),
     # abb_irb6700_support/urdf/irb6700_200_260_macro.xacro
@@ -309,6 +309,28 @@ def test_matches_ros_industrial_urdf(name):
     rng = np.random.default_rng(3)
     for q in random_q(robot, rng, 25):
         assert_pose(robot.fk(q), urdf_fk(chain, q, pre, post), TOL, name)
+
+
+# <limit lower upper> of joint_1..joint_6 (radians, or the macro's ${radians(deg)} in degrees).
+ROS_LIMITS = {
+    # ros-industrial/fanuc fanuc_lrmate200id_support/urdf/lrmate200id_macro.xacro, package 0.5.1
+    # (limits in degrees since commit 94d06d5, 2020-08-07; J3 was -2.450966 .. 4.886922 rad)
+    "fanuc_lrmate200id": np.radians([(-170, 170), (-100, 145), (-70, 205), (-190, 190),
+                                     (-125, 125), (-360, 360)]),
+    # ros-industrial/fanuc fanuc_m20ia_support/urdf/m20ia_macro.xacro
+    "fanuc_m20ia": np.array([(-2.967060, 2.967060), (-1.745329, 2.792527), (-3.228859, 4.766843),
+                             (-3.490658, 3.490658), (-2.443461, 2.443461), (-4.712389, 4.712389)]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(ROS_LIMITS))
+def test_fanuc_limits_are_the_ros_industrial_ones(name):
+    # The files round the radians to 0.01 deg (M-20iA J3 273.12 deg); robotcell applies the
+    # limits to the pendant's values (docs/robots.md, "J2/J3 coupling").
+    robot = robotcell.load_robot(name)
+    ros = ROS_LIMITS[name]
+    assert np.allclose(robot.lower, ros[:, 0], rtol=0, atol=0.006 * DEG)
+    assert np.allclose(robot.upper, ros[:, 1], rtol=0, atol=0.006 * DEG)
 
 
 @pytest.mark.parametrize("name", sorted(OPW))

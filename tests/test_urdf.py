@@ -173,3 +173,22 @@ def test_missing_parser_says_how_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "urdf_parser_py.urdf", None)
     with pytest.raises(RobotcellError, match=r"pip install 'robotcell\[urdf\]'"):
         read_urdf(SCARA)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_gantry_with_two_parallel_prismatic_axes(convention):
+    # A gantry whose X travel is split over two parallel carriages (a redundant axis, legal):
+    # the DH model holds both as prismatic joints and moves like the URDF.
+    text = urdf(
+        joint("x1", "prismatic", "base", "c1", xyz="0 0 1.5", axis="1 0 0")
+        + joint("x2", "prismatic", "c1", "c2", xyz="0 0.2 -0.1", axis="1 0 0")
+        + joint("z", "prismatic", "c2", "c3", axis="0 0 -1")
+        + joint("c", "revolute", "c3", "tool", xyz="0 0 -0.3", axis="0 0 1"),
+        links("base", "c1", "c2", "c3", "tool"),
+    )
+    chain = read_urdf(text)
+    der = dh_from_urdf(text, convention)
+    assert [j.type for j in der.robot.joints] == ["prismatic", "prismatic", "prismatic", "revolute"]
+    q = np.random.default_rng(8).uniform(-1, 1, (100, 4))
+    dp, dR = pose_error(der.robot.fk(q), chain.fk(q))
+    assert dp < 1e-9 and dR < 1e-9

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
+from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.dh import link_transform
 from robotcell.kinematics.robot import Robot
 
@@ -136,9 +137,10 @@ def normal_up(chain: Robot, R_world_0: ArrayLike, normal: ArrayLike,
     # (2 pi written out: importing robotcell.ik.limits would load the whole IK package into
     # every command that reads a cell file)
     lo, hi, turn = chain.lower, chain.upper, 2.0 * np.pi
-    shift = np.where(values < lo, np.ceil((lo - values) / turn),
-                     np.where(values > hi, -np.ceil((values - hi) / turn), 0.0))
+    low, high = values < lo - LIMIT_TOL, values > hi + LIMIT_TOL
+    shift = np.where(low, np.ceil((lo - values) / turn),
+                     np.where(high, -np.ceil((values - hi) / turn), 0.0))
     values = values + np.nan_to_num(shift) * turn
     with np.errstate(invalid="ignore"):
-        valid = np.all((values >= lo) & (values <= hi), axis=-1)
+        valid = np.all(within(values, lo, hi), axis=-1)
     return values, valid

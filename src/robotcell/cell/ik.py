@@ -46,6 +46,7 @@ from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.track import TrackChoice, TrackRobot
 from robotcell.ik.trackchoice import choose_track, scan_track
+from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import finite_array, invert, validate_pose
 
@@ -325,8 +326,8 @@ def _fit_limits(q: NDArray[np.float64], rev: NDArray[np.bool_], lo: NDArray[np.f
     with warnings.catch_warnings():  # a branch that reaches no target is all NaN
         warnings.simplefilter("ignore", RuntimeWarning)
         qmin, qmax = np.nanmin(q, axis=1), np.nanmax(q, axis=1)  # (K, 8, n)
-    kmin = np.ceil((lo - qmin) / TWO_PI)   # smallest turn count with min >= lo
-    kmax = np.floor((hi - qmax) / TWO_PI)  # largest with max <= hi
+    kmin = np.ceil((lo - LIMIT_TOL - qmin) / TWO_PI)   # smallest turn count with min >= lo
+    kmax = np.floor((hi + LIMIT_TOL - qmax) / TWO_PI)  # largest with max <= hi
     start = q[:, 0]
     target = start if ref is None else np.broadcast_to(ref, start.shape)
     want = np.round((target - start) / TWO_PI)
@@ -652,7 +653,7 @@ def _failure_cause(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int) -> 
     if not ps.reach[k, i, b]:
         return "reach", "out of reach (or track/table outside its limits)"
     if not ps.inside[k, i, b]:
-        j = int(np.argmax((qi < robot.lower) | (qi > robot.upper)))
+        j = int(np.argmax(~within(qi, robot.lower, robot.upper)))
         return "limit", f"axis {j + 1} leaves its limits ({math.degrees(qi[j]):.1f} deg)"
     j = int(np.argmax(np.abs(qi - ps.q[k, i - 1, b])))
     jump = math.degrees(abs(qi[j] - ps.q[k, i - 1, b, j]))

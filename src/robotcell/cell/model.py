@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import axischain, kinematics
 from robotcell.cell.kinematics import RESERVED_FRAMES
 from robotcell.errors import InputError
+from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import finite_array, validate_pose
 
@@ -165,9 +166,9 @@ class Track:
         return kinematics.track_pose(self.T_L_R0, self.direction * self.scale, e)
 
     def within_limits(self, e: ArrayLike) -> NDArray[np.bool_]:
-        """Whether track positions ``e`` (shape ``(...)``, metres) are within the limits."""
-        arr = np.asarray(e, dtype=float)
-        return (arr >= self.lower) & (arr <= self.upper)
+        """Whether track positions ``e`` (shape ``(...)``, metres) are within the limits (up to
+        rounding, :data:`robotcell.kinematics.bounds.LIMIT_TOL`)."""
+        return within(e, self.lower, self.upper)
 
 
 @dataclass
@@ -204,9 +205,9 @@ class Turntable:
         _limits(self.lower, self.upper, "turntable")
 
     def within_limits(self, theta: ArrayLike) -> NDArray[np.bool_]:
-        """Whether table angles ``theta`` (shape ``(...)``, radians) are within the limits."""
-        arr = np.asarray(theta, dtype=float)
-        return (arr >= self.lower) & (arr <= self.upper)
+        """Whether table angles ``theta`` (shape ``(...)``, radians) are within the limits (up to
+        rounding, :data:`robotcell.kinematics.bounds.LIMIT_TOL`)."""
+        return within(theta, self.lower, self.upper)
 
     # -- the interface shared with Positioner ----------------------------------------------------
     n_axes = 1
@@ -320,9 +321,9 @@ class Positioner:
         return self._axes.fk(self.axis_values(values), np.eye(4))
 
     def within_limits(self, values: ArrayLike) -> NDArray[np.bool_]:
-        """Whether axis values ``(..., n)`` are all within their limits, shape ``(...)``."""
-        v = self.axis_values(values)
-        return np.all((v >= self.lower) & (v <= self.upper), axis=-1)
+        """Whether axis values ``(..., n)`` are all within their limits (up to rounding,
+        :data:`robotcell.kinematics.bounds.LIMIT_TOL`), shape ``(...)``."""
+        return np.all(within(self.axis_values(values), self.lower, self.upper), axis=-1)
 
     def normal_up(self, normal: ArrayLike, T_world_parent: ArrayLike | None = None
                   ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:

@@ -199,7 +199,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         nominal = load_robot(robot)
         meas = read_measurements(measurements, nominal.prismatic)
     else:
-        nominal, meas = first_estimate(measurements)
+        nominal, meas = first_estimate(measurements, j23_factor=j23 or 0.0)
     if j23 is not None:
         result = identify_with_coupling(nominal, meas, j23, **options)
     else:

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.dhprocedure.axes import AxisChain
-from robotcell.errors import IllPosedError, InputError
+from robotcell.errors import InputError
 from robotcell.kinematics.dh import Convention
 from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import invert, make_pose
@@ -135,8 +135,11 @@ def dh_from_axes(
     ------
     InputError
         Unknown convention, or signs that are not +-1.
-    IllPosedError
-        Two consecutive prismatic joints along parallel axes (they make the same motion).
+
+    Notes
+    -----
+    Consecutive prismatic joints along parallel axes (a gantry with redundant axes) are legal:
+    DH holds them as two ``d`` variables along the same Z direction.
     """
     if convention not in ("standard", "modified"):
         raise InputError(f"convention must be 'standard' or 'modified', got {convention!r}")
@@ -144,14 +147,6 @@ def dh_from_axes(
     s = np.ones(n) if signs is None else np.asarray(signs, dtype=float)
     if s.shape != (n,) or not np.all(np.isin(s, (1.0, -1.0))):
         raise InputError(f"signs must be {n} values, each +1 or -1, got {signs!r}")
-    for k in range(n - 1):
-        both = chain.types[k] == chain.types[k + 1] == "prismatic"
-        if both and np.linalg.norm(np.cross(chain.directions[k], chain.directions[k + 1])) <= tol:
-            raise IllPosedError(
-                f"joints {chain.names[k]} and {chain.names[k + 1]} are both prismatic along "
-                "parallel axes: they make the same motion, so the chain has one axis too many; "
-                "merge them into one joint"
-            )
     flange = chain.flange
     points = np.vstack([chain.points, flange[:3, 3]])
     z = np.vstack([chain.directions * s[:, None], flange[:3, 2]])

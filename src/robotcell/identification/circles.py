@@ -13,6 +13,7 @@ before (``L_j(0) = M_{j-1}(-q_{j-1}) ... M_1(-q_1) L_j(q)``). The DH procedure o
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -147,7 +148,8 @@ def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
     return pts, dirs, types
 
 
-def first_estimate(path: str | Path, name: str = "identified") -> tuple[Robot, Measurements]:
+def first_estimate(path: str | Path, name: str = "identified", j23_factor: float = 0.0
+                   ) -> tuple[Robot, Measurements]:
     """Start model and measurements from a CSV without a nominal model.
 
     Parameters
@@ -158,24 +160,40 @@ def first_estimate(path: str | Path, name: str = "identified") -> tuple[Robot, M
         in mm).
     name : str
         Name of the model.
+    j23_factor : float
+        J2/J3 coupling ``k`` of the controller values in the CSV: the chain's joint 3 is
+        ``a3 + k * a2`` (FANUC: 1, the ROS-Industrial driver's ``J23_factor``). The rows must
+        move one joint of the chain at a time, i.e. in these model values (moving J2 alone on a
+        FANUC means a3 = -a2, so that the forearm keeps still relative to the upper arm).
 
     Returns
     -------
     robot : Robot
-        See :func:`start_model`.
+        See :func:`start_model`; its joint values are the chain's (model) values, without the
+        coupling, as :func:`~robotcell.identification.identify` with ``coupling=j23_factor``
+        expects of a nominal model.
     measurements : Measurements
-        The CSV in SI units, prismatic joints in metres.
+        The CSV in SI units, prismatic joints in metres: controller values, as in the file.
 
     Raises
     ------
     IllPosedError
-        A joint that no rows move alone.
+        A joint that no rows move alone (in model values).
     """
     raw = read_measurements(path)
-    types = axis_lines(raw)[2]
+    types = axis_lines(_model_values(raw, j23_factor))[2]
     pris = np.array([t == "prismatic" for t in types])
     meas = read_measurements(path, pris) if pris.any() else raw
-    return start_model(meas, pris, name), meas
+    return start_model(_model_values(meas, j23_factor), pris, name), meas
+
+
+def _model_values(meas: Measurements, k: float) -> Measurements:
+    """``meas`` with joint 3 replaced by the chain's ``a3 + k * a2`` (unchanged for ``k = 0``)."""
+    if not k or meas.q.shape[1] < 3:
+        return meas
+    q = meas.q.copy()
+    q[:, 2] += k * q[:, 1]
+    return replace(meas, q=q)
 
 
 def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,

@@ -14,6 +14,10 @@ Steps (``docs/identification.md``):
    nominal value; the parameters it duplicates are named in the reason.
 4. **Identification.** Levenberg-Marquardt (``scipy.optimize.least_squares``, MINPACK) over the
    identifiable set with the analytic Jacobian of :class:`~robotcell.identification.chain.Chain`.
+   A link constant whose 1-sigma (before the fit at the stated accuracies, after it a
+   posteriori) exceeds what a manufacturing error can plausibly be (``max_sigma_length``,
+   ``max_sigma_angle``) is held at its nominal value too, the worst first, and named with the
+   parameter it trades off against: the measurements see it too weakly to move it.
 5. **Uncertainty.** ``cov = s0^2 (J^T J)^-1`` with the weighted Jacobian and the a-posteriori
    variance factor ``s0^2 = chi^2 / dof``; correlations, the scaled condition number, and rows
    whose residual is an outlier at 3 sigma (leave-one-out noise level, hat-matrix leverage).
@@ -50,6 +54,12 @@ POINT_SIGMA = 0.05e-3
 ANGLE_SIGMA = math.radians(0.02)
 #: Probability inside "3 sigma" for a 1-D Gaussian: the outlier test level.
 _THREE_SIGMA_P = 0.9973
+#: Largest 1-sigma of a free link length (m) and angle (rad): several times what the link
+#: constants of an industrial arm can plausibly be off by (well under 1 mm and 0.5 deg).
+MAX_SIGMA_LENGTH = 5e-3
+MAX_SIGMA_ANGLE = math.radians(2.0)
+#: Parameter name endings that are lengths (the others of a link are angles).
+_LENGTHS = ("a", "d", "x", "y", "z")
 
 
 class _Problem:
@@ -238,6 +248,42 @@ def _identifiable(J: NDArray[np.float64], cand: Sequence[int], prio: Sequence[in
     return np.array(sorted(kept), dtype=int), fixed
 
 
+def _sigmas(J: NDArray[np.float64], factor: float = 1.0) -> tuple[NDArray[np.float64],
+                                                                  NDArray[np.float64]]:
+    """1-sigma of each column's parameter and the covariance, ``factor^2 (J^T J)^-1``."""
+    _, S, Vt = np.linalg.svd(J, full_matrices=False)
+    cov = (Vt.T / np.maximum(S, S[0] * 1e-15) ** 2) @ Vt * factor**2
+    return np.sqrt(np.abs(np.diag(cov))), cov
+
+
+def _too_uncertain(J: NDArray[np.float64], kept: Sequence[int], bound: NDArray[np.float64],
+                   names: Sequence[str], factor: float = 1.0) -> tuple[list[int], dict[int, str]]:
+    """Hold the parameters whose 1-sigma exceeds ``bound``, the worst (relative) first.
+
+    ``J`` is the weighted Jacobian over all parameters, ``factor`` the variance factor's square
+    root to apply (1 before the fit). Returns the parameters still free and a reason per held one.
+    """
+    kept, held = list(kept), {}
+    while True:
+        sig, cov = _sigmas(J[:, kept], factor)
+        ratio = sig / bound[kept]
+        w = int(np.argmax(ratio))
+        if ratio[w] <= 1.0:
+            return kept, held
+        corr = np.abs(cov[w] / (sig[w] * sig))
+        corr[w] = -1.0
+        c = kept[int(np.argmax(corr))]
+        length = names[kept[w]].split(".")[-1] in _LENGTHS
+        scale, unit = (1e3, "mm") if length else (180.0 / math.pi, "deg")
+        held[kept[w]] = (
+            f"not determined by these measurements: 1-sigma {sig[w] * scale:.3g} {unit}, more than "
+            f"the {bound[kept[w]] * scale:.3g} {unit} a link constant can plausibly be off "
+            f"(it trades off against {names[c]}, correlation {corr.max():.2f}); held at its "
+            "nominal value (measure configurations or targets that move it, e.g. targets away "
+            "from the last axis)")
+        kept.pop(w)
+
+
 def identify(
     nominal: Robot,
     measurements: Measurements,
@@ -249,6 +295,8 @@ def identify(
     coupling: float | None = None,
     fit_coupling: bool = False,
     rank_tol: float = 1e-6,
+    max_sigma_length: float = MAX_SIGMA_LENGTH,
+    max_sigma_angle: float = MAX_SIGMA_ANGLE,
     name: str | None = None,
 ) -> IdentificationResult:
     """Identify the kinematic parameters of a serial chain from measured points or poses.
@@ -278,6 +326,10 @@ def identify(
     rank_tol : float
         A scaled Jacobian column closer than this (sine of the angle) to the span of the columns
         kept before it is fixed as not identifiable.
+    max_sigma_length, max_sigma_angle : float
+        A link constant whose 1-sigma exceeds this (m, rad; default 5 mm and 2 deg, several
+        times any plausible manufacturing error) is held at its nominal value and named in
+        ``fixed``: the measurements see it too weakly to move it (``math.inf``: never).
     name : str, optional
         Name of the identified model (default ``<nominal>_identified``).
 
@@ -299,6 +351,9 @@ def identify(
     for label, s in (("point_sigma", point_sigma), ("angle_sigma", angle_sigma)):
         if not (math.isfinite(s) and s > 0):
             raise InputError(f"{label} must be a positive number, got {s}")
+    for label, s in (("max_sigma_length", max_sigma_length), ("max_sigma_angle", max_sigma_angle)):
+        if not s > 0:
+            raise InputError(f"{label} must be a positive number (math.inf: no limit), got {s}")
     pose = measurements.rotations is not None
     if nominal.coupling is not None and nominal.coupling.j23_factor is None:
         raise InputError(f"{nominal.name} has a joint coupling other than a J2/J3 factor (passive "
@@ -342,8 +397,20 @@ def identify(
             f"at least twice as many coordinates as unknowns are needed to check the result: "
             f"measure at least {-(-2 * kept.size // prob.ncomp)} configurations (better 3 to 5 times "
             "as many, spread over the joint ranges)")
-    x2 = _solve(prob, x1, kept)
-    return _result(nominal, chain, prob, x2, kept, fixed, rp0, rr0, name, x1)
+    length = np.array([nm.split(".")[-1] in _LENGTHS for nm in chain.names])
+    bound = np.where(groups == "link", np.where(length, max_sigma_length, max_sigma_angle), np.inf)
+    free, held = _too_uncertain(J1, kept, bound, chain.names)  # at the stated accuracies
+    while True:
+        fixed.update(held)
+        x2 = _solve(prob, x1, np.array(sorted(free), dtype=int))
+        # a posteriori: the variance factor may show that the stated accuracy was optimistic
+        w = prob.weighted(x2)
+        s0 = math.sqrt(max(float(np.sum(w**2)) / max(m - len(free), 1), 1.0))
+        free, held = _too_uncertain(prob.jacobian(x2), free, bound, chain.names, s0)
+        if not held:
+            break
+    return _result(nominal, chain, prob, x2, np.array(sorted(free), dtype=int), fixed, rp0, rr0,
+                   name, x1)
 
 
 def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> IdentificationResult:
@@ -460,7 +527,8 @@ def identify_with_coupling(nominal: Robot, measurements: Measurements, k: float,
         Stated factor: ``q3_model = J3 + k * J2`` (FANUC: -1 when J3 is the forearm's angle to the
         horizontal, as the ROS-Industrial FANUC driver's ``J23_factor``).
     **options
-        Passed to :func:`identify` (accuracies, ``scale``, ``rank_tol``, ``name``).
+        Passed to :func:`identify` (accuracies, ``scale``, ``rank_tol``, ``max_sigma_length``,
+        ``max_sigma_angle``, ``name``).
 
     Returns
     -------

@@ -32,9 +32,10 @@ from robotcell.ik.palletizer import (
     palletizer_parameters,
     palletizer_problems,
 )
-from robotcell.ik.result import IKSolutions, flat_reference
+from robotcell.ik.result import IKSolutions, exact_branches, flat_reference
 from robotcell.ik.seeded import SeededSolver
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
+from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, validate_pose
 
@@ -120,7 +121,7 @@ class AnalyticSolver:
             ok = self._fold(sub)
             q[..., per] = sub
             f = q[..., fixed]
-            ok &= np.all((f >= lo) & (f <= hi), axis=-1)
+            ok &= np.all(within(f, lo, hi), axis=-1)
         else:
             ok = self._fold(q)
         if inter is not None:
@@ -181,9 +182,10 @@ class AnalyticSolver:
                 rb = self._kernel(self.params, R, P, qb, err[s:s + _BLOCK],
                                   None if ref is None else ref[s:s + _BLOCK], lo, hi)
             if self._limits is None:
-                valid[s:s + _BLOCK] = rb & self._fold(qb)  # 2*pi rule and limits, in cache
+                vb = rb & self._fold(qb)  # 2*pi rule and limits, in cache
             else:
-                valid[s:s + _BLOCK] = self._controller(qb, rb)
+                vb = self._controller(qb, rb)
+            valid[s:s + _BLOCK] = exact_branches(vb, err[s:s + _BLOCK])
             reach[s:s + _BLOCK] = rb
         return IKSolutions(q.reshape(batch + (nb, n)), valid.reshape(batch + (nb,)),
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))

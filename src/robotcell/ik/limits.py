@@ -3,6 +3,8 @@
 A revolute joint that turns more than one revolution (KUKA A6 +-350 deg, ABB axis 6 +-400 deg,
 UR joints +-360 deg) reaches the same pose at ``q`` and ``q +- 2*pi``. The analytic solvers first
 produce the principal value in ``(-pi, pi]`` and then apply the rule of :class:`JointFolder`.
+Limits count up to rounding (:data:`robotcell.kinematics.bounds.LIMIT_TOL`): a value at a limit
+is inside it.
 """
 
 from __future__ import annotations
@@ -11,6 +13,8 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from robotcell.kinematics.bounds import LIMIT_TOL, within
 
 __all__ = ["TWO_PI", "JointFolder", "shift_into_interval", "wrap_to_pi"]
 
@@ -27,6 +31,9 @@ def shift_into_interval(q: NDArray[np.float64], lo: NDArray[np.float64] | float,
                         hi: NDArray[np.float64] | float) -> NDArray[np.float64]:
     """The smallest 2*pi-equivalent of ``q`` that is ``>= lo``, or NaN if it is above ``hi``.
 
+    Both bounds count up to rounding (:data:`robotcell.kinematics.bounds.LIMIT_TOL`): a value
+    ``lo - 1e-14`` stays, it is not moved up by a turn.
+
     Parameters
     ----------
     q : ndarray, shape (...)
@@ -39,8 +46,8 @@ def shift_into_interval(q: NDArray[np.float64], lo: NDArray[np.float64] | float,
     ndarray, shape (...)
         When ``hi - lo < 2*pi`` this is the only equivalent in ``[lo, hi]``, if any.
     """
-    out = q + TWO_PI * np.ceil((lo - q) * (1.0 / TWO_PI))
-    return np.where(out <= hi, out, np.nan)
+    out = q + TWO_PI * np.ceil((lo - LIMIT_TOL - q) * (1.0 / TWO_PI))
+    return np.where(out <= hi + LIMIT_TOL, out, np.nan)
 
 
 class JointFolder:
@@ -83,10 +90,10 @@ class JointFolder:
             col = q[..., j]
             if lo < -math.pi:
                 down = col - TWO_PI
-                col[...] = np.where((col > hi) & (down >= lo), down, col)
+                col[...] = np.where((col > hi + LIMIT_TOL) & (down >= lo - LIMIT_TOL), down, col)
             elif hi > math.pi:
                 up = col + TWO_PI
-                col[...] = np.where((col < lo) & (up <= hi), up, col)
-            ok = (col >= lo) & (col <= hi)
+                col[...] = np.where((col < lo - LIMIT_TOL) & (up <= hi + LIMIT_TOL), up, col)
+            ok = within(col, lo, hi)
             inside = ok if inside is None else inside & ok
         return inside

@@ -36,7 +36,7 @@ from robotcell.ik.axes import (
     line_distance,
     six_revolute_problems,
 )
-from robotcell.ik.limits import TWO_PI, wrap_to_pi
+from robotcell.ik.limits import shift_into_interval, wrap_to_pi
 from robotcell.ik.result import REACH_TOL
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, rot_y, rot_z
@@ -260,12 +260,12 @@ def reach_distance(err_sq: NDArray[np.float64] | float, d: NDArray[np.float64],
 
 
 def clamp_circular(q: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
-    """The 2*pi-equivalent of ``q`` (rad) inside ``[lo, hi]``, else the nearer limit (circularly)."""
-    k = np.ceil((lo - q) / TWO_PI)
-    up = q + TWO_PI * k  # smallest equivalent >= lo
+    """The 2*pi-equivalent of ``q`` (rad) inside ``[lo, hi]`` (up to rounding), else the nearer
+    limit (circularly)."""
+    up = shift_into_interval(q, lo, hi)  # smallest equivalent >= lo, NaN above hi
     d_lo = np.abs(wrap_to_pi(q - lo))
     d_hi = np.abs(wrap_to_pi(q - hi))
-    return np.where(up <= hi, up, np.where(d_lo <= d_hi, lo, hi))
+    return np.where(np.isnan(up), np.where(d_lo <= d_hi, lo, hi), up)
 
 
 def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.float64],

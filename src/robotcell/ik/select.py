@@ -16,6 +16,7 @@ from robotcell.errors import InputError
 from robotcell.ik.config import abb_confdata, kuka_status_turn
 from robotcell.ik.limits import TWO_PI, shift_into_interval
 from robotcell.ik.result import IKSolutions
+from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Robot
 
 __all__ = ["nearest", "select_abb", "select_kuka"]
@@ -72,7 +73,7 @@ def nearest(robot: Robot, solutions: IKSolutions, q_ref: ArrayLike,
     rev = ~robot.prismatic
     k = np.where(rev, np.round((r - q) / TWO_PI), 0.0)
     cands = q[..., None] + TWO_PI * (k[..., None] + np.array([0.0, -1.0, 1.0]))  # (..., 8, n, 3)
-    inside = (cands >= robot.lower[:, None]) & (cands <= robot.upper[:, None])
+    inside = within(cands, robot.lower[:, None], robot.upper[:, None])
     dist = np.where(inside, np.abs(cands - r[..., None]), np.inf)
     dist[..., ~rev, 1:] = np.inf
     j = np.argmin(dist, axis=-1)
@@ -89,8 +90,8 @@ def _signed(q: NDArray[np.float64], negative: NDArray[np.bool_], lo: NDArray[np.
     neg = nonneg - TWO_PI  # largest equivalent < 0
     out = np.where(negative, neg, nonneg)
     # Joints with less than one revolution of range: keep the value if it already has the sign.
-    out = np.where((q < 0) == negative, np.where((q >= lo) & (q <= hi), q, out), out)
-    return np.where((out >= lo) & (out <= hi), out, np.nan)
+    out = np.where((q < 0) == negative, np.where(within(q, lo, hi), q, out), out)
+    return np.where(within(out, lo, hi), out, np.nan)
 
 
 def select_kuka(robot: Robot, solutions: IKSolutions, status: ArrayLike, turn: ArrayLike
@@ -145,8 +146,8 @@ def select_abb(robot: Robot, solutions: IKSolutions, confdata: ArrayLike
     for col, c in ((0, cf[..., 0]), (3, cf[..., 1]), (5, cf[..., 2])):
         lo = c[..., None] * quarter
         v = shift_into_interval(q[..., col], lo, lo + quarter * (1 - 1e-15))
-        q[..., col] = np.where((v >= robot.lower[col]) & (v <= robot.upper[col]), v, np.nan)
-    inside = np.all((q >= robot.lower) & (q <= robot.upper), axis=-1)
+        q[..., col] = np.where(within(v, robot.lower[col], robot.upper[col]), v, np.nan)
+    inside = np.all(within(q, robot.lower, robot.upper), axis=-1)
     got = abb_confdata(robot, np.nan_to_num(q))
     ok = solutions.reachable & inside & (got[..., 3] == cf[..., None, 3])
     out, found, _ = _pick(q, ok)

@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.ik.analytic import solve
 from robotcell.ik.result import IKSolutions
+from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import invert, make_pose, rot_x, validate_pose
 
@@ -130,7 +131,7 @@ class TrackRobot:
         xs = np.broadcast_to(self._track(x), arr.shape[:-2])
         sol = solve(self.arm, invert(self.base_pose(xs)) @ arr, tool)
         xcol = np.broadcast_to(xs[..., None, None], sol.q.shape[:-1] + (1,))
-        xin = (xs >= self.lower) & (xs <= self.upper)
+        xin = within(xs, self.lower, self.upper)
         return IKSolutions(np.concatenate([xcol, sol.q], axis=-1), sol.valid & xin[..., None],
                            sol.reachable, sol.method, sol.reach_error)
 

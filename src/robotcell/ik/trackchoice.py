@@ -52,6 +52,7 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.opw import OPWParameters
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.track import TrackChoice, TrackRobot
+from robotcell.kinematics.bounds import LIMIT_TOL
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, validate_pose
 
@@ -180,7 +181,7 @@ class _Limits:
         ok: NDArray[np.bool_] | bool = True
         for _, row, const, lo, hi in self.rows:
             q = row[0] * qm[0] + row[1] * qm[1] + row[2] * qm[2] + const
-            ok = ok & (np.mod(q - lo, TWO_PI) <= hi - lo)
+            ok = ok & (np.mod(q - lo + LIMIT_TOL, TWO_PI) <= hi - lo + 2 * LIMIT_TOL)
         return ok
 
     def ok(self, j: int, c: NDArray[np.float64], s: NDArray[np.float64]

@@ -4,6 +4,7 @@
 - :mod:`robotcell.kinematics.dh`: Denavit-Hartenberg link transforms and chains;
 - :mod:`robotcell.kinematics.robot`: :class:`~robotcell.kinematics.robot.Robot` (FK, Jacobian);
 - :mod:`robotcell.kinematics.coupling`: linear coupling of motor and DH joint values (J2/J3);
+- :mod:`robotcell.kinematics.bounds`: limit checks up to rounding;
 - :mod:`robotcell.kinematics.models`: robot model files and the robot library.
 
 Inverse kinematics is the package :mod:`robotcell.ik`, which builds on this one.

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
+from robotcell.kinematics.bounds import LIMIT_TOL, within
 
 __all__ = ["Coupling"]
 
@@ -221,7 +222,7 @@ class Coupling:
         integer = np.all(np.where(revolute_model[:, None], C == np.round(C), C == 0.0), axis=0)
         return integer & revolute_axes
 
-    def within_interaction(self, q: NDArray[np.float64], tol: float = 0.0) -> NDArray[np.bool_]:
+    def within_interaction(self, q: NDArray[np.float64], tol: float = LIMIT_TOL) -> NDArray[np.bool_]:
         """Whether controller values respect the interaction limits (NaN gives False).
 
         Parameters
@@ -229,7 +230,8 @@ class Coupling:
         q : ndarray, shape (..., n)
             Controller axis values (rad, m).
         tol : float
-            Allowed excess (rad, m).
+            Allowed excess (rad, m); default the rounding tolerance
+            :data:`robotcell.kinematics.bounds.LIMIT_TOL`.
 
         Returns
         -------
@@ -238,7 +240,7 @@ class Coupling:
         if not self.interaction.shape[0]:
             return ~np.isnan(q[..., 0])
         v = q @ self.interaction.T
-        return np.all((v >= self.interaction_lower - tol) & (v <= self.interaction_upper + tol), axis=-1)
+        return np.all(within(v, self.interaction_lower, self.interaction_upper, tol), axis=-1)
 
     def extended(self, k: int = 1) -> Coupling:
         """The coupling of ``k`` uncoupled axes placed before these (e.g. a linear track)."""

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
+from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.dh import Chain, Convention
 from robotcell.kinematics.transforms import validate_pose
@@ -239,7 +240,7 @@ class Robot:
             raise InputError(f"{name} contains NaN or infinite values")
         return arr
 
-    def within_limits(self, q: ArrayLike, tol: float = 0.0) -> NDArray[np.bool_]:
+    def within_limits(self, q: ArrayLike, tol: float = LIMIT_TOL) -> NDArray[np.bool_]:
         """Whether controller values respect the joint limits and the coupling's interaction limits.
 
         Parameters
@@ -247,7 +248,8 @@ class Robot:
         q : array_like, shape (..., n)
             Controller axis values (rad, m).
         tol : float
-            Allowed excess beyond a limit (rad or m).
+            Allowed excess beyond a limit (rad or m); default the rounding tolerance
+            :data:`robotcell.kinematics.bounds.LIMIT_TOL`, so that a value at a limit is inside.
 
         Returns
         -------
@@ -255,9 +257,9 @@ class Robot:
         """
         return self._inside(self._joints(q), tol)
 
-    def _inside(self, q: NDArray[np.float64], tol: float = 0.0) -> NDArray[np.bool_]:
+    def _inside(self, q: NDArray[np.float64], tol: float = LIMIT_TOL) -> NDArray[np.bool_]:
         """:meth:`within_limits` of unchecked values ``(..., n)``: NaN values are outside."""
-        ok = np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+        ok = np.all(within(q, self.lower, self.upper, tol), axis=-1)
         if self.coupling is not None:
             ok &= self.coupling.within_interaction(q, tol)
         return ok

@@ -34,6 +34,7 @@ from robotcell.cell.kinematics import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.io.fileio import atomic_write
+from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
 
@@ -584,7 +585,7 @@ def _positioner_values(lower: float, upper: float, values: ArrayLike | None,
     v = np.atleast_1d(np.asarray(values, dtype=float))
     if v.ndim != 1 or not np.all(np.isfinite(v)):
         raise InputError(f"{what} values must be a list of finite numbers (rad)")
-    out = (v < lower) | (v > upper)
+    out = ~within(v, lower, upper)
     if np.any(out):
         raise InputError(f"{what} value(s) {', '.join(f'{math.degrees(x):g}' for x in v[out])} deg "
                          f"are outside the axis limits [{math.degrees(lower):g}, "
