@@ -27,7 +27,7 @@ SEAM = EXAMPLES / "seam_part.csv"
 #: whole degrees, so the pulses hold them exactly).
 PPD = 100.0
 EXT = {"kuka": ".src", "abb": ".mod", "fanuc": ".ls", "yaskawa": ".jbi"}
-FORMATS = ["kuka"]
+FORMATS = ["kuka", "abb", "fanuc", "yaskawa"]
 
 
 @pytest.fixture(scope="module")
@@ -72,7 +72,8 @@ def test_a_path_on_the_turntable_round_trips_through_every_format(cell, vendor, 
     T, table = _path_poses(SEAM)
     _assert_poses_equal(_in_frame(cell, report, "part", table), T)
     q = np.stack([p.q for p in report.points])
-    assert np.abs(q - result.q).max() < 1e-6  # the configuration as written is the one solved
+    # the configuration as written is the one solved (YASKAWA rounds to 1e-3 mm, 1e-4 deg)
+    assert np.abs(q - result.q).max() < 1e-5
 
 
 @pytest.mark.parametrize("vendor", FORMATS)

@@ -6,7 +6,7 @@ from pathlib import Path
 from types import ModuleType
 
 from robotcell.errors import InputError
-from robotcell.programs import kuka
+from robotcell.programs import abb, fanuc, kuka, yaskawa
 from robotcell.programs.model import VENDORS, Program
 
 __all__ = ["EXTENSIONS", "format_module", "read_program", "vendor_of"]
@@ -15,7 +15,8 @@ __all__ = ["EXTENSIONS", "format_module", "read_program", "vendor_of"]
 EXTENSIONS = {".src": "kuka", ".dat": "kuka", ".mod": "abb", ".prg": "abb", ".ls": "fanuc",
               ".jbi": "yaskawa"}
 
-_MODULES: dict[str, ModuleType] = {"kuka": kuka}
+_MODULES: dict[str, ModuleType] = {"kuka": kuka, "abb": abb, "fanuc": fanuc,
+                                   "yaskawa": yaskawa}
 
 
 def format_module(vendor: str) -> ModuleType:

@@ -32,7 +32,7 @@ from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.export.kuka import MACHINE_INDEX
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.programs.config import config_text
-from robotcell.programs.model import Config, Program, ProgramPoint, Ref
+from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
 from robotcell.programs.text import Lines, fmt_num, strip_comment
 
 __all__ = ["read", "write"]
@@ -100,7 +100,7 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
             src.append(f"$VEL.CP={p.speed:.6g}")
             speed = p.speed
         if p.motion == "ptp" and i == 0:
-            src.append("BAS(#VEL_PTP,20)")
+            src.append(f"BAS(#VEL_PTP,{PTP_SPEED * 100:.0f})")
         z = p.zone or 0.0
         if z > 0 and z != zone:
             src.append(f"$APO.CDIS={z * 1e3:.6g}")

@@ -18,13 +18,17 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MOTIONS", "VENDORS", "Config", "Program", "ProgramPoint", "Ref"]
+__all__ = ["MOTIONS", "PTP_SPEED", "VENDORS", "Config", "Program", "ProgramPoint", "Ref"]
 
 #: Program formats: one per controller family.
 VENDORS = ("kuka", "abb", "fanuc", "yaskawa")
 
 #: Motions a point is reached with: joint interpolation, or a straight line of the TCP.
 MOTIONS = ("ptp", "lin")
+
+#: Speed of joint motions where a format writes it as a fraction of the axes' maximum speed
+#: (KUKA ``BAS(#VEL_PTP,20)``, FANUC ``20%``, YASKAWA ``VJ=20.00``).
+PTP_SPEED = 0.2
 
 
 @dataclass(frozen=True)
@@ -112,8 +116,9 @@ class ProgramPoint:
         External axis values by the name the file gives them (``E1``, ``eax_b``, ``GP2:J1``,
         ``BC1``, ``EC1``), in the file's units (mm, deg, pulses).
     speed : float or None
-        TCP speed of a linear motion (m/s), or the fraction of the axes' speed of a joint
-        motion (0..1), as written.
+        TCP speed (m/s) where the file writes one: linear motions, and ABB's joint motions
+        (``speeddata``). The other formats move joint motions at a fraction of the axes' speed
+        (:data:`PTP_SPEED`).
     zone : float or None
         Corner distance (m; 0 for an exact stop) where the file writes one.
     where : str

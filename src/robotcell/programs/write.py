@@ -38,10 +38,6 @@ from robotcell.programs.text import NAME_LIMITS, program_name
 __all__ = ["PathBreaks", "WriteResult", "build_programs", "point_names", "write_program",
            "written_poses"]
 
-#: Joint speed of point-to-point motions (fraction of the axes' maximum speed).
-PTP_SPEED = 0.2
-
-
 class PathBreaks(RobotcellError):
     """A path that cannot be one program; ``breaks`` say where and why.
 
@@ -233,7 +229,7 @@ def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, n
         points.append(ProgramPoint(
             names[i], 0, motion, tool_ref, frame_ref, pose=poses[i], config=flags[i],
             external=axes.to_file(path.track[i], path.table[i]),
-            speed=float(targets.speed[j]) if motion == "lin" else PTP_SPEED,
+            speed=float(targets.speed[j]),
             zone=float(targets.zone[j])))
     return Program(name, vendor, points)
 
