@@ -178,3 +178,51 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
         return
     click.echo(format_table(["point", "line", "problem"], report.rows()), err=True)
     raise BadPoints(f"{program_file}: {len(report.bad)} of {n} points are bad")
+
+
+@program.command("retarget")
+@click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
+@click.option("--from", "old_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file the program was taught in.")
+@click.option("--to", "new_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file after the recalibration.")
+@click.option("-o", "--output", "folder", required=True, type=click.Path(file_okay=False),
+              help="Folder for the retargeted program files (created; its parent must exist).")
+@_ppd_option
+@click.option("--json", "as_json", is_flag=True, help="Print every joint point as JSON.")
+def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, ppd: str | None,
+                 as_json: bool) -> None:
+    """Move the joint points of PROGRAM (KUKA E6AXIS/AXIS, ABB jointtarget, FANUC joint
+    positions) so that the TCP stays where it was after a recalibration (a new tool, base,
+    track, table or identified arm): solved in the --to cell where the --from cell had the TCP.
+    Cartesian points are left as they are: they follow the exported tool and frame data.
+    Prints the largest axis change per point; a point the new cell cannot reach exits with
+    status 3 and nothing is written.
+
+    \b
+    Example:
+      robotcell program retarget prog/weld.src --from old.yaml --to cell.yaml -o prog_new
+    """
+    from robotcell.programs.retarget import RetargetFailed, retarget_program
+
+    old, new = Cell.load(old_path), Cell.load(new_path)
+    with _flags():
+        try:
+            result = retarget_program(program_file, old, new, folder, _ppd(ppd),
+                                      inputs=(old_path, new_path))
+        except RetargetFailed as exc:
+            raise BadPoints(f"{program_file}: {exc}") from None
+    rows = [[p.name, p.line, f"{math.degrees(p.change):.4f}", f"{p.tcp_error * 1e3:.6f}"]
+            for p in result.points]
+    if as_json:
+        click.echo(json.dumps({"files": result.files, "cartesian_points": result.cartesian,
+                               "points": [{"name": p.name, "line": p.line,
+                                           "change_deg": round(math.degrees(p.change), 9),
+                                           "tcp_error_mm": round(p.tcp_error * 1e3, 9)}
+                                          for p in result.points]}, indent=2))
+        return
+    if rows:
+        click.echo(format_table(["point", "line", "largest change (deg)", "TCP error (mm)"],
+                                rows))
+    click.echo(f"{len(result.points)} joint points retargeted, {result.cartesian} Cartesian "
+               f"points kept; wrote {', '.join(result.files)}")
