@@ -119,9 +119,13 @@ def _statements(lines: Lines) -> list[tuple[int, str]]:
     out: list[tuple[int, str]] = []
     cur: list[str] = []
     start = 0
+    header = False  # the %%% ... %%% block of old .prg/.mod files
     for lineno, raw in enumerate(lines.lines, start=1):
         line = strip_comment(raw, "!").strip()
-        if not line or line.startswith("%"):
+        if line.startswith("%%%"):
+            header = not header
+            continue
+        if not line or header:
             continue
         if not cur:
             start = lineno
@@ -267,7 +271,7 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
             raise lines.error(lineno, f"{instr} needs target, speed, zone and tool")
         target, speed, zone, tool = args[0], args[1], args[2], args[3]
         tool_name = tool.partition("\\")[0]
-        wobj = re.search(r"WObj\s*:=\s*(\w+)", tool, re.IGNORECASE)
+        wobj = re.search(r"\\WObj\s*:=\s*(\w+)", m.group(2), re.IGNORECASE)
         if target.startswith("["):
             kind = "jointtarget" if instr.lower() == "moveabsj" else "robtarget"
             value, pname = _Target(kind, target, lines, lineno), f"line {lineno}"

@@ -14,7 +14,9 @@ axis 0, with the table at the point's angle in group 2 (no coordinated motion is
 
 Read: the same, and what pendants and offline tools write: joint positions (``J1 = .. deg``),
 comments on positions (``P[3:"approach"]``), other numbers of decimals, ``cm/min``, ``sec``
-and ``%`` speeds, position registers and circular motions (skipped and named).
+and ``%`` speeds, a tool or user frame set in the program from a position register
+(``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win over the cell's), motions to
+position registers and circular motions (skipped and named).
 """
 
 from __future__ import annotations
@@ -117,6 +119,9 @@ _POS_HEAD_RE = re.compile(r"^\s*P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{")
 _VALUE_RE = re.compile(r"\b([A-Z]+\d*)\s*=\s*([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s*(mm|deg)?")
 _UF_RE = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
 _CONFIG_RE = re.compile(r"CONFIG\s*:\s*'([^']*)'")
+_PR_SET_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*([-+0-9.eE]+)\s*;")
+_FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*PR\[\s*(\d+)\s*\]\s*;",
+                           re.IGNORECASE)
 _SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|cm/min|inch/min|deg/sec|sec|msec|%)", re.IGNORECASE)
 
 
@@ -253,8 +258,22 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     positions = _positions(lines, pos_start + 1, marks["/END"]) if "/POS" in marks else {}
     points: list[ProgramPoint] = []
     skipped: list[str] = []
+    registers: dict[int, dict[int, float]] = {}
+    defined: dict[tuple[str, int], np.ndarray] = {}  # UTOOL/UFRAME set from a PR in the program
     for lineno in range(marks["/MN"] + 1, pos_start):
         text = lines.lines[lineno - 1]
+        if m := _PR_SET_RE.match(text):
+            registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = lines.number(
+                m.group(3), lineno)
+            continue
+        if m := _FRAME_SET_RE.match(text):
+            pr = registers.get(int(m.group(3)), {})
+            if sorted(pr) != [1, 2, 3, 4, 5, 6]:
+                raise lines.error(lineno, f"PR[{m.group(3)}] is not set in full (X..R) before "
+                                          f"{m.group(1)}[{m.group(2)}] takes it")
+            defined[(m.group(1).upper(), int(m.group(2)))] = pose_from_vendor(
+                [pr[i] for i in range(1, 7)], "fanuc")
+            continue
         m = _MOVE_RE.match(text)
         if not m:
             continue
@@ -271,8 +290,10 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
             raise lines.error(lineno, f"{label} is not in the /POS section")
         p = positions[n]
         motion = "ptp" if kind == "J" else "lin"
+        tool = Ref(number=p.ut, pose=defined.get(("UTOOL", p.ut)))
+        frame = Ref(number=p.uf, kind="base", pose=defined.get(("UFRAME", p.uf)))
         points.append(ProgramPoint(
-            label, lineno, motion, Ref(number=p.ut), Ref(number=p.uf, kind="base"), p.pose,
+            label, lineno, motion, tool, frame, p.pose,
             p.joints, p.config, dict(p.external), _speed(rest, motion, lines, lineno),
             _zone(rest, lines, lineno), p.where))
     return Program(name, "fanuc", points, (str(path),)), skipped
