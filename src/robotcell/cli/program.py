@@ -17,8 +17,7 @@ from robotcell.errors import InputError
 from robotcell.programs import VENDORS
 
 #: Library parameters as the command line names them.
-_FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split", "name": "--name",
-          "folder": "-o"}
+_FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split"}
 
 
 class BadPoints(click.ClickException):
