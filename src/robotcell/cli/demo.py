@@ -22,8 +22,8 @@ def demo(output: str, noise: float, seed: int) -> None:
     A KUKA KR 16 on a linear track beside a turntable, with a welding torch and a workpiece:
     every touch-up procedure is simulated with realistic noise, the cell is calibrated in order
     (tool, track, turntable, workpiece) with the same commands a technician types, each result
-    is printed beside the truth, and the HTML reports and the KUKA, ABB, FANUC and YASKAWA
-    exports are written to the output folder.
+    is printed beside the truth, and the HTML reports, the KUKA, ABB, FANUC and YASKAWA
+    exports and a KUKA program of a seam on the workpiece are written to the output folder.
 
     \b
     Example:

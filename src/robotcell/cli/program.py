@@ -200,7 +200,7 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
 
     \b
     Example:
-      robotcell program retarget prog/weld.src --from old.yaml --to cell.yaml -o prog_new
+      robotcell program retarget prog/seam_part.src --from examples/cell_kr16_track_turntable.yaml --to cell.yaml -o prog_new
     """
     from robotcell.programs.retarget import RetargetFailed, retarget_program
 
