@@ -67,6 +67,49 @@ def test_robodks_yaskawa_job_is_read():
     assert pts[0].speed == pytest.approx(0.2)
 
 
+@pytest.mark.parametrize("model,urdf", [("abb_irb1200_7_70.yaml", "irb1200_7_70.urdf"),
+                                        ("fanuc_m710ic.yaml", "m710ic50.urdf")])
+def test_the_models_written_for_robodks_programs_are_the_ros_industrial_chains(model, urdf):
+    pytest.importorskip("urdf_parser_py")
+    from robotcell import load_robot
+    from robotcell.dhprocedure import read_urdf
+
+    robot = load_robot(ROBODK / model)
+    chain = read_urdf(ROBODK / urdf)
+    q = np.random.default_rng(5).uniform(-1.5, 1.5, (40, 6))
+    serial = robot.uncoupled() if robot.coupling is not None else robot
+    qm = robot.coupling.to_model(q) if robot.coupling is not None else q
+    assert np.abs(serial.fk(qm)[..., :3, 3] - chain.fk(qm)[..., :3, 3]).max() < 1e-9
+    assert np.abs(serial.fk(qm)[..., :3, :3] - chain.fk(qm)[..., :3, :3]).max() < 1e-9
+
+
+def test_robodks_fanuc_program_is_good_in_an_m710ic_cell_under_robodks_flip_rule(tmp_path):
+    # Every point reachable as written, and the linear motion from the joint position P[2]
+    # (J5 = -56 deg) to P[3] ('N U T') keeps the configuration: N is J5 < 0, as RoboDK's post
+    # says. With F written instead the check finds the flip.
+    cell = Cell.load(ROBODK / "cell_m710ic.yaml")
+    report = check_program(read_program(ROBODK / "Program.LS")[0], cell)
+    assert report.good, report.rows()
+    assert np.degrees(report.points[2].q[4]) < 0
+    flipped = tmp_path / "flip.ls"
+    flipped.write_text((ROBODK / "Program.LS").read_text().replace("'N U T", "'F U T"))
+    bad = check_program(read_program(flipped)[0], cell)
+    assert "changes the arm's configuration" in bad.bad[0].problems[0]
+
+
+def test_robodks_rapid_module_in_an_irb1200_cell_is_reached_but_not_as_written():
+    # The module's targets are reachable by the IRB 1200, but no solution has the confdata the
+    # module writes: the station's points were not solved for this arm (its joint targets are
+    # the FANUC program's).
+    cell = Cell.load(ROBODK / "cell_irb1200.yaml")
+    report = check_program(read_program(ROBODK / "Program.mod")[0], cell)
+    assert not any("out of reach" in w for p in report.points for w in p.problems)
+    assert [p.name for p in report.bad] == ["line 21", "line 24", "line 25", "line 31", "line 34"]
+    assert "wrist singularity" in report.bad[0].problems[0]  # MoveAbsJ with axis 5 at 0
+    assert all("no solution has the configuration as written" in p.problems[0]
+               for p in report.bad[1:])
+
+
 # -- programs written by robotcell in the forms pendants keep them ------------------------------
 def test_an_abb_module_over_several_lines_with_options_reads_the_same(cell, tmp_path):
     result = write_program(SEAM, cell, "torch", "part", "abb", tmp_path / "p")
