@@ -92,6 +92,27 @@ def test_a_world_path_longer_than_the_reach_moves_the_track(cell, vendor, tmp_pa
     _assert_poses_equal(_in_frame(cell, report, "world", table), T)
 
 
+@pytest.mark.parametrize("vendor", FORMATS)
+def test_a_path_on_a_two_axis_positioner_round_trips(vendor, tmp_path):
+    cell = Cell.load(EXAMPLES / "cell_kr16_positioner.yaml")
+    k = np.arange(12)
+    a = np.radians(10.0 * k)
+    rows = np.column_stack([60 * np.cos(a), 60 * np.sin(a), 0 * k, 10 * k, 180 + 0 * k, 0 * k,
+                            0 * k, -10.0 * k])
+    path = tmp_path / "p.csv"
+    path.write_text("x,y,z,a,b,c,e1,e2\n" + "\n".join(",".join(f"{v:.6f}" for v in r)
+                                                     for r in rows) + "\n")
+    result = write_program(path, cell, "torch", "part", vendor, tmp_path / "prog",
+                           pulses_per_degree=[PPD, PPD] if vendor == "yaskawa" else None)
+    main = next(f for f in result.files if f.endswith(EXT[vendor]))
+    report = check_program_file(main, cell, [PPD, PPD] if vendor == "yaskawa" else None)
+    assert report.good, report.rows()
+    table = np.stack([p.table for p in report.points])
+    assert np.allclose(np.degrees(table), rows[:, 6:], atol=1e-9)
+    T = pose_from_vendor(rows[:, :6], "kuka")
+    _assert_poses_equal(_in_frame(cell, report, "part", table), T)
+
+
 def test_the_json_joints_through_the_cells_fk_give_the_path(cell, tmp_path, capsys):
     code, out, err = run(capsys, "program", "write", SEAM, "--cell", CELL, "--tool", "torch",
                          "--frame", "part", "--format", "kuka", "-o", tmp_path / "p", "--json")

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.cell import RESERVED_FRAMES, Cell
+from robotcell.cell import RESERVED_FRAMES, Cell, Positioner
 from robotcell.cell.kinematics import frame_pose, robot_pose
 from robotcell.errors import InputError
 from robotcell.io.export.common import ControllerData, Slot, collect, flatten_table
@@ -67,8 +67,7 @@ class Placement:
 
 def _table_batch(cell: Cell, table: ArrayLike) -> tuple[int, ...]:
     shape = np.shape(table)
-    positioner = cell.turntable is not None and cell.turntable.n_axes > 1
-    return shape[:-1] if positioner and shape else shape
+    return shape[:-1] if isinstance(cell.turntable, Positioner) and shape else shape
 
 
 def _reference(vendor: str) -> str:
