@@ -9,16 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
+from programs_helpers import CELL, EXT, SEAM
 from test_cli_fuzz import mutate_csv, mutate_text
 
 from robotcell.cell import Cell
 from robotcell.programs import write_program
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
-SEAM = EXAMPLES / "seam_part.csv"
 SEED = 2019
-EXT = {"kuka": ".src", "abb": ".mod", "fanuc": ".ls", "yaskawa": ".jbi"}
 
 
 def _check(code: int, out: str, err: str, match: str, code_wanted: int = 2) -> None:

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
+from programs_helpers import CELL, EXAMPLES, EXT, SEAM
 
 from robotcell import load_robot
 from robotcell.cell import Cell
@@ -20,13 +21,9 @@ from robotcell.programs import read_path, write_program
 from robotcell.programs.check import check_program_file, singular_distances
 from robotcell.programs.config import config_text, config_values, configs, select
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
-SEAM = EXAMPLES / "seam_part.csv"
 #: Station pulses per degree for the YASKAWA programs of the example cell (its table angles are
 #: whole degrees, so the pulses hold them exactly).
 PPD = 100.0
-EXT = {"kuka": ".src", "abb": ".mod", "fanuc": ".ls", "yaskawa": ".jbi"}
 FORMATS = ["kuka", "abb", "fanuc", "yaskawa"]
 
 

@@ -9,16 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
+from programs_helpers import CELL, ROBODK, SEAM
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.programs import read_program, write_program
 from robotcell.programs.check import check_program, check_program_file
-
-ROOT = Path(__file__).resolve().parent
-CELL = ROOT.parent / "examples" / "cell_kr16_track_turntable.yaml"
-SEAM = ROOT.parent / "examples" / "seam_part.csv"
-ROBODK = ROOT / "data" / "programs" / "robodk"
 
 
 @pytest.fixture(scope="module")

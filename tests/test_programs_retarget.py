@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
+from programs_helpers import CELL
 
 from robotcell.cell import Cell, Provenance
 from robotcell.io.poseformats import pose_from_vendor
@@ -16,8 +17,6 @@ from robotcell.programs import read_program
 from robotcell.programs.frames import tool_pose_of
 from robotcell.programs.retarget import RetargetFailed, retarget_program
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
 #: Joint points in the example cell: a1..a6 (deg), track (mm), table (deg).
 POINTS = [([-60, -80, 95, 10, 40, -20], 1200.0, 0.0),
           ([-75, -60, 85, -30, 60, 45], 1800.0, 90.0),

@@ -35,6 +35,7 @@ from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
+from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.axes import ExternalAxes, external_axes
 from robotcell.programs.config import candidates, config_text, config_values, select
@@ -148,7 +149,8 @@ def _num(v: float) -> float | None:
     return None if not math.isfinite(v) else round(float(v), 9)
 
 
-def singular_distances(robot, q: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
+def singular_distances(robot: Robot, q: ArrayLike
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Distances of configurations to the singularities of an ortho-parallel arm.
 
     Parameters
@@ -221,7 +223,7 @@ def _resolve(cell: Cell, point: ProgramPoint, axes: ExternalAxes) -> _Resolved:
     return _Resolved(T_tool, where, track, table, problems)
 
 
-def _outside(robot, q: NDArray[np.float64]) -> str:
+def _outside(robot: Robot, q: NDArray[np.float64]) -> str:
     """Words for the first axis of ``q`` outside its limits."""
     bad = (q < robot.lower) | (q > robot.upper)
     if not np.any(bad):
@@ -380,7 +382,7 @@ def _sequential(cell: Cell, pts: list[ProgramPoint], res: list[_Resolved], q: ND
             ref = q[i]
 
 
-def _jumps(robot, pts: list[ProgramPoint], q: NDArray, max_step: float,
+def _jumps(robot: Robot, pts: list[ProgramPoint], q: NDArray, max_step: float,
            problems: list[list[str]]) -> None:
     """Linear motions that change the configuration or turn an axis by more than max_step."""
     sides = np.full(len(pts), -1)

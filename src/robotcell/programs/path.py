@@ -87,20 +87,7 @@ def table_columns(cell: Cell) -> list[str]:
 
 
 def _numeric(cols: dict, name: str, path: str) -> NDArray[np.float64]:
-    v = cols[name]
-    if not isinstance(v, np.ndarray):
-        bad = next(i for i, x in enumerate(v) if not _is_number(x))
-        raise InputError(f"{path}: line {bad + 2}: column '{name}' must hold numbers, got "
-                         f"{v[bad]!r}")
-    return v
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    return require_columns(cols, [name], path)[:, 0]
 
 
 def _limits(values: NDArray[np.float64], lo: float, hi: float, what: str, unit: float,
