@@ -8,7 +8,8 @@ Written (sources in ``docs/programs.md``, chiefly the DX100 and NX100 manuals' j
   ``///RCONF l,m,n,o,p,q,0,0`` (where it changes) and ``Cxxxxx=X,Y,Z,Rx,Ry,Rz`` (mm, deg with
   ``R = Rz(Rz) Ry(Ry) Rx(Rx)``); the track as base axis ``BCxxxxx=mm``; then ``///POSTYPE
   PULSE``, ``///PULSE`` and the turntable or positioner as station axes ``ECxxxxx=pulses``;
-- ``//INST``: ``///ATTR SC,RW,RJ`` (Cartesian positions: a relative job) with ``///FRAME``,
+- ``//INST``: ``///ATTR SC,RW,RJ`` (Cartesian positions: a relative job) with ``///FRAME USER n``
+  for a user frame,
   ``///GROUP1 RB1[,BS1][,ST1]``, ``NOP``, ``MOVJ Cxxxxx [BCxxxxx] [ECxxxxx] VJ=20.00`` or
   ``MOVL ... V=100.0``, ``PL=k`` for a zone, ``END``.
 
@@ -89,9 +90,8 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
         pos += [f"EC{i:05d}=" + ",".join(str(round(p.external[k])) for k in station)
                 for i, p in enumerate(pts)]
     group = "RB1" + (",BS1" if base else "") + (",ST1" if station else "")
-    inst = ["//INST", "///DATE 2000/01/01 00:00", "///COMM robotcell",
-            "///ATTR SC,RW,RJ", f"///FRAME {'USER ' + str(user) if user else 'BASE'}",
-            f"///GROUP1 {group}", "NOP"]
+    inst = ["//INST", "///DATE 2000/01/01 00:00", "///COMM robotcell", "///ATTR SC,RW,RJ",
+            *([f"///FRAME USER {user}"] if user else []), f"///GROUP1 {group}", "NOP"]
     inst += [f"'{part}" for h in header for part in textwrap.wrap(h, COMMENT_CHARS)]
     for i, p in enumerate(pts):
         axes = f"C{i:05d}" + (f" BC{i:05d}" if base else "") + (f" EC{i:05d}" if station else "")
