@@ -239,3 +239,29 @@ def test_an_output_onto_an_input_is_refused(cell, tmp_path):
     with pytest.raises(InputError, match="it is an input of this run"):
         write_program(tmp_path / "seam.dat", cell, "torch", "part", "kuka", tmp_path,
                       name="seam")
+
+
+def test_the_written_poses_can_come_from_the_controllers_own_model(cell, tmp_path):
+    # The joints are solved in the true cell; the controller computes its joints from the
+    # written poses with its own (nominal) model: its torch 1 mm and 0.2 deg off here. The
+    # program written with controller=nominal makes the controller reach the solved joints, so
+    # the true TCP is on the path; the program written without it would miss by the offset.
+    from robotcell.cell import Provenance
+
+    nominal = Cell.load(CELL)
+    nominal.set_tool("torch", cell.tools["torch"].T_F_TCP @ pose_from_vendor(
+        [1.0, 0.0, 0.0, 0.2, 0.0, 0.0], "kuka"), Provenance())
+    result = write_program(SEAM, cell, "torch", "part", "kuka", tmp_path / "p",
+                           controller=nominal)
+    report = check_program_file(result.files[0], nominal)  # what the controller does
+    q = np.stack([p.q for p in report.points])
+    assert report.good and np.abs(q - result.q).max() < 1e-6
+    track = np.array([p.track for p in report.points])
+    T, table = _path_poses(SEAM)
+    true_tcp = cell.fk(q, track, table, tool="torch", frame="part")
+    _assert_poses_equal(true_tcp, T)
+    naive = check_program_file(write_program(SEAM, cell, "torch", "part", "kuka",
+                                             tmp_path / "n").files[0], nominal)
+    missed = cell.fk(np.stack([p.q for p in naive.points]), track, table, tool="torch",
+                     frame="part")
+    assert np.abs(missed[:, :3, 3] - T[:, :3, 3]).max() > 5e-4

@@ -262,8 +262,7 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     Raises
     ------
     InputError
-        A program of a format other than the one of its points, or a YASKAWA program with
-        station axes and no ``pulses_per_degree``.
+        A YASKAWA program for a cell with station axes and no ``pulses_per_degree``.
     """
     robot = cell.robot
     axes = external_axes(cell, program.vendor, pulses_per_degree)
