@@ -248,5 +248,9 @@ def test_documented_command_runs(where, line, command, folder, capsys, monkeypat
     assert code == 0, f"{where}:{line}: {command}\n{err}"
     for opt in ("-o", "--output", "--report"):
         if opt in argv:
-            assert Path(argv[argv.index(opt) + 1]).is_file(), f"{opt} not written"
+            written = Path(argv[argv.index(opt) + 1])
+            if argv[0] == "program":  # -o is the folder of the program files
+                assert written.is_dir() and any(written.iterdir()), f"{opt} not written"
+            else:
+                assert written.is_file(), f"{opt} not written"
 

@@ -19,6 +19,7 @@ from robotcell.cell import Cell, Frame, Tool, Turntable
 from robotcell.io.export import EXPORT_FORMATS, parse_export
 from robotcell.io.export.common import collect, flatten_table
 from robotcell.io.poseformats import pose_from_vendor
+from robotcell.programs.check import check_program_file
 from robotcell.studies.demo import EXPORT_FILES, VIEW_TABLE, demo_cells
 from robotcell.studies.plan import pose_error
 
@@ -117,6 +118,11 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
                  *(f"report_{p}.html" for p in ("tcp", "track", "turntable", "workpiece")),
                  "cell.html"]:
         assert (tmp_path / name).is_file(), name
+    # the demo's program of a seam on the part is good in the calibrated cell
+    assert "robot program" in out
+    report = check_program_file(tmp_path / "program" / "seam.src",
+                                Cell.load(tmp_path / "cell.yaml"))
+    assert report.good and len(report.points) == 36
     truth, nominal = demo_cells()
     cell = Cell.load(tmp_path / "cell.yaml")
     # The 3D view shows the calibrated cell: the torch 50 mm above the part's origin.

@@ -36,6 +36,7 @@ COMMANDS = {
     "identify": "robotcell.cli.identify:identify",
     "reach": "robotcell.cli.reach:reach",
     "sweep": "robotcell.cli.sweep:sweep_cmd",
+    "program": "robotcell.cli.program:program",
     "view": "robotcell.cli.view:view",
 }
 

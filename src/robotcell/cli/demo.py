@@ -23,7 +23,8 @@ def demo(output: str, noise: float, seed: int) -> None:
     every touch-up procedure is simulated with realistic noise, the cell is calibrated in order
     (tool, track, turntable, workpiece) with the same commands a technician types, each result
     is printed beside the truth, and the HTML reports, the KUKA, ABB, FANUC and YASKAWA
-    exports and the 3D view of the calibrated cell (cell.html) are written to the output folder.
+    exports, a KUKA program of a seam on the workpiece and the 3D view of the calibrated cell
+    (cell.html) are written to the output folder.
 
     \b
     Example:

@@ -13,8 +13,11 @@ from its layout position, a workpiece clamped off its nominal place. The demo
    tcp``, ``track``, ``turntable``, ``workpiece`` with ``--cell``) make, printing each command;
    the library never drives the command line, which keeps the import direction cli -> library;
 3. compares every calibrated value with the truth, in units of its reported 1-sigma;
-4. writes an HTML report per calibration, the controller exports (KUKA, ABB, FANUC,
-   YASKAWA) and the interactive 3D view of the calibrated cell (``cell.html``).
+4. writes an HTML report per calibration and the controller exports (KUKA, ABB, FANUC,
+   YASKAWA);
+5. writes a KUKA program of a seam on the workpiece through the calibrated cell, the track
+   following the seam, as ``robotcell program write`` does;
+6. writes the interactive 3D view of the calibrated cell (``cell.html``).
 """
 
 from __future__ import annotations
@@ -37,19 +40,33 @@ from robotcell.cell.history import backups
 from robotcell.errors import InputError, RobotcellError
 from robotcell.io.export import EXPORT_FORMATS, export_cell
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.io.tables import read_csv
+from robotcell.io.tables import read_csv, write_csv
 from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_y
+from robotcell.programs import write_program
 from robotcell.studies.plan import pose_error
 from robotcell.studies.simulate import simulate
 from robotcell.view.cellscene import cell_figure
 from robotcell.view.plot import write_html
 
-__all__ = ["DEMO_NOISE", "Comparison", "demo_cells", "run_demo"]
+__all__ = ["DEMO_NOISE", "Comparison", "demo_cells", "run_demo", "seam_rows"]
 
 #: Touch-up error of the demo (m, 1-sigma per coordinate): a careful technician with a pointed
 #: tool on a sharp reference.
 DEMO_NOISE = 1e-4
+
+#: The seam of the demo program, in the workpiece frame 'part': (x, y, z) mm and (a, b, c) deg
+#: of the torch on a circle of 200 mm, and the table angle (deg) at each point.
+SEAM_POINTS = 36
+
+
+def seam_rows() -> NDArray[np.float64]:
+    """The demo seam as path rows ``x, y, z, a, b, c, table`` (mm, deg)."""
+    k = np.arange(SEAM_POINTS)
+    ang = np.radians(10.0 * k)
+    return np.column_stack([200 * np.cos(ang), 200 * np.sin(ang), np.zeros_like(ang), 10.0 * k,
+                            np.full_like(ang, 180.0), np.zeros_like(ang), 200.0 - 9.0 * k])
+
 
 #: Export file names per format.
 EXPORT_FILES = {"kuka": "kuka_config.dat", "abb": "abb_cell.mod", "fanuc": "fanuc_frames.txt",
@@ -275,6 +292,16 @@ def _write_outputs(out: Path, cell: Cell, results: dict[str, dict[str, Any]],
     echo(f"3D view of the calibrated cell (open it in a browser): {page.name}")
     prov = [f"{name}: {p.source} (rms {p.rms_mm:.3f} mm)" for name, p in _provenances(cell)]
     echo("cell file provenance: " + "; ".join(prov))
+    seam = out / "seam.csv"
+    write_csv(seam, ["x", "y", "z", "a", "b", "c", "table"], seam_rows(), 3)
+    echo("robot program (a seam on the part, through the calibrated cell):")
+    echo("  $ robotcell program write seam.csv --cell cell.yaml --tool torch --frame part "
+         "--format kuka -o program")
+    result = write_program(seam, cell, "torch", "part", "kuka", out / "program", name="seam",
+                           inputs=(out / "cell.yaml",))
+    echo(f"  {', '.join(Path(f).relative_to(out).as_posix() for f in result.files)}: "
+         f"{len(result.programs[0].points)} points, track from {result.track[0] * 1e3:.0f} to "
+         f"{result.track[-1] * 1e3:.0f} mm")
 
 
 #: Table angle of the demo's 3D view (rad).

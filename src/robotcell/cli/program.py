@@ -1,0 +1,227 @@
+"""``robotcell program``: robot programs from a path through the cell, checked, retargeted."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+
+import click
+import numpy as np
+
+from robotcell.cell import Cell
+from robotcell.cli.common import format_table, parse_numbers
+from robotcell.errors import InputError
+from robotcell.programs import VENDORS
+
+#: Library parameters as the command line names them.
+_FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split"}
+
+
+class BadPoints(click.ClickException):
+    """A path that cannot be one program, or a program with bad points: exit status 3."""
+
+    exit_code = 3
+
+    def show(self, file: object = None) -> None:
+        click.echo(f"error: {self.message}", err=True)
+
+
+@contextmanager
+def _flags() -> Iterator[None]:
+    """Re-raise library errors with the command line's option names instead of parameters."""
+    try:
+        yield
+    except InputError as exc:
+        text = str(exc)
+        for param, flag in _FLAGS.items():
+            text = re.sub(rf"\b{param}\b", flag, text)
+        raise InputError(text) from None
+
+
+def _ppd(text: str | None) -> list[float] | None:
+    return None if text is None else parse_numbers(text, "--pulses-per-degree")
+
+
+def _cell_option(f: Callable) -> Callable:
+    return click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+                        help="Cell file (YAML, mm/deg).")(f)
+
+
+def _ppd_option(f: Callable) -> Callable:
+    return click.option("--pulses-per-degree", "ppd", default=None, metavar="N[,N...]",
+                        help="YASKAWA: encoder pulses per degree of each station axis.")(f)
+
+
+@click.group()
+def program() -> None:
+    """Robot programs: write a path as a KUKA, ABB, FANUC or YASKAWA program, check a program
+    against the cell, retarget joint points after a recalibration (docs/programs.md).
+
+    \b
+    Examples:
+      robotcell program write examples/seam_part.csv --cell cell.yaml --tool torch --frame part --format kuka -o prog
+      robotcell program check prog/seam_part.src --cell cell.yaml
+    """
+
+
+@program.command("write")
+@click.argument("path", type=click.Path(dir_okay=False))
+@_cell_option
+@click.option("--tool", required=True, help="Tool of the cell.")
+@click.option("--frame", default="world", show_default=True,
+              help="Frame of the path: world or a frame of the cell.")
+@click.option("--format", "vendor", required=True, type=click.Choice(VENDORS),
+              help="Program format.")
+@click.option("-o", "--output", "folder", required=True, type=click.Path(file_okay=False),
+              help="Folder for the program files (created; its parent must exist).")
+@click.option("--name", default=None, help="Program name (default: the path file's name).")
+@click.option("--split", is_flag=True,
+              help="Write one program per continuous piece instead of refusing a path that "
+                   "breaks.")
+@_ppd_option
+@click.option("--json", "as_json", is_flag=True, help="Print the files, joints and breaks as JSON.")
+def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, folder: str,
+              name: str | None, split: bool, ppd: str | None, as_json: bool) -> None:
+    """Write the path PATH (CSV: x, y, z mm and a, b, c deg in --frame; optional motion,
+    speed mm/s, zone mm, track mm, table deg or e1..en) as a program of --format.
+
+    The joints are solved through the cell with one arm configuration; the track follows the
+    path unless the file gives it. The tools and frames are the ones 'robotcell export' writes,
+    with the same numbers. A path that cannot be one program (reach, limit, singularity) exits
+    with status 3 naming the points, and nothing is written; --split writes one program per
+    piece.
+
+    \b
+    Example:
+      robotcell program write examples/seam_part.csv --cell cell.yaml --tool torch --frame part --format abb -o prog
+    """
+    from robotcell.programs import PathBreaks, write_program
+
+    cell = Cell.load(cell_path)
+    with _flags():
+        try:
+            result = write_program(path, cell, tool, frame, vendor, folder, name, split,
+                                   pulses_per_degree=_ppd(ppd), inputs=(cell_path,))
+        except PathBreaks as exc:
+            click.echo(format_table(["point", "why", "cause"],
+                                    [[b.index + 1, b.kind, b.message] for b in exc.breaks]),
+                       err=True)
+            raise BadPoints(f"{path}: {exc}".replace("with split", "with --split")) from None
+    for w in result.warnings:
+        click.echo(f"warning: {w}", err=True)
+    if as_json:
+        click.echo(json.dumps(_write_json(cell, result), indent=2))
+    else:
+        for f in result.files:
+            click.echo(f"wrote {f}")
+        for b in result.breaks:
+            click.echo(f"break at point {b.index + 1} ({b.kind}): {b.message}", err=True)
+
+
+def _deg(v: float) -> float | None:
+    return None if not math.isfinite(v) else round(math.degrees(v), 9)
+
+
+def _write_json(cell: Cell, result) -> dict:
+    from robotcell.programs.path import table_columns
+
+    tcols = table_columns(cell)
+    points = []
+    for i in range(result.q.shape[0]):
+        d: dict = {"point": i + 1, "program": (result.programs[result.program_of[i]].name
+                                               if result.program_of[i] >= 0 else None)}
+        d.update({f"a{j + 1}": _deg(v) for j, v in enumerate(result.q[i])})
+        if cell.track is not None:
+            t = result.track[i]
+            d["track"] = None if not math.isfinite(t) else round(t * 1e3, 9)
+        d.update({k: _deg(v) for k, v in zip(tcols, np.atleast_1d(result.table[i]))})
+        points.append(d)
+    return {"files": result.files, "points": points,
+            "breaks": [{"point": b.index + 1, "kind": b.kind, "message": b.message}
+                       for b in result.breaks]}
+
+
+@program.command("check")
+@click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
+@_cell_option
+@_ppd_option
+@click.option("--json", "as_json", is_flag=True, help="Print every point as JSON.")
+def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool) -> None:
+    """Check every point of PROGRAM (KUKA .src with its .dat, ABB .mod, FANUC .ls, YASKAWA
+    .jbi) against the cell: reach, limits, configuration as written, distance to singularities,
+    configuration changes and jumps on linear motions.
+
+    Exit status 0 when every point is good, 3 with a table of the bad points, 2 for a file that
+    cannot be read.
+
+    \b
+    Example:
+      robotcell program check prog/seam_part.src --cell cell.yaml
+    """
+    from robotcell.programs.check import check_program_file
+
+    cell = Cell.load(cell_path)
+    with _flags():
+        report = check_program_file(program_file, cell, _ppd(ppd))
+    if as_json:
+        click.echo(json.dumps(report.to_json(cell), indent=2))
+    for s in report.skipped:
+        click.echo(f"note: not checked: {s}", err=True)
+    n = len(report.points)
+    if report.good:
+        if not as_json:
+            click.echo(f"{program_file}: {n} points, all good")
+        return
+    click.echo(format_table(["point", "line", "problem"], report.rows()), err=True)
+    raise BadPoints(f"{program_file}: {len(report.bad)} of {n} points are bad")
+
+
+@program.command("retarget")
+@click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
+@click.option("--from", "old_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file the program was taught in.")
+@click.option("--to", "new_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file after the recalibration.")
+@click.option("-o", "--output", "folder", required=True, type=click.Path(file_okay=False),
+              help="Folder for the retargeted program files (created; its parent must exist).")
+@_ppd_option
+@click.option("--json", "as_json", is_flag=True, help="Print every joint point as JSON.")
+def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, ppd: str | None,
+                 as_json: bool) -> None:
+    """Move the joint points of PROGRAM (KUKA E6AXIS/AXIS, ABB jointtarget, FANUC joint
+    positions) so that the TCP stays where it was after a recalibration (a new tool, base,
+    track, table or identified arm): solved in the --to cell where the --from cell had the TCP.
+    Cartesian points are left as they are: they follow the exported tool and frame data.
+    Prints the largest axis change per point; a point the new cell cannot reach exits with
+    status 3 and nothing is written.
+
+    \b
+    Example:
+      robotcell program retarget prog/seam_part.src --from examples/cell_kr16_track_turntable.yaml --to cell.yaml -o prog_new
+    """
+    from robotcell.programs.retarget import RetargetFailed, retarget_program
+
+    old, new = Cell.load(old_path), Cell.load(new_path)
+    with _flags():
+        try:
+            result = retarget_program(program_file, old, new, folder, _ppd(ppd),
+                                      inputs=(old_path, new_path))
+        except RetargetFailed as exc:
+            raise BadPoints(f"{program_file}: {exc}") from None
+    rows = [[p.name, p.line, f"{math.degrees(p.change):.4f}", f"{p.tcp_error * 1e3:.6f}"]
+            for p in result.points]
+    if as_json:
+        click.echo(json.dumps({"files": result.files, "cartesian_points": result.cartesian,
+                               "points": [{"name": p.name, "line": p.line,
+                                           "change_deg": round(math.degrees(p.change), 9),
+                                           "tcp_error_mm": round(p.tcp_error * 1e3, 9)}
+                                          for p in result.points]}, indent=2))
+        return
+    if rows:
+        click.echo(format_table(["point", "line", "largest change (deg)", "TCP error (mm)"],
+                                rows))
+    click.echo(f"{len(result.points)} joint points retargeted, {result.cartesian} Cartesian "
+               f"points kept; wrote {', '.join(result.files)}")

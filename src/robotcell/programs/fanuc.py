@@ -1,0 +1,299 @@
+"""FANUC TP programs as ASCII listings: ``NAME.ls`` (``/PROG``, ``/ATTR``, ``/MN``, ``/POS``).
+
+Written (sources in ``docs/programs.md``):
+
+- ``/MN``: ``UFRAME_NUM=n``, ``UTOOL_NUM=n`` (the numbers of ``robotcell export``), then
+  ``J P[i] 20% FINE`` / ``L P[i] 100mm/sec CNTk`` per point;
+- ``/POS``: ``P[i]{ GP1: UF : n, UT : n, CONFIG : 'N U T, t1, t4, t6', X = .. mm, ..., R = .. deg``
+  and a rail as ``E1 = .. mm`` in group 1 (an integrated extended axis), and the turntable or
+  positioner as group 2, ``GP2: UF, UT, J1 = .. deg, ...``; ``};``.
+
+Positions are the TCP in the user frame, which ``robotcell export`` writes in FANUC WORLD (the
+robot base at rail position 0); a frame on the turntable is the user frame of its pose at table
+axis 0, with the table at the point's angle in group 2 (no coordinated motion is written).
+
+Read: the same, and what pendants and offline tools write: joint positions (``J1 = .. deg``),
+comments on positions (``P[3:"approach"]``), other numbers of decimals, ``cm/min``, ``sec``
+and ``%`` speeds, a tool or user frame set in the program from a position register
+(``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win over the cell's), motions to
+position registers and circular motions (skipped and named).
+"""
+
+from __future__ import annotations
+
+import re
+import textwrap
+from pathlib import Path
+
+import numpy as np
+
+from robotcell.errors import InputError
+from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.programs.config import config_text
+from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.programs.text import Lines, fmt_num
+
+__all__ = ["read", "write"]
+
+_POSE_KEYS = ("X", "Y", "Z", "W", "P", "R")
+#: Longest comment line of the TP editor (characters after ``!``).
+COMMENT_CHARS = 29
+
+
+# -- writing -------------------------------------------------------------------------------------
+def _cnt(zone: float) -> str:
+    mm = zone * 1e3
+    return "FINE" if mm <= 0 else f"CNT{min(100, max(1, round(mm)))}"
+
+
+def _position(p: ProgramPoint) -> list[str]:
+    assert p.pose is not None and p.config is not None
+    v = pose_to_vendor(p.pose, "fanuc")
+    uf, ut = p.frame.number or 0, p.tool.number or 0
+    L = [f"{p.name}{{", "   GP1:",
+         f"\tUF : {uf}, UT : {ut},\t\tCONFIG : {config_text(p.config)},",
+         "\t" + ",\t".join(f"{k} = {fmt_num(x, MM_DECIMALS)}  mm" for k, x in
+                           zip(_POSE_KEYS[:3], v[:3])) + ","]
+    rot = ",\t".join(f"{k} = {fmt_num(x, DEG_DECIMALS)} deg" for k, x in
+                     zip(_POSE_KEYS[3:], v[3:]))
+    rail = p.external.get("E1")
+    L.append(f"\t{rot}" + ("," if rail is not None else ""))
+    if rail is not None:
+        L.append(f"\tE1 = {fmt_num(rail, MM_DECIMALS)}  mm")
+    table = [(k.split(":")[1], v) for k, v in p.external.items() if k.startswith("GP2:")]
+    if table:
+        L += ["   GP2:", f"\tUF : {uf}, UT : {ut},",
+              "\t" + ",\t".join(f"{k} = {fmt_num(x, DEG_DECIMALS)} deg" for k, x in table)]
+    L.append("};")
+    return L
+
+
+def write(program: Program, header: list[str]) -> dict[str, str]:
+    """``NAME.ls`` of a program of Cartesian points.
+
+    Parameters
+    ----------
+    program : Program
+        Points with ``pose``, ``config`` (FANUC CONFIG) and ``external`` (``E1``, ``GP2:J1``..),
+        one tool and one user frame (by number).
+    header : list of str
+        Comment lines, shortened to the TP editor's comment width.
+
+    Returns
+    -------
+    dict of str to str
+    """
+    pts = program.points
+    first = pts[0]
+    gp2 = any(k.startswith("GP2:") for k in first.external)
+    mn = [f"! {part} ;" for h in header for part in textwrap.wrap(h, COMMENT_CHARS)]
+    mn += [f"UFRAME_NUM={first.frame.number or 0} ;", f"UTOOL_NUM={first.tool.number or 0} ;"]
+    for p in pts:
+        if p.motion == "ptp":
+            mn.append(f"J {p.name} {PTP_SPEED * 100:.0f}% {_cnt(p.zone or 0.0)} ;")
+        else:
+            mn.append(f"L {p.name} {(p.speed or 0.1) * 1e3:.0f}mm/sec {_cnt(p.zone or 0.0)} ;")
+    attr = ["/ATTR", "OWNER\t\t= MNEDITOR;", 'COMMENT\t\t= "robotcell";', "PROG_SIZE\t= 0;",
+            "CREATE\t\t= DATE 00-01-01  TIME 00:00:00;",
+            "MODIFIED\t= DATE 00-01-01  TIME 00:00:00;", "FILE_NAME\t= ;", "VERSION\t\t= 0;",
+            f"LINE_COUNT\t= {len(mn)};", "MEMORY_SIZE\t= 0;", "PROTECT\t\t= READ_WRITE;",
+            "TCD:  STACK_SIZE\t= 0,", "      TASK_PRIORITY\t= 50,", "      TIME_SLICE\t= 0,",
+            "      BUSY_LAMP_OFF\t= 0,", "      ABORT_REQUEST\t= 0,", "      PAUSE_REQUEST\t= 0;",
+            f"DEFAULT_GROUP\t= 1,{'1' if gp2 else '*'},*,*,*;",
+            "CONTROL_CODE\t= 00000000 00000000;"]
+    text = [f"/PROG  {program.name}", *attr, "/MN"]
+    for i, ln in enumerate(mn, start=1):
+        text.append(f"{i:4d}:{'' if ln[:2] in ('J ', 'L ') else '  '}{ln}")
+    text.append("/POS")
+    for p in pts:
+        text += _position(p)
+    text.append("/END")
+    return {f"{program.name}.ls": "\n".join(text) + "\n"}
+
+
+# -- reading -------------------------------------------------------------------------------------
+_MOVE_RE = re.compile(r"^\s*\d+\s*:\s*([JLCA])\s+(P|PR)\[\s*(\d+)\s*(?::[^\]]*)?\]\s*(.*?)\s*;?\s*$")
+_LINE_RE = re.compile(r"^\s*(\d+)\s*:(.*)$")
+_POS_HEAD_RE = re.compile(r"^\s*P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{")
+_VALUE_RE = re.compile(r"\b([A-Z]+\d*)\s*=\s*([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s*(mm|deg)?")
+_UF_RE = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
+_CONFIG_RE = re.compile(r"CONFIG\s*:\s*'([^']*)'")
+_PR_SET_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*([-+0-9.eE]+)\s*;")
+_FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*PR\[\s*(\d+)\s*\]\s*;",
+                           re.IGNORECASE)
+_SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|cm/min|inch/min|deg/sec|sec|msec|%)", re.IGNORECASE)
+
+
+def _config(text: str, lines: Lines, lineno: int) -> Config:
+    """``'N U T, 0, 0, 0'`` as FANUC flags (flip, down, back) and turn numbers."""
+    head, *turns = [t.strip() for t in text.split(",")]
+    letters = head.split()
+    if len(letters) != 3 or letters[0] not in "NF" or letters[1] not in "UD" \
+            or letters[2] not in "TB" or len(turns) != 3:
+        raise lines.error(lineno, f"CONFIG '{text}' is not 'F|N U|D T|B, t1, t4, t6'")
+    try:
+        t = tuple(int(x) for x in turns)
+    except ValueError:
+        raise lines.error(lineno, f"CONFIG '{text}': the turn numbers must be integers") from None
+    return Config("fanuc", (int(letters[0] == "F"), int(letters[1] == "D"),
+                            int(letters[2] == "B"), *t))
+
+
+class _Position:
+    """One ``P[n]{...};`` block: group 1 pose or joints, its config, UF/UT, external axes."""
+
+    def __init__(self, block: list[tuple[int, str]], lines: Lines) -> None:
+        start = block[0][0]
+        self.where = lines.where(start)
+        group = "GP1"
+        self.uf = self.ut = 0
+        self.config: Config | None = None
+        values: dict[str, float] = {}
+        self.external: dict[str, float] = {}
+        for lineno, text in block:
+            if re.match(r"^\s*GP(\d+)\s*:", text):
+                group = re.match(r"^\s*(GP\d+)", text).group(1)
+                continue
+            if group == "GP1":
+                if m := _UF_RE.search(text):
+                    self.uf, self.ut = int(m.group(1)), int(m.group(2))
+                if m := _CONFIG_RE.search(text):
+                    self.config = _config(m.group(1), lines, lineno)
+            for m in _VALUE_RE.finditer(text):
+                key, v = m.group(1), lines.number(m.group(2), lineno)
+                if group == "GP1" and re.fullmatch(r"E\d", key):
+                    self.external[key] = v
+                elif group == "GP1":
+                    values[key] = v
+                else:
+                    self.external[f"{group}:{key}"] = v
+        self.pose = self.joints = None
+        if all(k in values for k in _POSE_KEYS):
+            self.pose = pose_from_vendor([values[k] for k in _POSE_KEYS], "fanuc")
+        elif all(f"J{i}" in values for i in range(1, 7)):
+            self.joints = np.radians([values[f"J{i}"] for i in range(1, 7)])
+            self.config = None
+        else:
+            raise lines.error(start, "the position has neither X, Y, Z, W, P, R nor J1..J6 in "
+                                     "group 1")
+
+
+def _positions(lines: Lines, start: int, end: int) -> dict[int, _Position]:
+    out: dict[int, _Position] = {}
+    block: list[tuple[int, str]] = []
+    number = None
+    for lineno in range(start, end):
+        text = lines.lines[lineno - 1]
+        if number is None:
+            if m := _POS_HEAD_RE.match(text):
+                number, block = int(m.group(1)), [(lineno, text[m.end():])]
+            elif text.strip():
+                raise lines.error(lineno, f"expected P[n]{{, got {text.strip()[:40]!r}")
+            continue
+        if "};" in text:
+            block.append((lineno, text.split("};")[0]))
+            out[number] = _Position(block, lines)
+            number = None
+        else:
+            block.append((lineno, text))
+    if number is not None:
+        raise lines.error(end - 1, f"P[{number}] is not closed with '}};' (truncated file?)")
+    return out
+
+
+def _speed(text: str, motion: str, lines: Lines, lineno: int) -> float | None:
+    m = _SPEED_RE.match(text)
+    if not m:
+        return None
+    v, unit = lines.number(m.group(1), lineno), m.group(2).lower()
+    if motion == "ptp" or unit in ("%", "sec", "msec", "deg/sec"):
+        return None
+    return v * (1e-3 if unit == "mm/sec" else 1e-2 / 60 if unit == "cm/min" else 0.0254 / 60)
+
+
+def _zone(text: str, lines: Lines, lineno: int) -> float | None:
+    if re.search(r"\bFINE\b", text):
+        return 0.0
+    if m := re.search(r"\bCNT\s*(\d+)", text):
+        return int(m.group(1)) * 1e-3
+    return None
+
+
+def read(path: str | Path) -> tuple[Program, list[str]]:
+    """Read a FANUC ``.ls`` listing.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    program : Program
+        Points in the order the ``/MN`` section moves to them; ``line`` is the file's line of the
+        motion; the frame and tool are the ``UF``/``UT`` of each position.
+    skipped : list of str
+        Motions to position registers and circular motions.
+
+    Raises
+    ------
+    InputError
+        No ``/PROG``, ``/MN``, ``/POS`` or ``/END``, an unreadable position, a motion to a
+        position the file does not hold; the message names the file and line.
+    """
+    lines = Lines(path, "FANUC .ls file")
+    marks: dict[str, int] = {}
+    for lineno, text in enumerate(lines.lines, start=1):
+        key = text.strip().split()[0] if text.strip() else ""
+        if key in ("/PROG", "/ATTR", "/MN", "/POS", "/END", "/APPL") and key not in marks:
+            marks[key] = lineno
+    for key in ("/PROG", "/MN"):
+        if key not in marks:
+            raise InputError(f"{path}: no {key} line: not a FANUC .ls listing")
+    if "/END" not in marks:
+        raise InputError(f"{path}: line {len(lines.lines)}: no /END (truncated file?)")
+    name = lines.lines[marks["/PROG"] - 1].split()[1] if len(
+        lines.lines[marks["/PROG"] - 1].split()) > 1 else Path(path).stem
+    pos_start = marks.get("/POS", marks["/END"])
+    positions = _positions(lines, pos_start + 1, marks["/END"]) if "/POS" in marks else {}
+    points: list[ProgramPoint] = []
+    skipped: list[str] = []
+    registers: dict[int, dict[int, float]] = {}
+    defined: dict[tuple[str, int], np.ndarray] = {}  # UTOOL/UFRAME set from a PR in the program
+    for lineno in range(marks["/MN"] + 1, pos_start):
+        text = lines.lines[lineno - 1]
+        if m := _PR_SET_RE.match(text):
+            registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = lines.number(
+                m.group(3), lineno)
+            continue
+        if m := _FRAME_SET_RE.match(text):
+            pr = registers.get(int(m.group(3)), {})
+            if sorted(pr) != [1, 2, 3, 4, 5, 6]:
+                raise lines.error(lineno, f"PR[{m.group(3)}] is not set in full (X..R) before "
+                                          f"{m.group(1)}[{m.group(2)}] takes it")
+            defined[(m.group(1).upper(), int(m.group(2)))] = pose_from_vendor(
+                [pr[i] for i in range(1, 7)], "fanuc")
+            continue
+        m = _MOVE_RE.match(text)
+        if not m:
+            continue
+        kind, reg, n, rest = m.group(1), m.group(2), int(m.group(3)), m.group(4)
+        label = f"{reg}[{n}]"
+        if kind in ("C", "A"):
+            skipped.append(f"line {lineno}: {kind} {label} (circular motions are not checked)")
+            continue
+        if reg == "PR":
+            skipped.append(f"line {lineno}: {kind} {label} (a position register, not held by "
+                           "the program)")
+            continue
+        if n not in positions:
+            raise lines.error(lineno, f"{label} is not in the /POS section")
+        p = positions[n]
+        motion = "ptp" if kind == "J" else "lin"
+        tool = Ref(number=p.ut, pose=defined.get(("UTOOL", p.ut)))
+        frame = Ref(number=p.uf, kind="base", pose=defined.get(("UFRAME", p.uf)))
+        points.append(ProgramPoint(
+            label, lineno, motion, tool, frame, p.pose,
+            p.joints, p.config, dict(p.external), _speed(rest, motion, lines, lineno),
+            _zone(rest, lines, lineno), p.where))
+    return Program(name, "fanuc", points, (str(path),)), skipped

@@ -1,0 +1,216 @@
+"""Programs after a recalibration: joint points moved so that the TCP stays where it was.
+
+A Cartesian point follows a recalibrated tool or frame by itself: the controller computes its
+joints from the new tool and frame data (``robotcell export``). A point stored as joint values
+(KUKA ``E6AXIS``/``AXIS``, ABB ``jointtarget``, FANUC joint positions) does not: after the tool
+or the base is recalibrated, or the arm identified, the same joints put the TCP elsewhere.
+:func:`retarget_program` recomputes them: the TCP of each joint point in the old cell (with the
+old cell's tool, track and table; for an arm identified since, where the old nominal model put
+it) is solved in the new cell at the same track and table values, in the configuration nearest
+to the old joints. Only the joint values in the files change; every other line is kept.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.cell import Cell
+from robotcell.cell.kinematics import robot_pose
+from robotcell.errors import InputError, RobotcellError
+from robotcell.ik.select import nearest
+from robotcell.io.fileio import read_text
+from robotcell.kinematics.transforms import invert
+from robotcell.programs.axes import external_axes
+from robotcell.programs.files import write_all
+from robotcell.programs.formats import read_program
+from robotcell.programs.frames import tool_pose_of
+from robotcell.programs.model import Program, ProgramPoint
+from robotcell.programs.text import fmt_num
+
+__all__ = ["RetargetFailed", "RetargetResult", "RetargetedPoint", "retarget_program"]
+
+#: Decimals of the joint values written (deg): 1e-9 deg.
+JOINT_DECIMALS = 9
+
+
+class RetargetFailed(RobotcellError):
+    """Joint points the new cell cannot put where the old one had the TCP (nothing written)."""
+
+
+@dataclass
+class RetargetedPoint:
+    """A joint point before and after.
+
+    Attributes
+    ----------
+    name : str
+    line : int
+    q_old, q_new : ndarray, shape (6,)
+        Joint values (rad).
+    change : float
+        Largest change of an axis (rad).
+    tcp_error : float
+        Distance between the TCP of the new joints in the new cell and the TCP of the old joints
+        in the old cell (m): 0 up to rounding.
+    """
+
+    name: str
+    line: int
+    q_old: NDArray[np.float64]
+    q_new: NDArray[np.float64]
+    change: float
+    tcp_error: float
+
+
+@dataclass
+class RetargetResult:
+    """What :func:`retarget_program` did.
+
+    Attributes
+    ----------
+    program : Program
+        The program as read.
+    points : list of RetargetedPoint
+        The joint points, recomputed.
+    cartesian : int
+        Cartesian points, left as they are (they follow the exported tool and frame data).
+    files : list of str
+        The files written.
+    """
+
+    program: Program
+    points: list[RetargetedPoint] = field(default_factory=list)
+    cartesian: int = 0
+    files: list[str] = field(default_factory=list)
+
+
+def _solve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
+           pulses_per_degree: ArrayLike | None) -> tuple[list[RetargetedPoint], list[str]]:
+    axes_old = external_axes(old, vendor, pulses_per_degree)
+    axes_new = external_axes(new, vendor, pulses_per_degree)
+    out, problems = [], []
+    for p in points:
+        track, table, missing = axes_old.from_file(p.external)
+        track_n, table_n, _ = axes_new.from_file(p.external)
+        if missing:
+            problems.append(f"{p.name} (line {p.line}): {'; '.join(missing)}")
+            continue
+        try:
+            T_old = old.fk(p.joints, track, table, tool=tool_pose_of(old, vendor, p.tool))
+            T_tool = tool_pose_of(new, vendor, p.tool)
+        except InputError as exc:
+            problems.append(f"{p.name} (line {p.line}): {exc}")
+            continue
+        T_R_F = invert(robot_pose(new, track_n)) @ T_old @ invert(T_tool)
+        sol = new.robot.ik(T_R_F, tool=np.eye(4))
+        q, found, _ = nearest(new.robot, sol, p.joints)
+        if not found:
+            why = "out of reach" if not sol.reachable.any() else "outside the axis limits"
+            problems.append(f"{p.name} (line {p.line}): the new cell cannot put the TCP where "
+                            f"the old one had it ({why})")
+            continue
+        T_new = new.fk(q, track_n, table_n, tool=T_tool)
+        err = float(np.linalg.norm(T_new[:3, 3] - T_old[:3, 3]))
+        out.append(RetargetedPoint(p.name, p.line, p.joints.copy(), q,
+                                   float(np.max(np.abs(q - p.joints))), err))
+    return out, problems
+
+
+def _set_kuka(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
+    line = lines[idx]
+    for i in range(6):
+        line, n = re.subn(rf"(\bA{i + 1}\s+)[-+0-9.eE]+", lambda m, v=q[i]: m.group(1)
+                          + fmt_num(math.degrees(v), JOINT_DECIMALS), line, count=1,
+                          flags=re.IGNORECASE)
+        if n != 1:
+            return False
+    lines[idx] = line
+    return True
+
+
+def _set_abb(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
+    line = lines[idx]
+    m = re.search(r"\[\s*\[([^\[\]]*)\]", line)
+    if not m or len(m.group(1).split(",")) != 6:
+        return False
+    values = ",".join(fmt_num(math.degrees(v), JOINT_DECIMALS) for v in q)
+    lines[idx] = line[:m.start(1)] + values + line[m.end(1):]
+    return True
+
+
+def _set_fanuc(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
+    done = 0
+    for k in range(idx, len(lines)):
+        if k > idx and re.match(r"^\s*GP[2-9]\s*:", lines[k]):
+            break
+        for i in range(6):
+            lines[k], n = re.subn(rf"(\bJ{i + 1}\s*=\s*)[-+0-9.eE]+",
+                                  lambda m, v=q[i]: m.group(1)
+                                  + fmt_num(math.degrees(v), JOINT_DECIMALS), lines[k], count=1)
+            done += n
+        if "};" in lines[k]:
+            break
+    return done == 6
+
+
+_SETTERS = {"kuka": _set_kuka, "abb": _set_abb, "fanuc": _set_fanuc}
+
+
+def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
+                     pulses_per_degree: ArrayLike | None = None,
+                     inputs: tuple[str | Path, ...] = ()) -> RetargetResult:
+    """Recompute the joint points of a program for a recalibrated cell and write it to a folder.
+
+    Parameters
+    ----------
+    path : str or Path
+        The program (KUKA ``.src`` with its ``.dat``, ABB ``.mod``, FANUC ``.ls``).
+    old, new : Cell
+        The cell the program was taught in, and the cell after the recalibration (the same
+        tools and frames by name and number; a new tool pose, base, track, table or an
+        identified arm).
+    folder : str or Path
+        Where the program's files are written, under their names (all or none).
+    pulses_per_degree : float or array_like, optional
+        YASKAWA station axes (pulses per degree).
+    inputs : tuple of str or Path
+        Further files the run read (the cell files), which no output may replace.
+
+    Returns
+    -------
+    RetargetResult
+
+    Raises
+    ------
+    InputError
+        An unreadable program or a folder that cannot be written.
+    RetargetFailed
+        A joint point the new cell cannot reach or that names a tool the cells lack; nothing is
+        written.
+    """
+    program, _ = read_program(path)
+    vendor = program.vendor
+    joint = [p for p in program.points if p.joints is not None]
+    result = RetargetResult(program, cartesian=len(program.points) - len(joint))
+    if joint and vendor not in _SETTERS:
+        raise InputError(f"{path}: {vendor} joint points are not retargeted")
+    moved, problems = _solve(old, new, joint, vendor, pulses_per_degree)
+    if problems:
+        raise RetargetFailed("nothing written: " + "; ".join(problems))
+    result.points = moved
+    texts: dict[str, list[str]] = {f: read_text(f, "program file").splitlines()
+                                   for f in program.files}
+    for p, r in zip(joint, moved):
+        file, _, line = p.where.rpartition(":")
+        if not _SETTERS[vendor](texts[file], int(line) - 1, r.q_new):
+            raise RetargetFailed(f"nothing written: {p.name}: cannot find its six axis values "
+                                 f"on {file} line {line}")
+    out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}
+    result.files = write_all(folder, out, (*program.files, *inputs))
+    return result

@@ -1,0 +1,236 @@
+"""YASKAWA Motoman INFORM jobs: ``NAME.jbi`` (``/JOB``, ``//POS``, ``//INST``).
+
+Written (sources in ``docs/programs.md``, chiefly the DX100 and NX100 manuals' job data format):
+
+- ``//POS``: ``///NPOS c,bc,ec,0,0,0``; ``///USER n`` and ``///POSTYPE USER`` for a user frame
+  (``///POSTYPE BASE`` for the world, which YASKAWA measures in the base coordinates at base
+  axis 0), ``///TOOL n`` (the numbers of ``robotcell export``); ``///RECTAN``, then per point
+  ``///RCONF l,m,n,o,p,q,0,0`` (where it changes) and ``Cxxxxx=X,Y,Z,Rx,Ry,Rz`` (mm, deg with
+  ``R = Rz(Rz) Ry(Ry) Rx(Rx)``); the track as base axis ``BCxxxxx=mm``; then ``///POSTYPE
+  PULSE``, ``///PULSE`` and the turntable or positioner as station axes ``ECxxxxx=pulses``;
+- ``//INST``: ``///ATTR SC,RW,RJ`` (Cartesian positions: a relative job) with ``///FRAME USER n``
+  for a user frame,
+  ``///GROUP1 RB1[,BS1][,ST1]``, ``NOP``, ``MOVJ Cxxxxx [BCxxxxx] [ECxxxxx] VJ=20.00`` or
+  ``MOVL ... V=100.0``, ``PL=k`` for a zone, ``END``.
+
+Angles are written with 4 decimals (9e-7 rad), millimetres with 3, pulses as integers.
+
+Read: the same, and what pendants and offline tools write: several ``USER``/``TOOL``/``RCONF``
+blocks, ``RCONF`` with 6, 8 or 24 values, pulse positions of the robot (skipped: their pulses
+per degree are not in the job), ``///FRAME`` with three or four slashes, ``MOVC``/``MOVS``
+(skipped).
+"""
+
+from __future__ import annotations
+
+import re
+import textwrap
+from pathlib import Path
+
+from robotcell.errors import InputError
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.programs.config import config_text
+from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.programs.text import Lines, fmt_num
+
+__all__ = ["read", "write"]
+
+#: Decimals written: mm, deg.
+MM_PLACES, DEG_PLACES = 3, 4
+#: Longest comment line (characters after ``'``; "up to 32 characters", NX100 job data format).
+COMMENT_CHARS = 32
+
+
+# -- writing -------------------------------------------------------------------------------------
+def _pl(zone: float) -> str:
+    mm = zone * 1e3
+    return "" if mm <= 0 else f" PL={min(8, max(1, round(mm)))}"
+
+
+def write(program: Program, header: list[str]) -> dict[str, str]:
+    """``NAME.jbi`` of a program of Cartesian points.
+
+    Parameters
+    ----------
+    program : Program
+        Points with ``pose``, ``config`` (RCONF) and ``external`` (``BC1``, ``EC1``..), one
+        tool and one user frame (by number; None: the base coordinates).
+    header : list of str
+        Comment lines (``'`` comments, 32 characters each at most).
+
+    Returns
+    -------
+    dict of str to str
+    """
+    pts = program.points
+    first = pts[0]
+    n = len(pts)
+    base = [p.external["BC1"] for p in pts] if "BC1" in first.external else []
+    station = sorted(k for k in first.external if k.startswith("EC"))
+    user = first.frame.number
+    pos = ["/JOB", f"//NAME {program.name}", "//POS",
+           f"///NPOS {n},{n if base else 0},{n if station else 0},0,0,0"]
+    if user:
+        pos.append(f"///USER {user}")
+    pos += [f"///TOOL {first.tool.number or 0}",
+            f"///POSTYPE {'USER' if user else 'BASE'}", "///RECTAN"]
+    rconf = None
+    for i, p in enumerate(pts):
+        assert p.pose is not None and p.config is not None
+        text = config_text(p.config) + ",0,0"
+        if text != rconf:
+            pos.append(f"///RCONF {text}")
+            rconf = text
+        v = pose_to_vendor(p.pose, "yaskawa")
+        pos.append(f"C{i:05d}=" + ",".join(fmt_num(x, MM_PLACES if k < 3 else DEG_PLACES)
+                                            for k, x in enumerate(v)))
+    pos += [f"BC{i:05d}={fmt_num(b, MM_PLACES)}" for i, b in enumerate(base)]
+    if station:
+        pos += ["///POSTYPE PULSE", "///PULSE"]
+        pos += [f"EC{i:05d}=" + ",".join(str(round(p.external[k])) for k in station)
+                for i, p in enumerate(pts)]
+    group = "RB1" + (",BS1" if base else "") + (",ST1" if station else "")
+    inst = ["//INST", "///DATE 2000/01/01 00:00", "///COMM robotcell", "///ATTR SC,RW,RJ",
+            *([f"///FRAME USER {user}"] if user else []), f"///GROUP1 {group}", "NOP"]
+    inst += [f"'{part}" for h in header for part in textwrap.wrap(h, COMMENT_CHARS)]
+    for i, p in enumerate(pts):
+        axes = f"C{i:05d}" + (f" BC{i:05d}" if base else "") + (f" EC{i:05d}" if station else "")
+        if p.motion == "ptp":
+            inst.append(f"MOVJ {axes} VJ={PTP_SPEED * 100:.2f}{_pl(p.zone or 0.0)}")
+        else:
+            inst.append(f"MOVL {axes} V={(p.speed or 0.1) * 1e3:.1f}{_pl(p.zone or 0.0)}")
+    inst.append("END")
+    return {f"{program.name}.jbi": "\n".join(pos + inst) + "\n"}
+
+
+# -- reading -------------------------------------------------------------------------------------
+_DATA_RE = re.compile(r"^(C|BC|EC|P|BP|EX)(\d+)\s*=\s*(.*)$")
+_MOVE_RE = re.compile(r"^\s*(MOVJ|MOVL|MOVC|MOVS|SMOVJ|SMOVL)\s+(.*)$", re.IGNORECASE)
+
+
+class _Position:
+    def __init__(self, kind: str, values: list[float], postype: str, user: int, tool: int,
+                 rconf: tuple[int, ...] | None, where: str) -> None:
+        self.kind, self.values, self.postype = kind, values, postype
+        self.user, self.tool, self.rconf, self.where = user, tool, rconf, where
+
+
+def _pos_section(lines: Lines, start: int, end: int) -> dict[str, _Position]:
+    out: dict[str, _Position] = {}
+    postype, user, tool, rconf, rectan = "PULSE", 0, 0, None, False
+    for lineno in range(start, end):
+        text = lines.lines[lineno - 1].strip()
+        if not text:
+            continue
+        if text.startswith("///"):
+            key, _, value = text[3:].partition(" ")
+            key = key.upper()
+            if key == "USER":
+                user = int(lines.number(value, lineno))
+            elif key == "TOOL":
+                tool = int(lines.number(value, lineno))
+            elif key == "POSTYPE":
+                postype = value.strip().upper()
+            elif key in ("RECTAN", "PULSE"):
+                rectan = key == "RECTAN"
+            elif key == "RCONF":
+                parts = [p for p in value.split(",") if p.strip()]
+                if len(parts) < 6:
+                    raise lines.error(lineno, "RCONF needs at least 6 values l,m,n,o,p,q")
+                rconf = tuple(int(lines.number(p, lineno)) for p in parts[:6])
+            continue
+        m = _DATA_RE.match(text)
+        if not m:
+            raise lines.error(lineno, f"expected a position line, got {text[:40]!r}")
+        values = [lines.number(v, lineno) for v in m.group(3).split(",")]
+        kind = m.group(1) + ("" if m.group(1) != "C" or rectan else "-pulse")
+        if kind == "C" and len(values) < 6:
+            raise lines.error(lineno, f"C{m.group(2)} needs X, Y, Z, Rx, Ry, Rz")
+        out[m.group(1) + m.group(2)] = _Position(kind, values, postype if rectan else "PULSE",
+                                                 user, tool, rconf, lines.where(lineno))
+    return out
+
+
+def read(path: str | Path) -> tuple[Program, list[str]]:
+    """Read a YASKAWA ``.jbi`` job.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    program : Program
+        Points in the order the job moves to them; ``line`` is the file's line of the motion;
+        external axes as ``BC1`` (mm) and ``EC1``.. (pulses).
+    skipped : list of str
+        Motions to robot positions in pulses, circular and spline motions.
+
+    Raises
+    ------
+    InputError
+        No ``/JOB``, ``//POS``, ``//INST`` or final ``END``, an unreadable position, a motion to a
+        position the job does not hold; the message names the file and line.
+    """
+    lines = Lines(path, "YASKAWA job")
+    marks: dict[str, int] = {}
+    for lineno, text in enumerate(lines.lines, start=1):
+        key = text.strip().split(" ")[0].upper() if text.strip() else ""
+        if key in ("/JOB", "//POS", "//INST") and key not in marks:
+            marks[key] = lineno
+    for key in ("/JOB", "//POS", "//INST"):
+        if key not in marks:
+            raise InputError(f"{path}: no {key} line: not a YASKAWA job")
+    last = next((i for i in range(len(lines.lines), 0, -1) if lines.lines[i - 1].strip()), 0)
+    if lines.lines[last - 1].strip().upper() != "END":
+        raise InputError(f"{path}: line {last}: the job does not end with END (truncated file?)")
+    name = next((t.split(None, 1)[1].strip() for t in lines.lines
+                 if t.strip().upper().startswith("//NAME") and len(t.split()) > 1),
+                Path(path).stem)
+    positions = _pos_section(lines, marks["//POS"] + 1, marks["//INST"])
+    points: list[ProgramPoint] = []
+    skipped: list[str] = []
+    for lineno in range(marks["//INST"] + 1, last):
+        text = lines.lines[lineno - 1].strip()
+        m = _MOVE_RE.match(text)
+        if not m:
+            continue
+        instr, rest = m.group(1).upper(), m.group(2)
+        if instr in ("MOVC", "MOVS"):
+            skipped.append(f"line {lineno}: {instr} (circular and spline motions are not "
+                           "checked)")
+            continue
+        refs = re.findall(r"\b(C|BC|EC)(\d+)\b", rest)
+        cname = next((k + n for k, n in refs if k == "C"), None)
+        if cname is None:
+            skipped.append(f"line {lineno}: {instr} without a C position")
+            continue
+        missing = [k + n for k, n in refs if k + n not in positions]
+        if missing:
+            raise lines.error(lineno, f"{', '.join(missing)} not in the //POS section")
+        c = positions[cname]
+        if c.kind == "C-pulse":
+            skipped.append(f"line {lineno}: {instr} {cname} (robot pulses: their pulses per "
+                           "degree are not in the job)")
+            continue
+        external: dict[str, float] = {}
+        for k, n in refs:
+            if k == "BC":
+                external["BC1"] = positions[k + n].values[0]
+            elif k == "EC":
+                external.update({f"EC{i + 1}": v for i, v in enumerate(positions[k + n].values)})
+        frame = (Ref(number=c.user, kind="base") if c.postype == "USER" else
+                 Ref(kind="robot" if c.postype == "ROBOT" else "base", number=None))
+        if c.postype not in ("USER", "BASE", "ROBOT"):
+            raise lines.error(lineno, f"{cname}: POSTYPE {c.postype} is not read (USER, BASE, "
+                                      "ROBOT or PULSE)")
+        pose = pose_from_vendor(c.values[:6], "yaskawa")
+        config = Config("yaskawa", c.rconf) if c.rconf is not None else None
+        speed = re.search(r"\bV\s*=\s*([0-9.]+)", rest)
+        zone = re.search(r"\bPL\s*=\s*(\d+)", rest)
+        motion = "ptp" if instr.endswith("J") else "lin"
+        points.append(ProgramPoint(
+            cname, lineno, motion, Ref(number=c.tool), frame, pose, None, config, external,
+            lines.number(speed.group(1), lineno) * 1e-3 if speed and motion == "lin" else None,
+            lines.number(zone.group(1), lineno) * 1e-3 if zone else 0.0, c.where))
+    return Program(name, "yaskawa", points, (str(path),)), skipped

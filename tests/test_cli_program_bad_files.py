@@ -1,0 +1,142 @@
+"""Bad files and options for ``robotcell program write|check|retarget``: every run ends with a
+documented status (0, 2 with one ``error:`` line naming the cause, 3 for a path that cannot be
+one program or bad points), never 1 or a traceback, and a refused run writes nothing."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_helpers import run
+from programs_helpers import CELL, EXT, SEAM
+from test_cli_fuzz import mutate_csv, mutate_text
+
+from robotcell.cell import Cell
+from robotcell.programs import write_program
+
+SEED = 2019
+
+
+def _check(code: int, out: str, err: str, match: str, code_wanted: int = 2) -> None:
+    assert "Traceback" not in out + err
+    assert code == code_wanted, err
+    assert err.count("error:") == 1 and match.lower() in err.lower(), err
+
+
+def _write_args(path, out, vendor="kuka", *extra):
+    return ["program", "write", path, "--cell", CELL, "--tool", "torch", "--frame", "part",
+            "--format", vendor, "-o", out, "--pulses-per-degree", "100", *extra]
+
+
+@pytest.mark.parametrize("content,match", [
+    ("x,y,z,a,b\n0,0,0,0,0\n", "missing column(s) c"),
+    (SEAM.read_text().replace("\n197.0,", "\nabc,", 1), "must be numeric"),
+    ("", "header line and at least one data line"),
+    ("x,y,z,a,b,c,table\n200,0,0,0,180,0,200\n", "at least 2 targets"),
+    (SEAM.read_text().encode("utf-16"), "UTF-16"),
+    (bytes(range(256)) * 2, "not a text file"),
+])
+def test_a_bad_path_file_exits_2_and_writes_nothing(tmp_path, capsys, content, match):
+    path = tmp_path / "p.csv"
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    code, out, err = run(capsys, *_write_args(path, tmp_path / "out"))
+    _check(code, out, err, match)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("extra,match", [
+    (["--tool", "gripper"], "tool 'gripper' is not in the cell"),
+    (["--frame", "wall"], "frame 'wall' is not in the cell"),
+    (["--name", "9lives"], "is not a kuka program name"),
+    (["--pulses-per-degree", "abc"], "--pulses-per-degree must be comma-separated numbers"),
+])
+def test_bad_options_exit_2_naming_the_option(tmp_path, capsys, extra, match):
+    code, out, err = run(capsys, *_write_args(SEAM, tmp_path / "out", "kuka", *extra))
+    _check(code, out, err, match)
+    assert not (tmp_path / "out").exists()
+
+
+def test_yaskawa_without_pulses_per_degree_names_the_option(tmp_path, capsys):
+    args = ["program", "write", SEAM, "--cell", CELL, "--tool", "torch", "--frame", "part",
+            "--format", "yaskawa", "-o", tmp_path / "out"]
+    code, out, err = run(capsys, *args)
+    _check(code, out, err, "give --pulses-per-degree")
+
+
+def test_an_output_folder_that_is_a_file_or_has_no_parent(tmp_path, capsys):
+    (tmp_path / "f").write_text("x")
+    code, out, err = run(capsys, *_write_args(SEAM, tmp_path / "f"))
+    _check(code, out, err, "is a file")
+    code, out, err = run(capsys, *_write_args(SEAM, tmp_path / "none" / "out"))
+    _check(code, out, err, "does not exist")
+
+
+@pytest.mark.parametrize("name,match", [
+    ("prog.txt", "unknown program file type '.txt'"),
+    ("missing.src", "does not exist"),
+])
+def test_check_of_a_file_it_cannot_read(tmp_path, capsys, name, match):
+    if name.endswith(".txt"):
+        (tmp_path / name).write_text("PTP P1\n")
+    code, out, err = run(capsys, "program", "check", tmp_path / name, "--cell", CELL)
+    _check(code, out, err, match)
+
+
+@pytest.fixture(scope="module")
+def programs(tmp_path_factory) -> dict[str, Path]:
+    cell = Cell.load(CELL)
+    d = tmp_path_factory.mktemp("programs")
+    out = {}
+    for vendor, ext in EXT.items():
+        result = write_program(SEAM, cell, "torch", "part", vendor, d / vendor,
+                               pulses_per_degree=100 if vendor == "yaskawa" else None)
+        out[vendor] = Path(next(f for f in result.files if f.endswith(ext)))
+    return out
+
+
+def test_fuzz_mutated_paths_and_programs(tmp_path, capsys, programs):
+    """Seeded mutations of a valid path file (write) and of valid programs of every format
+    (check, retarget): documented exit statuses only, no traceback, nothing left on refusal."""
+    rng = np.random.default_rng(SEED)
+    failures, codes = [], {}
+    for k in range(60):
+        vendor = str(rng.choice(list(EXT)))
+        out = tmp_path / f"out{k}"
+        if k % 3 == 0:
+            content, what = mutate_csv(SEAM.read_text(), rng)
+            path = tmp_path / f"path{k}.csv"
+            path.write_bytes(content if isinstance(content, bytes) else content.encode(
+                "utf-8", errors="surrogatepass"))
+            args = _write_args(path, out, vendor)
+        else:
+            src = programs[vendor]
+            case = tmp_path / f"case{k}"
+            case.mkdir()
+            for f in src.parent.iterdir():
+                (case / f.name).write_bytes(f.read_bytes())
+            target = case / (src.with_suffix(".dat").name if vendor == "kuka" and rng.random()
+                             < 0.5 else src.name)
+            content, what = mutate_text(target.read_text(), rng)
+            target.write_bytes(content if isinstance(content, bytes) else content.encode(
+                "utf-8", errors="surrogatepass"))
+            args = (["program", "check", case / src.name, "--cell", CELL,
+                     "--pulses-per-degree", "100"] if k % 3 == 1 else
+                    ["program", "retarget", case / src.name, "--from", CELL, "--to", CELL,
+                     "-o", out, "--pulses-per-degree", "100"])
+        code, stdout, err = run(capsys, *args)
+        codes[code] = codes.get(code, 0) + 1
+        problems = []
+        if code not in (0, 2, 3):
+            problems.append(f"exit {code}")
+        if "Traceback" in stdout + err:
+            problems.append("traceback")
+        if code == 2 and err.count("error:") != 1:
+            problems.append("exit 2 without one 'error:' line")
+        if code in (2, 3) and out.exists() and any(out.iterdir()):
+            problems.append("a refused run left files")
+        if problems:
+            failures.append(f"case {k} ({vendor}, {what}): {', '.join(problems)}; "
+                            f"{' '.join(map(str, args))}\n  {err.strip()[-300:]}")
+    assert not failures, "\n".join(failures[:6])
+    assert codes.get(0, 0) > 0 and codes.get(2, 0) > 0, codes
