@@ -28,13 +28,14 @@ from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
 from robotcell.cli.common import check_output, parse_numbers, read_csv, write_output
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.robot import Robot
 
 
-class CalibrateGroup(click.Group):
+class CalibrateGroup(Group):
     """The ``calibrate`` group: its own subcommands plus the lazily imported ``REGISTERED`` ones."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -83,7 +84,7 @@ def measurement_options(func: Callable) -> Callable:
     func = click.option("--accept-poor", is_flag=True,
                         help="Write and exit 0 even when the verdict is poor (default: a poor "
                              "result exits with status 3 and changes no file).")(func)
-    func = click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+    func = click.option("-o", "--output", default=None, metavar="FILE", type=OUTPUT,
                         expose_value=False, callback=_keep_output,
                         help="Also write the result to FILE, atomically and only when the run "
                              "succeeds: the JSON object with --json, else the report. Use it "
@@ -97,7 +98,7 @@ def measurement_options(func: Callable) -> Callable:
                         help="Tool active during the touches (KUKA, mm/deg; with --cell also the "
                              "name of a tool of the cell), for joint-value input; default: the "
                              "robot model's tool.")(func)
-    func = click.option("--robot", default=None, metavar="NAME_OR_FILE",
+    func = click.option("--robot", default=None, metavar="NAME_OR_FILE", type=NAME_OR_FILE,
                         help="Robot model for joint-value input (columns a1..a6).")(func)
     return func
 

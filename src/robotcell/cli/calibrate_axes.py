@@ -31,12 +31,13 @@ from robotcell.cli.calibrate import (
     sigma_m,
 )
 from robotcell.cli.common import parse_numbers, read_csv
+from robotcell.cli.files import Command
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import validate_pose
 
 
-@click.command("track")
+@click.command("track", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--reference", "references", multiple=True, metavar="X,Y,Z",
               help="Known coordinates (mm) of a touched reference point in the track frame L; "
@@ -83,7 +84,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     emit(out.result, as_json)
 
 
-@click.command("turntable")
+@click.command("turntable", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--height", type=float, default=0.0, show_default=True, metavar="MM",
               help="Shift of the frame origin along the table axis from the plane of the touched "
@@ -120,7 +121,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     emit(out.result, as_json)
 
 
-@click.command("positioner")
+@click.command("positioner", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @cell_option
 @measurement_options
@@ -215,7 +216,7 @@ def _covariance(value: object, where: str) -> np.ndarray:
     return cov
 
 
-@click.command("workpiece")
+@click.command("workpiece", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--turntable", "turntable_json", default=None, metavar="TURNTABLE.json",
               type=click.Path(dir_okay=False),

@@ -6,13 +6,14 @@ import math
 
 import click
 
+from robotcell.cli.files import Command, OutputPath
 from robotcell.errors import InputError
 from robotcell.studies.demo import DEMO_NOISE, run_demo
 
 
-@click.command()
+@click.command(cls=Command)
 @click.option("-o", "--output", default="robotcell-demo", show_default=True,
-              type=click.Path(file_okay=False), help="Folder for the files the demo writes.")
+              type=OutputPath(file_okay=False), help="Folder for the files the demo writes.")
 @click.option("--noise", type=float, default=DEMO_NOISE * 1e3, show_default=True, metavar="MM",
               help="Touch-up error, 1-sigma per coordinate (mm).")
 @click.option("--seed", type=int, default=1, show_default=True, help="Seed of the touch-up errors.")

@@ -19,6 +19,7 @@ from robotcell.cli.cellargs import (
     track_values,
 )
 from robotcell.cli.common import check_output, parse_numbers, read_csv, require_columns, write_csv
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 from robotcell.kinematics.models import load_robot
@@ -40,11 +41,11 @@ def tool_option(text: str | None) -> np.ndarray | None:
     return pose_from_vendor(parse_numbers(text, "--tool", 6), "kuka")
 
 
-@click.command()
-@click.argument("robot", required=False)
+@click.command(cls=Command)
+@click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
-@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output_path", type=OUTPUT, callback=check_output,
               help="CSV to write, atomically: the poses of --input, or one row for --joints "
                    "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,

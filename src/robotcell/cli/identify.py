@@ -11,6 +11,7 @@ import click
 import numpy as np
 
 from robotcell.cli.common import check_not_folder, check_output, read_csv, warn_unknown_columns
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
@@ -105,11 +106,11 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
                    f"prismatic joints); measure them and add the columns {cols}")
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("measurements", type=click.Path(), required=False)
-@click.option("--robot", "robot", help="Nominal model: library name or model file. Without it the "
+@click.option("--robot", "robot", type=NAME_OR_FILE, help="Nominal model: library name or model file. Without it the "
               "circle point analysis builds the start model (rows moving one joint at a time).")
-@click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output", type=OUTPUT, callback=check_output,
               help="Write the identified model file (YAML), atomically; with --propose, the "
               "proposed configurations (CSV).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of the report.")
@@ -125,7 +126,7 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
 @click.option("--force", "force", is_flag=True, help="Write -o even when the verdict is poor.")
 @click.option("--folds", "folds", type=int, help="Also K-fold cross-validate: every row predicted "
               "by the models identified without it (mean, RMS, max before and after).")
-@click.option("--report", "report", type=click.Path(), callback=check_not_folder, help="Also write a "
+@click.option("--report", "report", type=OUTPUT, callback=check_not_folder, help="Also write a "
               "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
 @click.option("--offsets-for", "offsets_for", type=click.Choice(["kuka", "abb"]), help="Also print "
               "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "

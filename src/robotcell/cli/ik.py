@@ -31,6 +31,7 @@ from robotcell.cli.common import (
     require_columns,
     write_output,
 )
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
@@ -63,11 +64,11 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
         w.writerow([f"{v:.6f}" if isinstance(v, float) else v for v in r])
 
 
-@click.command()
-@click.argument("robot", required=False)
+@click.command(cls=Command)
+@click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
-@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output_path", type=OUTPUT, callback=check_output,
               help="File to write, atomically: the CSV of --input, or the table of --pose "
                    "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,

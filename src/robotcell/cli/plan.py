@@ -11,6 +11,7 @@ import click
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_output, format_table
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
 from robotcell.errors import InputError
 from robotcell.studies.plan import DESIGNS, LEVER, Candidate
@@ -41,7 +42,7 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
         yield from bar
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("procedure", type=click.Choice(list(DESIGNS)))
 @cell_options
 @click.option("--runs", type=click.IntRange(min=0), default=100, show_default=True,
@@ -50,7 +51,7 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
               help="frame/workpiece: largest triangle that fits on the part (mm).")
 @click.option("--max-radius", type=float, default=None, metavar="MM",
               help="turntable: largest distance of a touchable point from the axis (mm).")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=OUTPUT, default=None, callback=check_output,
               help="Write the proposed touches (exact joint values to teach) as CSV, atomically.")
 def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
          frame: str | None, track_mm: float | None, touches: int | None, repeats: int | None,

@@ -21,6 +21,7 @@ from robotcell.cli.cellargs import (
     track_values,
 )
 from robotcell.cli.common import check_output, read_csv, write_csv, write_output
+from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
@@ -92,14 +93,14 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
     return T, table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T))), track
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("targets", type=click.Path(dir_okay=False))
 @target_options
 @click.option("--track", "track_mm", type=float, default=None,
               help="Track position (mm) for every target (default: chosen per target).")
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=OUTPUT, default=None, callback=check_output,
               help="CSV to write, atomically (default: standard output).")
-@click.option("--html", "html_path", type=click.Path(), default=None, callback=check_output,
+@click.option("--html", "html_path", type=OUTPUT, default=None, callback=check_output,
               help="Self-contained HTML page with the map (default: next to -o, .html).")
 def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
           table_deg: str | None, choose_table: bool, track_mm: float | None, output: str | None,
@@ -121,6 +122,9 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
       robotcell reach --cell cell.yaml seam.csv --frame part --tool torch -o reach.csv
       robotcell reach --cell cell.yaml seam.csv --tool torch --html reach.html
     """
+    if html_path is None and output:
+        html_path = str(Path(output).with_suffix(".html"))
+        refuse_overwriting_inputs(click.get_current_context(), [("the map written next to -o", html_path)])
     cell = Cell.load(cell_path)
     T, th, track = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
     with ExitStack() as stack:
@@ -128,8 +132,6 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
                        progress=DeferredProgress(stack, "targets"))
     header, rows = reach_rows(rm, cell)
     write_csv(output if output else sys.stdout, header, rows, 6)
-    if html_path is None and output:
-        html_path = str(Path(output).with_suffix(".html"))
     if html_path:
         page = reach_html(rm, T[:, :3, 3], title=f"Reachability: {Path(targets).name} in "
                           f"{cell.name}", frame=frame)

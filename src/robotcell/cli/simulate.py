@@ -17,6 +17,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_output, parse_numbers
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.studies.simulate import PROCEDURES, Touches
 from robotcell.studies.simulate import simulate as simulate_touches
@@ -168,11 +169,11 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
     return " ".join(parts + t.options)
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("procedure", type=click.Choice(list(PROCEDURES)))
 @cell_options
 @design_options
-@click.option("-o", "--output", type=click.Path(), default=None, callback=check_output,
+@click.option("-o", "--output", type=OUTPUT, default=None, callback=check_output,
               help="CSV file to write, atomically (default: standard output).")
 def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
              frame: str | None, track_mm: float | None, output: str | None,
