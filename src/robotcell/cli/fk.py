@@ -11,6 +11,7 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     cell_tool,
+    check_axis_columns,
     row_values,
     table_angles,
     table_columns,
@@ -22,6 +23,7 @@ from robotcell.cli.common import check_output, parse_numbers, read_csv, require_
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
+from robotcell.io.tables import outside_limits
 from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.robot import Robot
 
@@ -96,8 +98,7 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
     if joints is not None:
         q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
         T = r.fk(q, tool=T_tool)
-        if not r.within_limits(q):
-            click.echo("warning: joint values outside the robot's limits", err=True)
+        warn_joint_limits(r, q, None)
         if output_path is not None:
             _write_poses(T[None], fmt, output_path)
             return
@@ -109,10 +110,22 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
     cols = read_csv(input_path, known=names)
     q = joints_to_si(r, require_columns(cols, names, input_path))
     T = r.fk(q, tool=T_tool)
-    outside = int(np.count_nonzero(~r.within_limits(q)))
-    if outside:
-        click.echo(f"warning: {outside} row(s) outside the robot's joint limits", err=True)
+    warn_joint_limits(r, q, input_path)
     _write_poses(T, fmt, output_path)
+
+
+def warn_joint_limits(robot: Robot, q: np.ndarray, source: str | None) -> None:
+    """A ``warning:`` line naming the joint values ``q`` (SI, ``(N, n)``) outside the robot's
+    limits: by line and column of the file ``source``, or by axis for ``--joints`` (None)."""
+    scale = np.where(robot.prismatic, 1e3, 180.0 / math.pi)
+    names = [f"a{i}" for i in range(1, robot.n_joints + 1)]
+    units = ["mm" if p else "deg" for p in robot.prismatic]
+    bad = outside_limits(np.atleast_2d(q) * scale, names, robot.lower * scale,
+                         robot.upper * scale, units, lines=source is not None)
+    if bad is not None:
+        where = f"{source}: " if source else ""
+        click.echo(f"warning: {where}joint values outside the limits of {robot.name}: {bad}; "
+                   "the pose is computed, but the robot cannot move there", err=True)
 
 
 def _echo_pose(T: np.ndarray, fmt: str) -> None:
@@ -156,13 +169,12 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
     else:
         names = [f"a{i}" for i in range(1, r.n_joints + 1)]
         cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
+        check_axis_columns(cell, cols, input_path)
         q = joints_to_si(r, require_columns(cols, names, input_path))
         e = track_values(cell, row_values(cols, "track", track_mm, len(q)))
         th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)))
     T = cell.fk(q, e, th, T_tool, frame)
-    outside = int(np.count_nonzero(~r.within_limits(q)))
-    if outside:
-        click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
+    warn_joint_limits(r, q, input_path)
     if joints is not None and output_path is None:
         click.echo(f"{cell.name}: TCP in frame {frame!r} ({fmt}, mm, deg)")
         _echo_pose(T, fmt)

@@ -14,6 +14,7 @@ from robotcell.cell import Cell, Positioner
 from robotcell.cli.cellargs import (
     NORMAL_UP,
     cell_tool,
+    check_axis_columns,
     check_normal_up,
     chunks,
     row_values,
@@ -292,6 +293,7 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     names = [f.lower() for f in FORMATS[fmt].fields]
     n_table, table_names = table_columns(cell)
     cols = read_csv(input_path, known=[*names, "track", *table_names])
+    check_axis_columns(cell, cols, input_path)
     T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
     n = len(T)
     e = track_values(cell, row_values(cols, "track", track_mm, n))

@@ -13,6 +13,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
+    check_axis_columns,
     row_values,
     table_angles,
     table_columns,
@@ -82,6 +83,7 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
+    check_axis_columns(cell, cols, path, track=track_column)
     T = pose_from_vendor(require_columns(cols, names, path), fmt)
     track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
                          else track_mm)

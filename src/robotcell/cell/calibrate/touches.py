@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.calibration.measurements import repeated_rows, track_column
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import tool_pose
+from robotcell.cell.validation import check_axis_limits
 from robotcell.errors import InputError
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import validate_pose
@@ -138,6 +139,8 @@ def track_positions(cell: Cell, cols: Table, source: str, label: str = "the cell
         raise InputError(f"{source}: column 'track' has non-zero values, but the cell "
                          f"{label} has no track; remove the column or add the track to "
                          "the cell file")
+    if e is not None:
+        check_axis_limits(cell.track, e, ["track"], source, label)
     return e
 
 
