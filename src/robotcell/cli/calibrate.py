@@ -197,13 +197,17 @@ def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | Non
     return model, T
 
 
+#: Smallest ``--sigma`` (mm): 1 um, below the accuracy of any touch-up.
+SIGMA_MIN_MM = 1e-3
+
+
 def sigma_m(sigma_mm: float | None) -> float | None:
-    """``--sigma`` in mm to metres, refusing non-positive values."""
+    """``--sigma`` in mm to metres, refusing what no touch-up accuracy is."""
     if sigma_mm is None:
         return None
-    if not 0 < sigma_mm <= 1000:
-        raise InputError(f"--sigma must be a positive number of millimetres (at most 1000), got "
-                         f"{sigma_mm}")
+    if not SIGMA_MIN_MM <= sigma_mm <= 1000:
+        raise InputError(f"--sigma must be a positive number of millimetres from {SIGMA_MIN_MM:g} "
+                         f"(1 um, below any touch-up accuracy) to 1000, got {sigma_mm:g}")
     return sigma_mm * 1e-3
 
 

@@ -34,6 +34,7 @@ from robotcell.cli.common import parse_numbers, read_csv
 from robotcell.cli.files import Command
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
+from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.kinematics.transforms import validate_pose
 
 
@@ -108,6 +109,9 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
       robotcell calibrate turntable table.csv --json -o turntable.json
       robotcell calibrate turntable table.csv --cell cell.yaml --tool pointer
     """
+    if not abs(height) <= CELL_EXTENT_MM:
+        raise InputError(f"--height must be a number of millimetres within +-{CELL_EXTENT_MM:g} "
+                         f"(100 m, the size of any real cell), got {height:g}")
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "track"])

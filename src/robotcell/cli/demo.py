@@ -16,7 +16,8 @@ from robotcell.studies.demo import DEMO_NOISE, run_demo
               type=OutputPath(file_okay=False), help="Folder for the files the demo writes.")
 @click.option("--noise", type=float, default=DEMO_NOISE * 1e3, show_default=True, metavar="MM",
               help="Touch-up error, 1-sigma per coordinate (mm).")
-@click.option("--seed", type=int, default=1, show_default=True, help="Seed of the touch-up errors.")
+@click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True,
+              help="Seed of the touch-up errors (a whole number >= 0).")
 def demo(output: str, noise: float, seed: int) -> None:
     """Calibrate a virtual cell end to end; needs no files and no network.
 

@@ -66,8 +66,9 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     Raises
     ------
     InputError
-        Missing or binary file, empty file, ragged rows, an empty cell, NaN or infinity, a number
-        beyond :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
+        Missing or binary file, empty file, a header of one column whose names are separated by
+        a tab or ``|``, ragged rows, an empty cell, NaN or infinity, a number beyond
+        :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
     """
     p = Path(path)
     if not p.is_file():
@@ -83,6 +84,12 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray | list[str]]:
     if len(rows) < 2:
         raise InputError(f"{path}: needs a header line and at least one data line")
     header = [h.strip().lower() for h in rows[0]]
+    other = next((name for s, name in (("\t", "tabs"), ("|", "'|'"))
+                  if len(header) == 1 and s in header[0]), None)
+    if other is not None:
+        raise InputError(f"{path}: the header is one column {rows[0][0].strip()!r}, its names "
+                         f"separated by {other}: robotcell reads values separated by ',' (or "
+                         "';' with decimal commas); save the file as CSV")
     if len(set(header)) != len(header):
         raise InputError(f"{path}: repeated column name in header {header}")
     cols: dict[str, list[str]] = {h: [] for h in header}

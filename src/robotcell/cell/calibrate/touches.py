@@ -77,9 +77,10 @@ def load_table(measurements: Table | str | Path, source: str | None = None
 
 
 def raw_rows(cols: Table, names: Sequence[str]) -> NDArray[np.float64]:
-    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note."""
+    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note; no
+    rows when none of them is there (the procedure then names the missing columns)."""
     use = [n for n in names if n in cols and isinstance(cols[n], np.ndarray)]
-    return np.stack([cols[n] for n in use], axis=1)
+    return np.stack([cols[n] for n in use], axis=1) if use else np.zeros((0, 0))
 
 
 def repeat_notes(cols: Table, names: Sequence[str], source: str) -> list[str]:
