@@ -4,7 +4,7 @@ size of any real cell.
 - :func:`check_axis_limits`: track positions and table or positioner axis values of a table of
   touches or targets against the limits of the cell's track, turntable or positioner, named by
   line and column (mm, deg).
-- :func:`check_lengths`: every length of a cell (frames, tools, track, turntable, positioner)
+- :func:`check_lengths`: every position of a cell (frames, tools, track, turntable, positioner)
   within :data:`~robotcell.io.tables.CELL_EXTENT_MM` (100 m) of its parent, named by its key in
   the cell file: a frame 1e308 mm away is a typing or unit error, and no computation with it
   means anything.
@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 
 from robotcell.cell.model import Cell, Positioner, Track, Turntable
 from robotcell.errors import InputError
-from robotcell.io.tables import CELL_EXTENT_MM, outside_limits
+from robotcell.io.tables import CELL_EXTENT_MM, MAX_ABS_VALUE, outside_limits
 
 __all__ = ["SCALE_RANGE", "check_axis_limits", "check_lengths"]
 
@@ -89,9 +89,6 @@ def _lengths(cell: Cell) -> Iterator[tuple[str, float]]:
         yield from _pose("turntable.frame", tt.T_parent_B)
     elif isinstance(tt, Positioner):
         yield from _pose("positioner.frame", tt.T_parent_root)
-        for i, j in enumerate(tt.chain.joints, start=1):
-            yield f"positioner.axes[{i}].a", j.a
-            yield f"positioner.axes[{i}].d", j.d
         yield from _pose("positioner.plate", tt.chain.flange)
     for name, tool in cell.tools.items():
         yield from _pose(f"tools.{name}.frame", tool.T_F_TCP)
@@ -121,9 +118,11 @@ def check_lengths(cell: Cell, origin: str = "cell") -> Cell:
     ------
     InputError
         Naming the key of the cell file (``turntable.frame.y``), its value in mm and the bound:
-        a track scale within :data:`SCALE_RANGE`, and every length within
-        :data:`~robotcell.io.tables.CELL_EXTENT_MM` of its parent (a track's limits, a
-        positioner's DH ``a`` and ``d``, a tool's centre of mass included).
+        a track scale within :data:`SCALE_RANGE`, every length of a pose within
+        :data:`~robotcell.io.tables.CELL_EXTENT_MM` of its parent (a track's limits and a
+        tool's centre of mass included), and a positioner's DH ``a`` and ``d`` within
+        :data:`~robotcell.io.tables.MAX_ABS_VALUE` (the ``d`` of nearly parallel axes is far
+        longer than the positioner).
     """
     if cell.track is not None and not SCALE_RANGE[0] <= cell.track.scale <= SCALE_RANGE[1]:
         raise InputError(f"{origin}: key 'track.scale' is {cell.track.scale:g}, outside "
@@ -134,4 +133,10 @@ def check_lengths(cell: Cell, origin: str = "cell") -> Cell:
             raise InputError(f"{origin}: key '{key}' is {v * 1e3:g} mm, beyond "
                              f"{CELL_EXTENT_MM / 1e3:g} m, the size of any real robot cell: a "
                              "typing or unit error (the cell file is in mm)")
+    if isinstance(cell.turntable, Positioner):
+        for i, j in enumerate(cell.turntable.chain.joints, start=1):
+            for k, v in (("a", j.a), ("d", j.d)):
+                if not abs(v) * 1e3 <= MAX_ABS_VALUE:
+                    raise InputError(f"{origin}: key 'positioner.axes[{i}].{k}' is {v * 1e3:g} "
+                                     f"mm, beyond {MAX_ABS_VALUE:.0e} mm: a typing error")
     return cell

@@ -30,6 +30,7 @@ from robotcell.cli.common import (
     parse_numbers,
     read_csv,
     require_columns,
+    target_poses,
     write_output,
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
@@ -147,7 +148,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
     ref = None if near is None else joints_to_si(r, np.array(parse_numbers(near, "--near", n)))
     scale = np.where(r.prismatic, 1e3, deg)  # controller values to deg (mm for prismatic axes)
     if pose is not None:
-        T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
+        T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
         sol = solver.solve(T, T_tool)
         if ref is not None:
             q, found, branch = nearest(r, sol, ref)
@@ -179,7 +180,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
     cols = read_csv(input_path, known=names)
-    T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
+    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     sol = solver.solve(T, T_tool)
     axes = [f"a{i}" for i in range(1, n + 1)]
     if ref is not None:
@@ -251,7 +252,7 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     deg = 180.0 / math.pi
     ref = None if near is None else np.radians(parse_numbers(near, "--near", r.n_joints))
     if pose is not None:
-        T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
+        T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
         th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
               else table_angles(cell, table_option(cell, table_deg)))
         sol = cell.ik(T, frame, track_values(cell, track_mm), th, T_tool)
@@ -294,7 +295,7 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     n_table, table_names = table_columns(cell)
     cols = read_csv(input_path, known=[*names, "track", *table_names])
     check_axis_columns(cell, cols, input_path)
-    T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
+    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     n = len(T)
     e = track_values(cell, row_values(cols, "track", track_mm, n))
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP

@@ -21,11 +21,11 @@ from robotcell.cli.cellargs import (
     table_rows,
     track_values,
 )
-from robotcell.cli.common import check_output, read_csv, write_csv, write_output
+from robotcell.cli.common import check_output, read_csv, target_poses, write_csv, write_output
 from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
-from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.poseformats import FORMATS
 from robotcell.io.tables import require_columns
 from robotcell.studies.reach import ReachMap, reach_html, reach_map
 
@@ -84,7 +84,7 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
     _, table_names = table_columns(cell)
     cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
     check_axis_columns(cell, cols, path, track=track_column)
-    T = pose_from_vendor(require_columns(cols, names, path), fmt)
+    T = target_poses(require_columns(cols, names, path), fmt, path)
     track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
                          else track_mm)
     if choose_table:

@@ -19,16 +19,19 @@ from robotcell.cell import Cell
 from robotcell.cli.common import check_output, parse_numbers
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.errors import InputError
+from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.studies.simulate import PROCEDURES, Touches
 from robotcell.studies.simulate import simulate as simulate_touches
 
 
 def _mm(option: str, positive: bool = False) -> Callable[[float], float]:
-    """Converter of a length option: mm to m, refusing (in mm) what the option cannot be."""
+    """Converter of a length option: mm to m, refusing (in mm) what the option cannot be: not
+    finite, beyond the size of any real cell, or (``positive``) not above 0."""
     def convert(value: float) -> float:
-        if not math.isfinite(value) or (positive and value <= 0):
-            kind = "a positive" if positive else "a finite"
-            raise InputError(f"--{option} must be {kind} number of millimetres, got {value:g}")
+        if not abs(value) <= CELL_EXTENT_MM or (positive and value <= 0):
+            kind = "a positive" if positive else "a"
+            raise InputError(f"--{option} must be {kind} number of millimetres within "
+                             f"+-{CELL_EXTENT_MM:g} (100 m), got {value:g}")
         return value * 1e-3
     return convert
 
