@@ -3,7 +3,8 @@ status 2 and a message naming the option or value at fault (README, "Files and e
 
 Each case is one the fuzzing of the CLI found: a ``|``-separated CSV, absurd option values
 (``--sigma 1e-300``, ``--accuracy 1e-300``, ``--j23-factor 1e308``, ``--seed -1``, ``--height
--1e300``). Option ranges are checked where the option is parsed.
+-1e300``, ``--noise 1e300``), a layouts file whose range ends are not numbers. Option ranges are
+checked where the option is parsed.
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ def files(tmp_path_factory) -> Path:
     simulate(Cell.load(POSITIONER), "positioner", seed=2, tool="pointer").write_csv(d / "p.csv")
     (d / "bar.csv").write_text((d / "p.csv").read_text().replace(",", "|"))
     (d / "tab.csv").write_text((d / "p.csv").read_text().replace(",", "\t"))
+    shutil.copy(ROOT / "examples" / "seam_part.csv", d / "seam.csv")
+    (d / "layouts.yaml").write_text("robot:\n  y: {from: {}, to: 300, steps: 2}\n")
     robot = load_robot("kuka_kr16")
     q = np.random.default_rng(5).uniform([-60, -100, 40, -90, -60, -90],
                                          [60, -50, 110, 90, 60, 90], (30, 6))
@@ -61,6 +64,11 @@ CASES = [
     (["identify", "--propose", "20", "--seed", "-1", "--robot", "kuka_kr16"],
      "Invalid value for '--seed': -1 is not in the range x>=0"),
     (["demo", "--seed", "-1", "-o", "demo"], "Invalid value for '--seed': -1 is not in the range"),
+    (["sweep", "--cell", "cell.yaml", "--targets", "seam.csv", "--layouts", "layouts.yaml",
+      "--frame", "part", "--tool", "torch", "--workers", "1"],
+     "layouts.yaml: robot.y: from and to must be numbers, got [{}, 300]"),
+    (["simulate", "frame", "--cell", "cell.yaml", "--tool", "pointer", "--frame", "fixture",
+      "--noise", "1e300"], "--noise must be a number of millimetres >= 0, at most 1000"),
 ]
 
 

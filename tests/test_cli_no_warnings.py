@@ -77,7 +77,7 @@ def test_a_target_1e14_mm_away_is_refused_naming_line_and_column(tmp_path, capsy
 
 def test_simulate_height_of_1e300_mm_is_refused(tmp_path, capsys):
     _refused(capsys, ["simulate", "turntable", "--cell", EXAMPLE, "--tool", "pointer", "--height",
-                      "-1e300"], "--height must be a number of millimetres within +-100000")
+                      "-1e300"], "--height must be within +-100000 mm (100 m, the size of any real cell)")
 
 
 def test_identical_rows_are_one_configuration(tmp_path, capsys):

@@ -26,8 +26,12 @@ from robotcell.io.tables import (
     write_csv,
 )
 
-__all__ = ["check_not_folder", "check_output", "format_table", "parse_numbers", "read_csv",
+__all__ = ["NOISE_MAX_MM", "check_not_folder", "check_output", "format_table", "parse_numbers", "read_csv",
            "require_columns", "target_poses", "write_csv", "write_output"]
+
+
+#: Largest touch-up error (``--noise`` of simulate, plan and demo; mm): 1 m is none.
+NOISE_MAX_MM = 1000.0
 
 
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:

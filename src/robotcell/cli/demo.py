@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import math
-
 import click
 
+from robotcell.cli.common import NOISE_MAX_MM
 from robotcell.cli.files import Command, OutputPath
 from robotcell.errors import InputError
 from robotcell.studies.demo import DEMO_NOISE, run_demo
@@ -32,6 +31,7 @@ def demo(output: str, noise: float, seed: int) -> None:
       robotcell demo
       robotcell demo -o /tmp/demo --noise 0.05 --seed 7
     """
-    if not (math.isfinite(noise) and noise > 0):
-        raise InputError(f"--noise must be a positive number of millimetres, got {noise}")
+    if not 0 < noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a positive number of millimetres, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
     run_demo(output, noise=noise * 1e-3, seed=seed, echo=click.echo)

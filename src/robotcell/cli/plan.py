@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from robotcell.cell import Cell
-from robotcell.cli.common import check_output, format_table
+from robotcell.cli.common import NOISE_MAX_MM, check_output, format_table
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
 from robotcell.errors import InputError
@@ -73,8 +73,9 @@ def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: s
       robotcell plan frame --cell cell.yaml --tool pointer --frame fixture --max-size 300 \\
           -o frame_touches.csv
     """
-    if not (math.isfinite(noise) and noise > 0):
-        raise InputError(f"--noise must be a positive number of millimetres, got {noise}")
+    if not 0 < noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a positive number of millimetres, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
     cell = Cell.load(cell_path)
     common = common_keywords(procedure, tool, frame, track_mm)
     common.update(design_keywords(procedure, {"touches": touches, "repeats": repeats}))
