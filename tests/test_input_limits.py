@@ -179,3 +179,20 @@ def test_a_track_scale_of_1000_is_refused(tmp_path, capsys):
                          + sorted((ROOT / "tests" / "data").glob("*.saved.yaml")))
 def test_every_example_cell_is_plausible(path):
     assert Cell.load(path).robot is not None
+
+
+def test_a_track_without_limits_still_ends_at_100_m(tmp_path, capsys):
+    text = EXAMPLE.read_text()
+    assert "  min: 0\n  max: 6000\n" in text
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(text.replace("  min: 0\n  max: 6000\n", ""))
+    for args in (["fk", "--cell", cell, "--joints", "0,-90,90,0,45,0", "--track", "1e300"],
+                 ["ik", "--cell", cell, "--pose", "100,0,50,0,180,0", "--frame", "part",
+                  "--tool", "torch", "--track", "1e300"]):
+        code, out, err = run(capsys, *args)
+        assert code == 2 and out == ""
+        assert "track position 1e+300 mm is outside the track limits [-100000, 100000] mm" in err
+    joints = tmp_path / "j.csv"
+    joints.write_text("a1,a2,a3,a4,a5,a6,track\n0,-90,90,0,45,0,1e14\n")
+    code, _, err = run(capsys, "fk", "--cell", cell, "--input", joints)
+    assert code == 2 and "line 2, column 'track': 1e+14 mm (limits -100000 .. 100000 mm)" in err

@@ -22,11 +22,21 @@ from robotcell.cell.model import Cell, Positioner, Track, Turntable
 from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM, MAX_ABS_VALUE, outside_limits
 
-__all__ = ["SCALE_RANGE", "check_axis_limits", "check_lengths"]
+__all__ = ["SCALE_RANGE", "axis_range", "check_axis_limits", "check_lengths"]
 
 #: Track scales (displacement per unit of the controller's track value) a real track has: a
 #: factor 10 from 1 is a unit error.
 SCALE_RANGE = (0.1, 10.0)
+
+
+def axis_range(axis: Track | Turntable | Positioner) -> tuple[np.ndarray, np.ndarray]:
+    """The values an axis can take (SI): its limits; a track's also within 100 m
+    (:data:`~robotcell.io.tables.CELL_EXTENT_MM`), whether or not the cell file gives limits."""
+    lower, upper = np.asarray(axis.lower, dtype=float), np.asarray(axis.upper, dtype=float)
+    if isinstance(axis, Track):
+        extent = CELL_EXTENT_MM * 1e-3
+        return np.maximum(lower, -extent), np.minimum(upper, extent)
+    return lower, upper
 
 
 def check_axis_limits(axis: Track | Turntable | Positioner | None, values: ArrayLike,
@@ -50,15 +60,17 @@ def check_axis_limits(axis: Track | Turntable | Positioner | None, values: Array
     Raises
     ------
     InputError
-        Naming the line and column of the first values outside the limits (mm or deg).
+        Naming the line and column of the first values outside the limits (mm or deg), a
+        track's within 100 m (:func:`axis_range`).
     """
     if axis is None:
         return
     track = isinstance(axis, Track)
     scale, unit = (1e3, "mm") if track else (180.0 / math.pi, "deg")
     k = len(columns)
-    lower = np.broadcast_to(np.asarray(axis.lower, dtype=float) * scale, (k,))
-    upper = np.broadcast_to(np.asarray(axis.upper, dtype=float) * scale, (k,))
+    lo, hi = axis_range(axis)
+    lower = np.broadcast_to(lo * scale, (k,))
+    upper = np.broadcast_to(hi * scale, (k,))
     v = np.asarray(values, dtype=float).reshape(-1, k) * scale
     bad = outside_limits(v, columns, lower, upper, [unit] * k)
     if bad is not None:

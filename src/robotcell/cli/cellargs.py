@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Positioner, Track, Turntable
-from robotcell.cell.validation import check_axis_limits
+from robotcell.cell.validation import axis_range, check_axis_limits
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
@@ -53,11 +53,12 @@ def _checked(values: NDArray[np.float64], unit_scale: float, unit: str, axis: Tr
         if np.any(values != 0):
             raise InputError(f"the cell has no {option}; leave out --{option} (or the {option} column)")
         return values
-    bad = np.atleast_1d(~axis.within_limits(values))
+    lower, upper = axis_range(axis)
+    bad = np.atleast_1d((values < lower) | (values > upper))
     if np.any(bad):
         first = float(np.atleast_1d(values)[bad][0]) * unit_scale
         raise InputError(f"{what} {first:g} {unit} is outside the {axis_name(axis)} limits "
-                         f"[{axis.lower * unit_scale:g}, {axis.upper * unit_scale:g}] {unit}")
+                         f"[{lower * unit_scale:g}, {upper * unit_scale:g}] {unit}")
     return values
 
 
