@@ -3,7 +3,8 @@
 Every command that writes a file is run with valid inputs and its output named like one of them
 (the same name, ``./name``, a symbolic link, a hard link): it exits with status 2, names both
 options, and leaves every file as it was. Without the check each of these runs succeeds and
-replaces its input.
+replaces its input. The inputs have names whose ending says no kind of file (``.dat``), so that
+nothing but the file's identity can refuse the output.
 """
 
 from __future__ import annotations
@@ -37,23 +38,23 @@ URDF = Path(__file__).resolve().parents[1] / "src" / "robotcell" / "robots" / "u
 def inputs(tmp_path_factory) -> Path:
     """Valid inputs of every command, written once; each test works on a copy."""
     d = tmp_path_factory.mktemp("inputs")
-    shutil.copy(EXAMPLE, d / "cell.yaml")
-    shutil.copy(EXAMPLES / "seam_part.csv", d / "seam.csv")
-    shutil.copy(EXAMPLES / "layouts_kr16.yaml", d / "layouts.yaml")
-    shutil.copy(URDF, d / "arm.urdf")
+    shutil.copy(EXAMPLE, d / "cell.dat")
+    shutil.copy(EXAMPLES / "seam_part.csv", d / "seam.dat")
+    shutil.copy(EXAMPLES / "layouts_kr16.yaml", d / "layouts.dat")
+    shutil.copy(URDF, d / "arm.dat")
     cell = Cell.load(EXAMPLE)
     for procedure in ("tcp", "turntable", "workpiece"):
-        simulate(cell, procedure, seed=1, tool="pointer").write_csv(d / f"{procedure}.csv")
-    table = cellcal.turntable(cell, d / "turntable.csv", tool="pointer").result
-    (d / "table.json").write_text(json.dumps(table.to_json()))
+        simulate(cell, procedure, seed=1, tool="pointer").write_csv(d / f"{procedure}.dat")
+    table = cellcal.turntable(cell, d / "turntable.dat", tool="pointer").result
+    (d / "table.dat").write_text(json.dumps(table.to_json()))
     robot = load_robot("kuka_kr16")
-    save_robot(robot, d / "model.yaml")
+    save_robot(robot, d / "model.dat")
     q = np.random.default_rng(0).uniform([-60, -100, 40, -90, -60, -90],
                                          [60, -50, 110, 90, 60, 90], (40, 6))
     xyz = robot.fk(np.radians(q))[:, :3, 3] * 1e3
-    write_csv(d / "joints.csv", [f"a{i}" for i in range(1, 7)], q[:4])
-    write_csv(d / "poses.csv", list("xyzabc"), pose_to_vendor(robot.fk(np.radians(q[:4])), "kuka"))
-    write_csv(d / "tracker.csv", [f"a{i}" for i in range(1, 7)] + list("xyz"), np.hstack([q, xyz]))
+    write_csv(d / "joints.dat", [f"a{i}" for i in range(1, 7)], q[:4])
+    write_csv(d / "poses.dat", list("xyzabc"), pose_to_vendor(robot.fk(np.radians(q[:4])), "kuka"))
+    write_csv(d / "tracker.dat", [f"a{i}" for i in range(1, 7)] + list("xyz"), np.hstack([q, xyz]))
     return d
 
 
@@ -68,29 +69,29 @@ def work(inputs, tmp_path, monkeypatch) -> Path:
 #: (command line, the input it names as output): every command that writes a file. Each line
 #: runs (exit 0 or 3) and replaces its input when the check is missing.
 CASES = [
-    ("export --cell cell.yaml --format kuka -o cell.yaml", "--cell cell.yaml"),
-    ("export --cell cell.yaml --format urdf -o ./cell.yaml", "--cell cell.yaml"),
-    ("calibrate turntable turntable.csv --cell cell.yaml --tool pointer --json -o turntable.csv",
-     "MEASUREMENTS turntable.csv"),
-    ("calibrate tcp tcp.csv --cell cell.yaml --name pointer -o cell.yaml", "--cell cell.yaml"),
-    (("calibrate workpiece workpiece.csv --cell cell.yaml --name part --tool pointer "
-     "--turntable table.json -o table.json"), "--turntable table.json"),
-    ("fk kuka_kr16 --input joints.csv -o joints.csv", "--input joints.csv"),
-    ("fk --cell cell.yaml --joints 0,-90,90,0,0,0 -o cell.yaml", "--cell cell.yaml"),
-    ("fk model.yaml --joints 0,-90,90,0,0,0 -o model.yaml", "ROBOT model.yaml"),
-    ("ik kuka_kr16 --input poses.csv -o poses.csv", "--input poses.csv"),
-    ("report table.json -o table.json", "RESULT table.json"),
-    ("reach --cell cell.yaml seam.csv --frame part --tool torch -o seam.csv", "TARGETS seam.csv"),
-    ("reach --cell cell.yaml seam.csv --frame part --tool torch --html cell.yaml",
-     "--cell cell.yaml"),
-    (("sweep --cell cell.yaml --targets seam.csv --layouts layouts.yaml --frame part "
-     "--tool torch --workers 1 -o layouts.yaml"), "--layouts layouts.yaml"),
-    ("simulate tcp --cell cell.yaml --tool pointer -o cell.yaml", "--cell cell.yaml"),
-    ("plan turntable --cell cell.yaml --tool pointer --runs 0 -o cell.yaml", "--cell cell.yaml"),
-    ("identify tracker.csv --robot kuka_kr16 -o tracker.csv", "MEASUREMENTS tracker.csv"),
-    ("identify tracker.csv --robot model.yaml --report model.yaml", "--robot model.yaml"),
-    ("dh from-urdf arm.urdf -o arm.urdf", "FILE arm.urdf"),
-    ("dh convert model.yaml --to modified -o model.yaml", "MODEL model.yaml"),
+    ("export --cell cell.dat --format kuka -o cell.dat", "--cell cell.dat"),
+    ("export --cell cell.dat --format urdf -o ./cell.dat", "--cell cell.dat"),
+    ("calibrate turntable turntable.dat --cell cell.dat --tool pointer --json -o turntable.dat",
+     "MEASUREMENTS turntable.dat"),
+    ("calibrate tcp tcp.dat --cell cell.dat --name pointer -o cell.dat", "--cell cell.dat"),
+    (("calibrate workpiece workpiece.dat --cell cell.dat --name part --tool pointer "
+     "--turntable table.dat -o table.dat"), "--turntable table.dat"),
+    ("fk kuka_kr16 --input joints.dat -o joints.dat", "--input joints.dat"),
+    ("fk --cell cell.dat --joints 0,-90,90,0,0,0 -o cell.dat", "--cell cell.dat"),
+    ("fk model.dat --joints 0,-90,90,0,0,0 -o model.dat", "ROBOT model.dat"),
+    ("ik kuka_kr16 --input poses.dat -o poses.dat", "--input poses.dat"),
+    ("report table.dat -o table.dat", "RESULT table.dat"),
+    ("reach --cell cell.dat seam.dat --frame part --tool torch -o seam.dat", "TARGETS seam.dat"),
+    ("reach --cell cell.dat seam.dat --frame part --tool torch --html cell.dat",
+     "--cell cell.dat"),
+    (("sweep --cell cell.dat --targets seam.dat --layouts layouts.dat --frame part "
+     "--tool torch --workers 1 -o layouts.dat"), "--layouts layouts.dat"),
+    ("simulate tcp --cell cell.dat --tool pointer -o cell.dat", "--cell cell.dat"),
+    ("plan turntable --cell cell.dat --tool pointer --runs 0 -o cell.dat", "--cell cell.dat"),
+    ("identify tracker.dat --robot kuka_kr16 -o tracker.dat", "MEASUREMENTS tracker.dat"),
+    ("identify tracker.dat --robot model.dat --report model.dat", "--robot model.dat"),
+    ("dh from-urdf arm.dat -o arm.dat", "FILE arm.dat"),
+    ("dh convert model.dat --to modified -o model.dat", "MODEL model.dat"),
 ]
 
 
@@ -110,25 +111,27 @@ def test_output_onto_an_input_is_refused_and_changes_nothing(work, capsys, line,
 @pytest.mark.parametrize("spelling", ["link", "hardlink", "dotdot"])
 def test_links_and_relative_paths_are_the_same_file(work, capsys, spelling):
     if spelling == "link":
-        os.symlink("cell.yaml", work / "alias.yaml")
-        out = "alias.yaml"
+        os.symlink("cell.dat", work / "alias.dat")
+        out = "alias.dat"
     elif spelling == "hardlink":
-        os.link(work / "cell.yaml", work / "alias.yaml")
-        out = "alias.yaml"
+        os.link(work / "cell.dat", work / "alias.dat")
+        out = "alias.dat"
     else:
         (work / "sub").mkdir()
-        out = f"sub/../../{work.name}/cell.yaml"
+        out = f"sub/../../{work.name}/cell.dat"
     before = _snapshot(work)
-    code, _, err = run(capsys, "export", "--cell", "cell.yaml", "--format", "kuka", "-o", out)
-    assert code == 2 and f"-o/--output {out} names the same file as --cell cell.yaml" in err
+    code, _, err = run(capsys, "export", "--cell", "cell.dat", "--format", "kuka", "-o", out)
+    assert code == 2 and f"-o/--output {out} names the same file as --cell cell.dat" in err
     assert _snapshot(work) == before
 
 
-def test_reach_map_next_to_the_csv_may_not_be_the_csv(work, capsys):
+def test_reach_map_next_to_the_csv_may_not_be_an_input(work, capsys):
+    shutil.copy(work / "seam.dat", work / "seam.html")
     before = _snapshot(work)
-    code, _, err = run(capsys, "reach", "--cell", "cell.yaml", "seam.csv", "--frame", "part",
-                       "--tool", "torch", "-o", "map.html")
-    assert code == 2 and "names the same file as -o/--output map.html" in err
+    code, _, err = run(capsys, "reach", "--cell", "cell.dat", "seam.html", "--frame", "part",
+                       "--tool", "torch", "-o", "seam.dat")
+    assert code == 2
+    assert "the map written next to -o seam.html names the same file as TARGETS seam.html" in err
     assert _snapshot(work) == before
 
 
