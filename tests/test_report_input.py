@@ -48,6 +48,9 @@ def _changed(data: dict, key: str, value: object) -> dict:
      "'sigma.T_R_B_position_mm[1]' is not a finite number"),
     ("tilt_deg", 10 ** 400, "'tilt_deg' is not a finite number"),
     ("rms_mm", 1e300, "'rms_mm' holds a length beyond 1e+15 mm"),
+    ("rotation", [[1, 0, 0], [0, 1, 0], [0, 0, -1]],
+     ("'rotation' is not a proper rotation (orthonormal, det = 1): rotation part has determinant "
+     "-1")),
 ])
 def test_a_result_calibrate_would_not_write_is_refused(tmp_path, capsys, result, key, value,
                                                        match):

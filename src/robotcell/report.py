@@ -44,8 +44,8 @@ def load_result(path: str | Path) -> dict[str, Any]:
         The file is missing, not JSON, or not a calibration result as ``calibrate`` writes it:
         a field missing or of the wrong type, an unknown ``procedure``, a number that is not
         finite (anywhere), a length (a key ending in ``_mm``, the translation of ``matrix``)
-        beyond :data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, or a ``matrix`` that is not a
-        rigid transform (a proper rotation).
+        beyond :data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, or a ``matrix`` (a track's
+        ``rotation``) that is not a rigid transform (a proper rotation).
     """
     p = Path(path)
     if not p.is_file():
@@ -135,6 +135,7 @@ def _malformed(data: dict[str, Any]) -> str | None:
         "sigma": lambda v: isinstance(v, dict),
         "matrix": lambda v: isinstance(v, list) and len(v) == 4
         and all(isinstance(r, list) and len(r) == 4 and all(map(_is_number, r)) for r in v),
+        "rotation": lambda v: _is_points(v, 3),
     }
     for key, ok in checks.items():
         if data.get(key) is not None and not ok(data[key]):
@@ -147,6 +148,12 @@ def _malformed(data: dict[str, Any]) -> str | None:
         ok, reasons = check_pose(T)
         if not ok:
             return f"'matrix' is not a rigid transform (R orthonormal, det R = 1): {reasons[0]}"
+    if data.get("rotation") is not None:  # the track's L_Q_R
+        T = np.eye(4)
+        T[:3, :3] = data["rotation"]
+        ok, reasons = check_pose(T)
+        if not ok:
+            return f"'rotation' is not a proper rotation (orthonormal, det = 1): {reasons[0]}"
     return None
 
 
