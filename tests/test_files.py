@@ -544,6 +544,8 @@ def test_read_only_file_is_not_replaced(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "kuka.dat"]  # no .bak
 
 
+# The suite turns warnings into errors; this test shows what a user sees when one is shown.
+@pytest.mark.filterwarnings("default::RuntimeWarning")
 def test_python_warning_is_one_line_without_source(capsys, monkeypatch):
     import warnings
 

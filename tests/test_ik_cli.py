@@ -51,7 +51,7 @@ def test_batch_round_trip(tmp_path, capsys):
         fh.write("x,y,z,a,b,c\n" + "\n".join(",".join(f"{v:.9f}" for v in row) for row in poses))
     dst = tmp_path / "joints.csv"
     run_ok(["ik", "kuka_kr16", "--input", str(src), "--output", str(dst)], capsys)
-    rows = list(csv.DictReader(dst.open()))
+    rows = list(csv.DictReader(dst.read_text().splitlines()))
     got = {}
     for r in rows:
         got.setdefault(int(r["pose"]), []).append([float(r[f"a{i}"]) for i in range(1, 7)])
@@ -61,7 +61,7 @@ def test_batch_round_trip(tmp_path, capsys):
     dst2 = tmp_path / "near.csv"
     run_ok(["ik", "kuka_kr16", "--input", str(src), "--output", str(dst2), "--near",
             ",".join(str(v) for v in np.degrees(q[0]))], capsys)
-    rows = list(csv.DictReader(dst2.open()))
+    rows = list(csv.DictReader(dst2.read_text().splitlines()))
     assert len(rows) == 20 and rows[0]["found"] == "1"
     np.testing.assert_allclose([float(rows[0][f"a{i}"]) for i in range(1, 7)], np.degrees(q[0]), atol=1e-5)
 

@@ -60,7 +60,7 @@ def test_cli_writes_csv_and_a_self_contained_html_map(capsys, tmp_path):
                        "torch", "-o", out)
     assert code == 0, err
     assert "36 of 36 targets reachable" in err
-    rows = list(csv.DictReader(out.open()))
+    rows = list(csv.DictReader(out.read_text().splitlines()))
     assert len(rows) == 36
     # Columns keep their types: integers as integers, booleans as true/false.
     assert [r["target"] for r in rows[:3]] == ["0", "1", "2"]
@@ -75,8 +75,8 @@ def test_cli_writes_csv_and_a_self_contained_html_map(capsys, tmp_path):
     code, _, err = run(capsys, "fk", "--cell", CELL, "--input", out, "--frame", "part",
                        "--tool", "torch", "-o", tmp_path / "back.csv")
     assert code == 0, err
-    back = list(csv.DictReader((tmp_path / "back.csv").open()))
-    seam = list(csv.DictReader(SEAM.open()))
+    back = list(csv.DictReader((tmp_path / "back.csv").read_text().splitlines()))
+    seam = list(csv.DictReader(SEAM.read_text().splitlines()))
     for k in "xyz":  # fk writes X,Y,Z; the seam has x,y,z (mm)
         assert [float(b[k.upper()]) for b in back] == pytest.approx([float(t[k]) for t in seam],
                                                                     abs=1e-4)

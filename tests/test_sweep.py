@@ -203,7 +203,7 @@ def test_reach_cli_reads_and_writes_a_positioners_axes_as_fk_does(capsys, tmp_pa
     code, _, err = run(capsys, "reach", "--cell", path, targets, "--frame", "part", "--tool",
                        "torch", "-o", out)
     assert code == 0, err
-    got = list(csv.DictReader(out.open()))
+    got = list(csv.DictReader(out.read_text().splitlines()))
     assert list(got[0])[3:12] == ["track", "e1", "e2", "branch", "a1", "a2", "a3", "a4", "a5"]
     assert np.allclose([[float(r["e1"]), float(r["e2"])] for r in got], np.degrees(v), atol=1e-6)
     code, back, err = run(capsys, "fk", "--cell", path, "--input", out, "--frame", "part",

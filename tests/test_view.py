@@ -232,13 +232,14 @@ def test_view_command_refuses_bad_input_and_writes_nothing(tmp_path, capsys):
         assert re.search(message, err), (args, err)
         assert "Traceback" not in err and not out.exists()
     # -o onto an input: refused before it is read, the input intact
-    copy = tmp_path / "cell.yaml"
+    # (a name whose ending says no kind of file, so that only the input check can refuse it)
+    copy = tmp_path / "cell.dat"
     copy.write_text(EXAMPLE.read_text())
     for args in ([copy, "-o", copy], [EXAMPLE, "--reach", copy, "-o", copy]):
         code, _, err = run(capsys, "view", *args)
-        assert code == 2 and "is the input file" in err and "give another file name" in err
+        assert code == 2 and "names the same file as" in err and "write to another file" in err
         assert copy.read_text() == EXAMPLE.read_text()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "missing_robot.yaml"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.dat", "missing_robot.yaml"]
 
 
 def test_page_of_a_scene_has_its_title(tmp_path):

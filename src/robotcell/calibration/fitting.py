@@ -225,7 +225,9 @@ def touch_statistics(J: NDArray[np.float64], residuals: ArrayLike,
     q = np.einsum("...ni,ni->...n", proj**2, inv)
     trace = np.trace(M, axis1=-2, axis2=-1)
     dof = m - u.shape[1]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # A touch that the others fit exactly (s2 at its floor), or one metres away from them, has an
+    # infinite statistic (p = 0: an outlier); its overflow is that result, not a failure.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         if prior_sigma is not None:
             s2 = np.broadcast_to(float(prior_sigma) ** 2, q.shape)
             pval = chdtrc(k, q / s2)

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
+from robotcell.io.tables import outside_limits
 from robotcell.kinematics.robot import Robot
 
 __all__ = [
@@ -139,16 +140,29 @@ def joint_columns(cols: Columns, robot: Robot, source: str) -> NDArray[np.float6
     cols : mapping
         CSV columns.
     robot : Robot
-        Model whose ``n_joints`` and joint types set the columns and units.
+        Model whose ``n_joints``, joint types and limits set the columns, units and ranges.
     source : str
 
     Returns
     -------
     ndarray, shape (N, n)
         Radians for revolute joints, metres for prismatic joints.
+
+    Raises
+    ------
+    InputError
+        A value outside the robot's joint limits (no touch can be recorded there), naming its
+        line and column.
     """
     names = [f"a{i + 1}" for i in range(robot.n_joints)]
     q = _numeric(cols, names, source)
+    scale = np.where(robot.prismatic, 1e3, 180.0 / np.pi)
+    units = ["mm" if p else "deg" for p in robot.prismatic]
+    bad = outside_limits(q, names, robot.lower * scale, robot.upper * scale, units)
+    if bad is not None:
+        raise InputError(f"{source}: joint values outside the limits of {robot.name}: {bad}. A "
+                         "touch is recorded within the limits: correct the value (a typing or "
+                         "unit error?), or give the robot that touched")
     return np.where(robot.prismatic, q * 1e-3, np.radians(q))
 
 

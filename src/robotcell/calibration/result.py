@@ -26,7 +26,11 @@ from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import format_table
 
-__all__ = ["CalibrationResult", "pose_fields", "to_jsonable"]
+__all__ = ["PROCEDURES", "CalibrationResult", "pose_fields", "to_jsonable"]
+
+#: The ``procedure`` of every result robotcell's calibrations write (``--json``).
+PROCEDURES = ("tcp", "frame-3point", "frame-npoint", "external-tcp", "track", "turntable",
+              "workpiece", "positioner-2axis")
 
 #: Conditioning figure above which a result is flagged: Schroer's threshold of about 100 for
 #: a trustworthy identification, as cited by Nahvi and Hollerbach (ICRA 1996).

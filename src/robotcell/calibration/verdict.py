@@ -34,6 +34,8 @@ from typing import Any
 import numpy as np
 from scipy.special import chdtri
 
+from robotcell.io.tables import CELL_EXTENT_MM
+
 __all__ = [
     "CELL_EXTENT_MM",
     "CHI2_P",
@@ -65,8 +67,6 @@ CONDITION_POOR = 1000.0
 SCALE_CHECK = 0.02
 #: ... and that no real track has (a unit error or touches of different points).
 SCALE_POOR = 0.10
-#: Largest length (mm) in any real robot cell: 100 m.
-CELL_EXTENT_MM = 1e5
 #: Redundant coordinates left after removing one touch (3 coordinates) needed to single out a
 #: wrong touch: with 6, an outlier flagged half the time is at most twice the one flagged with a
 #: known noise (the F(3, 6) against the chi-square(3) 3-sigma test); with 3 it is 3.7 times.

@@ -37,6 +37,7 @@ from robotcell.cell.model import (
     Turntable,
     _check_name,
 )
+from robotcell.cell.validation import check_lengths
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, check_destination, read_text
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
@@ -297,9 +298,10 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
             provenance=rd.provenance(fd.get("provenance"), f"{key}.provenance"),
         )
     try:
-        return Cell(tools=tools, frames=frames, **kwargs)
+        cell = Cell(tools=tools, frames=frames, **kwargs)
     except InputError as exc:
         raise InputError(f"{origin}: {exc}") from None
+    return check_lengths(cell, origin)
 
 
 _AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "sign", "min", "max"}

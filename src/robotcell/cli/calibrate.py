@@ -28,13 +28,14 @@ from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
 from robotcell.cli.common import check_kind, check_output, parse_numbers, read_csv, write_output
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.robot import Robot
 
 
-class CalibrateGroup(click.Group):
+class CalibrateGroup(Group):
     """The ``calibrate`` group: its own subcommands plus the lazily imported ``REGISTERED`` ones."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -102,7 +103,7 @@ def measurement_options(func: Callable) -> Callable:
     func = click.option("--accept-poor", is_flag=True,
                         help="Write and exit 0 even when the verdict is poor (default: a poor "
                              "result exits with status 3 and changes no file).")(func)
-    func = click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+    func = click.option("-o", "--output", default=None, metavar="FILE", type=OUTPUT,
                         expose_value=False, callback=_keep_output,
                         help="Also write the result to FILE, atomically and only when the run "
                              "succeeds: the JSON object with --json, else the report. Use it "
@@ -117,7 +118,7 @@ def measurement_options(func: Callable) -> Callable:
                         help="Tool active during the touches (KUKA, mm/deg; with --cell also the "
                              "name of a tool of the cell), for joint-value input; default: the "
                              "robot model's tool.")(func)
-    func = click.option("--robot", default=None, metavar="NAME_OR_FILE",
+    func = click.option("--robot", default=None, metavar="NAME_OR_FILE", type=NAME_OR_FILE,
                         help="Robot model for joint-value input (columns a1..a6).")(func)
     return func
 
@@ -217,13 +218,17 @@ def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | Non
     return model, T
 
 
+#: Smallest ``--sigma`` (mm): 1 um, below the accuracy of any touch-up.
+SIGMA_MIN_MM = 1e-3
+
+
 def sigma_m(sigma_mm: float | None) -> float | None:
-    """``--sigma`` in mm to metres, refusing non-positive values."""
+    """``--sigma`` in mm to metres, refusing what no touch-up accuracy is."""
     if sigma_mm is None:
         return None
-    if not 0 < sigma_mm <= 1000:
-        raise InputError(f"--sigma must be a positive number of millimetres (at most 1000), got "
-                         f"{sigma_mm}")
+    if not SIGMA_MIN_MM <= sigma_mm <= 1000:
+        raise InputError(f"--sigma must be a positive number of millimetres from {SIGMA_MIN_MM:g} "
+                         f"(1 um, below any touch-up accuracy) to 1000, got {sigma_mm:g}")
     return sigma_mm * 1e-3
 
 

@@ -31,12 +31,14 @@ from robotcell.cli.calibrate import (
     sigma_m,
 )
 from robotcell.cli.common import parse_numbers, read_csv
+from robotcell.cli.files import Command
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
+from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.kinematics.transforms import validate_pose
 
 
-@click.command("track")
+@click.command("track", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--reference", "references", multiple=True, metavar="X,Y,Z",
               help="Known coordinates (mm) of a touched reference point in the track frame L; "
@@ -83,7 +85,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     emit(out.result, as_json)
 
 
-@click.command("turntable")
+@click.command("turntable", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--height", type=float, default=0.0, show_default=True, metavar="MM",
               help="Shift of the frame origin along the table axis from the plane of the touched "
@@ -107,6 +109,9 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
       robotcell calibrate turntable table.csv --json -o turntable.json
       robotcell calibrate turntable table.csv --cell cell.yaml --tool pointer
     """
+    if not abs(height) <= CELL_EXTENT_MM:
+        raise InputError(f"--height must be a number of millimetres within +-{CELL_EXTENT_MM:g} "
+                         f"(100 m, the size of any real cell), got {height:g}")
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "track"])
@@ -120,7 +125,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     emit(out.result, as_json)
 
 
-@click.command("positioner")
+@click.command("positioner", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @cell_option
 @measurement_options
@@ -215,7 +220,7 @@ def _covariance(value: object, where: str) -> np.ndarray:
     return cov
 
 
-@click.command("workpiece")
+@click.command("workpiece", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--turntable", "turntable_json", default=None, metavar="TURNTABLE.json",
               type=click.Path(dir_okay=False),

@@ -9,6 +9,7 @@ import click
 from robotcell.cell import Cell, Provenance, Turntable
 from robotcell.cell.history import cell_history
 from robotcell.cli.common import format_table
+from robotcell.cli.files import Group
 from robotcell.io.poseformats import pose_to_vendor
 
 
@@ -26,7 +27,7 @@ def _row(name: str, kind: str, number: object, T, p: Provenance) -> list[object]
             *(float(v) for v in pose_to_vendor(T, "kuka")), _prov(p)]
 
 
-@click.group()
+@click.group(cls=Group)
 def cell() -> None:
     """Inspect cell files and their history.
 

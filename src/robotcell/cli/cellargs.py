@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Positioner, Track, Turntable
+from robotcell.cell.validation import axis_range, check_axis_limits
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
@@ -28,6 +29,7 @@ __all__ = [
     "batch_table",
     "batch_track",
     "cell_tool",
+    "check_axis_columns",
     "check_normal_up",
     "chunks",
     "row_values",
@@ -66,11 +68,12 @@ def _checked(values: NDArray[np.float64], unit_scale: float, unit: str, axis: Tr
         if np.any(values != 0):
             raise InputError(f"the cell has no {option}; leave out --{option} (or the {option} column)")
         return values
-    bad = np.atleast_1d(~axis.within_limits(values))
+    lower, upper = axis_range(axis)
+    bad = np.atleast_1d((values < lower) | (values > upper))
     if np.any(bad):
         first = float(np.atleast_1d(values)[bad][0]) * unit_scale
         raise InputError(f"{what} {first:g} {unit} is outside the {axis_name(axis)} limits "
-                         f"[{axis.lower * unit_scale:g}, {axis.upper * unit_scale:g}] {unit}")
+                         f"[{lower * unit_scale:g}, {upper * unit_scale:g}] {unit}")
     return values
 
 
@@ -178,6 +181,18 @@ def table_rows(cell: Cell, cols: dict, option: NDArray[np.float64] | float, n: i
         raise InputError(f"positioner {pos.name!r} has {pos.n_axes} axes: missing column(s) "
                          f"{missing} (deg)")
     return np.column_stack([row_values(cols, c, None, n) for c in names])
+
+
+def check_axis_columns(cell: Cell, cols: dict, source: str, track: bool = True) -> None:
+    """Refuse the ``track`` (unless ``track`` is False: a column the command does not use) and
+    table columns (``table``, or a positioner's ``e1..en``) of a batch file whose values are
+    outside the limits of the cell's axes, naming line and column."""
+    if track and cell.track is not None and isinstance(cols.get("track"), np.ndarray):
+        check_axis_limits(cell.track, cols["track"] * 1e-3, ["track"], source, f"cell {cell.name!r}")
+    _, names = table_columns(cell)
+    if cell.turntable is not None and all(isinstance(cols.get(c), np.ndarray) for c in names):
+        values = np.radians(np.column_stack([cols[c] for c in names]))
+        check_axis_limits(cell.turntable, values, names, source, f"cell {cell.name!r}")
 
 
 def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[np.float64] | None:

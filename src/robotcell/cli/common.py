@@ -12,14 +12,38 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import click
+import numpy as np
 
 from robotcell.errors import InputError
 from robotcell.io import tables
 from robotcell.io.fileio import atomic_write, check_destination
-from robotcell.io.tables import format_table, require_columns, write_csv
+from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.tables import (
+    CELL_EXTENT_MM,
+    format_table,
+    outside_limits,
+    require_columns,
+    write_csv,
+)
 
-__all__ = ["check_kind", "check_not_folder", "check_output", "format_table", "output_of",
-           "parse_numbers", "read_csv", "require_columns", "write_csv", "write_output"]
+__all__ = [
+    "NOISE_MAX_MM",
+    "check_kind",
+    "check_not_folder",
+    "check_output",
+    "format_table",
+    "output_of",
+    "parse_numbers",
+    "read_csv",
+    "require_columns",
+    "target_poses",
+    "write_csv",
+    "write_output",
+]
+
+
+#: Largest touch-up error (``--noise`` of simulate, plan and demo; mm): 1 m is none.
+NOISE_MAX_MM = 1000.0
 
 
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:
@@ -37,6 +61,23 @@ def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]
         raise InputError(f"{what} has a value beyond {tables.MAX_ABS_VALUE:.0e} in size: no "
                          "length in mm or angle in deg is that large")
     return values
+
+
+def target_poses(values: np.ndarray, fmt: str, source: str) -> np.ndarray:
+    """Poses (m) from values of vendor format ``fmt`` (mm, deg), refusing a position beyond
+    the size of any real cell (no target is that far), named by line and column of the file
+    ``source`` (``(N, k)`` values) or by field of the option ``source`` (``(k,)`` values)."""
+    f = FORMATS[fmt]
+    limit = CELL_EXTENT_MM * 1e-3 / f.length_scale
+    unit = "m" if f.length_scale == 1.0 else "mm"
+    v = np.asarray(values, dtype=float)
+    names = [n.lower() for n in f.fields[:3]]
+    bad = outside_limits(np.atleast_2d(v)[:, :3], names, [-limit] * 3, [limit] * 3, [unit] * 3,
+                         lines=v.ndim == 2)
+    if bad is not None:
+        raise InputError(f"{source}: a target beyond {CELL_EXTENT_MM * 1e-3:g} m, the size of any "
+                         f"real cell: {bad}; correct the value (a typing or unit error?)")
+    return pose_from_vendor(v, fmt)
 
 
 def read_csv(path: str, known: Iterable[str] | None = None) -> dict:

@@ -2,20 +2,21 @@
 
 from __future__ import annotations
 
-import math
-
 import click
 
+from robotcell.cli.common import NOISE_MAX_MM
+from robotcell.cli.files import Command, OutputPath
 from robotcell.errors import InputError
 from robotcell.studies.demo import DEMO_NOISE, run_demo
 
 
-@click.command()
+@click.command(cls=Command)
 @click.option("-o", "--output", default="robotcell-demo", show_default=True,
-              type=click.Path(file_okay=False), help="Folder for the files the demo writes.")
+              type=OutputPath(file_okay=False), help="Folder for the files the demo writes.")
 @click.option("--noise", type=float, default=DEMO_NOISE * 1e3, show_default=True, metavar="MM",
               help="Touch-up error, 1-sigma per coordinate (mm).")
-@click.option("--seed", type=int, default=1, show_default=True, help="Seed of the touch-up errors.")
+@click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True,
+              help="Seed of the touch-up errors (a whole number >= 0).")
 def demo(output: str, noise: float, seed: int) -> None:
     """Calibrate a virtual cell end to end; needs no files and no network.
 
@@ -31,6 +32,7 @@ def demo(output: str, noise: float, seed: int) -> None:
       robotcell demo
       robotcell demo -o /tmp/demo --noise 0.05 --seed 7
     """
-    if not (math.isfinite(noise) and noise > 0):
-        raise InputError(f"--noise must be a positive number of millimetres, got {noise}")
+    if not 0 < noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a positive number of millimetres, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
     run_demo(output, noise=noise * 1e-3, seed=seed, echo=click.echo)

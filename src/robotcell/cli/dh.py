@@ -10,6 +10,7 @@ import math
 import click
 
 from robotcell.cli.common import format_table, output_of, parse_numbers
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.dhprocedure import (
     AxisChain,
     DHDerivation,
@@ -25,7 +26,7 @@ from robotcell.kinematics.robot import Joint, Robot
 _CONVENTION = click.Choice(["standard", "modified"])
 
 
-@click.group()
+@click.group(cls=Group)
 def dh() -> None:
     """Denavit-Hartenberg procedure: DH tables from URDF, conversions, explanations, algebra.
 
@@ -47,7 +48,7 @@ def dh() -> None:
               help="Last link (default: the only leaf; needed when the tree branches).")
 @click.option("--signs", default=None,
               help="Sign corrections, one +1/-1 per joint: -1 points Z against the URDF axis.")
-@click.option("-o", "--output", type=click.Path(), default=None,
+@click.option("-o", "--output", type=OUTPUT, default=None,
               callback=output_of("YAML", "the model file"),
               help="Write the model file (YAML, mm/deg) here, atomically.")
 def from_urdf(file: str, convention: str, base_link: str | None, tip_link: str | None,
@@ -72,9 +73,9 @@ def from_urdf(file: str, convention: str, base_link: str | None, tip_link: str |
 
 
 @dh.command()
-@click.argument("model")
+@click.argument("model", type=NAME_OR_FILE)
 @click.option("--to", "target", type=_CONVENTION, required=True, help="Target convention.")
-@click.option("-o", "--output", type=click.Path(), default=None,
+@click.option("-o", "--output", type=OUTPUT, default=None,
               callback=output_of("YAML", "the model file"),
               help="Write the converted model file (YAML, mm/deg) here, atomically.")
 def convert(model: str, target: str, output: str | None) -> None:
@@ -96,7 +97,7 @@ def convert(model: str, target: str, output: str | None) -> None:
 
 
 @dh.command()
-@click.argument("model")
+@click.argument("model", type=NAME_OR_FILE)
 @click.option("--convention", type=_CONVENTION, default=None,
               help="Convention of the derivation (default: the model's; standard for URDF).")
 def explain(model: str, convention: str | None) -> None:
@@ -132,7 +133,7 @@ def explain(model: str, convention: str | None) -> None:
 
 
 @dh.command()
-@click.argument("model")
+@click.argument("model", type=NAME_OR_FILE)
 @click.option("--latex", is_flag=True, help="Print LaTeX instead of text.")
 @click.option("--numeric", is_flag=True,
               help="Substitute the lengths (mm) and angles instead of keeping a_i, d_i symbols.")

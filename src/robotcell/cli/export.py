@@ -6,15 +6,16 @@ import click
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_kind, check_output, write_output
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.io.export import WRITE_FORMATS, export_cell
 
 
-@click.command()
+@click.command(cls=Command)
 @click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file (YAML, mm/deg).")
 @click.option("--format", "fmt", required=True, type=click.Choice(list(WRITE_FORMATS)),
               help="Controller format.")
-@click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output", type=OUTPUT, callback=check_output,
               help="File to write, atomically (default: standard output).")
 def export(cell_path: str, fmt: str, output: str | None) -> None:
     """Write what to paste into the controller: tools, bases/work objects/user frames and the

@@ -13,6 +13,7 @@ from robotcell.cli.cellargs import (
     batch_table,
     batch_track,
     cell_tool,
+    check_axis_columns,
     row_values,
     setup_text,
     table_angles,
@@ -29,8 +30,10 @@ from robotcell.cli.common import (
     require_columns,
     write_csv,
 )
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
+from robotcell.io.tables import outside_limits
 from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.robot import Robot
 
@@ -50,12 +53,11 @@ def tool_option(text: str | None) -> np.ndarray | None:
     return pose_from_vendor(parse_numbers(text, "--tool", 6), "kuka")
 
 
-@click.command()
-@click.argument("robot", required=False)
+@click.command(cls=Command)
+@click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
-@click.option("-o", "--output", "output_path", type=click.Path(),
-              callback=output_of("CSV", "the poses"),
+@click.option("-o", "--output", "output_path", type=OUTPUT, callback=output_of("CSV", "the poses"),
               help="CSV to write, atomically: the poses of --input, or one row for --joints "
                    "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(FORMAT_CHOICES), default="kuka", show_default=True,
@@ -107,8 +109,7 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
     if joints is not None:
         q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
         T = r.fk(q, tool=T_tool)
-        if not r.within_limits(q):
-            click.echo("warning: joint values outside the robot's limits", err=True)
+        warn_joint_limits(r, q, None)
         if output_path is not None:
             _write_poses(T[None], fmt, output_path)
             return
@@ -120,10 +121,22 @@ def fk(robot: str | None, joints: str | None, input_path: str | None, output_pat
     cols = read_csv(input_path, known=names)
     q = joints_to_si(r, require_columns(cols, names, input_path))
     T = r.fk(q, tool=T_tool)
-    outside = int(np.count_nonzero(~r.within_limits(q)))
-    if outside:
-        click.echo(f"warning: {outside} row(s) outside the robot's joint limits", err=True)
+    warn_joint_limits(r, q, input_path)
     _write_poses(T, fmt, output_path)
+
+
+def warn_joint_limits(robot: Robot, q: np.ndarray, source: str | None) -> None:
+    """A ``warning:`` line naming the joint values ``q`` (SI, ``(N, n)``) outside the robot's
+    limits: by line and column of the file ``source``, or by axis for ``--joints`` (None)."""
+    scale = np.where(robot.prismatic, 1e3, 180.0 / math.pi)
+    names = [f"a{i}" for i in range(1, robot.n_joints + 1)]
+    units = ["mm" if p else "deg" for p in robot.prismatic]
+    bad = outside_limits(np.atleast_2d(q) * scale, names, robot.lower * scale,
+                         robot.upper * scale, units, lines=source is not None)
+    if bad is not None:
+        where = f"{source}: " if source else ""
+        click.echo(f"warning: {where}joint values outside the limits of {robot.name}: {bad}; "
+                   "the pose is computed, but the robot cannot move there", err=True)
 
 
 def _echo_pose(T: np.ndarray, fmt: str) -> None:
@@ -172,15 +185,14 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
     else:
         names = [f"a{i}" for i in range(1, r.n_joints + 1)]
         cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
+        check_axis_columns(cell, cols, input_path)
         q = joints_to_si(r, require_columns(cols, names, input_path))
         e = track_values(cell, row_values(cols, "track", track, len(q)))
         th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)))
         setup = setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "0 mm (default)"),
                            batch_table(cell, cols, table_deg))
     T = cell.fk(q, e, th, T_tool, frame)
-    outside = int(np.count_nonzero(~r.within_limits(q)))
-    if outside:
-        click.echo(f"warning: {outside} configuration(s) outside the robot's joint limits", err=True)
+    warn_joint_limits(r, q, input_path)
     if joints is not None and output_path is None:
         click.echo(f"{setup} ({fmt}, mm, deg)")
         _echo_pose(T, fmt)

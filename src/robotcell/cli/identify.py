@@ -17,6 +17,7 @@ from robotcell.cli.common import (
     read_csv,
     warn_unknown_columns,
 )
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
@@ -70,6 +71,12 @@ def _print_offsets(offsets: dict, vendor: str) -> None:
     click.echo(format_table(head, rows))
 
 
+#: Range of ``--accuracy`` (mm) and ``--angle-accuracy`` (deg): 0.1 um (0.1 mdeg) is finer than
+#: any measuring device, 1 m (1000 deg) coarser than any measurement worth a fit.
+ACCURACY_MIN, ACCURACY_MAX = 1e-4, 1e3
+#: Largest ``|--j23-factor|``: a J2/J3 linkage moves axis 3 by about as much as axis 2 (FANUC: -1).
+J23_MAX = 10.0
+
 #: Random configurations within the joint limits that --propose picks from.
 _CANDIDATES = 1000
 
@@ -111,11 +118,11 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
                    f"prismatic joints); measure them and add the columns {cols}")
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("measurements", type=click.Path(), required=False)
-@click.option("--robot", "robot", help="Nominal model: library name or model file. Without it the "
+@click.option("--robot", "robot", type=NAME_OR_FILE, help="Nominal model: library name or model file. Without it the "
               "circle point analysis builds the start model (rows moving one joint at a time).")
-@click.option("-o", "--output", "output", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output", type=OUTPUT, callback=check_output,
               help="Write the identified model file (YAML), atomically; with --propose, the "
               "proposed configurations (CSV).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of the report.")
@@ -131,7 +138,7 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
 @click.option("--force", "force", is_flag=True, help="Write -o even when the verdict is poor.")
 @click.option("--folds", "folds", type=int, help="Also K-fold cross-validate: every row predicted "
               "by the models identified without it (mean, RMS, max before and after).")
-@click.option("--report", "report", type=click.Path(), callback=check_not_folder, help="Also write a "
+@click.option("--report", "report", type=OUTPUT, callback=check_not_folder, help="Also write a "
               "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
 @click.option("--offsets-for", "offsets_for", type=click.Choice(["kuka", "abb"]), help="Also print "
               "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "
@@ -143,7 +150,7 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               help="With --propose: reflectors measured per configuration.")
 @click.option("--orientation", "orientation", is_flag=True,
               help="With --propose: the orientation is measured too (6D probe, camera).")
-@click.option("--seed", "seed", type=int, default=0, show_default=True,
+@click.option("--seed", "seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="With --propose: seed of the random candidates and comparison sets.")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
@@ -173,11 +180,14 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
       robotcell identify tracker.csv --robot fanuc_m20ia --j23-factor -1 --json
       robotcell identify --propose 30 --robot kuka_kr16 --targets 3 -o to_measure.csv
     """
-    for name, value in (("--accuracy", accuracy), ("--angle-accuracy", angle_accuracy)):
-        if not (math.isfinite(value) and value > 0):
-            raise InputError(f"{name} must be a positive number, got {value}")
-    if j23 is not None and not math.isfinite(j23):
-        raise InputError(f"--j23-factor must be a finite number, got {j23}")
+    for name, value, unit in (("--accuracy", accuracy, "mm"),
+                              ("--angle-accuracy", angle_accuracy, "deg")):
+        if not ACCURACY_MIN <= value <= ACCURACY_MAX:
+            raise InputError(f"{name} must be a positive number of {unit} from {ACCURACY_MIN:g} "
+                             f"to {ACCURACY_MAX:g}, got {value:g}")
+    if j23 is not None and not abs(j23) <= J23_MAX:
+        raise InputError(f"--j23-factor must be a finite number from -{J23_MAX:g} to {J23_MAX:g} "
+                         f"(a linkage's ratio; FANUC: -1), got {j23:g}")
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")

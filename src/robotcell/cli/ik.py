@@ -16,6 +16,7 @@ from robotcell.cli.cellargs import (
     batch_table,
     batch_track,
     cell_tool,
+    check_axis_columns,
     check_normal_up,
     chunks,
     row_values,
@@ -34,8 +35,10 @@ from robotcell.cli.common import (
     parse_numbers,
     read_csv,
     require_columns,
+    target_poses,
     write_output,
 )
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
@@ -68,11 +71,11 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
         w.writerow([f"{v:.6f}" if isinstance(v, float) else v for v in r])
 
 
-@click.command()
-@click.argument("robot", required=False)
+@click.command(cls=Command)
+@click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
-@click.option("-o", "--output", "output_path", type=click.Path(), callback=check_output,
+@click.option("-o", "--output", "output_path", type=OUTPUT, callback=check_output,
               help="File to write, atomically: the CSV of --input, or the table of --pose "
                    "(default: standard output).")
 @click.option("--format", "fmt", type=click.Choice(list(FORMATS)), default="kuka", show_default=True,
@@ -152,7 +155,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
     ref = None if near is None else joints_to_si(r, np.array(parse_numbers(near, "--near", n)))
     scale = np.where(r.prismatic, 1e3, deg)  # controller values to deg (mm for prismatic axes)
     if pose is not None:
-        T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
+        T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
         sol = solver.solve(T, T_tool)
         if ref is not None:
             q, found, branch = nearest(r, sol, ref)
@@ -184,7 +187,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
     cols = read_csv(input_path, known=names)
-    T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
+    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     sol = solver.solve(T, T_tool)
     axes = [f"a{i}" for i in range(1, n + 1)]
     if ref is not None:
@@ -244,7 +247,7 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     deg = 180.0 / math.pi
     ref = None if near is None else np.radians(parse_numbers(near, "--near", r.n_joints))
     if pose is not None:
-        T = pose_from_vendor(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt)
+        T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
         th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
               else table_angles(cell, table_option(cell, table_deg)))
         sol = cell.ik(T, frame, track_values(cell, track_mm), th, T_tool)
@@ -286,7 +289,8 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     names = [f.lower() for f in FORMATS[fmt].fields]
     n_table, table_names = table_columns(cell)
     cols = read_csv(input_path, known=[*names, "track", *table_names])
-    T = pose_from_vendor(require_columns(cols, names, input_path), fmt)
+    check_axis_columns(cell, cols, input_path)
+    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     n = len(T)
     e = track_values(cell, row_values(cols, "track", track_mm, n))
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP

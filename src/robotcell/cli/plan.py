@@ -10,7 +10,8 @@ from typing import Any
 import click
 
 from robotcell.cell import Cell
-from robotcell.cli.common import format_table, output_of
+from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
 from robotcell.errors import InputError
 from robotcell.studies.plan import DESIGNS, LEVER, Candidate
@@ -41,7 +42,7 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
         yield from bar
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("procedure", type=click.Choice(list(DESIGNS)))
 @cell_options
 @click.option("--runs", type=click.IntRange(min=0), default=100, show_default=True,
@@ -50,7 +51,7 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
               help="frame/workpiece: largest triangle that fits on the part (mm).")
 @click.option("--max-radius", type=float, default=None, metavar="MM",
               help="turntable: largest distance of a touchable point from the axis (mm).")
-@click.option("-o", "--output", type=click.Path(), default=None,
+@click.option("-o", "--output", type=OUTPUT, default=None,
               callback=output_of("CSV", "the proposed touches"),
               help="Write the proposed touches (exact joint values to teach) as CSV, atomically.")
 def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
@@ -73,8 +74,9 @@ def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: s
       robotcell plan frame --cell cell.yaml --tool pointer --frame fixture --max-size 300 \\
           -o frame_touches.csv
     """
-    if not (math.isfinite(noise) and noise > 0):
-        raise InputError(f"--noise must be a positive number of millimetres, got {noise}")
+    if not 0 < noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a positive number of millimetres, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
     cell = Cell.load(cell_path)
     common = common_keywords(procedure, tool, frame, track_mm)
     common.update(design_keywords(procedure, {"touches": touches, "repeats": repeats}))

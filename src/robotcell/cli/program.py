@@ -13,6 +13,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import format_table, parse_numbers
+from robotcell.cli.files import Group, OutputPath
 from robotcell.errors import InputError
 from robotcell.programs import VENDORS
 
@@ -55,7 +56,7 @@ def _ppd_option(f: Callable) -> Callable:
                         help="YASKAWA: encoder pulses per degree of each station axis.")(f)
 
 
-@click.group()
+@click.group(cls=Group)
 def program() -> None:
     """Robot programs: write a path as a KUKA, ABB, FANUC or YASKAWA program, check a program
     against the cell, retarget joint points after a recalibration (docs/programs.md).
@@ -75,7 +76,7 @@ def program() -> None:
               help="Frame of the path: world or a frame of the cell.")
 @click.option("--format", "vendor", required=True, type=click.Choice(VENDORS),
               help="Program format.")
-@click.option("-o", "--output", "folder", required=True, type=click.Path(file_okay=False),
+@click.option("-o", "--output", "folder", required=True, type=OutputPath(file_okay=False),
               help="Folder for the program files (created; its parent must exist).")
 @click.option("--name", default=None, help="Program name (default: the path file's name).")
 @click.option("--split", is_flag=True,
@@ -185,7 +186,7 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
               help="Cell file the program was taught in.")
 @click.option("--to", "new_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file after the recalibration.")
-@click.option("-o", "--output", "folder", required=True, type=click.Path(file_okay=False),
+@click.option("-o", "--output", "folder", required=True, type=OutputPath(file_okay=False),
               help="Folder for the retargeted program files (created; its parent must exist).")
 @_ppd_option
 @click.option("--json", "as_json", is_flag=True, help="Print every joint point as JSON.")

@@ -13,6 +13,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
+    check_axis_columns,
     row_values,
     table_angles,
     table_columns,
@@ -20,10 +21,16 @@ from robotcell.cli.cellargs import (
     table_rows,
     track_values,
 )
-from robotcell.cli.common import output_of, read_csv, write_output
+from robotcell.cli.common import (
+    output_of,
+    read_csv,
+    target_poses,
+    write_output,
+)
+from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
-from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.poseformats import FORMATS
 from robotcell.io.tables import require_columns, write_columns
 from robotcell.studies.reach import ReachMap, reach_html, reach_map
 
@@ -85,7 +92,8 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
-    T = pose_from_vendor(require_columns(cols, names, path), fmt)
+    check_axis_columns(cell, cols, path, track=track_column)
+    T = target_poses(require_columns(cols, names, path), fmt, path)
     track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
                          else track_mm)
     if choose_table:
@@ -96,15 +104,14 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
     return T, table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T))), track
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("targets", type=click.Path(dir_okay=False))
 @target_options
 @click.option("--track", "track_mm", type=float, default=None,
               help="Track position (mm) for every target (default: chosen per target).")
-@click.option("-o", "--output", type=click.Path(), default=None,
-              callback=output_of("CSV", "the scores"),
+@click.option("-o", "--output", type=OUTPUT, default=None, callback=output_of("CSV", "the scores"),
               help="CSV to write, atomically (default: standard output).")
-@click.option("--html", "html_path", type=click.Path(), default=None,
+@click.option("--html", "html_path", type=OUTPUT, default=None,
               callback=output_of("HTML", "the map"),
               help="Self-contained HTML page with the map (default: next to -o, .html).")
 def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
@@ -127,14 +134,15 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
       robotcell reach --cell cell.yaml seam.csv --frame part --tool torch -o reach.csv
       robotcell reach --cell cell.yaml seam.csv --tool torch --html reach.html
     """
+    if html_path is None and output:
+        html_path = str(Path(output).with_suffix(".html"))
+        refuse_overwriting_inputs(click.get_current_context(), [("the map written next to -o", html_path)])
     cell = Cell.load(cell_path)
     T, th, track = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
     with ExitStack() as stack:
         rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
                        progress=DeferredProgress(stack, "targets"))
     write_columns(output if output else sys.stdout, reach_columns(rm, cell), 6)
-    if html_path is None and output:
-        html_path = str(Path(output).with_suffix(".html"))
     if html_path:
         page = reach_html(rm, T[:, :3, 3], title=f"Reachability: {Path(targets).name} in "
                           f"{cell.name}", frame=frame)

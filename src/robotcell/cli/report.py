@@ -5,12 +5,13 @@ from __future__ import annotations
 import click
 
 from robotcell.cli.common import check_kind, check_not_folder
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.report import load_result, verdict, write_report
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("result", type=click.Path())
-@click.option("-o", "--output", default="report.html", show_default=True, type=click.Path(),
+@click.option("-o", "--output", default="report.html", show_default=True, type=OUTPUT,
               callback=check_not_folder,
               help="HTML file to write; its figures are embedded, nothing else is written.")
 def report(result: str, output: str) -> None:

@@ -8,12 +8,13 @@ import click
 import numpy as np
 
 from robotcell.cli.common import format_table
+from robotcell.cli.files import NAME_OR_FILE, Group
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.models import list_robots, load_robot
 from robotcell.kinematics.robot import Robot
 
 
-@click.group(invoke_without_command=True)
+@click.group(cls=Group, invoke_without_command=True)
 @click.pass_context
 def robots(ctx: click.Context) -> None:
     """List the built-in robot library.
@@ -45,7 +46,7 @@ def coupling_summary(r: Robot) -> str:
 
 
 @robots.command()
-@click.argument("name")
+@click.argument("name", type=NAME_OR_FILE)
 def show(name: str) -> None:
     """Print the DH table of a library robot or model file (mm, deg).
 

@@ -16,18 +16,24 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import output_of, parse_numbers
+from robotcell.cli.common import NOISE_MAX_MM, output_of, parse_numbers
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.errors import InputError
+from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.studies.simulate import PROCEDURES, Touches
 from robotcell.studies.simulate import simulate as simulate_touches
 
 
 def _mm(option: str, positive: bool = False) -> Callable[[float], float]:
-    """Converter of a length option: mm to m, refusing (in mm) what the option cannot be."""
+    """Converter of a length option: mm to m, refusing (in mm) what the option cannot be: not
+    finite, beyond the size of any real cell, or (``positive``) not above 0."""
     def convert(value: float) -> float:
         if not math.isfinite(value) or (positive and value <= 0):
             kind = "a positive" if positive else "a finite"
             raise InputError(f"--{option} must be {kind} number of millimetres, got {value:g}")
+        if abs(value) > CELL_EXTENT_MM:
+            raise InputError(f"--{option} must be within +-{CELL_EXTENT_MM:g} mm (100 m, the size "
+                             f"of any real cell), got {value:g}")
         return value * 1e-3
     return convert
 
@@ -168,12 +174,11 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
     return " ".join(parts + t.options)
 
 
-@click.command()
+@click.command(cls=Command)
 @click.argument("procedure", type=click.Choice(list(PROCEDURES)))
 @cell_options
 @design_options
-@click.option("-o", "--output", type=click.Path(), default=None,
-              callback=output_of("CSV", "the touches"),
+@click.option("-o", "--output", type=OUTPUT, default=None, callback=output_of("CSV", "the touches"),
               help="CSV file to write, atomically (default: standard output).")
 def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
              frame: str | None, track_mm: float | None, output: str | None,
@@ -193,8 +198,9 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
       robotcell simulate tcp --cell cell.yaml --tool torch --tilt 40 --seed 1 -o tcp.csv
       robotcell simulate positioner --cell truth.yaml --tool pointer --noise 0.1 -o touches.csv
     """
-    if not (math.isfinite(noise) and noise >= 0):
-        raise InputError(f"--noise must be a number of millimetres >= 0, got {noise}")
+    if not 0 <= noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a number of millimetres >= 0, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
     cell = Cell.load(cell_path)
     kw = common_keywords(procedure, tool, frame, track_mm)
     kw.update(design_keywords(procedure, design))

@@ -11,6 +11,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import format_table, output_of
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
 from robotcell.errors import InputError
@@ -36,7 +37,7 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
     return None if n == 1 else stack.enter_context(ProcessPoolExecutor(n))
 
 
-@click.command()
+@click.command(cls=Command)
 @target_options
 @click.option("--targets", "targets", required=True, type=click.Path(dir_okay=False),
               help="CSV of target poses (columns of --format; optional 'table' in deg, a "
@@ -49,8 +50,7 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
               help="Run on a Dask cluster, e.g. tcp://10.0.0.5:8786 (pip install "
                    "'robotcell[dask]').")
 @click.option("--top", type=int, default=10, show_default=True, help="Layouts to print.")
-@click.option("-o", "--output", type=click.Path(), default=None,
-              callback=output_of("CSV", "the ranking"),
+@click.option("-o", "--output", type=OUTPUT, default=None, callback=output_of("CSV", "the ranking"),
               help="CSV of every layout, ranked (written atomically).")
 def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool: str | None,
               fmt: str, table_deg: str | None, choose_table: bool, workers: int | None,

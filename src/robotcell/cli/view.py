@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import click
 import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import cell_tool, table_angles, table_option, track_values
-from robotcell.cli.common import check_output, parse_numbers
+from robotcell.cli.common import output_of, parse_numbers
+from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.kinematics.robot import Robot
@@ -32,15 +32,8 @@ def joint_option(robot: Robot, text: str | None) -> np.ndarray | None:
     return q
 
 
-def refuse_inputs(output: str, *inputs: str | None) -> None:
-    """Refuse an output file that is one of the input files: writing it would destroy it."""
-    out = Path(output).resolve()
-    for given in inputs:
-        if given is not None and Path(given).resolve() == out:
-            raise InputError(f"-o {output} is the input file {given}: give another file name")
 
-
-@click.command()
+@click.command(cls=Command)
 @click.argument("cell_path", metavar="CELL.yaml", type=click.Path(dir_okay=False))
 @click.option("--joints", default=None, metavar="A1,A2,...",
               help="Arm axis values (deg; mm for a prismatic axis); default the robot model's "
@@ -54,8 +47,8 @@ def refuse_inputs(output: str, *inputs: str | None) -> None:
 @click.option("--tool", default=None,
               help="With --reach: the tool the map was made with (a tool of the cell, or "
                    "X,Y,Z,A,B,C in mm, deg); default the robot model's tool.")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
-              callback=check_output, help="HTML file to write, atomically.")
+@click.option("-o", "--output", required=True, type=OUTPUT,
+              callback=output_of("HTML", "the view"), help="HTML file to write, atomically.")
 def view(cell_path: str, joints: str | None, track_mm: float, table_deg: str | None,
          reach_path: str | None, tool: str | None, output: str) -> None:
     """Interactive 3D view of a cell: one HTML file that opens offline, with no server.
@@ -74,7 +67,6 @@ def view(cell_path: str, joints: str | None, track_mm: float, table_deg: str | N
           --track 1500 --table 30 -o cell.html
       robotcell view cell.yaml --reach reach.csv --tool torch -o reach3d.html
     """
-    refuse_inputs(output, cell_path, reach_path)
     if tool is not None and reach_path is None:
         raise InputError("--tool says which tool the --reach map was made with; give --reach")
     cell = Cell.load(cell_path)

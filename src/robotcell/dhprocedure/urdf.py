@@ -26,6 +26,7 @@ from robotcell.dhprocedure.axes import AxisChain
 from robotcell.dhprocedure.procedure import DHDerivation, dh_from_axes
 from robotcell.errors import InputError, RobotcellError
 from robotcell.io.fileio import read_text
+from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.kinematics.dh import Convention
 from robotcell.kinematics.transforms import make_pose
 
@@ -33,6 +34,9 @@ __all__ = ["UrdfChain", "UrdfJoint", "dh_from_urdf", "read_urdf"]
 
 INSTALL_HINT = "reading URDF files needs the optional package urdf-parser-py: pip install 'robotcell[urdf]'"
 _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
+#: Largest limit of a revolute joint (rad): 1000 rad, about 160 turns, is more than any joint
+#: with limits has; a larger one is a typing error.
+MAX_TURN_RAD = 1000.0
 
 
 @dataclass(frozen=True)
@@ -164,9 +168,10 @@ def read_urdf(
     Raises
     ------
     InputError
-        Unreadable file or XML, unknown link, several root links, a branch without ``tip_link`` (naming the link and
-        its joints), a floating or planar joint (naming it), an axis of zero length, or no
-        movable joint.
+        Unreadable file or XML, unknown link, several root links, a branch without ``tip_link``
+        (naming the link and its joints), a floating or planar joint (naming it), an origin, axis
+        or limit that is not finite, an origin or a prismatic limit beyond 100 m, a revolute
+        limit beyond :data:`MAX_TURN_RAD`, an axis of zero length, or no movable joint.
     RobotcellError
         urdf-parser-py is not installed (the message says how to install it).
     """
@@ -194,7 +199,7 @@ def read_urdf(
     joints: list[UrdfJoint] = []
     acc = np.eye(4)
     for j in path:
-        acc = acc @ _origin(j)
+        acc = acc @ _origin(j, origin)
         if j.type == "fixed":
             continue
         if j.type not in _MOVABLE:
@@ -202,14 +207,23 @@ def read_urdf(
                 f"{origin}: joint {j.name!r} is {j.type}: a DH chain has revolute, continuous, "
                 "prismatic and fixed joints only; end the chain before it with tip_link (--tip-link)"
             )
-        axis = np.array(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+        axis = _finite(j.axis if j.axis is not None else (1.0, 0.0, 0.0), origin, j, "axis xyz")
+        axis = axis / max(float(np.abs(axis).max()), 1e-300)  # only the direction counts
         norm = float(np.linalg.norm(axis))
         if norm < 1e-12:
             raise InputError(f"{origin}: joint {j.name!r} has an axis of zero length; give <axis "
                              "xyz=\"0 0 1\"/> or the direction it moves about")
         lo, hi = -np.inf, np.inf
-        if j.type != "continuous" and j.limit is not None and j.limit.lower < j.limit.upper:
-            lo, hi = float(j.limit.lower), float(j.limit.upper)
+        if j.type != "continuous" and j.limit is not None:
+            lo, hi = _finite([j.limit.lower, j.limit.upper], origin, j, "limit lower, upper")
+            bound = CELL_EXTENT_MM * 1e-3 if j.type == "prismatic" else MAX_TURN_RAD
+            if max(abs(lo), abs(hi)) > bound:
+                raise InputError(f"{origin}: joint {j.name!r}: limits [{lo:g}, {hi:g}] reach "
+                                 f"beyond {bound:g} {'m' if j.type == 'prismatic' else 'rad'}; "
+                                 "give the joint's real limits (a joint without them is "
+                                 "'continuous')")
+            if not lo < hi:
+                lo, hi = -np.inf, np.inf
         joints.append(UrdfJoint(j.name, _MOVABLE[j.type], acc, axis / norm, lo, hi))
         acc = np.eye(4)
     if not joints:
@@ -285,8 +299,28 @@ def _path(model: Any, start: str, tip: str | None, origin: str) -> list[Any]:
     return out
 
 
-def _origin(joint: Any) -> NDArray[np.float64]:
+def _finite(values: Any, origin: str, joint: Any, what: str) -> NDArray[np.float64]:
+    """``values`` of ``joint`` as finite floats, or an error naming the joint and attribute."""
+    try:
+        v = np.array(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{origin}: joint {joint.name!r}: {what} must be numbers, got "
+                         f"{values!r}") from None
+    if not np.all(np.isfinite(v)):
+        raise InputError(f"{origin}: joint {joint.name!r}: {what} {v.tolist()} must be finite")
+    return v
+
+
+def _origin(joint: Any, origin: str) -> NDArray[np.float64]:
+    """The joint's ``<origin>``, refused when not finite or farther than any real robot reaches
+    (:data:`~robotcell.io.tables.CELL_EXTENT_MM`)."""
     o = joint.origin
-    xyz = o.xyz if o is not None and o.xyz is not None else (0.0, 0.0, 0.0)
-    rpy = o.rpy if o is not None and o.rpy is not None else (0.0, 0.0, 0.0)
-    return make_pose(Rotation.from_euler("xyz", rpy).as_matrix(), np.array(xyz, dtype=float))
+    xyz = _finite(o.xyz if o is not None and o.xyz is not None else (0.0, 0.0, 0.0), origin,
+                  joint, "origin xyz")
+    rpy = _finite(o.rpy if o is not None and o.rpy is not None else (0.0, 0.0, 0.0), origin,
+                  joint, "origin rpy")
+    if np.abs(xyz).max() > CELL_EXTENT_MM * 1e-3:
+        raise InputError(f"{origin}: joint {joint.name!r}: origin xyz {xyz.tolist()} m is beyond "
+                         f"{CELL_EXTENT_MM * 1e-3:g} m, the size of any real robot cell: a "
+                         "typing or unit error (URDF lengths are in metres)")
+    return make_pose(Rotation.from_euler("xyz", rpy).as_matrix(), xyz)

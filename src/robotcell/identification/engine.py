@@ -390,10 +390,14 @@ def identify(
         cand.append(chain.coupling_param)
     J1 = prob.jacobian(x1)
     kept, fixed = _identifiable(J1, cand, set(prio), chain.names, rank_tol)
-    m = prob.N * prob.ncomp
+    # Rows that repeat a configuration measure it again; they say nothing more about the chain.
+    distinct = len(np.unique(measurements.q, axis=0))
+    m = distinct * prob.ncomp
     if m < 2 * kept.size:
+        rows = (f"{prob.N} rows" if distinct == prob.N else
+                f"{prob.N} rows in {distinct} distinct configuration(s) (the others repeat them)")
         raise IllPosedError(
-            f"{prob.N} rows give {m} measured coordinates for {kept.size} identifiable unknowns; "
+            f"{rows} give {m} measured coordinates for {kept.size} identifiable unknowns; "
             f"at least twice as many coordinates as unknowns are needed to check the result: "
             f"measure at least {-(-2 * kept.size // prob.ncomp)} configurations (better 3 to 5 times "
             "as many, spread over the joint ranges)")

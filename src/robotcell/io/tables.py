@@ -20,13 +20,32 @@ from numpy.typing import ArrayLike
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, read_text
 
-__all__ = ["MAX_ABS_VALUE", "NOTE_COLUMNS", "format_table", "read_csv", "require_columns", "unknown_columns",
-           "write_columns", "write_csv"]
+__all__ = [
+    "CELL_EXTENT_MM",
+    "LIMIT_TOLERANCE",
+    "MAX_ABS_VALUE",
+    "NOTE_COLUMNS",
+    "format_table",
+    "outside_limits",
+    "read_csv",
+    "require_columns",
+    "unknown_columns",
+    "write_columns",
+    "write_csv",
+]
 
 
 #: Largest magnitude of a number in a table or an option (mm, deg): a float64 of 1e15 resolves
 #: only 0.125 mm, so a larger value cannot be a measurement; it is a typing error.
 MAX_ABS_VALUE = 1e15
+
+#: Largest length in any real robot cell (mm): 100 m. A length beyond it, in a file or an option,
+#: is a unit or typing error; a calibration result beyond it is graded poor.
+CELL_EXTENT_MM = 1e5
+
+#: A value beyond a limit by up to this much (mm or deg: the resolution a pendant shows) is a
+#: value at the limit, rounded in the file, and counts as within it.
+LIMIT_TOLERANCE = 1e-3
 
 #: Columns every reader accepts and ignores: free text beside the measurements.
 NOTE_COLUMNS = ("note", "notes", "comment", "comments", "remark", "remarks", "description")
@@ -62,8 +81,9 @@ def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray 
     Raises
     ------
     InputError
-        Missing or binary file, empty file, ragged rows, an empty cell, NaN or infinity, a number
-        beyond :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
+        Missing or binary file, empty file, a header of one column whose names are separated by
+        a tab or ``|``, ragged rows, an empty cell, NaN or infinity, a number beyond
+        :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
     """
     p = Path(path)
     if not p.is_file():
@@ -79,6 +99,12 @@ def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray 
     if len(rows) < 2:
         raise InputError(f"{path}: needs a header line and at least one data line")
     header = [h.strip().lower() for h in rows[0]]
+    other = next((name for s, name in (("\t", "tabs"), ("|", "'|'"))
+                  if len(header) == 1 and s in header[0]), None)
+    if other is not None:
+        raise InputError(f"{path}: the header is one column {rows[0][0].strip()!r}, its names "
+                         f"separated by {other}: robotcell reads values separated by ',' (or "
+                         "';' with decimal commas); save the file as CSV")
     if len(set(header)) != len(header):
         raise InputError(f"{path}: repeated column name in header {header}")
     cols: dict[str, list[str]] = {h: [] for h in header}
@@ -162,6 +188,46 @@ def unknown_columns(cols: dict, known: Iterable[str]) -> list[str]:
         close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
         out.append(f"{name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
     return out
+
+
+def outside_limits(values: np.ndarray, columns: Sequence[str], lower: Sequence[float],
+                   upper: Sequence[float], units: Sequence[str], shown: int = 3,
+                   lines: bool = True) -> str | None:
+    """The values of a table outside the limits of their columns, named by line and column.
+
+    Parameters
+    ----------
+    values : ndarray, shape (N, k)
+        The values as the file holds them (mm, deg); row ``i`` is line ``i + 2`` of the file.
+    columns : sequence of str, length k
+        Column names.
+    lower, upper : sequence of float, length k
+        Limits of each column, in the units of the file; infinite for none. A value beyond a
+        limit by up to :data:`LIMIT_TOLERANCE` counts as within it.
+    units : sequence of str, length k
+        Unit of each column, for the message.
+    shown : int
+        How many values to name; the others are counted.
+    lines : bool
+        Name the line of each value; False for a single row given otherwise (an option).
+
+    Returns
+    -------
+    str or None
+        None when every value is within its limits, else the first ones, e.g. ``"line 4,
+        column 'a6': 150000 deg (limits -350 .. 350 deg); line 9, ...; and 5 more"``.
+    """
+    v = np.asarray(values, dtype=float).reshape(len(values), len(columns))
+    lo = np.asarray(lower, dtype=float) - LIMIT_TOLERANCE
+    hi = np.asarray(upper, dtype=float) + LIMIT_TOLERANCE
+    rows, cols = np.nonzero((v < lo) | (v > hi))
+    if not rows.size:
+        return None
+    named = [(f"line {i + 2}, column '{columns[j]}'" if lines else columns[j])
+             + f": {v[i, j]:g} {units[j]} (limits {lower[j]:g} .. {upper[j]:g} {units[j]})"
+             for i, j in zip(rows[:shown], cols[:shown])]
+    more = f"; and {rows.size - shown} more" if rows.size > shown else ""
+    return "; ".join(named) + more
 
 
 def require_columns(cols: dict, names: Sequence[str], path: str | Path) -> np.ndarray:

@@ -27,6 +27,7 @@ import numpy as np
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, read_text
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.io.yamlfile import dump_yaml, parse_yaml
 from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.robot import Joint, Robot
@@ -220,13 +221,33 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
     if not isinstance(verified, bool):
         raise InputError(f"{origin}: key 'verified' must be true or false, got {verified!r}")
     try:
-        return Robot(
+        robot = Robot(
             name=str(data["name"]), joints=tuple(joints), convention=convention,
             title=str(data.get("title", data["name"])), source=str(data.get("source", "")),
             verified=verified, verification=str(data.get("verification", "")), **kwargs,
         )
     except InputError as exc:
         raise InputError(f"{origin}: {exc}") from None
+    _check_lengths(robot, origin)
+    return robot
+
+
+def _check_lengths(robot: Robot, origin: str) -> None:
+    """Refuse a model with a length beyond :data:`~robotcell.io.tables.MAX_ABS_VALUE` mm (a
+    typing error, named by its key), as a measurement table does. The bound is not the size of
+    a cell: the DH ``d`` of nearly parallel axes is far longer than the arm (an identified
+    model's can be 100 m)."""
+    lengths = []
+    for i, j in enumerate(robot.joints, start=1):
+        lengths += [(f"joint {i}: key 'a'", j.a), (f"joint {i}: key 'd'", j.d)]
+        if j.prismatic:
+            lengths += [(f"joint {i}: key 'min'", j.lower), (f"joint {i}: key 'max'", j.upper)]
+    for key in ("base", "flange", "tool"):
+        lengths.append((f"key '{key}'", float(np.abs(getattr(robot, key)[:3, 3]).max())))
+    for key, v in lengths:
+        if math.isfinite(v) and abs(v) * 1e3 > MAX_ABS_VALUE:
+            raise InputError(f"{origin}: {key} is {v * 1e3:g} mm, beyond {MAX_ABS_VALUE:.0e} mm: "
+                             "no robot has such a length; a typing error")
 
 
 def _ik_seed(value: Any, origin: str) -> Robot:

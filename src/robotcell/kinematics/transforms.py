@@ -83,8 +83,10 @@ def check_pose(T: ArrayLike, tol: float = POSE_TOL) -> tuple[NDArray[np.bool_], 
         raise InputError(f"a pose must have shape (..., 4, 4), got {arr.shape}")
     finite = np.all(np.isfinite(arr), axis=(-2, -1))
     R = np.where(finite[..., None, None], arr, 0.0)[..., :3, :3]
-    ortho = np.max(np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)), axis=(-2, -1))
-    det = np.linalg.det(R)
+    # Entries of 1e300 overflow to an infinite defect: refused, as they should be.
+    with np.errstate(over="ignore", invalid="ignore"):
+        ortho = np.max(np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)), axis=(-2, -1))
+        det = np.linalg.det(R)
     last = np.max(np.abs(np.where(finite[..., None], arr[..., 3, :], 0.0) - [0, 0, 0, 1]), axis=-1)
     ok = finite & (ortho <= tol) & (np.abs(det - 1.0) <= tol) & (last <= tol)
     reasons = []

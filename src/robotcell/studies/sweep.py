@@ -43,6 +43,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
+from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.io.yamlfile import parse_yaml
 from robotcell.kinematics.transforms import make_pose
 from robotcell.studies.reach import reach_map
@@ -118,7 +119,10 @@ def _values(spec: Any, where: str) -> list[float]:
         if not isinstance(steps, int) or isinstance(steps, bool) or not 1 <= steps <= MAX_LAYOUTS:
             raise InputError(f"{where}: steps must be a whole number from 1 to {MAX_LAYOUTS}, "
                              f"got {steps!r}")
-        vals = np.linspace(float(spec["from"]), float(spec["to"]), steps).tolist()
+        ends = [spec["from"], spec["to"]]
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in ends):
+            raise InputError(f"{where}: from and to must be numbers, got {ends!r}")
+        vals = np.linspace(*map(float, ends), steps).tolist()
     elif isinstance(spec, list) and spec:
         vals = spec
     elif isinstance(spec, (int, float)) and not isinstance(spec, bool):
@@ -131,6 +135,9 @@ def _values(spec: Any, where: str) -> list[float]:
         raise InputError(f"{where}: values must be numbers, got {vals!r}") from None
     if not all(math.isfinite(v) for v in out):
         raise InputError(f"{where}: values must be finite numbers")
+    if not all(abs(v) <= CELL_EXTENT_MM for v in out):
+        raise InputError(f"{where}: values must be offsets within +-{CELL_EXTENT_MM:g} (mm or "
+                         "deg; 100 m, the size of any real cell)")
     return out
 
 

@@ -50,6 +50,7 @@ from robotcell.cell.calibrate.touches import (
     tool_transform,
     track_positions,
 )
+from robotcell.cell.validation import check_axis_limits
 from robotcell.errors import IllPosedError, InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import require_columns
@@ -461,6 +462,8 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
                          "positions are column e1")
     f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
     e = external_axis(cols, source, "track")
+    if cell is not None:
+        check_axis_limits(cell.track, e, ["e1"], source, label)
     check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "point"], source))
@@ -551,8 +554,9 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
                          "file first")
     cols, source = load_table(measurements, source)
     f = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
-    n = cell.turntable.n_axes
-    values = np.radians(require_columns(cols, [f"e{i + 1}" for i in range(n)], source))
+    names = [f"e{i + 1}" for i in range(cell.turntable.n_axes)]
+    values = np.radians(require_columns(cols, names, source))
+    check_axis_limits(cell.turntable, values, names, source, label)
     if cell.turntable.parent == "world":
         return values, transform_points(robot_in_world(cell, cols, source, len(f), label), f)
     track_positions(cell, cols, source, label)
@@ -673,6 +677,8 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     cols, source = load_table(measurements, source)
     f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
     theta = external_axis(cols, source, "table")
+    if cell is not None:
+        check_axis_limits(cell.turntable, theta, ["e1"], source, label)
     check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
@@ -805,6 +811,8 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     cols, source = load_table(measurements, source)
     f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
     theta = external_axis(cols, source, "workpiece")
+    if cell is not None:
+        check_axis_limits(cell.turntable, theta, ["e1"], source, label)
     roles = point_roles(cols, source)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
     f = _table_touches(cell, cols, source, f, label)

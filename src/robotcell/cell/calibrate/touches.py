@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.calibration.measurements import repeated_rows, track_column
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import tool_pose
+from robotcell.cell.validation import check_axis_limits
 from robotcell.errors import InputError
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import validate_pose
@@ -76,9 +77,10 @@ def load_table(measurements: Table | str | Path, source: str | None = None
 
 
 def raw_rows(cols: Table, names: Sequence[str]) -> NDArray[np.float64]:
-    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note."""
+    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note; no
+    rows when none of them is there (the procedure then names the missing columns)."""
     use = [n for n in names if n in cols and isinstance(cols[n], np.ndarray)]
-    return np.stack([cols[n] for n in use], axis=1)
+    return np.stack([cols[n] for n in use], axis=1) if use else np.zeros((0, 0))
 
 
 def repeat_notes(cols: Table, names: Sequence[str], source: str) -> list[str]:
@@ -138,6 +140,8 @@ def track_positions(cell: Cell, cols: Table, source: str, label: str = "the cell
         raise InputError(f"{source}: column 'track' has non-zero values, but the cell "
                          f"{label} has no track; remove the column or add the track to "
                          "the cell file")
+    if e is not None:
+        check_axis_limits(cell.track, e, ["track"], source, label)
     return e
 
 

@@ -1,0 +1,146 @@
+"""The files a command reads and writes: an output that is one of its inputs is refused.
+
+Every ``robotcell`` command is a :class:`Command` (in a :class:`Group`). Before its body runs,
+and so before anything is written, it compares the files it would write (its parameters of type
+:class:`OutputPath`: ``-o``, ``--html``, ``--report``) with the files it reads (every other
+``click.Path`` parameter, e.g. the measurements or ``--cell``, and a robot model given by file
+name, :data:`NAME_OR_FILE`), and refuses with exit status 2 when one names the same file as
+another: ``robotcell export --cell cell.yaml -o cell.yaml`` would replace the cell by the
+export. Paths are compared resolved (symbolic links, ``./``, ``..``), and existing files also by
+identity (hard links).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+import click
+
+from robotcell.errors import InputError
+
+__all__ = ["NAME_OR_FILE", "OUTPUT", "Command", "Group", "NameOrFile", "OutputPath",
+           "refuse_overwriting_inputs"]
+
+#: Key of ``click.Context.meta`` under which :class:`OutputPath` keeps the output files given.
+_OUTPUTS = "robotcell.files.outputs"
+
+
+class OutputPath(click.Path):
+    """Type of a parameter naming a file (or folder) the command writes.
+
+    The value is kept for :func:`refuse_overwriting_inputs` also when the parameter is not
+    passed to the command's function (``expose_value=False``).
+    """
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        value = super().convert(value, param, ctx)
+        if ctx is not None and param is not None:
+            ctx.meta.setdefault(_OUTPUTS, {})[param.name] = value
+        return value
+
+
+class NameOrFile(click.ParamType):
+    """Type of a parameter that is a library name or the path of a file to read (``--robot``)."""
+
+    name = "name_or_file"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        return value
+
+
+#: An output file (``-o FILE``); the callbacks of :mod:`robotcell.cli.common` check its folder.
+OUTPUT = OutputPath()
+#: A robot model: a library name, or a model file (an input).
+NAME_OR_FILE = NameOrFile()
+
+
+def _label(param: click.Parameter) -> str:
+    """The parameter as the help names it: ``-o/--output``, ``--cell``, ``MEASUREMENTS``."""
+    if isinstance(param, click.Option):
+        return "/".join(param.opts)
+    return param.human_readable_name
+
+
+def _values(value: Any) -> Iterator[str]:
+    if value is None:
+        return
+    if isinstance(value, (tuple, list)):
+        for v in value:
+            yield from _values(v)
+    else:
+        yield os.fspath(value)
+
+
+def _same_file(a: str, b: str) -> bool:
+    """Whether paths ``a`` and ``b`` name one file: equal when resolved, or the same inode."""
+    if Path(a).resolve() == Path(b).resolve():
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet)
+        return False
+
+
+def _inputs(ctx: click.Context) -> Iterator[tuple[click.Parameter, str]]:
+    for param in ctx.command.params:
+        if isinstance(param.type, OutputPath):
+            continue
+        if isinstance(param.type, click.Path):
+            files = list(_values(ctx.params.get(param.name)))
+        elif isinstance(param.type, NameOrFile):
+            files = [v for v in _values(ctx.params.get(param.name)) if Path(v).is_file()]
+        else:
+            continue
+        for f in files:
+            yield param, f
+
+
+def refuse_overwriting_inputs(ctx: click.Context, derived: Iterable[tuple[str, str]] = ()) -> None:
+    """Refuse an output of the command that is one of its inputs, or another of its outputs.
+
+    Parameters
+    ----------
+    ctx : click.Context
+        The command's context, its parameters parsed.
+    derived : iterable of (str, str)
+        Further files the command writes, with what names them (``("reach.html", "-o")`` for
+        the page written next to ``-o reach.csv``).
+
+    Raises
+    ------
+    InputError
+        Naming both parameters and the file.
+    """
+    given = ctx.meta.get(_OUTPUTS, {})
+    outputs = [(_label(p), f) for p in ctx.command.params if isinstance(p.type, OutputPath)
+               for f in _values(given.get(p.name))]
+    outputs += list(derived)
+    inputs = list(_inputs(ctx))
+    for k, (out_label, out) in enumerate(outputs):
+        for param, f in inputs:
+            if _same_file(out, f):
+                raise InputError(f"{out_label} {out} names the same file as {_label(param)} {f}, "
+                                 "which this command reads: writing it would replace that input; "
+                                 "write to another file")
+        for other_label, other in outputs[:k]:
+            if _same_file(out, other):
+                raise InputError(f"{out_label} {out} names the same file as {other_label} "
+                                 f"{other}: give each output its own file")
+
+
+class Command(click.Command):
+    """A ``robotcell`` command: refuses to write over its inputs before it runs."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        refuse_overwriting_inputs(ctx)
+        return super().invoke(ctx)
+
+
+class Group(click.Group):
+    """A ``robotcell`` command group: its subcommands are :class:`Command` s."""
+
+    command_class = Command
+    group_class = type
