@@ -41,7 +41,7 @@ from robotcell.view.cellscene import cell_items, fixed_items, frame_size
 from robotcell.view.scene import AXIS_COLORS, Item, Lines, Points, Scene, Step, Triads
 from robotcell.view.shapes import OUTLIER_COLOR
 
-__all__ = ["DECIMALS", "MOVING", "path_scene", "triad_line"]
+__all__ = ["DECIMALS", "MOVING", "ordinal", "path_scene", "triad_line"]
 
 #: Decimals of the millimetre coordinates of a path's view: 0.01 mm.
 DECIMALS = 2
@@ -49,6 +49,12 @@ DECIMALS = 2
 MOVING = "cell at the point"
 #: Two vertices closer than this at every point are one (m).
 SAME = 1e-9
+
+
+def ordinal(k: int) -> str:
+    """``2nd``, ``3rd``, ``11th``, ``21st``."""
+    suffix = "th" if 10 <= k % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(k % 10, "th")
+    return f"{k}{suffix}"
 
 
 def _same(a: Item, b: Item) -> bool:
@@ -291,6 +297,6 @@ def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLik
                                size=2.0, labels=[lab for lab, _ in frames_here]))
         frames.append(Step(labs[i], (*step, *others[k])))
     if every > 1:
-        notes.append(f"the arm is drawn at every {every}th of the {n} points (the path and "
-                     "every mark at all of them)")
+        notes.append(f"the arm is drawn at every {ordinal(every)} of the {n} points (the path "
+                     "and every mark at all of them)")
     return Scene(title, items, notes, frames, decimals=DECIMALS)
