@@ -25,6 +25,7 @@ from robotcell.cell import Cell
 from robotcell.kinematics.transforms import transform_points
 from robotcell.studies.reach import reach_map
 from robotcell.view import (
+    Arrows,
     Scene,
     Step,
     Triads,
@@ -95,6 +96,100 @@ def test_turntable_calibration_scene_shows_touches_circle_and_magnified_residual
     assert "magnified 20 x" in fig["layout"]["title"]["text"]
     assert_triad(triads(fig, "turntable B")["B"], T)
     assert fig["layout"]["scene"]["xaxis"]["title"]["text"] == "x in robot base R (mm)"
+
+
+def test_calibration_scenes_of_each_procedure():
+    from test_identification_positioner import GRID, NOISE, NOMINAL, _truth
+    from test_report import frame_result
+
+    from robotcell.calibration.tcp import calibrate_tool
+    from robotcell.calibration.track import calibrate_track
+    from robotcell.identification.positioner import calibrate_positioner
+    from robotcell.view.calibration import calibration_scene
+
+    def items(scene):
+        return {i.name: i for i in scene.items}
+
+    rng = np.random.default_rng(4)
+    R = np.eye(4)
+    # a TCP: its touches are one point, the reference tip; each is drawn at the tip of its
+    # magnified residual, the robot base 1.1 m away is left out (a note says how far)
+    flange = np.stack([make_pose(rot_z(0.9 * k) @ rot_x(2.6 + 0.1 * k), [0, 0, 0]) for k in range(6)])
+    flange[:, :3, 3] = np.array([1.1, -0.2, 0.3]) - flange[:, :3, :3] @ [0.01, 0.005, 0.2]
+    flange[:, :3, 3] += rng.normal(0, 5e-5, (6, 3))
+    tcp = calibrate_tool(flange).to_json()
+    scene = calibration_scene(tcp, "robot base R", [("robot base R", R)])
+    got = items(scene)
+    pivot = np.array(tcp["pivot_mm"]) * 1e-3
+    res = np.array(tcp["residuals_xyz_mm"]) * 1e-3
+    factor = float(next(n for n in scene.notes if "magnified" in n).split()[3])
+    np.testing.assert_allclose(got["touches"].points, pivot + factor * res, atol=1e-12)
+    np.testing.assert_allclose(got[f"residuals x {factor:g}"].origins, np.repeat([pivot], 6, 0),
+                               atol=1e-12)
+    assert "robot base R" not in got and "the origin of robot base R is 1.1" in scene.notes[0]
+    assert not got["touches"].hover_xyz  # drawn where no touch was
+    # a track with one unknown point: its line along the fitted direction, through every
+    # fitted point
+    e = np.linspace(0, 1.5, 6)
+    f = np.array([1.5, 0.8, 0.3]) - np.outer(e, [0.9998, 0.02, 0.0]) + rng.normal(0, 5e-5, (6, 3))
+    track = calibrate_track(e, f).to_json()
+    line = items(calibration_scene(track, "robot base R", [("robot base R", R)]))["track line"]
+    u = np.diff(line.points, axis=0)[0]
+    u /= np.linalg.norm(u)
+    assert abs(abs(u @ track["direction"]) - 1) < 1e-12
+    fitted = (np.array(track["points_mm"]) - np.array(track["residuals_xyz_mm"])) * 1e-3
+    off = (fitted - line.points[0]) - np.outer((fitted - line.points[0]) @ u, u)
+    assert np.abs(off).max() < 1e-9
+    # a tilt-rotate positioner: both axes and their common normal, as the result gives them
+    ch, x = _truth(np.random.default_rng(31))
+    f = ch.predict(x, GRID)[0][:, 0] + np.random.default_rng(2).normal(0, NOISE, (len(GRID), 3))
+    pos = calibrate_positioner(GRID, f, nominal=NOMINAL, prior_sigma=NOISE).result.to_json()
+    got = items(calibration_scene(pos, "robot base R", [("robot base R", R),
+                                                        ("turntable B", pos["matrix"])]))
+    for name, point, axis in (("tilt axis", "tilt_point_mm", "tilt_axis"),
+                              ("rotate axis (tilt at 0)", "rotate_point_mm", "rotate_axis")):
+        ends = got[name].points
+        d = np.cross(ends - np.array(pos[point]) * 1e-3, pos[axis])
+        assert np.abs(d).max() < 1e-12, name
+    np.testing.assert_allclose(np.linalg.norm(np.diff(got["common normal"].points, axis=0)) * 1e3,
+                               pos["normal_length_mm"], rtol=1e-9)
+    # a frame: its triad, each touch; a workpiece result holds no touched points
+    frame = frame_result(outlier=True)
+    T = np.array(frame["matrix"])
+    scene = calibration_scene(frame, "robot base R", [("robot base R", R), ("workpiece W", T)])
+    assert {"workpiece W", "touches", "touches (outliers)"} <= set(items(scene))
+    lean = calibration_scene(frame, "robot base R", [("robot base R", R)], arrows=False)
+    assert not any(isinstance(i, Arrows) for i in lean.items)
+    dots = items(lean)["touches"]
+    assert dots.values is not None and dots.value_title == "residual (mm)"
+    work = {"procedure": "workpiece", "residuals_xyz_mm": frame["residuals_xyz_mm"],
+            "labels": frame["labels"], "warnings": []}
+    scene = calibration_scene(work, "turntable B", [("turntable B", R), ("workpiece W", T)])
+    assert set(items(scene)) == {"turntable B", "workpiece W"}
+    assert "holds no touched points" in scene.notes[0]
+
+
+def test_a_scene_too_large_for_the_page_is_drawn_lighter_or_left_out():
+    from robotcell.view.plot import embed, embed_within
+
+    rng = np.random.default_rng(5)
+    p = rng.uniform(-1, 1, (300, 3))
+    r = rng.normal(0, 1e-4, (300, 3))
+    full = Scene("many", [*touches(p, residuals=r, show_labels=False),
+                          residual_arrows(p, r, 100.0, hover=False)])
+    dots = Scene("many", touches(p, residuals=r, show_labels=False, color_by_residual=True))
+    size = len(embed(full).encode())
+    text, drawn = embed_within([full, dots], size)
+    assert drawn is full and len(text.encode()) == size
+    text, drawn = embed_within([full, dots], size - 1)  # no hover texts, no arrow heads
+    assert drawn.notes[-1] == "hover texts and arrow heads left out, to keep the page under 5 MB"
+    assert len(text.encode()) < size and drawn.items[0].hover is None
+    heads = traces(figure_from_page(text), "residuals x 100", "heads")[0]
+    assert drawn.items[-1].head == 0 and not heads.get("x")
+    light = len(text.encode())
+    text, drawn = embed_within([full, dots], light - 1)  # the lighter scene: no arrows
+    assert drawn.items[0].values is not None and len(text.encode()) < light
+    assert embed_within([full, dots], 1_000_000) == ("", None)
 
 
 def test_magnification_states_a_round_factor():
