@@ -134,8 +134,12 @@ def test_the_program_view_refuses_bad_input_and_writes_nothing(tmp_path, capsys)
     cell = Cell.load(CELL)
     src = seam_program(cell, tmp_path / "p")
     out = tmp_path / "v.html"
-    # a truncated program: its file and line named
+    # -o onto the .dat the KUKA program is read from, beside its .src
     dat = src.with_suffix(".dat")
+    before = dat.read_text()
+    code, _, err = run(capsys, "view", CELL, "--program", src, "-o", dat)
+    assert code == 2 and "which the program is read from" in err and dat.read_text() == before
+    # a truncated program: its file and line named
     dat.write_text(dat.read_text().replace("DECL E6POS XP3=", "DECL E6POS XP3=X", 1))
     code, _, err = run(capsys, "view", CELL, "--program", src, "-o", out)
     assert code == 2 and "seam_part.dat: line" in err and "Traceback" not in err, err

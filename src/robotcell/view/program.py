@@ -139,9 +139,15 @@ def write_program_view(cell: Cell, program: str | Path, path: str | Path,
     ------
     InputError
         A program that cannot be read (the file and line named), one whose points cannot be
-        placed in the cell, or one whose path alone would make the page too large.
+        placed in the cell, one whose path alone would make the page too large, or ``path``
+        naming a file the program is read from (a KUKA ``.dat``).
     """
     report = check_program_file(program, cell, pulses_per_degree)
+    read = next((f for f in report.program.files if Path(f).resolve() == Path(path).resolve()),
+                None)
+    if read is not None:  # a KUKA program's .dat beside its .src
+        raise InputError(f"{path} is {read}, which the program is read from: writing the view "
+                         "there would replace it; write to another file")
     n = len(report.points)
     pages: dict[int, str] = {}
 
