@@ -144,8 +144,9 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: tables, pose formats) and the pose algebra sit under the kinematics, which reads model files;
 #: the controller exports of ``io`` sit over the cell they export; reports of results sit with the
 #: estimators whose results they show, and with them the 3D scenes and their plotly drawing
-#: (``robotcell.view.scene``, ``.shapes``, ``.arm``, ``.plot``), which the reports will use; the
-#: view of a cell, its paths and reach maps sits over the exports. Imports inside functions
+#: (``robotcell.view.scene``, ``.shapes``, ``.arm``, ``.plot``) and the scenes of results
+#: (``.calibration``, ``.identification``), which the reports draw; the view of a cell, its
+#: paths, programs and reach maps sits over the programs. Imports inside functions
 #: (``Robot.ik`` offers the solvers of :mod:`robotcell.ik`) do not count, as for cycles.
 LAYERS = [
     {"robotcell.errors", "robotcell.kinematics.transforms", "robotcell.io.fileio",
@@ -154,7 +155,7 @@ LAYERS = [
     {"robotcell.kinematics", "robotcell.ik"},
     {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification",
      "robotcell.report", "robotcell.view.scene", "robotcell.view.shapes", "robotcell.view.arm",
-     "robotcell.view.plot"},
+     "robotcell.view.plot", "robotcell.view.calibration", "robotcell.view.identification"},
     {"robotcell.cell"},
     {"robotcell.io.export"},
     {"robotcell.programs"},
@@ -179,6 +180,7 @@ def test_every_module_is_in_a_layer():
     assert layer("robotcell.io.export.kuka") == 4 and layer("robotcell.io.tables") == 0
     assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 8
     assert layer("robotcell.view.plot") == 2 and layer("robotcell.view.cellscene") == 6
+    assert layer("robotcell.view.calibration") == 2 and layer("robotcell.view.program") == 6
     assert layer("robotcell.programs.kuka") == 5
 
 

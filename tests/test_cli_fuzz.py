@@ -2,9 +2,10 @@
 
 Every case starts from valid inputs of one command (calibrate tcp, frame, external-tcp, track,
 turntable, workpiece, positioner, also into a cell; fk, ik, also --cell; export, also URDF;
-report; cell show; identify, also --propose; reach; sweep; simulate; plan; dh from-urdf, dh
-convert; robots show; demo) and applies one or two seeded mutations to a file (measurement CSV,
-cell YAML, report JSON, URDF, robot model YAML, layouts YAML: truncation, wrong types, huge
+report; cell show, cell history; identify, also --propose; reach; sweep; simulate; plan; dh
+from-urdf, dh convert; robots show; demo; view, also --reach and --program) and applies one or
+two seeded mutations to a file (measurement CSV, cell YAML and its backups, report JSON, URDF,
+robot model YAML, layouts YAML, reach CSV, KUKA, ABB and FANUC programs: truncation, wrong types, huge
 values, NaN, other encodings, swapped or misspelt columns, empty files, binary junk, European
 CSV, ...) or to an option (negative, zero, NaN, infinite, 1e300, 1e-300, text), or names an
 input as the output. It runs the command in process, in a folder of its own. Each run must end
@@ -58,7 +59,8 @@ CASES = {"tcp": (12, 120), "frame": (12, 120), "external-tcp": (8, 60), "track":
          "export": (8, 90), "urdf": (5, 60), "cell-show": (8, 90), "report": (5, 80),
          "identify": (3, 50), "reach": (4, 60), "sweep": (4, 40), "simulate": (8, 80),
          "plan": (1, 6), "dh-from-urdf": (6, 60), "dh-convert": (6, 50), "robots-show": (6, 50),
-         "demo": (2, 10)}
+         "demo": (2, 10), "view": (4, 40), "view-reach": (3, 30), "view-program": (4, 50),
+         "cell-history": (4, 50)}
 #: Commands whose cases need not include a successful run (demo: only refused options, since a
 #: valid demo takes seconds; plan: few cases, each mutated).
 REFUSALS_ONLY = {"demo", "plan"}
@@ -622,12 +624,73 @@ def _demo(rng, d, good, out):
     return ["demo", "-o", d / "demo", *opts], " ".join(opts), [], [d / "demo"]
 
 
+def _view(kind: str):
+    """view CELL (options mutated), view --reach REACH.csv (the CSV mutated), view --program
+    PROGRAM (a KUKA, ABB or FANUC program of the example seam, one of its files mutated)."""
+    def build(rng, d, good, out):
+        cell, what = _cell_for("view", rng, d)
+        html = d / "view.html"
+        inputs = [cell]
+        if kind == "cell":
+            opts = _maybe(rng, 0.7, {"--joints": BAD_LISTS + ["0,-90,90,0,45,0", "0,-90,90,0,0,400"],
+                                     "--track": BAD_FLOATS + ["7000", "1500"],
+                                     "--table": BAD_LISTS + ["30", "400", "30,90"],
+                                     "--tool": ["torch"]})
+        elif kind == "reach":
+            path, w = _mutated(good["reach.csv"].read_text(encoding="utf-8"), rng, d, "reach.csv")
+            what += "; " + w
+            inputs.append(path)
+            opts = ["--reach", path, "--tool", "torch",
+                    *_maybe(rng, 0.2, {"--track": BAD_FLOATS + ["2324"],
+                                       "--table": BAD_LISTS + ["150"]})]
+        else:
+            vendor = str(rng.choice(["kuka", "abb", "fanuc"]))
+            files = [Path(shutil.copy(f, d)) for f in sorted(good[f"prog_{vendor}"].iterdir())]
+            target = files[int(rng.integers(0, len(files)))]
+            if rng.random() < 0.85:
+                content, w = mutate_text(target.read_text(encoding="utf-8"), rng)
+                _write(target, content)
+                what += f"; {target.name}: {w}"
+            main = next(f for f in files if f.suffix.lower() in (".src", ".mod", ".ls"))
+            inputs += files
+            opts = ["--program", main,
+                    *_maybe(rng, 0.15, {"--joints": ["0,-90,90,0,45,0"], "--track": ["100"],
+                                        "--pulses-per-degree": BAD_LISTS + ["100"],
+                                        "--reach": [str(cell)]})]
+        return (["view", cell, *opts, "-o", html], f"{what} {' '.join(map(str, opts))}", inputs,
+                [html])
+    return build
+
+
+def _cell_history(rng, d, good, out):
+    """cell history CELL: the cell file and up to three numbered backups, any of them mutated
+    (a version that cannot be read is listed as such); or no cell file at all (refused unless a
+    backup is left)."""
+    text = EXAMPLE.read_text(encoding="utf-8")
+    cell, what = _cell_for("cell-history", rng, d)
+    inputs = [cell]
+    if rng.random() < 0.15:
+        cell.unlink()
+        what, inputs = "no cell file", []
+    for k in range(1, int(rng.integers(0, 4)) + 1):
+        backup = d / f"cell.yaml.{k}.bak"
+        if rng.random() < 0.3:
+            backup, w = _mutated(text, rng, d, backup.name)
+            what += f"; {w}"
+        else:
+            _write(backup, text)
+        inputs.append(backup)
+    return ["cell", "history", cell], what, inputs, []
+
+
 BUILDERS = {"fk": _fk, "ik": _ik, "export": _export, "cell-show": _cell_show, "report": _report,
             "identify": _identify, "reach": _reach_sweep("reach"), "sweep": _reach_sweep("sweep"),
             "positioner": _positioner, "simulate": _simulate, "plan": _plan,
             "fk-cell": _fk_ik_cell("fk-cell"), "ik-cell": _fk_ik_cell("ik-cell"), "urdf": _urdf,
             "dh-from-urdf": _dh_from_urdf, "dh-convert": _dh_convert,
-            "robots-show": _robots_show, "demo": _demo}
+            "robots-show": _robots_show, "demo": _demo, "view": _view("cell"),
+            "view-reach": _view("reach"), "view-program": _view("program"),
+            "cell-history": _cell_history}
 
 
 def _write(path: Path, content: bytes | str) -> Path:
@@ -673,6 +736,16 @@ def good(tmp_path_factory) -> dict[str, Path]:
     simulate(Cell.load(POSITIONER), "positioner", seed=SEED, tool="pointer").write_csv(
         d / "positioner.csv")
     save_robot(load_robot("kuka_kr16"), d / "model.yaml")
+    from robotcell.cli import main
+    from robotcell.programs import write_program
+
+    for vendor in ("kuka", "abb", "fanuc"):
+        write_program(SEAM, cell, "torch", "part", vendor, d / f"prog_{vendor}")
+    try:
+        main(["reach", "--cell", str(EXAMPLE), str(SEAM), "--frame", "part", "--tool", "torch",
+              "--table", "150", "-o", str(d / "reach.csv")])
+    except SystemExit as exc:
+        assert not exc.code
     return {p.name: p for p in d.iterdir()}
 
 

@@ -4,6 +4,7 @@ one program or bad points), never 1 or a traceback, and a refused run writes not
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -93,6 +94,30 @@ def programs(tmp_path_factory) -> dict[str, Path]:
                                pulses_per_degree=100 if vendor == "yaskawa" else None)
         out[vendor] = Path(next(f for f in result.files if f.endswith(ext)))
     return out
+
+
+@pytest.mark.parametrize("vendor,old,new,match", [
+    ("kuka", ",S 4,", ",S 1e300,", "'1e300' is not a status or turn value"),
+    ("kuka", ",S 4,", ",S 'B1111111111111111111111111111111111111111111111111111111',",
+     "is not a status or turn value"),
+    ("kuka", r",Z [-0-9.]+,", ",Z 1e300,", "is beyond 1e+15 in size, which no value of a program is"),
+    ("fanuc", r", 0, 0, 0'", ", 0, 99999999999999999999999, 0'",
+     "the turn numbers must be integers"),
+])
+def test_huge_numbers_in_a_program_are_refused_naming_the_line(tmp_path, capsys, programs,
+                                                              vendor, old, new, match):
+    # an integer beyond what numpy holds made the check fail with OverflowError (exit 1), a
+    # length of 1e300 mm with numpy overflow warnings in the IK
+    src = programs[vendor]
+    for f in src.parent.iterdir():
+        (tmp_path / f.name).write_bytes(f.read_bytes())
+    target = tmp_path / (src.with_suffix(".dat").name if vendor == "kuka" else src.name)
+    text = target.read_text()
+    assert re.search(old, text)
+    target.write_text(re.sub(old, lambda _: new, text, count=1))
+    code, out, err = run(capsys, "program", "check", tmp_path / src.name, "--cell", CELL)
+    _check(code, out, err, match)
+    assert f"{target.name}: line " in err and "Warning" not in err
 
 
 def test_fuzz_mutated_paths_and_programs(tmp_path, capsys, programs):

@@ -116,13 +116,18 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
                  *(f"{p}.{ext}" for p in ("tcp", "track", "turntable", "workpiece")
                    for ext in ("csv", "json")),
                  *(f"report_{p}.html" for p in ("tcp", "track", "turntable", "workpiece")),
-                 "cell.html"]:
+                 "cell.html", "program.html"]:
         assert (tmp_path / name).is_file(), name
+        assert name.endswith(".html") <= ((tmp_path / name).stat().st_size < 5_000_000), name
     # the demo's program of a seam on the part is good in the calibrated cell
     assert "robot program" in out
     report = check_program_file(tmp_path / "program" / "seam.src",
                                 Cell.load(tmp_path / "cell.yaml"))
     assert report.good and len(report.points) == 36
+    # and its view has the arm at each of them, named as the program names them
+    program = figure_from_page((tmp_path / "program.html").read_text(encoding="utf-8"))
+    assert [s["label"] for s in program["layout"]["sliders"][0]["steps"]] == [
+        p.name for p in report.points]
     truth, nominal = demo_cells()
     cell = Cell.load(tmp_path / "cell.yaml")
     # The 3D view shows the calibrated cell: the torch 50 mm above the part's origin.

@@ -1,13 +1,11 @@
 """HTML reports: verdicts, files, and the page as a real headless browser renders it."""
 
 import base64
-import html
 import json
 import os
 import re
 import shutil
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -42,8 +40,9 @@ def turntable_result(seed=0):
 
 
 def embedded_pngs(page):
-    """The PNG images embedded in a report page, decoded."""
-    return [base64.b64decode(b) for b in re.findall(r'src="data:image/png;base64,([^"]+)"', page)]
+    """The PNG images of a report page's ``<img>`` elements, decoded."""
+    return [base64.b64decode(b) for b in re.findall(r'<img src="data:image/png;base64,([^"]+)"',
+                                                      page)]
 
 
 def test_verdicts():
@@ -65,12 +64,15 @@ def test_write_report_is_one_self_contained_file(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]
     page = files[0].read_text()
     assert "GOOD" in page and "frame-npoint" in page
-    # Every <img> is an embedded PNG: the page refers to no other file.
-    assert page.count("<img ") == 2
+    # Every <img> is an embedded PNG, the 3D scene's plotly.js is inline: the page refers to
+    # no other file, and stays under 5 MB.
+    assert page.count("<img ") == 1
     pngs = embedded_pngs(page)
-    assert len(pngs) == 2
+    assert len(pngs) == 1
     for png in pngs:
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
+    assert "Plotly.newPlot(" in page and "<script src=" not in page
+    assert len(page.encode()) < 5_000_000
 
 
 def test_report_names_the_frame_of_the_figure(tmp_path):
@@ -146,20 +148,16 @@ def _run_chromium(exe, tmp_path, *args):
 
 
 def test_report_renders_figures_in_headless_chromium(tmp_path):
+    from view_helpers import js_errors, render
+
     exe = _chromium()
     written = write_report(frame_result(), tmp_path / "made" / "report.html")[0]
     # The page alone, copied into an empty folder, as a user mails or copies it.
-    alone = tmp_path / "copy"
-    alone.mkdir()
-    page = Path(shutil.copy(written, alone))
-    assert [p.name for p in alone.iterdir()] == ["report.html"]
-    url = page.resolve().as_uri()
-    dom = _run_chromium(exe, tmp_path, "--virtual-time-budget=5000", "--dump-dom", url).stdout
-    # The page's own script marks the body once every <img> has loaded with a size
-    # (complete and naturalWidth > 0).
-    assert 'data-figures="loaded"' in dom
-    shot = tmp_path / "shot.png"
-    _run_chromium(exe, tmp_path, "--window-size=1000,2600", f"--screenshot={shot}", url)
+    dom, console, shot = render(exe, written, tmp_path, size=(1000, 2600))
+    # The page's own scripts mark the body once every <img> has loaded with a size
+    # (complete and naturalWidth > 0), and once plotly has drawn the 3D scene; no error.
+    assert 'data-figures="loaded"' in dom and 'data-scene="rendered"' in dom
+    assert not js_errors(console), console
     import matplotlib.image
 
     img = matplotlib.image.imread(shot)[..., :3]
@@ -168,9 +166,42 @@ def test_report_renders_figures_in_headless_chromium(tmp_path):
     blue = np.all(np.abs(img - np.array([31, 119, 180]) / 255) < 0.06, axis=-1).sum()
     green = np.all(np.abs(img - np.array([0xD8, 0xF3, 0xDC]) / 255) < 0.02, axis=-1).sum()
     assert blue > 500 and green > 5000
-    # The 3D view: its residual vectors are tab:orange (255, 127, 14), in no other figure.
-    orange = np.all(np.abs(img - np.array([255, 127, 14]) / 255) < 0.06, axis=-1).sum()
+    # The 3D scene: its residual vectors are darkorange (255, 140, 0), in no other figure.
+    orange = np.all(np.abs(img - np.array([255, 140, 0]) / 255) < 0.06, axis=-1).sum()
     assert orange > 50
+
+
+def test_turntable_report_scene_shows_each_touch_and_the_fitted_circle(tmp_path):
+    from view_helpers import figure_from_page, traces, xyz
+
+    result = turntable_result()
+    result["residuals_xyz_mm"][3] = [2.0, 0.0, 0.0]  # flagged as an outlier:
+    result["points_mm"][3] = (np.array(result["points_mm"][3]) + [2.0, 0.0, 0.0]).tolist()
+    result["warnings"].append(f"touch {result['labels'][3]} is an outlier at 3 sigma")
+    page = write_report(result, tmp_path / "t.html")[0].read_text()
+    fig = figure_from_page(page)
+    points = np.array(result["points_mm"])
+    # each touch where it was touched, to 1 um; the outlier apart
+    good = traces(fig, "touches")[0]
+    bad = traces(fig, "touches (outliers)")[0]
+    np.testing.assert_allclose(xyz(good), np.delete(points, 3, axis=0), rtol=0, atol=5e-4)
+    np.testing.assert_allclose(xyz(bad), points[[3]], rtol=0, atol=5e-4)
+    assert bad["text"] == [result["labels"][3]] and "outlier" in bad["hovertext"][0]
+    # the fitted circle: the touched point about Z_B at the fitted radius, height_mm below B
+    T = np.array(result["matrix"])
+    circle = xyz(traces(fig, "fitted circle")[0])
+    centre = T[:3, 3] - result["height_mm"] * T[:3, 2]
+    np.testing.assert_allclose(np.linalg.norm(circle - centre, axis=1), result["radius_mm"],
+                               rtol=0, atol=1e-3)
+    np.testing.assert_allclose((circle - centre) @ T[:3, 2], 0.0, atol=1e-3)
+    # every touch near the circle, the residual vectors magnified by the factor the scene states
+    factor = float(re.search(r"residual vectors magnified (\d+) x", page)[1])
+    shafts = xyz(traces(fig, f"residuals x {factor:g}", "shafts")[0])
+    res = np.array(result["residuals_xyz_mm"])
+    np.testing.assert_allclose(shafts[0::3], points - res, rtol=0, atol=1e-3)
+    np.testing.assert_allclose(shafts[1::3], points - res + factor * res, rtol=0, atol=1e-3)
+    assert fig["layout"]["scene"]["aspectmode"] == "data"  # equal axes
+    assert "in the world frame" in page and "turntable B" in {t["name"] for t in fig["data"]}
 
 
 def _result_table(page):
@@ -185,7 +216,9 @@ def _result_table(page):
 
 def test_demo_reports_for_a_technician_in_headless_chromium(tmp_path, capsys):
     """The demo's reports: each quantity named with its unit and 1-sigma, internals in an
-    appendix, 3D figures on equal axes with every magnified residual inside the plot."""
+    appendix, 3D scenes on equal axes with the residuals magnified by a stated factor."""
+    from view_helpers import figure_from_page, js_errors, render, traces
+
     exe = _chromium()
     assert main_exit(["demo", "-o", str(tmp_path / "demo")]) == 0
     capsys.readouterr()
@@ -211,23 +244,23 @@ def test_demo_reports_for_a_technician_in_headless_chromium(tmp_path, capsys):
         for internal in ("dof", "noise_source", "covariance"):
             assert f"<th>{internal}" not in main_part
         assert "<th>dof" in appendix and "<th>noise_source" in appendix
-        # The 3D figure: equal axes, the magnified residuals inside the limits.
-        geometry = json.loads(html.unescape(re.search(r'data-geometry="([^"]+)"', page)[1]))
-        limits = np.array(geometry["limits_mm"])
-        spans = limits[:, 1] - limits[:, 0]
-        np.testing.assert_allclose(spans, spans[0], rtol=1e-9)
-        if procedure != "workpiece":  # the workpiece result carries no measured points
-            low, high = np.array(geometry["tips_mm"])
-            assert np.all(low > limits[:, 0]) and np.all(high < limits[:, 1]), procedure
-            gain = geometry["gain"]
-            assert f"residual vectors magnified {gain:g} times" in page
-        # Rendered by a browser: not blank, the figures loaded.
-        url = path.resolve().as_uri()
-        dom = _run_chromium(exe, tmp_path, "--virtual-time-budget=5000", "--dump-dom",
-                            url).stdout
-        assert 'data-figures="loaded"' in dom, procedure
-        shot = tmp_path / f"{procedure}.png"
-        _run_chromium(exe, tmp_path, "--window-size=1000,2000", f"--screenshot={shot}", url)
+        # The 3D scene: equal axes (plotly scales the data alike), a touch per residual and
+        # the residual vectors magnified by the factor it states (plotly fits the view to
+        # everything drawn); the workpiece result carries no touched points.
+        fig = figure_from_page(page)
+        assert fig["layout"]["scene"]["aspectmode"] == "data"
+        if procedure != "workpiece":
+            n = sum(len(t["x"]) for t in traces(fig, "touches") + traces(fig, "touches (outliers)"))
+            assert n == len(json.loads((tmp_path / "demo" / f"{procedure}.json").read_text())
+                            ["residuals_mm"]), procedure
+            assert re.search(r"residual vectors magnified \d+ x", page), procedure
+        else:
+            assert "this result holds no touched points" in page
+        assert len(page.encode()) < 5_000_000, procedure
+        # Rendered by a browser: not blank, the figures loaded, the scene drawn, no error.
+        dom, console, shot = render(exe, path, tmp_path, size=(1000, 2000))
+        assert 'data-figures="loaded"' in dom and 'data-scene="rendered"' in dom, procedure
+        assert not js_errors(console), (procedure, console)
         import matplotlib.image
 
         img = matplotlib.image.imread(shot)[..., :3]

@@ -1,6 +1,8 @@
 """Scenes other than the cell's: calibration touches with the fitted geometry and magnified
 residuals, a path with the arm at each point on a slider, a reach map, on synthetic data."""
 
+import json
+
 import numpy as np
 import pytest
 from cli_helpers import run
@@ -10,6 +12,7 @@ from view_helpers import (
     assert_triad,
     figure_from_page,
     js_errors,
+    moving_parts,
     render,
     traces,
     triads,
@@ -22,6 +25,7 @@ from robotcell.cell import Cell
 from robotcell.kinematics.transforms import transform_points
 from robotcell.studies.reach import reach_map
 from robotcell.view import (
+    Arrows,
     Scene,
     Step,
     Triads,
@@ -94,6 +98,100 @@ def test_turntable_calibration_scene_shows_touches_circle_and_magnified_residual
     assert fig["layout"]["scene"]["xaxis"]["title"]["text"] == "x in robot base R (mm)"
 
 
+def test_calibration_scenes_of_each_procedure():
+    from test_identification_positioner import GRID, NOISE, NOMINAL, _truth
+    from test_report import frame_result
+
+    from robotcell.calibration.tcp import calibrate_tool
+    from robotcell.calibration.track import calibrate_track
+    from robotcell.identification.positioner import calibrate_positioner
+    from robotcell.view.calibration import calibration_scene
+
+    def items(scene):
+        return {i.name: i for i in scene.items}
+
+    rng = np.random.default_rng(4)
+    R = np.eye(4)
+    # a TCP: its touches are one point, the reference tip; each is drawn at the tip of its
+    # magnified residual, the robot base 1.1 m away is left out (a note says how far)
+    flange = np.stack([make_pose(rot_z(0.9 * k) @ rot_x(2.6 + 0.1 * k), [0, 0, 0]) for k in range(6)])
+    flange[:, :3, 3] = np.array([1.1, -0.2, 0.3]) - flange[:, :3, :3] @ [0.01, 0.005, 0.2]
+    flange[:, :3, 3] += rng.normal(0, 5e-5, (6, 3))
+    tcp = calibrate_tool(flange).to_json()
+    scene = calibration_scene(tcp, "robot base R", [("robot base R", R)])
+    got = items(scene)
+    pivot = np.array(tcp["pivot_mm"]) * 1e-3
+    res = np.array(tcp["residuals_xyz_mm"]) * 1e-3
+    factor = float(next(n for n in scene.notes if "magnified" in n).split()[3])
+    np.testing.assert_allclose(got["touches"].points, pivot + factor * res, atol=1e-12)
+    np.testing.assert_allclose(got[f"residuals x {factor:g}"].origins, np.repeat([pivot], 6, 0),
+                               atol=1e-12)
+    assert "robot base R" not in got and "the origin of robot base R is 1.1" in scene.notes[0]
+    assert not got["touches"].hover_xyz  # drawn where no touch was
+    # a track with one unknown point: its line along the fitted direction, through every
+    # fitted point
+    e = np.linspace(0, 1.5, 6)
+    f = np.array([1.5, 0.8, 0.3]) - np.outer(e, [0.9998, 0.02, 0.0]) + rng.normal(0, 5e-5, (6, 3))
+    track = calibrate_track(e, f).to_json()
+    line = items(calibration_scene(track, "robot base R", [("robot base R", R)]))["track line"]
+    u = np.diff(line.points, axis=0)[0]
+    u /= np.linalg.norm(u)
+    assert abs(abs(u @ track["direction"]) - 1) < 1e-12
+    fitted = (np.array(track["points_mm"]) - np.array(track["residuals_xyz_mm"])) * 1e-3
+    off = (fitted - line.points[0]) - np.outer((fitted - line.points[0]) @ u, u)
+    assert np.abs(off).max() < 1e-9
+    # a tilt-rotate positioner: both axes and their common normal, as the result gives them
+    ch, x = _truth(np.random.default_rng(31))
+    f = ch.predict(x, GRID)[0][:, 0] + np.random.default_rng(2).normal(0, NOISE, (len(GRID), 3))
+    pos = calibrate_positioner(GRID, f, nominal=NOMINAL, prior_sigma=NOISE).result.to_json()
+    got = items(calibration_scene(pos, "robot base R", [("robot base R", R),
+                                                        ("turntable B", pos["matrix"])]))
+    for name, point, axis in (("tilt axis", "tilt_point_mm", "tilt_axis"),
+                              ("rotate axis (tilt at 0)", "rotate_point_mm", "rotate_axis")):
+        ends = got[name].points
+        d = np.cross(ends - np.array(pos[point]) * 1e-3, pos[axis])
+        assert np.abs(d).max() < 1e-12, name
+    np.testing.assert_allclose(np.linalg.norm(np.diff(got["common normal"].points, axis=0)) * 1e3,
+                               pos["normal_length_mm"], rtol=1e-9)
+    # a frame: its triad, each touch; a workpiece result holds no touched points
+    frame = frame_result(outlier=True)
+    T = np.array(frame["matrix"])
+    scene = calibration_scene(frame, "robot base R", [("robot base R", R), ("workpiece W", T)])
+    assert {"workpiece W", "touches", "touches (outliers)"} <= set(items(scene))
+    lean = calibration_scene(frame, "robot base R", [("robot base R", R)], arrows=False)
+    assert not any(isinstance(i, Arrows) for i in lean.items)
+    dots = items(lean)["touches"]
+    assert dots.values is not None and dots.value_title == "residual (mm)"
+    work = {"procedure": "workpiece", "residuals_xyz_mm": frame["residuals_xyz_mm"],
+            "labels": frame["labels"], "warnings": []}
+    scene = calibration_scene(work, "turntable B", [("turntable B", R), ("workpiece W", T)])
+    assert set(items(scene)) == {"turntable B", "workpiece W"}
+    assert "holds no touched points" in scene.notes[0]
+
+
+def test_a_scene_too_large_for_the_page_is_drawn_lighter_or_left_out():
+    from robotcell.view.plot import embed, embed_within
+
+    rng = np.random.default_rng(5)
+    p = rng.uniform(-1, 1, (300, 3))
+    r = rng.normal(0, 1e-4, (300, 3))
+    full = Scene("many", [*touches(p, residuals=r, show_labels=False),
+                          residual_arrows(p, r, 100.0, hover=False)])
+    dots = Scene("many", touches(p, residuals=r, show_labels=False, color_by_residual=True))
+    size = len(embed(full).encode())
+    text, drawn = embed_within([full, dots], size)
+    assert drawn is full and len(text.encode()) == size
+    text, drawn = embed_within([full, dots], size - 1)  # no hover texts, no arrow heads
+    assert drawn.notes[-1] == "hover texts and arrow heads left out, to keep the page under 5 MB"
+    assert len(text.encode()) < size and drawn.items[0].hover is None
+    heads = traces(figure_from_page(text), "residuals x 100", "heads")[0]
+    assert drawn.items[-1].head == 0 and not heads.get("x")
+    light = len(text.encode())
+    text, drawn = embed_within([full, dots], light - 1)  # the lighter scene: no arrows
+    assert drawn.items[0].values is not None and len(text.encode()) < light
+    assert embed_within([full, dots], 1_000_000) == ("", None)
+
+
 def test_magnification_states_a_round_factor():
     r = np.array([[0.0, 0.0, 3e-4], [1e-4, 0, 0]])  # longest 0.3 mm
     assert magnification(r, size=1.0) == 200.0  # 0.1 m / 0.3 mm = 333 -> 200
@@ -160,42 +258,96 @@ def seam(cell, n=12):
     return cell.ik_path(T, frame="part", table=np.radians(150), tool="torch")
 
 
+def chain_vertices(cell, q, e, th):
+    """The vertices of the robot's links (mm) at each configuration, without those that
+    coincide with the one before at every configuration (as the path's view drops them)."""
+    from robotcell.cell.kinematics import robot_pose
+    from robotcell.view.arm import chain_pose
+
+    v = np.stack([chain_pose(cell.robot, qi, robot_pose(cell, ei)).vertices
+                  for qi, ei in zip(q, e)]) * 1e3
+    keep = np.concatenate([[True], ~np.all(np.isclose(v[:, 1:], v[:, :-1], rtol=0, atol=1e-6),
+                                           axis=(0, 2))])
+    return v[:, keep]
+
+
+def assert_triad_line(drawn, T, length_mm, tol):
+    """A triad drawn as one polyline (origin, X tip, gap, origin, Y tip, gap, origin, Z tip) is
+    the pose ``T`` (m) to ``tol`` mm."""
+    o = T[:3, 3] * 1e3
+    np.testing.assert_allclose(drawn[[0, 3, 6]], [o] * 3, rtol=0, atol=tol)
+    np.testing.assert_allclose(drawn[[1, 4, 7]], o + length_mm * T[:3, :3].T, rtol=0, atol=tol)
+    assert np.all(np.isnan(drawn[[2, 5]]))
+
+
 def test_path_scene_puts_the_arm_at_each_point_where_fk_does():
+    from robotcell.view.cellscene import frame_size
+
     cell = Cell.load(EXAMPLE)
     path = seam(cell)
     n = len(path.q)
     table = np.radians(150 + np.linspace(0, 20, n))  # the table turns along the path
+    track = path.track + np.linspace(0, 0.3, n)  # and the track moves
     bad = np.zeros(n, bool)
     bad[4] = True
     reasons = [""] * n
     reasons[4] = "A5 within 1 deg of its limit"
-    scene = path_scene(cell, path.q, path.track, table, tool="torch", bad=bad, reasons=reasons)
-    fig = scene_figure(scene)
-    data = figure_from_page(page(fig))
+    scene = path_scene(cell, path.q, track, table, tool="torch", bad=bad, reasons=reasons)
+    data = figure_from_page(page(scene_figure(scene)))
     assert len(data["frames"]) == n
     assert [s["label"] for s in data["layout"]["sliders"][0]["steps"]] == [str(k + 1) for k in range(n)]
-    # the marked point, with its reason
+    # the marked point, with its reason; the path through every TCP (0.01 mm in the page)
     mark = traces(data, "bad points")[0]
     assert mark["hovertext"] == ["<b>point 5</b>: A5 within 1 deg of its limit"]
-    tcp = cell.fk(path.q, path.track, table, tool="torch")
-    np.testing.assert_allclose(xyz(mark)[0], tcp[4, :3, 3] * 1e3, atol=1e-6)
-    np.testing.assert_allclose(xyz(traces(data, "TCP path")[0]), tcp[:, :3, 3] * 1e3, atol=1e-6)
-    # at each step, the TCP, the flange and the frames carried by the table are the cell's FK
-    first = {t["meta"]["item"] + ":" + t["meta"]["part"]: i for i, t in enumerate(data["data"])}
-    for k, frame in enumerate(data["frames"]):
-        step = {"data": [dict(data["data"][i], **t) for i, t in zip(frame["traces"], frame["data"])]}
-        assert_triad(triads(step, "TCP")[f"point {k + 1}"], tcp[k])
-        assert_triad(triads(step, "robot kuka_kr16: flange F")["flange F"],
-                     cell.fk(path.q[k], path.track[k], table[k], tool=np.eye(4)))
-        assert_triad(triads(step, "frames")["part"], cell.frame_pose("part", path.track[k], table[k]))
-    # what does not move is drawn once, outside the steps: the world axes, the robot base (the
-    # track stays where the path's IK put it)
-    assert np.ptp(path.track) == 0
+    tcp = cell.fk(path.q, track, table, tool="torch")
+    np.testing.assert_allclose(xyz(mark)[0], tcp[4, :3, 3] * 1e3, rtol=0, atol=0.005)
+    np.testing.assert_allclose(xyz(traces(data, "TCP path")[0]), tcp[:, :3, 3] * 1e3, rtol=0,
+                               atol=0.005)
+    # at each step the links, the tool, the TCP and the frame on the table where the cell's FK
+    # puts them, to the 0.01 mm the page holds
+    links = chain_vertices(cell, path.q, track, table)
+    length = frame_size(cell.robot) * 1e3
+    flange = cell.fk(path.q, track, table, tool=np.eye(4))
+    for k in range(n):
+        parts = moving_parts(data, k)
+        np.testing.assert_allclose(parts["robot kuka_kr16: links"], links[k], rtol=0, atol=0.005)
+        np.testing.assert_allclose(parts["tool"], [flange[k, :3, 3] * 1e3, tcp[k, :3, 3] * 1e3],
+                                   rtol=0, atol=0.005)
+        assert_triad_line(parts["TCP"], tcp[k], length, 0.005)
+        assert_triad_line(parts["frames: part"], cell.frame_pose("part", track[k], table[k]),
+                          length, 0.005)
+    # what does not move is drawn once, outside the steps: the world axes, the fixture, the
+    # turntable's plate (a disk turned about its axis is the same disk); what moves is one
+    # polyline and the labels of the frames on the table
     moving = {data["data"][i]["meta"]["item"] for i in data["frames"][0]["traces"]}
-    assert "world:origins" in first and "robot R" not in moving
-    assert moving == {"robot kuka_kr16: links", "robot kuka_kr16: flange F",
-                      "turntable DKP_400_01: plate P", "turntable DKP_400_01: plate", "frames",
-                      "TCP"}
+    assert moving == {"cell at the point", "moving frames"}
+    still = {t["meta"]["item"] for t in data["data"]}
+    assert {"world", "frames: fixture", "turntable DKP_400_01: plate"} <= still
+    assert triads(data, "frames: fixture")["fixture"]
+    # each step is a frame's vertices only: a path of 300 points fits in 5 MB with plotly.js
+    frame = json.dumps(data["frames"][1], separators=(",", ":"))
+    assert '"type"' not in frame and len(frame) < 900
+
+
+def test_path_of_hundreds_of_points_fits_in_a_page(tmp_path):
+    # the track moving along 320 points, the arm at each: under 5 MB (docs/view.md)
+    cell = Cell.load(EXAMPLE)
+    path = seam(cell, n=320)
+    track = path.track + np.linspace(0, 0.5, 320)
+    text = page(path_scene(cell, path.q, track, np.radians(150), tool="torch"))
+    assert len(text.encode()) < 5_000_000
+    data = figure_from_page(text)
+    assert len(data["frames"]) == 320 and len(data["layout"]["sliders"][0]["steps"]) == 320
+    # the slider's steps name their frame only; the page does not play on opening
+    assert data["layout"]["sliders"][0]["steps"][7]["args"] == [["7"], {"mode": "immediate"}]
+    assert "Plotly.animate" not in text[text.index("Plotly.newPlot("):]
+    # every 4th point: the whole path, the arm at 80 points, and the page says so
+    scene = path_scene(cell, path.q, track, np.radians(150), tool="torch", every=4)
+    assert [s.label for s in scene.steps] == [str(k + 1) for k in range(0, 320, 4)]
+    assert len(scene.items[[i.name for i in scene.items].index("TCP path")].points) == 320
+    assert "the arm is drawn at every 4th of the 320 points" in " ".join(scene.notes)
+    with pytest.raises(InputError, match="every must be a whole number >= 1, got 0"):
+        path_scene(cell, path.q, every=0)
 
 
 def test_browser_plays_the_path(tmp_path):
@@ -223,21 +375,35 @@ def test_path_scene_with_points_without_joint_values():
     where = cell.fk(path.q, path.track, np.radians(150), tool="torch")[:, :3, 3]
     bad = np.arange(5) == 2
     reasons = ["", "", "unreachable: 40 mm beyond the arm's reach", "", ""]
-    with pytest.raises(InputError, match="point 3 has no joint values: give its position in points"):
-        path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad, reasons=reasons)
+    # without its position it cannot be marked: a note names it
+    scene = path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad, reasons=reasons)
+    assert "bad points" not in [i.name for i in scene.items]
+    assert "not drawn, no position: point 3: unreachable: 40 mm beyond the arm's reach" in scene.notes
     scene = path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad,
                        reasons=reasons, points=where)
     fig = scene_figure(scene).to_plotly_json()
-    np.testing.assert_allclose(xyz(traces(fig, "bad points")[0])[0], where[2] * 1e3, atol=1e-6)
+    np.testing.assert_allclose(xyz(traces(fig, "bad points")[0])[0], where[2] * 1e3, atol=0.005)
     # its step shows the arm of the point before it
-    assert scene.steps[2].items[-1].labels == ("point 3",)
-    np.testing.assert_array_equal(scene.steps[2].items[-1].poses, scene.steps[1].items[-1].poses)
+    np.testing.assert_array_equal(scene.steps[2].items[0].points, scene.steps[1].items[0].points)
+    # a tool per point, unknown (NaN) at one: no TCP drawn there, the arm is
+    tools = np.repeat(cell.tools["torch"].T_F_TCP[None], 5, axis=0)
+    tools[3] = np.nan
+    scene = path_scene(cell, path.q, path.track, np.radians(150), tool=tools)
+    parts = {name: (a, b) for name, a, b in scene.steps[3].items[0].parts}
+    a, b = parts["TCP"]
+    assert np.all(np.isnan(scene.steps[3].items[0].points[a:b]))
+    assert np.all(np.isfinite(scene.steps[2].items[0].points[a:b][[0, 1]]))
     with pytest.raises(InputError, match=r"q must have shape \(N, 6\)"):
         path_scene(cell, q[:, :5])
     with pytest.raises(InputError, match="no point of the path has joint values"):
         path_scene(cell, np.full((2, 6), np.nan))
-    with pytest.raises(InputError, match=r"labels, bad and reasons need one entry per point \(5\)"):
+    with pytest.raises(InputError, match=r"labels, bad, reasons and hover need one entry per "
+                                         r"point \(5\)"):
         path_scene(cell, path.q, path.track, labels=["a"])
+    with pytest.raises(InputError, match=r"tool must have shape \(4, 4\) or \(5, 4, 4\)"):
+        path_scene(cell, path.q, path.track, tool=tools[:2])
+    with pytest.raises(InputError, match=r"points must have shape \(5, 3\)"):
+        path_scene(cell, path.q, path.track, points=where[:2])
 
 
 def test_reach_map_read_back_from_the_csv_of_reach(tmp_path, capsys):

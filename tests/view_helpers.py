@@ -60,6 +60,16 @@ def xyz(trace):
     return np.array([[np.nan if v is None else v for v in trace[c]] for c in "xyz"]).T
 
 
+def moving_parts(fig, k, item="cell at the point"):
+    """The pieces of a path's moving polyline at step ``k`` (robotcell.view.path.MOVING): piece
+    name -> its vertices (N, 3), mm, as the page's animation frame ``k`` draws them."""
+    index = next(i for i, t in enumerate(fig["data"]) if t.get("meta", {}).get("item") == item)
+    base = fig["data"][index]
+    frame = fig["frames"][k]
+    drawn = xyz({**base, **frame["data"][frame["traces"].index(index)]})
+    return {name: drawn[a:b] for name, a, b in base["meta"]["parts"]}
+
+
 def triads(fig, item):
     """Frames of a Triads item: label -> (origin (3,), axis tips (3, 3) as rows X, Y, Z, length),
     all mm."""

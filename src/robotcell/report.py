@@ -3,10 +3,11 @@
 A report is made from the JSON a calibration writes (``robotcell calibrate ... --json``, or
 ``CalibrationResult.to_json()``), so it can be produced later and elsewhere. It shows, at a glance,
 whether the calibration is good (a verdict with its reasons), the result, the 1-sigma
-uncertainties, residuals per touch, and a 3D view of the measured points with their residual
-vectors magnified. The figures are PNG images embedded in the page (``data:`` URIs), so the
-HTML file alone is the whole report: it can be mailed or copied anywhere. matplotlib is imported
-only here, and only when a report is written.
+uncertainties, residuals per touch, and an interactive 3D scene of the touches, the fitted
+geometry and the residual vectors magnified (:mod:`robotcell.view.calibration`, drawn with
+plotly). The residual figure is a PNG image embedded in the page (a ``data:`` URI) and plotly.js
+is inlined, so the HTML file alone is the whole report (about 4.9 MB): it can be mailed or copied
+anywhere and opens offline. matplotlib and plotly are imported only when a report is written.
 """
 
 from __future__ import annotations
@@ -30,6 +31,9 @@ from robotcell.io.fileio import atomic_write, read_text
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.kinematics.transforms import check_pose
+from robotcell.view.calibration import calibration_scene, outliers
+from robotcell.view.plot import MAX_PAGE_BYTES, embed_within
+from robotcell.view.scene import Scene
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 
@@ -218,77 +222,31 @@ def _png(fig: Any) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def _nice_gain(gain: float) -> float:
-    """The largest 1, 2 or 5 times a power of ten not above ``gain`` (a factor easy to read)."""
-    if gain <= 0 or not math.isfinite(gain):
-        return 1.0
-    decade = 10.0 ** math.floor(math.log10(gain))
-    return max(m * decade for m in (1.0, 2.0, 5.0) if m * decade <= gain)
+#: Where the 3D scene goes in a page, until the room it has is known.
+SCENE_SLOT = "<!-- the 3D scene -->"
 
 
-def _figure_view(result: dict[str, Any]) -> tuple[str, dict[str, Any]]:
-    """The 3D view (PNG data URI) and its geometry: axis limits (mm), gain, residual tips.
+def scene_figure(scenes: list[Scene], room: int, what: str) -> str:
+    """An interactive 3D scene as a ``<figure>`` of a report, with its caption, in at most
+    ``room`` bytes: the first of ``scenes`` (the full one, then lighter ones) that fits
+    (:func:`robotcell.view.plot.embed_within`); a paragraph that says it is left out when none
+    does."""
+    fragment, drawn = embed_within(scenes, room - 2_000, height="620px")
+    if drawn is None:
+        return (f"<p>The 3D scene of {what} is left out: it would make this page larger than "
+                f"{MAX_PAGE_BYTES / 1e6:g} MB.</p>")
+    return (f'<figure class="view">{fragment}<figcaption>{html.escape(what[0].upper() + what[1:])} '
+            f"in the {html.escape(drawn.frame)} frame (mm), on equal axes: drag to turn, scroll "
+            "to zoom, hover for names and values, click a legend entry to hide or show it; "
+            f"{html.escape('; '.join(drawn.notes))}.</figcaption></figure>")
 
-    The axes are equal (one cube, one scale on X, Y and Z), and the residual vectors are
-    magnified by a round factor that makes the longest a tenth of the scene; the limits
-    include every magnified residual, so none leaves the plot.
-    """
-    import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(7, 6))
-    ax = fig.add_subplot(projection="3d")
-    res = np.array(result.get("residuals_xyz_mm") or [], dtype=float).reshape(-1, 3)
-    pts = result.get("points_mm")
-    anchor = None
-    if pts is not None:
-        anchor = np.array(pts, dtype=float).reshape(-1, 3)
-    elif result.get("pivot_mm") is not None:
-        anchor = np.repeat(np.array(result["pivot_mm"], dtype=float)[None], len(res), axis=0)
+def _scene(result: dict[str, Any], room: int) -> str:
+    """The interactive 3D scene of the result (:func:`robotcell.view.calibration
+    .calibration_scene`) as a figure of the page, plotly.js inlined."""
     where, frames = _frames(result)
-    cloud = [T[:3, 3] for _, T in frames]
-    if anchor is not None:
-        cloud += list(anchor)
-    size = max(float(np.ptp(np.array(cloud), axis=0).max()) if len(cloud) > 1 else 100.0, 50.0)
-    axis_len = 0.15 * size
-    for label, T in frames:
-        for k, color in enumerate(("tab:red", "tab:green", "tab:blue")):
-            ax.quiver(*T[:3, 3], *(T[:3, k] * axis_len), color=color, linewidth=2)
-            cloud.append(T[:3, 3] + T[:3, k] * axis_len)
-        ax.text(*T[:3, 3], f" {label}", fontsize=9)
-    gain = None
-    tips = np.empty((0, 3))
-    if anchor is not None and len(res) == len(anchor) and len(res):
-        ax.scatter(*anchor.T, color="black", s=18, label="measured points")
-        longest = float(np.linalg.norm(res, axis=1).max())
-        gain = _nice_gain(0.1 * size / longest) if longest > 0 else 1.0
-        tips = anchor + res * gain
-        cloud += list(tips)
-        ax.quiver(*anchor.T, *(res.T * gain), color="tab:orange", linewidth=1.5,
-                  label=f"residuals x {gain:g}")
-        ax.legend(loc="upper left")
-    cloud_arr = np.array(cloud)
-    centre = (cloud_arr.min(axis=0) + cloud_arr.max(axis=0)) / 2
-    half = 0.55 * float(np.ptp(cloud_arr, axis=0).max())  # 10 % margin
-    limits = [[float(c - half), float(c + half)] for c in centre]
-    ax.set_xlim(*limits[0])
-    ax.set_ylim(*limits[1])
-    ax.set_zlim(*limits[2])
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("X [mm]")
-    ax.set_ylabel("Y [mm]")
-    ax.set_zlabel("Z [mm]")
-    title = f"Frames and measured points (in {where}, mm, equal axes)"
-    if gain is not None:
-        title += f"\nresidual vectors magnified {gain:g}x"
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    geometry = {"limits_mm": limits, "gain": gain,
-                "tips_mm": [tips.min(axis=0).tolist(), tips.max(axis=0).tolist()]
-                if len(tips) else None}
-    return _png(fig), geometry
+    scenes = [calibration_scene(result, where, frames, arrows=a) for a in (True, False)]
+    return scene_figure(scenes, room, "the frames, touches and fitted geometry")
 
 
 def _figure_residuals(result: dict[str, Any]) -> str:
@@ -300,14 +258,11 @@ def _figure_residuals(result: dict[str, Any]) -> str:
     r = np.array(result["residuals_mm"], dtype=float)
     labels = result.get("labels") or [str(i + 1) for i in range(len(r))]
     fig, ax = plt.subplots(figsize=(7, 3.2))
-    # The calibration flags outliers with each touch's leverage taken into account; show its
-    # verdict rather than a fixed threshold.
-    flagged = {lab for lab in labels
-               if any(w.startswith(f"touch {lab} is an outlier") for w in result.get("warnings", []))}
-    colors = ["tab:red" if lab in flagged else "tab:blue" for lab in labels]
+    flagged = outliers(result, [str(lab) for lab in labels])
+    colors = ["tab:red" if bad else "tab:blue" for bad in flagged]
     ax.bar(range(len(r)), r, color=colors)
     ax.axhline(result["rms_mm"], color="tab:green", linestyle="--", label=f"RMS {result['rms_mm']:.3f} mm")
-    if flagged:
+    if flagged.any():
         ax.bar([], [], color="tab:red", label="outlier (see warnings)")
     ax.set_xticks(range(len(r)), labels, rotation=45 if len(r) > 8 else 0, fontsize=8)
     ax.set_ylabel("residual [mm]")
@@ -355,6 +310,10 @@ _QUANTITIES: dict[str, tuple[str, str]] = {
     "tilt_deg": ("tilt of the axis from vertical", "deg"),
     "height_mm": ("origin above the touched point (--height)", "mm"),
     "spread_deg": ("arc covered by the touches", "deg"),
+    "tilt_point_mm": ("point of the tilt axis at the common normal (X, Y, Z)", "mm"),
+    "tilt_axis": ("tilt axis direction (unit vector X, Y, Z)", "1"),
+    "rotate_point_mm": ("point of the rotate axis at the common normal, tilt at 0 (X, Y, Z)", "mm"),
+    "rotate_axis": ("rotate axis direction, tilt at 0 (unit vector X, Y, Z)", "1"),
     "normal_length_mm": ("length of the common normal of the two axes", "mm"),
     "axis_angle_deg": ("angle between the two axes", "deg"),
     "tilt_zero_deg": ("zero of the tilt axis", "deg"),
@@ -482,8 +441,6 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
     """
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    where = _frames(result)[0]
-    view, geometry = _figure_view(result)
     resid = _figure_residuals(result)
     grade, reasons = verdict(result)
     proc = html.escape(str(result["procedure"]))
@@ -511,8 +468,6 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
         vals = result.get(key) or []
         return "<ul>" + "".join(f"<li>{html.escape(str(v))}</li>" for v in vals) + "</ul>" if vals else "<p>none</p>"
 
-    gain_text = ("" if geometry["gain"] is None else
-                 f"; residual vectors magnified {geometry['gain']:g} times")
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell report: {proc}</title>
 <style>{_CSS}</style><script>{_SCRIPT}</script></head>
@@ -529,9 +484,7 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
 <h2>Not determined by the measurements</h2>{items('undetermined')}
 <h2>Warnings</h2>{items('warnings')}
 <h2>Figures</h2>
-<figure class="view" data-geometry="{html.escape(json.dumps(geometry))}">
-<img src="{view}" alt="3D view of frames and measured points">
-<figcaption>Frames and measured points in the {html.escape(where)} frame (mm), on equal axes{gain_text}.</figcaption></figure>
+{SCENE_SLOT}
 <figure><img src="{resid}" alt="residual per touch"></figure>
 <h2>Residuals per touch</h2>
 <table><tr><th>touch</th><th>|residual| (mm)</th><th>x, y, z (mm)</th></tr>{touches}</table>
@@ -541,5 +494,6 @@ above is all that is needed to use the calibration.</p>
 <table>{appendix}</table>
 </body></html>
 """
-    atomic_write(out, page)
+    room = MAX_PAGE_BYTES - len(page.encode())
+    atomic_write(out, page.replace(SCENE_SLOT, _scene(result, room), 1))
     return [out]

@@ -23,9 +23,10 @@ def demo(output: str, noise: float, seed: int) -> None:
     A KUKA KR 16 on a linear track beside a turntable, with a welding torch and a workpiece:
     every touch-up procedure is simulated with realistic noise, the cell is calibrated in order
     (tool, track, turntable, workpiece) with the same commands a technician types, each result
-    is printed beside the truth, and the HTML reports, the KUKA, ABB, FANUC and YASKAWA
-    exports, a KUKA program of a seam on the workpiece and the 3D view of the calibrated cell
-    (cell.html) are written to the output folder.
+    is printed beside the truth, and the HTML reports (each with a 3D scene of its touches),
+    the KUKA, ABB, FANUC and YASKAWA exports, a KUKA program of a seam on the workpiece, the 3D
+    view of the calibrated cell (cell.html) and that of the program (program.html) are written
+    to the output folder.
 
     \b
     Example:

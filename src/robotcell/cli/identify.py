@@ -227,7 +227,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
                                     pose=meas.rotations is not None, point_sigma=options["point_sigma"],
                                     angle_sigma=options["angle_sigma"])
-        write_identification_report(result, report, cross, obs)
+        write_identification_report(result, report, cross, obs, meas)
     offsets = None if offsets_for is None else _offsets(result, offsets_for)
     if as_json:
         data = result.to_json()

@@ -15,7 +15,9 @@ from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.kinematics.robot import Robot
 from robotcell.view.cellscene import cell_figure
-from robotcell.view.plot import write_html
+from robotcell.view.path import ordinal
+from robotcell.view.plot import MAX_PAGE_BYTES, write_html
+from robotcell.view.program import write_program_view
 from robotcell.view.reach import read_reach
 
 
@@ -32,14 +34,13 @@ def joint_option(robot: Robot, text: str | None) -> np.ndarray | None:
     return q
 
 
-
 @click.command(cls=Command)
 @click.argument("cell_path", metavar="CELL.yaml", type=click.Path(dir_okay=False))
 @click.option("--joints", default=None, metavar="A1,A2,...",
               help="Arm axis values (deg; mm for a prismatic axis); default the robot model's "
                    "home configuration, else 0.")
-@click.option("--track", "track_mm", type=float, default=0.0, metavar="MM",
-              help="Track position (mm).")
+@click.option("--track", "track_mm", type=float, default=None, metavar="MM",
+              help="Track position (mm); default 0.")
 @click.option("--table", "table_deg", default=None, metavar="DEG[,DEG...]",
               help="Turntable angle (deg), or one value per positioner axis; default 0.")
 @click.option("--reach", "reach_path", type=click.Path(dir_okay=False), default=None,
@@ -47,31 +48,63 @@ def joint_option(robot: Robot, text: str | None) -> np.ndarray | None:
 @click.option("--tool", default=None,
               help="With --reach: the tool the map was made with (a tool of the cell, or "
                    "X,Y,Z,A,B,C in mm, deg); default the robot model's tool.")
+@click.option("--program", "program_path", type=click.Path(dir_okay=False), default=None,
+              help="A robot program to draw (KUKA .src with its .dat, ABB .mod, FANUC .ls, "
+                   "YASKAWA .jbi): its path, the arm at each point on a slider, the points "
+                   "'robotcell program check' finds bad marked.")
+@click.option("--pulses-per-degree", "ppd", default=None, metavar="N[,N...]",
+              help="With --program, YASKAWA: encoder pulses per degree of each station axis.")
 @click.option("-o", "--output", required=True, type=OUTPUT,
               callback=output_of("HTML", "the view"), help="HTML file to write, atomically.")
-def view(cell_path: str, joints: str | None, track_mm: float, table_deg: str | None,
-         reach_path: str | None, tool: str | None, output: str) -> None:
+def view(cell_path: str, joints: str | None, track_mm: float | None, table_deg: str | None,
+         reach_path: str | None, tool: str | None, program_path: str | None, ppd: str | None,
+         output: str) -> None:
     """Interactive 3D view of a cell: one HTML file that opens offline, with no server.
 
     The robot as its links and joint axes, the track and its travel, the turntable or
     positioner axes and plate, every tool and frame as a labelled triad (X red, Y green, Z
     blue) and the world axes, in mm; hover over a frame for its pose (x, y, z mm; a, b, c deg,
     R = Rz(a) Ry(b) Rx(c)). With --reach, the targets of a reachability map where the TCP
-    reaches them, coloured by score. Refused with exit status 2: a cell file that cannot be
-    read (a missing robot model), joint, track or table values outside their limits, -o onto
-    an input file. See docs/view.md.
+    reaches them, coloured by score. With --program, the program's path and the arm at each
+    of its points (a slider and a play button), the points 'program check' finds bad (an
+    unreachable one among them) marked with their problems. Refused with exit status 2: a cell
+    file or program that cannot be read (a missing robot model, the program's file and line
+    named), joint, track or table values outside their limits, -o onto an input file. See
+    docs/view.md.
 
     \b
     Examples:
       robotcell view examples/cell_kr16_track_turntable.yaml --joints 0,-60,100,0,50,0 \\
           --track 1500 --table 30 -o cell.html
       robotcell view cell.yaml --reach reach.csv --tool torch -o reach3d.html
+      robotcell view cell.yaml --program prog/seam_part.src -o program.html
     """
     if tool is not None and reach_path is None:
         raise InputError("--tool says which tool the --reach map was made with; give --reach")
+    if ppd is not None and program_path is None:
+        raise InputError("--pulses-per-degree is for a YASKAWA --program; give --program")
+    if program_path is not None:
+        given = [flag for flag, v in (("--joints", joints), ("--track", track_mm),
+                                      ("--table", table_deg), ("--reach", reach_path)) if v is not None]
+        if given:
+            raise InputError(f"--program draws the arm at the program's points: leave out "
+                             f"{', '.join(given)}")
+        cell = Cell.load(cell_path)
+        pulses = None if ppd is None else parse_numbers(ppd, "--pulses-per-degree")
+        try:
+            made = write_program_view(cell, program_path, output, pulses)
+        except InputError as exc:
+            raise InputError(str(exc).replace("pulses_per_degree", "--pulses-per-degree")) from None
+        rep = made.report
+        arm = "every point" if made.every == 1 else (
+            f"every {ordinal(made.every)} point (the page stays under {MAX_PAGE_BYTES / 1e6:g} MB)")
+        click.echo(f"{made.path}: 3D view of {rep.program.name} in {cell.name}: "
+                   f"{len(rep.points)} points, {len(rep.bad)} bad, the arm at {arm}; "
+                   f"{made.size / 1e6:.1f} MB; open it in a browser", err=True)
+        return
     cell = Cell.load(cell_path)
     q = joint_option(cell.robot, joints)
-    e = float(track_values(cell, track_mm))
+    e = float(track_values(cell, track_mm or 0.0))
     th = table_angles(cell, table_option(cell, table_deg))
     reach = read_reach(reach_path, cell) if reach_path is not None else None
     fig = cell_figure(cell, q, e, th, reach, cell_tool(tool))

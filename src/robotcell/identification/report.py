@@ -2,11 +2,14 @@
 
 The page (``robotcell identify ... --report FILE.html``) shows the verdict, the position error of
 the nominal and the identified model (mean, RMS, max; per row and as a histogram; the orientation
-error with pose measurements; the J2/J3 check with a stated coupling), the K-fold
-cross-validated error, the parameters held and why, every parameter with its 1-sigma and the
-largest correlations, and the observability index O1 of the measured configurations against
-random ones. Figures are PNG ``data:`` URIs made with the helpers of :mod:`robotcell.report`
-(matplotlib imported only when a report is written).
+error with pose measurements; the J2/J3 check with a stated coupling), given the measurements an
+interactive 3D scene of them (:mod:`robotcell.view.identification`: the measured targets, the
+residuals magnified, the identified arm beside the nominal one), the K-fold cross-validated
+error, the parameters held and why, every parameter with its 1-sigma and the largest
+correlations, and the observability index O1 of the measured configurations against random
+ones. Figures are PNG ``data:`` URIs made with the helpers of :mod:`robotcell.report`, the scene
+a plotly figure with plotly.js inlined (matplotlib and plotly imported only when a report is
+written).
 """
 
 from __future__ import annotations
@@ -18,10 +21,13 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
-from robotcell.report import _CSS, _SCRIPT, _fmt, _png
+from robotcell.report import _CSS, _SCRIPT, SCENE_SLOT, _fmt, _png, scene_figure
+from robotcell.view.identification import identification_scene
+from robotcell.view.plot import MAX_PAGE_BYTES
 
 __all__ = ["write_identification_report"]
 
@@ -86,6 +92,7 @@ def write_identification_report(
     path: str | Path,
     cross_validation: CrossValidation | None = None,
     observability: tuple[float, NDArray[np.float64]] | None = None,
+    measurements: Measurements | None = None,
 ) -> Path:
     """Write the HTML report of an identification (one file, figures embedded).
 
@@ -99,6 +106,9 @@ def write_identification_report(
     observability : (float, ndarray), optional
         O1 of the measured configurations and of random sets
         (:func:`~robotcell.identification.compare_observability`).
+    measurements : Measurements, optional
+        The measurements identified: given, the page shows their 3D scene
+        (:func:`~robotcell.view.identification.identification_scene`).
 
     Returns
     -------
@@ -163,6 +173,7 @@ def write_identification_report(
                     f"better than {better:.0f} % of them. <code>robotcell identify --propose N</code> "
                     f"proposes configurations that maximise O1.</p>"
                     f'<figure><img src="{_figure_observability(o1, rand)}" alt="observability"></figure>')
+    scene_html = "" if measurements is None else f"<h2>3D view of the measurements</h2>{SCENE_SLOT}"
     name = html.escape(result.nominal.name)
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell identification: {name}</title>
@@ -175,7 +186,7 @@ def write_identification_report(
 <h2>Position error before and after identification</h2>{errors}
 <p>Condition number {result.condition:.1f}, redundancy {result.dof}, variance factor
 {result.variance_factor:.3f} (1 when the stated accuracy is right).</p>
-<figure><img src="{fig_fit}" alt="errors before and after"></figure>{extra}
+<figure><img src="{fig_fit}" alt="errors before and after"></figure>{extra}{scene_html}
 <h2>Cross-validation</h2>{cv_html}
 <h2>Parameters held at their nominal value, and why</h2>{fixed}
 <h2>Parameters (mm, deg) with 1-sigma</h2>{params}
@@ -184,5 +195,11 @@ def write_identification_report(
 <h2>Errors per row (mm)</h2>{per_row}
 </body></html>
 """
+    if measurements is not None:
+        scenes = [identification_scene(result, measurements.q, measurements.points, arrows=a)
+                  for a in (True, False)]
+        figure = scene_figure(scenes, MAX_PAGE_BYTES - len(page.encode()),
+                              "the measured targets and the identified arm")
+        page = page.replace(SCENE_SLOT, figure, 1)
     atomic_write(out, page)
     return out

@@ -133,7 +133,7 @@ def _config(text: str, lines: Lines, lineno: int) -> Config:
             or letters[2] not in "TB" or len(turns) != 3:
         raise lines.error(lineno, f"CONFIG '{text}' is not 'F|N U|D T|B, t1, t4, t6'")
     try:
-        t = tuple(int(x) for x in turns)
+        t = tuple(lines.integer(x, lineno) for x in turns)
     except ValueError:
         raise lines.error(lineno, f"CONFIG '{text}': the turn numbers must be integers") from None
     return Config("fanuc", (int(letters[0] == "F"), int(letters[1] == "D"),

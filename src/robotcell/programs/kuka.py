@@ -31,6 +31,7 @@ from robotcell.errors import InputError
 from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.export.kuka import MACHINE_INDEX
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.programs.config import config_text
 from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
 from robotcell.programs.text import Lines, fmt_num, strip_comment
@@ -175,10 +176,13 @@ def _int_value(text: str, lines: Lines, lineno: int) -> int:
     t = text.strip().strip("'")
     try:
         if t[:1] in "Bb" and len(t) > 1:
-            return int(t[1:], 2)
+            return lines.integer(t[1:], lineno, 2)
         if t[:1] in "Hh" and len(t) > 1:
-            return int(t[1:], 16)
-        return int(float(t))
+            return lines.integer(t[1:], lineno, 16)
+        v = float(t)
+        if not abs(v) <= MAX_ABS_VALUE:  # NaN, infinite, 1e300
+            raise ValueError(t)
+        return int(v)
     except ValueError:
         raise lines.error(lineno, f"{text.strip()!r} is not a status or turn value") from None
 

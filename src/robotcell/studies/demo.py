@@ -16,8 +16,9 @@ from its layout position, a workpiece clamped off its nominal place. The demo
 4. writes an HTML report per calibration and the controller exports (KUKA, ABB, FANUC,
    YASKAWA);
 5. writes a KUKA program of a seam on the workpiece through the calibrated cell, the track
-   following the seam, as ``robotcell program write`` does;
-6. writes the interactive 3D view of the calibrated cell (``cell.html``).
+   following the seam, as ``robotcell program write`` does (``program/seam.src``);
+6. writes the interactive 3D views of the calibrated cell (``cell.html``) and of the program,
+   the arm at each of its points (``program.html``, as ``robotcell view --program`` does).
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ from robotcell.studies.plan import pose_error
 from robotcell.studies.simulate import simulate
 from robotcell.view.cellscene import cell_figure
 from robotcell.view.plot import write_html
+from robotcell.view.program import write_program_view
 
 __all__ = ["DEMO_NOISE", "Comparison", "demo_cells", "run_demo", "seam_rows"]
 
@@ -302,6 +304,10 @@ def _write_outputs(out: Path, cell: Cell, results: dict[str, dict[str, Any]],
     echo(f"  {', '.join(Path(f).relative_to(out).as_posix() for f in result.files)}: "
          f"{len(result.programs[0].points)} points, track from {result.track[0] * 1e3:.0f} to "
          f"{result.track[-1] * 1e3:.0f} mm")
+    echo("  $ robotcell view cell.yaml --program program/seam.src -o program.html")
+    made = write_program_view(cell, result.files[0], out / "program.html")
+    echo(f"  {made.path.name}: the 3D view of the program, the arm at each of its "
+         f"{len(made.report.points)} points (open it in a browser)")
 
 
 #: Table angle of the demo's 3D view (rad).

@@ -3,9 +3,14 @@
 - :mod:`robotcell.view.scene`: what a view shows (items in SI units), independent of the
   plotting library; :mod:`robotcell.view.shapes` and :mod:`robotcell.view.arm` build items
   (touches, residual vectors, fitted circles and lines, plates; a DH chain's links and axes).
-- :mod:`robotcell.view.plot`: a scene as a plotly figure (mm), and as one self-contained page.
+- :mod:`robotcell.view.plot`: a scene as a plotly figure (mm), as one self-contained page, and
+  as a fragment of a report's page.
+- :mod:`robotcell.view.calibration`: the scene of a calibration result (its touches, the fitted
+  geometry, the residuals magnified); :mod:`robotcell.view.identification`: the scene of a
+  kinematic identification (the measured targets, the identified arm beside the nominal one).
 - :mod:`robotcell.view.cellscene`: the view of a cell (:func:`cell_figure`);
   :mod:`robotcell.view.path`: a path with the arm at each point, on a slider;
+  :mod:`robotcell.view.program`: a robot program in it, its bad points marked;
   :mod:`robotcell.view.reach`: a reachability map in the cell.
 
 The names below are imported on first use (PEP 562): the scene and plotting modules sit below
@@ -20,24 +25,31 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from robotcell.view.calibration import calibration_scene
     from robotcell.view.cellscene import cell_figure, cell_scene
+    from robotcell.view.identification import identification_scene
     from robotcell.view.path import path_scene
     from robotcell.view.plot import page, scene_figure, write_html
+    from robotcell.view.program import program_scene, write_program_view
     from robotcell.view.reach import read_reach
     from robotcell.view.scene import Arrows, Lines, Mesh, Points, Scene, Step, Triads
 
 #: public name -> module that defines it
 _LAZY = {
+    "calibration_scene": "robotcell.view.calibration",
     **dict.fromkeys(["cell_figure", "cell_scene"], "robotcell.view.cellscene"),
+    "identification_scene": "robotcell.view.identification",
     "path_scene": "robotcell.view.path",
     **dict.fromkeys(["page", "scene_figure", "write_html"], "robotcell.view.plot"),
+    **dict.fromkeys(["program_scene", "write_program_view"], "robotcell.view.program"),
     "read_reach": "robotcell.view.reach",
     **dict.fromkeys(["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads"],
                     "robotcell.view.scene"),
 }
 
-__all__ = ["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads", "cell_figure",
-           "cell_scene", "page", "path_scene", "read_reach", "scene_figure", "write_html"]
+__all__ = ["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads", "calibration_scene",
+           "cell_figure", "cell_scene", "identification_scene", "page", "path_scene",
+           "program_scene", "read_reach", "scene_figure", "write_html", "write_program_view"]
 
 
 def __getattr__(name: str) -> Any:

@@ -97,7 +97,8 @@ def joint_values(robot: Robot, joints: ArrayLike | None) -> NDArray[np.float64]:
 
 
 def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLike,
-               size: float, detail: bool = True, with_tools: bool = True) -> list[Item]:
+               size: float, detail: bool = True, with_tools: bool = True,
+               triads: bool = True) -> list[Item]:
     """The moving parts of a cell at one configuration: robot, tools, positioner, frames.
 
     Parameters
@@ -116,6 +117,10 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
         (:func:`robotcell.view.arm.chain_items`).
     with_tools : bool
         Draw the cell's tools (and the robot model's own tool, when it has one).
+    triads : bool
+        Draw the robot base R, the flange F, the table's root and its plate P as triads
+        (False: the moving parts of a path, drawn at each of its points, are the links, the
+        plate and the frames).
 
     Returns
     -------
@@ -125,10 +130,10 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
     """
     T_world_R = robot_pose(cell, track)
     items: list[Item] = [Triads("robot R", T_world_R, ["robot R"], length=size,
-                                hover=[_hover("robot base R", T_world_R)])]
+                                hover=[_hover("robot base R", T_world_R)])] if triads else []
     arm = chain_items(cell.robot, q, T_world_R, name=f"robot {cell.robot.name}",
                       axis_length=0.6 * size, frame_length=0.5 * size, detail=detail)
-    items += arm
+    items += arm if triads else arm[:-1]
     T_world_F = arm[-1].poses[0]
     tools = {name: tool.T_F_TCP for name, tool in cell.tools.items()} if with_tools else {}
     if with_tools and not np.array_equal(cell.robot.tool, np.eye(4)):
@@ -148,13 +153,14 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
         T_world_parent = np.eye(4) if pos.parent == "world" else T_world_R
         T_world_root = T_world_parent @ pos.T_parent_root
         label = "turntable B" if kind == "turntable" else "positioner root"
-        items.append(Triads(label, T_world_root, [label], length=size,
-                            hover=[_hover(f"{kind} {pos.name} root", T_world_root,
-                                          f"in its parent ({pos.parent})", pos.T_parent_root)]))
+        if triads:
+            items.append(Triads(label, T_world_root, [label], length=size,
+                                hover=[_hover(f"{kind} {pos.name} root", T_world_root,
+                                              f"in its parent ({pos.parent})", pos.T_parent_root)]))
         chain = chain_items(pos.chain, v, T_world_parent, name=f"{kind} {pos.name}",
                             color="slategray", axis_length=0.6 * size, frame_length=0.5 * size,
                             flange_label="plate P", detail=detail)
-        items += chain
+        items += chain if triads else chain[:-1]
         T_world_P = chain[-1].poses[0]
         carried = [f.pose[:2, 3] for f in cell.frames.values() if f.parent == "turntable"]
         radius = max([size, *(float(np.linalg.norm(p)) + PLATE_MARGIN for p in carried)])

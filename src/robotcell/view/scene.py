@@ -76,6 +76,14 @@ class Lines:
         Hover text per vertex (None: no hover).
     visible : bool
         False: listed in the legend, drawn when clicked there.
+    colors : tuple of str or None
+        A CSS colour per vertex, instead of ``color`` (a segment between two colours is drawn
+        as a gradient; a row of NaN between them keeps each piece in its own colour).
+    hover_xyz : bool
+        Append each vertex's position (mm, as the browser formats it) to its hover text.
+    parts : tuple of (str, int, int)
+        Pieces drawn as one line (the moving parts of a cell at a point of a path): name, first
+        vertex and one past the last, so that a reader can tell them apart.
     """
 
     name: str
@@ -85,10 +93,19 @@ class Lines:
     dash: str = "solid"
     hover: tuple[str, ...] | None = None
     visible: bool = True
+    colors: tuple[str, ...] | None = None
+    hover_xyz: bool = False
+    parts: tuple[tuple[str, int, int], ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "points", _points(self.points, self.name, nan_ok=True))
-        object.__setattr__(self, "hover", _texts(self.hover, len(self.points), self.name))
+        pts = _points(self.points, self.name, nan_ok=True)
+        object.__setattr__(self, "points", pts)
+        object.__setattr__(self, "hover", _texts(self.hover, len(pts), self.name))
+        object.__setattr__(self, "colors", _texts(self.colors, len(pts), self.name))
+        parts = tuple((str(n), int(a), int(b)) for n, a, b in self.parts)
+        if any(not 0 <= a <= b <= len(pts) for _, a, b in parts):
+            raise InputError(f"{self.name}: a part refers to vertices that do not exist")
+        object.__setattr__(self, "parts", parts)
 
 
 @dataclass(frozen=True)
@@ -118,6 +135,8 @@ class Points:
     hover : tuple of str or None
         Hover text per point.
     visible : bool
+    hover_xyz : bool
+        Append each point's position (mm, as the browser formats it) to its hover text.
     """
 
     name: str
@@ -132,6 +151,7 @@ class Points:
     labels: tuple[str, ...] | None = None
     hover: tuple[str, ...] | None = None
     visible: bool = True
+    hover_xyz: bool = False
 
     def __post_init__(self) -> None:
         pts = _points(self.points, self.name)
@@ -301,6 +321,10 @@ class Scene:
         Optional: the points of a path, shown one at a time on a slider (the first one first).
     frame : str
         Name of the frame the items are in, for the axis titles.
+    decimals : int
+        Decimals of the millimetre coordinates a figure holds: 6 (1e-6 mm) reads a cell back
+        to its kinematics; fewer keep a page with much data small (a path of hundreds of
+        points: 2, i.e. 0.01 mm; touches: 3).
     """
 
     title: str
@@ -308,8 +332,11 @@ class Scene:
     notes: list[str] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     frame: str = "world"
+    decimals: int = 6
 
     def __post_init__(self) -> None:
+        if not 0 <= self.decimals <= 9:
+            raise InputError(f"decimals must be within 0..9, got {self.decimals}")
         kinds = [tuple(type(i) for i in s.items) for s in self.steps]
         if any(k != kinds[0] for k in kinds):
             raise InputError("every step of a scene must hold the same kinds of item in the "

@@ -99,7 +99,9 @@ def disk(name: str, T: ArrayLike, radius: float, color: str = "lightgray", opaci
     ----------
     name : str
     T : array_like, shape (4, 4)
-        Centre and normal (Z) of the disk (m).
+        Centre and normal (Z) of the disk (m); its X and Y do not matter: a disk turned about
+        its normal is the same disk, with the same vertices (a path's view draws a turning
+        plate once).
     radius : float
         (m).
     color : str
@@ -111,13 +113,21 @@ def disk(name: str, T: ArrayLike, radius: float, color: str = "lightgray", opaci
     Returns
     -------
     Mesh
-        ``n + 1`` vertices: the centre, then ``n`` on the rim.
+        ``n + 1`` vertices: the centre, then ``n`` on the rim, the first in the direction of
+        the plane closest to the X axis of the scene (its Y axis when the normal is along X).
     """
-    rim = circle_points(T, radius, n)[:-1]
-    centre = _pose(T, "disk pose")[:3, 3]
+    P = _pose(T, "disk pose")
+    z = P[:3, 2]
+    ref = np.eye(3)[0] if abs(z[0]) < 0.9 else np.eye(3)[1]
+    x = ref - (ref @ z) * z
+    x /= np.linalg.norm(x)
+    plane = np.eye(4)
+    plane[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+    plane[:3, 3] = P[:3, 3]
+    rim = circle_points(plane, radius, n)[:-1]
     k = np.arange(n)
     faces = np.column_stack([np.zeros(n, dtype=int), 1 + k, 1 + (k + 1) % n])
-    return Mesh(name, np.vstack([centre, rim]), faces, color=color, opacity=opacity, hover=hover)
+    return Mesh(name, np.vstack([P[:3, 3], rim]), faces, color=color, opacity=opacity, hover=hover)
 
 
 def line_through(name: str, point: ArrayLike, direction: ArrayLike, points: ArrayLike,
@@ -157,7 +167,9 @@ def line_through(name: str, point: ArrayLike, direction: ArrayLike, points: Arra
 
 
 def touches(points: ArrayLike, labels: Sequence[str] | None = None,
-            outliers: ArrayLike | None = None, name: str = "touches") -> list[Points]:
+            outliers: ArrayLike | None = None, name: str = "touches",
+            show_labels: bool = True, residuals: ArrayLike | None = None,
+            hover_xyz: bool = True, color_by_residual: bool = False) -> list[Points]:
     """Touched points, the outliers apart in a colour and symbol of their own.
 
     Parameters
@@ -170,12 +182,22 @@ def touches(points: ArrayLike, labels: Sequence[str] | None = None,
         Touches flagged as outliers by the calibration.
     name : str
         Legend entry; the outliers get ``name + " (outliers)"``.
+    show_labels : bool
+        Draw each label beside its touch (else in its hover text only: many touches, or touches
+        on one spot).
+    residuals : array_like, shape (N, 3), optional
+        Residual of each touch (m): its length (mm) joins the hover text.
+    hover_xyz : bool
+        The position (mm) in the hover text (False: ``points`` are not where the touches were).
+    color_by_residual : bool
+        Colour the touches that are not outliers by the length of their residual (mm, Viridis
+        from 0 to the longest), instead of residual vectors.
 
     Returns
     -------
     list of Points
         The touches that are not outliers, then the outliers (when there are any), each with
-        its position in mm in the hover text.
+        its name, residual and position in the hover text.
     """
     p = as_points(points, "touches").reshape(-1, 3)
     labs = [str(i + 1) for i in range(len(p))] if labels is None else [str(s) for s in labels]
@@ -184,16 +206,28 @@ def touches(points: ArrayLike, labels: Sequence[str] | None = None,
     bad = np.zeros(len(p), bool) if outliers is None else np.asarray(outliers, dtype=bool)
     if bad.shape != (len(p),):
         raise InputError(f"touches: outliers must be {len(p)} booleans, got shape {bad.shape}")
-    hover = [f"touch {lab}<br>x {x:.3f} y {y:.3f} z {z:.3f} mm" for lab, (x, y, z)
-             in zip(labs, p * 1e3)]
+    hover = [f"touch {lab}" for lab in labs]
+    norms = None
+    if residuals is not None:
+        r = as_points(residuals, "residuals").reshape(-1, 3)
+        if r.shape != p.shape:
+            raise InputError(f"touches: {len(r)} residuals for {len(p)} points")
+        norms = np.linalg.norm(r, axis=1) * 1e3
+        hover = [f"{h}: residual {n:.3f} mm" for h, n in zip(hover, norms)]
+    if color_by_residual and norms is None:
+        raise InputError("touches: color_by_residual needs the residuals")
     out = []
     for mask, suffix, color, symbol, size in ((~bad, "", "black", "circle", 4.0),
                                               (bad, " (outliers)", OUTLIER_COLOR, "x", 7.0)):
         if np.any(mask) or not suffix:
             idx = np.flatnonzero(mask)
+            by = {} if norms is None or not color_by_residual or suffix else {
+                "values": norms[idx], "value_range": (0.0, max(float(norms.max()), 1e-9)),
+                "value_title": "residual (mm)"}
             out.append(Points(name + suffix, p[idx], color=color, symbol=symbol, size=size,
-                              labels=[labs[i] for i in idx],
-                              hover=[hover[i] + ("<br>outlier" if suffix else "") for i in idx]))
+                              labels=[labs[i] for i in idx] if show_labels else None,
+                              hover=[hover[i] + (", an outlier" if suffix else "") for i in idx],
+                              hover_xyz=hover_xyz, **by))
     return out
 
 
@@ -228,7 +262,8 @@ def magnification(residuals: ArrayLike, size: float, share: float = 0.1) -> floa
 
 
 def residual_arrows(points: ArrayLike, residuals: ArrayLike, factor: float,
-                    labels: Sequence[str] | None = None, name: str = "residuals") -> Arrows:
+                    labels: Sequence[str] | None = None, name: str = "residuals",
+                    hover: bool = True) -> Arrows:
     """Residual vectors magnified by ``factor``, from the point the fit predicts.
 
     Parameters
@@ -244,6 +279,8 @@ def residual_arrows(points: ArrayLike, residuals: ArrayLike, factor: float,
         Name of each touch, for the hover texts.
     name : str
         Legend entry; the factor is appended, e.g. ``"residuals x 200"``.
+    hover : bool
+        Hover texts on the arrows (False: the touches carry their residuals, :func:`touches`).
 
     Returns
     -------
@@ -256,6 +293,7 @@ def residual_arrows(points: ArrayLike, residuals: ArrayLike, factor: float,
         raise InputError(f"residuals: {len(r)} vectors for {len(p)} touches")
     f = _length(factor, "factor")
     labs = [str(i + 1) for i in range(len(p))] if labels is None else [str(s) for s in labels]
-    hover = [f"touch {lab}: residual {n:.3f} mm (drawn x {f:g})"
-             for lab, n in zip(labs, np.linalg.norm(r, axis=1) * 1e3)]
-    return Arrows(f"{name} x {f:g}", p - r, f * r, color=RESIDUAL_COLOR, width=4.0, hover=hover)
+    text = [f"touch {lab}: residual {n:.3f} mm (drawn x {f:g})"
+            for lab, n in zip(labs, np.linalg.norm(r, axis=1) * 1e3)]
+    return Arrows(f"{name} x {f:g}", p - r, f * r, color=RESIDUAL_COLOR, width=4.0,
+                  hover=text if hover else None)
