@@ -33,15 +33,17 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.cell import Cell
 from robotcell.cell.ik import CellIKSolutions
-from robotcell.cell.kinematics import tool_pose
+from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.errors import InputError, RobotcellError
 from robotcell.identification.uncertainty import position_sigma
 from robotcell.ik.select import nearest
-from robotcell.kinematics.transforms import validate_pose
+from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.transforms import invert, validate_pose
 from robotcell.programs.config import config_text, select
 from robotcell.programs.model import Config
 
-__all__ = ["MAX_CORRECTION", "FilterRefused", "FilteredPoses", "filter_poses"]
+__all__ = ["MAX_CORRECTION", "MAX_ROTATION", "FilterRefused", "FilteredPoses", "filter_poses",
+           "identified_joints", "refuse", "too_large"]
 
 #: Largest position correction taken (m): beyond it the identified model is wrong.
 MAX_CORRECTION = 5e-3
@@ -106,6 +108,27 @@ def _angles(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float6
     return Rotation.from_matrix(np.swapaxes(A[:, :3, :3], -1, -2) @ B[:, :3, :3]).magnitude()
 
 
+def too_large(dpos: NDArray[np.float64], drot: NDArray[np.float64], done: NDArray[np.bool_],
+              max_correction: float, max_rotation: float) -> list[tuple[int, str]]:
+    """``(index, why)`` of the corrections above the limits (m, rad) among ``done``."""
+    return [(int(i), (f"the correction is {dpos[i] * 1e3:.3f} mm, {math.degrees(drot[i]):.4f} "
+                      f"deg, above the {max_correction * 1e3:g} mm, "
+                      f"{math.degrees(max_rotation):g} deg a real arm can be off its nominal model: "
+                      "the identified model is wrong (another robot, another unit?)"))
+            for i in np.flatnonzero(done & ((dpos > max_correction) | (drot > max_rotation)))]
+
+
+def refuse(refused: list[tuple[int, str]], what: str, names: list[str] | None = None) -> None:
+    """Raise :class:`FilterRefused` naming each refused item (``what`` 1-based, or by ``names``)."""
+    if not refused:
+        return
+    refused = sorted(refused)
+    label = (lambda i: names[i]) if names is not None else (lambda i: f"{what} {i + 1}")
+    text = "; ".join(f"{label(i)}: {why}" for i, why in refused[:10])
+    more = f" (and {len(refused) - 10} more)" if len(refused) > 10 else ""
+    raise FilterRefused(f"{len(refused)} {what}(s) cannot be filtered: {text}{more}", refused)
+
+
 def _nominal_branch(ctrl: Cell, sol: CellIKSolutions, config: list[Config] | None
                     ) -> tuple[NDArray[np.float64], NDArray[np.int_]]:
     """The nominal arm's solution per pose and its branch: the given flags, else nearest home."""
@@ -124,24 +147,54 @@ def _nominal_branch(ctrl: Cell, sol: CellIKSolutions, config: list[Config] | Non
     return q, np.where(found, branch, -1)
 
 
-def _polish(cell: Cell, q: NDArray[np.float64], track: NDArray[np.float64],
-            table: NDArray[np.float64], tool: NDArray[np.float64] | None, frame: str,
-            T: NDArray[np.float64], steps: int = 2) -> NDArray[np.float64]:
-    """Newton steps of the identified arm from ``q`` onto the poses ``T`` (frame ``frame``).
+def _polish(robot: Robot, q: NDArray[np.float64], T: NDArray[np.float64], steps: int = 2
+            ) -> NDArray[np.float64]:
+    """Newton steps of ``robot`` from ``q`` onto the flange poses ``T`` (robot base frame).
 
     The seeded IK stops within 1e-9 m and rad; two steps bring that to rounding, so that the
     commanded poses take the real arm onto the desired ones to 1e-12 m.
     """
-    robot = cell.robot
+    eye = np.eye(4)
     for _ in range(steps):
-        T_cur = cell.fk(q, track, table, tool=tool, frame=frame)
-        T_R = robot.fk(q, tool=tool)
-        T_R_des = T_R @ np.linalg.inv(T_cur) @ T
-        dp = T_R_des[:, :3, 3] - T_R[:, :3, 3]
-        dw = Rotation.from_matrix(T_R_des[:, :3, :3] @ np.swapaxes(T_R[:, :3, :3], -1, -2)).as_rotvec()
-        J = robot.jacobian(q, tool=tool)
+        T_cur = robot.fk(q, tool=eye)
+        dp = T[:, :3, 3] - T_cur[:, :3, 3]
+        dw = Rotation.from_matrix(T[:, :3, :3] @ np.swapaxes(T_cur[:, :3, :3], -1, -2)).as_rotvec()
+        J = robot.jacobian(q, tool=eye)
         q = q + np.einsum("nij,nj->ni", np.linalg.pinv(J), np.concatenate([dp, dw], axis=-1))
     return q
+
+
+def identified_joints(cell: Cell, T_R_F: ArrayLike, q_nominal: ArrayLike
+                      ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """The identified arm's joints for flange poses, in the nominal joints' configuration.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell with an identified arm.
+    T_R_F : array_like, shape (N, 4, 4)
+        Desired flange poses in the robot base frame (m).
+    q_nominal : array_like, shape (N, n)
+        The nominal arm's joints for them (rad, m): their IK branch is the configuration kept.
+
+    Returns
+    -------
+    q : ndarray, shape (N, n)
+        The identified arm's solution on the same branch nearest to ``q_nominal``, refined to
+        rounding (rad, m; 0 where none).
+    found : ndarray of bool, shape (N,)
+        The identified arm reaches the pose on that branch within the limits.
+    """
+    T = np.asarray(T_R_F, dtype=float)
+    q_nom = np.nan_to_num(np.asarray(q_nominal, dtype=float))
+    eye = np.eye(4)
+    nominal = cell.nominal_robot
+    _, known, branch = nearest(nominal, nominal.ik(T, tool=eye), q_nom)
+    ident = cell.robot.ik(T, tool=eye)
+    same = ident.valid & (np.arange(ident.valid.shape[-1]) == branch[:, None])
+    q, found, _ = nearest(cell.robot, replace(ident, valid=same), q_nom)
+    found &= known
+    return _polish(cell.robot, np.where(found[:, None], q, 0.0), T), found
 
 
 def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayLike | None = None,
@@ -194,41 +247,30 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
         raise InputError(f"config must give one Config per pose ({n}), got {len(config)}")
     ctrl = cell.controller()
     T_tool = tool_pose(cell, tool)
+    T_F_TCP = cell.robot.tool if T_tool is None else T_tool
     nom = ctrl.ik(Tq, frame, track, table, T_tool)
     q_nom, branch = _nominal_branch(ctrl, nom, config)
-    ident = cell.ik(Tq, frame, nom.track, nom.table, T_tool)
-    same = ident.valid & (np.arange(ident.valid.shape[-1]) == branch[:, None])
-    q, found, _ = nearest(cell.robot, replace(ident, valid=same), np.nan_to_num(q_nom))
+    track_, table_ = nom.track, nom.table
+    T_R_F = (invert(robot_pose(cell, track_)) @ cell.frame_pose(frame, track_, table_) @ Tq
+             @ invert(T_F_TCP))
+    q, found = identified_joints(cell, T_R_F, q_nom)
     refused: list[tuple[int, str]] = []
     for i in np.flatnonzero(branch < 0):
         what = "with the flags given" if config is not None else "within the axis limits"
         extra = f" ({config_text(config[i])})" if config is not None else ""
         refused.append((int(i), f"the nominal arm does not reach it {what}{extra}"))
     for i in np.flatnonzero((branch >= 0) & ~found):
-        refused.append((int(i), "the identified arm cannot reach it in the configuration the "
-                                "nominal arm uses (within the axis limits)"))
-    ok = found & (branch >= 0)
-    track_, table_ = nom.track, nom.table
-    qq = _polish(cell, np.where(ok[:, None], q, 0.0), track_, table_, T_tool, frame, Tq)
-    T_cmd = ctrl.fk(qq, track_, table_, tool=T_tool, frame=frame)
+        refused.append((int(i), ("the identified arm cannot reach it in the configuration the "
+                                 "nominal arm uses (within the axis limits)")))
+    T_cmd = ctrl.fk(q, track_, table_, tool=T_tool, frame=frame)
     dpos = np.linalg.norm(T_cmd[:, :3, 3] - Tq[:, :3, 3], axis=-1)
     drot = _angles(Tq, T_cmd)
-    for i in np.flatnonzero(ok & ((dpos > max_correction) | (drot > max_rotation))):
-        refused.append((int(i), f"the correction is {dpos[i] * 1e3:.3f} mm, "
-                                f"{math.degrees(drot[i]):.4f} deg, above the "
-                                f"{max_correction * 1e3:g} mm, {math.degrees(max_rotation):g} deg "
-                                "a real arm can be off its nominal model: the identified model "
-                                "is wrong (another robot, another unit?)"))
-    if refused:
-        refused.sort()
-        text = "; ".join(f"pose {i + 1}: {why}" for i, why in refused[:10])
-        more = f" (and {len(refused) - 10} more)" if len(refused) > 10 else ""
-        raise FilterRefused(f"{len(refused)} pose(s) cannot be filtered: {text}{more}", refused)
+    refused += too_large(dpos, drot, found, max_correction, max_rotation)
+    refuse(refused, "pose")
     T_real = cell.fk(np.nan_to_num(q_nom), track_, table_, tool=T_tool, frame=frame)
     error = np.linalg.norm(T_real[:, :3, 3] - Tq[:, :3, 3], axis=-1)
     error_rot = _angles(Tq, T_real)
-    robot = cell.robot
-    sigma = (np.full(n, np.nan) if robot.covariance is None
-             else position_sigma(robot, qq, robot.tool if T_tool is None else T_tool))
-    return FilteredPoses(T_cmd, qq, np.asarray(track_, dtype=float), np.asarray(table_, dtype=float),
+    sigma = (np.full(n, np.nan) if cell.robot.covariance is None
+             else position_sigma(cell.robot, q, T_F_TCP))
+    return FilteredPoses(T_cmd, q, np.asarray(track_, dtype=float), np.asarray(table_, dtype=float),
                          dpos, drot, error, error_rot, sigma, branch)
