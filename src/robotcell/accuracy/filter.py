@@ -52,14 +52,15 @@ MAX_ROTATION = math.radians(1.0)
 
 
 class FilterRefused(RobotcellError):
-    """Poses that cannot be filtered; ``points`` name each (0-based index and why).
+    """Poses or points that cannot be filtered; ``points`` name each and say why.
 
     Attributes
     ----------
-    points : list of (int, str)
+    points : list of (str, str)
+        ``("pose 3", why)``, or the point's name in a program (``"XP7 (line 12)"``).
     """
 
-    def __init__(self, message: str, points: list[tuple[int, str]]) -> None:
+    def __init__(self, message: str, points: list[tuple[str, str]]) -> None:
         super().__init__(message)
         self.points = points
 
@@ -122,11 +123,11 @@ def refuse(refused: list[tuple[int, str]], what: str, names: list[str] | None = 
     """Raise :class:`FilterRefused` naming each refused item (``what`` 1-based, or by ``names``)."""
     if not refused:
         return
-    refused = sorted(refused)
-    label = (lambda i: names[i]) if names is not None else (lambda i: f"{what} {i + 1}")
-    text = "; ".join(f"{label(i)}: {why}" for i, why in refused[:10])
-    more = f" (and {len(refused) - 10} more)" if len(refused) > 10 else ""
-    raise FilterRefused(f"{len(refused)} {what}(s) cannot be filtered: {text}{more}", refused)
+    labelled = [(names[i] if names is not None else f"{what} {i + 1}", why)
+                for i, why in sorted(refused)]
+    text = "; ".join(f"{label}: {why}" for label, why in labelled[:10])
+    more = f" (and {len(labelled) - 10} more)" if len(labelled) > 10 else ""
+    raise FilterRefused(f"{len(labelled)} {what}(s) cannot be filtered: {text}{more}", labelled)
 
 
 def _nominal_branch(ctrl: Cell, sol: CellIKSolutions, config: list[Config] | None

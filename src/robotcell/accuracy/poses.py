@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_poses
+from robotcell.accuracy.report import write_accuracy_report
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
@@ -110,8 +111,8 @@ def _configs(path: str, cols: dict) -> list[Config] | None:
 
 
 def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "world",
-                     output: str | Path | None = None, max_correction: float = MAX_CORRECTION
-                     ) -> CompensatedPoses:
+                     output: str | Path | None = None, max_correction: float = MAX_CORRECTION,
+                     report: str | Path | None = None) -> CompensatedPoses:
     """Filter the poses of a file and write the poses to command (all or nothing).
 
     Parameters
@@ -128,6 +129,9 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
         The CSV to write (atomically; not written when a pose is refused).
     max_correction : float
         Largest correction taken (m).
+    report : str or Path, optional
+        Also write the HTML page of the predicted errors and 1-sigma per pose
+        (:func:`robotcell.accuracy.report.write_accuracy_report`).
 
     Returns
     -------
@@ -166,4 +170,7 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
     rows = np.hstack(parts)
     if output is not None:
         write_csv(output, header, rows, DECIMALS)
+    if report is not None:
+        write_accuracy_report(report, Path(path).name, [f"pose {i + 1}" for i in range(len(rows))],
+                              r.error, r.dpos, r.sigma)
     return CompensatedPoses(r, header, rows, list(targets.warnings))

@@ -33,6 +33,7 @@ from robotcell.accuracy.filter import (
     refuse,
     too_large,
 )
+from robotcell.accuracy.report import write_accuracy_report
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose
 from robotcell.errors import InputError
@@ -143,7 +144,8 @@ def _angle(A: NDArray[np.float64], B: NDArray[np.float64]) -> float:
 def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints: str = "taught",
                        pulses_per_degree: ArrayLike | None = None,
                        max_correction: float = MAX_CORRECTION, max_rotation: float = MAX_ROTATION,
-                       inputs: tuple[str | Path, ...] = ()) -> CompensatedProgram:
+                       inputs: tuple[str | Path, ...] = (), report: str | Path | None = None
+                       ) -> CompensatedProgram:
     """Filter every Cartesian point of a program and write it to a folder, all files or none.
 
     Parameters
@@ -163,6 +165,9 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
         Largest correction taken (m, rad).
     inputs : tuple of str or Path
         Further files the run read (the cell file), which no output may replace.
+    report : str or Path, optional
+        Also write the HTML page of the predicted errors and 1-sigma per point
+        (:func:`robotcell.accuracy.report.write_accuracy_report`).
 
     Returns
     -------
@@ -259,4 +264,8 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     refuse(refused, "point", names)
     out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}
     result.files = write_all(folder, out, (*program.files, *inputs))
+    if report is not None:
+        pp = result.points
+        write_accuracy_report(report, Path(path).name, [p.name for p in pp],
+                              [p.error for p in pp], [p.dpos for p in pp], [p.sigma for p in pp])
     return result
