@@ -192,7 +192,7 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     program, skipped = read_program(path)
     vendor = program.vendor
     ctrl = cell.controller()
-    report = check_program(program, ctrl, pulses_per_degree)
+    checked = check_program(program, ctrl, pulses_per_degree)
     pts = program.points
     todo = [i for i, p in enumerate(pts)
             if p.pose is not None or (joints == "offline" and p.joints is not None)]
@@ -201,7 +201,7 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     refused: list[tuple[int, str]] = []
     tools: dict[int, NDArray[np.float64]] = {}
     for i in todo:
-        cp = report.points[i]
+        cp = checked.points[i]
         if not (np.isfinite(cp.q).all() and np.isfinite(cp.T_world_TCP).all()):
             refused.append((i, "the controller cannot place it: " + "; ".join(cp.problems)))
             continue
@@ -210,10 +210,10 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     if not todo:
         raise InputError(f"{path}: no Cartesian point to filter (joint points taught on the arm "
                          "stay; joints='offline' filters them)")
-    T_world = np.stack([report.points[i].T_world_TCP for i in todo])
-    track = np.array([report.points[i].track for i in todo])
-    table = np.stack([np.asarray(report.points[i].table, dtype=float) for i in todo])
-    q_nom = np.stack([report.points[i].q for i in todo])
+    T_world = np.stack([checked.points[i].T_world_TCP for i in todo])
+    track = np.array([checked.points[i].track for i in todo])
+    table = np.stack([np.asarray(checked.points[i].table, dtype=float) for i in todo])
+    q_nom = np.stack([checked.points[i].q for i in todo])
     T_tool = np.stack([tools[i] for i in todo])
     T_R_F = invert(robot_pose(cell, track)) @ T_world @ invert(T_tool)
     q, found = identified_joints(cell, T_R_F, q_nom)

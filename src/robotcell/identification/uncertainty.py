@@ -21,7 +21,7 @@ from robotcell.identification.chain import Chain
 from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import validate_pose
 
-__all__ = ["position_covariance", "position_sigma"]
+__all__ = ["position_covariance", "position_jacobian", "position_sigma"]
 
 
 def _chain_values(robot: Robot, chain: Chain) -> NDArray[np.float64]:
@@ -43,9 +43,9 @@ def _chain_values(robot: Robot, chain: Chain) -> NDArray[np.float64]:
     return x
 
 
-def position_covariance(robot: Robot, q: ArrayLike, tool: ArrayLike | None = None
-                        ) -> NDArray[np.float64]:
-    """Covariance of the TCP position from the identified constants' covariance.
+def position_jacobian(robot: Robot, q: ArrayLike, tool: ArrayLike | None = None
+                      ) -> NDArray[np.float64]:
+    """Derivative of the TCP position with respect to the covariance's parameters.
 
     Parameters
     ----------
@@ -58,8 +58,8 @@ def position_covariance(robot: Robot, q: ArrayLike, tool: ArrayLike | None = Non
 
     Returns
     -------
-    ndarray, shape (..., 3, 3)
-        In the robot base frame R (m^2).
+    ndarray, shape (..., 3, p)
+        In the robot base frame R, one column per name of ``robot.covariance`` (m per m or rad).
 
     Raises
     ------
@@ -83,8 +83,25 @@ def position_covariance(robot: Robot, q: ArrayLike, tool: ArrayLike | None = Non
     pts, _ = chain.predict(x, flat)
     cols = [chain.index(n) for n in cov.names]
     J = chain.point_jacobian(x, flat, ev, pts)[:, 0][..., cols]  # (N, 3, p)
-    out = J @ cov.matrix @ np.swapaxes(J, -1, -2)
-    return out.reshape(arr.shape[:-1] + (3, 3))
+    return J.reshape(arr.shape[:-1] + (3, len(cols)))
+
+
+def position_covariance(robot: Robot, q: ArrayLike, tool: ArrayLike | None = None
+                        ) -> NDArray[np.float64]:
+    """Covariance of the TCP position from the identified constants' covariance.
+
+    Parameters
+    ----------
+    robot, q, tool
+        As for :func:`position_jacobian`.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        In the robot base frame R (m^2).
+    """
+    J = position_jacobian(robot, q, tool)
+    return J @ robot.covariance.matrix @ np.swapaxes(J, -1, -2)
 
 
 def position_sigma(robot: Robot, q: ArrayLike, tool: ArrayLike | None = None
