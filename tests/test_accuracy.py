@@ -528,3 +528,33 @@ def test_identify_into_a_cell_keeps_the_previous_file_and_states_the_provenance(
     assert cell.identified.model == str((tmp_path / "arm.yaml").resolve())
     assert cell.nominal_robot.name == "kuka_kr16" and cell.robot.name == "kuka_kr16_identified"
     assert cell.identified.provenance.rms_mm < 0.05
+
+
+def test_the_cell_file_names_the_identified_arm_relative_to_itself(kr16, tmp_path):
+    _, _, res = kr16
+    cell = Cell.load(_cell_with(tmp_path, res.robot))
+    assert cell.identified.provenance.source == "manual"  # none written: typed in
+    assert np.array_equal(cell.robot.tool, NOMINAL.tool) and cell.robot.name.endswith("identified")
+    (tmp_path / "sub").mkdir()
+    cell.save(tmp_path / "sub" / "cell.yaml")
+    text = (tmp_path / "sub" / "cell.yaml").read_text()
+    assert "identified: ../arm.yaml" in text and "provenance: {source: manual}" in text
+    back = Cell.load(tmp_path / "sub" / "cell.yaml")
+    q = np.radians([10, -80, 90, 20, 30, 40])
+    assert np.allclose(back.fk(q, tool="torch"), cell.fk(q, tool="torch"), atol=1e-15)
+    assert np.allclose(back.controller().fk(q, tool="torch"),
+                       Cell.load(tmp_path / "sub" / "cell.yaml").controller().fk(q, tool="torch"))
+    assert not np.allclose(back.fk(q, tool="torch"), back.controller().fk(q, tool="torch"),
+                           atol=1e-4)
+
+
+@pytest.mark.parametrize("edit,match", [
+    ("  identified: nowhere.yaml\n", "key 'robot.identified' names model file"),
+    ("  provenance: {source: identify}\n", ("key 'robot.provenance' is the provenance of an "
+                                           "identified arm")),
+])
+def test_bad_identified_keys_name_the_key(tmp_path, capsys, edit, match):
+    (tmp_path / "cell.yaml").write_text(CELL.replace("  model: kuka_kr16\n",
+                                                     "  model: kuka_kr16\n" + edit))
+    code, _out, err = run(capsys, "cell", "show", tmp_path / "cell.yaml")
+    assert code == 2 and match in err, err

@@ -140,3 +140,22 @@ def test_fuzz_mutated_paths_and_programs(tmp_path, capsys, programs):
                             f"{' '.join(map(str, args))}\n  {err.strip()[-300:]}")
     assert not failures, "\n".join(failures[:6])
     assert codes.get(0, 0) > 0 and codes.get(2, 0) > 0, codes
+
+
+@pytest.mark.parametrize("vendor,old,new,match", [
+    ("kuka", "Y 0.000000,Z", "Y 1e300,Z", "1e300 is beyond 1e+15 in size"),
+    ("kuka", "S 4,T", "S 1e300,T", "is not a status or turn value"),
+    ("abb", "[-2,-2,-1,3]", "[-2,-2,-1,1e300]", "1e300 is beyond 1e+15 in size"),
+    ("fanuc", "Y =", "Y = 1e300  mm, Q =", "1e300 is beyond 1e+15 in size"),
+    ("fanuc", "'N D T, 0,", "'N D T, 99999999999999999999,", "a turn number that large"),
+])
+def test_absurd_values_in_a_program_are_refused_naming_the_line(tmp_path, capsys, programs,
+                                                                vendor, old, new, match):
+    # values a controller cannot hold: refused where they are read, not an overflow later
+    src = programs[vendor]
+    for f in src.parent.iterdir():
+        text = f.read_text()
+        (tmp_path / f.name).write_text(text.replace(old, new, 1) if old in text else text)
+    code, out, err = run(capsys, "program", "check", tmp_path / src.name, "--cell", CELL)
+    _check(code, out, err, match)
+    assert "line" in err

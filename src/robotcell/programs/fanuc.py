@@ -31,7 +31,7 @@ from robotcell.errors import InputError
 from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.programs.config import config_text
-from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
 from robotcell.programs.text import Lines, fmt_num
 
 __all__ = ["parse_config", "read", "write"]
@@ -142,6 +142,8 @@ def parse_config(text: str) -> Config:
         t = tuple(int(x) for x in turns)
     except ValueError:
         raise InputError(f"CONFIG '{text}': the turn numbers must be integers") from None
+    if max(abs(x) for x in t) >= FLAG_LIMIT:
+        raise InputError(f"CONFIG '{text}': a turn number that large is a typing error")
     return Config("fanuc", (int(letters[0] == "F"), int(letters[1] == "D"),
                             int(letters[2] == "B"), *t))
 

@@ -32,7 +32,7 @@ from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.export.kuka import MACHINE_INDEX
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.programs.config import config_text
-from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
 from robotcell.programs.text import Lines, fmt_num, strip_comment
 
 __all__ = ["read", "write"]
@@ -175,12 +175,16 @@ def _int_value(text: str, lines: Lines, lineno: int) -> int:
     t = text.strip().strip("'")
     try:
         if t[:1] in "Bb" and len(t) > 1:
-            return int(t[1:], 2)
-        if t[:1] in "Hh" and len(t) > 1:
-            return int(t[1:], 16)
-        return int(float(t))
-    except ValueError:
-        raise lines.error(lineno, f"{text.strip()!r} is not a status or turn value") from None
+            v = int(t[1:], 2)
+        elif t[:1] in "Hh" and len(t) > 1:
+            v = int(t[1:], 16)
+        else:
+            v = int(float(t))
+    except (ValueError, OverflowError):
+        v = FLAG_LIMIT
+    if abs(v) >= FLAG_LIMIT:
+        raise lines.error(lineno, f"{text.strip()!r} is not a status or turn value")
+    return v
 
 
 class _Point:

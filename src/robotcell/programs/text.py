@@ -13,6 +13,7 @@ from pathlib import Path
 from robotcell.errors import InputError
 from robotcell.io.export.common import fmt_num, parse_float
 from robotcell.io.fileio import read_text
+from robotcell.io.tables import MAX_ABS_VALUE
 
 __all__ = ["NAME_LIMITS", "Lines", "fmt_num", "program_name", "strip_comment"]
 
@@ -73,5 +74,10 @@ class Lines:
         return f"{self.path}:{lineno}"
 
     def number(self, text: str, lineno: int) -> float:
-        """A finite number, or an error naming the line."""
-        return parse_float(text.strip(), f"{self.path}: line {lineno}")
+        """A finite number within :data:`~robotcell.io.tables.MAX_ABS_VALUE` (no length in mm,
+        angle in deg or pulse count is larger), or an error naming the line."""
+        v = parse_float(text.strip(), f"{self.path}: line {lineno}")
+        if abs(v) > MAX_ABS_VALUE:
+            raise self.error(lineno, f"{text.strip()} is beyond {MAX_ABS_VALUE:.0e} in size: no "
+                                     "value of a program is that large; a typing error")
+        return v
