@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
-from programs_helpers import CELL, EXT, SEAM
-from test_cli_fuzz import mutate_csv, mutate_text
+from programs_helpers import CELL, EXT, SEAM, mutated_program, outcome_problems, write_mutation
+from test_cli_fuzz import mutate_csv
 
 from robotcell.cell import Cell
 from robotcell.programs import write_program
@@ -106,35 +106,19 @@ def test_fuzz_mutated_paths_and_programs(tmp_path, capsys, programs):
         if k % 3 == 0:
             content, what = mutate_csv(SEAM.read_text(), rng)
             path = tmp_path / f"path{k}.csv"
-            path.write_bytes(content if isinstance(content, bytes) else content.encode(
-                "utf-8", errors="surrogatepass"))
+            write_mutation(path, content)
             args = _write_args(path, out, vendor)
         else:
             src = programs[vendor]
             case = tmp_path / f"case{k}"
-            case.mkdir()
-            for f in src.parent.iterdir():
-                (case / f.name).write_bytes(f.read_bytes())
-            target = case / (src.with_suffix(".dat").name if vendor == "kuka" and rng.random()
-                             < 0.5 else src.name)
-            content, what = mutate_text(target.read_text(), rng)
-            target.write_bytes(content if isinstance(content, bytes) else content.encode(
-                "utf-8", errors="surrogatepass"))
+            what = mutated_program(src, case, rng)
             args = (["program", "check", case / src.name, "--cell", CELL,
                      "--pulses-per-degree", "100"] if k % 3 == 1 else
                     ["program", "retarget", case / src.name, "--from", CELL, "--to", CELL,
                      "-o", out, "--pulses-per-degree", "100"])
         code, stdout, err = run(capsys, *args)
         codes[code] = codes.get(code, 0) + 1
-        problems = []
-        if code not in (0, 2, 3):
-            problems.append(f"exit {code}")
-        if "Traceback" in stdout + err:
-            problems.append("traceback")
-        if code == 2 and err.count("error:") != 1:
-            problems.append("exit 2 without one 'error:' line")
-        if code in (2, 3) and out.exists() and any(out.iterdir()):
-            problems.append("a refused run left files")
+        problems = outcome_problems(code, stdout, err, out.exists() and any(out.iterdir()))
         if problems:
             failures.append(f"case {k} ({vendor}, {what}): {', '.join(problems)}; "
                             f"{' '.join(map(str, args))}\n  {err.strip()[-300:]}")
