@@ -558,3 +558,27 @@ def test_bad_identified_keys_name_the_key(tmp_path, capsys, edit, match):
                                                      "  model: kuka_kr16\n" + edit))
     code, _out, err = run(capsys, "cell", "show", tmp_path / "cell.yaml")
     assert code == 2 and match in err, err
+
+
+def test_robots_show_prints_the_beta_of_an_identified_model(kr16, tmp_path, capsys):
+    _, _, res = kr16
+    save_robot(res.robot, tmp_path / "arm.yaml")
+    code, out, err = run(capsys, "robots", "show", tmp_path / "arm.yaml")
+    assert code == 0, err
+    assert "beta [deg]" in out and "Rot(y, beta) after Rot(x, alpha)" in out
+    code, out, _ = run(capsys, "robots", "show", "kuka_kr16")
+    assert "beta" not in out
+
+
+def test_an_identified_scale_is_the_same_robot_a_j23_factor_is_not():
+    from robotcell.kinematics.coupling import Coupling
+
+    cell = Cell.load(Path(__file__).parents[1] / "examples" / "cell_kr16_track_turntable.yaml")
+    scaled = replace(NOMINAL, coupling=Coupling(np.diag(1.0 + np.full(6, 2e-4))))
+    cell.set_identified(scaled, "scaled.yaml", Provenance("identify"))
+    assert cell.nominal_robot.coupling is None and cell.robot.coupling is not None
+    C = np.eye(6)
+    C[2, 1] = -1.0
+    with pytest.raises(Exception, match=r"its joint coupling differs \(q_model = C q: C\[3, 2\]"):
+        cell.set_identified(replace(NOMINAL, coupling=Coupling(C)), "j23.yaml",
+                            Provenance("identify"))
