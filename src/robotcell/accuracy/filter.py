@@ -153,7 +153,9 @@ def _polish(robot: Robot, q: NDArray[np.float64], T: NDArray[np.float64], steps:
     """Newton steps of ``robot`` from ``q`` onto the flange poses ``T`` (robot base frame).
 
     The seeded IK stops within 1e-9 m and rad; two steps bring that to rounding, so that the
-    commanded poses take the real arm onto the desired ones to 1e-12 m.
+    commanded poses take the real arm onto the desired ones to 1e-12 m. Directions of the
+    Jacobian weaker than 1e-6 of its strongest (a singular wrist) get no step: a residual of
+    1e-9 there must not turn an axis.
     """
     eye = np.eye(4)
     for _ in range(steps):
@@ -161,7 +163,8 @@ def _polish(robot: Robot, q: NDArray[np.float64], T: NDArray[np.float64], steps:
         dp = T[:, :3, 3] - T_cur[:, :3, 3]
         dw = Rotation.from_matrix(T[:, :3, :3] @ np.swapaxes(T_cur[:, :3, :3], -1, -2)).as_rotvec()
         J = robot.jacobian(q, tool=eye)
-        q = q + np.einsum("nij,nj->ni", np.linalg.pinv(J), np.concatenate([dp, dw], axis=-1))
+        step = np.linalg.pinv(J, rcond=1e-6)
+        q = q + np.einsum("nij,nj->ni", step, np.concatenate([dp, dw], axis=-1))
     return q
 
 
