@@ -197,6 +197,9 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
+        if cell_path is not None:
+            raise InputError("--propose N writes configurations to measure; --cell takes an "
+                             "identified model, give it with MEASUREMENTS.csv and -o")
         if robot is None:
             raise InputError("--propose needs --robot NOMINAL (library name or model file)")
         check_kind(output, "CSV", "the proposed configurations")
