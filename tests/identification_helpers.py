@@ -90,6 +90,15 @@ def write_csv(path, meas: Measurements, prismatic=None) -> None:
         fh.writelines(",".join(f"{v:.9f}" for v in r) + "\n" for r in rows)
 
 
+def target_tool(data: dict) -> np.ndarray:
+    """``T_F_T`` (m) from the JSON of ``identify``: the target frame, else the first reflector."""
+    T = np.array(data["target"], dtype=float) if "target" in data else np.eye(4)
+    if "target" not in data:
+        T[:3, 3] = data["targets"][0]
+    T[:3, 3] /= 1e3
+    return T
+
+
 def one_joint_rows(robot: Robot, per_joint: int = 7, span_deg: float = 60.0) -> np.ndarray:
     """Rows moving each joint alone about zero (rad)."""
     rows = []

@@ -124,7 +124,7 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
 #: package's ``__init__``, ``errors``, ``report`` (one concept, one module) and ``_aliases``.
 CONCEPTS = {"kinematics", "ik", "dhprocedure", "calibration", "identification", "cell", "io",
-            "programs", "studies", "view", "cli", "robots"}
+            "programs", "accuracy", "studies", "view", "cli", "robots"}
 TOP_MODULES = {"__init__.py", "errors.py", "report.py", "_aliases.py"}
 
 
@@ -159,6 +159,7 @@ LAYERS = [
     {"robotcell.cell"},
     {"robotcell.io.export"},
     {"robotcell.programs"},
+    {"robotcell.accuracy"},
     {"robotcell.view"},
     {"robotcell.studies"},
     {"robotcell.cli"},
@@ -178,10 +179,10 @@ def layer(module: str) -> int:
 
 def test_every_module_is_in_a_layer():
     assert layer("robotcell.io.export.kuka") == 4 and layer("robotcell.io.tables") == 0
-    assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 8
-    assert layer("robotcell.view.plot") == 2 and layer("robotcell.view.cellscene") == 6
-    assert layer("robotcell.view.calibration") == 2 and layer("robotcell.view.program") == 6
-    assert layer("robotcell.programs.kuka") == 5
+    assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 9
+    assert layer("robotcell.view.plot") == 2 and layer("robotcell.view.cellscene") == 7
+    assert layer("robotcell.view.calibration") == 2 and layer("robotcell.view.program") == 7
+    assert layer("robotcell.programs.kuka") == 5 and layer("robotcell.accuracy.filter") == 6
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES

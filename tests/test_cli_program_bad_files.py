@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
-from programs_helpers import CELL, EXT, SEAM
-from test_cli_fuzz import mutate_csv, mutate_text
+from programs_helpers import CELL, EXT, SEAM, mutated_program, outcome_problems, write_mutation
+from test_cli_fuzz import mutate_csv
 
 from robotcell.cell import Cell
 from robotcell.programs import write_program
@@ -131,37 +131,40 @@ def test_fuzz_mutated_paths_and_programs(tmp_path, capsys, programs):
         if k % 3 == 0:
             content, what = mutate_csv(SEAM.read_text(), rng)
             path = tmp_path / f"path{k}.csv"
-            path.write_bytes(content if isinstance(content, bytes) else content.encode(
-                "utf-8", errors="surrogatepass"))
+            write_mutation(path, content)
             args = _write_args(path, out, vendor)
         else:
             src = programs[vendor]
             case = tmp_path / f"case{k}"
-            case.mkdir()
-            for f in src.parent.iterdir():
-                (case / f.name).write_bytes(f.read_bytes())
-            target = case / (src.with_suffix(".dat").name if vendor == "kuka" and rng.random()
-                             < 0.5 else src.name)
-            content, what = mutate_text(target.read_text(), rng)
-            target.write_bytes(content if isinstance(content, bytes) else content.encode(
-                "utf-8", errors="surrogatepass"))
+            what = mutated_program(src, case, rng)
             args = (["program", "check", case / src.name, "--cell", CELL,
                      "--pulses-per-degree", "100"] if k % 3 == 1 else
                     ["program", "retarget", case / src.name, "--from", CELL, "--to", CELL,
                      "-o", out, "--pulses-per-degree", "100"])
         code, stdout, err = run(capsys, *args)
         codes[code] = codes.get(code, 0) + 1
-        problems = []
-        if code not in (0, 2, 3):
-            problems.append(f"exit {code}")
-        if "Traceback" in stdout + err:
-            problems.append("traceback")
-        if code == 2 and err.count("error:") != 1:
-            problems.append("exit 2 without one 'error:' line")
-        if code in (2, 3) and out.exists() and any(out.iterdir()):
-            problems.append("a refused run left files")
+        problems = outcome_problems(code, stdout, err, out.exists() and any(out.iterdir()))
         if problems:
             failures.append(f"case {k} ({vendor}, {what}): {', '.join(problems)}; "
                             f"{' '.join(map(str, args))}\n  {err.strip()[-300:]}")
     assert not failures, "\n".join(failures[:6])
     assert codes.get(0, 0) > 0 and codes.get(2, 0) > 0, codes
+
+
+@pytest.mark.parametrize("vendor,old,new,match", [
+    ("kuka", "Y 0.000000,Z", "Y 1e300,Z", "1e300 is beyond 1e+15 in size"),
+    ("kuka", "S 4,T", "S 1e300,T", "is not a status or turn value"),
+    ("abb", "[-2,-2,-1,3]", "[-2,-2,-1,1e300]", "1e300 is beyond 1e+15 in size"),
+    ("fanuc", "Y =", "Y = 1e300  mm, Q =", "1e300 is beyond 1e+15 in size"),
+    ("fanuc", "'N D T, 0,", "'N D T, 99999999999999999999,", "a turn number that large"),
+])
+def test_absurd_values_in_a_program_are_refused_naming_the_line(tmp_path, capsys, programs,
+                                                                vendor, old, new, match):
+    # values a controller cannot hold: refused where they are read, not an overflow later
+    src = programs[vendor]
+    for f in src.parent.iterdir():
+        text = f.read_text()
+        (tmp_path / f.name).write_text(text.replace(old, new, 1) if old in text else text)
+    code, out, err = run(capsys, "program", "check", tmp_path / src.name, "--cell", CELL)
+    _check(code, out, err, match)
+    assert "line" in err

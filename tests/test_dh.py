@@ -142,3 +142,36 @@ def test_input_errors():
         Robot("x", (Joint("revolute", sign=2.0),))
     with pytest.raises(InputError, match="joint 1: lower limit"):
         Robot("x", (Joint("revolute", lower=1.0, upper=0.0),))
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_hayati_beta_is_a_rotation_about_y_after_the_twist(convention):
+    # standard Tz(d) Rz(theta) Tx(a) Rx(alpha) Ry(beta); modified Rx(alpha) Ry(beta) Tx(a) Rz Tz,
+    # element by element, against the compiled chain (batched, one pose) and link_transform
+    from dataclasses import replace
+
+    from robotcell.kinematics.transforms import rot_y, rot_z
+
+    rng = np.random.default_rng(9)
+    std = random_standard_robot(rng)
+    base = std if convention == "standard" else to_modified(std)
+    r = replace(base, joints=tuple(replace(j, beta=rng.uniform(-0.3, 0.3)) for j in base.joints))
+    q = rng.uniform(-3, 3, (20, 6))
+    var = r.dh_variables(q)
+    for k in range(len(q)):
+        ref = r.base.copy()
+        via_link = r.base.copy()
+        for i, j in enumerate(r.joints):
+            th = j.theta if j.prismatic else var[k, i]
+            d = var[k, i] if j.prismatic else j.d
+            Tz, Rz = make_pose(p=[0, 0, d]), make_pose(rot_z(th))
+            Tx, Rx, Ry = make_pose(p=[j.a, 0, 0]), make_pose(rot_x(j.alpha)), make_pose(rot_y(j.beta))
+            ref = ref @ (Tz @ Rz @ Tx @ Rx @ Ry if convention == "standard" else Rx @ Ry @ Tx @ Rz @ Tz)
+            via_link = via_link @ link_transform(th, d, j.a, j.alpha, convention, j.beta)
+        ref = ref @ r.flange
+        np.testing.assert_allclose(via_link @ r.flange, ref, atol=1e-12)
+        np.testing.assert_allclose(r.fk(q[k]), ref, atol=1e-12)
+        np.testing.assert_allclose(r.fk(q[k:k + 1])[0], ref, atol=1e-12)
+    # beta 0 is plain DH, at no cost: the compiled program has no rotation about y
+    assert all(op.kind != "ry" for op in base._chain.ops)
+    assert sum(op.kind == "ry" for op in r._chain.ops) == 6

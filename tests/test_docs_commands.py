@@ -9,7 +9,9 @@ command's --help. They run in process, in order, in a fresh folder that holds a 
 names are made the way the docs say: ``cell.yaml`` is a copy of the example cell (of the
 positioner cell for positioner commands), touch files come from ``robotcell simulate``,
 ``joints.csv`` from ``identify --propose``, ``poses.csv`` from ``fk --input``, ``tracker.csv``
-from the block of docs/identification.md that simulates it. Each command must exit 0 without a
+from the block of docs/identification.md that simulates it; the cell of a command that filters
+(``compensate``, ``program compensate``, ``program check`` of a filtered program) gets the arm
+identified from that ``tracker.csv`` (``identify ... --cell cell.yaml``, docs/accuracy.md). Each command must exit 0 without a
 traceback and write the files it names. ``LEFT_OUT`` lists the commands not run, and why.
 """
 
@@ -198,6 +200,13 @@ def prepare(capsys, argv: list[str]) -> None:
                                       encoding="utf-8")
     if argv[0] == "identify" and "tracker.csv" in argv:
         _tracker()
+    if argv[0] == "compensate" or (argv[0] == "program" and (
+            argv[1] == "compensate" or any("filtered" in a for a in argv))):
+        _tracker()
+        code, _, err = run(capsys, "identify", "tracker.csv", "--robot", "kuka_kr16",
+                           "--accuracy", "0.02", "--folds", "2", "-o", "kr16_identified.yaml",
+                           "--cell", "cell.yaml")
+        assert code == 0, err
     if argv[0] in ("fk", "ik") and "--input" in argv:
         given = argv[argv.index("--input") + 1]
         code, _, err = run(capsys, "identify", "--propose", "10", "--robot", "kuka_kr16",

@@ -8,6 +8,7 @@ would). Every exported pose, read back from the controller text, must match the 
 
 import json
 import math
+import re
 import time
 
 import numpy as np
@@ -128,6 +129,11 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
     program = figure_from_page((tmp_path / "program.html").read_text(encoding="utf-8"))
     assert [s["label"] for s in program["layout"]["sliders"][0]["steps"]] == [
         p.name for p in report.points]
+    # the last step identifies a virtual arm and filters a path: both errors are printed
+    m = re.search(r"([0-9.]+) mm RMS from it without filtering, ([0-9.]+) mm filtered", out)
+    assert m and float(m.group(1)) > 0.5 and float(m.group(2)) < 0.05, out[-600:]
+    assert Cell.load(tmp_path / "accuracy" / "cell.yaml").identified.provenance.source == "identify"
+    assert (tmp_path / "accuracy" / "commanded.csv").is_file()
     truth, nominal = demo_cells()
     cell = Cell.load(tmp_path / "cell.yaml")
     # The 3D view shows the calibrated cell: the torch 50 mm above the part's origin.

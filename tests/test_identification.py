@@ -123,8 +123,8 @@ def test_positioner_with_pose_measurements():
     for p in res.parameters:
         if p.free and not p.name.startswith(("base.", "target.")):
             assert abs(p.value - exact.parameter(p.name).value) <= 3 * p.sigma, p.name
-    # The identified robot with its tool predicts the measured target pose.
-    T = res.base @ res.robot.fk(qv[:5])
+    # The identified robot with the target as its tool predicts the measured target pose.
+    T = res.base @ res.robot.fk(qv[:5], tool=res.target_tool)
     assert np.allclose(T[:, :3, 3], ch.predict(x, qv[:5])[0][:, 0], atol=2e-4)
     assert res.to_json()["target"][3] == [0.0, 0.0, 0.0, 1.0]
 
@@ -144,8 +144,8 @@ def test_model_file_round_trip_predicts_the_measurements(kr16_result, tmp_path):
     save_robot(res.robot, path)
     robot = load_robot(path)
     q = meas.q[:10]
-    # Same joint values as the CSV; the tool is reflector 1; base maps R into the tracker frame.
-    p = (res.base @ robot.fk(q))[:, :3, 3]
+    # Same joint values as the CSV; reflector 1 as the tool; base maps R into the tracker frame.
+    p = (res.base @ robot.fk(q, tool=res.target_tool))[:, :3, 3]
     assert np.allclose(p, res.predict(q)[0][:, 0], atol=1e-7)
     assert robot.convention == nominal.convention
     assert [j.sign for j in robot.joints] == [j.sign for j in nominal.joints]
@@ -215,7 +215,7 @@ def test_scale_and_coupling_round_trip_through_the_model_file(tmp_path):
     assert "coupling:" in path.read_text() and "matrix:" in path.read_text()
     robot = load_robot(path)
     q = configurations(nominal, 20, rng)
-    pred = (res.base @ robot.fk(q))[:, :3, 3]  # controller values, as in the CSV
+    pred = (res.base @ robot.fk(q, tool=res.target_tool))[:, :3, 3]  # controller values, as in the CSV
     assert np.allclose(pred, res.predict(q)[0][:, 0], atol=1e-7)
     assert np.allclose(pred, ch.predict(x, q)[0][:, 0], atol=5 * NOISE)
     T = robot.fk(q[:4])
@@ -238,7 +238,8 @@ def test_nominal_j23_coupling_is_used_and_kept():
     assert res.rms_after < 2 * NOISE * math.sqrt(3)
     assert res.robot.coupling.j23_factor == 1.0
     q = configurations(nominal, 5, rng)
-    assert np.allclose((res.base @ res.robot.fk(q))[:, :3, 3], res.predict(q)[0][:, 0], atol=1e-7)
+    assert np.allclose((res.base @ res.robot.fk(q, tool=res.target_tool))[:, :3, 3],
+                       res.predict(q)[0][:, 0], atol=1e-7)
 
 
 def test_nominal_with_passive_joints_is_refused():
@@ -278,7 +279,8 @@ def test_modified_dh_nominal_with_hayati_beta(tmp_path):
     save_robot(res.robot, tmp_path / "m.yaml")
     robot = load_robot(tmp_path / "m.yaml")
     assert robot.convention == "modified"
-    assert np.allclose((res.base @ robot.fk(qv))[:, :3, 3], res.predict(qv)[0][:, 0], atol=1e-7)
+    assert np.allclose((res.base @ robot.fk(qv, tool=res.target_tool))[:, :3, 3],
+                       res.predict(qv)[0][:, 0], atol=1e-7)
 
 
 def test_reported_sigma_matches_the_errors_over_seeds():

@@ -12,6 +12,7 @@ from identification_helpers import (
     measure,
     one_joint_rows,
     perturbed,
+    target_tool,
     truth_chain,
     write_csv,
 )
@@ -66,7 +67,7 @@ def test_identify_json_and_model_file(kr16_truth, tmp_path, capsys):
     robot = load_robot(out)
     T = np.array(data["base"])
     T[:3, 3] /= 1e3
-    pred = (T @ robot.fk(meas.q))[:, :3, 3]
+    pred = (T @ robot.fk(meas.q, tool=target_tool(data)))[:, :3, 3]
     assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 0.05e-3
 
 
@@ -116,7 +117,7 @@ def test_identify_without_nominal_uses_circle_point_analysis(tmp_path, capsys):
     qv[:, 2] = rng.uniform(0.1, 0.9, 100)
     T = np.array(data["base"])
     T[:3, 3] /= 1e3
-    err = (T @ robot.fk(qv))[:, :3, 3] - ch.predict(x, qv)[0][:, 0]
+    err = (T @ robot.fk(qv, tool=target_tool(data)))[:, :3, 3] - ch.predict(x, qv)[0][:, 0]
     assert np.sqrt(np.mean(np.sum(err**2, axis=1))) < 0.03e-3
 
 
@@ -138,7 +139,7 @@ def test_identify_j23_factor_report(tmp_path, capsys):
     assert "coupling: {j23_factor: -1}" in out.read_text()
     base = np.array(data["base"])
     base[:3, 3] /= 1e3
-    pred = (base @ load_robot(out).fk(meas.q))[:, :3, 3]
+    pred = (base @ load_robot(out).fk(meas.q, tool=target_tool(data)))[:, :3, 3]
     assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 0.05e-3
 
 
@@ -171,7 +172,7 @@ def test_identify_without_nominal_groups_rows_in_model_values_of_a_coupled_arm(t
     assert "coupling: {j23_factor: 1}" in (tmp_path / "fanuc.yaml").read_text()
     base = np.array(data["base"])
     base[:3, 3] /= 1e3
-    pred = (base @ load_robot(tmp_path / "fanuc.yaml").fk(meas.q))[:, :3, 3]
+    pred = (base @ load_robot(tmp_path / "fanuc.yaml").fk(meas.q, tool=target_tool(data)))[:, :3, 3]
     assert np.sqrt(np.mean(np.sum((pred - meas.points[:, 0]) ** 2, axis=1))) < 1.1 * floor
 
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from robotcell import InputError, list_robots, load_robot, save_robot
+from robotcell.kinematics.transforms import make_pose, rot_z
 
 ISSUE_EXAMPLE = """\
 name: my_robot
@@ -109,3 +110,42 @@ def test_unknown_names_offer_the_closest():
         load_robot("ur5")
     with pytest.raises(InputError, match=r"robot model file 'missing.yaml' does not exist"):
         load_robot("missing.yaml")
+
+
+def test_hayati_beta_round_trips_and_the_readers_follow_it(tmp_path):
+    # an identified link of nearly parallel axes holds beta (deg in the file); FK, the URDF
+    # origins (axis_frames) and the track as one chain follow it; conversions refuse it
+    from dataclasses import replace
+
+    from robotcell.cell.axischain import axis_frames
+    from robotcell.dhprocedure.convert import convert_convention
+    from robotcell.ik.track import TrackRobot
+
+    (tmp_path / "m.yaml").write_text(
+        "name: tilted\njoints:\n"
+        "  - {type: revolute, a: 100, alpha: 0, d: 400, theta: 0, beta: 0.05}\n"
+        "  - {type: revolute, a: 300, alpha: -90, d: 0, theta: 0}\n"
+        "  - {type: revolute, a: 0, alpha: 0, d: 50, theta: 0}\n")
+    r = load_robot(tmp_path / "m.yaml")
+    assert r.joints[0].beta == pytest.approx(np.radians(0.05))
+    save_robot(r, tmp_path / "back.yaml")
+    text = (tmp_path / "back.yaml").read_text()
+    assert "beta: 0.05" in text and text.count("beta") == 1  # written only where it is set
+    q = np.random.default_rng(1).uniform(-2, 2, (10, 3))
+    np.testing.assert_allclose(load_robot(tmp_path / "back.yaml").fk(q), r.fk(q), atol=1e-15)
+    pre, post = axis_frames(r)
+    for qi in q:
+        T = r.base
+        for i in range(3):
+            T = T @ pre[i] @ make_pose(rot_z(qi[i]))
+        np.testing.assert_allclose(T @ post, r.fk(qi), atol=1e-12)
+    modified = replace(r, convention="modified")
+    track = TrackRobot(modified, make_pose(rot_z(0.2), [0.1, 0.2, 0.0]), lower=-1.0, upper=3.0)
+    qt = np.column_stack([np.linspace(0, 2, 10), q])
+    np.testing.assert_allclose(track.as_robot().fk(qt), track.fk(qt), atol=1e-12)
+    with pytest.raises(InputError, match=r"joint\(s\) A1 have a Hayati beta"):
+        convert_convention(r, "modified")
+    with pytest.raises(InputError, match="key 'beta' must be a number"):
+        (tmp_path / "bad.yaml").write_text((tmp_path / "m.yaml").read_text().replace(
+            "beta: 0.05", "beta: x"))
+        load_robot(tmp_path / "bad.yaml")

@@ -1,7 +1,7 @@
 """The robot cell: its data model, its file, coupled kinematics, and calibrating into it.
 
 - :mod:`robotcell.cell.model`: :class:`Cell`, :class:`Tool`, :class:`Frame`, :class:`Track`,
-  :class:`Turntable`, :class:`Positioner`, :class:`Provenance` (SI units);
+  :class:`Turntable`, :class:`Positioner`, :class:`Provenance`, :class:`IdentifiedArm` (SI units);
 - :mod:`robotcell.cell.schema`: the YAML cell file (millimetres, degrees), its reader and writer,
   and the atomic save that keeps comments and layout;
 - :mod:`robotcell.cell.history`: the numbered backups of a cell file and its history;
@@ -18,6 +18,7 @@ from robotcell.cell.model import (
     NAME_RE,
     Cell,
     Frame,
+    IdentifiedArm,
     Positioner,
     Provenance,
     Tool,
@@ -26,5 +27,5 @@ from robotcell.cell.model import (
 )
 from robotcell.cell.schema import cell_from_dict, cell_to_dict
 
-__all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool",
-           "Track", "Turntable", "cell_from_dict", "cell_to_dict"]
+__all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "IdentifiedArm", "Positioner",
+           "Provenance", "Tool", "Track", "Turntable", "cell_from_dict", "cell_to_dict"]

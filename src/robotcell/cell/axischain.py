@@ -45,11 +45,11 @@ def axis_frames(robot: Robot) -> tuple[NDArray[np.float64], NDArray[np.float64]]
     Notes
     -----
     Standard DH ``T_{i-1,i}(q) = M_i(q) S_i`` with ``S_i = Rot(z, theta_i) Trans(z, d_i) Trans(x,
-    a_i) Rot(x, alpha_i)`` at the constant offsets, so ``pre_1 = I``, ``pre_i = S_{i-1}``,
+    a_i) Rot(x, alpha_i) Rot(y, beta_i)`` at the constant offsets, so ``pre_1 = I``, ``pre_i = S_{i-1}``,
     ``post = S_n T_n_F``. Modified DH ``T_{i-1,i}(q) = S_i M_i(q)``, so ``pre_i = S_i`` and
     ``post = T_n_F``. ``M_i`` is ``Rot(z, sign_i q_i)`` or ``Trans(z, sign_i q_i)``.
     """
-    S = np.array([link_transform(j.theta, j.d, j.a, j.alpha, robot.convention)
+    S = np.array([link_transform(j.theta, j.d, j.a, j.alpha, robot.convention, j.beta)
                   for j in robot.joints])
     if robot.convention == "standard":
         pre = np.concatenate([np.eye(4)[None], S[:-1]])

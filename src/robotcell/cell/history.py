@@ -124,6 +124,9 @@ def _items(data: Any) -> dict[str, dict[str, Any]]:
     if not isinstance(data, Mapping):
         return {}
     out: dict[str, dict[str, Any]] = {}
+    robot = data.get("robot")
+    if isinstance(robot, Mapping) and robot.get("identified"):
+        out[f"robot {robot['identified']}"] = dict(robot.get("provenance") or {})
     for section in ("track", "turntable", "positioner"):
         entry = data.get(section)
         if isinstance(entry, Mapping):

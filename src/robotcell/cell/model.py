@@ -42,8 +42,8 @@ from robotcell.kinematics.transforms import finite_array, validate_pose
 if TYPE_CHECKING:
     from robotcell.cell.ik import CellIKSolutions, CellPath
 
-__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "Positioner", "Provenance", "Tool", "Track",
-           "Turntable"]
+__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "IdentifiedArm", "Positioner", "Provenance", "Tool",
+           "Track", "Turntable"]
 
 #: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
 #: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
@@ -419,6 +419,79 @@ def _check_number(n: Any, what: str) -> None:
         raise InputError(f"{what} must be an integer >= 1, got {n!r}")
 
 
+#: Largest distance (m) and angle (rad) between the flange of an identified arm and its nominal's
+#: at any configuration: a real arm is a few mm and tenths of a degree off its drawing, so a larger
+#: difference is a model of another robot (or in other joint conventions).
+IDENTIFIED_MAX_OFFSET = 0.05
+IDENTIFIED_MAX_ANGLE = math.radians(5.0)
+
+
+@dataclass
+class IdentifiedArm:
+    """The arm as an identification found it, beside the model its controller computes with.
+
+    Attributes
+    ----------
+    nominal : Robot
+        The controller's model (``robot.model`` of the cell file): it turns joint values into the
+        Cartesian points a program is told.
+    model : str
+        The identified model file (absolute, or relative to the working directory).
+    provenance : Provenance
+        Where the identification comes from (``identify``, its time, RMS, held-out error).
+    """
+
+    nominal: Robot
+    model: str
+    provenance: Provenance = field(default_factory=lambda: Provenance("manual"))
+
+
+def check_identified(nominal: Robot, identified: Robot) -> None:
+    """Refuse an identified model that is not an identification of ``nominal``.
+
+    Parameters
+    ----------
+    nominal, identified : Robot
+
+    Raises
+    ------
+    InputError
+        Another number or type of joints, another joint coupling (a J2/J3 factor; a scale of an
+        axis may differ by up to 1 %), or a flange more than 50 mm or 5 deg from the nominal's
+        at a configuration within the limits (the name says which).
+    """
+    who = f"the identified model {identified.name!r} is not an identification of {nominal.name!r}"
+    if identified.n_joints != nominal.n_joints or len(identified.joints) != len(nominal.joints):
+        raise InputError(f"{who}: it has {identified.n_joints} axes, {nominal.name} has "
+                         f"{nominal.n_joints}")
+    kinds = [(j.type, j.passive) for j in nominal.joints]
+    if [(j.type, j.passive) for j in identified.joints] != kinds:
+        raise InputError(f"{who}: its joint types differ "
+                         f"({', '.join(j.type for j in identified.joints)})")
+    eye = np.eye(len(nominal.joints), nominal.n_joints)
+    C0 = eye if nominal.coupling is None else nominal.coupling.matrix
+    C1 = eye if identified.coupling is None else identified.coupling.matrix
+    if np.abs(C1 - C0).max() > 0.01:
+        i, j = np.unravel_index(np.argmax(np.abs(C1 - C0)), C0.shape)
+        raise InputError(f"{who}: its joint coupling differs (q_model = C q: C[{i + 1}, {j + 1}] is "
+                         f"{C1[i, j]:g}, the nominal's {C0[i, j]:g}; a J2/J3 factor?)")
+    lo = np.where(np.isfinite(nominal.lower), nominal.lower, -math.pi)
+    hi = np.where(np.isfinite(nominal.upper), nominal.upper, math.pi)
+    q = np.vstack([np.clip(np.zeros(nominal.n_joints), lo, hi),
+                   lo + (hi - lo) * np.random.default_rng(0).random((24, nominal.n_joints))])
+    T0, T1 = nominal.fk(q, tool=np.eye(4)), identified.fk(q, tool=np.eye(4))
+    dp = np.linalg.norm(T1[:, :3, 3] - T0[:, :3, 3], axis=-1)
+    cos = (np.trace(np.swapaxes(T0[:, :3, :3], -1, -2) @ T1[:, :3, :3], axis1=-2, axis2=-1) - 1) / 2
+    da = np.arccos(np.clip(cos, -1.0, 1.0))
+    k = int(np.argmax(np.maximum(dp / IDENTIFIED_MAX_OFFSET, da / IDENTIFIED_MAX_ANGLE)))
+    if dp[k] > IDENTIFIED_MAX_OFFSET or da[k] > IDENTIFIED_MAX_ANGLE:
+        raise InputError(f"{who}: its flange is {dp[k] * 1e3:.1f} mm and {math.degrees(da[k]):.2f} "
+                         f"deg from the nominal's at joints "
+                         f"{np.round(np.degrees(q[k]), 1).tolist()} deg (a real arm is a few mm "
+                         f"off; at most {IDENTIFIED_MAX_OFFSET * 1e3:g} mm and "
+                         f"{math.degrees(IDENTIFIED_MAX_ANGLE):g} deg are taken)")
+
+
 # -- the cell -------------------------------------------------------------------------------------
 @dataclass
 class Cell:
@@ -440,6 +513,11 @@ class Cell:
     tools : dict of str to Tool
     frames : dict of str to Frame
     name : str
+    identified : IdentifiedArm or None
+        Set when ``robot`` is an identified arm: then ``robot`` says where the TCP goes (FK, IK,
+        reach, checks, touches given as joint values) and ``identified.nominal``, the controller's
+        model, turns joint values into what the controller is told (:meth:`controller`).
+        ``robot`` carries the nominal's tool.
     """
 
     robot: Robot
@@ -450,9 +528,14 @@ class Cell:
     tools: dict[str, Tool] = field(default_factory=dict)
     frames: dict[str, Frame] = field(default_factory=dict)
     name: str = "cell"
+    identified: IdentifiedArm | None = None
 
     def __post_init__(self) -> None:
         self.T_world_R = _pose(self.T_world_R, "robot T_world_R")
+        if self.identified is not None:
+            check_identified(self.identified.nominal, self.robot)
+            if not np.array_equal(self.robot.tool, self.identified.nominal.tool):
+                self.robot = self.robot.with_tool(self.identified.nominal.tool)
         if self.track is not None and not np.allclose(self.T_world_R, np.eye(4), atol=0):
             raise InputError("a robot on a track is placed by the track (track frame and "
                              "robot_at_zero); do not give the robot a frame as well")
@@ -463,6 +546,39 @@ class Cell:
             self._check_parent(name, fr)
         _unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
         _unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
+
+    @property
+    def nominal_robot(self) -> Robot:
+        """The model the controller computes with: the nominal of an identified arm, else ``robot``."""
+        return self.robot if self.identified is None else self.identified.nominal
+
+    def controller(self) -> Cell:
+        """The cell as the controller computes it: with the nominal arm (``self`` without an
+        identified one). Its FK of joint values is what a program's Cartesian point says."""
+        if self.identified is None:
+            return self
+        return replace(self, robot=self.identified.nominal, identified=None)
+
+    def set_identified(self, robot: Robot, model: str, provenance: Provenance) -> None:
+        """Make ``robot`` (an identification of the cell's arm) the arm the cell computes with.
+
+        Parameters
+        ----------
+        robot : Robot
+            The identified model (e.g. ``IdentificationResult.robot``).
+        model : str
+            The model file it is (or will be) saved as; the cell file names it.
+        provenance : Provenance
+
+        Raises
+        ------
+        InputError
+            ``robot`` is not an identification of the cell's nominal arm (:func:`check_identified`).
+        """
+        nominal = self.nominal_robot
+        check_identified(nominal, robot)
+        self.identified = IdentifiedArm(nominal, model, provenance)
+        self.robot = robot.with_tool(nominal.tool)
 
     @property
     def positioner(self) -> Turntable | Positioner | None:

@@ -30,12 +30,14 @@ from robotcell.cell.history import keep_version
 from robotcell.cell.model import (
     Cell,
     Frame,
+    IdentifiedArm,
     Positioner,
     Provenance,
     Tool,
     Track,
     Turntable,
     _check_name,
+    check_identified,
 )
 from robotcell.cell.validation import check_lengths
 from robotcell.errors import InputError
@@ -188,6 +190,27 @@ def _is_model_path(text: str) -> bool:
     return text.lower().endswith((".yaml", ".yml")) or "/" in text or os.sep in text
 
 
+def _robot(rd: _Reader, value: Any, key: str, base_dir: str | Path) -> tuple[str, Any]:
+    """A robot the cell file names at ``key``: how the cell keeps the name, and the model."""
+    model = rd.string(value, key)
+    if _is_model_path(model):
+        model_path = Path(model) if Path(model).is_absolute() else Path(base_dir) / model
+        if not model_path.is_file():
+            raise rd.fail(key, f"names model file {str(model_path)!r}, which does not exist")
+        model = str(model_path)
+    try:
+        return model, load_robot(model)
+    except InputError as exc:
+        raise rd.fail(key, f"is invalid: {exc}") from None
+
+
+def _relative(model: str, base_dir: str | Path) -> str:
+    """A model file path as the cell file in ``base_dir`` writes it (a library name as it is)."""
+    if _is_model_path(model):
+        return os.path.relpath(Path(model).resolve(), Path(base_dir).resolve())
+    return model
+
+
 def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> Cell:
     """Build a cell from the parsed content of a cell file.
 
@@ -210,18 +233,22 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
     if top is None:
         raise InputError(f"{origin}: a cell file must be a YAML mapping with keys robot, tools, "
                          "frames, ...")
-    rob = rd.mapping(top["robot"], "robot", {"model", "frame"}, ("model",))
-    model = rd.string(rob["model"], "robot.model")
-    if _is_model_path(model):
-        model_path = Path(model) if Path(model).is_absolute() else Path(base_dir) / model
-        if not model_path.is_file():
-            raise rd.fail("robot.model", f"names model file {str(model_path)!r}, which does not exist")
-        model = str(model_path)
-    try:
-        robot = load_robot(model)
-    except InputError as exc:
-        raise rd.fail("robot.model", f"is invalid: {exc}") from None
+    rob = rd.mapping(top["robot"], "robot", {"model", "frame", "identified", "provenance"},
+                     ("model",))
+    model, robot = _robot(rd, rob["model"], "robot.model", base_dir)
     kwargs: dict[str, Any] = {"robot": robot, "robot_model": model}
+    if rob.get("identified") is not None:
+        path, arm = _robot(rd, rob["identified"], "robot.identified", base_dir)
+        prov = (rd.provenance(rob["provenance"], "robot.provenance") if "provenance" in rob
+                else Provenance("manual"))
+        kwargs.update(robot=arm, identified=IdentifiedArm(robot, path, prov))
+        try:
+            check_identified(robot, arm)
+        except InputError as exc:
+            raise rd.fail("robot.identified", f"is refused: {exc}") from None
+    elif "provenance" in rob:
+        raise rd.fail("robot.provenance", "is the provenance of an identified arm: give "
+                      "robot.identified (the identified model file) or remove it")
     if "frame" in rob:
         kwargs["T_world_R"] = rd.pose(rob["frame"], "robot.frame")
     if "name" in top:
@@ -304,7 +331,7 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
     return check_lengths(cell, origin)
 
 
-_AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "sign", "min", "max"}
+_AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "beta", "sign", "min", "max"}
 
 
 def _positioner_from_dict(rd: _Reader, value: Any) -> Positioner:
@@ -387,12 +414,12 @@ def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
     -------
     dict
     """
-    model = cell.robot_model
-    if _is_model_path(model):
-        model = os.path.relpath(Path(model).resolve(), Path(base_dir).resolve())
-    rob: dict[str, Any] = {"model": model}
+    rob: dict[str, Any] = {"model": _relative(cell.robot_model, base_dir)}
     if not np.allclose(cell.T_world_R, np.eye(4), atol=0):
         rob["frame"] = _pose_dict(cell.T_world_R)
+    if cell.identified is not None:
+        rob["identified"] = _relative(cell.identified.model, base_dir)
+        rob["provenance"] = _prov_dict(cell.identified.provenance)
     data: dict[str, Any] = {"name": cell.name, "robot": rob}
     if cell.track is not None:
         t = cell.track

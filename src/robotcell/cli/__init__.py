@@ -38,6 +38,7 @@ COMMANDS = {
     "sweep": "robotcell.cli.sweep:sweep_cmd",
     "program": "robotcell.cli.program:program",
     "view": "robotcell.cli.view:view",
+    "compensate": "robotcell.cli.compensate:compensate",
 }
 
 

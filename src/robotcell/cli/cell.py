@@ -50,7 +50,14 @@ def show(path: str) -> None:
       robotcell cell show examples/cell_kr16_track_turntable.yaml
     """
     c = Cell.load(path)
-    click.echo(f"cell {c.name}: robot {c.robot.name} ({c.robot_model})")
+    click.echo(f"cell {c.name}: robot {c.nominal_robot.name} ({c.robot_model})")
+    if c.identified is not None:
+        p = c.identified.provenance
+        click.echo(f"identified arm {c.robot.name} ({c.identified.model}): it says where the TCP "
+                   f"goes, the nominal model what the controller is told; source {p.source}"
+                   + (f", {p.time}" if p.time else "")
+                   + (f", RMS {p.rms_mm:g} mm" if p.rms_mm is not None else "")
+                   + (f"; {p.note}" if p.note else ""))
     head = ["name", "what (in parent)", "no.", "X", "Y", "Z", "A", "B", "C", "provenance"]
     rows: list[list[object]] = []
     if c.track is not None:

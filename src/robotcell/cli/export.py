@@ -6,8 +6,8 @@ import click
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_kind, check_output, write_output
-from robotcell.cli.files import OUTPUT, Command
-from robotcell.io.export import WRITE_FORMATS, export_cell
+from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
+from robotcell.io.export import WRITE_FORMATS, export_cell, export_files, ur_kinematics_path
 
 
 @click.command(cls=Command)
@@ -27,7 +27,9 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     fanuc    UTOOL/UFRAME values for Direct Entry (X Y Z W P R)
     yaskawa  TOOL/UFRAME values for the pendant (X Y Z Rx Ry Rz)
     urdf     the calibrated cell as a URDF tree for ROS tools (m, rad): robot, track and
-             turntable joints, tools and frames as fixed links
+             turntable joints, tools and frames as fixed links; the identified arm where the
+             cell has one, and for a Universal Robots arm also OUT_kinematics.yaml, the UR
+             description's calibration file (with -o)
 
     \b
     Examples:
@@ -35,7 +37,13 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
       robotcell export --cell cell.yaml --format abb -o cell_frames.mod
     """
     check_kind(output, "URDF" if fmt == "urdf" else "text", f"the {fmt} export")
-    text = export_cell(Cell.load(cell_path), fmt)
-    write_output(output, text)
-    if output is not None:
-        click.echo(f"wrote {output}", err=True)
+    cell = Cell.load(cell_path)
+    if output is None:
+        write_output(None, export_cell(cell, fmt))
+        return
+    if fmt == "urdf":
+        refuse_overwriting_inputs(click.get_current_context(),
+                                  [("the UR calibration file written next to -o",
+                                    str(ur_kinematics_path(output)))])
+    for f in export_files(cell, fmt, output):
+        click.echo(f"wrote {f}", err=True)

@@ -10,6 +10,8 @@ import sys
 import click
 import numpy as np
 
+from robotcell.cell import Cell
+from robotcell.cell.identified import adopt_identified, identification_provenance
 from robotcell.cli.common import (
     check_kind,
     check_not_folder,
@@ -152,11 +154,15 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               help="With --propose: the orientation is measured too (6D probe, camera).")
 @click.option("--seed", "seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="With --propose: seed of the random candidates and comparison sets.")
+@click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
+              help="Also make the identified model (-o) the arm of this cell file "
+                   "(robot.identified), with the identification's time, RMS and held-out error "
+                   "(--folds or 5); its robot.model is the nominal when --robot is not given.")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
              compliance: bool, force: bool, folds: int | None, report: str | None,
              offsets_for: str | None, propose: int | None, targets: int, orientation: bool,
-             seed: int) -> None:
+             seed: int, cell_path: str | None) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -191,6 +197,9 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
+        if cell_path is not None:
+            raise InputError("--propose N writes configurations to measure; --cell takes an "
+                             "identified model, give it with MEASUREMENTS.csv and -o")
         if robot is None:
             raise InputError("--propose needs --robot NOMINAL (library name or model file)")
         check_kind(output, "CSV", "the proposed configurations")
@@ -199,14 +208,16 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     if measurements is None:
         raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
     check_kind(output, "YAML", "the identified model file")
+    if cell_path is not None and output is None:
+        raise InputError("--cell needs -o FILE.yaml: the identified model file the cell will name")
     if offsets_for is not None and robot is None:
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
     _check_columns(measurements)
     options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale,
                "compliance": compliance}
-    if robot is not None:
-        nominal = load_robot(robot)
+    if robot is not None or cell_path is not None:
+        nominal = load_robot(robot) if robot is not None else Cell.load(cell_path).nominal_robot
         meas = read_measurements(measurements, nominal.prismatic)
     else:
         nominal, meas = first_estimate(measurements, j23_factor=j23 or 0.0)
@@ -216,7 +227,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         result = run_identify(nominal, meas, **options)
     verdict, why = result.verdict
     cv = cross = None
-    if report is not None and folds is None:
+    if (report is not None or cell_path is not None) and folds is None:
         folds = min(5, meas.n_rows)
     if folds is not None:
         if j23 is not None:
@@ -246,9 +257,14 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
                        f"{cv['before_max_mm']:.4f}; identified mean {cv['after_mean_mm']:.4f} RMS "
                        f"{cv['after_rms_mm']:.4f} max {cv['after_max_mm']:.4f}")
     if output is not None and (verdict != "poor" or force):
-        save_robot(result.robot, output)
+        if cell_path is None:
+            save_robot(result.robot, output)
+        else:
+            adopt_identified(cell_path, result, output, identification_provenance(result, cross))
         if not as_json:
-            click.echo(f"identified model written to {output}")
+            click.echo(f"identified model written to {output}"
+                       + (f"; {cell_path} computes with it (robot.identified)" if cell_path
+                          else ""))
     if report is not None and not as_json:
         click.echo(f"report written to {report}")
     if verdict == "poor":

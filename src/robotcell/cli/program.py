@@ -18,7 +18,8 @@ from robotcell.errors import InputError
 from robotcell.programs import VENDORS
 
 #: Library parameters as the command line names them.
-_FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split"}
+_FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split",
+          "max_correction": "--max-correction", "joints": "--joints"}
 
 
 class BadPoints(click.ClickException):
@@ -59,7 +60,8 @@ def _ppd_option(f: Callable) -> Callable:
 @click.group(cls=Group)
 def program() -> None:
     """Robot programs: write a path as a KUKA, ABB, FANUC or YASKAWA program, check a program
-    against the cell, retarget joint points after a recalibration (docs/programs.md).
+    against the cell, retarget joint points after a recalibration, filter a program through
+    the cell's identified arm (docs/programs.md, docs/accuracy.md).
 
     \b
     Examples:
@@ -226,3 +228,65 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
                                 rows))
     click.echo(f"{len(result.points)} joint points retargeted, {result.cartesian} Cartesian "
                f"points kept; wrote {', '.join(result.files)}")
+
+
+@program.command("compensate")
+@click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
+@_cell_option
+@click.option("-o", "--output", "folder", required=True, type=OutputPath(file_okay=False),
+              help="Folder for the filtered program files (created; its parent must exist).")
+@click.option("--joints", "joints", type=click.Choice(["taught", "offline"]), default="taught",
+              show_default=True, help="Joint points taught on the real arm (kept) or computed "
+                                      "offline with the nominal model (filtered too).")
+@click.option("--max-correction", "max_correction", type=float, default=5.0, show_default=True,
+              help="Largest correction taken (mm); above it the identified model is wrong.")
+@click.option("--report", "report", type=OutputPath(dir_okay=False),
+              help="Also write an HTML page: predicted error without filtering and 1-sigma "
+                   "after, per point.")
+@_ppd_option
+@click.option("--json", "as_json", is_flag=True, help="Print every filtered point as JSON.")
+def compensate_cmd(program_file: str, cell_path: str, folder: str, joints: str,
+                   max_correction: float, report: str | None, ppd: str | None,
+                   as_json: bool) -> None:
+    """Filter every Cartesian point of PROGRAM (KUKA .src with its .dat, ABB .mod, FANUC .ls,
+    YASKAWA .jbi) through the cell's identified arm and write the program to the folder with
+    nothing else changed: each point becomes the pose the controller's nominal model computes
+    for the joints that put the real arm where the point was meant (docs/accuracy.md).
+
+    Joint points stay as they are (taught on the real arm); --joints offline filters them too.
+    Prints the largest correction. Exit status 3 naming each point that cannot be filtered
+    (out of the identified arm's reach as written, a correction above --max-correction); nothing
+    is written then.
+
+    \b
+    Example:
+      robotcell program compensate prog/seam_part.src --cell cell.yaml -o prog_filtered
+    """
+    from robotcell.accuracy.filter import FilterRefused
+    from robotcell.accuracy.program import compensate_program
+    from robotcell.cli.common import check_kind
+    from robotcell.cli.compensate import MAX_CORRECTION_MM
+
+    lo, hi = MAX_CORRECTION_MM
+    if not lo <= max_correction <= hi:
+        raise InputError(f"--max-correction must be from {lo:g} to {hi:g} mm, got "
+                         f"{max_correction:g}")
+    check_kind(report, "HTML", "the accuracy report", "--report")
+    cell = Cell.load(cell_path)
+    with _flags():
+        try:
+            result = compensate_program(program_file, cell, folder, joints, _ppd(ppd),
+                                        max_correction * 1e-3, inputs=(cell_path,),
+                                        report=report)
+        except FilterRefused as exc:
+            click.echo(format_table(["point", "why"], [list(p) for p in exc.points]), err=True)
+            raise BadPoints(f"{program_file}: {exc}") from None
+    if as_json:
+        click.echo(json.dumps(result.to_json(), indent=2))
+        return
+    big = result.largest
+    for s in result.skipped:
+        click.echo(f"note: not filtered: {s}", err=True)
+    click.echo(f"{len(result.points)} points filtered, {result.kept} joint points kept; largest "
+               f"correction {big.dpos * 1e3:.4f} mm, {math.degrees(big.drot):.4f} deg at "
+               f"{big.name}; wrote {', '.join(result.files)}")

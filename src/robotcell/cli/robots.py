@@ -64,15 +64,21 @@ def show(name: str) -> None:
         click.echo("T_{i-1,i} = Rot(x, alpha_{i-1}) Trans(x, a_{i-1}) Rot(z, theta) Trans(z, d)")
         heads = ("joint", "type", "a_{i-1} [mm]", "alpha_{i-1} [deg]", "d [mm]", "theta [deg]")
     click.echo("DH variable = sign * q + offset (theta for revolute, d for prismatic joints)")
+    beta = any(j.beta for j in r.joints)
+    if beta:
+        click.echo("beta: Hayati's Rot(y, beta) after Rot(x, alpha) (an identified arm's nearly "
+                   "parallel axes)")
     rows = []
     for j in r.joints:
         unit = 1e3 if j.prismatic else 180 / math.pi
         lo = f"{j.lower * unit:.1f}" if math.isfinite(j.lower) else "-inf"
         hi = f"{j.upper * unit:.1f}" if math.isfinite(j.upper) else "inf"
         rows.append((j.name, j.type, j.a * 1e3, math.degrees(j.alpha), j.d * 1e3,
-                     math.degrees(j.theta), f"{j.sign:+.0f}", "passive" if j.passive else f"{lo} .. {hi}",
-                     "mm" if j.prismatic else "deg"))
-    click.echo(format_table(heads + ("sign", "limits", "unit"), rows))
+                     math.degrees(j.theta)) + ((math.degrees(j.beta),) if beta else ())
+                    + (f"{j.sign:+.0f}", "passive" if j.passive else f"{lo} .. {hi}",
+                       "mm" if j.prismatic else "deg"))
+    click.echo(format_table(heads + (("beta [deg]",) if beta else ()) + ("sign", "limits", "unit"),
+                            rows))
     _show_coupling(r)
     for key, label in (("base", "base   T_R_0"), ("flange", "flange T_n_F"), ("tool", "tool   T_F_TCP")):
         v = pose_to_vendor(getattr(r, key), "kuka")

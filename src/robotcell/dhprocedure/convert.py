@@ -48,6 +48,11 @@ def convert_convention(robot: Robot, to: Convention) -> Robot:
         raise InputError(f"target convention must be 'standard' or 'modified', got {to!r}")
     if robot.convention == to:
         return robot
+    tilted = [j.name or str(i) for i, j in enumerate(robot.joints, start=1) if j.beta != 0.0]
+    if tilted:
+        raise InputError(f"{robot.name}: joint(s) {', '.join(tilted)} have a Hayati beta, which "
+                         "has no equivalent row in the other convention; keep the model in its "
+                         "own convention")
     js = robot.joints
     if to == "modified":
         shifted = [(0.0, 0.0)] + [(j.a, j.alpha) for j in js[:-1]]

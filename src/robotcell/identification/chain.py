@@ -18,7 +18,7 @@ Links follow the nominal model's convention (``docs/conventions.md``)::
 
 The rotation ``Ry(beta_i)`` (Hayati and Mirmirani, "Improving the absolute positioning accuracy of
 robot manipulators", J. Robotic Systems 2(4), 1985) is added where the two axes the link joins are
-nominally parallel. There plain DH is discontinuous (a tilt of 0.01 deg moves the common normal
+nominally parallel (or where the nominal model has one: a model identified before). There plain DH is discontinuous (a tilt of 0.01 deg moves the common normal
 metres away), while with ``beta`` every small tilt is a small change of parameters. The joint
 variable enters as ``theta_i = sign_i * qm_i + theta_i`` (revolute) or ``d_i = sign_i * qm_i + d_i``
 (prismatic) with the model joint value ``qm_i = (1 + scale_i) q_i``, plus ``k * q_2`` on joint 3 for
@@ -143,17 +143,17 @@ class Chain:
                 op("rz", f"{nm}.theta", j.theta, "link", *jr)
                 op("tx", f"{nm}.a", j.a, "link")
                 op("rx", f"{nm}.alpha", j.alpha, "link")
-                if parallel:
-                    op("ry", f"{nm}.beta", 0.0, "link")
+                if parallel or j.beta:
+                    op("ry", f"{nm}.beta", j.beta, "link")
             else:
                 parallel = i > 0 and _parallel(z[i - 1], z[i])
                 op("rx", f"{nm}.alpha", j.alpha, "link")
-                if parallel:
-                    op("ry", f"{nm}.beta", 0.0, "link")
+                if parallel or j.beta:
+                    op("ry", f"{nm}.beta", j.beta, "link")
                 op("tx", f"{nm}.a", j.a, "link")
                 op("rz", f"{nm}.theta", j.theta, "link", *jr)
                 op("tz", f"{nm}.d", j.d, "link", *jz)
-            if parallel:
+            if parallel or j.beta:
                 self.beta_joints.append(i)
         self.n_chain_ops = len(ops)
         if pose_target:

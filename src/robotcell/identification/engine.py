@@ -36,7 +36,6 @@ from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from robotcell.calibration.fitting import kabsch, scaled_condition
-from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import COMPLIANT_JOINTS, Chain
 from robotcell.identification.gravity import require_masses
@@ -45,6 +44,7 @@ from robotcell.identification.result import IdentificationResult, Parameter
 from robotcell.ik import analytic_solver
 from robotcell.ik.seeded import SeededSolver
 from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.covariance import ParameterCovariance
 from robotcell.kinematics.robot import Robot
 
 __all__ = ["identify", "identify_with_coupling"]
@@ -453,7 +453,10 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
                                 "length" if (nm.split(".")[-1] in ("a", "d", "x", "y", "z")) else
                                 ("number" if g in ("scale", "coupling") else
                                  "compliance" if g == "compliance" else "angle")))
-    robot = _to_robot(nominal, chain, x, name)
+    arm = [i for i, k in enumerate(kept) if chain.groups[k] in ("link", "scale", "coupling")]
+    covariance = ParameterCovariance(tuple(chain.names[kept[i]] for i in arm),
+                                     cov[np.ix_(arm, arm)])
+    robot = _to_robot(nominal, chain, x, name, covariance)
     return IdentificationResult(
         robot=robot, nominal=nominal, base=chain.base_pose(x), targets=chain.targets(x),
         target=chain.tool_pose(x) if chain.pose_target else None,
@@ -470,23 +473,30 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
     )
 
 
-def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | None) -> Robot:
-    """The identified chain as a DH model (the nominal's convention) via the DH procedure."""
-    pts, dirs, flange = chain.axis_lines(x)
-    axes = AxisChain(points=pts, directions=dirs, types=tuple(j.type for j in nominal.joints),
-                     flange=flange, names=tuple(chain.joint_names),
-                     lower=nominal.lower, upper=nominal.upper)
-    nm = name or f"{nominal.name}_identified"
-    der = dh_from_axes(axes, nominal.convention, signs=[j.sign for j in nominal.joints], name=nm,
-                       title=f"{nominal.title or nominal.name}, identified",
-                       source=f"identified from measurements, nominal {nominal.name}")
-    joints = tuple(replace(j, mass=n.mass, com=n.com) for j, n in zip(der.robot.joints, nominal.joints))
-    tool = chain.tool_pose(x)
-    if not chain.pose_target and chain.n_targets:
-        tool = np.eye(4)
-        tool[:3, 3] = chain.targets(x)[0]
-    return replace(der.robot, joints=joints, tool=tool, home=nominal.home, ik_seed=_ik_seed(nominal),
-                   coupling=_coupling(nominal, chain, x))
+def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | None,
+              covariance: ParameterCovariance | None = None) -> Robot:
+    """The identified chain as a model: the nominal's joints with the identified constants.
+
+    The constants are the parameters of the chain, in the nominal's own convention and frames
+    (signs, offsets; Hayati's ``beta`` where two axes are nearly parallel), so the model file holds
+    the numbers the report prints; the ones held stay at their nominal values (those of joint 1
+    along and about its axis keep the robot base frame R the nominal's). Base, flange, tool and
+    limits are the nominal's: the measured target is not the arm's tool
+    (:attr:`IdentificationResult.target_tool`). ``covariance``: that of the arm's constants.
+    """
+    def value(joint: str, key: str, nominal_value: float) -> float:
+        label = f"{joint}.{key}"
+        return float(x[chain.index(label)]) if label in chain.names else nominal_value
+
+    joints = tuple(replace(j, a=value(nm, "a", j.a), alpha=value(nm, "alpha", j.alpha),
+                           d=value(nm, "d", j.d), theta=value(nm, "theta", j.theta),
+                           beta=value(nm, "beta", j.beta))
+                   for j, nm in zip(nominal.joints, chain.joint_names))
+    return replace(nominal, name=name or f"{nominal.name}_identified", joints=joints,
+                   title=f"{nominal.title or nominal.name}, identified",
+                   source=f"identified from measurements, nominal {nominal.name}", verified=False,
+                   verification="", ik_seed=_ik_seed(nominal), coupling=_coupling(nominal, chain, x),
+                   covariance=covariance)
 
 
 def _coupling(nominal: Robot, chain: Chain, x: NDArray[np.float64]) -> Coupling | None:

@@ -188,7 +188,7 @@ def calibrate_positioner(
     T_R_B = np.eye(4)
     T_R_B[:3, :3], T_R_B[:3, 3] = geo["R"], geo["origin"]
     values = {"T_R_B": T_R_B, **{k: geo[k] if np.size(geo[k]) > 1 else float(geo[k]) for k in keys}}
-    robot = replace(ident.robot, base=ident.base @ ident.robot.base)
+    robot = replace(ident.robot, base=ident.base @ ident.robot.base, tool=ident.target_tool)
     res = ident.residuals[:, 0, :]
     warnings = []
     if ident.condition > CONDITION_LIMIT:

@@ -61,11 +61,11 @@ class IdentificationResult:
     Attributes
     ----------
     robot : Robot
-        The identified model (nominal convention, names, signs, limits). Its FK takes the
-        controller values: identified scales and J2/J3 factor are its ``coupling``; ``ik_seed``
-        is the nominal model (when that has an analytic IK); its tool is the
-        measured target (the first reflector for points), so ``base @ robot.fk(q)`` predicts the
-        measurement in the device frame.
+        The identified model: the nominal's joints (convention, names, signs, limits) with the
+        identified constants, Hayati's ``beta`` at nearly parallel axes, and the nominal's base,
+        flange and tool. Its FK takes the controller values: identified scales and J2/J3 factor
+        are its ``coupling``; ``ik_seed`` is the nominal model (when that has an analytic IK).
+        ``base @ robot.fk(q, tool=target_tool)`` predicts the measurement in the device frame.
     nominal : Robot
     base : ndarray, shape (4, 4)
         ``T_D_R``: the robot base in the device frame (m).
@@ -155,6 +155,19 @@ class IdentificationResult:
     def row_errors(self) -> NDArray[np.float64]:
         """Position error per row (largest over its targets), shape (N,), m."""
         return np.linalg.norm(self.residuals, axis=-1).max(axis=1)
+
+    @property
+    def target_tool(self) -> NDArray[np.float64]:
+        """``T_F_T``: the measured target as a tool on the flange, shape (4, 4) (m).
+
+        The target frame for pose measurements, else the first reflector (identity rotation).
+        """
+        if self.target is not None:
+            return self.target.copy()
+        T = np.eye(4)
+        if len(self.targets):
+            T[:3, 3] = self.targets[0]
+        return T
 
     def parameter(self, name: str) -> Parameter:
         """The parameter called ``name``."""

@@ -30,7 +30,7 @@ from robotcell.ik.analytic import solve
 from robotcell.ik.result import IKSolutions
 from robotcell.kinematics.bounds import within
 from robotcell.kinematics.robot import Joint, Robot
-from robotcell.kinematics.transforms import invert, make_pose, rot_x, validate_pose
+from robotcell.kinematics.transforms import invert, make_pose, rot_x, rot_y, validate_pose
 
 __all__ = ["TrackChoice", "TrackRobot"]
 
@@ -210,8 +210,9 @@ class TrackRobot:
         arm = self.arm
         j1 = arm.joints[0]
         C = self.T_L_R0 @ arm.base  # arm DH frame 0 (standard) in L
-        if arm.convention == "modified":
-            C = C @ make_pose(rot_x(j1.alpha), [j1.a, 0.0, 0.0])  # the constant part of row 1
+        if arm.convention == "modified":  # the constant part of row 1: Rx(alpha) Ry(beta) Tx(a)
+            R1 = rot_x(j1.alpha) @ rot_y(j1.beta)
+            C = C @ make_pose(R1, R1 @ [j1.a, 0.0, 0.0])
         u, zc, xc = self.direction, C[:3, 2], C[:3, 0]
         n = np.cross(u, zc)
         s = float(np.linalg.norm(n))
@@ -229,7 +230,7 @@ class TrackRobot:
             first = replace(j1, theta=j1.theta + gamma)
         else:
             track = Joint("prismatic", 0.0, 0.0, 0.0, 0.0, 1.0, self.lower, self.upper, "track")
-            first = replace(j1, a=0.0, alpha=alpha, theta=j1.theta + gamma)
+            first = replace(j1, a=0.0, alpha=alpha, beta=0.0, theta=j1.theta + gamma)
         home = None
         if arm.home is not None:
             mid = 0.5 * (self.lower + self.upper) if math.isfinite(self.lower + self.upper) else 0.0

@@ -2,15 +2,19 @@
 
 Standard DH (the lecture's form)::
 
-    T_{i-1,i} = Trans(z, d_i) Rot(z, theta_i) Trans(x, a_i) Rot(x, alpha_i)
+    T_{i-1,i} = Trans(z, d_i) Rot(z, theta_i) Trans(x, a_i) Rot(x, alpha_i) [Rot(y, beta_i)]
 
 Modified DH (Craig)::
 
-    T_{i-1,i} = Rot(x, alpha_{i-1}) Trans(x, a_{i-1}) Rot(z, theta_i) Trans(z, d_i)
+    T_{i-1,i} = Rot(x, alpha_{i-1}) [Rot(y, beta_i)] Trans(x, a_{i-1}) Rot(z, theta_i) Trans(z, d_i)
+
+``Rot(y, beta_i)`` is Hayati's extra twist (Hayati and Mirmirani, J. Robotic Systems 2(4), 1985)
+of an identified link whose two axes are nearly parallel, where plain DH would put their common
+normal metres away; it is 0 (and costs nothing) everywhere else.
 
 :func:`link_transform` builds these matrices directly (the reference, used in tests and by
 whoever wants one link). :class:`Chain` compiles a whole chain into a list of elementary
-operations (rotations about z or x, translations along z or x) with the constants folded: a zero
+operations (rotations about z or x, or y for a beta, translations along z or x) with the constants folded: a zero
 offset costs nothing and a twist of +-90 degrees is a swap of two columns. Applying those
 operations column by column to a batch is several times faster than multiplying ``(N, 4, 4)``
 matrices, and the same program evaluated with Python floats makes a single pose cheap.
@@ -37,7 +41,7 @@ _BLOCK = 2048
 
 def link_transform(
     theta: ArrayLike, d: ArrayLike, a: ArrayLike, alpha: ArrayLike,
-    convention: Convention = "standard",
+    convention: Convention = "standard", beta: float = 0.0,
 ) -> NDArray[np.float64]:
     """One DH link transform ``T_{i-1,i}``.
 
@@ -47,6 +51,8 @@ def link_transform(
         Joint angle (rad), joint distance (m), link length (m), twist (rad). For the modified
         convention ``a`` and ``alpha`` are Craig's ``a_{i-1}`` and ``alpha_{i-1}``.
     convention : {"standard", "modified"}
+    beta : float
+        Hayati's rotation about y after the twist (rad; 0 for plain DH).
 
     Returns
     -------
@@ -66,14 +72,27 @@ def link_transform(
     else:
         raise ValueError(f"convention must be 'standard' or 'modified', got {convention!r}")
     T[..., 3, 3] = 1.0
-    return T
+    if beta == 0.0:
+        return T
+    cb, sb = math.cos(beta), math.sin(beta)
+    if convention == "standard":
+        Ry = np.array([[cb, 0.0, sb, 0.0], [0.0, 1.0, 0.0, 0.0], [-sb, 0.0, cb, 0.0],
+                       [0.0, 0.0, 0.0, 1.0]])
+        return T @ Ry
+    # Rx(alpha) Ry(beta) Tx(a), then Rz(theta) Tz(d) (the plain link with a = alpha = 0)
+    P = np.zeros(theta.shape + (4, 4))
+    P[..., 0, :] = np.stack([np.full_like(ca, cb), np.zeros_like(ca), np.full_like(ca, sb), a * cb], axis=-1)
+    P[..., 1, :] = np.stack([sa * sb, ca, -sa * cb, a * sa * sb], axis=-1)
+    P[..., 2, :] = np.stack([-ca * sb, sa, ca * cb, -a * ca * sb], axis=-1)
+    P[..., 3, 3] = 1.0
+    return P @ link_transform(theta, d, 0.0, 0.0, "modified")
 
 
 @dataclass(frozen=True)
 class _Op:
     """One elementary operation ``T <- T @ op``.
 
-    ``kind`` is ``rz``/``rx`` (rotation) or ``tz``/``tx`` (translation). A variable operation
+    ``kind`` is ``rz``/``rx``/``ry`` (rotation) or ``tz``/``tx`` (translation). A variable operation
     reads joint ``joint`` and uses ``sign * q + value``; a constant one uses ``value``. ``quarter``
     is set for constant rotations by an exact multiple of 90 degrees (0..3 quarter turns).
     """
@@ -102,9 +121,12 @@ class Chain:
     prismatic : sequence of bool, length n
     sign : sequence of float, length n
         +1 or -1: the DH variable is ``sign * q + offset``.
+    beta : sequence of float, length n, optional
+        Hayati's rotation about y after each twist (rad); default none.
     """
 
-    def __init__(self, convention: Convention, a, alpha, d, theta, prismatic, sign) -> None:
+    def __init__(self, convention: Convention, a, alpha, d, theta, prismatic, sign,
+                 beta=None) -> None:
         self.convention = convention
         self.n = len(a)
         ops: list[_Op] = []
@@ -114,7 +136,9 @@ class Chain:
             z_rot = _Op("rz", theta[i], i, sign[i]) if not prismatic[i] else self._const("rz", theta[i])
             z_tr = _Op("tz", d[i], i, sign[i]) if prismatic[i] else self._const("tz", d[i])
             x_tr, x_rot = self._const("tx", a[i]), self._const("rx", alpha[i])
-            seq = [z_tr, z_rot, x_tr, x_rot] if convention == "standard" else [x_rot, x_tr, z_rot, z_tr]
+            y_rot = None if beta is None else self._const("ry", beta[i])
+            seq = ([z_tr, z_rot, x_tr, x_rot, y_rot] if convention == "standard"
+                   else [x_rot, y_rot, x_tr, z_rot, z_tr])
             ops.extend(op for op in seq if op is not None)
             self.frame_ends.append(len(ops))
         self.ops = tuple(ops)
@@ -123,9 +147,9 @@ class Chain:
         self._rot_row = {j: r for r, j in enumerate(rot)}
         self._sign = np.array([sign[j] for j in rot], dtype=float)
         self._offset = np.array([theta[j] for j in rot], dtype=float)
-        # The single-pose program: (code, joint, sign, value, quarter) with code 0..3 for
-        # rz, rx, tz, tx.
-        codes = {"rz": 0, "rx": 1, "tz": 2, "tx": 3}
+        # The single-pose program: (code, joint, sign, value, quarter) with code 0..4 for
+        # rz, rx, tz, tx, ry.
+        codes = {"rz": 0, "rx": 1, "tz": 2, "tx": 3, "ry": 4}
         self._program = tuple((codes[op.kind], op.joint, op.sign, op.value, op.quarter) for op in ops)
 
     @staticmethod
@@ -182,8 +206,8 @@ class Chain:
         ends = set(self.frame_ends) if frames else ()
         for k, op in enumerate(self.ops, start=1):
             kind = op.kind
-            if kind in ("rz", "rx"):
-                i, j = (0, 1) if kind == "rz" else (1, 2)
+            if kind in ("rz", "rx", "ry"):
+                i, j = {"rz": (0, 1), "rx": (1, 2), "ry": (2, 0)}[kind]
                 ci, cj = cols[i], cols[j]
                 if op.quarter == 1:
                     cols[i], cols[j] = cj, -ci
@@ -262,8 +286,12 @@ class Chain:
                                               c * c0 - s * b0, c * c1 - s * b1, c * c2 - s * b2)
             elif code == 2:
                 p0, p1, p2 = p0 + v * c0, p1 + v * c1, p2 + v * c2
-            else:
+            elif code == 3:
                 p0, p1, p2 = p0 + v * a0, p1 + v * a1, p2 + v * a2
+            else:  # a constant rotation about y (Hayati's beta): columns z and x
+                c, s = cos(v), sin(v)
+                c0, c1, c2, a0, a1, a2 = (c * c0 + s * a0, c * c1 + s * a1, c * c2 + s * a2,
+                                          c * a0 - s * c0, c * a1 - s * c1, c * a2 - s * c2)
         return [a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2]
 
 

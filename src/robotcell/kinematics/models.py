@@ -30,17 +30,19 @@ from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.io.yamlfile import dump_yaml, parse_yaml
 from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.covariance import ParameterCovariance, parameter_kind
 from robotcell.kinematics.robot import Joint, Robot
 
 __all__ = ["list_robots", "load_robot", "robot_from_dict", "robot_to_dict", "save_robot"]
 
 _LENGTH = {"mm": 1e-3, "m": 1.0}
 _ANGLE = {"deg": math.pi / 180, "rad": 1.0}
-_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "sign", "min", "max", "name", "passive", "mass", "com"}
+_JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "beta", "sign", "min", "max", "name", "passive",
+               "mass", "com"}
 _COUPLING_KEYS = {"j23_factor", "matrix", "offset", "interaction"}
 _POSE_KEYS = {"x", "y", "z", "a", "b", "c"}
 _TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
-             "source", "verified", "verification", "coupling", "ik_seed"}
+             "source", "verified", "verification", "coupling", "ik_seed", "covariance"}
 
 
 def _library_dir():
@@ -191,6 +193,7 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
             alpha=_number(jd["alpha"], f"{where}: key 'alpha'") * as_,
             d=_number(jd["d"], f"{where}: key 'd'") * ls,
             theta=_number(jd["theta"], f"{where}: key 'theta'") * as_,
+            beta=_number(jd.get("beta", 0.0), f"{where}: key 'beta'") * as_,
             sign=sign, lower=lo, upper=hi, name=str(jd.get("name", f"P{i}" if passive else f"A{i}")),
             passive=passive,
         ))
@@ -202,6 +205,8 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
                          "how they move")
     if "ik_seed" in data:
         kwargs["ik_seed"] = _ik_seed(data["ik_seed"], origin)
+    if "covariance" in data:
+        kwargs["covariance"] = _covariance(data["covariance"], origin, ls, as_)
     for key in ("base", "flange", "tool"):
         if key in data:
             kwargs[key] = _pose(data[key], f"{origin}: key '{key}'", ls, as_)
@@ -261,6 +266,30 @@ def _ik_seed(value: Any, origin: str) -> Robot:
     if isinstance(value, dict):
         return robot_from_dict(value, where)
     raise InputError(f"{where} must be a library robot name or a nested model mapping")
+
+
+def _unit_scales(names: tuple[str, ...], ls: float, as_: float) -> np.ndarray:
+    """Per parameter, the SI value of one file unit (length ``ls``, angle ``as_``, number 1)."""
+    return np.array([{"length": ls, "angle": as_, "number": 1.0}[parameter_kind(n)] for n in names])
+
+
+def _covariance(value: Any, origin: str, ls: float, as_: float) -> ParameterCovariance:
+    """Parse key ``covariance`` (file units) into a :class:`ParameterCovariance` in SI units."""
+    where = f"{origin}: key 'covariance'"
+    _mapping(value, where, {"parameters", "matrix"},
+             f"{where} must be a mapping with keys parameters, matrix", ("parameters", "matrix"))
+    names, rows = value["parameters"], value["matrix"]
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise InputError(f"{where}.parameters must be a list of names (A2.a, A3.beta, ...)")
+    if not isinstance(rows, list) or not all(isinstance(r, list) for r in rows):
+        raise InputError(f"{where}.matrix must be a list of rows")
+    M = np.array([[_number(v, f"{where}.matrix row {i}") for v in r]
+                  for i, r in enumerate(rows, start=1)] if rows else np.zeros((0, 0)))
+    try:
+        s = _unit_scales(tuple(names), ls, as_)
+        return ParameterCovariance(tuple(names), M * s[:, None] * s[None, :])
+    except (InputError, ValueError) as exc:
+        raise InputError(f"{where}: {exc}") from None
 
 
 def _coupling(value: Any, joints: list[Joint], origin: str, ls: float, as_: float) -> Coupling:
@@ -332,10 +361,11 @@ def _coupling_to_dict(robot: Robot) -> dict[str, Any]:
     s_axis = np.array([1e3 if j.prismatic else 180 / math.pi for j in robot.axes])
     out: dict[str, Any]
     if k is not None:
-        out = {"j23_factor": _clean(k)}
+        out = {"j23_factor": _clean(k, 12)}
     else:
         C = c.matrix * s_model[:, None] / s_axis[None, :]
-        out = {"matrix": [[_clean(float(v)) for v in row] for row in C]}
+        # 12 decimals: an identified scale of 1e-6 times a turn moves the TCP by micrometres
+        out = {"matrix": [[_clean(float(v), 12) for v in row] for row in C]}
         if np.any(c.offset):
             out["offset"] = [_clean(float(v)) for v in c.offset * s_model]
     limits = []
@@ -361,6 +391,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
             "name": j.name, "type": j.type, "a": j.a * 1e3, "alpha": math.degrees(j.alpha),
             "d": j.d * 1e3, "theta": math.degrees(j.theta), "sign": int(j.sign),
         }
+        if j.beta != 0.0:
+            entry["beta"] = math.degrees(j.beta)
         if math.isfinite(j.lower):
             entry["min"] = j.lower * qs
         if math.isfinite(j.upper) and not j.passive:
@@ -384,6 +416,12 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         data["coupling"] = _coupling_to_dict(robot)
     if robot.ik_seed is not None:
         data["ik_seed"] = _ik_seed_to_dict(robot.ik_seed)
+    if robot.covariance is not None:
+        cov = robot.covariance
+        s = 1.0 / _unit_scales(cov.names, 1e-3, math.pi / 180)
+        M = cov.matrix * s[:, None] * s[None, :]
+        data["covariance"] = {"parameters": list(cov.names),
+                              "matrix": [[float(f"{v:.12g}") for v in row] for row in M]}
     if robot.home is not None:
         data["home"] = [
             _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.axes)
@@ -401,10 +439,10 @@ def _ik_seed_to_dict(seed: Robot) -> str | dict[str, Any]:
     return data
 
 
-def _clean(v: Any) -> Any:
-    """A plain Python int or float (YAML cannot write numpy scalars), rounded to 9 decimals."""
+def _clean(v: Any, decimals: int = 9) -> Any:
+    """A plain Python int or float (YAML cannot write numpy scalars), rounded to ``decimals``."""
     if isinstance(v, (float, np.floating)):
-        r = round(float(v), 9)
+        r = round(float(v), decimals)
         return int(r) if r == int(r) and abs(r) < 1e15 else r
     if isinstance(v, np.integer):
         return int(v)

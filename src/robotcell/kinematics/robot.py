@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.coupling import Coupling
+from robotcell.kinematics.covariance import ParameterCovariance
 from robotcell.kinematics.dh import Chain, Convention
 from robotcell.kinematics.transforms import validate_pose
 
@@ -58,6 +59,10 @@ class Joint:
         compliance in identification.
     com : tuple of 3 float
         Centre of mass of that link in its DH frame (m).
+    beta : float
+        Hayati's rotation about the link's y axis after the twist (rad; 0 for plain DH): standard
+        ``Tz(d) Rz(theta) Tx(a) Rx(alpha) Ry(beta)``, modified ``Rx(alpha) Ry(beta) Tx(a) Rz(theta)
+        Tz(d)``. An identified arm has it where two axes are nearly parallel (docs/models.md).
     """
 
     type: Literal["revolute", "prismatic"]
@@ -72,6 +77,7 @@ class Joint:
     passive: bool = False
     mass: float = 0.0
     com: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    beta: float = 0.0
 
     @property
     def prismatic(self) -> bool:
@@ -108,6 +114,9 @@ class Robot:
     ik_seed : Robot or None
         A nearby model with a closed-form IK (an identified arm's nominal model): when this model
         has none, :meth:`ik` refines the seed's analytic branches numerically (docs/ik.md).
+    covariance : ParameterCovariance or None
+        An identified model's: the covariance of the constants the identification moved
+        (docs/accuracy.md).
     """
 
     name: str
@@ -123,6 +132,7 @@ class Robot:
     verification: str = ""
     coupling: Coupling | None = None
     ik_seed: Robot | None = None
+    covariance: ParameterCovariance | None = None
 
     def __post_init__(self) -> None:
         if self.convention not in ("standard", "modified"):
@@ -145,6 +155,13 @@ class Robot:
                 f"(non-passive) axis, shape ({len(self.joints)}, {len(axes)}); got "
                 f"{self.coupling.matrix.shape}"
             )
+        if self.covariance is not None:
+            known = {j.name or f"A{i}" for i, j in enumerate(self.joints, start=1)}
+            bad = [n for n in self.covariance.names
+                   if n != "j23_factor" and n.rpartition(".")[0] not in known]
+            if bad:
+                raise InputError(f"covariance: parameter(s) {', '.join(bad)} of no joint of this "
+                                 f"robot (joints {', '.join(sorted(known))})")
         object.__setattr__(self, "_axes", axes)
         for key in ("base", "flange", "tool"):
             object.__setattr__(self, key, validate_pose(getattr(self, key), key).copy())
@@ -152,7 +169,8 @@ class Robot:
             object.__setattr__(self, "home", self._joints(self.home, "home"))
         js = self.joints
         chain = Chain(self.convention, [j.a for j in js], [j.alpha for j in js], [j.d for j in js],
-                      [j.theta for j in js], [j.prismatic for j in js], [j.sign for j in js])
+                      [j.theta for j in js], [j.prismatic for j in js], [j.sign for j in js],
+                      [j.beta for j in js])
         object.__setattr__(self, "_chain", chain)
         tail = self.flange @ self.tool
         object.__setattr__(self, "_tail", tail)

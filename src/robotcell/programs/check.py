@@ -17,6 +17,11 @@ says what is wrong with it:
   may move the axes as far as they like.
 
 A point is good when it has no problem; the program is good when every point is.
+
+In a cell with an identified arm the controller still computes with its nominal model: a
+Cartesian point's joints are the nominal arm's solution in the configuration written
+(:meth:`~robotcell.cell.model.Cell.controller`), and its TCP is where the identified arm takes those
+joints, so a filtered program is checked where it really goes (docs/accuracy.md).
 """
 
 from __future__ import annotations
@@ -264,7 +269,8 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     InputError
         A YASKAWA program for a cell with station axes and no ``pulses_per_degree``.
     """
-    robot = cell.robot
+    ctrl = cell.controller()
+    robot = ctrl.robot
     axes = external_axes(cell, program.vendor, pulses_per_degree)
     pts = program.points
     n = len(pts)
@@ -275,7 +281,7 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     cart = [i for i, (p, r) in enumerate(zip(pts, res))
             if p.pose is not None and r.where is not None and r.T_F_TCP is not None]
     if cart:
-        _solve_cartesian(cell, pts, res, cart, q, T_world, problems)
+        _solve_cartesian(ctrl, pts, res, cart, q, T_world, problems)
     for i, (p, r) in enumerate(zip(pts, res)):
         if p.joints is not None:
             q[i] = p.joints
@@ -283,7 +289,11 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
                 problems[i].append(_outside(robot, p.joints))
             if r.T_F_TCP is not None:
                 T_world[i] = cell.fk(p.joints, r.track, r.table, tool=r.T_F_TCP)
-    _sequential(cell, pts, res, q, T_world, problems)
+    _sequential(ctrl, pts, res, q, T_world, problems)
+    if cell.identified is not None:  # where the real arm takes the controller's joints
+        for i in cart:
+            if np.isfinite(q[i]).all():
+                T_world[i] = cell.fk(q[i], res[i].track, res[i].table, tool=res[i].T_F_TCP)
     wrist, elbow, shoulder = singular_distances(robot, np.nan_to_num(q))
     for i in range(n):
         if np.isnan(q[i]).any():

@@ -31,10 +31,10 @@ from robotcell.errors import InputError
 from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.programs.config import config_text
-from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
 from robotcell.programs.text import Lines, fmt_num
 
-__all__ = ["read", "write"]
+__all__ = ["parse_config", "read", "write"]
 
 _POSE_KEYS = ("X", "Y", "Z", "W", "P", "R")
 #: Longest comment line of the TP editor (characters after ``!``).
@@ -125,19 +125,35 @@ _FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*P
 _SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|cm/min|inch/min|deg/sec|sec|msec|%)", re.IGNORECASE)
 
 
-def _config(text: str, lines: Lines, lineno: int) -> Config:
-    """``'N U T, 0, 0, 0'`` as FANUC flags (flip, down, back) and turn numbers."""
+def parse_config(text: str) -> Config:
+    """``N U T, 0, 0, 0`` (a FANUC ``CONFIG`` string) as flags (flip, down, back) and turns.
+
+    Raises
+    ------
+    InputError
+        Text that is not ``F|N U|D T|B, t1, t4, t6`` with integer turn numbers.
+    """
     head, *turns = [t.strip() for t in text.split(",")]
     letters = head.split()
     if len(letters) != 3 or letters[0] not in "NF" or letters[1] not in "UD" \
             or letters[2] not in "TB" or len(turns) != 3:
-        raise lines.error(lineno, f"CONFIG '{text}' is not 'F|N U|D T|B, t1, t4, t6'")
+        raise InputError(f"CONFIG '{text}' is not 'F|N U|D T|B, t1, t4, t6'")
     try:
-        t = tuple(lines.integer(x, lineno) for x in turns)
+        t = tuple(int(x) for x in turns)
     except ValueError:
-        raise lines.error(lineno, f"CONFIG '{text}': the turn numbers must be integers") from None
+        raise InputError(f"CONFIG '{text}': the turn numbers must be integers") from None
+    if max(abs(x) for x in t) >= FLAG_LIMIT:
+        raise InputError(f"CONFIG '{text}': a turn number that large is a typing error")
     return Config("fanuc", (int(letters[0] == "F"), int(letters[1] == "D"),
                             int(letters[2] == "B"), *t))
+
+
+def _config(text: str, lines: Lines, lineno: int) -> Config:
+    """:func:`parse_config`, the error naming the file and line."""
+    try:
+        return parse_config(text)
+    except InputError as exc:
+        raise lines.error(lineno, str(exc)) from None
 
 
 class _Position:

@@ -33,7 +33,7 @@ from robotcell.io.export.kuka import MACHINE_INDEX
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.programs.config import config_text
-from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
 from robotcell.programs.text import Lines, fmt_num, strip_comment
 
 __all__ = ["read", "write"]
@@ -176,15 +176,19 @@ def _int_value(text: str, lines: Lines, lineno: int) -> int:
     t = text.strip().strip("'")
     try:
         if t[:1] in "Bb" and len(t) > 1:
-            return lines.integer(t[1:], lineno, 2)
-        if t[:1] in "Hh" and len(t) > 1:
-            return lines.integer(t[1:], lineno, 16)
-        v = float(t)
-        if not abs(v) <= MAX_ABS_VALUE:  # NaN, infinite, 1e300
-            raise ValueError(t)
-        return int(v)
+            v = lines.integer(t[1:], lineno, 2)
+        elif t[:1] in "Hh" and len(t) > 1:
+            v = lines.integer(t[1:], lineno, 16)
+        else:
+            f = float(t)
+            if not abs(f) <= MAX_ABS_VALUE:  # NaN, infinite, 1e300
+                raise ValueError(t)
+            v = int(f)
     except ValueError:
-        raise lines.error(lineno, f"{text.strip()!r} is not a status or turn value") from None
+        v = FLAG_LIMIT
+    if abs(v) >= FLAG_LIMIT:
+        raise lines.error(lineno, f"{text.strip()!r} is not a status or turn value")
+    return v
 
 
 class _Point:

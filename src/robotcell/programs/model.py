@@ -18,10 +18,15 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MOTIONS", "PTP_SPEED", "VENDORS", "Config", "Program", "ProgramPoint", "Ref"]
+__all__ = ["FLAG_LIMIT", "MOTIONS", "PTP_SPEED", "VENDORS", "Config", "Program", "ProgramPoint",
+           "Ref"]
 
 #: Program formats: one per controller family.
 VENDORS = ("kuka", "abb", "fanuc", "yaskawa")
+
+#: Largest size of a configuration value (a flag, a quadrant or turn count) a file may write: a
+#: larger one is a typing error, not a configuration of an arm.
+FLAG_LIMIT = 2**31
 
 #: Motions a point is reached with: joint interpolation, or a straight line of the TCP.
 MOTIONS = ("ptp", "lin")

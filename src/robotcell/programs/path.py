@@ -99,7 +99,7 @@ def _limits(values: NDArray[np.float64], lo: float, hi: float, what: str, unit: 
                          f"outside the {what} limits [{lo * unit:g}, {hi * unit:g}]")
 
 
-def read_path(path: str | Path, cell: Cell) -> PathTargets:
+def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> PathTargets:
     """Read a path file for ``cell``.
 
     Parameters
@@ -108,6 +108,8 @@ def read_path(path: str | Path, cell: Cell) -> PathTargets:
         CSV with the columns of the module's table.
     cell : Cell
         Says which external axis columns exist and their limits.
+    extra : tuple of str
+        Further columns the caller reads itself (not named as unused).
 
     Returns
     -------
@@ -123,7 +125,7 @@ def read_path(path: str | Path, cell: Cell) -> PathTargets:
     p = str(path)
     cols = read_csv(path)
     tcols = table_columns(cell)
-    known = [*_POSE, "motion", "speed", "zone", "track", *tcols, "name"]
+    known = [*_POSE, "motion", "speed", "zone", "track", *tcols, "name", *extra]
     warnings = [f"{p}: column(s) {', '.join(unknown)} not used and ignored; check the spelling"
                 for unknown in [unknown_columns(cols, known)] if unknown]
     T = pose_from_vendor(require_columns(cols, _POSE, p), "kuka")

@@ -12,8 +12,6 @@ to the old joints. Only the joint values in the files change; every other line i
 
 from __future__ import annotations
 
-import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,16 +25,13 @@ from robotcell.ik.select import nearest
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.axes import external_axes
+from robotcell.programs.edit import set_joints
 from robotcell.programs.files import write_all
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import tool_pose_of
 from robotcell.programs.model import Program, ProgramPoint
-from robotcell.programs.text import fmt_num
 
 __all__ = ["RetargetFailed", "RetargetResult", "RetargetedPoint", "retarget_program"]
-
-#: Decimals of the joint values written (deg): 1e-9 deg.
-JOINT_DECIMALS = 9
 
 
 class RetargetFailed(RobotcellError):
@@ -122,46 +117,6 @@ def _solve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
     return out, problems
 
 
-def _set_kuka(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
-    line = lines[idx]
-    for i in range(6):
-        line, n = re.subn(rf"(\bA{i + 1}\s+)[-+0-9.eE]+", lambda m, v=q[i]: m.group(1)
-                          + fmt_num(math.degrees(v), JOINT_DECIMALS), line, count=1,
-                          flags=re.IGNORECASE)
-        if n != 1:
-            return False
-    lines[idx] = line
-    return True
-
-
-def _set_abb(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
-    line = lines[idx]
-    m = re.search(r"\[\s*\[([^\[\]]*)\]", line)
-    if not m or len(m.group(1).split(",")) != 6:
-        return False
-    values = ",".join(fmt_num(math.degrees(v), JOINT_DECIMALS) for v in q)
-    lines[idx] = line[:m.start(1)] + values + line[m.end(1):]
-    return True
-
-
-def _set_fanuc(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
-    done = 0
-    for k in range(idx, len(lines)):
-        if k > idx and re.match(r"^\s*GP[2-9]\s*:", lines[k]):
-            break
-        for i in range(6):
-            lines[k], n = re.subn(rf"(\bJ{i + 1}\s*=\s*)[-+0-9.eE]+",
-                                  lambda m, v=q[i]: m.group(1)
-                                  + fmt_num(math.degrees(v), JOINT_DECIMALS), lines[k], count=1)
-            done += n
-        if "};" in lines[k]:
-            break
-    return done == 6
-
-
-_SETTERS = {"kuka": _set_kuka, "abb": _set_abb, "fanuc": _set_fanuc}
-
-
 def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
                      pulses_per_degree: ArrayLike | None = None,
                      inputs: tuple[str | Path, ...] = ()) -> RetargetResult:
@@ -198,7 +153,7 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
     vendor = program.vendor
     joint = [p for p in program.points if p.joints is not None]
     result = RetargetResult(program, cartesian=len(program.points) - len(joint))
-    if joint and vendor not in _SETTERS:
+    if joint and vendor not in ("kuka", "abb", "fanuc"):
         raise InputError(f"{path}: {vendor} joint points are not retargeted")
     moved, problems = _solve(old, new, joint, vendor, pulses_per_degree)
     if problems:
@@ -208,7 +163,7 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
                                    for f in program.files}
     for p, r in zip(joint, moved):
         file, _, line = p.where.rpartition(":")
-        if not _SETTERS[vendor](texts[file], int(line) - 1, r.q_new):
+        if not set_joints(vendor, texts[file], int(line) - 1, r.q_new):
             raise RetargetFailed(f"nothing written: {p.name}: cannot find its six axis values "
                                  f"on {file} line {line}")
     out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}

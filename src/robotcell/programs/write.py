@@ -8,9 +8,10 @@ a joint limit, a configuration change) raises :class:`PathBreaks` naming the poi
 with ``split`` every continuous piece becomes its own program.
 
 The Cartesian values a program holds come from one function, :func:`written_poses`: the pose of
-the TCP, computed from the joints by the FK of the cell (or of a ``controller`` cell: the model
-the controller itself uses, when the joints were solved on another, e.g. identified, arm), in
-the frame the program measures its points in.
+the TCP, computed from the joints by the FK of the cell's controller model (the nominal arm of a
+cell with an identified one: :meth:`~robotcell.cell.model.Cell.controller`; or of a given
+``controller`` cell), in the frame the program measures its points in. Joints solved on the
+identified arm and written through the nominal one are filtered points (docs/accuracy.md).
 """
 
 from __future__ import annotations
@@ -165,7 +166,9 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
     split : bool
         Write one program per continuous piece instead of refusing a path that breaks.
     controller : Cell, optional
-        The cell whose FK gives the Cartesian values written (default ``cell``).
+        The cell whose FK gives the Cartesian values written (default ``cell.controller()``: the
+        cell itself, or with an identified arm the cell with its nominal arm, so that the
+        controller's own model takes the written points to the joints solved on the real arm).
     pulses_per_degree : float or array_like, optional
         YASKAWA: encoder pulses per degree of each station axis.
     max_step : float
@@ -200,8 +203,8 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
         q[a:b], track[a:b], table[a:b] = path.q, path.track, path.table
         owner[a:b] = k
         pname = base_name if len(pieces) == 1 else _piece_name(base_name, k + 1, vendor)
-        programs.append(_program(controller or cell, targets, a, b, path, pname, vendor,
-                                 tool_ref, frame_ref, where, axes))
+        programs.append(_program(controller or cell.controller(), targets, a, b, path, pname,
+                                 vendor, tool_ref, frame_ref, where, axes))
     return WriteResult([], programs, q, track, table, breaks, owner, list(targets.warnings))
 
 

@@ -19,6 +19,9 @@ from its layout position, a workpiece clamped off its nominal place. The demo
    following the seam, as ``robotcell program write`` does (``program/seam.src``);
 6. writes the interactive 3D views of the calibrated cell (``cell.html``) and of the program,
    the arm at each of its points (``program.html``, as ``robotcell view --program`` does).
+7. identifies a virtual arm that is not quite its drawing from simulated laser-tracker data and
+   filters a path through it (:mod:`robotcell.studies.demo_accuracy`), printing how far the real
+   arm misses the path without filtering and with it.
 """
 
 from __future__ import annotations
@@ -45,6 +48,7 @@ from robotcell.io.tables import read_csv, write_csv
 from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_y
 from robotcell.programs import write_program
+from robotcell.studies.demo_accuracy import accuracy_step
 from robotcell.studies.plan import pose_error
 from robotcell.studies.simulate import simulate
 from robotcell.view.cellscene import cell_figure
@@ -229,6 +233,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
     echo(_comparison_table(comparisons))
     _write_outputs(out, calibrated, results, echo)
+    accuracy_step(out, seed, echo)
     echo(f"\ndone in {time.perf_counter() - t_start:.1f} s; everything is in {out}/")
     return comparisons
 

@@ -1,0 +1,96 @@
+"""Putting an identified arm into a cell file: the model file and ``robot.identified``, together.
+
+``robotcell identify ... -o ARM.yaml --cell CELL.yaml`` writes the identified model file and sets
+the cell's ``robot.identified`` to it, with the identification's provenance (time, RMS of the
+residuals, held-out error of the cross-validation). Both files change or neither: everything is
+checked first (the model is an identification of the cell's arm, both destinations can be
+written), then the model file is written atomically, then the cell file is saved (atomically,
+with a numbered backup); if that fails the model file is put back as it was.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotcell.cell.model import Cell, Provenance
+from robotcell.cell.schema import cell_to_dict, load_cell
+from robotcell.errors import InputError
+from robotcell.identification.result import IdentificationResult
+from robotcell.identification.validation import CrossValidation
+from robotcell.io.fileio import atomic_write, check_destination, read_text
+from robotcell.kinematics.models import save_robot
+
+__all__ = ["adopt_identified", "identification_provenance"]
+
+
+def identification_provenance(result: IdentificationResult,
+                              cross: CrossValidation | None = None) -> Provenance:
+    """The provenance of an identified arm: now, its RMS, rows, and the held-out error.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    cross : CrossValidation, optional
+        A cross-validation of the same measurements; its held-out RMS goes into the note.
+
+    Returns
+    -------
+    Provenance
+        ``source: identify``, ``rms_mm`` the identified model's residual RMS (mm).
+    """
+    note = (f"{len(result.labels)} rows, nominal {result.nominal.name}, RMS before "
+            f"{result.rms_before * 1e3:.4f} mm, verdict {result.verdict[0]}")
+    if cross is not None:
+        s = cross.stats()
+        note += (f"; held-out RMS {s['after_rms_mm']:.4f} mm (nominal {s['before_rms_mm']:.4f} mm, "
+                 f"{cross.folds}-fold cross-validation)")
+    return Provenance.now("identify", rms_mm=round(result.rms_after * 1e3, 6), note=note)
+
+
+def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_path: str | Path,
+                     provenance: Provenance) -> Cell:
+    """Write the identified model file and make it the arm of a cell file, both or neither.
+
+    Parameters
+    ----------
+    cell_path : str or Path
+        The cell file; its ``robot.identified`` is set (relative to it) with ``provenance``.
+    result : IdentificationResult
+        Its ``robot`` is written to ``model_path``.
+    model_path : str or Path
+        The identified model file (YAML).
+    provenance : Provenance
+        See :func:`identification_provenance`.
+
+    Returns
+    -------
+    Cell
+        The cell as saved.
+
+    Raises
+    ------
+    InputError
+        The cell file cannot be read, the identified model is not of the cell's arm (the
+        nominal the identification started from must be the cell's ``robot.model``), or a file
+        cannot be written: nothing is changed then.
+    """
+    cell = load_cell(cell_path)
+    try:
+        cell.set_identified(result.robot, str(Path(model_path).resolve()), provenance)
+    except InputError as exc:
+        raise InputError(f"{cell_path}: {exc} (the cell's robot.model is {cell.robot_model})") \
+            from None
+    check_destination(model_path)
+    check_destination(cell_path)
+    cell_to_dict(cell, Path(cell_path).resolve().parent)  # every value writable before any write
+    old = read_text(model_path, "model file") if Path(model_path).is_file() else None
+    save_robot(result.robot, model_path)
+    try:
+        cell.save(cell_path)
+    except BaseException:
+        if old is None:
+            Path(model_path).unlink(missing_ok=True)
+        else:
+            atomic_write(model_path, old)
+        raise
+    return cell

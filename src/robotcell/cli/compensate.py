@@ -1,0 +1,86 @@
+"""``robotcell compensate``: the poses to command so that the identified arm reaches the desired ones."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import click
+
+from robotcell.cell import Cell
+from robotcell.cli.common import format_table, output_of
+from robotcell.cli.files import OUTPUT, Command
+from robotcell.cli.program import BadPoints
+from robotcell.errors import InputError
+
+#: Range of --max-correction (mm): a real arm is 0.1 to a few mm off its drawing.
+MAX_CORRECTION_MM = (0.001, 100.0)
+
+
+@click.command(cls=Command)
+@click.argument("poses", type=click.Path(dir_okay=False))
+@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file (YAML, mm/deg) whose robot has an identified arm (robot.identified).")
+@click.option("--tool", required=True, help="Tool of the cell.")
+@click.option("--frame", default="world", show_default=True,
+              help="Frame of the poses: world or a frame of the cell.")
+@click.option("-o", "--output", "output", type=OUTPUT,
+              callback=output_of("CSV", "the commanded poses"),
+              help="CSV of the poses to command, atomically (default: standard output).")
+@click.option("--max-correction", "max_correction", type=float, default=5.0, show_default=True,
+              help="Largest correction taken (mm); above it the identified model is wrong.")
+@click.option("--report", "report", type=OUTPUT, callback=output_of("HTML", "the accuracy report"),
+              help="Also write an HTML page: predicted error without filtering and 1-sigma "
+                   "after, per pose.")
+@click.option("--json", "as_json", is_flag=True,
+              help='Print {"points": [{"x": .., "a1": .., "dpos": .., "drot": .., "error_mm": '
+                   '.., "sigma_mm": ..}, ...]}.')
+def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | None,
+               max_correction: float, report: str | None, as_json: bool) -> None:
+    """Filter POSES (CSV: x, y, z mm and a, b, c deg in --frame; optional track mm, table or
+    e1..en deg; optional flags s, t or cf1, cf4, cf6, cfx or config) through the cell's
+    identified arm: for each desired pose, the pose to tell the controller, whose nominal model
+    then moves the real arm onto it (docs/accuracy.md).
+
+    The configuration is the one the nominal arm uses for the desired pose (nearest to the
+    robot's home) unless flag columns give one. The output has x, y, z, a, b, c (the pose to
+    command), a1..a6 (the controller's joints, deg), the external axes, dpos (mm) and drot (deg),
+    the size of the correction.
+
+    Exit status 0 when done; 2 for refused input; 3 when a pose cannot be filtered (out of the
+    identified arm's reach in its configuration, or a correction above --max-correction: a wrong
+    model), with a table naming each; nothing is written then.
+
+    \b
+    Example:
+      robotcell compensate examples/seam_part.csv --cell cell.yaml --tool torch --frame part -o commanded.csv
+    """
+    from robotcell.accuracy.filter import FilterRefused
+    from robotcell.accuracy.poses import DECIMALS, compensate_poses
+    from robotcell.io.tables import write_csv
+
+    lo, hi = MAX_CORRECTION_MM
+    if not lo <= max_correction <= hi:
+        raise InputError(f"--max-correction must be from {lo:g} to {hi:g} mm, got "
+                         f"{max_correction:g}")
+    cell = Cell.load(cell_path)
+    try:
+        result = compensate_poses(poses, cell, tool, frame, output, max_correction * 1e-3, report)
+    except FilterRefused as exc:
+        click.echo(format_table(["pose", "why"], [list(p) for p in exc.points]), err=True)
+        raise BadPoints(f"{poses}: {exc}".replace("max_correction", "--max-correction")) \
+            from None
+    for w in result.warnings:
+        click.echo(f"warning: {w}", err=True)
+    if as_json:
+        click.echo(json.dumps(result.to_json(), indent=2))
+    elif output is None:
+        write_csv(sys.stdout, result.header, result.rows, DECIMALS)
+    data = result.to_json()
+    if not as_json:
+        sigma = data["max_sigma_mm"]
+        click.echo(f"{len(result.rows)} poses filtered: largest correction "
+                   f"{data['max_dpos_mm']:.4f} mm; predicted error without filtering up to "
+                   f"{data['max_error_mm']:.4f} mm"
+                   + (f", 1-sigma after filtering up to {sigma:.4f} mm" if sigma is not None
+                      else "") + (f"; wrote {output}" if output else ""), err=output is None)

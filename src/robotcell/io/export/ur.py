@@ -1,0 +1,131 @@
+"""The identified geometry of a Universal Robots arm as the UR description's calibration file.
+
+Universal Robots' ROS description (UniversalRobots/Universal_Robots_ROS2_Description, BSD-3-Clause;
+the same layout in ros-industrial/universal_robot ``ur_description``) builds the arm from
+``config/<type>/default_kinematics.yaml``, or from the file its ``kinematics_params_file``
+(``kinematics_parameters_file``) argument names, which ``ur_calibration`` writes from a robot's
+factory calibration::
+
+    kinematics:
+      shoulder:  {x, y, z, roll, pitch, yaw}
+      upper_arm: {...}
+      forearm:   {...}
+      wrist_1:   {...}
+      wrist_2:   {...}
+      wrist_3:   {...}
+      hash: calib_...
+
+``urdf/ur_macro.xacro`` makes each entry the ``<origin xyz="x y z" rpy="roll pitch yaw"/>`` of one
+joint, in the order shoulder_pan (``shoulder``), shoulder_lift (``upper_arm``), elbow
+(``forearm``), wrist_1, wrist_2, wrist_3 (``urdf/inc/ur_common.xacro`` reads the keys), every joint
+turning about its local Z (``<axis xyz="0 0 1"/>``), after ``base_link_inertia`` (``base_link``
+turned by pi about Z, the controller's Base frame); ``tool0`` is ``wrist_3_link`` (the fixed
+``flange`` rpy (0, -pi/2, -pi/2) and ``tool0`` rpy (pi/2, 0, pi/2) compose to the identity). URDF
+``rpy`` is fixed-axis roll, pitch, yaw: ``R = Rz(yaw) Ry(pitch) Rx(roll)``.
+
+:func:`ur_kinematics` writes the identified arm that way: with the DH link of joint ``i``
+``Tz(d) Rz(theta) Tx(a) Rx(alpha) Ry(beta)``, the origin of joint ``i`` holds the ``Tx Rx Ry``
+part of link ``i - 1`` and the ``Tz Rz`` part of link ``i`` (a screw about the joint's own axis,
+which commutes with its motion), so a nominal arm gives the layout of ``default_kinematics.yaml``
+(``shoulder z = d1``, ``upper_arm roll = alpha1``, ``forearm x = a2``, ``wrist_1 x = a3, z = d4``,
+...). The ``hash`` names the file's numbers (``robotcell_`` and 16 hex digits of their SHA-256):
+it is not the controller's calibration hash, and the UR driver, which compares the two, says so
+when it connects (the controller keeps its own calibration; this file is the arm as measured).
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.cell import Cell
+from robotcell.errors import InputError
+from robotcell.kinematics.dh import link_transform
+from robotcell.kinematics.robot import Robot
+
+__all__ = ["SEGMENTS", "cell_ur_kinematics", "is_ur_arm", "ur_kinematics", "ur_origins"]
+
+#: The keys of the joints' origins in the calibration file, base to tip.
+SEGMENTS = ("shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3")
+#: Largest offset (m, rad) of the last link's x part and the flange from the identity.
+_SCREW_TOL = 1e-9
+
+
+def is_ur_arm(robot: Robot) -> bool:
+    """Whether ``robot`` (or the nominal model it is identified from) is a UR-type arm."""
+    from robotcell.ik.ur import ur_problems  # the IK package only when a URDF is exported
+
+    nominal = robot.ik_seed or robot
+    return (nominal.n_joints == 6 and robot.convention == "standard" and robot.coupling is None
+            and not ur_problems(nominal))
+
+
+def _split(j) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A standard DH link's constant part as ``Tz(d) Rz(theta)`` (about the joint's axis) and
+    ``Tx(a) Rx(alpha) Ry(beta)``."""
+    return (link_transform(j.theta, j.d, 0.0, 0.0), link_transform(0.0, 0.0, j.a, j.alpha,
+                                                                    beta=j.beta))
+
+
+def ur_origins(robot: Robot) -> NDArray[np.float64]:
+    """The six joint origins of the UR description for ``robot``, shape (6, 4, 4) (m).
+
+    Raises
+    ------
+    InputError
+        Not a standard-DH six-axis arm with every sign +1, or a last link and flange that are not
+        a screw about the last axis (the description's ``tool0`` is fixed to ``wrist_3_link``).
+    """
+    if robot.n_joints != 6 or robot.convention != "standard" or robot.coupling is not None \
+            or any(j.sign != 1.0 or j.prismatic for j in robot.joints):
+        raise InputError(f"{robot.name}: the UR calibration format describes six revolute joints "
+                         "in standard DH with the controller's directions (sign +1), no coupling")
+    z_parts, x_parts = zip(*(_split(j) for j in robot.joints))
+    origins = [robot.base @ z_parts[0]]
+    origins += [x_parts[i - 1] @ z_parts[i] for i in range(1, 6)]
+    rest = x_parts[5] @ robot.flange
+    if np.abs(rest - np.eye(4)).max() > _SCREW_TOL:
+        raise InputError(f"{robot.name}: its last link and flange are not the description's "
+                         "tool0 (wrist_3_link): a6, alpha6, beta6 and the flange must be 0")
+    return np.array(origins)
+
+
+def ur_kinematics(robot: Robot) -> str:
+    """The calibration file (YAML text) of a UR-type arm, e.g. an identified one (m, rad).
+
+    Parameters
+    ----------
+    robot : Robot
+        Six revolute joints, standard DH, signs +1 (the library's UR models and what
+        ``robotcell identify`` makes of them).
+
+    Returns
+    -------
+    str
+    """
+    O = ur_origins(robot)
+    rpy = Rotation.from_matrix(O[:, :3, :3]).as_euler("xyz")
+    lines = ["# robotcell: the kinematics of " + robot.name + " in the calibration format of",
+             "# Universal_Robots_ROS2_Description (config/<type>/default_kinematics.yaml):",
+             "# joint origins xyz (m) and fixed-axis roll, pitch, yaw (rad). docs/export.md",
+             "kinematics:"]
+    numbers = []
+    for name, T, (r, p, y) in zip(SEGMENTS, O, rpy):
+        lines.append(f"  {name}:")
+        for key, v in zip(("x", "y", "z", "roll", "pitch", "yaw"), (*T[:3, 3], r, p, y)):
+            text = repr(float(v) + 0.0)
+            numbers.append(text)
+            lines.append(f"    {key}: {text}")
+    digest = hashlib.sha256(",".join(numbers).encode()).hexdigest()[:16]
+    lines.append(f"  hash: robotcell_{digest}")
+    return "\n".join(lines) + "\n"
+
+
+def cell_ur_kinematics(cell: Cell) -> str | None:
+    """The calibration file of a cell whose identified arm is a UR-type arm, else None."""
+    if cell.identified is None or not is_ur_arm(cell.robot):
+        return None
+    return ur_kinematics(cell.robot)
