@@ -27,9 +27,23 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.calibration.propagate import propagate
-from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
-from robotcell.errors import InputError
+from robotcell.calibration.fitting import (
+    DEFAULT_TOUCH_SIGMA,
+    Fit,
+    keeps_out,
+    outlier_warnings,
+    solution_fit,
+    worst_touch,
+)
+from robotcell.calibration.propagate import jacobian
+from robotcell.calibration.result import (
+    CONDITION_LIMIT,
+    CalibrationResult,
+    fit_fields,
+    pose_fields,
+)
+from robotcell.calibration.uncertainty import Inputs, estimate
+from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.circles import start_model
 from robotcell.identification.engine import identify
 from robotcell.identification.measurements import Measurements
@@ -38,9 +52,6 @@ from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import as_points
 
 __all__ = ["PositionerCalibration", "calibrate_positioner"]
-
-#: Touch accuracy used to weight the fit when none is given (m per coordinate).
-DEFAULT_SIGMA = 0.1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,6 +109,21 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, 
             "radius": np.array(np.linalg.norm(r)), "R": R, "origin": f0}
 
 
+def _fit_of(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
+            used: NDArray[np.bool_], prior_sigma: float | None, inputs: Inputs | None) -> Fit:
+    """The uncertainty and the touch tests of an identification, over every touch.
+
+    The Jacobian of the touched point with respect to the identified (free) parameters, at all
+    touches (those left out of the identification too), and the residuals.
+    """
+    ch, x = ident._chain, ident._x
+    kept = np.array([ch.index(nm) for nm in ident.free])
+    pts = ch.predict(x, q)[0]
+    J = -ch.point_jacobian(x, q, ch.evaluate(x, q), pts)[:, 0][..., kept]
+    return solution_fit(x[kept], J, f - pts[:, 0], used=used, prior_sigma=prior_sigma,
+                        inputs=inputs)
+
+
 def calibrate_positioner(
     angles: ArrayLike,
     points: ArrayLike,
@@ -105,8 +131,14 @@ def calibrate_positioner(
     nominal: Robot | None = None,
     prior_sigma: float | None = None,
     labels: Sequence[str] | None = None,
+    inputs: Inputs | None = None,
 ) -> PositionerCalibration:
     """Calibrate a tilt-rotate positioner from touches of one point on its table.
+
+    The uncertainty rests on the touch accuracy (``prior_sigma``, or the default 0.5 mm), the
+    residuals being its chi-square check, and every touch gets the leave-one-out test of every
+    calibration (:func:`robotcell.calibration.fitting.solution_fit`): one flagged touch that the
+    others single out is left out and the chain identified again.
 
     Parameters
     ----------
@@ -117,11 +149,15 @@ def calibrate_positioner(
     nominal : Robot, optional
         Nominal 2-joint model of the positioner (any base). Without it the touches must contain,
         for each axis, at least 3 that move that axis alone over 10 deg or more (e.g. a grid of 3
-        tilt by 4 rotate values), and the circle point analysis gives the start.
+        tilt by 4 rotate values), and the circle point analysis gives the start. With it, of the
+        equivalent ways to write the identified axes the one nearest the nominal is returned.
     prior_sigma : float, optional
-        Known touch accuracy (m per coordinate); default: estimated from the residuals.
+        Touch accuracy (m per coordinate) the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
         Name of each touch (default ``"1".."N"``).
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (the tool, a track).
 
     Returns
     -------
@@ -151,16 +187,27 @@ def calibrate_positioner(
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
     meas = Measurements(q, f, None, tuple(labels))
     start = nominal if nominal is not None else start_model(meas, np.zeros(2, dtype=bool), "positioner")
-    ident = identify(start, meas, point_sigma=prior_sigma or DEFAULT_SIGMA,
-                     name=f"{start.name}_calibrated")
+    sigma = prior_sigma if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
+    name = f"{start.name}_calibrated"
+    ident = identify(start, meas, point_sigma=sigma, name=name)
+    used = np.ones(len(f), dtype=bool)
+    res = _fit_of(ident, q, f, used, prior_sigma, inputs)
+    worst = worst_touch(res)
+    if worst is not None:
+        keep = used.copy()
+        keep[worst] = False
+        try:
+            other = identify(start, Measurements(q[keep], f[keep], None,
+                                                 tuple(np.array(labels)[keep])),
+                             point_sigma=sigma, name=name)
+        except IllPosedError:
+            other = None
+        if other is not None:
+            res_other = _fit_of(other, q, f, keep, prior_sigma, inputs)
+            if keeps_out(res_other, worst):
+                ident, res = other, res_other
     ch, x = ident._chain, ident._x
     kept = np.array([ch.index(nm) for nm in ident.free])
-    cov = ident.covariance
-    if prior_sigma is not None and math.isfinite(ident.variance_factor):
-        cov = cov / ident.variance_factor**2  # the stated accuracy, not the residuals
-        noise, source = prior_sigma, "prior"
-    else:
-        noise, source = ident.variance_factor * DEFAULT_SIGMA, "residuals"
 
     def at(v: NDArray[np.float64]) -> NDArray[np.float64]:
         xx = x.copy()
@@ -176,32 +223,27 @@ def calibrate_positioner(
         rot = Rotation.from_matrix(g["R"] @ geo["R"].T).as_rotvec()
         return np.concatenate([np.ravel(g[k]) for k in keys] + [g["origin"], rot])
 
-    C = propagate(flat, x[kept], cov)
+    A = jacobian(flat, x[kept])
+    C = A @ res.covariance @ A.T
     sig = np.sqrt(np.abs(np.diag(C)))
-    sigma: dict[str, object] = {}
+    sigma_out: dict[str, object] = {}
     k0 = 0
     for k in keys:
         size = np.size(geo[k])
-        sigma[k] = sig[k0:k0 + size] if size > 1 else float(sig[k0])
+        sigma_out[k] = sig[k0:k0 + size] if size > 1 else float(sig[k0])
         k0 += size
-    sigma["T_R_B_position"], sigma["T_R_B_rotation"] = sig[k0:k0 + 3], sig[k0 + 3:k0 + 6]
+    sigma_out["T_R_B_position"], sigma_out["T_R_B_rotation"] = sig[k0:k0 + 3], sig[k0 + 3:k0 + 6]
     T_R_B = np.eye(4)
     T_R_B[:3, :3], T_R_B[:3, 3] = geo["R"], geo["origin"]
     values = {"T_R_B": T_R_B, **{k: geo[k] if np.size(geo[k]) > 1 else float(geo[k]) for k in keys}}
     robot = replace(ident.robot, base=ident.base @ ident.robot.base)
-    res = ident.residuals[:, 0, :]
     warnings = []
-    if ident.condition > CONDITION_LIMIT:
-        warnings.append(f"condition number {ident.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
                         "at more tilt and rotate values, spread over their ranges")
-    warnings += [f"touch {labels[i]} is an outlier at 3 sigma: re-touch it or remove it"
-                 for i in ident.outliers]
-    verdict, why = ident.verdict
-    if verdict != "good":
-        warnings.append(f"verdict {verdict}: {why}")
+    warnings += outlier_warnings(res, labels)
     result = CalibrationResult(
-        procedure="positioner-2axis", values=values, sigma=sigma, residuals=res,
-        condition=ident.condition, dof=ident.dof, noise_sigma=noise, noise_source=source,
+        procedure="positioner-2axis", values=values, sigma=sigma_out,
         labels=labels, undetermined=[f"{n}: {w}" for n, w in ident.fixed], warnings=warnings,
         next_step=("enter T_R_B and the axis geometry as the positioner's kinematics in the "
                    "controller (KUKA: external kinematics ROOT and links; ABB: the mechanical unit's "
@@ -216,6 +258,7 @@ def calibrate_positioner(
         covariance=C, parameter_names=[f"{k}[{i}]" if np.size(geo[k]) > 1 else k for k in keys
                                        for i in range(np.size(geo[k]))]
         + ["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z"],
-        points=f,
+        points=f, estimates={"T_R_B": estimate(res.sources, res.input_gain, A[-6:])},
+        **fit_fields(res),
     )
     return PositionerCalibration(result=result, robot=robot, identification=ident)
