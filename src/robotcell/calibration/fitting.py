@@ -42,7 +42,6 @@ __all__ = [
     "scaled_condition",
     "solution_fit",
     "touch_statistics",
-    "worst_touch",
 ]
 
 #: Probability inside "3 sigma" for a 1-D Gaussian; used for the 3-D residual test ...
@@ -119,6 +118,10 @@ class Fit:
         Expected length of each residual for a good touch (metres).
     excluded : list of int
         Touches left out of the fit (at most one: a gross error the others single out).
+    suspects : list of int
+        Flagged touches each of which alone would explain the residuals' excess (see
+        :func:`fit`): one is left out; several disagree, and the others cannot tell which is
+        wrong, so none is.
     unchecked : list of int
         Touches whose error in some direction goes into the result with nothing to check it (no
         other touch measures that direction).
@@ -154,6 +157,7 @@ class Fit:
     pvalues: NDArray[np.float64]
     expected: NDArray[np.float64]
     excluded: list[int]
+    suspects: list[int]
     unchecked: list[int]
     gross: list[int]
     sources: Sources
@@ -163,8 +167,19 @@ class Fit:
     own_covariance: NDArray[np.float64]
 
     @property
+    def disagreeing(self) -> list[int]:
+        """Touches that disagree: several suspects, of which the data cannot tell the wrong one."""
+        return list(self.suspects) if len(self.suspects) > 1 else []
+
+    @property
     def outliers(self) -> list[int]:
-        """Touches used by the fit whose residual is an outlier at 3 sigma."""
+        """Touches used by the fit whose residual is an outlier at 3 sigma.
+
+        None when touches disagree: one of them explains every residual's excess, so the
+        others flagged with it are not wrong themselves (their residuals carry its error).
+        """
+        if self.disagreeing:
+            return []
         bad = np.flatnonzero(self.pvalues < OUTLIER_P)
         return [int(i) for i in bad if i not in self.excluded]
 
@@ -214,6 +229,26 @@ class _Solved:
     q: NDArray[np.float64]          # statistic / sigma^2 per touch
     k: NDArray[np.int_]
     unchecked: NDArray[np.bool_]
+    suspects: list[int]
+
+
+def _suspects(chi2: float | None, dof: int, pvalues, q, k, used) -> list[int]:
+    """Flagged touches each of which alone explains the residuals' excess.
+
+    Without touch i the chi-square drops by its leave-one-out statistic ``q_i`` (the deletion
+    formula of least squares, exact for a linear model), over ``dof - k_i`` degrees of freedom:
+    a touch is a suspect when the others then pass the chi-square check. One suspect is the bad
+    touch; several are touches that disagree, and the others cannot tell which is wrong (the
+    two touches of one point).
+    """
+    if chi2 is None:
+        return []
+    out = []
+    for i in np.flatnonzero(used & (pvalues < OUTLIER_P)):
+        rest = dof - int(k[i])
+        if rest > 0 and chi2 - q[i] <= chi2_bound(rest):
+            out.append(int(i))
+    return out
 
 
 def fit(
@@ -295,20 +330,14 @@ def fit(
         raise IllPosedError(
             "the measurements do not determine " + ", ".join(involved)
             + f" (their combination is unobservable with these touches); {advice}")
-    worst = worst_touch(sol)
-    if robust and worst is not None:
+    if robust and len(sol.suspects) == 1:
+        worst = sol.suspects[0]
         keep = used.copy()
         keep[worst] = False
         other = _solve(fun, sol.x, keep, measured, inputs, factor, s)
         if keeps_out(other, worst):
             sol = other
     return _finish(sol, s, prior_sigma is not None, inputs, factor)
-
-
-def worst_touch(result: Fit | _Solved) -> int | None:
-    """The touch with the smallest outlier probability when it fails at 3 sigma, else None."""
-    p = np.where(np.isfinite(result.pvalues), result.pvalues, np.inf)
-    return int(np.argmin(p)) if p.size and p.min() < OUTLIER_P else None
 
 
 def keeps_out(result: Fit | _Solved, worst: int) -> bool:
@@ -393,7 +422,7 @@ def _analyse(x, J, r, P, used, inputs, factor, s) -> _Solved:
         nan = np.full(n, np.nan)
         return _Solved(x, r, Ju, Jv.reshape(3 * n, -1) * np.repeat(w, 3)[:, None], P, used,
                        np.full((p, p), np.nan), cond, dof, None, nan, nan, nan,
-                       np.zeros(n, dtype=int), np.zeros(n, dtype=bool))
+                       np.zeros(n, dtype=int), np.zeros(n, dtype=bool), [])
     C0 = np.linalg.inv(Ju.T @ Ju)
     Jvu = Jv.reshape(3 * n, -1) * np.repeat(w, 3)[:, None]
     B = Jvu @ factor if factor.size else np.zeros((3 * n, 0))
@@ -413,7 +442,9 @@ def _analyse(x, J, r, P, used, inputs, factor, s) -> _Solved:
         p_i, e_i, q_i, k_i = _block_test(cov[None], r[i][None], s)
         pvalues[i], expected[i], q[i], k[i] = p_i[0], e_i[0], q_i[0], k_i[0]
         unchecked[i] = False
-    return _Solved(x, r, Ju, Jvu, P, used, C0, cond, dof, chi2, pvalues, expected, q, k, unchecked)
+    suspects = _suspects(chi2, dof, pvalues, q, k, used)
+    return _Solved(x, r, Ju, Jvu, P, used, C0, cond, dof, chi2, pvalues, expected, q, k, unchecked,
+                   suspects)
 
 
 def _finish(sol: _Solved, s: float, stated: bool, inputs: Inputs | None,
@@ -441,7 +472,7 @@ def _finish(sol: _Solved, s: float, stated: bool, inputs: Inputs | None,
         touch_sigma=touch, accuracy_source="stated" if stated else "default",
         residual_sigma=residual_sigma, chi2=sol.chi2, dof=sol.dof, condition=sol.condition,
         pvalues=sol.pvalues, expected=sol.expected,
-        excluded=[int(i) for i in np.flatnonzero(~sol.used)],
+        excluded=[int(i) for i in np.flatnonzero(~sol.used)], suspects=list(sol.suspects),
         unchecked=[int(i) for i in np.flatnonzero(sol.unchecked)],
         gross=[int(i) for i in np.flatnonzero((sol.pvalues < OUTLIER_P) & (gross_p < OUTLIER_P))],
         sources=sources, input_gain=G, input_information=info,
@@ -537,7 +568,8 @@ def outlier_warnings(result: Fit, labels: Sequence[str]) -> list[str]:
     Each residual is tested against its own variance (:func:`touch_statistics`: the touch's
     leverage, the touch accuracy and the inputs' errors) and flagged when a residual at least
     this large has a probability below ``1 - 0.9973`` on good data: the false-alarm rate per
-    touch is the 3-sigma rate, 0.27 %. A touch left out of the fit says so.
+    touch is the 3-sigma rate, 0.27 %. A touch left out of the fit says so; touches that
+    disagree (one of them is wrong, and the others cannot tell which) are named together.
 
     Parameters
     ----------
@@ -559,6 +591,11 @@ def outlier_warnings(result: Fit, labels: Sequence[str]) -> list[str]:
     for i in result.outliers:
         out.append(f"touch {labels[i]} is an outlier at 3 sigma: residual {norms[i] * 1e3:.3f} "
                    f"mm, expected about {result.expected[i] * 1e3:.3f} mm; re-touch it or remove it")
+    if result.disagreeing:
+        names = ", ".join(labels[i] for i in result.disagreeing)
+        out.append(f"touches {names} disagree (residuals up to "
+                   f"{norms[result.disagreeing].max() * 1e3:.3f} mm): one of them is an outlier, "
+                   "and the other touches cannot tell which; re-touch them")
     return out
 
 

@@ -161,6 +161,8 @@ class CalibrationResult:
         Touches that no other touch checks in some direction they decide.
     outliers : list of int
         Touches used by the result whose residual is an outlier at 3 sigma.
+    disagreeing : list of int
+        Touches that disagree beyond 3 sigma, one of them wrong, with nothing to tell which.
     gross : list of int
         Outliers beyond 3 sigma even for three times the touch accuracy.
     estimates : dict of str to Estimate
@@ -195,6 +197,7 @@ class CalibrationResult:
     excluded: list[int] = field(default_factory=list)
     unchecked: list[int] = field(default_factory=list)
     outliers: list[int] = field(default_factory=list)
+    disagreeing: list[int] = field(default_factory=list)
     gross: list[int] = field(default_factory=list)
     estimates: dict[str, Estimate] = field(default_factory=dict)
     fit: Fit | None = None
@@ -344,6 +347,7 @@ class CalibrationResult:
             "excluded": [self.labels[i] for i in self.excluded],
             "unchecked": [self.labels[i] for i in self.unchecked],
             "outliers": [self.labels[i] for i in self.outliers],
+            "disagreeing": [self.labels[i] for i in self.disagreeing],
             "gross_outliers": [self.labels[i] for i in self.gross],
             "sigma": self._sigma_json(),
             "undetermined": list(self.undetermined),
@@ -450,11 +454,12 @@ def fit_fields(res: Fit) -> dict[str, Any]:
     dict
         ``residuals``, ``condition``, ``dof``, ``noise_sigma``, ``noise_source``,
         ``touch_sigma``, ``accuracy_source``, ``residual_sigma``, ``chi2``, ``excluded``,
-        ``unchecked``, ``outliers``, ``gross`` and ``fit``.
+        ``unchecked``, ``outliers``, ``disagreeing``, ``gross`` and ``fit``.
     """
     return {"residuals": res.residuals, "condition": res.condition, "dof": res.dof,
             "noise_sigma": res.noise_sigma, "noise_source": res.noise_source,
             "touch_sigma": res.touch_sigma, "accuracy_source": res.accuracy_source,
             "residual_sigma": res.residual_sigma, "chi2": res.chi2,
             "excluded": list(res.excluded), "unchecked": list(res.unchecked),
-            "outliers": res.outliers, "gross": list(res.gross), "fit": res}
+            "outliers": res.outliers, "disagreeing": res.disagreeing, "gross": list(res.gross),
+            "fit": res}

@@ -280,7 +280,16 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         outliers = len(set(flagged) | set(excluded))
     else:  # a result written before the outliers had their own field
         outliers = about_outliers
+    disagreeing = _names(result.get("disagreeing"))
     gross = [g for g in _names(result.get("gross_outliers")) if g not in excluded]
+    if set(gross) & set(disagreeing):
+        poor.append(f"touches {', '.join(disagreeing)} disagree by far more than the touch "
+                    "accuracy: one of them is wrong, and the other touches cannot tell which; "
+                    "re-touch them")
+    elif disagreeing:
+        check.append(f"touches {', '.join(disagreeing)} disagree at 3 sigma: one of them may be "
+                     "wrong; re-touch them")
+    gross = [g for g in gross if g not in disagreeing]
     if gross:
         poor.append(f"touch(es) {', '.join(gross)} lie beyond 3 sigma even for {POOR_FACTOR:g} "
                     "times the touch accuracy, and the result cannot be computed without them: "

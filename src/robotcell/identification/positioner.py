@@ -10,11 +10,16 @@ off the identified chain, with first-order uncertainties from its covariance:
 * their common normal: foot points on both axes, length, and the angle between the axes;
 * the zero of each: ``tilt_zero`` is the angle about the tilt axis from "up" (the robot base's
   ``+Z`` made perpendicular to the tilt axis) to the rotate axis at tilt 0, so 0 for a level table;
-  ``rotate_zero`` is the angle about the rotate axis from the common normal (pointing away from
-  the tilt axis) to the reference point at rotate 0;
+  ``rotate_zero`` is the angle about the rotate axis from ``X_B`` to the reference point at
+  rotate 0;
 * ``T_R_B``, the root frame: ``Z_B`` along the tilt axis, origin at the foot of the common normal
-  on it, ``X_B`` along the common normal toward the rotate axis (along ``z_tilt x z_rotate`` when
-  the axes intersect).
+  on it, ``X_B`` along the common normal. Of its two directions (``+-z_tilt x z_rotate``; for
+  axes that nearly intersect, the touch noise alone would decide "toward the rotate axis") the
+  one nearest the nominal's root X is taken, else ``z_tilt x z_rotate``.
+
+The identified chain is written in the nominal's conventions: of the equivalent DH tables
+(the root frame turned about its Z axis, an intermediate frame turned by 180 deg about its Z,
+with the offsets that compensate), the one nearest the nominal's root and zeros.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from robotcell.calibration.fitting import (
@@ -33,7 +39,6 @@ from robotcell.calibration.fitting import (
     keeps_out,
     outlier_warnings,
     solution_fit,
-    worst_touch,
 )
 from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.result import (
@@ -79,8 +84,12 @@ def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
     return v / np.linalg.norm(v)
 
 
-def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
-    """Axis lines, common normal, zeros and root frame in R for the full parameter vector ``x``."""
+def _geometry(ident: IdentificationResult, x: NDArray[np.float64],
+              reference: NDArray[np.float64] | None = None) -> dict[str, NDArray[np.float64]]:
+    """Axis lines, common normal, zeros and root frame in R for the full parameter vector ``x``.
+
+    ``reference`` (3,): the direction ``X_B`` should be nearest (the nominal's), or None.
+    """
     ch = ident._chain
     pts, dirs, _ = ch.axis_lines(x)
     T = ch.base_pose(x)
@@ -94,7 +103,9 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, 
     f0, f1 = p[0] + s * u[0], p[1] + t * u[1]
     n = f1 - f0
     length = float(np.linalg.norm(n))
-    x_b = _unit(n) if length > 1e-6 else _unit(w)
+    x_b = _unit(w)
+    if reference is not None and x_b @ reference < 0:
+        x_b = -x_b
     up = np.array([0.0, 0.0, 1.0]) if abs(u[0][2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     up = _unit(up - (up @ u[0]) * u[0])
     tilt_zero = math.atan2(np.cross(up, u[1]) @ u[0], up @ u[1])
@@ -107,6 +118,92 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, 
             "normal_length": np.array(length), "axis_angle": np.array(math.acos(np.clip(u[0] @ u[1], -1, 1))),
             "tilt_zero": np.array(tilt_zero), "rotate_zero": np.array(rotate_zero),
             "radius": np.array(np.linalg.norm(r)), "R": R, "origin": f0}
+
+
+def _wrap(a: float) -> float:
+    """An angle in (-pi, pi]."""
+    return math.pi - (math.pi - a) % (2.0 * math.pi)
+
+
+def nearest_writing(robot: Robot, nominal: Robot) -> Robot:
+    """The same chain written in the DH table nearest the nominal's.
+
+    Two tables describe the same motion when (a) the root frame turns about its Z axis by
+    ``phi`` and the first joint's offset by ``-phi`` (standard DH), or (b) an intermediate
+    frame turns by 180 deg about its Z axis: its joint's offset ``+ pi``, the next one's
+    ``- pi``, and the link between (standard DH: that joint's; modified: the next row's) gets
+    ``-a`` and ``-alpha``. (a) takes the root X nearest the nominal's; (b) is taken where it
+    brings the twists and offsets nearer the nominal's. Every joint value moves each frame to
+    the same place, so every pose of the chain is the same.
+
+    Parameters
+    ----------
+    robot : Robot
+        An identified chain.
+    nominal : Robot
+        The nominal chain, same joints and convention.
+
+    Returns
+    -------
+    Robot
+    """
+    joints = list(robot.joints)
+    base = robot.base.copy()
+    standard = robot.convention == "standard"
+    if standard or (joints[0].a == 0.0 and joints[0].alpha == 0.0):
+        z, x = base[:3, 2], base[:3, 0]
+        xn = nominal.base[:3, 0] - (nominal.base[:3, 0] @ z) * z
+        if np.linalg.norm(xn) > 1e-6:
+            phi = math.atan2(np.cross(x, xn) @ z, x @ xn)
+            base[:3, :3] = base[:3, :3] @ Rotation.from_rotvec([0.0, 0.0, phi]).as_matrix()
+            joints[0] = replace(joints[0], theta=_wrap(joints[0].theta - phi))
+
+    def distance(js: list) -> float:
+        return sum(_wrap(j.alpha - n.alpha) ** 2 + _wrap(j.theta - n.theta) ** 2
+                   + ((j.a - n.a) / 0.1) ** 2 for j, n in zip(js, nominal.joints))
+
+    for i in range(len(joints) - 1):
+        flipped = list(joints)
+        link = i if standard else i + 1
+        flipped[i] = replace(flipped[i], theta=_wrap(flipped[i].theta + math.pi))
+        flipped[link] = replace(flipped[link], a=-flipped[link].a, alpha=-flipped[link].alpha)
+        flipped[i + 1] = replace(flipped[i + 1], theta=_wrap(flipped[i + 1].theta - math.pi))
+        if distance(flipped) < distance(joints):
+            joints = flipped
+    return replace(robot, base=base, joints=tuple(joints))
+
+
+def _imputed(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
+             keep: NDArray[np.bool_]) -> NDArray[np.float64]:
+    """The touches with those left out replaced by the chain fitted to the others.
+
+    The chain is refitted to the touches ``keep`` from the identified one (a few Gauss-Newton
+    steps, it is near); a touch replaced by that fit's prediction has no residual there, so the
+    identification of the whole grid with it (a balanced design the engine starts from
+    reliably) has the same optimum as the fit without the touch.
+    """
+    ch = ident._chain
+    kept = np.array([ch.index(nm) for nm in ident.free])
+    x = ident._x.copy()
+
+    def model(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        x[kept] = v
+        return ch.predict(x, q)[0][:, 0]
+
+    def resid(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return (f - model(v))[keep].ravel()
+
+    def jac(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        x[kept] = v
+        pts = ch.predict(x, q)[0]
+        return -ch.point_jacobian(x, q, ch.evaluate(x, q), pts)[keep, 0][..., kept].reshape(
+            -1, len(kept))
+
+    v = least_squares(resid, x[kept], jac=jac, method="lm", xtol=1e-12, ftol=1e-12,
+                      gtol=1e-12).x
+    out = f.copy()
+    out[~keep] = model(v)[~keep]
+    return out
 
 
 def _fit_of(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
@@ -192,14 +289,13 @@ def calibrate_positioner(
     ident = identify(start, meas, point_sigma=sigma, name=name)
     used = np.ones(len(f), dtype=bool)
     res = _fit_of(ident, q, f, used, prior_sigma, inputs)
-    worst = worst_touch(res)
-    if worst is not None:
+    if len(res.suspects) == 1:
+        worst = res.suspects[0]
         keep = used.copy()
         keep[worst] = False
         try:
-            other = identify(start, Measurements(q[keep], f[keep], None,
-                                                 tuple(np.array(labels)[keep])),
-                             point_sigma=sigma, name=name)
+            other = identify(start, Measurements(q, _imputed(ident, q, f, keep), None,
+                                                 tuple(labels)), point_sigma=sigma, name=name)
         except IllPosedError:
             other = None
         if other is not None:
@@ -214,12 +310,13 @@ def calibrate_positioner(
         xx[kept] = v
         return xx
 
-    geo = _geometry(ident, x)
+    reference = None if nominal is None else nominal.frames(np.zeros(2))[1, :3, 0]
+    geo = _geometry(ident, x, reference)
     keys = ["tilt_point", "tilt_axis", "rotate_point", "rotate_axis", "normal_length", "axis_angle",
             "tilt_zero", "rotate_zero", "radius"]
 
     def flat(v: NDArray[np.float64]) -> NDArray[np.float64]:
-        g = _geometry(ident, at(v))
+        g = _geometry(ident, at(v), reference)
         rot = Rotation.from_matrix(g["R"] @ geo["R"].T).as_rotvec()
         return np.concatenate([np.ravel(g[k]) for k in keys] + [g["origin"], rot])
 
@@ -237,6 +334,8 @@ def calibrate_positioner(
     T_R_B[:3, :3], T_R_B[:3, 3] = geo["R"], geo["origin"]
     values = {"T_R_B": T_R_B, **{k: geo[k] if np.size(geo[k]) > 1 else float(geo[k]) for k in keys}}
     robot = replace(ident.robot, base=ident.base @ ident.robot.base)
+    if nominal is not None:
+        robot = nearest_writing(robot, nominal)
     warnings = []
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
