@@ -38,9 +38,8 @@ def test_positioner_geometry_and_robot():
     f = ch.predict(x, GRID)[0][:, 0] + rng.normal(0, NOISE, (len(GRID), 3))
     for nominal in (NOMINAL, None):  # None: circle point analysis of the grid
         cal = calibrate_positioner(GRID, f, nominal=nominal, prior_sigma=NOISE)
-        # X_B: of its two directions the nominal's, else z_tilt x z_rotate.
-        reference = None if nominal is None else nominal.frames(np.zeros(2))[1, :3, 0]
-        truth = _geometry(SimpleNamespace(_chain=ch), x, reference)
+        # X_B: along -z_tilt x z_rotate as the nominal's DH writes it, else +.
+        truth = _geometry(SimpleNamespace(_chain=ch), x, 1.0 if nominal is None else -1.0)
         v, s = cal.result.values, cal.result.sigma
         for key in ("normal_length", "axis_angle", "tilt_zero", "rotate_zero", "radius"):
             assert abs(v[key] - float(truth[key])) <= 4 * s[key], key
@@ -60,7 +59,7 @@ def test_positioner_sigma_matches_monte_carlo():
     rng = np.random.default_rng(32)
     ch, x = _truth(rng)
     clean = ch.predict(x, GRID)[0][:, 0]
-    truth = _geometry(SimpleNamespace(_chain=ch), x, NOMINAL.frames(np.zeros(2))[1, :3, 0])
+    truth = _geometry(SimpleNamespace(_chain=ch), x, -1.0)
     keys = ("normal_length", "axis_angle", "tilt_zero", "rotate_zero", "radius")
     z = {k: [] for k in keys + ("tilt_axis_y", "origin_y")}
     for _ in range(120):

@@ -13,9 +13,9 @@ off the identified chain, with first-order uncertainties from its covariance:
   ``rotate_zero`` is the angle about the rotate axis from ``X_B`` to the reference point at
   rotate 0;
 * ``T_R_B``, the root frame: ``Z_B`` along the tilt axis, origin at the foot of the common normal
-  on it, ``X_B`` along the common normal. Of its two directions (``+-z_tilt x z_rotate``; for
-  axes that nearly intersect, the touch noise alone would decide "toward the rotate axis") the
-  one nearest the nominal's root X is taken, else ``z_tilt x z_rotate``.
+  on it, ``X_B`` along the common normal. Of its two directions, ``+-z_tilt x z_rotate`` (for
+  axes that nearly intersect, the touch noise alone would decide "toward the rotate axis"), the
+  one on the side the nominal's DH frame between the axes takes, else ``z_tilt x z_rotate``.
 
 The identified chain is written in the nominal's conventions: of the equivalent DH tables
 (the root frame turned about its Z axis, an intermediate frame turned by 180 deg about its Z,
@@ -85,10 +85,10 @@ def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _geometry(ident: IdentificationResult, x: NDArray[np.float64],
-              reference: NDArray[np.float64] | None = None) -> dict[str, NDArray[np.float64]]:
+              side: float = 1.0) -> dict[str, NDArray[np.float64]]:
     """Axis lines, common normal, zeros and root frame in R for the full parameter vector ``x``.
 
-    ``reference`` (3,): the direction ``X_B`` should be nearest (the nominal's), or None.
+    ``side``: ``X_B = side * unit(z_tilt x z_rotate)`` (+1 or -1).
     """
     ch = ident._chain
     pts, dirs, _ = ch.axis_lines(x)
@@ -103,9 +103,7 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64],
     f0, f1 = p[0] + s * u[0], p[1] + t * u[1]
     n = f1 - f0
     length = float(np.linalg.norm(n))
-    x_b = _unit(w)
-    if reference is not None and x_b @ reference < 0:
-        x_b = -x_b
+    x_b = side * _unit(w)
     up = np.array([0.0, 0.0, 1.0]) if abs(u[0][2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     up = _unit(up - (up @ u[0]) * u[0])
     tilt_zero = math.atan2(np.cross(up, u[1]) @ u[0], up @ u[1])
@@ -118,6 +116,15 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64],
             "normal_length": np.array(length), "axis_angle": np.array(math.acos(np.clip(u[0] @ u[1], -1, 1))),
             "tilt_zero": np.array(tilt_zero), "rotate_zero": np.array(rotate_zero),
             "radius": np.array(np.linalg.norm(r)), "R": R, "origin": f0}
+
+
+def _normal_side(nominal: Robot) -> float:
+    """+1 when the nominal's DH frame between its two axes has X along ``z_1 x z_2`` (the axes
+    of motion), else -1: the nominal's way of writing the common normal, whatever its place."""
+    q = np.zeros(2)
+    axes = nominal.jacobian(q)[3:]  # angular part: the directions of motion
+    x1 = nominal.frames(q)[1, :3, 0]
+    return 1.0 if x1 @ np.cross(axes[:, 0], axes[:, 1]) >= 0 else -1.0
 
 
 def _wrap(a: float) -> float:
@@ -310,13 +317,13 @@ def calibrate_positioner(
         xx[kept] = v
         return xx
 
-    reference = None if nominal is None else nominal.frames(np.zeros(2))[1, :3, 0]
-    geo = _geometry(ident, x, reference)
+    side = 1.0 if nominal is None else _normal_side(nominal)
+    geo = _geometry(ident, x, side)
     keys = ["tilt_point", "tilt_axis", "rotate_point", "rotate_axis", "normal_length", "axis_angle",
             "tilt_zero", "rotate_zero", "radius"]
 
     def flat(v: NDArray[np.float64]) -> NDArray[np.float64]:
-        g = _geometry(ident, at(v), reference)
+        g = _geometry(ident, at(v), side)
         rot = Rotation.from_matrix(g["R"] @ geo["R"].T).as_rotvec()
         return np.concatenate([np.ravel(g[k]) for k in keys] + [g["origin"], rot])
 

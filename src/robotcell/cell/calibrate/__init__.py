@@ -9,6 +9,7 @@ identification engine); ``cellcal.positioner_touches`` gives its input.
 See ``docs/python-api.md``.
 """
 
+from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
 from robotcell.cell.calibrate.procedures import (
     SAME_POSE,
     CellCalibration,
@@ -23,6 +24,7 @@ from robotcell.cell.calibrate.procedures import (
 )
 from robotcell.cell.calibrate.touches import load_table, robot_in_world, track_positions
 
-__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "load_table",
+__all__ = ["NOMINAL_ACCURACY", "SAME_POSE", "CellCalibration", "NominalAccuracy", "TurntablePose",
+           "frame", "load_table",
            "positioner", "positioner_touches", "robot_in_world", "tcp", "track", "track_positions", "turntable",
            "workpiece"]
