@@ -411,7 +411,7 @@ def _prov_dict(p: Provenance, base_dir: str | Path = ".") -> dict[str, Any]:
             sigma["scale"] = _clean(sd[6])
         out["sigma"] = sigma
         out["covariance_mm_rad"] = [[float(f"{v:.6g}") for v in row] for row in cov]
-        out["sources_mm_rad"] = {k: [[float(f"{v:.8g}") for v in row] for row in f * unit[:, None]]
+        out["sources_mm_rad"] = {k: [[float(f"{v:.6g}") for v in row] for row in f * unit[:, None]]
                                  for k, f in p.sources.items()}
     return out
 

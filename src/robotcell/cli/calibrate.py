@@ -255,7 +255,7 @@ def echo_note(note: str) -> None:
     click.echo(note, err=True)
 
 
-def emit(result: CalibrationResult, as_json: bool) -> None:
+def emit(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool) -> None:
     """Print a result: the terminal report, or one JSON object with ``--json``.
 
     With ``-o FILE`` the terminal shows the report and FILE gets the JSON object (``--json``) or
@@ -280,7 +280,8 @@ class PoorCalibration(click.ClickException):
         click.echo(f"error: {self.message}", err=True)
 
 
-def gate(result: CalibrationResult, as_json: bool, accept_poor: bool) -> None:
+def gate(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool,
+         accept_poor: bool) -> None:
     """Stop before anything is written when the verdict is poor, unless ``--accept-poor``.
 
     The report is printed (stdout) so the technician sees why; then :class:`PoorCalibration`
@@ -425,6 +426,42 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     result = external_tcp(p, roles, prior, line_labels(len(roles), roles))
     gate(result, as_json, accept_poor)
     emit(result, as_json)
+
+
+@calibrate.command("cell")
+@cell_option
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+              expose_value=False, callback=_keep_output,
+              help="Also write the result to FILE (the JSON object with --json, else the report).")
+@click.option("--accept-poor", is_flag=True,
+              help="Write the cell and exit 0 even when the verdict is poor.")
+def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
+    """The whole cell in one fit, from every touch file its calibrations recorded.
+
+    \b
+    Every calibration written with --cell records its touch file (with a checksum), its
+    options and the items it used. This repeats them all and fits every calibrated item at
+    once (maximum likelihood, full covariance): a tool is estimated from its own touches and
+    from those taken with it, and the track, turntable and frames measured with it follow it.
+    The report says what changed, by how much and in units of its 1-sigma. A missing or changed
+    touch file is refused (exit 2), naming it; a poor verdict writes nothing (exit 3).
+
+    \b
+    Example:
+      robotcell calibrate cell --cell cell.yaml
+    """
+    if cell_path is None:
+        raise InputError("calibrate cell needs --cell CELL.yaml: the cell whose calibrations "
+                         "are fitted together")
+    target = CellTarget.open(cell_path, None)
+    nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
+    out = cellcal.calibrate_cell(target.cell, cell_label=cell_path, nominal=nominal,
+                                 on_note=echo_note)
+    gate(out, as_json, accept_poor)
+    target.save(out.cell, f"{len(out.items)} item(s) fitted with the whole cell "
+                f"({', '.join(out.items)})")
+    emit(out, as_json)
 
 
 # ------------------------------------------------------------------------------------------------
