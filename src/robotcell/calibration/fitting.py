@@ -235,13 +235,15 @@ class _Solved:
 def _suspects(chi2: float | None, dof: int, pvalues, q, k, used) -> list[int]:
     """Flagged touches each of which alone explains the residuals' excess.
 
-    Without touch i the chi-square drops by its leave-one-out statistic ``q_i`` (the deletion
-    formula of least squares, exact for a linear model), over ``dof - k_i`` degrees of freedom:
-    a touch is a suspect when the others then pass the chi-square check. One suspect is the bad
-    touch; several are touches that disagree, and the others cannot tell which is wrong (the
-    two touches of one point).
+    When the residuals fail the chi-square check against the touch accuracy: without touch i
+    the chi-square drops by its leave-one-out statistic ``q_i`` (the deletion formula of least
+    squares, exact for a linear model), over ``dof - k_i`` degrees of freedom, and the touch is
+    a suspect when the others then pass. One suspect is the bad touch; several are touches that
+    disagree, and the others cannot tell which is wrong (the two touches of one point). Residuals
+    that pass the check have no suspect: a touch flagged among many good ones is an outlier at
+    the 3-sigma rate, not a gross error.
     """
-    if chi2 is None:
+    if chi2 is None or chi2 <= chi2_bound(dof):
         return []
     out = []
     for i in np.flatnonzero(used & (pvalues < OUTLIER_P)):

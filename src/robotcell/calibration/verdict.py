@@ -7,11 +7,12 @@ made later from a saved result judges it exactly as the terminal did.
 
 The rule (``docs/calibration.md``, "Verdict"):
 
-- **Accuracy.** The touch accuracy ``s`` is the one stated with ``--sigma`` (``noise_source ==
-  "prior"``) or :data:`DEFAULT_TOUCH_SIGMA_MM`. If the touches were that accurate,
-  ``SSR / s^2`` (SSR the sum of squared residuals) would be chi-square distributed with the
-  redundancy ``dof`` as degrees of freedom. Above its :data:`CHI2_P` quantile the residuals are
-  larger than the accuracy explains: *check*; above that quantile for ``POOR_FACTOR * s``: *poor*.
+- **Accuracy.** The touch accuracy ``s`` is the one stated with ``--sigma``
+  (``accuracy_source == "stated"``) or :data:`DEFAULT_TOUCH_SIGMA_MM`. If the touches were that
+  accurate, ``chi2`` (``SSR / s^2``, SSR the sum of squared residuals of the touches used, the
+  inputs' errors taken out) would be chi-square distributed with the redundancy ``dof`` as
+  degrees of freedom. Above its :data:`CHI2_P` quantile the residuals are larger than the
+  accuracy explains: *check*; above that quantile for ``POOR_FACTOR * s``: *poor*.
 - **Scale** (track): more than :data:`SCALE_CHECK` from 1: *check*; more than
   :data:`SCALE_POOR`: *poor*.
 - **Conditioning**: condition number above :data:`CONDITION_GOOD`: *check*; above
@@ -21,7 +22,11 @@ The rule (``docs/calibration.md``, "Verdict"):
 - **Redundancy**: without :data:`OUTLIER_REDUNDANCY` redundant coordinates a wrong touch cannot be
   singled out (see :func:`touches_for_outlier_check`): *check*, naming how many touches would
   make the check possible. With no redundancy at all nothing checks the result.
-- Any warning of the procedure (an outlier among them): *check*.
+- **Touches.** A touch flagged as an outlier, or left out as one: *check*; one flagged beyond
+  3 sigma for ``POOR_FACTOR * s`` that could not be left out, or touches that disagree by that
+  much (one is wrong, nothing tells which): *poor*. A touch that alone decides a direction of the
+  result (``unchecked``): *check*, naming it.
+- Any other warning of the procedure: *check*.
 """
 
 from __future__ import annotations
