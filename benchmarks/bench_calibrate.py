@@ -40,8 +40,7 @@ R_TOOL = Rotation.from_euler("zyx", [10, -80, 5], degrees=True).as_matrix()
 def write(path: Path, header: list[str], rows: np.ndarray, roles: list[str] | None = None) -> str:
     with open(path, "w", encoding="utf-8") as fh:
         fh.write(",".join(header + (["point"] if roles else [])) + "\n")
-        for i, row in enumerate(rows):
-            fh.write(",".join(f"{v:.6f}" for v in row) + (f",{roles[i]}" if roles else "") + "\n")
+        fh.writelines(",".join(f"{v:.6f}" for v in row) + (f",{roles[i]}" if roles else "") + "\n" for i, row in enumerate(rows))
     return str(path)
 
 
@@ -97,7 +96,7 @@ def cases(n: int, folder: Path, rng) -> dict[str, tuple]:
             folder / "fn.csv", xyz + ["nominal_x", "nominal_y", "nominal_z"],
             np.c_[noisy(transform_points(T_FRAME, nominal)), nominal * 1e3]), {}),
         "track": (cellcal.track, write(folder / "tr.csv", xyz + ["e1"], np.c_[noisy(
-            (np.array([1.5, 0.8, 0.3]) - np.outer(e, [1, 0, 0]))), e * 1e3]), {}),
+            np.array([1.5, 0.8, 0.3]) - np.outer(e, [1, 0, 0])), e * 1e3]), {}),
         "turntable": (cellcal.turntable, write(folder / "tt.csv", xyz + ["e1"],
                                                np.c_[noisy(table), np.degrees(theta)]), {}),
         "workpiece": (cellcal.workpiece, write(folder / "wp.csv", xyz + ["e1"],
