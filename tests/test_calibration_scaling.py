@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-import robotcell.calibration.fitting as fitting
+from robotcell.calibration import fitting
 from robotcell.calibration.frame import external_tcp, frame_3point, frame_npoint
 from robotcell.calibration.tcp import calibrate_tool
 from robotcell.calibration.track import calibrate_track
