@@ -17,7 +17,7 @@ results.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -262,9 +262,3 @@ def joined(inputs: Inputs | None, sensitivity: ArrayLike, sources: Sources,
     if inputs is None:
         return Inputs(np.asarray(sensitivity, dtype=float), sources, list(names))
     return inputs.joined(sensitivity, sources, names)
-
-
-def item_sources(mapping: Mapping[str, ArrayLike], size: int) -> Sources:
-    """:class:`Sources` from a mapping of source name to factor (as a cell file stores them)."""
-    return Sources(size, {str(k): np.asarray(v, dtype=float).reshape(size, -1)
-                          for k, v in mapping.items()})
