@@ -271,9 +271,10 @@ def fit(
     (chi-square with the redundancy as degrees of freedom, inputs' errors included); only when
     they fail that check at the verdict's level (:data:`~robotcell.calibration.verdict.CHI2_P`)
     is the larger noise they need used instead. Each touch is tested with its leave-one-out
-    residual (:func:`touch_statistics`); when one fails at 3 sigma, the fit is repeated without
-    the worst, which is kept out when the others then pass the chi-square check and the design
-    stays determined.
+    residual (:func:`touch_statistics`). When the residuals fail the chi-square check and one
+    flagged touch alone explains it (the only suspect), the fit is repeated without it, and it
+    stays out when the others then pass the check, single it out and still determine the result;
+    several suspects are touches that disagree, and none is left out.
 
     Parameters
     ----------
@@ -298,7 +299,7 @@ def fit(
         Earlier calibrations the touches rest on: ``inputs.sensitivity`` is the derivative of
         each residual (as ``fun`` returns it) with respect to the input parameters.
     robust : bool
-        Leave out one touch that fails the outlier test when the others then pass (default).
+        Leave out the one touch that explains a failed chi-square check (default).
 
     Returns
     -------

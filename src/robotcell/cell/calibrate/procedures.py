@@ -179,7 +179,7 @@ class _Record:
     nominal: NominalAccuracy
 
 
-def _sha256(path: str | Path) -> str:
+def sha256_of(path: str | Path) -> str:
     """SHA-256 of a file's bytes, hex."""
     try:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
@@ -198,7 +198,7 @@ def _provenance(procedure: str, result: CalibrationResult, n: int, source: str,
     determine keeping the item's previous ones).
     """
     stamp = time or Provenance.now(procedure).time
-    sha = None if record.file is None else _sha256(record.file)
+    sha = None if record.file is None else sha256_of(record.file)
     ident = f"{item} {sha[:12]}" if sha else f"{item} {stamp}"
     sources: dict[str, NDArray[np.float64]] = {}
     est = result.estimates.get(value)
@@ -263,7 +263,7 @@ def _chained(cell: Cell | None, cols: Table, source: str, p_R: NDArray[np.float6
     return chained
 
 
-def _copy(cell: Cell) -> Cell:
+def copied(cell: Cell) -> Cell:
     """A cell sharing the components of ``cell`` with its own tool and frame tables."""
     return replace(cell, tools=dict(cell.tools), frames=dict(cell.frames))
 
@@ -407,7 +407,7 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     record = _Record(_file(measurements, file), _options(sigma, world=world_mode), chained,
                      nominal)
     prov = _provenance("tcp", result, len(T), source, time, cell, key, "T_F_TCP", record)
-    new = _copy(cell)
+    new = copied(cell)
     kept = _write_tool(new, name, result, prov, label)
     return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes), tuple(kept),
                            key, "T_F_TCP", chained.keys)
@@ -509,7 +509,7 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
     record = _Record(_file(measurements, file), _options(sigma, tool, parent=parent), chained,
                      nominal)
     prov = _provenance("frame", result, len(p), source, time, cell, item, key, record)
-    new = _copy(cell)
+    new = copied(cell)
     new.update_frame(name, result.values[key], prov, parent=parent)
     return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov, tuple(notes),
                            key=item, value=key, inputs=chained.keys)
@@ -629,7 +629,7 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
                      f"points measure it): kept the offset of {label} ({offset} mm)")
     record = _Record(_file(measurements, file), options, chained, nominal)
     prov = _provenance("track", result, len(f), source, time, cell, "track", "T_L_R", record)
-    new = _copy(cell)
+    new = copied(cell)
     new.update_track(prov, T_L_R0=T_L_R0, scale=float(result.values["scale"]))
     return CellCalibration(result, new, f"track {tr.name!r} (robot_at_zero, scale)", prov,
                            tuple(notes), tuple(kept), "track", "T_L_R", chained.keys)
@@ -797,7 +797,7 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
     record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
     prov = _provenance("positioner", result, len(points), source, time, cell, "positioner",
                        "", record)
-    new = _copy(cell)
+    new = copied(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
     return CellCalibration(result, new, f"positioner {pos.name!r} (axes, root)", prov,
                            tuple(notes), key="positioner", inputs=chained.keys)
@@ -854,7 +854,7 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     record = _Record(_file(measurements, file), _options(sigma, tool, height_mm=height * 1e3),
                      chained, nominal)
     prov = _provenance("turntable", result, len(f), source, time, cell, "turntable", key, record)
-    new = _copy(cell)
+    new = copied(cell)
     tt = new.update_turntable(prov, T_parent_B=result.values[key])
     return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov, tuple(notes),
                            key="turntable", value=key, inputs=chained.keys)
@@ -931,7 +931,7 @@ def _positioner_workpiece(cell: Cell, measurements: Table | str | Path, name: st
     record = _Record(record_file, _options(sigma, tool), chained, nominal)
     prov = _provenance("workpiece", result, len(points), source, time, cell, item, "T_P_W",
                        record)
-    new = _copy(cell)
+    new = copied(cell)
     new.update_frame(name, result.values["T_P_W"], prov, parent="turntable")
     return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
                            key=item, value="T_P_W", inputs=chained.keys)
@@ -1005,7 +1005,7 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
     prov = _provenance("workpiece", result, len(f), source, time, cell, item, "T_B_W", record,
                        inputs)
-    new = _copy(cell)
+    new = copied(cell)
     new.update_frame(name, result.values["T_B_W"], prov, parent="turntable")
     return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
                            key=item, value="T_B_W", inputs=inputs)

@@ -38,7 +38,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.calibration.result import to_jsonable
 from robotcell.calibration.uncertainty import OWN, Sources, factor_of
 from robotcell.calibration.verdict import Verdict
-from robotcell.cell import Cell, Provenance
+from robotcell.cell import Cell, Positioner, Provenance
 from robotcell.cell.calibrate import procedures
 from robotcell.cell.calibrate.chain import (
     NOMINAL_ACCURACY,
@@ -194,7 +194,7 @@ def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
         path = Path(prov.measurements)
         if not path.is_file():
             problems.append(f"{key}: touch file {path} is missing")
-        elif prov.sha256 is not None and procedures._sha256(path) != prov.sha256:
+        elif prov.sha256 is not None and procedures.sha256_of(path) != prov.sha256:
             problems.append(f"{key}: touch file {path} has changed since the calibration "
                             "(checksum differs)")
         else:
@@ -373,9 +373,9 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
                 on_note(text)
 
     original = {k: _values(cell, k) for k, _ in recorded if k != "turntable"
-                or not isinstance(cell.turntable, procedures.Positioner)}
+                or not isinstance(cell.turntable, Positioner)}
     estimated = [k for k, p in recorded if p.source != "positioner"]
-    current = procedures._copy(cell)
+    current = procedures.copied(cell)
     prior = {k: item_sources(cell, k, nominal)[0] for k in estimated}
     for it in range(1, MAX_ITERATIONS + 1):
         runs = [_run(current, k, p, nominal, time) for k, p in recorded]
@@ -397,7 +397,7 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
             break
     runs = [_run(current, k, p, nominal, time) for k, p in recorded]
     stamp = time or Provenance.now("cell").time
-    new = procedures._copy(cell)
+    new = procedures.copied(cell)
     changes = []
     for key, prov in recorded:
         if key not in estimated:  # the positioner chain: its calibration at the fitted values
