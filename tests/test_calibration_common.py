@@ -40,10 +40,11 @@ def test_fit_sigma_matches_monte_carlo_spread():
     errors, sigmas, noise_est = [], [], []
     for _ in range(400):
         meas = line_model(s)(truth) + rng.normal(scale=noise, size=(8, 3))
-        res = fit(lambda x, m=meas: m - line_model(s)(x), np.zeros(6), list("abcdef"))
+        res = fit(lambda x, m=meas: m - line_model(s)(x), np.zeros(6), list("abcdef"),
+                  prior_sigma=noise)
         errors.append(res.x - truth)
         sigmas.append(res.sigma)
-        noise_est.append(res.noise_sigma)
+        noise_est.append(res.residual_sigma)
     spread = np.sqrt(np.mean(np.square(errors), axis=0))
     assert np.all(np.abs(spread / np.mean(sigmas, axis=0) - 1) < 0.25)
     # analytic: intercept sigma = noise / sqrt(N) (s has zero mean)
@@ -55,7 +56,9 @@ def test_fit_prior_and_no_redundancy():
     rng = np.random.default_rng(2)
     meas = rng.normal(size=(1, 3))
     res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"])
-    assert res.dof == 0 and res.noise_source == "none" and np.all(np.isnan(res.sigma))
+    # No redundancy and no stated accuracy: the default 0.5 mm, never an unknown sigma.
+    assert res.dof == 0 and res.noise_source == "default" and res.chi2 is None
+    np.testing.assert_allclose(res.sigma, 0.5e-3)
     res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-3)
     assert res.noise_source == "prior"
     np.testing.assert_allclose(res.sigma, 1e-3)
@@ -74,14 +77,17 @@ def test_outlier_is_named_and_clean_data_rarely_flagged():
     flagged = 0
     for _ in range(200):
         meas = rng.normal(scale=1e-4, size=(10, 3))
-        res = fit(lambda x, m=meas: m - x, np.zeros(3), ["x", "y", "z"])
+        res = fit(lambda x, m=meas: m - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-4)
         flagged += len(outlier_warnings(res, [str(i) for i in range(10)]))
     assert flagged / 2000 < 0.01
     meas = rng.normal(scale=1e-4, size=(10, 3))
     meas[6] += [1.5e-3, 0, 0]
-    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"])
+    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-4)
     warnings = outlier_warnings(res, [f"row {i}" for i in range(10)])
     assert len(warnings) == 1 and "row 6" in warnings[0] and "3 sigma" in warnings[0]
+    # The others single it out: it is left out, and the estimate is their mean.
+    assert res.excluded == [6] and "left out" in warnings[0]
+    np.testing.assert_allclose(res.x, np.delete(meas, 6, axis=0).mean(axis=0), atol=1e-12)
 
 
 def test_kabsch_recovers_pose_and_rotations_are_proper():

@@ -24,16 +24,18 @@ def rot_err(T):
 def test_3point_exact_is_kukas_definition():
     r = frame_3point(transform_points(T_TRUE, LOCAL), ROLES)
     np.testing.assert_allclose(r.values["T_R_W"], T_TRUE, atol=1e-12)
-    assert r.dof == 0 and r.noise_source == "none"
-    assert any("uncertainties are unknown" in w for w in r.warnings)
+    assert r.dof == 0 and r.noise_source == "default" and r.chi2 is None
+    # Without redundancy the 1-sigma rests on the default touch accuracy, 0.5 mm.
+    assert r.noise_sigma == pytest.approx(0.5e-3) and np.all(r.sigma["T_R_W_position"] > 0)
+    assert r.verdict.level == "check" and "no redundancy" in r.verdict.reasons[-1]
     j = r.to_json()
     np.testing.assert_allclose(np.array(j["matrix"])[:3, 3], O_TRUE * 1e3)
     assert len(j["xyzabc"]) == 6
 
 
-@pytest.mark.parametrize("repeats, prior", [(1, 2e-4), (3, None)])
+@pytest.mark.parametrize("repeats, prior", [(1, 2e-4), (3, 2e-4)])
 def test_3point_monte_carlo_sigma(repeats, prior):
-    """Three touches with the touch-up accuracy given, or each point touched 3 times."""
+    """Three touches, or each point touched 3 times, with the touch-up accuracy given."""
     rng = np.random.default_rng(20 + repeats)
     local = np.repeat(LOCAL, repeats, axis=0)
     roles = [r for r in ROLES for _ in range(repeats)]
@@ -57,7 +59,7 @@ def test_npoint_monte_carlo_sigma_and_accuracy():
     clean = transform_points(T_TRUE, q)
     ep, er, sp, sr = [], [], [], []
     for _ in range(300):
-        r = frame_npoint(clean + rng.normal(scale=3e-4, size=clean.shape), q)
+        r = frame_npoint(clean + rng.normal(scale=3e-4, size=clean.shape), q, 3e-4)
         ep.append(r.values["T_R_W"][:3, 3] - O_TRUE)
         er.append(rot_err(r.values["T_R_W"]))
         sp.append(r.sigma["T_R_W_position"])

@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell import IllPosedError, InputError
 from robotcell.calibration.turntable import calibrate_turntable
+from robotcell.calibration.uncertainty import OWN, Sources
 from robotcell.calibration.workpiece import calibrate_workpiece, table_points, workpiece_pose
 from robotcell.kinematics.transforms import make_pose, rot_z
 
@@ -41,8 +42,7 @@ def test_three_points_at_any_table_angles_recover_the_frame():
     theta = np.radians([15.0, 140.0, 250.0])
     r = calibrate_workpiece(theta, touch(roles, theta), roles, T_R_B)
     np.testing.assert_allclose(r.values["T_B_W"], T_B_W, atol=1e-10)
-    assert r.dof == 0 and r.max < 1e-12 and r.noise_source == "none"
-    assert any("no uncertainty can be stated" in w for w in r.warnings)
+    assert r.dof == 0 and r.max < 1e-12 and r.noise_source == "default"
     assert any("turntable" in u for u in r.undetermined)
     assert len(r.json_fields["xyzabc"]) == 6
 
@@ -68,8 +68,8 @@ def test_n_point_fit_uses_every_touch_and_estimates_noise():
     np.testing.assert_allclose(r.values["T_B_W"], T_B_W, atol=1e-10)
     assert r.dof == 3 * 2 + 2 * 3 + 3 - 6
     f = touch(roles, theta, offsets, rng=np.random.default_rng(1))
-    r = calibrate_workpiece(theta, f, roles, T_R_B)
-    assert r.noise_source == "residuals" and 0.3 * SIGMA < r.noise_sigma < 3 * SIGMA
+    r = calibrate_workpiece(theta, f, roles, T_R_B, prior_sigma=SIGMA)
+    assert r.noise_source == "prior" and 0.3 * SIGMA < r.residual_sigma < 3 * SIGMA
     assert r.residuals.shape == (8, 3) and r.rms > 0
 
 
@@ -84,9 +84,9 @@ def test_sigmas_including_the_turntable_match_monte_carlo(roles, theta):
     rng = np.random.default_rng(11)
     errs, sigmas = [], []
     for _ in range(150):
-        tt = calibrate_turntable(TABLE_THETA, table_touches(rng))
+        tt = calibrate_turntable(TABLE_THETA, table_touches(rng), prior_sigma=SIGMA)
         r = calibrate_workpiece(theta, touch(roles, theta, rng=rng), roles, tt.values["T_R_B"],
-                                T_R_B_covariance=tt.covariance[:6, :6], noise_sigma=tt.noise_sigma)
+                                T_R_B_covariance=tt.covariance[:6, :6], prior_sigma=SIGMA)
         T = r.values["T_B_W"]
         errs.append(np.r_[T[:3, 3] - T_B_W[:3, 3], rot_error(T[:3, :3], T_B_W[:3, :3])])
         sigmas.append(np.r_[r.sigma["T_B_W_position"], r.sigma["T_B_W_rotation"]])
@@ -117,15 +117,15 @@ def test_refusals():
         calibrate_workpiece(theta, f, ["origin", "x", "z"], T_R_B)
     near = touch(roles, theta, [[0, 0, 0], [-0.145, 0, 0], [0, 0, 0]])
     r = calibrate_workpiece(theta, near, roles, T_R_B)  # 5 mm: computed, with a warning
-    assert any(r"+X point is only 5.0 mm from the origin" in w for w in r.warnings)
+    assert any(r"+X touch is only 5 mm from the origin" in w for w in r.warnings)
     at_origin = touch(roles, theta, [[0, 0, 0], [-0.15, 0, 0], [0, 0, 0]])
-    with pytest.raises(IllPosedError, match=r"\+X point is at the origin, so it defines no direction"):
+    with pytest.raises(IllPosedError, match=r"\+X touch is at the origin touch, so it defines no "):
         calibrate_workpiece(theta, at_origin, roles, T_R_B)
     collinear = touch(roles, theta, [[0, 0, 0], [0, 0, 0], [0.0, -0.115, 0]])
     r = calibrate_workpiece(theta, collinear, roles, T_R_B)
     assert any("nearly collinear" in w for w in r.warnings)
     on_axis = touch(roles, theta, [[0, 0, 0], [0, 0, 0], [0.0, -0.12, 0]])
-    with pytest.raises(IllPosedError, match="lies on the X axis .* collinear.*not determined"):
+    with pytest.raises(IllPosedError, match="collinear .*lies on the X line.*not determined"):
         calibrate_workpiece(theta, on_axis, roles, T_R_B)
     bad = T_R_B.copy()
     bad[:3, 0] *= -1.0
@@ -137,10 +137,23 @@ def test_refusals():
         calibrate_workpiece(theta[:2], f, roles, T_R_B)
 
 
-def test_three_points_borrow_the_turntable_noise_and_say_so():
+def test_three_points_rest_on_the_stated_accuracy_and_carry_the_turntable_sources():
+    """Without redundancy the 1-sigma rests on the touch accuracy (stated or the 0.5 mm
+    default), never on a noise borrowed elsewhere; the turntable's error sources go into the
+    result under their names, so a later step knows what it shares with the turntable."""
     roles = ["origin", "x", "xy"]
     theta = np.radians([15.0, 140.0, 250.0])
-    r = calibrate_workpiece(theta, touch(roles, theta), roles, T_R_B, noise_sigma=2e-4)
-    assert r.noise_source == "turntable" and r.noise_sigma == pytest.approx(2e-4)
-    assert "taken from the turntable calibration" in r.summary()
-    assert "as given (--sigma)" not in r.summary()
+    f = touch(roles, theta)
+    cov = np.diag([1e-8, 2e-8, 1e-8, 1e-8, 4e-8, 1e-8])
+    plain = calibrate_workpiece(theta, f, roles, T_R_B, T_R_B_covariance=cov, prior_sigma=2e-4)
+    named = calibrate_workpiece(theta, f, roles, T_R_B,
+                                T_R_B_covariance=Sources.of("turntable DKP", cov), prior_sigma=2e-4)
+    assert plain.noise_source == "prior" and plain.noise_sigma == pytest.approx(2e-4)
+    np.testing.assert_allclose(named.sigma["T_B_W_rotation"], plain.sigma["T_B_W_rotation"])
+    sources = named.estimates["T_B_W"].sources.factors
+    assert set(sources) == {OWN, "turntable DKP"}
+    np.testing.assert_allclose(named.estimates["T_B_W"].covariance,
+                               named.covariance, atol=1e-20)
+    default = calibrate_workpiece(theta, f, roles, T_R_B)
+    assert default.noise_source == "default" and default.noise_sigma == pytest.approx(5e-4)
+    assert "the default (state yours with --sigma)" in default.summary()

@@ -62,7 +62,7 @@ def test_cli_cell_results_equal_the_library_call_byte_for_byte(tmp_path, capsys,
         before = Cell.load(lib_file)
         content = cell_to_dict(before)
         call = getattr(cellcal, procedure)
-        got = call(before, read_csv(csv), source=str(csv),
+        got = call(before, read_csv(csv), source=str(csv), file=csv,
                    **lib_kw, **touches.keywords())
         got.cell.save(lib_file)
         assert cli_file.read_bytes() == lib_file.read_bytes(), procedure
@@ -90,8 +90,15 @@ def test_library_call_returns_a_new_cell_and_leaves_the_given_one(tmp_path):
     assert nominal.tools["torch"].provenance.source == "nominal"
     tool = got.cell.tools["torch"]
     assert np.linalg.norm(tool.T_F_TCP[:3, 3] - truth.tools["torch"].T_F_TCP[:3, 3]) < 1e-3
-    assert tool.provenance == Provenance("tcp", STAMP, got.result.rms * 1e3,
-                                         f"{len(touches.q)} touches from measurements")
+    prov = tool.provenance
+    assert (prov.source, prov.time, prov.rms_mm, prov.note) == (
+        "tcp", STAMP, got.result.rms * 1e3, f"{len(touches.q)} touches from measurements")
+    # A table, not a file: nothing to repeat it from; named by the item and the time.
+    assert prov.measurements is None and prov.id == f"tools.torch {STAMP}"
+    # Its uncertainty is recorded for the next steps, as the result reports it.
+    cov = sum(f @ f.T for f in prov.sources.values())
+    np.testing.assert_allclose(np.sqrt(np.diag(cov)), np.r_[got.result.sigma["tcp"], got.result.sigma[
+        "T_F_TCP_rotation"]], rtol=1e-9)
     assert got.item == "tool 'torch'" and tool.number == 1 and tool.mass == 3.2
 
 
@@ -110,16 +117,26 @@ def test_workpiece_takes_the_turntable_result_and_propagates_its_uncertainty():
     rng = np.random.default_rng(4)
     tt = cellcal.turntable(nominal, simulate(truth, "turntable", noise=1e-4, seed=rng,
                                              tool="torch").to_table(), tool="torch",
-                           height=-0.05)
+                           height=-0.05, sigma=1e-4)
     wp_touches = simulate(truth, "workpiece", noise=1e-4, seed=rng, tool="torch", frame="part")
     with_tt = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch",
-                                turntable=tt.result)
-    without = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch")
-    assert with_tt.notes == ()
-    assert "does not include the turntable's uncertainty" in without.notes[0]
+                                turntable=tt.result, sigma=1e-4)
+    from_cell = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch",
+                                  sigma=1e-4)
+    cov = tt.result.estimates["T_world_B"].covariance
+    apart = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch", sigma=1e-4,
+                              turntable=cellcal.TurntablePose(tt.result.values["T_world_B"], cov,
+                                                              "world"))
+    # The cell records the turntable's uncertainty (sources shared with the torch included):
+    # from the cell or from the result, the workpiece carries the same.
+    assert not any("turntable" in n for n in with_tt.notes + from_cell.notes)
     s_with = np.linalg.norm(with_tt.result.sigma["T_B_W_position"])
-    s_without = np.linalg.norm(without.result.sigma["T_B_W_position"])
-    assert s_with > s_without
+    np.testing.assert_allclose(np.linalg.norm(from_cell.result.sigma["T_B_W_position"]), s_with,
+                               rtol=1e-9)
+    # The torch's error moved the turntable and the workpiece touches alike, and largely
+    # cancels in T_B_W: the same turntable covariance taken as independent of the torch
+    # (a bare matrix) overstates the workpiece's uncertainty.
+    assert np.linalg.norm(apart.result.sigma["T_B_W_position"]) > 1.5 * s_with
     assert with_tt.cell.frames["part"].parent == "turntable"
 
 

@@ -394,8 +394,10 @@ def test_workpiece_without_turntable_json_uses_the_cells_turntable(tmp_path, cap
                          "--json")
     assert code == 0, err
     j = json.loads(out)
-    assert "does not include the turntable's uncertainty" in err
-    assert j["turntable_included"] is False
+    # The example's turntable records no uncertainty: it is taken at the nominal accuracy.
+    assert ("note: turntable is calibrated without a recorded uncertainty: its accuracy is "
+            "taken as 1 mm and 0.5 deg per axis") in err
+    assert j["turntable_included"] is True
     part = Cell.load(path).frames["part"]
     assert part.parent == "turntable" and part.number == 2
     assert_pose_within(part.pose, TRUE_T_B_PART, j["sigma"]["T_B_W_position_mm"],

@@ -102,7 +102,7 @@ def programs(tmp_path_factory) -> dict[str, Path]:
      "is not a status or turn value"),
     ("kuka", r",Z [-0-9.]+,", ",Z 1e300,", "is beyond 1e+15 in size, which no value of a program is"),
     ("fanuc", r", 0, 0, 0'", ", 0, 99999999999999999999999, 0'",
-     "the turn numbers must be integers"),
+     "a turn number that large is a typing error"),
 ])
 def test_huge_numbers_in_a_program_are_refused_naming_the_line(tmp_path, capsys, programs,
                                                               vendor, old, new, match):

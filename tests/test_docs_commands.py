@@ -8,10 +8,12 @@ command's --help. They run in process, in order, in a fresh folder that holds a 
 ``examples/``, as a user who runs them from the root of the repository. The input files a command
 names are made the way the docs say: ``cell.yaml`` is a copy of the example cell (of the
 positioner cell for positioner commands), touch files come from ``robotcell simulate``,
-``joints.csv`` from ``identify --propose``, ``poses.csv`` from ``fk --input``, ``tracker.csv``
+``joints.csv`` from ``identify --propose``, ``poses.csv`` from ``fk --input``, a cell for
+``calibrate cell`` from a TCP and a turntable calibration into it, ``tracker.csv``
 from the block of docs/identification.md that simulates it; the cell of a command that filters
 (``compensate``, ``program compensate``, ``program check`` of a filtered program) gets the arm
-identified from that ``tracker.csv`` (``identify ... --cell cell.yaml``, docs/accuracy.md). Each command must exit 0 without a
+identified from that ``tracker.csv`` (``identify ... --cell cell.yaml``, docs/accuracy.md). Each
+command must exit 0 without a
 traceback and write the files it names. ``LEFT_OUT`` lists the commands not run, and why.
 """
 
@@ -177,6 +179,14 @@ def prepare(capsys, argv: list[str]) -> None:
     if "truth_calibrated.yaml" in argv:  # docs/simulate.md: cp truth.yaml truth_calibrated.yaml
         shutil.copy(truth, "truth.yaml")
         shutil.copy(truth, "truth_calibrated.yaml")
+    if argv[:2] == ["calibrate", "cell"]:  # a cell whose calibrations recorded their files
+        for proc, extra in (("tcp", ["--name", "pointer"]),
+                            ("turntable", ["--tool", "pointer", "--height=-50"])):
+            _simulate(capsys, proc, f"{proc}.csv", truth, "--tool", "pointer")
+            code, _, err = run(capsys, "calibrate", proc, f"{proc}.csv", "--cell", "cell.yaml",
+                               "--sigma", "0.1", *extra)
+            assert code == 0, err
+        return
     if argv[0] == "calibrate":
         proc, data = argv[1], argv[2]
         tool = argv[argv.index("--tool") + 1] if "--tool" in argv else "pointer"

@@ -18,13 +18,13 @@ from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 from robotcell.report import load_result, verdict, write_report
 
 
-def frame_result(seed=0, outlier=False, size=0.004):
+def frame_result(seed=0, outlier=False, size=0.004, touches=(3,)):
     rng = np.random.default_rng(seed)
     T = make_pose(rot_z(0.4), [1.2, -0.3, 0.5])
     nominal = rng.uniform(-0.4, 0.4, (8, 3))
     measured = transform_points(T, nominal) + rng.normal(0, 1e-4, (8, 3))
     if outlier:
-        measured[3] += [size, 0, 0]
+        measured[list(touches)] += [size, 0, 0]
     return frame_npoint(measured, nominal).to_json()
 
 
@@ -48,10 +48,11 @@ def embedded_pngs(page):
 def test_verdicts():
     good = frame_result()
     assert verdict(good)[0] == "good"
-    # A flagged touch asks for a check; one far beyond the touch accuracy makes the result poor.
+    # A touch the others single out is left out, and the result asks for a check; two far
+    # beyond the touch accuracy (no one touch to leave out) make it poor.
     grade, reasons = verdict(frame_result(outlier=True))
-    assert grade == "check" and any("outlier" in r for r in reasons)
-    grade, reasons = verdict(frame_result(outlier=True, size=0.04))
+    assert grade == "check" and any("left out as outlier" in r for r in reasons)
+    grade, reasons = verdict(frame_result(outlier=True, size=0.04, touches=(3, 5)))
     assert grade == "poor" and any("far beyond the default touch accuracy" in r for r in reasons)
     assert verdict({**good, "condition": 500.0})[0] == "check"
     assert verdict({**good, "condition": 5000.0})[0] == "poor"
@@ -246,16 +247,13 @@ def test_demo_reports_for_a_technician_in_headless_chromium(tmp_path, capsys):
         assert "<th>dof" in appendix and "<th>noise_source" in appendix
         # The 3D scene: equal axes (plotly scales the data alike), a touch per residual and
         # the residual vectors magnified by the factor it states (plotly fits the view to
-        # everything drawn); the workpiece result carries no touched points.
+        # everything drawn).
         fig = figure_from_page(page)
         assert fig["layout"]["scene"]["aspectmode"] == "data"
-        if procedure != "workpiece":
-            n = sum(len(t["x"]) for t in traces(fig, "touches") + traces(fig, "touches (outliers)"))
-            assert n == len(json.loads((tmp_path / "demo" / f"{procedure}.json").read_text())
-                            ["residuals_mm"]), procedure
-            assert re.search(r"residual vectors magnified \d+ x", page), procedure
-        else:
-            assert "this result holds no touched points" in page
+        n = sum(len(t["x"]) for t in traces(fig, "touches") + traces(fig, "touches (outliers)"))
+        assert n == len(json.loads((tmp_path / "demo" / f"{procedure}.json").read_text())
+                        ["residuals_mm"]), procedure
+        assert re.search(r"residual vectors magnified \d+ x", page), procedure
         assert len(page.encode()) < 5_000_000, procedure
         # Rendered by a browser: not blank, the figures loaded, the scene drawn, no error.
         dom, console, shot = render(exe, path, tmp_path, size=(1000, 2000))

@@ -367,7 +367,7 @@ def test_calibration_recovers_the_truth(case):
     if t.procedure == "tcp":
         F = cell.robot.fk(q, tool=np.eye(4))
         r = np.array(roles)
-        res = calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"])
+        res = calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=NOISE)
         assert_pose_within(res.values["T_F_TCP"], t.truth["T_F_TCP"],
                            res.sigma["T_F_TCP_position"], res.sigma["T_F_TCP_rotation"])
         # The reference point: the design's point in the robot base.
@@ -375,7 +375,8 @@ def test_calibration_recovers_the_truth(case):
     elif t.procedure == "track":
         f = cell.fk(q, e, tool=t.tool, frame="robot")[:, :3, 3]
         refs = [[float(v) * 1e-3 for v in o.split("=", 1)[1].split(",")] for o in t.options]
-        res = calibrate_track(e, f, references=refs, point=[int(p) - 1 for p in roles])
+        res = calibrate_track(e, f, references=refs, point=[int(p) - 1 for p in roles],
+                              prior_sigma=NOISE)
         assert_pose_within(res.values["T_L_R"], t.truth["T_L_R"], res.sigma["T_L_R_position"],
                            res.sigma["T_L_R_rotation"])
         assert abs(res.values["scale"] - t.truth["scale"]) <= 4 * res.sigma["scale"]
@@ -383,24 +384,24 @@ def test_calibration_recovers_the_truth(case):
         # Touches in the frame the table is fixed in; --height in mm.
         f = cell.fk(q, e, tool=t.tool, frame=t.truth["parent"])[:, :3, 3]
         height = float(t.options[0].split("=", 1)[1]) * 1e-3
-        res = calibrate_turntable(table, f, height=height)
+        res = calibrate_turntable(table, f, height=height, prior_sigma=NOISE)
         assert_pose_within(res.values["T_R_B"], t.truth["pose"], res.sigma["T_R_B_position"],
                            res.sigma["T_R_B_rotation"])
         assert abs(res.values["radius"] - t.truth["radius"]) <= 4 * res.sigma["radius"]
     elif t.procedure == "workpiece":
         tt = cell.turntable
         f = cell.fk(q, e, tool=t.tool, frame=tt.parent)[:, :3, 3]
-        res = calibrate_workpiece(table, f, roles, tt.T_parent_B)
+        res = calibrate_workpiece(table, f, roles, tt.T_parent_B, prior_sigma=NOISE)
         assert_pose_within(res.values["T_B_W"], t.truth["pose"], res.sigma["T_B_W_position"],
                            res.sigma["T_B_W_rotation"])
     elif t.procedure == "frame":
         f = cell.fk(q, e, tool=t.tool, frame=t.truth["parent"])[:, :3, 3]
-        res = frame_3point(f, roles)
+        res = frame_3point(f, roles, NOISE)
         assert_pose_within(res.values["T_R_W"], t.truth["pose"], res.sigma["T_R_W_position"],
                            res.sigma["T_R_W_rotation"])
-    # The calibration sees touch-up errors of the simulated size (estimated from a few touches).
-    assert res.noise_source == "residuals"
-    assert 0.3 * NOISE < res.noise_sigma < 3 * NOISE
+    # The residuals show touch-up errors of the simulated size (estimated from a few touches).
+    assert res.noise_source == "prior"
+    assert 0.3 * NOISE < res.residual_sigma < 3 * NOISE
 
 
 # -- 7. refusals ----------------------------------------------------------------------------------

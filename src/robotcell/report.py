@@ -204,6 +204,14 @@ def _frames(result: dict[str, Any]) -> tuple[str, list[tuple[str, np.ndarray]]]:
     frames : list of (str, ndarray of shape (4, 4))
         Label and pose (translation in mm) of each frame to draw.
     """
+    if result.get("procedure") == "workpiece" and isinstance(result.get("turntable_matrix"), list):
+        # The touches are where the table had turned each of them, in the turntable's parent
+        # (the world in a cell, else the robot base): drawn there, with B and W at table 0.
+        T_P_B = np.array(result["turntable_matrix"], dtype=float)
+        T_B_W = np.array(result["matrix"], dtype=float)
+        parent = "the turntable's parent frame"
+        return parent, [(parent, np.eye(4)), (_FRAME_NAMES["B"], T_P_B),
+                        ("workpiece W at table 0", T_P_B @ T_B_W)]
     keys = [*result, *(result.get("sigma") or {})]
     match = next((m for m in map(_POSE_KEY.fullmatch, keys) if m), None)
     if match is None or match[1] == "F" or not isinstance(result.get("matrix"), list):

@@ -20,7 +20,13 @@ from robotcell.calibration.fitting import (
     perturb_rotation,
     pose_sigma,
 )
-from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.calibration.result import (
+    CONDITION_LIMIT,
+    CalibrationResult,
+    fit_fields,
+    pose_fields,
+)
+from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points
 
@@ -70,33 +76,45 @@ def _check_roles(p: NDArray[np.float64], roles: list[str]) -> None:
             "the X axis, ideally near +Y")
 
 
-def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | None):
-    """ML fit of origin, rotation and the free coordinates of each +X / XY-plane touch."""
+def role_projectors(R: NDArray[np.float64], roles: NDArray[np.str_]) -> NDArray[np.float64]:
+    """Directions each touch of a 3-point frame measures, as projectors (N, 3, 3).
+
+    An ``origin`` touch measures all 3; an ``x`` touch, anywhere on the +X line, the 2 across it
+    (``I - X X^T``); an ``xy`` touch, anywhere in the plane, the 1 along Z (``Z Z^T``).
+    """
+    X, Z = R[:, 0], R[:, 2]
+    P = np.broadcast_to(np.eye(3), (len(roles), 3, 3)).copy()
+    P[roles == "x"] -= np.outer(X, X)
+    P[roles == "xy"] = np.outer(Z, Z)
+    return P
+
+
+def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | None,
+              inputs: Inputs | None):
+    """ML fit of origin and rotation; each +X / XY-plane touch's free coordinates eliminated.
+
+    The free coordinates of a touch (its distance along X; x and y in the plane) take their
+    best values for any frame (the foot of the touch on the line or plane), so the fit runs over
+    the 6 frame parameters only, with each touch measuring the directions across its feature
+    (:func:`role_projectors`): the same maximum-likelihood estimate, at a cost linear in the
+    number of touches.
+    """
     r = np.array(roles)
-    io, ix, ixy = (np.flatnonzero(r == k) for k in ("origin", "x", "xy"))
-    o0 = p[io].mean(axis=0)
-    X0 = _unit(p[ix].mean(axis=0) - o0)
-    Y0 = _unit((w := p[ixy].mean(axis=0) - o0) - (w @ X0) * X0)
+    o0 = p[r == "origin"].mean(axis=0)
+    X0 = _unit(p[r == "x"].mean(axis=0) - o0)
+    Y0 = _unit((w := p[r == "xy"].mean(axis=0) - o0) - (w @ X0) * X0)
     R0 = np.column_stack([X0, Y0, np.cross(X0, Y0)])
-    a0 = (p[ix] - o0) @ X0
-    bc0 = (p[ixy] - o0) @ R0[:, :2]
-    x0 = np.concatenate([o0, np.zeros(3), a0, bc0.ravel()])
-    nx, nxy = len(ix), len(ixy)
 
-    def model(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        R = perturb_rotation(R0, x[3:6])
-        a = x[6:6 + nx]
-        bc = x[6 + nx:].reshape(nxy, 2)
-        m = np.empty_like(p)
-        m[io] = x[:3]
-        m[ix] = x[:3] + a[:, None] * R[:, 0]
-        m[ixy] = x[:3] + bc @ R[:, :2].T
-        return m
+    def measured(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return role_projectors(perturb_rotation(R0, x[3:6]), r)
 
-    names = (["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
-              "rotation about z"] + [f"distance of touch {i + 1} along X" for i in ix]
-             + [f"{c} of touch {i + 1} in the XY plane" for i in ixy for c in ("x", "y")])
-    res = fit(lambda x: p - model(x), x0, names, prior_sigma)
+    def resid(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.einsum("nij,nj->ni", measured(x), p - x[:3])
+
+    names = ["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
+             "rotation about z"]
+    res = fit(resid, np.concatenate([o0, np.zeros(3)]), names, prior_sigma, measured=measured,
+              inputs=inputs)
     T = np.eye(4)
     T[:3, :3] = perturb_rotation(R0, res.x[3:6])
     T[:3, 3] = res.x[:3]
@@ -109,24 +127,24 @@ def _common(procedure: str, key: str, T: NDArray[np.float64], res, labels: list[
             points: NDArray[np.float64] | None = None) -> CalibrationResult:
     sp, sr = pose_sigma(res.covariance[:6, :6])
     warnings = list(warnings) + outlier_warnings(res, labels)
-    if res.noise_source == "none":
-        warnings.append("no redundant touches and no measurement sigma given: uncertainties are "
-                        "unknown; touch each point twice or give the touch-up accuracy (--sigma)")
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: the "
                         "touches are poorly spread; spread them further apart")
+    p = len(res.x)
     return CalibrationResult(
         procedure=procedure, values={key: T}, sigma={key + "_position": sp, key + "_rotation": sr},
-        residuals=res.residuals, condition=res.condition, dof=res.dof,
-        noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
-        undetermined=undetermined or [], warnings=warnings, next_step=next_step,
+        labels=labels, undetermined=undetermined or [], warnings=warnings, next_step=next_step,
         json_fields=pose_fields(T), covariance=res.covariance[:6, :6],
         parameter_names=names or ["x", "y", "z", "rx", "ry", "rz"], points=points,
+        estimates={key: estimate(res.sources, res.input_gain, np.eye(6, p),
+                                 None if p == 6 else np.eye(6, p))},
+        **fit_fields(res),
     )
 
 
 def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,
-                 labels: Sequence[str] | None = None) -> CalibrationResult:
+                 labels: Sequence[str] | None = None, *,
+                 inputs: Inputs | None = None) -> CalibrationResult:
     """Frame from touches of its origin, a point on +X, and a point in the XY plane with Y > 0.
 
     KUKA's BASE 3-point method (also Fanuc's and Yaskawa's three-point user frame), generalised
@@ -141,10 +159,13 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
     roles : sequence of str, length N
         ``"origin"``, ``"x"`` or ``"xy"`` for each touch; each role at least once.
     prior_sigma : float, optional
-        Touch-up accuracy (metres, 1-sigma per coordinate); used for the uncertainties instead of
-        the residuals. Needed for uncertainties with exactly 3 touches.
+        Touch-up accuracy (metres, 1-sigma per coordinate) the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
         Name of each touch for the report.
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (the tool, a track), whose errors are
+        added to the uncertainty; ``inputs.sensitivity`` is the derivative of each point.
 
     Returns
     -------
@@ -169,7 +190,7 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
                          + (f"; missing {', '.join(missing)}" if missing else ""))
     _check_roles(p, roles)
     labs = _labels(len(p), labels, roles)
-    res, T = _role_fit(p, roles, prior_sigma)
+    res, T = _role_fit(p, roles, prior_sigma, inputs)
     warnings = []
     r = np.array(roles)
     lx = np.linalg.norm(p[r == "x"].mean(axis=0) - p[r == "origin"].mean(axis=0))
@@ -191,7 +212,8 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
 
 
 def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | None = None,
-                 labels: Sequence[str] | None = None) -> CalibrationResult:
+                 labels: Sequence[str] | None = None, *,
+                 inputs: Inputs | None = None) -> CalibrationResult:
     """Best-fit frame to touched points whose coordinates in the frame are known.
 
     Maximum likelihood under isotropic Gaussian noise on the touched points: minimises
@@ -205,8 +227,11 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
     nominal : array_like, shape (N, 3)
         Coordinates of the same points in the frame W, e.g. from the drawing (metres).
     prior_sigma : float, optional
-        Touch-up accuracy (metres); needed for uncertainties with exactly 3 points.
+        Touch-up accuracy (metres); default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (see :func:`frame_3point`).
 
     Returns
     -------
@@ -238,7 +263,7 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
 
     names = ["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
              "rotation about z"]
-    res = fit(resid, np.concatenate([T0[:3, 3], np.zeros(3)]), names, prior_sigma)
+    res = fit(resid, np.concatenate([T0[:3, 3], np.zeros(3)]), names, prior_sigma, inputs=inputs)
     T = np.eye(4)
     T[:3, :3] = perturb_rotation(R0, res.x[3:6])
     T[:3, 3] = res.x[:3]
@@ -254,7 +279,8 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
 
 
 def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,
-                 labels: Sequence[str] | None = None) -> CalibrationResult:
+                 labels: Sequence[str] | None = None, *,
+                 inputs: Inputs | None = None) -> CalibrationResult:
     """Pose of a fixed (external) tool in the robot base frame, touched with a reference tool.
 
     The robot carries a reference tool of known TCP; the recorded TCP positions (robot base
@@ -272,8 +298,12 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
     roles : sequence of str, length N
         ``"tcp"``, ``"x"`` or ``"xy"``.
     prior_sigma : float, optional
-        Touch-up accuracy (metres).
+        Touch-up accuracy (metres); default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (the reference tool; see
+        :func:`frame_3point`).
 
     Returns
     -------
@@ -296,7 +326,8 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
                  "tool) and check by moving a workpiece point to the fixed TCP in two orientations")
     if "x" not in roles and "xy" not in roles:
         pt = p[np.array(roles) == "tcp"]
-        res = fit(lambda x: pt - x, pt.mean(axis=0), ["x", "y", "z"], prior_sigma)
+        res = fit(lambda x: pt - x, pt.mean(axis=0), ["x", "y", "z"], prior_sigma,
+                  inputs=None if inputs is None else inputs.subset(np.array(roles) == "tcp"))
         T = np.eye(4)
         T[:3, 3] = res.x
         out = _common("external-tcp", "T_R_TCP", T, res, labs, [], next_step,
@@ -308,12 +339,10 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
     if "x" not in roles or "xy" not in roles:
         raise IllPosedError("the fixed tool's orientation needs touches of both a point on its +X axis "
                             "(role x) and a point in its XY plane with positive Y (role xy)")
-    out = frame_3point(p, ["origin" if r == "tcp" else r for r in roles], prior_sigma, labs)
-    T = out.values.pop("T_R_W")
+    out = frame_3point(p, ["origin" if r == "tcp" else r for r in roles], prior_sigma, labs,
+                       inputs=inputs).renamed("T_R_W", "T_R_TCP")
+    T = out.values["T_R_TCP"]
     out.procedure = "external-tcp"
-    out.values["T_R_TCP"] = T
-    out.sigma = {"T_R_TCP_position": out.sigma["T_R_W_position"],
-                 "T_R_TCP_rotation": out.sigma["T_R_W_rotation"]}
     out.next_step = next_step
     out.json_fields.update({"tcp_mm": T[:3, 3] * 1e3, "rotation_determined": True})
     return out

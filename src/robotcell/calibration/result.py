@@ -15,6 +15,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.calibration.fitting import Fit
+from robotcell.calibration.uncertainty import Estimate
 from robotcell.calibration.verdict import (
     CONDITION_GOOD,
     CONDITION_POOR,
@@ -26,7 +28,7 @@ from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import format_table
 
-__all__ = ["PROCEDURES", "CalibrationResult", "pose_fields", "to_jsonable"]
+__all__ = ["PROCEDURES", "CalibrationResult", "fit_fields", "pose_fields", "to_jsonable"]
 
 #: The ``procedure`` of every result robotcell's calibrations write (``--json``).
 PROCEDURES = ("tcp", "frame-3point", "frame-npoint", "external-tcp", "track", "turntable",
@@ -120,12 +122,11 @@ class CalibrationResult:
     dof : int
         Redundancy: number of scalar measurements minus number of estimated parameters.
     noise_sigma : float
-        Measurement noise (metres, per coordinate) behind ``sigma``: estimated from the residuals
-        (``noise_source == "residuals"``) or the prior the user gave (``"prior"``); NaN
-        (``"none"``) when there is no redundancy and no prior.
-    noise_source : {"residuals", "prior", "turntable", "none"}
-        ``"turntable"``: no redundancy here, so the noise level estimated by the turntable
-        calibration is used (workpiece on the turntable).
+        Touch noise (metres, per coordinate) behind ``sigma``: the stated touch accuracy
+        (``noise_source == "prior"``), the default (``"default"``), or, when the residuals are
+        larger than the accuracy explains (chi-square test), the noise they need
+        (``"residuals"``). Never less than the accuracy.
+    noise_source : {"prior", "default", "residuals"}
     labels : list of str
         Name of each measurement for reports (e.g. ``"row 3 (xy)"``); length N.
     undetermined : list of str
@@ -148,6 +149,32 @@ class CalibrationResult:
     points : ndarray, shape (N, 3) or None
         The measured points behind ``residuals`` (metres, same axes), for reports; None when the
         procedure has no single point per measurement.
+    touch_sigma : float
+        The touch accuracy the residuals are tested against (metres per coordinate): stated, or
+        the default.
+    accuracy_source : {"stated", "default"}
+    residual_sigma : float
+        Noise estimated from the residuals (metres per coordinate), a check against
+        ``touch_sigma``; NaN without redundancy.
+    chi2 : float or None
+        Residuals against the touch accuracy and the inputs' errors; chi-square with ``dof``
+        degrees of freedom for good touches. None without redundancy.
+    excluded : list of int
+        Touches left out of the result (a gross error singled out by the others).
+    unchecked : list of int
+        Touches that no other touch checks in some direction they decide.
+    outliers : list of int
+        Touches used by the result whose residual is an outlier at 3 sigma.
+    disagreeing : list of int
+        Touches that disagree beyond 3 sigma, one of them wrong, with nothing to tell which.
+    gross : list of int
+        Outliers beyond 3 sigma even for three times the touch accuracy.
+    estimates : dict of str to Estimate
+        For the calibrated quantities a later calibration can use (a tool, an axis, a frame):
+        their error sources and how they follow the inputs of this calibration.
+    fit : Fit or None
+        The least-squares fit behind the result (its linearisation, for a fit of several
+        calibrations together).
     """
 
     procedure: str
@@ -167,6 +194,17 @@ class CalibrationResult:
     covariance: NDArray[np.float64] | None = None
     parameter_names: list[str] = field(default_factory=list)
     points: NDArray[np.float64] | None = None
+    touch_sigma: float = float("nan")
+    accuracy_source: str = "default"
+    residual_sigma: float = float("nan")
+    chi2: float | None = None
+    excluded: list[int] = field(default_factory=list)
+    unchecked: list[int] = field(default_factory=list)
+    outliers: list[int] = field(default_factory=list)
+    disagreeing: list[int] = field(default_factory=list)
+    gross: list[int] = field(default_factory=list)
+    estimates: dict[str, Estimate] = field(default_factory=dict)
+    fit: Fit | None = None
 
     def __post_init__(self) -> None:
         self.residuals = np.asarray(self.residuals, dtype=float).reshape(-1, 3)
@@ -179,15 +217,22 @@ class CalibrationResult:
         return np.linalg.norm(self.residuals, axis=1)
 
     @property
+    def used_norms(self) -> NDArray[np.float64]:
+        """Residual lengths of the touches the result uses (not those left out), metres."""
+        keep = np.ones(len(self.residuals), dtype=bool)
+        keep[self.excluded] = False
+        return self.residual_norms[keep]
+
+    @property
     def rms(self) -> float:
-        """Root mean square of the residual lengths (metres)."""
-        n = self.residual_norms
+        """Root mean square of the residual lengths of the touches used (metres)."""
+        n = self.used_norms
         return float(np.sqrt(np.mean(n**2))) if n.size else 0.0
 
     @property
     def max(self) -> float:
-        """Largest residual length (metres)."""
-        n = self.residual_norms
+        """Largest residual length of the touches used (metres)."""
+        n = self.used_norms
         return float(n.max()) if n.size else 0.0
 
     def renamed(self, old_key: str, new_key: str) -> CalibrationResult:
@@ -238,6 +283,7 @@ class CalibrationResult:
         json_names = {k: new_key + k[len(old_key):] for k in self.json_fields
                       if k.startswith(old_key + "_")}
         return replace(self, values=swap(self.values, {old_key: new_key}),
+                       estimates=swap(self.estimates, {old_key: new_key}),
                        sigma=swap(self.sigma, sigma_names),
                        kinds=swap(self.kinds, {old_key: new_key}),
                        json_fields=swap(self.json_fields, json_names),
@@ -278,7 +324,10 @@ class CalibrationResult:
         dict
             ``procedure``, ``residuals_mm`` (length of each residual), ``residuals_xyz_mm``
             (N x 3), ``labels``, ``rms_mm``, ``max_mm``, ``condition``, ``dof``,
-            ``noise_sigma_mm`` and ``noise_source``, ``sigma`` (1-sigma of each estimated
+            ``noise_sigma_mm`` and ``noise_source`` (the noise behind the 1-sigma),
+            ``touch_sigma_mm`` and ``accuracy_source`` (the accuracy the residuals are tested
+            against), ``residual_sigma_mm`` (the residuals' estimate) and ``chi2``, the touches
+            ``excluded``, ``unchecked``, ``outliers`` and ``gross_outliers`` (labels), ``sigma`` (1-sigma of each estimated
             quantity, keys with units), ``undetermined``, ``warnings``, ``next_step``,
             ``points_mm`` (N x 3, when the procedure records its measured points), then the
             procedure's own fields (``json_fields``), and ``verdict`` (level, reasons, the
@@ -295,6 +344,15 @@ class CalibrationResult:
             "dof": self.dof,
             "noise_sigma_mm": self.noise_sigma * 1e3,
             "noise_source": self.noise_source,
+            "touch_sigma_mm": self.touch_sigma * 1e3,
+            "accuracy_source": self.accuracy_source,
+            "residual_sigma_mm": self.residual_sigma * 1e3,
+            "chi2": self.chi2,
+            "excluded": [self.labels[i] for i in self.excluded],
+            "unchecked": [self.labels[i] for i in self.unchecked],
+            "outliers": [self.labels[i] for i in self.outliers],
+            "disagreeing": [self.labels[i] for i in self.disagreeing],
+            "gross_outliers": [self.labels[i] for i in self.gross],
             "sigma": self._sigma_json(),
             "undetermined": list(self.undetermined),
             "warnings": list(self.warnings),
@@ -336,6 +394,19 @@ class CalibrationResult:
             lines.append(f"  {key}{unit and ' (' + unit.strip() + ')'}: {text}")
         return lines
 
+    def _noise_line(self) -> str:
+        """The touch accuracy, the residuals' check against it and the noise the 1-sigma uses."""
+        s = self.touch_sigma * 1e3
+        text = (f"{s:.3f} mm per coordinate, as given (--sigma)" if self.accuracy_source == "stated"
+                else f"{s:.3f} mm per coordinate, the default (state yours with --sigma)")
+        if self.chi2 is None or not math.isfinite(self.residual_sigma):
+            return text + "; no redundant touches check it"
+        text += (f"; the residuals need {self.residual_sigma * 1e3:.3f} mm (chi-square "
+                 f"{self.chi2:.3g} for {self.dof} redundant coordinates)")
+        if self.noise_source == "residuals":
+            text += ": more than the accuracy explains, so the 1-sigma uses that"
+        return text
+
     def summary(self) -> str:
         """Readable report for the terminal, in millimetres and degrees.
 
@@ -349,25 +420,20 @@ class CalibrationResult:
         r = self.residuals * 1e3
         rows = [[lab, float(a), float(b), float(c), float(n)]
                 for lab, (a, b, c), n in zip(self.labels, r, self.residual_norms * 1e3)]
-        if self.noise_source == "residuals":
-            noise = f"{self.noise_sigma * 1e3:.3f} mm per coordinate, estimated from the residuals"
-        elif self.noise_source == "prior":
-            noise = f"{self.noise_sigma * 1e3:.3f} mm per coordinate, as given (--sigma)"
-        elif self.noise_source == "turntable":
-            noise = (f"{self.noise_sigma * 1e3:.3f} mm per coordinate, taken from the turntable "
-                     "calibration (no redundant touches here)")
-        else:
-            noise = "unknown (no redundant measurements and no --sigma given)"
+        noise = self._noise_line()
         v = self.verdict
         lines = [f"calibration: {self.procedure}", "", "result:"]
         lines += self._value_lines()
         lines += ["", "residuals (measured - model, mm):",
                   format_table(["touch", "dx", "dy", "dz", "|r|"], rows), "",
                   (f"RMS {self.rms * 1e3:.3f} mm, max {self.max * 1e3:.3f} mm "
-                   f"over {len(r)} measurements, redundancy {self.dof}"),
-                  f"measurement noise: {noise}",
+                   f"over {len(self.used_norms)} measurements, redundancy {self.dof}"),
+                  f"touch accuracy: {noise}",
                   (f"condition number: {format_condition(v.condition)} (below "
                    f"{CONDITION_GOOD:.0f} is good, above {CONDITION_POOR:.0f} poor)")]
+        if self.excluded:
+            lines += ["", "left out of the result (outliers; see the warnings): "
+                      + ", ".join(self.labels[i] for i in self.excluded)]
         if self.undetermined:
             lines += ["", "not determined by these measurements:"]
             lines += [f"  - {u}" for u in self.undetermined]
@@ -378,3 +444,26 @@ class CalibrationResult:
             lines += ["", f"next step: {self.next_step}"]
         lines += ["", v.line()]
         return "\n".join(lines)
+
+
+def fit_fields(res: Fit) -> dict[str, Any]:
+    """The fields of a :class:`CalibrationResult` that come from its fit, as keyword arguments.
+
+    Parameters
+    ----------
+    res : Fit
+
+    Returns
+    -------
+    dict
+        ``residuals``, ``condition``, ``dof``, ``noise_sigma``, ``noise_source``,
+        ``touch_sigma``, ``accuracy_source``, ``residual_sigma``, ``chi2``, ``excluded``,
+        ``unchecked``, ``outliers``, ``disagreeing``, ``gross`` and ``fit``.
+    """
+    return {"residuals": res.residuals, "condition": res.condition, "dof": res.dof,
+            "noise_sigma": res.noise_sigma, "noise_source": res.noise_source,
+            "touch_sigma": res.touch_sigma, "accuracy_source": res.accuracy_source,
+            "residual_sigma": res.residual_sigma, "chi2": res.chi2,
+            "excluded": list(res.excluded), "unchecked": list(res.unchecked),
+            "outliers": res.outliers, "disagreeing": res.disagreeing, "gross": list(res.gross),
+            "fit": res}

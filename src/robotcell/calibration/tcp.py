@@ -30,7 +30,13 @@ from robotcell.calibration.fitting import (
     scaled_condition,
 )
 from robotcell.calibration.frame import COLLINEAR_SIN, NEAR_COLLINEAR_SIN
-from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.calibration.result import (
+    CONDITION_LIMIT,
+    CalibrationResult,
+    fit_fields,
+    pose_fields,
+)
+from robotcell.calibration.uncertainty import OWN, Estimate, Inputs, Sources
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import validate_pose
 
@@ -107,6 +113,7 @@ def calibrate_tool(
     world_mode: str = "6d",
     prior_sigma: float | None = None,
     labels: Sequence[str] | None = None,
+    inputs: Inputs | None = None,
 ) -> CalibrationResult:
     """Calibrate a robot-held tool: TCP in the flange frame, reference point, optional orientation.
 
@@ -130,9 +137,14 @@ def calibrate_tool(
         ``"5d"``: only tool +X along world -Z; the rotation about the tool axis is fixed by the
         convention "smallest rotation from the flange X axis" and reported as undetermined.
     prior_sigma : float, optional
-        Touch-up accuracy (metres, 1-sigma per coordinate).
+        Touch-up accuracy (metres, 1-sigma per coordinate) the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
         Names of the touches in the order touches, axis_touches, plane_touches.
+    inputs : Inputs, optional
+        Earlier calibrations the flange poses rest on (a track the touches are mapped through),
+        in the order touches, axis_touches, plane_touches: ``inputs.sensitivity`` is the
+        derivative of the reference point as each flange pose places it.
 
     Returns
     -------
@@ -140,7 +152,9 @@ def calibrate_tool(
         ``values["tcp"]`` (3,) TCP in the flange frame, ``values["pivot"]`` (3,) reference point
         in the base frame, and with an orientation method ``values["T_F_TCP"]`` (4x4). JSON
         fields ``tcp_mm``, ``pivot_mm``, ``mean_mm``/``min_mm`` (as ABB reports) and, with an
-        orientation, ``matrix``/``xyzabc`` of ``T_F_TCP``.
+        orientation, ``matrix``/``xyzabc`` of ``T_F_TCP``. ``estimates["T_F_TCP"]`` over its
+        origin and rotation vector (about the flange axes); the rotation is not determined
+        without an orientation method.
 
     Raises
     ------
@@ -197,29 +211,37 @@ def calibrate_tool(
                                 "sideways so the reference point is off its axis on the tool's +Y side")
         Y = w / np.linalg.norm(w)
         R0 = np.column_stack([X, Y, np.cross(X, Y)])
-        x0 += [np.zeros(3), da, (f_p @ R0[:, :2]).ravel()]
+        x0 += [np.zeros(3)]
     x0 = np.concatenate(x0)
+    across = (np.diag([0.0, 1.0, 1.0]), np.diag([0.0, 0.0, 1.0]))  # in the tool frame
+
+    def measured(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        P = np.broadcast_to(np.eye(3), (n + na + nq, 3, 3)).copy()
+        if na:
+            R = perturb_rotation(R0, x[6:9])
+            for Tk, E, rows in ((Ta, across[0], slice(n, n + na)),
+                                (Tp, across[1], slice(n + na, None))):
+                RkR = Tk[:, :3, :3] @ R
+                P[rows] = RkR @ E @ np.swapaxes(RkR, 1, 2)
+        return P
 
     def resid(x: NDArray[np.float64]) -> NDArray[np.float64]:
         t, c = x[:3], x[3:6]
         out = [c - (T[:, :3, :3] @ t + T[:, :3, 3])]
         if na:
             R = perturb_rotation(R0, x[6:9])
-            d = x[9:9 + na]
-            xy = x[9 + na:].reshape(nq, 2)
-            ta = t - d[:, None] * R[:, 0]
-            tp = t + xy @ R[:, :2].T
-            out.append(c - (np.einsum("nij,nj->ni", Ta[:, :3, :3], ta) + Ta[:, :3, 3]))
-            out.append(c - (np.einsum("nij,nj->ni", Tp[:, :3, :3], tp) + Tp[:, :3, 3]))
+            for Tk, E in ((Ta, across[0]), (Tp, across[1])):
+                RkR = Tk[:, :3, :3] @ R
+                v = np.einsum("nji,nj->ni", RkR, c - Tk[:, :3, 3]) - t @ R  # in the tool frame
+                out.append(np.einsum("nij,nj->ni", RkR, v @ E))
         return np.concatenate(out)
 
     names = ["tcp x", "tcp y", "tcp z", "pivot x", "pivot y", "pivot z"]
     if na:
         names += ["tool rotation about flange x", "tool rotation about flange y",
                   "tool rotation about flange z"]
-        names += [f"distance of touch {labels[n + i]} along -X" for i in range(na)]
-        names += [f"{k} of touch {labels[n + na + i]}" for i in range(nq) for k in ("x", "y")]
-    res = fit(resid, x0, names, prior_sigma, advice=SIMILAR)
+    flipped = None if inputs is None else Inputs(-inputs.sensitivity, inputs.sources, inputs.names)
+    res = fit(resid, x0, names, prior_sigma, advice=SIMILAR, measured=measured, inputs=flipped)
     t, c = res.x[:3], res.x[3:6]
     values: dict = {"tcp": t, "pivot": c}
     sigma: dict = {"tcp": res.sigma[:3], "pivot": res.sigma[3:6]}
@@ -229,18 +251,26 @@ def calibrate_tool(
         warnings.append(f"the touch orientations differ by only {np.degrees(spread):.1f} deg in their "
                         f"least-varied direction: the TCP is poorly determined; {ADVICE}")
     R_tool = None
+    A = np.eye(6, len(res.x))  # T_F_TCP (origin, rotation vector) from the fit's parameters
+    A[3:6] = 0.0
+    extra_own = np.zeros((6, 0))
     if na:
         R_tool = perturb_rotation(R0, res.x[6:9])
+        A[3:6, 6:9] = np.eye(3)
         sigma_rot = res.sigma[6:9]
-        if np.any(res.x[9:9 + na] <= 0):
+        # The reference point in the tool frame at each ABC 2-point touch.
+        local = [np.einsum("nji,nj->ni", Tk[:, :3, :3] @ R_tool, c - Tk[:, :3, 3]) - t @ R_tool
+                 for Tk in (Ta, Tp)]
+        dist = -local[0][:, 0]
+        if np.any(dist <= 0):
             raise IllPosedError("in a -X touch the reference point lies on the tool's positive X side; "
                                 "the -X touch must move the tool back, against its tool direction")
-        xy = res.x[9 + na:].reshape(nq, 2)
+        xy = local[1][:, :2]
         if np.any(xy[:, 1] <= 0):
             raise IllPosedError("the XY-plane touches lie on both sides of the tool's X axis; keep them "
                                 "all on the tool's positive Y side")
-        if res.x[9:9 + na].min() < GOOD_AXIS_DISTANCE:
-            warnings.append(f"in a -X touch the reference point is only {res.x[9:9 + na].min() * 1e3:.1f}"
+        if dist.min() < GOOD_AXIS_DISTANCE:
+            warnings.append(f"in a -X touch the reference point is only {dist.min() * 1e3:.1f}"
                             " mm from the TCP: the tool direction is poorly determined; move the tool "
                             f"back along its axis by at least {GOOD_AXIS_DISTANCE * 1e3:.0f} mm")
         sin_xy = np.min(xy[:, 1] / np.linalg.norm(xy, axis=1))
@@ -250,6 +280,7 @@ def calibrate_tool(
                             "determined; move the tool sideways, toward its +Y side")
     elif len(Tw):
         R_tool, sigma_rot = _world_orientation(Tw[:, :3, :3], world_mode)
+        extra_own = np.vstack([np.zeros((3, 3)), np.diag(np.nan_to_num(sigma_rot))])
         if len(Tw) < 2:
             warnings.append("one ABC World alignment: its accuracy is unknown; align 2-3 times to get "
                             "the orientation uncertainty")
@@ -258,11 +289,12 @@ def calibrate_tool(
                                 "rotation from the flange X axis is used)")
     else:
         undetermined.append("tool orientation (add ABC 2-point touches or ABC World alignments)")
-    if res.noise_source == "none":
-        warnings.append("no redundant touches and no measurement sigma given: uncertainties are unknown; "
-                        "touch more than the minimum or give the touch-up accuracy (--sigma)")
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: {ADVICE}")
+    tool = res.sources.map(A)
+    if extra_own.size:  # ABC World: the spread of the alignments, independent of the touches
+        tool = Sources(6, {**tool.factors, OWN: np.hstack([tool.factors[OWN], extra_own])})
+    determined = np.eye(6) if R_tool is not None else np.eye(6)[:, :3]
     norms = np.linalg.norm(res.residuals, axis=1)
     extra = {"tcp_mm": t * 1e3, "pivot_mm": c * 1e3, "mean_mm": norms.mean() * 1e3,
              "min_mm": norms.min() * 1e3}
@@ -279,9 +311,8 @@ def calibrate_tool(
         next_step = ("enter tcp_mm as the tool's X,Y,Z, then calibrate its orientation (ABC 2-point or "
                      "ABC World) if the process needs the tool direction")
     return CalibrationResult(
-        procedure="tcp", values=values, sigma=sigma, residuals=res.residuals,
-        condition=res.condition, dof=res.dof, noise_sigma=res.noise_sigma,
-        noise_source=res.noise_source, labels=list(labels), undetermined=undetermined,
-        warnings=warnings, next_step=next_step, json_fields=extra, covariance=res.covariance,
-        parameter_names=names,
+        procedure="tcp", values=values, sigma=sigma, labels=list(labels),
+        undetermined=undetermined, warnings=warnings, next_step=next_step, json_fields=extra,
+        covariance=res.covariance, parameter_names=names,
+        estimates={"T_F_TCP": Estimate(tool, A @ res.input_gain, determined)}, **fit_fields(res),
     )

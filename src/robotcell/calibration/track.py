@@ -36,8 +36,9 @@ from robotcell.calibration.fitting import (
     outlier_warnings,
     perturb_rotation,
 )
-from robotcell.calibration.propagate import propagate
-from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult
+from robotcell.calibration.propagate import jacobian, propagate
+from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, fit_fields
+from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points, make_pose
 
@@ -148,7 +149,8 @@ def _check_references(refs: NDArray[np.float64], d: NDArray[np.float64]) -> list
     return []
 
 
-def _fit_unknown_point(e: NDArray[np.float64], f: NDArray[np.float64], prior: float | None):
+def _fit_unknown_point(e: NDArray[np.float64], f: NDArray[np.float64], prior: float | None,
+                       inputs: Inputs | None):
     """Linear ML fit of ``f_i = p_mean - (e_i - e_mean) m``; returns the fit and ``e_mean``."""
     e_mean = float(e.mean())
     de = e - e_mean
@@ -159,11 +161,13 @@ def _fit_unknown_point(e: NDArray[np.float64], f: NDArray[np.float64], prior: fl
     m0 = -(de @ (f - f.mean(axis=0))) / (de @ de)
     names = ["fixed point x", "fixed point y", "fixed point z",
              "track vector x", "track vector y", "track vector z"]
-    return fit(residuals, np.concatenate([f.mean(axis=0), m0]), names, prior), e_mean
+    return fit(residuals, np.concatenate([f.mean(axis=0), m0]), names, prior,
+               inputs=inputs), e_mean
 
 
 def _fit_known_points(e: NDArray[np.float64], f: NDArray[np.float64], refs: NDArray[np.float64],
-                      groups: NDArray[np.int_], d: NDArray[np.float64], prior: float | None):
+                      groups: NDArray[np.int_], d: NDArray[np.float64], prior: float | None,
+                      inputs: Inputs | None):
     """ML fit of rotation, scale (and centred offset for two or more points)."""
     r = refs[groups]
     e_mean = float(e.mean())
@@ -189,7 +193,7 @@ def _fit_known_points(e: NDArray[np.float64], f: NDArray[np.float64], refs: NDAr
     names = ["rotation about L x", "rotation about L y", "rotation about L z", "track scale"]
     if with_offset:
         names += ["carriage offset x", "carriage offset y", "carriage offset z"]
-    return fit(residuals, x0, names, prior), unpack
+    return fit(residuals, x0, names, prior, inputs=inputs), unpack
 
 
 def calibrate_track(
@@ -202,6 +206,7 @@ def calibrate_track(
     roll: str | None = None,
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
+    inputs: Inputs | None = None,
 ) -> CalibrationResult:
     """Calibrate a linear track from TCP touches of fixed reference points.
 
@@ -231,8 +236,11 @@ def calibrate_track(
     labels : sequence of str, optional
         Name of each touch for messages and reports (default ``"1".."N"``).
     prior_sigma : float, optional
-        Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
-        the residuals.
+        Touch accuracy (metres per coordinate) the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (the tool), whose errors are added to
+        the uncertainty.
 
     Returns
     -------
@@ -241,6 +249,8 @@ def calibrate_track(
         travel); ``point`` (3,) m, the unknown point in R at track position 0 (no references);
         ``T_L_R`` (4, 4) the pose of R in L at track position 0 when the rotation is determined
         or fixed by convention. ``sigma`` for each, ``residuals`` (N, 3) in R,
+        ``estimates["T_L_R"]`` over the 7 parameters origin (m), rotation vector (rad, about
+        the axes of L) and scale, the directions the touches do not determine left out,
         ``json_fields``: ``direction``, ``scale``, ``rotation`` (3x3 ``L_Q_R`` or None),
         ``offset_mm`` (or None), ``straightness_mm`` (residual across the track per touch),
         ``axis``, ``rotation_source``.
@@ -298,9 +308,10 @@ def calibrate_track(
 
     values: dict = {}
     sigma: dict = {}
+    estimates: dict = {}
     undetermined: list[str] = []
     if refs is None:
-        res, e_mean = _fit_unknown_point(e, f, prior_sigma)
+        res, e_mean = _fit_unknown_point(e, f, prior_sigma, inputs)
 
         def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
             s = np.linalg.norm(x[3:])
@@ -325,8 +336,15 @@ def calibrate_track(
                 return Rotation.from_matrix(zero_roll_rotation(derived(x)[:3], axis) @ Q.T).as_rotvec()
 
             values["T_L_R"] = make_pose(Q, np.zeros(3))
-            sigma["T_L_R_rotation"] = np.sqrt(np.abs(np.diag(
-                propagate(roll_rotvec, res.x, res.covariance))))
+            A = np.zeros((7, 6))
+            A[3:6] = jacobian(roll_rotvec, res.x)
+            A[6] = jacobian(lambda x: [np.linalg.norm(x[3:])], res.x)
+            sigma["T_L_R_rotation"] = np.sqrt(np.abs(np.diag(A[3:6] @ res.covariance @ A[3:6].T)))
+            across = np.eye(3) - np.outer(d, d)
+            U = np.linalg.svd(across)[0][:, :2]
+            determined = np.zeros((7, 3))
+            determined[3:6, :2], determined[6, 2] = U, 1.0
+            estimates["T_L_R"] = estimate(res.sources, res.input_gain, A, determined)
             source, offset = "convention: zero roll", None
             next_step = ("the rotation about the track axis is a convention, not a measurement; to "
                          "measure it, touch reference points with known coordinates in L (--reference)")
@@ -337,9 +355,15 @@ def calibrate_track(
                          "the track axis (two or more also give the carriage offset) and pass them "
                          "with --reference, or accept the zero-roll convention (--roll zero)")
     else:
-        res, unpack = _fit_known_points(e, f, refs, groups, d, prior_sigma)
+        res, unpack = _fit_known_points(e, f, refs, groups, d, prior_sigma, inputs)
         Q, scale, c = unpack(res.x)
         scale = float(scale)
+        A = np.zeros((7, len(res.x)))
+        A[:3] = jacobian(lambda x: unpack(x)[2], res.x)
+        A[3:6, :3] = np.eye(3)
+        A[6, 3] = 1.0
+        determined = np.eye(7)[:, 3:] if len(refs) < 2 else None
+        estimates["T_L_R"] = estimate(res.sources, res.input_gain, A, determined)
 
         def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
             Qx, _, cx = unpack(x)
@@ -395,13 +419,11 @@ def calibrate_track(
         "straightness_mm": np.linalg.norm(across, axis=1) * 1e3,
     }
     return CalibrationResult(
-        procedure="track", values=values, sigma=sigma, residuals=res.residuals,
-        condition=res.condition, dof=res.dof, noise_sigma=res.noise_sigma,
-        noise_source=res.noise_source, labels=labels, undetermined=undetermined,
+        procedure="track", values=values, sigma=sigma, labels=labels, undetermined=undetermined,
         warnings=warnings, next_step=next_step,
         kinds={"direction": "number", "scale": "number", "point": "length"},
         json_fields=json_fields, covariance=res.covariance,
-        parameter_names=_names(refs), points=f,
+        parameter_names=_names(refs), points=f, estimates=estimates, **fit_fields(res),
     )
 
 

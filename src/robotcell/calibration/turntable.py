@@ -23,7 +23,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.fitting import SAME_POINT, fit, outlier_warnings, perturb_rotation
 from robotcell.calibration.propagate import propagate
-from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
+from robotcell.calibration.result import (
+    CONDITION_LIMIT,
+    CalibrationResult,
+    fit_fields,
+    pose_fields,
+)
+from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points, make_pose, rot_z
 
@@ -98,6 +104,7 @@ def calibrate_turntable(
     height: float = 0.0,
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
+    inputs: Inputs | None = None,
 ) -> CalibrationResult:
     """Calibrate the root frame B of a turntable from touches of one point on the table.
 
@@ -117,8 +124,11 @@ def calibrate_turntable(
     labels : sequence of str, optional
         Name of each touch (default ``"1".."N"``).
     prior_sigma : float, optional
-        Known touch noise (metres per coordinate) for the uncertainties; default: estimated from
-        the residuals.
+        Touch accuracy (metres per coordinate) the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (the tool, a track), whose errors are
+        added to the uncertainty.
 
     Returns
     -------
@@ -169,7 +179,7 @@ def calibrate_turntable(
     names = ["origin x", "origin y", "origin z", "rotation about R x", "rotation about R y",
              "rotation about R z", "radius"]
     x0 = np.concatenate([b_plane + height * R0[:, 2], np.zeros(3), [r0]])
-    res = fit(residuals, x0, names, prior_sigma)
+    res = fit(residuals, x0, names, prior_sigma, inputs=inputs)
     T, radius = unpack(res.x)
     axis = T[:3, 2]
     tilt = float(np.arccos(np.clip(axis[2], -1.0, 1.0)))
@@ -220,9 +230,7 @@ def calibrate_turntable(
         sigma={"T_R_B_position": res.sigma[:3], "T_R_B_rotation": res.sigma[3:6],
                "radius": float(res.sigma[6]), "axis": np.sqrt(np.abs(np.diag(axis_cov))),
                "tilt": tilt_sigma},
-        residuals=res.residuals, condition=res.condition, dof=res.dof,
-        noise_sigma=res.noise_sigma, noise_source=res.noise_source, labels=labels,
-        warnings=warnings, points=f,
+        labels=labels, warnings=warnings, points=f,
         next_step=("enter T_R_B as the turntable's root frame in the controller (KUKA: ROOT of "
                    "the external kinematics; ABB: base frame of the mechanical unit), then "
                    "calibrate the workpiece frame on the table (robotcell calibrate workpiece)"),
@@ -230,4 +238,6 @@ def calibrate_turntable(
         json_fields=json_fields, covariance=res.covariance,
         parameter_names=["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z",
                          "radius"],
+        estimates={"T_R_B": estimate(res.sources, res.input_gain, np.eye(6, 7))},
+        **fit_fields(res),
     )

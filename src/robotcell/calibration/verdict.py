@@ -7,11 +7,12 @@ made later from a saved result judges it exactly as the terminal did.
 
 The rule (``docs/calibration.md``, "Verdict"):
 
-- **Accuracy.** The touch accuracy ``s`` is the one stated with ``--sigma`` (``noise_source ==
-  "prior"``) or :data:`DEFAULT_TOUCH_SIGMA_MM`. If the touches were that accurate,
-  ``SSR / s^2`` (SSR the sum of squared residuals) would be chi-square distributed with the
-  redundancy ``dof`` as degrees of freedom. Above its :data:`CHI2_P` quantile the residuals are
-  larger than the accuracy explains: *check*; above that quantile for ``POOR_FACTOR * s``: *poor*.
+- **Accuracy.** The touch accuracy ``s`` is the one stated with ``--sigma``
+  (``accuracy_source == "stated"``) or :data:`DEFAULT_TOUCH_SIGMA_MM`. If the touches were that
+  accurate, ``chi2`` (``SSR / s^2``, SSR the sum of squared residuals of the touches used, the
+  inputs' errors taken out) would be chi-square distributed with the redundancy ``dof`` as
+  degrees of freedom. Above its :data:`CHI2_P` quantile the residuals are larger than the
+  accuracy explains: *check*; above that quantile for ``POOR_FACTOR * s``: *poor*.
 - **Scale** (track): more than :data:`SCALE_CHECK` from 1: *check*; more than
   :data:`SCALE_POOR`: *poor*.
 - **Conditioning**: condition number above :data:`CONDITION_GOOD`: *check*; above
@@ -21,7 +22,11 @@ The rule (``docs/calibration.md``, "Verdict"):
 - **Redundancy**: without :data:`OUTLIER_REDUNDANCY` redundant coordinates a wrong touch cannot be
   singled out (see :func:`touches_for_outlier_check`): *check*, naming how many touches would
   make the check possible. With no redundancy at all nothing checks the result.
-- Any warning of the procedure (an outlier among them): *check*.
+- **Touches.** A touch flagged as an outlier, or left out as one: *check*; one flagged beyond
+  3 sigma for ``POOR_FACTOR * s`` that could not be left out, or touches that disagree by that
+  much (one is wrong, nothing tells which): *poor*. A touch that alone decides a direction of the
+  result (``unchecked``): *check*, naming it.
+- Any other warning of the procedure: *check*.
 """
 
 from __future__ import annotations
@@ -74,7 +79,7 @@ OUTLIER_REDUNDANCY = 6
 
 #: JSON keys in mm that are not lengths of the result (residual statistics, uncertainties).
 _NOT_LENGTHS = {"residuals_mm", "residuals_xyz_mm", "rms_mm", "max_mm", "mean_mm", "min_mm",
-                "noise_sigma_mm", "straightness_mm"}
+                "noise_sigma_mm", "straightness_mm", "touch_sigma_mm", "residual_sigma_mm"}
 
 
 @dataclass(frozen=True)
@@ -191,6 +196,11 @@ def _lengths(result: Mapping[str, Any]) -> list[tuple[str, float]]:
     return out
 
 
+def _names(value: Any) -> list[str]:
+    """A JSON list of touch labels as strings (empty for anything else)."""
+    return [str(v) for v in value] if isinstance(value, list) else []
+
+
 def verdict(result: Mapping[str, Any]) -> Verdict:
     """Grade a calibration result by the rule of this module.
 
@@ -210,6 +220,8 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
     check: list[str] = []
     cond = _number(result.get("condition"))
     dof = int(_number(result.get("dof"), 0.0))
+    labels = [str(v) for v in result.get("labels") or []]
+    excluded = _names(result.get("excluded"))
     res = result.get("residuals_xyz_mm")
     if res is None:
         res = result.get("residuals_mm") or []
@@ -217,9 +229,14 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         r = _floats(res)
     except (TypeError, ValueError):
         r = np.full(1, np.nan)  # unreadable residuals: no bound can hold
+    if excluded and len(labels) == len(r):
+        r = r[[lab not in excluded for lab in labels]]
     n = len(r) if r.ndim else 0
     ssr = float(np.sum(r**2)) if np.all(np.isfinite(r)) else float("inf")
-    stated = _number(result.get("noise_sigma_mm")) if result.get("noise_source") == "prior" else 0.0
+    if result.get("accuracy_source") in ("stated", "default"):
+        stated = _number(result.get("touch_sigma_mm")) if result["accuracy_source"] == "stated" else 0.0
+    else:  # a result written before the accuracy had its own field
+        stated = _number(result.get("noise_sigma_mm")) if result.get("noise_source") == "prior" else 0.0
     stated = stated if stated > 0 else 0.0
     s = stated or DEFAULT_TOUCH_SIGMA_MM
     source = "stated" if stated else "default"
@@ -232,12 +249,14 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
                         f"({CELL_EXTENT_MM / 1e3:.0f} m): a unit or typing error in the measurements")
     x2 = bound = None
     if dof > 0:
-        x2 = ssr / s**2
+        x2 = _number(result.get("chi2"), ssr / s**2)
+        if not math.isfinite(ssr):
+            x2 = float("inf")
         bound = float(chdtri(dof, 1.0 - CHI2_P))
         rms = math.sqrt(ssr / n) if n else 0.0
         if x2 > bound * POOR_FACTOR**2:
             poor.append(f"RMS {rms:.3f} mm is far beyond {what}: the residuals need a noise of "
-                        f"{math.sqrt(ssr / dof):.3f} mm per coordinate (chi-square "
+                        f"{s * math.sqrt(x2 / dof):.3f} mm per coordinate (chi-square "
                         f"{x2:.3g} > {bound * POOR_FACTOR ** 2:.3g}, the {CHI2_P:.1%} bound "
                         f"for {POOR_FACTOR:g} times the accuracy); look for a wrong row or unit")
         elif x2 > bound:
@@ -260,11 +279,36 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
                      "spread the touches")
     warnings = result.get("warnings") or []
     warnings = list(warnings) if isinstance(warnings, list) else [str(warnings)]
-    outliers = sum("outlier" in str(w) for w in warnings)
-    if outliers:
-        check.append(f"{outliers} touch(es) flagged as outlier: re-touch them")
-    if len(warnings) > outliers:
-        check.append(f"{len(warnings) - outliers} warning(s), listed below")
+    about_outliers = sum("outlier" in str(w) for w in warnings)
+    flagged = _names(result.get("outliers"))
+    if "outliers" in result:
+        outliers = len(set(flagged) | set(excluded))
+    else:  # a result written before the outliers had their own field
+        outliers = about_outliers
+    disagreeing = _names(result.get("disagreeing"))
+    gross = [g for g in _names(result.get("gross_outliers")) if g not in excluded]
+    if set(gross) & set(disagreeing):
+        poor.append(f"touches {', '.join(disagreeing)} disagree by far more than the touch "
+                    "accuracy: one of them is wrong, and the other touches cannot tell which; "
+                    "re-touch them")
+    elif disagreeing:
+        check.append(f"touches {', '.join(disagreeing)} disagree at 3 sigma: one of them may be "
+                     "wrong; re-touch them")
+    gross = [g for g in gross if g not in disagreeing]
+    if gross:
+        poor.append(f"touch(es) {', '.join(gross)} lie beyond 3 sigma even for {POOR_FACTOR:g} "
+                    "times the touch accuracy, and the result cannot be computed without them: "
+                    "re-touch them")
+    if excluded:
+        check.append(f"touch(es) {', '.join(excluded)} left out as outlier(s): re-touch them")
+    if outliers - len(excluded) > 0:
+        check.append(f"{outliers - len(excluded)} touch(es) flagged as outlier: re-touch them")
+    if len(warnings) > about_outliers:
+        check.append(f"{len(warnings) - about_outliers} warning(s), listed below")
+    unchecked = _names(result.get("unchecked"))
+    if unchecked and dof > 0:
+        check.append(f"touch(es) {', '.join(unchecked)} decide part of the result alone (no other "
+                     "touch checks them, so an error there goes unseen): repeat them")
     needed = touches_for_outlier_check(n, dof) if n else None
     if needed is not None:
         if dof <= 0:

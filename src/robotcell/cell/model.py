@@ -53,7 +53,7 @@ NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,23}$")
 # -- provenance -----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Provenance:
-    """Where a calibrated value comes from.
+    """Where a calibrated value comes from, and how uncertain it is.
 
     Attributes
     ----------
@@ -67,12 +67,35 @@ class Provenance:
         Residual RMS of the calibration (mm).
     note : str
         Free text (operator, number of points, instrument).
+    id : str or None
+        Name of this calibration as an error source: the values calibrated later with this one
+        (a turntable touched with this tool) carry its share under this name.
+    measurements : str or None
+        The touch file the calibration read (a path; written relative to the cell file).
+    sha256 : str or None
+        SHA-256 of that file's bytes when it was read, to tell a changed file.
+    options : dict
+        The calibration's options, to repeat it (``robotcell calibrate cell``): units of the
+        command line (mm, deg), e.g. ``{"tool": "pointer", "sigma_mm": 0.1}``.
+    inputs : tuple of str
+        The items of the cell the calibration used (``tools.pointer``, ``track``,
+        ``turntable``), in the order of their parameters.
+    sources : dict of str to ndarray
+        Error sources of the value (see :class:`robotcell.calibration.uncertainty.Sources`):
+        per source a factor over the value's parameters (SI: origin m, rotation vector rad
+        about the parent's axes, then the scale of a track). Empty: no uncertainty recorded.
     """
 
     source: str = "nominal"
     time: str | None = None
     rms_mm: float | None = None
     note: str = ""
+    id: str | None = None
+    measurements: str | None = None
+    sha256: str | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+    inputs: tuple[str, ...] = ()
+    sources: dict[str, NDArray[np.float64]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not isinstance(self.source, str) or not self.source.strip():
@@ -81,12 +104,18 @@ class Provenance:
             _iso_time(self.time, "provenance time")
         if self.rms_mm is not None and not (math.isfinite(self.rms_mm) and self.rms_mm >= 0):
             raise InputError(f"provenance rms_mm must be a finite number >= 0, got {self.rms_mm}")
+        sizes = {np.shape(f)[0] for f in self.sources.values()}
+        if len(sizes) > 1 or any(np.ndim(f) != 2 or not np.all(np.isfinite(f))
+                                 for f in self.sources.values()):
+            raise InputError("provenance sources must be finite matrices with one row per "
+                             "parameter of the value")
 
     @classmethod
-    def now(cls, source: str, rms_mm: float | None = None, note: str = "") -> Provenance:
+    def now(cls, source: str, rms_mm: float | None = None, note: str = "",
+            **fields: Any) -> Provenance:
         """Provenance stamped with the current local time (ISO 8601, seconds, with UTC offset)."""
         stamp = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
-        return cls(source=source, time=stamp, rms_mm=rms_mm, note=note)
+        return cls(source=source, time=stamp, rms_mm=rms_mm, note=note, **fields)
 
 
 def _iso_time(value: str, where: str) -> str:

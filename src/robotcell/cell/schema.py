@@ -50,6 +50,14 @@ __all__ = ["cell_from_dict", "cell_to_dict", "load_cell", "save_cell"]
 
 _POSE_KEYS = ("x", "y", "z", "a", "b", "c")
 
+_PROVENANCE_KEYS = {"source", "time", "rms_mm", "note", "id", "measurements", "sha256", "options",
+                    "inputs", "sigma", "covariance_mm_rad", "sources_mm_rad"}
+
+
+def _mm_rad(size: int) -> NDArray[np.float64]:
+    """Per parameter of a calibrated value (origin, rotation vector, scale): SI to the file."""
+    return np.r_[np.full(min(size, 3), 1e3), np.ones(max(size - 3, 0))]
+
 _HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z, a, b, c} with\n"
            "# R = Rz(a) Ry(b) Rx(c). Schema: docs/cell.md\n")
 
@@ -120,8 +128,9 @@ def _as_written(path: Path, base: Path) -> tuple[Any, dict[str, Any]] | None:
 class _Reader:
     """Typed access to the parsed YAML with errors naming the file and the key."""
 
-    def __init__(self, origin: str):
+    def __init__(self, origin: str, base_dir: str | Path = "."):
         self.origin = origin
+        self.base_dir = Path(base_dir)
 
     def fail(self, key: str, msg: str) -> InputError:
         return InputError(f"{self.origin}: key '{key}' {msg}")
@@ -159,19 +168,61 @@ class _Reader:
     def provenance(self, value: Any, key: str) -> Provenance:
         if value is None:
             return Provenance()
-        m = self.mapping(value, key, {"source", "time", "rms_mm", "note"}, ("source",))
+        m = self.mapping(value, key, _PROVENANCE_KEYS, ("source",))
         time = m.get("time")
         if isinstance(time, (_dt.datetime, _dt.date)):  # YAML reads unquoted timestamps
             time = time.isoformat()
         try:
+            measurements = m.get("measurements")
+            if measurements is not None:
+                path = Path(self.string(measurements, f"{key}.measurements"))
+                measurements = str(path if path.is_absolute() else self.base_dir / path)
+            options = self.mapping(m.get("options") or {}, f"{key}.options",
+                                   set(m.get("options") or {}))
+            inputs = m.get("inputs") or []
+            if not isinstance(inputs, list):
+                raise self.fail(f"{key}.inputs", f"must be a list of item names, got {inputs!r}")
             return Provenance(
                 source=self.string(m["source"], f"{key}.source"),
                 time=time,
                 rms_mm=None if m.get("rms_mm") is None else self.number(m["rms_mm"], f"{key}.rms_mm"),
                 note=str(m.get("note", "")),
+                id=None if m.get("id") is None else self.string(m["id"], f"{key}.id"),
+                measurements=measurements,
+                sha256=None if m.get("sha256") is None else self.string(m["sha256"],
+                                                                        f"{key}.sha256"),
+                options=dict(options),
+                inputs=tuple(self.string(v, f"{key}.inputs") for v in inputs),
+                sources=self.sources(m, key),
             )
         except InputError as exc:
             raise self.fail(key, f"is invalid: {str(exc).lstrip()}") from None
+
+    def matrix(self, value: Any, key: str) -> NDArray[np.float64]:
+        if not isinstance(value, list) or not value or not all(isinstance(r, list) for r in value):
+            raise self.fail(key, "must be a matrix: a list of rows, each a list of numbers")
+        rows = [[self.number(v, f"{key}[{i}]") for v in r] for i, r in enumerate(value)]
+        if len({len(r) for r in rows}) != 1:
+            raise self.fail(key, "must have rows of equal length")
+        return np.array(rows)
+
+    def sources(self, m: dict, key: str) -> dict[str, NDArray[np.float64]]:
+        """``sources_mm_rad`` (per source a factor, mm and rad), or a ``covariance_mm_rad`` alone."""
+        out: dict[str, NDArray[np.float64]] = {}
+        given = m.get("sources_mm_rad")
+        if given is not None:
+            for name, f in self.mapping(given, f"{key}.sources_mm_rad", set(given)).items():
+                out[str(name)] = self.matrix(f, f"{key}.sources_mm_rad.{name}")
+        elif m.get("covariance_mm_rad") is not None:
+            cov = self.matrix(m["covariance_mm_rad"], f"{key}.covariance_mm_rad")
+            try:
+                if cov.shape[0] != cov.shape[1] or not np.allclose(cov, cov.T):
+                    raise np.linalg.LinAlgError
+                out[str(m.get("id") or key)] = np.linalg.cholesky(cov)
+            except np.linalg.LinAlgError:
+                raise self.fail(f"{key}.covariance_mm_rad", "must be a symmetric positive "
+                                "definite matrix (the stated accuracy of the value)") from None
+        return {k: f / _mm_rad(len(f))[:, None] for k, f in out.items()}
 
     def limits(self, m: dict, key: str, scale: float) -> tuple[float, float]:
         lo = self.number(m["min"], f"{key}.min") * scale if "min" in m else -math.inf
@@ -227,7 +278,7 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
     -------
     Cell
     """
-    rd = _Reader(origin)
+    rd = _Reader(origin, base_dir)
     top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "positioner", "tools",
                                 "frames"}, ("robot",)) if isinstance(data, dict) else None
     if top is None:
@@ -359,7 +410,7 @@ def _positioner_from_dict(rd: _Reader, value: Any) -> Positioner:
                       provenance=rd.provenance(p.get("provenance"), "positioner.provenance"))
 
 
-def _positioner_dict(pos: Positioner) -> dict[str, Any]:
+def _positioner_dict(pos: Positioner, base_dir: str | Path) -> dict[str, Any]:
     """The ``positioner`` section of ``pos`` (mm, deg)."""
     out: dict[str, Any] = {"name": pos.name, "parent": pos.parent,
                            "frame": _pose_dict(pos.chain.base),
@@ -368,7 +419,7 @@ def _positioner_dict(pos: Positioner) -> dict[str, Any]:
                     if k != "type"} for j in robot_to_dict(pos.chain)["joints"]]
     if not np.allclose(pos.chain.flange, np.eye(4), atol=0):
         out["plate"] = _pose_dict(pos.chain.flange)
-    out["provenance"] = _prov_dict(pos.provenance)
+    out["provenance"] = _prov_dict(pos.provenance, base_dir)
     return out
 
 
@@ -390,7 +441,7 @@ def _pose_dict(T: NDArray[np.float64]) -> dict[str, float | int]:
     return {k: _clean(v) for k, v in zip(_POSE_KEYS, pose_to_vendor(T, "kuka"))}
 
 
-def _prov_dict(p: Provenance) -> dict[str, Any]:
+def _prov_dict(p: Provenance, base_dir: str | Path = ".") -> dict[str, Any]:
     out: dict[str, Any] = {"source": p.source}
     if p.time is not None:
         out["time"] = p.time
@@ -398,6 +449,30 @@ def _prov_dict(p: Provenance) -> dict[str, Any]:
         out["rms_mm"] = p.rms_mm
     if p.note:
         out["note"] = p.note
+    if p.id is not None:
+        out["id"] = p.id
+    if p.measurements is not None:
+        out["measurements"] = os.path.relpath(Path(p.measurements).resolve(),
+                                              Path(base_dir).resolve())
+    if p.sha256 is not None:
+        out["sha256"] = p.sha256
+    if p.options:
+        out["options"] = dict(p.options)
+    if p.inputs:
+        out["inputs"] = list(p.inputs)
+    if p.sources:
+        size = len(next(iter(p.sources.values())))
+        unit = _mm_rad(size)
+        cov = sum(f @ f.T for f in p.sources.values()) * np.outer(unit, unit)
+        sd = np.sqrt(np.diag(cov))
+        sigma = {"position_mm": [_clean(v) for v in sd[:3]],
+                 "rotation_deg": [_clean(math.degrees(v)) for v in sd[3:6]]}
+        if size > 6:
+            sigma["scale"] = _clean(sd[6])
+        out["sigma"] = sigma
+        out["covariance_mm_rad"] = [[float(f"{v:.6g}") for v in row] for row in cov]
+        out["sources_mm_rad"] = {k: [[float(f"{v:.6g}") for v in row] for row in f * unit[:, None]]
+                                 for k, f in p.sources.items()}
     return out
 
 
@@ -430,10 +505,10 @@ def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
             td["min"] = _clean(t.lower * 1e3)
         if math.isfinite(t.upper):
             td["max"] = _clean(t.upper * 1e3)
-        td["provenance"] = _prov_dict(t.provenance)
+        td["provenance"] = _prov_dict(t.provenance, base_dir)
         data["track"] = td
     if isinstance(cell.turntable, Positioner):
-        data["positioner"] = _positioner_dict(cell.turntable)
+        data["positioner"] = _positioner_dict(cell.turntable, base_dir)
     elif cell.turntable is not None:
         b = cell.turntable
         bd: dict[str, Any] = {"name": b.name, "parent": b.parent, "frame": _pose_dict(b.T_parent_B)}
@@ -441,7 +516,7 @@ def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
             bd["min"] = _clean(math.degrees(b.lower))
         if math.isfinite(b.upper):
             bd["max"] = _clean(math.degrees(b.upper))
-        bd["provenance"] = _prov_dict(b.provenance)
+        bd["provenance"] = _prov_dict(b.provenance, base_dir)
         data["turntable"] = bd
     tools: dict[str, Any] = {}
     for name, tool in cell.tools.items():
@@ -453,7 +528,7 @@ def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
             entry["mass"] = _clean(tool.mass)
         if tool.cog is not None:
             entry["cog"] = [_clean(v * 1e3) for v in tool.cog]
-        entry["provenance"] = _prov_dict(tool.provenance)
+        entry["provenance"] = _prov_dict(tool.provenance, base_dir)
         tools[name] = entry
     data["tools"] = tools
     frames: dict[str, Any] = {}
@@ -463,7 +538,7 @@ def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
             entry["number"] = fr.number
         entry["parent"] = fr.parent
         entry["frame"] = _pose_dict(fr.pose)
-        entry["provenance"] = _prov_dict(fr.provenance)
+        entry["provenance"] = _prov_dict(fr.provenance, base_dir)
         frames[name] = entry
     data["frames"] = frames
     return data

@@ -15,6 +15,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -26,6 +27,7 @@ from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
+from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
 from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
 from robotcell.cli.common import check_kind, check_output, parse_numbers, read_csv, write_output
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
@@ -112,8 +114,9 @@ def measurement_options(func: Callable) -> Callable:
     func = click.option("--json", "as_json", is_flag=True, callback=_keep_json,
                         help="Print one JSON object (and write it to -o FILE).")(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
-                        help="Touch-up accuracy, 1-sigma per coordinate (mm); used for the "
-                             "uncertainties instead of the residuals.")(func)
+                        help="Touch-up accuracy, 1-sigma per coordinate (mm), which the "
+                             "uncertainties rest on and the residuals are checked against "
+                             "(default 0.5).")(func)
     func = click.option("--tool", default=None, metavar="X,Y,Z,A,B,C",
                         help="Tool active during the touches (KUKA, mm/deg; with --cell also the "
                              "name of a tool of the cell), for joint-value input; default: the "
@@ -123,13 +126,47 @@ def measurement_options(func: Callable) -> Callable:
     return func
 
 
+#: Key of ``click.Context.meta`` under which ``--nominal-accuracy`` is kept.
+NOMINAL_KEY = "robotcell.calibrate.nominal"
+
+
+def parse_nominal(text: str | None, option: str = "--nominal-accuracy") -> NominalAccuracy:
+    """``MM,DEG[,SCALE]`` as a :class:`NominalAccuracy` (SI); the default without a value."""
+    if text is None:
+        return NOMINAL_ACCURACY
+    v = parse_numbers(text, option)
+    if len(v) not in (2, 3) or not all(x > 0 for x in v):
+        raise InputError(f"{option} needs 2 or 3 positive numbers MM,DEG[,SCALE] (the 1-sigma of "
+                         f"a nominal position, rotation and track scale), got {text!r}")
+    return NominalAccuracy(v[0] * 1e-3, math.radians(v[1]), *v[2:])
+
+
+def _keep_nominal(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+    ctx.meta[NOMINAL_KEY] = parse_nominal(value)
+
+
 def cell_option(func: Callable) -> Callable:
-    """Option ``--cell CELL.yaml`` of the subcommands that can update a cell file."""
+    """Options ``--cell CELL.yaml`` and ``--nominal-accuracy`` of the subcommands that can
+    update a cell file."""
+    func = click.option(
+        "--nominal-accuracy", default=None, metavar="MM,DEG[,SCALE]", expose_value=False,
+        callback=_keep_nominal,
+        help="With --cell: 1-sigma of the cell items the touches rest on that have no recorded "
+             "uncertainty (a nominal tool, track or turntable): position (mm), rotation (deg) "
+             f"and track scale. Default {NOMINAL_ACCURACY.position * 1e3:g},"
+             f"{math.degrees(NOMINAL_ACCURACY.rotation):g},{NOMINAL_ACCURACY.scale:g}.")(func)
     return click.option(
         "--cell", "cell_path", default=None, metavar="CELL.yaml", type=click.Path(dir_okay=False),
         help="Write the result into this cell file (atomically, keeping its comments and "
              "layout; the previous version is kept as CELL.yaml.N.bak). Joint values a1..a6 then use the cell's robot, and --tool may name "
              "a tool of the cell.")(func)
+
+
+def chain_options(measurements: str) -> dict:
+    """The keywords of a calibration into a cell that record its file and state the nominal
+    accuracy: ``file`` and ``nominal``."""
+    nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
+    return {"file": measurements, "nominal": nominal}
 
 
 @dataclass
@@ -157,8 +194,9 @@ class CellTarget:
                              f"robot is the cell's (robot.model in {path}); drop --robot")
         return cls(path, Cell.load(path))
 
-    def tool(self, text: str) -> NDArray[np.float64]:
-        """``T_F_TCP`` (m) of ``--tool``: a tool name of the cell, or X,Y,Z,A,B,C (mm, deg)."""
+    def tool(self, text: str) -> str | NDArray[np.float64]:
+        """``--tool``: the name of a tool of the cell (its uncertainty goes with it), or
+        ``T_F_TCP`` (m) from X,Y,Z,A,B,C (mm, deg)."""
         name = text.strip()
         if not NAME_RE.match(name):
             return pose_from_vendor(parse_numbers(text, "--tool", 6), "kuka")
@@ -166,7 +204,7 @@ class CellTarget:
             known = ", ".join(self.cell.tools) or "none"
             raise InputError(f"--tool {name!r} is not a tool of {self.path} (its tools: {known}); "
                              "give one of them or X,Y,Z,A,B,C in mm/deg")
-        return self.cell.tools[name].T_F_TCP
+        return name
 
     def save(self, cell: Cell, what: str, notes: tuple[str, ...] = ()) -> None:
         """Write ``cell`` into the cell file; say on stderr ``notes`` and what was updated."""
@@ -200,11 +238,12 @@ def refuse_track_column(cols: dict, source: str, why: str) -> None:
 
 
 def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | None = None
-                   ) -> tuple[Robot | None, np.ndarray | None]:
-    """The robot model and ``T_F_TCP`` (m) for joint-value input.
+                   ) -> tuple[Robot | None, str | np.ndarray | None]:
+    """The robot model and the tool for joint-value input.
 
-    Without a cell: ``--robot`` loaded and ``--tool`` parsed (KUKA X,Y,Z,A,B,C in mm/deg). With
-    ``--cell``: the cell's robot, and ``--tool`` a tool name of the cell or X,Y,Z,A,B,C.
+    Without a cell: ``--robot`` loaded and ``--tool`` parsed (KUKA X,Y,Z,A,B,C in mm/deg) to
+    ``T_F_TCP`` (m). With ``--cell``: the cell's robot, and ``--tool`` a tool name of the cell
+    (kept as the name) or X,Y,Z,A,B,C.
     """
     if target is not None:
         return target.cell.robot, None if tool is None else target.tool(tool)
@@ -242,7 +281,7 @@ def echo_note(note: str) -> None:
     click.echo(note, err=True)
 
 
-def emit(result: CalibrationResult, as_json: bool) -> None:
+def emit(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool) -> None:
     """Print a result: the terminal report, or one JSON object with ``--json``.
 
     With ``-o FILE`` the terminal shows the report and FILE gets the JSON object (``--json``) or
@@ -267,7 +306,8 @@ class PoorCalibration(click.ClickException):
         click.echo(f"error: {self.message}", err=True)
 
 
-def gate(result: CalibrationResult, as_json: bool, accept_poor: bool) -> None:
+def gate(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool,
+         accept_poor: bool) -> None:
     """Stop before anything is written when the verdict is poor, unless ``--accept-poor``.
 
     The report is printed (stdout) so the technician sees why; then :class:`PoorCalibration`
@@ -323,7 +363,8 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     cell, label = cell_of(target)
     out = cellcal.tcp(cell, cols, name, robot=None if cell else model, world_mode=world_mode,
-                      sigma=prior, source=measurements, cell_label=label, on_note=echo_note)
+                      sigma=prior, source=measurements, cell_label=label, on_note=echo_note,
+                      **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)
@@ -370,7 +411,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
     cell, label = cell_of(target)
     out = cellcal.frame(cell, cols, name, parent=parent, robot=None if cell else model,
                         tool=T_tool, sigma=prior, source=measurements, cell_label=label,
-                        on_note=echo_note)
+                        on_note=echo_note, **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)
@@ -411,6 +452,42 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     result = external_tcp(p, roles, prior, line_labels(len(roles), roles))
     gate(result, as_json, accept_poor)
     emit(result, as_json)
+
+
+@calibrate.command("cell")
+@cell_option
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
+              expose_value=False, callback=_keep_output,
+              help="Also write the result to FILE (the JSON object with --json, else the report).")
+@click.option("--accept-poor", is_flag=True,
+              help="Write the cell and exit 0 even when the verdict is poor.")
+def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
+    """The whole cell in one fit, from every touch file its calibrations recorded.
+
+    \b
+    Every calibration written with --cell records its touch file (with a checksum), its
+    options and the items it used. This repeats them all and fits every calibrated item at
+    once (maximum likelihood, full covariance): a tool is estimated from its own touches and
+    from those taken with it, and the track, turntable and frames measured with it follow it.
+    The report says what changed, by how much and in units of its 1-sigma. A missing or changed
+    touch file is refused (exit 2), naming it; a poor verdict writes nothing (exit 3).
+
+    \b
+    Example:
+      robotcell calibrate cell --cell cell.yaml
+    """
+    if cell_path is None:
+        raise InputError("calibrate cell needs --cell CELL.yaml: the cell whose calibrations "
+                         "are fitted together")
+    target = CellTarget.open(cell_path, None)
+    nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
+    out = cellcal.calibrate_cell(target.cell, cell_label=cell_path, nominal=nominal,
+                                 on_note=echo_note)
+    gate(out, as_json, accept_poor)
+    target.save(out.cell, f"{len(out.items)} item(s) fitted with the whole cell "
+                f"({', '.join(out.items)})")
+    emit(out, as_json)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -10,7 +10,6 @@ turntable, positioner and workpiece.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import click
@@ -22,6 +21,7 @@ from robotcell.cli.calibrate import (
     CellTarget,
     cell_of,
     cell_option,
+    chain_options,
     echo_note,
     emit,
     gate,
@@ -78,7 +78,8 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     cell, label = cell_of(target)
     out = cellcal.track(cell, cols, references=refs, axis=axis, roll=roll,
                         robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
-                        source=measurements, cell_label=label, on_note=echo_note)
+                        source=measurements, cell_label=label, on_note=echo_note,
+                        **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)
@@ -118,7 +119,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     cell, label = cell_of(target)
     out = cellcal.turntable(cell, cols, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label, on_note=echo_note)
+                            cell_label=label, on_note=echo_note, **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)
@@ -153,7 +154,7 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     cell, label = cell_of(target)
     out = cellcal.positioner(cell, cols, robot=None if cell else model, tool=T_tool,
                              sigma=sigma_m(sigma), source=measurements, cell_label=label,
-                             on_note=echo_note)
+                             on_note=echo_note, **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)
@@ -161,7 +162,7 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
 
 
 def _load_turntable(path: str) -> cellcal.TurntablePose:
-    """The turntable pose (m), its 6x6 covariance (SI), the touch noise (m) and its frame.
+    """The turntable pose (m), its 6x6 covariance (SI) and its frame.
 
     Reads the ``--json`` output of ``calibrate turntable``: ``T_R_B`` (frame ``"robot"``), or
     ``T_world_B`` (frame ``"world"``) when it was calibrated with ``--cell`` in the world.
@@ -193,14 +194,7 @@ def _load_turntable(path: str) -> cellcal.TurntablePose:
         cov = _covariance(cov, f"{path}: {key!r}")
         to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
         cov = cov * np.outer(to_si, to_si)
-    noise = data.get("noise_sigma_mm")
-    if noise is not None and (isinstance(noise, bool) or not isinstance(noise, (int, float))
-                              or not math.isfinite(noise) or noise < 0):
-        raise InputError(f"{path}: 'noise_sigma_mm' must be a number of millimetres >= 0, got "
-                         f"{noise!r}; pass the unchanged --json output of 'robotcell calibrate "
-                         "turntable'")
-    return cellcal.TurntablePose(T, cov, float(noise) * 1e-3 if noise is not None else None,
-                                 frame, path)
+    return cellcal.TurntablePose(T, cov, frame, path)
 
 
 def _covariance(value: object, where: str) -> np.ndarray:
@@ -225,7 +219,7 @@ def _covariance(value: object, where: str) -> np.ndarray:
 @click.option("--turntable", "turntable_json", default=None, metavar="TURNTABLE.json",
               type=click.Path(dir_okay=False),
               help="--json output of 'robotcell calibrate turntable'. Optional with --cell (the "
-                   "cell's turntable is used, without its uncertainty).")
+                   "cell's turntable is used, with its recorded uncertainty).")
 @click.option("--name", default=None, metavar="FRAME",
               help="With --cell: the frame on the turntable to write (added when new).")
 @cell_option
@@ -256,7 +250,7 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     cell, label = cell_of(target)
     out = cellcal.workpiece(cell, cols, name, turntable=given, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label, on_note=echo_note)
+                            cell_label=label, on_note=echo_note, **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
     if out.cell is not None:
         target.save(out.cell, out.item, out.update_notes)

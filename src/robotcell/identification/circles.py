@@ -60,7 +60,7 @@ def _fit_group(qj: NDArray[np.float64], p: NDArray[np.float64]):
     if travel > 0 and line_rms < LINE_TOL * travel:
         d = coef[1] / np.linalg.norm(coef[1])
         return "prismatic", c, d, travel
-    _, _, vt = np.linalg.svd(p - c)
+    _, _, vt = np.linalg.svd(p - c, full_matrices=False)
     n = vt[2]
     u = vt[0]
     v = np.cross(n, u)

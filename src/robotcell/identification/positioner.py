@@ -10,11 +10,16 @@ off the identified chain, with first-order uncertainties from its covariance:
 * their common normal: foot points on both axes, length, and the angle between the axes;
 * the zero of each: ``tilt_zero`` is the angle about the tilt axis from "up" (the robot base's
   ``+Z`` made perpendicular to the tilt axis) to the rotate axis at tilt 0, so 0 for a level table;
-  ``rotate_zero`` is the angle about the rotate axis from the common normal (pointing away from
-  the tilt axis) to the reference point at rotate 0;
+  ``rotate_zero`` is the angle about the rotate axis from ``X_B`` to the reference point at
+  rotate 0;
 * ``T_R_B``, the root frame: ``Z_B`` along the tilt axis, origin at the foot of the common normal
-  on it, ``X_B`` along the common normal toward the rotate axis (along ``z_tilt x z_rotate`` when
-  the axes intersect).
+  on it, ``X_B`` along the common normal. Of its two directions, ``+-z_tilt x z_rotate`` (for
+  axes that nearly intersect, the touch noise alone would decide "toward the rotate axis"), the
+  one on the side the nominal's DH frame between the axes takes, else ``z_tilt x z_rotate``.
+
+The identified chain is written in the nominal's conventions: of the equivalent DH tables
+(the root frame turned about its Z axis, an intermediate frame turned by 180 deg about its Z,
+with the offsets that compensate), the one nearest the nominal's root and zeros.
 """
 
 from __future__ import annotations
@@ -25,11 +30,25 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from robotcell.calibration.propagate import propagate
-from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, pose_fields
-from robotcell.errors import InputError
+from robotcell.calibration.fitting import (
+    DEFAULT_TOUCH_SIGMA,
+    Fit,
+    keeps_out,
+    outlier_warnings,
+    solution_fit,
+)
+from robotcell.calibration.propagate import jacobian
+from robotcell.calibration.result import (
+    CONDITION_LIMIT,
+    CalibrationResult,
+    fit_fields,
+    pose_fields,
+)
+from robotcell.calibration.uncertainty import Inputs, estimate
+from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.circles import start_model
 from robotcell.identification.engine import identify
 from robotcell.identification.measurements import Measurements
@@ -38,9 +57,6 @@ from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import as_points
 
 __all__ = ["PositionerCalibration", "calibrate_positioner"]
-
-#: Touch accuracy used to weight the fit when none is given (m per coordinate).
-DEFAULT_SIGMA = 0.1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,8 +84,12 @@ def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
     return v / np.linalg.norm(v)
 
 
-def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
-    """Axis lines, common normal, zeros and root frame in R for the full parameter vector ``x``."""
+def _geometry(ident: IdentificationResult, x: NDArray[np.float64],
+              side: float = 1.0) -> dict[str, NDArray[np.float64]]:
+    """Axis lines, common normal, zeros and root frame in R for the full parameter vector ``x``.
+
+    ``side``: ``X_B = side * unit(z_tilt x z_rotate)`` (+1 or -1).
+    """
     ch = ident._chain
     pts, dirs, _ = ch.axis_lines(x)
     T = ch.base_pose(x)
@@ -83,7 +103,7 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, 
     f0, f1 = p[0] + s * u[0], p[1] + t * u[1]
     n = f1 - f0
     length = float(np.linalg.norm(n))
-    x_b = _unit(n) if length > 1e-6 else _unit(w)
+    x_b = side * _unit(w)
     up = np.array([0.0, 0.0, 1.0]) if abs(u[0][2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     up = _unit(up - (up @ u[0]) * u[0])
     tilt_zero = math.atan2(np.cross(up, u[1]) @ u[0], up @ u[1])
@@ -98,6 +118,116 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64]) -> dict[str, 
             "radius": np.array(np.linalg.norm(r)), "R": R, "origin": f0}
 
 
+def _normal_side(nominal: Robot) -> float:
+    """+1 when the nominal's DH frame between its two axes has X along ``z_1 x z_2`` (the axes
+    of motion), else -1: the nominal's way of writing the common normal, whatever its place."""
+    q = np.zeros(2)
+    axes = nominal.jacobian(q)[3:]  # angular part: the directions of motion
+    x1 = nominal.frames(q)[1, :3, 0]
+    return 1.0 if x1 @ np.cross(axes[:, 0], axes[:, 1]) >= 0 else -1.0
+
+
+def _wrap(a: float) -> float:
+    """An angle in (-pi, pi]."""
+    return math.pi - (math.pi - a) % (2.0 * math.pi)
+
+
+def nearest_writing(robot: Robot, nominal: Robot) -> Robot:
+    """The same chain written in the DH table nearest the nominal's.
+
+    Two tables describe the same motion when (a) the root frame turns about its Z axis by
+    ``phi`` and the first joint's offset by ``-phi`` (standard DH), or (b) an intermediate
+    frame turns by 180 deg about its Z axis: its joint's offset ``+ pi``, the next one's
+    ``- pi``, and the link between (standard DH: that joint's; modified: the next row's) gets
+    ``-a`` and ``-alpha``. (a) takes the root X nearest the nominal's; (b) is taken where it
+    brings the twists and offsets nearer the nominal's. Every joint value moves each frame to
+    the same place, so every pose of the chain is the same.
+
+    Parameters
+    ----------
+    robot : Robot
+        An identified chain.
+    nominal : Robot
+        The nominal chain, same joints and convention.
+
+    Returns
+    -------
+    Robot
+    """
+    joints = list(robot.joints)
+    base = robot.base.copy()
+    standard = robot.convention == "standard"
+    if standard or (joints[0].a == 0.0 and joints[0].alpha == 0.0):
+        z, x = base[:3, 2], base[:3, 0]
+        xn = nominal.base[:3, 0] - (nominal.base[:3, 0] @ z) * z
+        if np.linalg.norm(xn) > 1e-6:
+            phi = math.atan2(np.cross(x, xn) @ z, x @ xn)
+            base[:3, :3] = base[:3, :3] @ Rotation.from_rotvec([0.0, 0.0, phi]).as_matrix()
+            joints[0] = replace(joints[0], theta=_wrap(joints[0].theta - phi))
+
+    def distance(js: list) -> float:
+        return sum(_wrap(j.alpha - n.alpha) ** 2 + _wrap(j.theta - n.theta) ** 2
+                   + ((j.a - n.a) / 0.1) ** 2 for j, n in zip(js, nominal.joints))
+
+    for i in range(len(joints) - 1):
+        flipped = list(joints)
+        link = i if standard else i + 1
+        flipped[i] = replace(flipped[i], theta=_wrap(flipped[i].theta + math.pi))
+        flipped[link] = replace(flipped[link], a=-flipped[link].a, alpha=-flipped[link].alpha)
+        flipped[i + 1] = replace(flipped[i + 1], theta=_wrap(flipped[i + 1].theta - math.pi))
+        if distance(flipped) < distance(joints):
+            joints = flipped
+    return replace(robot, base=base, joints=tuple(joints))
+
+
+def _imputed(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
+             keep: NDArray[np.bool_]) -> NDArray[np.float64]:
+    """The touches with those left out replaced by the chain fitted to the others.
+
+    The chain is refitted to the touches ``keep`` from the identified one (a few Gauss-Newton
+    steps, it is near); a touch replaced by that fit's prediction has no residual there, so the
+    identification of the whole grid with it (a balanced design the engine starts from
+    reliably) has the same optimum as the fit without the touch.
+    """
+    ch = ident._chain
+    kept = np.array([ch.index(nm) for nm in ident.free])
+    x = ident._x.copy()
+
+    def model(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        x[kept] = v
+        return ch.predict(x, q)[0][:, 0]
+
+    def resid(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return (f - model(v))[keep].ravel()
+
+    def jac(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        x[kept] = v
+        pts = ch.predict(x, q)[0]
+        return -ch.point_jacobian(x, q, ch.evaluate(x, q), pts)[keep, 0][..., kept].reshape(
+            -1, len(kept))
+
+    v = least_squares(resid, x[kept], jac=jac, method="lm", xtol=1e-12, ftol=1e-12,
+                      gtol=1e-12).x
+    out = f.copy()
+    out[~keep] = model(v)[~keep]
+    return out
+
+
+def _fit_of(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
+            used: NDArray[np.bool_], prior_sigma: float | None, inputs: Inputs | None) -> Fit:
+    """The uncertainty and the touch tests of an identification, over every touch.
+
+    The Jacobian of the touched point with respect to the identified (free) parameters, at all
+    touches (those left out of the identification too), and the residuals.
+    """
+    ch, x = ident._chain, ident._x
+    kept = np.array([ch.index(nm) for nm in ident.free])
+    pts = ch.predict(x, q)[0]
+    J = -ch.point_jacobian(x, q, ch.evaluate(x, q), pts)[:, 0][..., kept]
+    return solution_fit(x[kept], J, f - pts[:, 0], used=used, prior_sigma=prior_sigma,
+                        inputs=inputs)
+
+
 def calibrate_positioner(
     angles: ArrayLike,
     points: ArrayLike,
@@ -105,8 +235,14 @@ def calibrate_positioner(
     nominal: Robot | None = None,
     prior_sigma: float | None = None,
     labels: Sequence[str] | None = None,
+    inputs: Inputs | None = None,
 ) -> PositionerCalibration:
     """Calibrate a tilt-rotate positioner from touches of one point on its table.
+
+    The uncertainty rests on the touch accuracy (``prior_sigma``, or the default 0.5 mm), the
+    residuals being its chi-square check, and every touch gets the leave-one-out test of every
+    calibration (:func:`robotcell.calibration.fitting.solution_fit`): one flagged touch that the
+    others single out is left out and the chain identified again.
 
     Parameters
     ----------
@@ -117,11 +253,15 @@ def calibrate_positioner(
     nominal : Robot, optional
         Nominal 2-joint model of the positioner (any base). Without it the touches must contain,
         for each axis, at least 3 that move that axis alone over 10 deg or more (e.g. a grid of 3
-        tilt by 4 rotate values), and the circle point analysis gives the start.
+        tilt by 4 rotate values), and the circle point analysis gives the start. With it, of the
+        equivalent ways to write the identified axes the one nearest the nominal is returned.
     prior_sigma : float, optional
-        Known touch accuracy (m per coordinate); default: estimated from the residuals.
+        Touch accuracy (m per coordinate) the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
         Name of each touch (default ``"1".."N"``).
+    inputs : Inputs, optional
+        Earlier calibrations the touched points rest on (the tool, a track).
 
     Returns
     -------
@@ -151,57 +291,65 @@ def calibrate_positioner(
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
     meas = Measurements(q, f, None, tuple(labels))
     start = nominal if nominal is not None else start_model(meas, np.zeros(2, dtype=bool), "positioner")
-    ident = identify(start, meas, point_sigma=prior_sigma or DEFAULT_SIGMA,
-                     name=f"{start.name}_calibrated")
+    sigma = prior_sigma if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
+    name = f"{start.name}_calibrated"
+    ident = identify(start, meas, point_sigma=sigma, name=name)
+    used = np.ones(len(f), dtype=bool)
+    res = _fit_of(ident, q, f, used, prior_sigma, inputs)
+    if len(res.suspects) == 1:
+        worst = res.suspects[0]
+        keep = used.copy()
+        keep[worst] = False
+        try:
+            other = identify(start, Measurements(q, _imputed(ident, q, f, keep), None,
+                                                 tuple(labels)), point_sigma=sigma, name=name)
+        except IllPosedError:
+            other = None
+        if other is not None:
+            res_other = _fit_of(other, q, f, keep, prior_sigma, inputs)
+            if keeps_out(res_other, worst):
+                ident, res = other, res_other
     ch, x = ident._chain, ident._x
     kept = np.array([ch.index(nm) for nm in ident.free])
-    cov = ident.covariance
-    if prior_sigma is not None and math.isfinite(ident.variance_factor):
-        cov = cov / ident.variance_factor**2  # the stated accuracy, not the residuals
-        noise, source = prior_sigma, "prior"
-    else:
-        noise, source = ident.variance_factor * DEFAULT_SIGMA, "residuals"
 
     def at(v: NDArray[np.float64]) -> NDArray[np.float64]:
         xx = x.copy()
         xx[kept] = v
         return xx
 
-    geo = _geometry(ident, x)
+    side = 1.0 if nominal is None else _normal_side(nominal)
+    geo = _geometry(ident, x, side)
     keys = ["tilt_point", "tilt_axis", "rotate_point", "rotate_axis", "normal_length", "axis_angle",
             "tilt_zero", "rotate_zero", "radius"]
 
     def flat(v: NDArray[np.float64]) -> NDArray[np.float64]:
-        g = _geometry(ident, at(v))
+        g = _geometry(ident, at(v), side)
         rot = Rotation.from_matrix(g["R"] @ geo["R"].T).as_rotvec()
         return np.concatenate([np.ravel(g[k]) for k in keys] + [g["origin"], rot])
 
-    C = propagate(flat, x[kept], cov)
+    A = jacobian(flat, x[kept])
+    C = A @ res.covariance @ A.T
     sig = np.sqrt(np.abs(np.diag(C)))
-    sigma: dict[str, object] = {}
+    sigma_out: dict[str, object] = {}
     k0 = 0
     for k in keys:
         size = np.size(geo[k])
-        sigma[k] = sig[k0:k0 + size] if size > 1 else float(sig[k0])
+        sigma_out[k] = sig[k0:k0 + size] if size > 1 else float(sig[k0])
         k0 += size
-    sigma["T_R_B_position"], sigma["T_R_B_rotation"] = sig[k0:k0 + 3], sig[k0 + 3:k0 + 6]
+    sigma_out["T_R_B_position"], sigma_out["T_R_B_rotation"] = sig[k0:k0 + 3], sig[k0 + 3:k0 + 6]
     T_R_B = np.eye(4)
     T_R_B[:3, :3], T_R_B[:3, 3] = geo["R"], geo["origin"]
     values = {"T_R_B": T_R_B, **{k: geo[k] if np.size(geo[k]) > 1 else float(geo[k]) for k in keys}}
     robot = replace(ident.robot, base=ident.base @ ident.robot.base, tool=ident.target_tool)
-    res = ident.residuals[:, 0, :]
+    if nominal is not None:
+        robot = nearest_writing(robot, nominal)
     warnings = []
-    if ident.condition > CONDITION_LIMIT:
-        warnings.append(f"condition number {ident.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
                         "at more tilt and rotate values, spread over their ranges")
-    warnings += [f"touch {labels[i]} is an outlier at 3 sigma: re-touch it or remove it"
-                 for i in ident.outliers]
-    verdict, why = ident.verdict
-    if verdict != "good":
-        warnings.append(f"verdict {verdict}: {why}")
+    warnings += outlier_warnings(res, labels)
     result = CalibrationResult(
-        procedure="positioner-2axis", values=values, sigma=sigma, residuals=res,
-        condition=ident.condition, dof=ident.dof, noise_sigma=noise, noise_source=source,
+        procedure="positioner-2axis", values=values, sigma=sigma_out,
         labels=labels, undetermined=[f"{n}: {w}" for n, w in ident.fixed], warnings=warnings,
         next_step=("enter T_R_B and the axis geometry as the positioner's kinematics in the "
                    "controller (KUKA: external kinematics ROOT and links; ABB: the mechanical unit's "
@@ -219,6 +367,7 @@ def calibrate_positioner(
         covariance=C, parameter_names=[f"{k}[{i}]" if np.size(geo[k]) > 1 else k for k in keys
                                        for i in range(np.size(geo[k]))]
         + ["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z"],
-        points=f,
+        points=f, estimates={"T_R_B": estimate(res.sources, res.input_gain, A[-6:])},
+        **fit_fields(res),
     )
     return PositionerCalibration(result=result, robot=robot, identification=ident)

@@ -78,7 +78,7 @@ class Lines:
         error naming the line."""
         v = parse_float(text.strip(), f"{self.path}: line {lineno}")
         if abs(v) > MAX_ABS_VALUE:
-            raise self.error(lineno, f"{text.strip()!r} is beyond {MAX_ABS_VALUE:.0e} in size, "
+            raise self.error(lineno, f"{text.strip()} is beyond {MAX_ABS_VALUE:.0e} in size, "
                                      "which no value of a program is")
         return v
 
@@ -87,6 +87,6 @@ class Lines:
         :data:`~robotcell.io.tables.MAX_ABS_VALUE` in size; ``ValueError`` if it is none."""
         v = int(text.strip(), base)
         if abs(v) > MAX_ABS_VALUE:
-            raise self.error(lineno, f"{text.strip()!r} is beyond {MAX_ABS_VALUE:.0e} in size, "
+            raise self.error(lineno, f"{text.strip()} is beyond {MAX_ABS_VALUE:.0e} in size, "
                                      "which no value of a program is")
         return v

@@ -16,7 +16,8 @@ report (:mod:`robotcell.report`) is, in the frame the touches are in. It shows
   factor (:func:`robotcell.view.shapes.magnification`) that the scene's notes state.
 
 A TCP's touches are one point, the reference tip: each is drawn at the tip of its magnified
-residual. A workpiece result holds no touched points: its scene shows the frames only.
+residual. A workpiece's touches are drawn where the table had turned each of them, in the
+turntable's parent frame, with the turntable B and the workpiece W at table angle 0.
 """
 
 from __future__ import annotations

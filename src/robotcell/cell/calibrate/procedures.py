@@ -21,11 +21,12 @@ writes the identified chain with :meth:`Cell.update_positioner`.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,12 +35,22 @@ from robotcell.calibration.measurements import (
     check_count,
     external_axis,
     flange_poses,
+    joint_columns,
     nominal_points,
     point_roles,
     tcp_positions,
 )
 from robotcell.calibration.result import CalibrationResult
+from robotcell.calibration.uncertainty import OWN, Sources
 from robotcell.cell import Cell, Positioner, Provenance, Turntable
+from robotcell.cell.calibrate.chain import (
+    NOMINAL_ACCURACY,
+    Chained,
+    NominalAccuracy,
+    item_sources,
+    touch_inputs,
+    written_sources,
+)
 from robotcell.cell.calibrate.touches import (
     POSE_COLUMNS,
     Table,
@@ -86,6 +97,14 @@ class CellCalibration:
         touches mapped to the world, ...), as passed to ``on_note``.
     update_notes : tuple of str
         Remarks on what was written (a value kept because the touches do not measure it).
+    key : str
+        The item of the cell the result is for (``tools.NAME``, ``frames.NAME``, ``track``,
+        ``turntable``, ``positioner``), also when nothing was written; empty without a cell.
+    value : str
+        The key of ``result.values`` (and ``result.estimates``) that holds the item's pose.
+    inputs : tuple of str
+        The items of the cell the calibration used, in the order of the input parameters of
+        ``result.fit`` (see :mod:`robotcell.cell.calibrate.chain`).
     """
 
     result: CalibrationResult
@@ -94,6 +113,9 @@ class CellCalibration:
     provenance: Provenance | None = None
     notes: tuple[str, ...] = ()
     update_notes: tuple[str, ...] = ()
+    key: str = ""
+    value: str = ""
+    inputs: tuple[str, ...] = ()
 
 
 class _Notes(list):
@@ -118,10 +140,9 @@ class TurntablePose:
     ----------
     T : ndarray, shape (4, 4)
         Pose of the turntable root B (metres) in ``frame``.
-    covariance : ndarray, shape (6, 6), or None
-        Covariance of ``T`` (origin in m, rotation vector in rad, about the axes of ``frame``).
-    noise_sigma : float or None
-        Touch noise estimated by the turntable calibration (m per coordinate).
+    covariance : ndarray, shape (6, 6), or Sources, or None
+        Uncertainty of ``T`` (origin in m, rotation vector in rad, about the axes of ``frame``):
+        a covariance, or its error sources.
     frame : {"robot", "world"}
         Frame of ``T``: the robot base (``T_R_B``) or the world (``T_world_B``).
     source : str
@@ -129,8 +150,7 @@ class TurntablePose:
     """
 
     T: NDArray[np.float64]
-    covariance: NDArray[np.float64] | None = None
-    noise_sigma: float | None = None
+    covariance: NDArray[np.float64] | Sources | None = None
     frame: Literal["robot", "world"] = "robot"
     source: str = "the turntable result"
 
@@ -144,22 +164,107 @@ class TurntablePose:
         if result.procedure != "turntable":
             raise InputError(f"{source}: not a turntable result (procedure {result.procedure!r})")
         key = "T_world_B" if "T_world_B" in result.values else "T_R_B"
-        cov = None if result.covariance is None else np.array(result.covariance[:6, :6])
-        noise = result.noise_sigma if np.isfinite(result.noise_sigma) else None
-        return cls(result.values[key], cov, noise, "world" if key == "T_world_B" else "robot",
-                   source)
+        est = result.estimates.get(key)
+        cov = (est.sources.renamed(OWN, f"turntable of {source}") if est is not None
+               else None if result.covariance is None else np.array(result.covariance[:6, :6]))
+        return cls(result.values[key], cov, "world" if key == "T_world_B" else "robot", source)
 
 
-def _provenance(source: str, result: CalibrationResult, n: int, measurements: str,
-                time: str | None) -> Provenance:
-    """Provenance of a calibration read from ``measurements`` with ``n`` touches."""
-    note = f"{n} touches from {Path(measurements).name}"
-    if time is None:
-        return Provenance.now(source, rms_mm=result.rms * 1e3, note=note)
-    return Provenance(source, time=time, rms_mm=result.rms * 1e3, note=note)
+@dataclass(frozen=True)
+class _Record:
+    """What a calibration in a cell records with the item it writes (internal)."""
+
+    file: str | None
+    options: dict[str, Any]
+    chained: Chained
+    nominal: NominalAccuracy
 
 
-def _copy(cell: Cell) -> Cell:
+def sha256_of(path: str | Path) -> str:
+    """SHA-256 of a file's bytes, hex."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as exc:
+        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+
+
+def _provenance(procedure: str, result: CalibrationResult, n: int, source: str,
+                time: str | None, cell: Cell, item: str, value: str, record: _Record,
+                inputs: tuple[str, ...] | None = None) -> Provenance:
+    """Provenance of a calibration read from ``source`` with ``n`` touches, for ``item``.
+
+    It names the calibration as an error source (by the item and the file's checksum), records
+    the file, the options and the inputs so that ``calibrate cell`` can repeat it, and the
+    error sources of the value (``result.estimates[value]``, the directions it does not
+    determine keeping the item's previous ones).
+    """
+    stamp = time or Provenance.now(procedure).time
+    sha = None if record.file is None else sha256_of(record.file)
+    ident = f"{item} {sha[:12]}" if sha else f"{item} {stamp}"
+    sources: dict[str, NDArray[np.float64]] = {}
+    est = result.estimates.get(value)
+    if est is not None:
+        try:
+            old = item_sources(cell, item, record.nominal)[0]
+        except InputError:  # a new tool or frame
+            size = est.sources.size
+            old = Sources(size, {f"{item} nominal": np.diag(record.nominal.sigma(size))})
+        sources = written_sources(est, old, ident)
+    return Provenance(procedure, time=stamp, rms_mm=result.rms * 1e3,
+                      note=f"{n} touches from {Path(source).name}", id=ident,
+                      measurements=None if record.file is None else str(Path(record.file).resolve()),
+                      sha256=sha, options=dict(record.options),
+                      inputs=record.chained.keys if inputs is None else inputs, sources=sources)
+
+
+def _file(measurements: Table | str | Path, file: str | Path | None) -> str | None:
+    """The touch file behind a calibration: ``file``, or ``measurements`` when it is a path."""
+    if file is not None:
+        return str(file)
+    return str(measurements) if isinstance(measurements, (str, Path)) else None
+
+
+def _tool_option(tool: str | ArrayLike | None) -> dict[str, Any]:
+    """The ``tool`` option as recorded: a tool name, or X,Y,Z,A,B,C (mm, deg)."""
+    if tool is None:
+        return {}
+    if isinstance(tool, str):
+        return {"tool": tool}
+    v = pose_to_vendor(np.asarray(tool, dtype=float), "kuka")
+    return {"tool": [round(float(x), 9) + 0.0 for x in v]}
+
+
+def _options(sigma: float | None, tool: str | ArrayLike | None = None, **more: Any
+             ) -> dict[str, Any]:
+    """Options of a calibration in the units of the command line (mm, deg)."""
+    out = _tool_option(tool)
+    if sigma is not None:
+        out["sigma_mm"] = float(sigma) * 1e3
+    out.update({k: v for k, v in more.items() if v is not None})
+    return out
+
+
+def _flange(cols: Table, source: str, robot: Robot | None) -> NDArray[np.float64] | None:
+    """Flange poses of touches given as joint values (None for x, y, z touches)."""
+    if robot is None or "a1" not in cols or "x" in cols:
+        return None
+    return robot.fk(joint_columns(cols, robot, source), np.eye(4))
+
+
+def _chained(cell: Cell | None, cols: Table, source: str, p_R: NDArray[np.float64],
+             tool: str | ArrayLike | None, track: NDArray[np.float64] | None,
+             nominal: NominalAccuracy, notes: _Notes) -> Chained:
+    """The tool and track the touches rest on (nothing without a cell); notes go to ``notes``."""
+    if cell is None:
+        return Chained()
+    chained = touch_inputs(cell, p_R, flange=_flange(cols, source, cell.robot),
+                           tool=tool if isinstance(tool, str) else None, track=track,
+                           nominal=nominal)
+    notes.add(list(chained.notes))
+    return chained
+
+
+def copied(cell: Cell) -> Cell:
     """A cell sharing the components of ``cell`` with its own tool and frame tables."""
     return replace(cell, tools=dict(cell.tools), frames=dict(cell.frames))
 
@@ -216,7 +321,8 @@ def _write_tool(cell: Cell, name: str, result: CalibrationResult, prov: Provenan
 def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
         robot: Robot | None = None, world_mode: Literal["6d", "5d"] = "6d",
         sigma: float | None = None, source: str | None = None, cell_label: str | None = None,
-        time: str | None = None, on_note: Callable[[str], None] | None = None
+        time: str | None = None, on_note: Callable[[str], None] | None = None,
+        file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
         ) -> CellCalibration:
     """Tool TCP (XYZ 4-point / N-point) and orientation (ABC 2-point, ABC World) into a cell.
 
@@ -236,7 +342,8 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     world_mode : {"6d", "5d"}
         ABC World alignment of rows with ``point=world``.
     sigma : float, optional
-        Touch-up accuracy, 1-sigma per coordinate (m), used for the uncertainties.
+        Touch-up accuracy, 1-sigma per coordinate (m), which the uncertainties rest on; default
+        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     source : str, optional
         Name of the measurements in messages and the provenance note.
     cell_label : str, optional
@@ -245,6 +352,11 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
         ISO 8601 time of the provenance; default now.
     on_note : callable, optional
         Receives each note on the measurements as it arises (e.g. to print it on stderr).
+    file : str or Path, optional
+        The touch file a table was read from; it is recorded in the provenance with its
+        checksum (``measurements`` given as a path is recorded without it).
+    nominal : NominalAccuracy
+        Accuracy of the cell items the touches rest on that have no recorded uncertainty.
 
     Returns
     -------
@@ -265,6 +377,7 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     notes = _Notes(on_note)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["track"], source))
     check_count(roles.count("tcp"), 3, "touches of the reference point (point=tcp)", source)
+    e = None
     if cell is None:
         _refuse_track_column(cols, source, _NO_CELL_TRACK)
     else:
@@ -278,12 +391,27 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
                             world_mode=world_mode, prior_sigma=sigma,
                             labels=[labels[i] for i in order])
+    chained = Chained()
+    if cell is not None and e is not None and cell.track is not None:
+        # The reference point, as each flange pose placed it, moves with the track.
+        T_wR = cell.frame_pose("robot", track=e[order])
+        c_R = np.einsum("nji,nj->ni", T_wR[:, :3, :3], result.values["pivot"] - T_wR[:, :3, 3])
+        chained = touch_inputs(cell, c_R, track=e[order], nominal=nominal)
+        notes.add(list(chained.notes))
+        result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
+                                world_mode=world_mode, prior_sigma=sigma,
+                                labels=[labels[i] for i in order], inputs=chained.inputs)
+    key = f"tools.{name}" if cell is not None and name is not None else ""
     if cell is None or name is None:
-        return CellCalibration(result, notes=tuple(notes))
-    prov = _provenance("tcp", result, len(T), source, time)
-    new = _copy(cell)
+        return CellCalibration(result, notes=tuple(notes), key=key, value="T_F_TCP",
+                               inputs=chained.keys)
+    record = _Record(_file(measurements, file), _options(sigma, world=world_mode), chained,
+                     nominal)
+    prov = _provenance("tcp", result, len(T), source, time, cell, key, "T_F_TCP", record)
+    new = copied(cell)
     kept = _write_tool(new, name, result, prov, label)
-    return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes), tuple(kept))
+    return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes), tuple(kept),
+                           key, "T_F_TCP", chained.keys)
 
 
 # -- frame -----------------------------------------------------------------------------------------
@@ -308,8 +436,9 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
           parent: Literal["world", "robot"] | None = None, robot: Robot | None = None,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
           source: str | None = None, cell_label: str | None = None,
-          time: str | None = None, on_note: Callable[[str], None] | None = None
-        ) -> CellCalibration:
+          time: str | None = None, on_note: Callable[[str], None] | None = None,
+          file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
+          ) -> CellCalibration:
     """A base / user frame (3-point, or N-point to known coordinates) into a cell.
 
     Parameters
@@ -329,8 +458,9 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
         Robot model for joint values when no cell is given.
     tool : str or array_like of shape (4, 4), optional
         Tool that touched: a tool of the cell by name, or ``T_F_TCP`` (m); default the robot
-        model's tool.
-    sigma, source, cell_label, time, on_note
+        model's tool. Its uncertainty (recorded in the cell, else the nominal accuracy) and the
+        track's, for touches mapped to the world, are part of the result's.
+    sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`tcp`.
 
     Returns
@@ -349,30 +479,41 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y", "nominal_z"],
                            source))
     in_world = False
+    p_R, e = p, None
     if cell is None:
         _refuse_track_column(cols, source, _NO_CELL_TRACK)
     else:
         parent = _frame_parent(cell, name, parent, label)  # type: ignore[assignment]
         if parent == "world":
             p = transform_points(robot_in_world(cell, cols, source, len(p), label), p)
+            e = track_positions(cell, cols, source, label)
+            e = np.zeros(len(p)) if e is None else e
             in_world = True
         else:
             track_positions(cell, cols, source, label)
+    chained = _chained(cell, cols, source, p_R, tool, e, nominal, notes)
     if "nominal_x" in cols:
         check_count(len(p), 3, "points", source)
-        result = frame_npoint(p, nominal_points(cols, source), sigma, line_labels(len(p)))
+        result = frame_npoint(p, nominal_points(cols, source), sigma, line_labels(len(p)),
+                              inputs=chained.inputs)
     else:
         roles = point_roles(cols, source)
-        result = frame_3point(p, roles, sigma, line_labels(len(roles), roles))
+        result = frame_3point(p, roles, sigma, line_labels(len(roles), roles),
+                              inputs=chained.inputs)
+    item = f"frames.{name}" if cell is not None and name is not None else ""
     if cell is None or name is None:
-        return CellCalibration(result, notes=tuple(notes))
+        return CellCalibration(result, notes=tuple(notes), key=item, value="T_R_W",
+                               inputs=chained.keys)
     key = f"T_world_{name}" if in_world else "T_R_W"
     if in_world:
         result = result.renamed("T_R_W", key)
-    prov = _provenance("frame", result, len(p), source, time)
-    new = _copy(cell)
+    record = _Record(_file(measurements, file), _options(sigma, tool, parent=parent), chained,
+                     nominal)
+    prov = _provenance("frame", result, len(p), source, time, cell, item, key, record)
+    new = copied(cell)
     new.update_frame(name, result.values[key], prov, parent=parent)
-    return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov, tuple(notes))
+    return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov, tuple(notes),
+                           key=item, value=key, inputs=chained.keys)
 
 
 # -- track -----------------------------------------------------------------------------------------
@@ -421,8 +562,9 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
           roll: Literal["zero"] | None = None, robot: Robot | None = None,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
           source: str | None = None, cell_label: str | None = None,
-          time: str | None = None, on_note: Callable[[str], None] | None = None
-        ) -> CellCalibration:
+          time: str | None = None, on_note: Callable[[str], None] | None = None,
+          file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
+          ) -> CellCalibration:
     """Linear track (direction, scale, straightness, rotation when determined) into a cell.
 
     Parameters
@@ -439,7 +581,7 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
         Axis of L along which the carriage moves; default the cell's, else x.
     roll : {"zero"}, optional
         Without references: fix the rotation about the track axis to zero (a convention).
-    robot, tool, sigma, source, cell_label, time, on_note
+    robot, tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
 
     Returns
@@ -468,13 +610,16 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
     notes = _Notes(on_note)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "point"], source))
     idx = _reference_indices(cols, len(refs), source)
+    options = _options(sigma, tool, references_mm=(refs * 1e3).tolist() if len(refs) else None,
+                       axis=axis, roll=roll)
     keep_offset = cell is not None and len(refs) < 2
     if keep_offset:
         # The fit takes the unmeasured carriage offset as zero; the cell knows it.
         refs = refs - cell.track.T_L_R0[:3, 3]
+    chained = _chained(cell, cols, source, f, tool, None, nominal, notes)
     result = calibrate_track(e, f, references=refs if len(refs) else None, point=idx,
                              axis=axis or "x", roll=roll, labels=line_labels(len(f)),
-                             prior_sigma=sigma)
+                             prior_sigma=sigma, inputs=chained.inputs)
     if cell is None:
         return CellCalibration(result, notes=tuple(notes))
     tr = cell.track
@@ -485,11 +630,12 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
         offset = ", ".join(f"{v:.3f}" for v in tr.T_L_R0[:3, 3] * 1e3 + 0.0)
         kept.append(f"note: the carriage offset is not measured (two or more --reference "
                      f"points measure it): kept the offset of {label} ({offset} mm)")
-    prov = _provenance("track", result, len(f), source, time)
-    new = _copy(cell)
+    record = _Record(_file(measurements, file), options, chained, nominal)
+    prov = _provenance("track", result, len(f), source, time, cell, "track", "T_L_R", record)
+    new = copied(cell)
     new.update_track(prov, T_L_R0=T_L_R0, scale=float(result.values["scale"]))
     return CellCalibration(result, new, f"track {tr.name!r} (robot_at_zero, scale)", prov,
-                           tuple(notes), tuple(kept))
+                           tuple(notes), tuple(kept), "track", "T_L_R", chained.keys)
 
 
 # -- turntable -------------------------------------------------------------------------------------
@@ -517,6 +663,16 @@ def _table_touches(cell: Cell | None, cols: Table, source: str, f: NDArray[np.fl
         return transform_points(robot_in_world(cell, cols, source, len(f), label), f)
     track_positions(cell, cols, source, label)
     return f
+
+
+def _world_track(cell: Cell | None, cols: Table, source: str, n: int
+                 ) -> NDArray[np.float64] | None:
+    """Track positions of touches mapped to the world through the track of a turntable cell."""
+    if cell is None or cell.track is None or cell.turntable is None or (
+            cell.turntable.parent != "world"):
+        return None
+    e = track_positions(cell, cols, source)
+    return np.zeros(n) if e is None else e
 
 
 def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
@@ -585,7 +741,8 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
                robot: Robot | None = None, tool: str | ArrayLike | None = None,
                sigma: float | None = None, source: str | None = None,
                cell_label: str | None = None, time: str | None = None,
-               on_note: Callable[[str], None] | None = None) -> CellCalibration:
+               on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
+               nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
     """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
 
     The touches (:func:`positioner_touches`) go to
@@ -605,7 +762,7 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
         rotate) values ``e1``, ``e2`` (deg).
     robot : Robot, optional
         Robot model for joint values when no cell is given.
-    tool, sigma, source, cell_label, time, on_note
+    tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
 
     Returns
@@ -635,21 +792,27 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
     _arm(cell, robot)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2", "track"], source))
     values, points = positioner_touches(cell, cols, tool=tool, source=source, cell_label=label)
+    p_R = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
+    chained = _chained(cell, cols, source, p_R, tool, _world_track(cell, cols, source, len(p_R)),
+                       nominal, notes)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
-                                labels=line_labels(len(points)))
+                                labels=line_labels(len(points)), inputs=chained.inputs)
     result = done.result.renamed("T_R_B", "T_world_B") if pos.parent == "world" else done.result
-    prov = _provenance("positioner", result, len(points), source, time)
-    new = _copy(cell)
+    record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
+    prov = _provenance("positioner", result, len(points), source, time, cell, "positioner",
+                       "", record)
+    new = copied(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
     return CellCalibration(result, new, f"positioner {pos.name!r} (axes, root)", prov,
-                           tuple(notes))
+                           tuple(notes), key="positioner", inputs=chained.keys)
 
 
 def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: float = 0.0,
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
               sigma: float | None = None, source: str | None = None,
               cell_label: str | None = None, time: str | None = None,
-              on_note: Callable[[str], None] | None = None) -> CellCalibration:
+              on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
+              nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
     """Turntable root frame B and radius, from touches of one point on the table, into a cell.
 
     Parameters
@@ -661,7 +824,7 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
         turntable in the world of a cell with a track, ``track`` (mm).
     height : float
         Shift of the frame origin along the table axis from the plane of the touched point (m).
-    robot, tool, sigma, source, cell_label, time, on_note
+    robot, tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
 
     Returns
@@ -682,24 +845,30 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
+    f_R = f
     f = _table_touches(cell, cols, source, f, label)
+    chained = _chained(cell, cols, source, f_R, tool, _world_track(cell, cols, source, len(f)),
+                       nominal, notes)
     result = calibrate_turntable(theta, f, height=height, labels=line_labels(len(f)),
-                                 prior_sigma=sigma)
+                                 prior_sigma=sigma, inputs=chained.inputs)
     if cell is None:
         return CellCalibration(result, notes=tuple(notes))
     key = "T_R_B"
     if parent == "world":
         key = "T_world_B"
         result = result.renamed("T_R_B", key)
-    prov = _provenance("turntable", result, len(f), source, time)
-    new = _copy(cell)
+    record = _Record(_file(measurements, file), _options(sigma, tool, height_mm=height * 1e3),
+                     chained, nominal)
+    prov = _provenance("turntable", result, len(f), source, time, cell, "turntable", key, record)
+    new = copied(cell)
     tt = new.update_turntable(prov, T_parent_B=result.values[key])
-    return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov, tuple(notes))
+    return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov, tuple(notes),
+                           key="turntable", value=key, inputs=chained.keys)
 
 
 # -- workpiece -------------------------------------------------------------------------------------
-def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: str
-                         ) -> tuple[TurntablePose, list[str]]:
+def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: str,
+                         nominal: NominalAccuracy) -> tuple[TurntablePose, list[str]]:
     """The turntable root in the frame of the touches, and notes on where it comes from."""
     if cell is None:
         if given is None:
@@ -713,10 +882,9 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
         return given, []
     tt = _cell_turntable(cell, label)
     if given is None:
-        return TurntablePose(tt.T_parent_B, frame=tt.parent, source=label), [
-            (f"note: the turntable pose comes from {label}, which holds no covariance: the "
-             "1-sigma of T_B_W does not include the turntable's uncertainty (pass --turntable "
-             "TURNTABLE.json to include it)")]
+        sources, note = item_sources(cell, "turntable", nominal)
+        return TurntablePose(tt.T_parent_B, sources, frame=tt.parent, source=label), (
+            [note] if note else [])
     if given.frame != tt.parent:
         raise InputError(f"{given.source} holds the turntable in the "
                          f"{'world' if given.frame == 'world' else 'robot base'}, but the "
@@ -737,30 +905,42 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
 def _positioner_workpiece(cell: Cell, measurements: Table | str | Path, name: str | None, *,
                           tool: str | ArrayLike | None, sigma: float | None, source: str | None,
                           label: str, time: str | None,
-                          on_note: Callable[[str], None] | None) -> CellCalibration:
+                          on_note: Callable[[str], None] | None, file: str | Path | None,
+                          nominal: NominalAccuracy) -> CellCalibration:
     """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P."""
     from robotcell.calibration.frame import frame_3point
 
     values, points = positioner_touches(cell, measurements, tool=tool, source=source,
                                         cell_label=label)
+    record_file = _file(measurements, file)
     cols, source = load_table(measurements, source)
     pos = cell.turntable
     notes = _Notes(on_note)
     notes.add([(f"note: the touches are taken into the plate of positioner {pos.name!r} "
-                f"through its chain in {label}, which holds no covariance: the 1-sigma of T_P_W "
-                "does not include the positioner's uncertainty")])
+                f"through its chain in {label}: the 1-sigma of T_P_W does not include the "
+                "positioner's uncertainty")])
     roles = point_roles(cols, source)
     notes.add(repeat_notes(cols, POSE_COLUMNS + [f"e{i + 1}" for i in range(pos.n_axes)]
                            + ["track"], source))
-    p_P = transform_points(invert(pos.T_parent_root @ pos.T_root_P(values)), points)
-    result = frame_3point(p_P, roles, sigma, line_labels(len(roles), roles)).renamed("T_R_W",
-                                                                                    "T_P_W")
+    T_P_parent = invert(pos.T_parent_root @ pos.T_root_P(values))
+    p_P = transform_points(T_P_parent, points)
+    p_R = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
+    chained = _chained(cell, cols, source, p_R, tool,
+                       _world_track(cell, cols, source, len(p_R)), nominal, notes)
+    if chained.inputs is not None:
+        chained = replace(chained, inputs=chained.inputs.rotated(T_P_parent[:, :3, :3]))
+    result = frame_3point(p_P, roles, sigma, line_labels(len(roles), roles),
+                          inputs=chained.inputs).renamed("T_R_W", "T_P_W")
+    item = "" if name is None else f"frames.{name}"
     if name is None:
-        return CellCalibration(result, notes=tuple(notes))
-    prov = _provenance("workpiece", result, len(points), source, time)
-    new = _copy(cell)
+        return CellCalibration(result, notes=tuple(notes), value="T_P_W", inputs=chained.keys)
+    record = _Record(record_file, _options(sigma, tool), chained, nominal)
+    prov = _provenance("workpiece", result, len(points), source, time, cell, item, "T_P_W",
+                       record)
+    new = copied(cell)
     new.update_frame(name, result.values["T_P_W"], prov, parent="turntable")
-    return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes))
+    return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
+                           key=item, value="T_P_W", inputs=chained.keys)
 
 
 def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
@@ -768,7 +948,8 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
               sigma: float | None = None, source: str | None = None,
               cell_label: str | None = None, time: str | None = None,
-              on_note: Callable[[str], None] | None = None) -> CellCalibration:
+              on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
+              nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
     """Workpiece frame ``T_B_W`` on a calibrated turntable into a cell (parent turntable).
 
     Parameters
@@ -785,8 +966,9 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
         Frame of the cell to write (added when new). Without it nothing is written.
     turntable : TurntablePose or CalibrationResult, optional
         The turntable calibration, whose uncertainty is then propagated; default the cell's
-        turntable (without uncertainty).
-    robot, tool, sigma, source, cell_label, time, on_note
+        turntable with its recorded uncertainty (or the nominal accuracy), whose error sources
+        it may share with the tool.
+    robot, tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
 
     Returns
@@ -801,11 +983,12 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
             raise InputError(f"{label} has a positioner chain, which carries its own "
                              "calibration: give no turntable result")
         return _positioner_workpiece(cell, measurements, name, tool=tool, sigma=sigma,
-                                     source=source, label=label, time=time, on_note=on_note)
+                                     source=source, label=label, time=time, on_note=on_note,
+                                     file=file, nominal=nominal)
     if isinstance(turntable, CalibrationResult):
         turntable = TurntablePose.from_result(turntable)
     model = _arm(cell, robot)
-    tt, where = _workpiece_turntable(cell, turntable, label)
+    tt, where = _workpiece_turntable(cell, turntable, label, nominal)
     notes = _Notes(on_note)
     notes.add(where)
     cols, source = load_table(measurements, source)
@@ -815,14 +998,23 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
         check_axis_limits(cell.turntable, theta, ["e1"], source, label)
     roles = point_roles(cols, source)
     notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
+    f_R = f
     f = _table_touches(cell, cols, source, f, label)
+    chained = _chained(cell, cols, source, f_R, tool, _world_track(cell, cols, source, len(f)),
+                       nominal, notes)
     result = calibrate_workpiece(theta, f, roles, tt.T, T_R_B_covariance=tt.covariance,
-                                 noise_sigma=tt.noise_sigma, prior_sigma=sigma,
+                                 inputs=chained.inputs, prior_sigma=sigma,
                                  labels=line_labels(len(roles), roles))
+    inputs = chained.keys + (("turntable",) if cell is not None and turntable is None else ())
+    item = "" if cell is None or name is None else f"frames.{name}"
     if cell is None or name is None:
-        return CellCalibration(result, notes=tuple(notes))
-    prov = _provenance("workpiece", result, len(f), source, time)
-    new = _copy(cell)
+        return CellCalibration(result, notes=tuple(notes), key=item, value="T_B_W",
+                               inputs=inputs)
+    record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
+    prov = _provenance("workpiece", result, len(f), source, time, cell, item, "T_B_W", record,
+                       inputs)
+    new = copied(cell)
     new.update_frame(name, result.values["T_B_W"], prov, parent="turntable")
-    return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes))
+    return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
+                           key=item, value="T_B_W", inputs=inputs)
 

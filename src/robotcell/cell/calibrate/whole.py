@@ -1,0 +1,469 @@
+"""The whole cell in one fit: every calibrated item re-estimated from all the touches behind it.
+
+Each calibration of a cell records its touch file (with its checksum), its options and the items it
+used (:class:`~robotcell.cell.Provenance`). :func:`calibrate_cell` repeats every recorded
+calibration on the cell as it stands and combines them into one maximum-likelihood fit of all the
+items at once: a tool is then estimated from its own touches *and* from the turntable, track and
+frame touches taken with it, and every item measured with it follows it.
+
+The combination is exact to first order and needs no model beyond the procedures' own. Around the
+current values, calibration ``s`` (own item ``u_s``, inputs ``v_s``) contributes
+
+* its estimate: ``u_s - G_s v_s = u_hat_s`` (the procedure's result given the inputs, ``G_s`` how
+  it follows them), with the covariance of its own touch noise, in the directions its touches
+  determine;
+* what its residuals say about the inputs: the part of the inputs' effect on the touches that its
+  own item cannot absorb, ``J_v^T (I - H) J_v / s^2`` (``Fit.input_information``).
+
+Minimising the sum over all calibrations (Gauss-Newton, repeated with every calibration re-run at
+the new values until the step is below 1e-4 of its 1-sigma) is the maximum-likelihood fit of all
+the touches together. Items no calibration measures (a nominal tool, a track's roll about its
+axis) keep their values and enter with their recorded uncertainty (or the nominal accuracy). The
+covariance of the result is the inverse of the combined information plus the share of those kept
+values; it is written back as error sources, so later calibrations chain on it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from robotcell.calibration.result import to_jsonable
+from robotcell.calibration.uncertainty import OWN, Sources, factor_of
+from robotcell.calibration.verdict import Verdict
+from robotcell.cell import Cell, Positioner, Provenance
+from robotcell.cell.calibrate import procedures
+from robotcell.cell.calibrate.chain import (
+    NOMINAL_ACCURACY,
+    NominalAccuracy,
+    item_pose,
+    item_sources,
+    perturbed,
+)
+from robotcell.errors import InputError
+from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
+from robotcell.io.tables import format_table
+
+__all__ = ["CellRecalibration", "ItemChange", "calibrate_cell"]
+
+#: Gauss-Newton steps at most, and the step (in units of each parameter's 1-sigma) below which
+#: the fit has converged.
+MAX_ITERATIONS = 20
+CONVERGED = 1e-4
+
+_PROCEDURES = ("tcp", "frame", "track", "turntable", "workpiece", "positioner")
+_LEVELS = ("good", "check", "poor")
+
+
+@dataclass(frozen=True)
+class ItemChange:
+    """What the whole-cell fit changed in one item.
+
+    Attributes
+    ----------
+    key : str
+        ``tools.NAME``, ``frames.NAME``, ``track`` or ``turntable``.
+    before, after : ndarray, shape (4, 4)
+        The item's pose (m) in the cell given and in the fit.
+    change : ndarray, shape (6,) or (7,)
+        ``after`` relative to ``before``: origin (m), rotation vector (rad, about the parent's
+        axes), and for the track the scale.
+    sigma : ndarray, shape (6,) or (7,)
+        1-sigma of ``after`` in the same parameters (the whole-cell fit's).
+    sigma_before : ndarray, shape (6,) or (7,)
+        1-sigma of ``before`` as the cell recorded it (its sequential calibration).
+    """
+
+    key: str
+    before: NDArray[np.float64]
+    after: NDArray[np.float64]
+    change: NDArray[np.float64]
+    sigma: NDArray[np.float64]
+    sigma_before: NDArray[np.float64]
+
+    @property
+    def change_sigmas(self) -> NDArray[np.float64]:
+        """``change / sigma`` per parameter."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.sigma > 0, self.change / self.sigma, 0.0)
+
+
+@dataclass(frozen=True)
+class CellRecalibration:
+    """Outcome of :func:`calibrate_cell`.
+
+    Attributes
+    ----------
+    cell : Cell
+        The cell with every re-estimated item written in (a new cell).
+    changes : tuple of ItemChange
+        Per estimated item, in the order of ``items``.
+    steps : tuple of CellCalibration
+        Every recorded calibration, repeated at the fitted values (residuals per touch, verdict).
+    items : tuple of str
+        The estimated items.
+    covariance : ndarray
+        Joint covariance of the items' parameters (SI), in the order of ``items``.
+    iterations : int
+        Gauss-Newton steps taken.
+    notes : tuple of str
+        Items taken at their recorded or nominal accuracy.
+    """
+
+    cell: Cell
+    changes: tuple[ItemChange, ...]
+    steps: tuple[procedures.CellCalibration, ...]
+    items: tuple[str, ...]
+    covariance: NDArray[np.float64]
+    iterations: int
+    notes: tuple[str, ...] = ()
+
+    @property
+    def verdict(self) -> Verdict:
+        """The worst verdict of the calibrations, with the reasons of each that is not good."""
+        verdicts = [(s.key or s.result.procedure, s.result.verdict) for s in self.steps]
+        level = max((v.level for _, v in verdicts), key=_LEVELS.index, default="good")
+        reasons = [f"{k}: {'; '.join(v.reasons)}" for k, v in verdicts if v.level == level]
+        return Verdict(level=level, reasons=reasons)
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (mm, deg): ``items`` with their change, 1-sigma and change in
+        sigmas, ``steps`` (each calibration's result), ``verdict``."""
+        items = []
+        for c in self.changes:
+            to_mm = np.r_[np.full(3, 1e3), np.full(3, 180.0 / math.pi), np.ones(len(c.change) - 6)]
+            entry = {"item": c.key, "before_xyzabc": pose_to_vendor(c.before, "kuka"),
+                     "after_xyzabc": pose_to_vendor(c.after, "kuka"),
+                     "change_mm_deg": c.change * to_mm, "sigma_mm_deg": c.sigma * to_mm,
+                     "sigma_before_mm_deg": c.sigma_before * to_mm,
+                     "change_sigmas": c.change_sigmas}
+            items.append(entry)
+        v = self.verdict
+        return to_jsonable({"procedure": "cell", "iterations": self.iterations, "items": items,
+                            "steps": [{"item": s.key, **s.result.to_json()} for s in self.steps],
+                            "notes": list(self.notes),
+                            "verdict": {"level": v.level, "reasons": v.reasons}})
+
+    def summary(self) -> str:
+        """Readable report: per item the change and its 1-sigma, per calibration its verdict."""
+        rows = []
+        for c in self.changes:
+            d = c.change
+            rows.append([c.key, float(np.linalg.norm(d[:3]) * 1e3),
+                         float(np.degrees(np.linalg.norm(d[3:6]))),
+                         float(np.linalg.norm(c.sigma[:3]) * 1e3),
+                         float(np.degrees(np.linalg.norm(c.sigma[3:6]))),
+                         float(np.max(np.abs(c.change_sigmas))),
+                         float(np.linalg.norm(c.sigma_before[:3]) * 1e3)])
+        lines = [(f"calibration: the whole cell, {len(self.steps)} calibrations fitted together "
+                  f"({self.iterations} iterations)"), "",
+                 ("changes (|position| mm, |rotation| deg; largest change in 1-sigma; 1-sigma "
+                  "before):"),
+                 format_table(["item", "moved mm", "turned deg", "1-sigma mm", "1-sigma deg",
+                               "max |change|/sigma", "1-sigma before mm"], rows), "",
+                 "calibrations (at the fitted values):"]
+        for s in self.steps:
+            r = s.result
+            lines.append(f"  {s.key or r.procedure}: RMS {r.rms * 1e3:.3f} mm over "
+                         f"{len(r.used_norms)} touches, {r.verdict.line()}")
+        if self.notes:
+            lines += ["", "notes:"] + [f"  - {n}" for n in self.notes]
+        v = self.verdict
+        lines += ["", f"verdict: {v.level.upper()}: " + ("; ".join(v.reasons) or "every "
+                                                             "calibration is good")]
+        return "\n".join(lines)
+
+
+def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
+    """Items with a recorded touch file, refusing missing or changed files (all named)."""
+    items: list[tuple[str, Any]] = [(f"tools.{n}", t) for n, t in cell.tools.items()]
+    items += [(f"frames.{n}", f) for n, f in cell.frames.items()]
+    items += [("track", cell.track), ("turntable", cell.turntable)]
+    out, problems = [], []
+    for key, owner in items:
+        prov = None if owner is None else owner.provenance
+        if prov is None or prov.measurements is None or prov.source not in _PROCEDURES:
+            continue
+        path = Path(prov.measurements)
+        if not path.is_file():
+            problems.append(f"{key}: touch file {path} is missing")
+        elif prov.sha256 is not None and procedures.sha256_of(path) != prov.sha256:
+            problems.append(f"{key}: touch file {path} has changed since the calibration "
+                            "(checksum differs)")
+        else:
+            out.append((key, prov))
+    if problems:
+        raise InputError(f"{label}: cannot repeat the calibrations: " + "; ".join(problems)
+                         + ". Restore the files, or calibrate those items again")
+    if not out:
+        raise InputError(f"{label} records no calibration with its touch file: calibrate its "
+                         "items with --cell first (each calibration then records its file)")
+    return out
+
+
+def _tool(option: Any) -> str | NDArray[np.float64] | None:
+    if option is None or isinstance(option, str):
+        return option
+    return pose_from_vendor(np.asarray(option, dtype=float), "kuka")
+
+
+def _run(cell: Cell, key: str, prov: Provenance, nominal: NominalAccuracy, time: str | None
+         ) -> procedures.CellCalibration:
+    """Repeat one recorded calibration on ``cell``."""
+    o = prov.options
+    name = key.partition(".")[2] or None
+    kw: dict[str, Any] = {"sigma": o["sigma_mm"] * 1e-3 if "sigma_mm" in o else None,
+                          "file": prov.measurements, "nominal": nominal, "time": time}
+    path = prov.measurements
+    if prov.source == "tcp":
+        return procedures.tcp(cell, path, name, world_mode=o.get("world", "6d"), **kw)
+    kw["tool"] = _tool(o.get("tool"))
+    if prov.source == "frame":
+        return procedures.frame(cell, path, name, parent=o.get("parent"), **kw)
+    if prov.source == "track":
+        refs = o.get("references_mm")
+        return procedures.track(cell, path, references=None if refs is None
+                                else np.asarray(refs, dtype=float) * 1e-3,
+                                axis=o.get("axis"), roll=o.get("roll"), **kw)
+    if prov.source == "turntable":
+        return procedures.turntable(cell, path, height=o.get("height_mm", 0.0) * 1e-3, **kw)
+    if prov.source == "workpiece":
+        return procedures.workpiece(cell, path, name, **kw)
+    return procedures.positioner(cell, path, **kw)
+
+
+def _size(key: str) -> int:
+    return 7 if key == "track" else 6
+
+
+def _values(cell: Cell, key: str) -> tuple[NDArray[np.float64], float]:
+    """An item's pose and (track) scale."""
+    T = item_pose(cell, key)[0]
+    return T, cell.track.scale if key == "track" else 1.0
+
+
+def _difference(T: NDArray[np.float64], scale: float, T0: NDArray[np.float64],
+                scale0: float, size: int) -> NDArray[np.float64]:
+    """Item parameters of ``(T, scale)`` relative to ``(T0, scale0)``."""
+    d = np.r_[T[:3, 3] - T0[:3, 3], Rotation.from_matrix(T[:3, :3] @ T0[:3, :3].T).as_rotvec()]
+    return np.r_[d, scale - scale0] if size == 7 else d
+
+
+def _estimate_value(run: procedures.CellCalibration, cell: Cell
+                    ) -> tuple[NDArray[np.float64], float]:
+    """The pose (and scale) a calibration estimates for its item; unmeasured parts as they are."""
+    r = run.result
+    T, scale = _values(cell, run.key)
+    if run.value in r.values:
+        T = r.values[run.value]
+    elif "tcp" in r.values:  # a TCP without orientation
+        T = T.copy()
+        T[:3, 3] = r.values["tcp"]
+    return T, float(r.values.get("scale", scale))
+
+
+def _moved(cell: Cell, key: str, d: NDArray[np.float64], prov: Provenance) -> None:
+    """Write item ``key`` of ``cell`` moved by parameters ``d``, with provenance ``prov``."""
+    kind, _, name = key.partition(".")
+    if kind == "tools":
+        cell.set_tool(name, perturbed(cell.tools[name].T_F_TCP, d), prov)
+    elif kind == "frames":
+        cell.update_frame(name, perturbed(cell.frames[name].pose, d), prov)
+    elif key == "track":
+        cell.update_track(prov, T_L_R0=perturbed(cell.track.T_L_R0, d[:6]),
+                          scale=cell.track.scale + float(d[6]))
+    else:
+        cell.update_turntable(prov, T_parent_B=perturbed(cell.turntable.T_parent_B, d))
+
+
+class _System:
+    """The normal equations of all calibrations over the estimated items and the kept ones."""
+
+    def __init__(self, estimated: list[str], kept: dict[str, Sources]):
+        self.slices: dict[str, slice] = {}
+        n = 0
+        for key in estimated + list(kept):
+            self.slices[key] = slice(n, n + _size(key))
+            n += _size(key)
+        self.nu = sum(_size(k) for k in estimated)
+        self.kept = kept
+        self.N = np.zeros((n, n))
+        self.b = np.zeros(n)
+        self.shares: list[tuple[NDArray[np.float64], dict[str, NDArray[np.float64]]]] = []
+
+    def add(self, cols: list[int], H: NDArray[np.float64], W: NDArray[np.float64],
+            y: NDArray[np.float64], errors: dict[str, NDArray[np.float64]]) -> None:
+        """Equations ``H w[cols] = y + e``, ``cov(e) = W^-1``, ``e = sum_k F_k z_k`` by source.
+
+        Equations added under one source name are independent parts of its error (the
+        estimate and the residuals of one calibration).
+        """
+        idx = np.asarray(cols, dtype=int)
+        HtW = H.T @ W
+        self.N[np.ix_(idx, idx)] += HtW @ H
+        self.b[idx] += HtW @ y
+        gain = np.zeros((len(self.b), H.shape[0]))
+        gain[idx] = HtW
+        self.shares.append((gain, errors))
+
+    def solve(self) -> tuple[NDArray[np.float64], Sources]:
+        """The step of the estimated items and their error sources."""
+        nu = self.nu
+        Ninv = np.linalg.inv(self.N[:nu, :nu])
+        step = Ninv @ self.b[:nu]
+        factors: dict[str, NDArray[np.float64]] = {}
+        for gain, errors in self.shares:
+            for name, F in errors.items():
+                f = Ninv @ gain[:nu] @ F
+                factors[name] = np.hstack([factors[name], f]) if name in factors else f
+        if self.kept:
+            K = -Ninv @ self.N[:nu, nu:]
+            for name, F in Sources.stack(list(self.kept.values())).map(K).factors.items():
+                if name in factors and factors[name].shape == F.shape:
+                    factors[name] = factors[name] + F
+                else:  # the same source reached by another route: its parts side by side
+                    factors[name] = np.hstack([factors[name], F]) if name in factors else F
+        return step, Sources(nu, {k: _compact(f) for k, f in factors.items()})
+
+
+def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
+                   nominal: NominalAccuracy = NOMINAL_ACCURACY, time: str | None = None,
+                   on_note: Callable[[str], None] | None = None) -> CellRecalibration:
+    """Re-estimate every calibrated item of a cell from all the touch files its calibrations used.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell whose items carry the provenance of calibrations into it (touch file, checksum,
+        options: what ``calibrate ... --cell`` records).
+    cell_label : str, optional
+        Name of the cell in messages (its file).
+    nominal : NominalAccuracy
+        Accuracy of the items the calibrations used that have no recorded uncertainty.
+    time : str, optional
+        ISO 8601 time of the new provenance; default now.
+    on_note : callable, optional
+        Receives each note as it arises.
+
+    Returns
+    -------
+    CellRecalibration
+
+    Raises
+    ------
+    InputError
+        A recorded touch file is missing or changed (each is named), or the cell records no
+        calibration with its file.
+    """
+    label = cell_label or f"cell {cell.name!r}"
+    recorded = _recorded(cell, label)
+    notes: list[str] = []
+
+    def note(text: str) -> None:
+        if text not in notes:
+            notes.append(text)
+            if on_note is not None:
+                on_note(text)
+
+    original = {k: _values(cell, k) for k, _ in recorded if k != "turntable"
+                or not isinstance(cell.turntable, Positioner)}
+    estimated = [k for k, p in recorded if p.source != "positioner"]
+    current = procedures.copied(cell)
+    prior = {k: item_sources(cell, k, nominal)[0] for k in estimated}
+    for it in range(1, MAX_ITERATIONS + 1):
+        runs = [_run(current, k, p, nominal, time) for k, p in recorded]
+        kept: dict[str, Sources] = {}
+        for run in runs:
+            for key in run.inputs:
+                if key not in estimated and key not in kept:
+                    kept[key], text = _input_sources(current, key, nominal)
+                    if text:
+                        note(text)
+        system = _System(estimated, kept)
+        for run, (key, prov) in zip(runs, recorded):
+            _equations(system, run, current, prov.id or key, original.get(key), prior.get(key))
+        step, sources = system.solve()
+        sigma = np.sqrt(np.diag(sources.covariance))
+        for key in estimated:
+            _moved(current, key, step[system.slices[key]], item_pose(current, key)[1].provenance)
+        if np.max(np.abs(step) / np.maximum(sigma, 1e-15)) < CONVERGED:
+            break
+    runs = [_run(current, k, p, nominal, time) for k, p in recorded]
+    stamp = time or Provenance.now("cell").time
+    new = procedures.copied(cell)
+    changes = []
+    for key, prov in recorded:
+        if key not in estimated:  # the positioner chain: its calibration at the fitted values
+            run = runs[[k for k, _ in recorded].index(key)]
+            new.update_positioner(run.provenance, run.cell.turntable.chain)
+            continue
+        rows = system.slices[key]
+        item = sources.select(np.arange(rows.start, rows.stop))
+        T, scale = _values(current, key)
+        T0, scale0 = original[key]
+        delta = _difference(T, scale, T0, scale0, _size(key))
+        _moved(new, key, delta, replace(prov, time=stamp, sources=item.factors,
+                                        note=f"{prov.note}; fitted with the whole cell"))
+        changes.append(ItemChange(key, T0, T, delta, item.sigma, prior[key].sigma))
+    return CellRecalibration(new, tuple(changes), tuple(runs), tuple(estimated),
+                             sources.covariance, it, tuple(notes))
+
+
+def _compact(F: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A factor with the same ``F F^T`` and as few columns as its rank (every item's rows at
+    once, so the correlations between items stay)."""
+    U, S, _ = np.linalg.svd(F, full_matrices=False)
+    keep = S > S[0] * 1e-9 if S.size and S[0] > 0 else np.zeros(S.shape, dtype=bool)
+    return U[:, keep] * S[keep]
+
+
+def _input_sources(cell: Cell, key: str, nominal: NominalAccuracy) -> tuple[Sources, str | None]:
+    """Sources of an input that is not estimated: a kept cell item, or a tool given as a pose."""
+    try:
+        return item_sources(cell, key, nominal)
+    except InputError:
+        return Sources(6, {f"{key} nominal": np.diag(nominal.sigma(6))}), None
+
+
+def _equations(system: _System, run: procedures.CellCalibration, cell: Cell, name: str,
+               original: tuple[NDArray[np.float64], float] | None, prior: Sources | None) -> None:
+    """The equations of one calibration (its touch noise is the error source ``name``).
+
+    What its residuals say about its inputs, ``L^T dv = y`` with ``L L^T`` the input information
+    and ``L y = -score`` (the normal equations of ``|r + J dv|^2 / s^2``); its estimate of its
+    item in the directions its touches determine; and, for the other directions of the item,
+    its values before the fit with their recorded uncertainty (``original``, ``prior``).
+    """
+    fit = run.result.fit
+    cols_in = [i for key in run.inputs for i in range(system.slices[key].start,
+                                                      system.slices[key].stop)]
+    s2 = fit.noise_sigma ** 2
+    if run.inputs:
+        L = factor_of(fit.input_information / s2)
+        y = np.linalg.lstsq(L, -fit.input_score / s2, rcond=None)[0]
+        system.add(cols_in, L.T, np.eye(L.shape[1]), y, {name: np.eye(L.shape[1])})
+    est = run.result.estimates.get(run.value)
+    if est is None or original is None or prior is None:
+        return
+    size = _size(run.key)
+    own_cols = list(range(system.slices[run.key].start, system.slices[run.key].stop))
+    D = est.determined
+    own = D.T @ est.sources.factors[OWN]
+    T, scale = _estimate_value(run, cell)
+    Tc, scale_c = _values(cell, run.key)
+    y = D.T @ _difference(T, scale, Tc, scale_c, size)
+    H = np.hstack([D.T, -D.T @ est.gain]) if run.inputs else D.T
+    system.add(own_cols + cols_in, H, np.linalg.inv(own @ own.T), y, {name: own})
+    if D.shape[1] < size:
+        Nb = np.linalg.svd(np.eye(size) - D @ D.T)[0][:, :size - D.shape[1]]
+        errors = prior.map(Nb.T).factors
+        C = sum(f @ f.T for f in errors.values())
+        y = Nb.T @ _difference(*original, Tc, scale_c, size)
+        system.add(own_cols, Nb.T, np.linalg.pinv(C), y, errors)

@@ -1,0 +1,90 @@
+"""Uncertainty through the chain a technician runs: each step's 1-sigma includes the errors of the
+steps it used.
+
+Seeded Monte Carlo of the chains "tool, then turntable, then workpiece" and "tool, then track" in
+the example cells, every step calibrated into the cell as ``robotcell calibrate --cell`` does it
+(the tool's recorded error sources go with it). For every reported position and angle the spread
+of (error / reported 1-sigma) must lie in 0.8-1.25. With 200 trials the spread of a correct
+1-sigma is 1 +- 0.05 (chi-square with 200 degrees of freedom): 0.8 and 1.25 are 4.1 and 4.9
+standard deviations away, so over the 31 quantities a correct propagation fails with a
+probability below 0.1 %; leaving out the tool's error (the spread of the turntable origin along Z
+is then 3 times its 1-sigma) cannot pass. Of the GOOD verdicts fewer than 1 % may be more than 4
+sigma off (a correct 1-sigma puts 6e-5 of a Gaussian there).
+"""
+
+from dataclasses import replace
+
+import numpy as np
+from touch_helpers import pose_error, retouched
+
+from robotcell.cell import Cell
+from robotcell.cell import calibrate as cellcal
+from robotcell.studies.simulate import simulate
+
+NOISE = 1e-4
+TRIALS = 200
+EXAMPLE = "examples/cell_kr16_track_turntable.yaml"
+
+
+def cells():
+    """The example cell on its track, and the same cell with the robot fixed at track 2.5 m."""
+    track_cell = Cell.load(EXAMPLE)
+    fixed = replace(track_cell, track=None, T_world_R=track_cell.frame_pose("robot", track=2.5))
+    return track_cell, fixed
+
+
+def z_scores(T_est, T_true, sigma_position, sigma_rotation):
+    return pose_error(T_est, T_true) / np.r_[sigma_position, sigma_rotation]
+
+
+def test_each_step_carries_the_error_of_the_steps_before_it():
+    track_cell, fixed = cells()
+    tool = fixed.tools["pointer"].T_F_TCP
+    designs = {"tcp": simulate(fixed, "tcp", noise=0.0, tool="pointer"),
+               "turntable": simulate(fixed, "turntable", noise=0.0, tool="pointer"),
+               "workpiece": simulate(fixed, "workpiece", noise=0.0, tool="pointer",
+                                     frame="part"),
+               "track": simulate(track_cell, "track", noise=0.0, tool="pointer")}
+    refs = designs["track"].keywords()["references"]
+    rng = np.random.default_rng(1)
+    z = {"tool": [], "turntable": [], "workpiece": [], "track": []}
+    good = off = 0
+    for _ in range(TRIALS):
+        t = cellcal.tcp(fixed, retouched(designs["tcp"], fixed, tool, rng, NOISE), "pointer",
+                        sigma=NOISE)
+        r = t.result
+        z["tool"].append(z_scores(r.values["T_F_TCP"], tool, r.sigma["T_F_TCP_position"],
+                                  r.sigma["T_F_TCP_rotation"]))
+        steps = [(r, z["tool"][-1])]
+        tt = cellcal.turntable(t.cell, retouched(designs["turntable"], fixed, tool, rng, NOISE),
+                               tool="pointer", sigma=NOISE, height=-0.05)
+        r = tt.result
+        z["turntable"].append(z_scores(r.values["T_world_B"], fixed.turntable.T_parent_B,
+                                       r.sigma["T_world_B_position"],
+                                       r.sigma["T_world_B_rotation"]))
+        steps.append((r, z["turntable"][-1]))
+        wp = cellcal.workpiece(tt.cell, retouched(designs["workpiece"], fixed, tool, rng, NOISE),
+                               "part", tool="pointer", sigma=NOISE)
+        r = wp.result
+        z["workpiece"].append(z_scores(r.values["T_B_W"], fixed.frames["part"].pose,
+                                       r.sigma["T_B_W_position"], r.sigma["T_B_W_rotation"]))
+        steps.append((r, z["workpiece"][-1]))
+        # The same calibrated tool on the robot of the track cell.
+        on_track = replace(track_cell, tools={**track_cell.tools,
+                                              "pointer": t.cell.tools["pointer"]})
+        tr = cellcal.track(on_track, retouched(designs["track"], track_cell, tool, rng, NOISE),
+                           references=refs, tool="pointer", sigma=NOISE)
+        r = tr.result
+        z["track"].append(np.r_[
+            z_scores(r.values["T_L_R"], track_cell.track.T_L_R0, r.sigma["T_L_R_position"],
+                     r.sigma["T_L_R_rotation"]),
+            (r.values["scale"] - track_cell.track.scale) / r.sigma["scale"]])
+        steps.append((r, z["track"][-1]))
+        for result, zs in steps:
+            if result.verdict.level == "good":
+                good += 1
+                off += bool(np.max(np.abs(zs)) > 4.0)
+    spreads = {k: np.sqrt(np.mean(np.square(v), axis=0)) for k, v in z.items()}
+    for name, spread in spreads.items():
+        assert np.all((spread > 0.8) & (spread < 1.25)), (name, np.round(spread, 3))
+    assert good >= TRIALS and off < 0.01 * good, (good, off)
