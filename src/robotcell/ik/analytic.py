@@ -1,4 +1,4 @@
-"""Batched analytic inverse kinematics of a :class:`~robotcell.kinematics.robot.Robot`.
+"""Batched analytic inverse kinematics of an :class:`~robotcell.kinematics.arm.Arm`.
 
 :func:`solve` recognises the structure of the model once (cached per robot object) and returns
 all 8 solutions of every pose: ortho-parallel arms with a spherical wrist through
@@ -35,8 +35,8 @@ from robotcell.ik.palletizer import (
 from robotcell.ik.result import IKSolutions, exact_branches, flat_reference
 from robotcell.ik.seeded import SeededSolver
 from robotcell.ik.ur import URParameters, ur_kernel, ur_parameters, ur_problems
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.bounds import within
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, validate_pose
 
 __all__ = ["AnalyticSolver", "analytic_solver", "solve"]
@@ -52,7 +52,7 @@ class AnalyticSolver:
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         A model with one of the supported structures.
 
     Raises
@@ -61,7 +61,7 @@ class AnalyticSolver:
         When the model has neither structure; the message says which conditions fail.
     """
 
-    def __init__(self, robot: Robot) -> None:
+    def __init__(self, robot: Arm) -> None:
         coupling = robot.coupling
         # The kernels see the model's joint values; a palletizer's kernel works on the controller
         # values directly (its parameters are read off the coupled forward kinematics).
@@ -191,10 +191,10 @@ class AnalyticSolver:
                            reach.reshape(batch + (nb,)), self.method, err.reshape(batch + (nb,)))
 
 
-_CACHE: weakref.WeakKeyDictionary[Robot, AnalyticSolver | SeededSolver] = weakref.WeakKeyDictionary()
+_CACHE: weakref.WeakKeyDictionary[Arm, AnalyticSolver | SeededSolver] = weakref.WeakKeyDictionary()
 
 
-def analytic_solver(robot: Robot) -> AnalyticSolver | SeededSolver:
+def analytic_solver(robot: Arm) -> AnalyticSolver | SeededSolver:
     """The (cached) IK solver of ``robot``; raises :class:`InputError` if it has none.
 
     The analytic solver of its structure; for a robot without one but with an ``ik_seed``, the
@@ -212,13 +212,13 @@ def analytic_solver(robot: Robot) -> AnalyticSolver | SeededSolver:
     return solver
 
 
-def solve(robot: Robot, T: ArrayLike, tool: ArrayLike | None = None,
+def solve(robot: Arm, T: ArrayLike, tool: ArrayLike | None = None,
           q_ref: ArrayLike | None = None) -> IKSolutions:
     """All analytic IK solutions of ``robot`` for TCP poses ``T`` (see :meth:`AnalyticSolver.solve`).
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
     T : array_like, shape (..., 4, 4)
         ``T_R_TCP`` (m), including the robot's base, flange and tool transforms.
     tool : array_like, shape (4, 4), optional

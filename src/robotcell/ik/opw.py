@@ -38,7 +38,7 @@ from robotcell.ik.axes import (
 )
 from robotcell.ik.limits import shift_into_interval, wrap_to_pi
 from robotcell.ik.result import REACH_TOL
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.transforms import invert, rot_y, rot_z
 
 __all__ = ["OPWParameters", "clamp_circular", "opw_fk", "opw_kernel", "opw_parameters", "opw_problems",
@@ -83,12 +83,12 @@ class OPWParameters:
     T_e_n: NDArray[np.float64]
 
 
-def opw_problems(robot: Robot) -> list[str]:
+def opw_problems(robot: Arm) -> list[str]:
     """Reasons why ``robot`` is not an ortho-parallel arm with a spherical wrist (empty if it is).
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
 
     Returns
     -------
@@ -128,7 +128,7 @@ def _pick(sign_source: float) -> float:
     return -1.0 if sign_source < -AXIS_TOL else 1.0
 
 
-def opw_parameters(robot: Robot) -> OPWParameters:
+def opw_parameters(robot: Arm) -> OPWParameters:
     """Derive the ortho-parallel parameters of a robot model.
 
     The frame O has its z axis along axis 1 (pointing to the same side as ``Z_R``), its y axis
@@ -138,7 +138,7 @@ def opw_parameters(robot: Robot) -> OPWParameters:
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         Six revolute joints: axis 1 perpendicular to axis 2, axes 2 and 3 parallel, axis 4
         perpendicular to axis 3, axes 4, 5, 6 mutually perpendicular and meeting in one point.
 

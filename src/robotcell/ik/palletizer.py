@@ -29,7 +29,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.errors import InputError
 from robotcell.ik.axes import AXIS_TOL
 from robotcell.ik.limits import wrap_to_pi
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 
 __all__ = ["PalletizerParameters", "palletizer_kernel", "palletizer_parameters", "palletizer_problems"]
 
@@ -81,7 +81,7 @@ class PalletizerParameters:
     T_e_n: NDArray[np.float64]
 
 
-def _end(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
+def _end(robot: Arm, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Pose of the last DH frame n in R at controller values ``q`` (..., 4)."""
     return robot.frames(q)[..., -1, :, :]
 
@@ -100,7 +100,7 @@ def _circle(p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
     return centre, float(np.linalg.norm(a - centre))
 
 
-def palletizer_problems(robot: Robot) -> list[str]:
+def palletizer_problems(robot: Arm) -> list[str]:
     """Why ``robot`` is not a 4-axis palletizer with a level flange (empty if it is)."""
     if robot.n_joints != 4:
         return [f"it has {robot.n_joints} controller axes, not 4"]
@@ -123,7 +123,7 @@ def palletizer_problems(robot: Robot) -> list[str]:
     return out
 
 
-def palletizer_parameters(robot: Robot) -> PalletizerParameters:
+def palletizer_parameters(robot: Arm) -> PalletizerParameters:
     """Identify the planar parameters of a palletizer from its forward kinematics.
 
     Raises

@@ -52,8 +52,8 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.opw import OPWParameters
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.track import TrackChoice, TrackRobot
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.bounds import LIMIT_TOL
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, validate_pose
 
 __all__ = ["TrackScan", "arm_manipulability", "choose_track", "manipulability", "scan_track",
@@ -146,7 +146,7 @@ class _Limits:
     2*pi-equivalent) iff ``cos(t - mid) >= cos(half)`` for ``t = sign * q + offset``, tested on
     the (cos t, sin t) pair the geometry gives, without an arctangent."""
 
-    def __init__(self, pa: OPWParameters, arm: Robot) -> None:
+    def __init__(self, pa: OPWParameters, arm: Arm) -> None:
         self.cone: dict[int, tuple[float, float, float]] = {}
         lower, upper = arm.lower, arm.upper
         # A coupled axis's limit is on the controller value, not on the model angle: left to
@@ -434,7 +434,7 @@ def manipulability(pa: OPWParameters, q: ArrayLike) -> NDArray[np.float64]:
     return n * pa.c2 * cross * np.abs(np.sin(t5))
 
 
-def arm_manipulability(arm: Robot, q: ArrayLike) -> NDArray[np.float64]:
+def arm_manipulability(arm: Arm, q: ArrayLike) -> NDArray[np.float64]:
     """``|det J|`` of an ortho-parallel ``arm`` at controller values ``q`` (..., 6) (m^3).
 
     The closed form of :func:`manipulability` on the model's joint values; for an arm with a
@@ -450,7 +450,7 @@ def arm_manipulability(arm: Robot, q: ArrayLike) -> NDArray[np.float64]:
     return manipulability(pa, c.to_model(q)) * abs(float(np.linalg.det(c.matrix)))
 
 
-def _best_valid(arm: Robot, sol: IKSolutions) -> NDArray[np.float64]:
+def _best_valid(arm: Arm, sol: IKSolutions) -> NDArray[np.float64]:
     """``|det J|`` of the best valid branch of track solutions ``(N, 8, 7)`` (0 if none).
 
     The two wrists of an arm configuration (branches ``2k``, ``2k + 1``) have the same value."""

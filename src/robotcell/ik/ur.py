@@ -42,8 +42,8 @@ from robotcell.ik.axes import (
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.ik.opw import ROUND, _controller_angle, reach_distance
 from robotcell.ik.result import REACH_TOL
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.dh import link_transform
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert
 
 __all__ = ["URParameters", "ur_fk", "ur_kernel", "ur_parameters", "ur_problems"]
@@ -82,7 +82,7 @@ class URParameters:
     T_e_n: NDArray[np.float64]
 
 
-def ur_problems(robot: Robot) -> list[str]:
+def ur_problems(robot: Arm) -> list[str]:
     """Reasons why ``robot`` is not a Universal-Robots-type arm (empty if it is)."""
     basic = six_revolute_problems(robot)
     if basic:
@@ -127,7 +127,7 @@ def ur_fk(params: URParameters, theta: NDArray[np.float64]) -> NDArray[np.float6
     return T
 
 
-def ur_parameters(robot: Robot) -> URParameters:
+def ur_parameters(robot: Arm) -> URParameters:
     """Derive the canonical UR parameters of a robot model.
 
     Frame O: z along axis 1 (its positive direction), y opposite to axis 2 (so that the canonical
