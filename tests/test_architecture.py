@@ -160,13 +160,15 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: The layers, bottom first: a module imports only modules of its own layer or of lower layers
 #: (a module belongs to the longest prefix listed). The vendor-boundary helpers of ``io`` (files,
 #: tables, pose formats) and the pose algebra sit under the kinematics, which reads model files;
+#: the pose algebra compiles its one-pose check with ``robotcell.kinematics.jit``, below it;
 #: the controller exports of ``io`` sit over the cell they export; reports of results sit with the
 #: estimators whose results they show, and with them the 3D scenes and their plotly drawing
 #: (``robotcell.view.scene``, ``.shapes``, ``.arm``, ``.plot``), which the reports will use; the
 #: view of a cell, its paths and reach maps sits over the exports. Imports inside functions
 #: count as for cycles (in the packages of :data:`LAZY_COUNTED`).
 LAYERS = [
-    {"robotcell.errors", "robotcell.kinematics.transforms", "robotcell.io.fileio",
+    {"robotcell.errors", "robotcell.kinematics.jit", "robotcell.kinematics.transforms",
+     "robotcell.io.fileio",
      "robotcell.io.tables", "robotcell.io.poseformats", "robotcell.io.yamlfile",
      "robotcell.ik.result"},
     {"robotcell.kinematics", "robotcell.ik"},

@@ -142,3 +142,27 @@ def test_input_errors():
         Robot("x", (Joint("revolute", sign=2.0),))
     with pytest.raises(InputError, match="joint 1: lower limit"):
         Robot("x", (Joint("revolute", lower=1.0, upper=0.0),))
+
+
+def test_one_pose_kernel_compiled_equals_python_and_the_batch():
+    # The chain is written once (robotcell.kinematics.dh.chain_kernel): run as Python on floats,
+    # compiled by numba for one pose, and by numpy on a batch. Compiled and Python give the same
+    # bits; the batch takes cos and sin from tan(theta/2) (SIMD), equal to rounding.
+    from robotcell.kinematics import dh
+
+    rng = np.random.default_rng(8)
+    for r in (random_standard_robot(rng), to_modified(random_standard_robot(rng))):
+        q = rng.uniform(-4, 4, 6)
+        tail = r.flange @ make_pose(p=[0.1, -0.02, 0.3])
+        python, compiled = np.empty((4, 4)), np.empty((4, 4))
+        assert dh.chain_kernel(r._chain.program, q, r.base, tail, python, None, None)
+        assert dh.CHAIN.compile()(r._chain.program, q, r.base, tail, compiled, None, None)
+        assert np.array_equal(python, compiled)
+        np.testing.assert_array_equal(r.fk(q, tool=make_pose(p=[0.1, -0.02, 0.3])), compiled)
+        np.testing.assert_allclose(r.fk(q[None], tool=make_pose(p=[0.1, -0.02, 0.3]))[0],
+                                   compiled, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(r.frames(q), r.frames(q[None])[0], rtol=0, atol=1e-14)
+        np.testing.assert_allclose(r.jacobian(q), r.jacobian(q[None])[0], rtol=0, atol=1e-14)
+        # NaN is refused by the compiled kernel as by the batch
+        assert not dh.CHAIN.call(r._chain.program, np.full(6, np.nan), r.base, tail, compiled,
+                                 None, None)

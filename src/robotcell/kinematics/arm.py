@@ -20,8 +20,8 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.dh import Chain, Convention
-from robotcell.kinematics.transforms import validate_pose
+from robotcell.kinematics.dh import CHAIN, JACOBIAN, Chain, Convention
+from robotcell.kinematics.transforms import validate_pose, validate_single_pose
 
 __all__ = ["Arm", "Joint"]
 
@@ -153,12 +153,9 @@ class Arm:
         chain = Chain(self.convention, [j.a for j in js], [j.alpha for j in js], [j.d for j in js],
                       [j.theta for j in js], [j.prismatic for j in js], [j.sign for j in js])
         object.__setattr__(self, "_chain", chain)
-        tail = self.flange @ self.tool
-        object.__setattr__(self, "_tail", tail)
-        # Start pose of the single-pose kernel, as columns; the tail is applied afterwards.
-        object.__setattr__(self, "_start_cols", [self.base[:3, k].tolist() for k in range(4)])
-        object.__setattr__(self, "_tail_cols", tail[:3, :].tolist())
-        object.__setattr__(self, "_tail_is_identity", bool(np.array_equal(tail, np.eye(4))))
+        object.__setattr__(self, "_tail", self.flange @ self.tool)
+        object.__setattr__(self, "_sign", np.array([j.sign for j in js]))
+        object.__setattr__(self, "_prismatic", np.array([j.prismatic for j in js]))
 
     # -- properties -----------------------------------------------------------------------------
     @property
@@ -223,7 +220,29 @@ class Arm:
     # -- validation -----------------------------------------------------------------------------
     def _tail_for(self, tool: ArrayLike | None) -> NDArray[np.float64]:
         """``T_n_TCP = T_n_F @ T_F_TCP`` for ``tool`` (the default tool when None), metres."""
-        return self._tail if tool is None else self.flange @ validate_pose(tool, "tool")
+        return self._tail if tool is None else self.flange @ validate_single_pose(tool, "tool")
+
+    def _one(self, q: ArrayLike) -> NDArray[np.float64] | None:
+        """The chain's joint values of one configuration ``(m,)`` (a C-contiguous float array),
+        or None when ``q`` is a batch. Not checked for NaN (the kernels do that)."""
+        if type(q) is np.ndarray:
+            if q.ndim != 1:
+                return None
+            arr = np.ascontiguousarray(q, dtype=float)
+        elif isinstance(q, (list, tuple)):
+            try:
+                arr = np.array(q, dtype=float)
+            except (TypeError, ValueError):
+                arr = self._joints(q)  # raises the error
+            if arr.ndim != 1:
+                return None
+        else:
+            return None
+        if arr.shape[0] != len(self._axes):
+            self._joints(arr)  # raises the error
+        if self.coupling is not None:
+            arr = np.array(self.coupling.to_model_list(arr.tolist()))
+        return arr
 
     def _joints(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
         try:
@@ -302,22 +321,13 @@ class Arm:
         ndarray, shape (..., 4, 4)
             Pose of the TCP in the robot base frame (metres).
         """
-        tail = self._tail_for(tool)
-        # One pose: evaluate with Python floats, much cheaper than numpy calls on tiny arrays.
-        if isinstance(q, (list, tuple)) or (isinstance(q, np.ndarray) and q.ndim == 1):
-            vals = q.tolist() if isinstance(q, np.ndarray) else [float(v) for v in q]
-            if len(vals) != self.n_joints or not math.isfinite(sum(vals)):
-                self._joints(vals)  # raises the precise error
-            if self.coupling is not None:
-                vals = self.coupling.to_model_list(vals)
-            m = self._chain.apply_one(self._start_cols, vals)
-            if tool is None and self._tail_is_identity:
-                a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
-                return np.array(
-                    (a0, b0, c0, p0, a1, b1, c1, p1, a2, b2, c2, p2, 0.0, 0.0, 0.0, 1.0)
-                ).reshape(4, 4)
-            tc = self._tail_cols if tool is None else tail[:3, :].tolist()
-            return _compose_cols(m, tc)
+        tail = self._tail if tool is None else self._tail_for(tool)
+        one = self._one(q)
+        if one is not None:
+            out = np.empty((4, 4))
+            if not CHAIN.call(self._chain.program, one, self.base, tail, out, None, None):
+                self._joints(q)  # raises: NaN or infinite values
+            return out
         arr = self.model_values(q)
         batch = arr.shape[:-1]
         T = self._chain.apply(self.base, arr.reshape(-1, len(self.joints)), tail=tail)
@@ -338,9 +348,15 @@ class Arm:
             (``m`` joints in the chain, ``m = n`` without passive joints). The flange is
             ``frames[..., m] @ robot.flange``.
         """
+        m = len(self.joints)
+        one = self._one(q)
+        if one is not None:
+            F = np.empty((m + 1, 4, 4))
+            if not self._chain.one(one, self.base, self._tail, F, frames=True):
+                self._joints(q)  # raises: NaN or infinite values
+            return F
         arr = self.model_values(q)
         batch = arr.shape[:-1]
-        m = len(self.joints)
         F = self._chain.apply(self.base, arr.reshape(-1, m), frames=True)
         return F.reshape(batch + (m + 1, 4, 4))
 
@@ -361,31 +377,18 @@ class Arm:
             velocity (rad/s) per unit velocity of each controller axis (rad/s or m/s); with a
             coupling ``J_model @ C`` (chain rule).
         """
-        F = self.frames(q)
         tail = self._tail_for(tool)
-        p_e = (F[..., -1, :, :] @ tail)[..., :3, 3]
-        # Joint i moves about Z_{i-1} (standard DH) or Z_i (modified DH).
-        axes = F[..., :-1, :, :] if self.convention == "standard" else F[..., 1:, :, :]
-        z = axes[..., :3, 2]
-        o = axes[..., :3, 3]
-        sign = np.array([j.sign for j in self.joints])[:, None]
-        pris = np.array([j.prismatic for j in self.joints])[:, None]
-        v = np.where(pris, z, np.cross(z, p_e[..., None, :] - o))
-        w = np.where(pris, 0.0, z)
-        J = np.swapaxes(np.concatenate([v * sign, w * sign], axis=-1), -1, -2)  # (..., 6, m)
+        first = 0 if self.convention == "standard" else 1
+        m = len(self.joints)
+        one = self._one(q)
+        if one is not None:
+            F = np.empty((m + 1, 4, 4))
+            if not self._chain.one(one, self.base, tail, F, frames=True):
+                self._joints(q)  # raises: NaN or infinite values
+            J = np.empty((6, m))
+            JACOBIAN.call(F, tail, first, self._sign, self._prismatic, J)
+        else:
+            arr = self.model_values(q)
+            J = self._chain.jacobian(self.base, arr.reshape(-1, m), tail, first, self._sign,
+                                     self._prismatic).reshape(arr.shape[:-1] + (6, m))
         return J if self.coupling is None else self.coupling.jacobian(J)
-
-
-def _compose_cols(m: list[float], tail: list[list[float]]) -> NDArray[np.float64]:
-    """``[[R, p], [0, 1]] @ tail`` for a chain result given as columns and a 3x4 tail."""
-    a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
-    (t00, t01, t02, t03), (t10, t11, t12, t13), (t20, t21, t22, t23) = tail
-    return np.array((
-        a0 * t00 + b0 * t10 + c0 * t20, a0 * t01 + b0 * t11 + c0 * t21,
-        a0 * t02 + b0 * t12 + c0 * t22, a0 * t03 + b0 * t13 + c0 * t23 + p0,
-        a1 * t00 + b1 * t10 + c1 * t20, a1 * t01 + b1 * t11 + c1 * t21,
-        a1 * t02 + b1 * t12 + c1 * t22, a1 * t03 + b1 * t13 + c1 * t23 + p1,
-        a2 * t00 + b2 * t10 + c2 * t20, a2 * t01 + b2 * t11 + c2 * t21,
-        a2 * t02 + b2 * t12 + c2 * t22, a2 * t03 + b2 * t13 + c2 * t23 + p2,
-        0.0, 0.0, 0.0, 1.0,
-    )).reshape(4, 4)
