@@ -50,6 +50,10 @@ class Robot(Arm):
             (rad, NaN for unreachable branches) and ``valid`` ``(..., 8)`` (reachable and within
             the joint limits).
         """
-        from robotcell.ik.analytic import solve  # the solvers load when a pose is solved
+        solver = self.__dict__.get("_ik_solver")
+        if solver is None:
+            from robotcell.ik.analytic import analytic_solver  # loads when a pose is solved
 
-        return solve(self, T, tool)
+            solver = analytic_solver(self)
+            object.__setattr__(self, "_ik_solver", solver)
+        return solver.solve(T, tool)

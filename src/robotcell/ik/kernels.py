@@ -1,0 +1,557 @@
+"""The compiled analytic IK: one scalar kernel per structure, run for one pose and for batches.
+
+Each solver is written once, for one pose, in numba's nopython mode: the ortho-parallel arm
+(:mod:`robotcell.ik.opw`, Brandstoetter et al. 2014), the Universal-Robots-type arm
+(:mod:`robotcell.ik.ur`) and the 4-axis palletizer (:mod:`robotcell.ik.palletizer`); those
+modules describe the methods and derive the parameters. :func:`solve_poses` loops over the poses
+of a batch in compiled code (a single pose is a batch of one): it moves each target into the
+solver's frame, solves every branch, applies the 2*pi rule and the joint limits of
+:class:`robotcell.ik.limits.JointFolder` and the exact-branch rule of
+:class:`robotcell.ik.result.IKSolutions`.
+
+This module is imported when a solver is built (loading numba takes about 0.3 s, the cached
+machine code about 0.3 s more; the first process after an install compiles it). It holds every
+function its kernels call and takes every tolerance as an argument (:func:`pack`): numba's cache
+notices changes of this file only.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from robotcell.kinematics.jit import NUMBA_OPTIONS
+
+__all__ = ["FOLD_CHECK", "FOLD_DOWN", "FOLD_NONE", "FOLD_UP", "METHODS", "exact_rows",
+           "fold_modes", "fold_rows", "pack", "solve_poses"]
+
+TWO_PI = 2.0 * math.pi
+#: Codes of the structures in :func:`pack`.
+METHODS = {"opw": 0, "ur": 1, "palletizer": 2}
+#: Per joint, how :func:`fold_rows` treats it: not at all (its limits hold a whole turn), fold a
+#: value above the upper limit down by 2*pi, fold a value below the lower limit up, only check.
+FOLD_NONE, FOLD_DOWN, FOLD_UP, FOLD_CHECK = 0, 1, 2, 3
+
+# Layout of the configuration array of pack(): header, tolerances, T_O_R, limits, parameters.
+_METHOD, _N, _BRANCHES, _FINISH = 0, 1, 2, 3
+_LIMIT_TOL, _REACH_TOL, _EXACT_TOL, _SINGULAR_TOL, _ROUND, _LEVEL_TOL, _COS_TOL, _AXIS_TOL = range(4, 12)
+_T_O_R = 12
+_LIMITS = 28
+
+
+def fold_modes(lower: NDArray[np.float64], upper: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The :func:`fold_rows` mode of each revolute joint with limits ``lower``, ``upper`` (rad).
+
+    The rule of :class:`robotcell.ik.limits.JointFolder`: a joint whose limits hold all of
+    ``(-pi, pi]`` needs nothing; a lower limit below ``-pi`` folds down, else an upper limit above
+    ``pi`` folds up; otherwise the value is only checked.
+    """
+    modes = np.full(len(lower), float(FOLD_CHECK))
+    for j, (lo, hi) in enumerate(zip(lower, upper)):
+        if lo <= -math.pi and hi >= math.pi:
+            modes[j] = FOLD_NONE
+        elif lo < -math.pi:
+            modes[j] = FOLD_DOWN
+        elif hi > math.pi:
+            modes[j] = FOLD_UP
+    return modes
+
+
+def pack(method: str, params: NDArray[np.float64], T_O_R: NDArray[np.float64],
+         lower: NDArray[np.float64], upper: NDArray[np.float64], modes: NDArray[np.float64],
+         finish: bool, tolerances: dict[str, float]) -> NDArray[np.float64]:
+    """The configuration array of :func:`solve_poses` for one solver.
+
+    Parameters
+    ----------
+    method : {"opw", "ur", "palletizer"}
+    params : ndarray
+        The structure's parameters in the order of its ``*_params`` (see the kernels below).
+    T_O_R : ndarray, shape (4, 4)
+        Pose of the robot base frame R in the solver's frame O (m).
+    lower, upper : ndarray, shape (n,)
+        Limits of the joint values the kernel returns (rad); with ``modes`` the 2*pi rule.
+    modes : ndarray, shape (n,)
+        :func:`fold_modes` of the limits (or :data:`FOLD_NONE` for columns not to check).
+    finish : bool
+        Fold, check the limits and keep the exact branches in :func:`solve_poses` (False when a
+        coupling maps the kernel's values first).
+    tolerances : dict
+        ``LIMIT_TOL``, ``REACH_TOL``, ``EXACT_TOL``, ``SINGULAR_TOL``, ``ROUND``, ``LEVEL_TOL``,
+        ``COS_TOL``, ``AXIS_TOL`` (rad, m): passed at run time, never frozen into the cache.
+    """
+    n = len(lower)
+    head = [METHODS[method], n, 4 if method == "palletizer" else 8, 1.0 if finish else 0.0]
+    tol = [tolerances[k] for k in ("LIMIT_TOL", "REACH_TOL", "EXACT_TOL", "SINGULAR_TOL", "ROUND",
+                                   "LEVEL_TOL", "COS_TOL", "AXIS_TOL")]
+    return np.concatenate([np.array(head + tol, dtype=float), np.ravel(T_O_R), lower, upper,
+                           modes, np.asarray(params, dtype=float)])
+
+
+# -- angles ---------------------------------------------------------------------------------------
+@njit(**NUMBA_OPTIONS)
+def _wrap(a: float) -> float:
+    """The equivalent of ``a`` in ``(-pi, pi]`` (rad), as :func:`robotcell.ik.limits.wrap_to_pi`."""
+    return a - TWO_PI * np.ceil((a - math.pi) * (1.0 / TWO_PI))
+
+
+@njit(**NUMBA_OPTIONS)
+def _angle(p, j: int, y: float, x: float) -> float:
+    """Controller value ``sign_j * (atan2(y, x) - offset_j)`` in ``(-pi, pi]`` by one atan2: the
+    pair ``(y, x)`` (any positive scale) is turned by ``-offset_j``, mirrored for sign -1.
+
+    ``p`` holds the signs, the offsets and their cosines and sines at ``p[0:6]``, ``p[6:12]``,
+    ``p[12:18]``, ``p[18:24]``.
+    """
+    if p[6 + j] != 0.0:
+        c, s = p[12 + j], p[18 + j]
+        y, x = y * c - x * s, x * c + y * s
+    return math.atan2(-y if p[j] < 0 else y, x)
+
+
+@njit(**NUMBA_OPTIONS)
+def _clamp_circular(q: float, lo: float, hi: float, tol: float) -> float:
+    """The 2*pi-equivalent of ``q`` inside ``[lo, hi]`` up to ``tol``, else the nearer limit
+    (circularly)."""
+    up = q + TWO_PI * np.ceil((lo - tol - q) * (1.0 / TWO_PI))
+    if up <= hi + tol:
+        return up
+    return lo if abs(_wrap(q - lo)) <= abs(_wrap(q - hi)) else hi
+
+
+@njit(**NUMBA_OPTIONS)
+def _excess(d: float, rnd: float) -> float:
+    """The square of an excess distance ``d`` (m), 0 up to the rounding ``rnd``."""
+    return d * d if d > rnd else 0.0
+
+
+# -- ortho-parallel arm with a spherical wrist ----------------------------------------------------
+def opw_params(a1, a2, b, c1, c2, c3, c4, signs, offsets) -> NDArray[np.float64]:
+    """Parameters of :func:`_opw` (lengths in m, signs, offsets in rad)."""
+    return np.concatenate([[a1, a2, b, c1, c2, c3, c4], _angles(signs, offsets)])
+
+
+def _angles(signs, offsets) -> NDArray[np.float64]:
+    offsets = np.asarray(offsets, dtype=float)
+    return np.concatenate([signs, offsets, np.cos(offsets), np.sin(offsets)])
+
+
+@njit(**NUMBA_OPTIONS)
+def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
+    """All 8 branches of an ortho-parallel arm for the target ``R``, ``P`` in O (see
+    :mod:`robotcell.ik.opw`): controller values into ``q`` (8, 6), NaN where the branch does not
+    reach; the wrist centre's distance outside the reach into ``err`` (8,); ``reach`` (8,).
+
+    Branch ``k = 4 * shoulder + 2 * elbow + wrist``: shoulder 1 = wrist centre behind axis 1,
+    elbow 1 = behind the line of axes 2 and 3, wrist 1 = negative paper angle t5. Where axis 1 is
+    free (wrist centre on it) it takes the reference's value (behind: + pi), else the one that puts
+    axis 6 in the arm plane, inside its limits; where axis 4 is free (wrist singularity) it keeps
+    the reference's value, else 0 of the paper.
+    """
+    a1, a2, b, c1_, c2, c3, c4 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    ang = p[7:]
+    sing, reach_tol = cfg[_SINGULAR_TOL], cfg[_REACH_TOL]
+    kappa = math.hypot(a2, c3)
+    cpsi, spsi = c3 / kappa, a2 / kappa
+    cx = P[0] - c4 * R[0][2]
+    cy = P[1] - c4 * R[1][2]
+    cz = P[2] - c4 * R[2][2]
+    rho2 = cx * cx + cy * cy
+    # Rounding of the wrist centre and of the lengths: excesses below it count as 0.
+    rnd = cfg[_ROUND] * 2 * (abs(c4) + abs(a1) + abs(b) + abs(c1_) + c2 + kappa)
+    # The wrist centre must not be nearer to axis 1 than the lateral offset |b| (Puma type).
+    err_sh = _excess(abs(b) - math.sqrt(rho2), rnd)
+    n = math.sqrt(max(rho2 - b * b, 0.0))
+    axial = rho2 < sing * sing
+    inv = 1.0 / (1.0 if axial else rho2)
+    Z = cz - c1_
+    denom = 1.0 / (2.0 * c2 * kappa)
+    base = c2 * c2 + kappa * kappa
+    q1_free = 0.0
+    if axial:
+        q1_free = ref[0] if has_ref else ang[0] * math.atan2(R[1][2], R[0][2])
+    straight_ref = ang[3] * ref[3] + ang[9] if has_ref else 0.0
+    for sh in range(2):
+        if sh == 0:
+            cs1 = (cx * n + cy * b) * inv
+            sn1 = (cy * n - cx * b) * inv
+            X = n - a1
+        else:
+            cs1 = -(cx * n - cy * b) * inv
+            sn1 = -(cy * n + cx * b) * inv
+            X = -(n + a1)
+        if axial:
+            lo1, hi1 = cfg[_LIMITS], cfg[_LIMITS + 6]
+            t1 = ang[0] * _clamp_circular(q1_free + sh * math.pi, lo1, hi1, cfg[_LIMIT_TOL]) + ang[6]
+            cs1, sn1 = math.cos(t1), math.sin(t1)
+        s_2 = X * X + Z * Z
+        s = math.sqrt(s_2)
+        # The wrist centre must lie between the folded and the stretched elbow.
+        e = math.sqrt(err_sh + _excess(max(s - (c2 + kappa), abs(c2 - kappa) - s), rnd))
+        ok = e <= reach_tol
+        K = min(max((s_2 - base) * denom, -1.0), 1.0)
+        S = math.sqrt(1.0 - K * K)
+        M00 = cs1 * R[0][0] + sn1 * R[1][0]
+        M01 = cs1 * R[0][1] + sn1 * R[1][1]
+        M02 = cs1 * R[0][2] + sn1 * R[1][2]
+        M10 = cs1 * R[1][0] - sn1 * R[0][0]
+        M11 = cs1 * R[1][1] - sn1 * R[0][1]
+        M12 = cs1 * R[1][2] - sn1 * R[0][2]
+        wz = c2 + kappa * K
+        t1q = _angle(ang, 0, sn1, cs1)
+        for el in range(2):
+            sphi = S if el == 0 else -S
+            cs3 = K * cpsi + sphi * spsi
+            sn3 = sphi * cpsi - K * spsi
+            wx = kappa * sphi
+            cu = wx * X + wz * Z
+            su = wz * X - wx * Z
+            norm = math.sqrt(s_2 * (wx * wx + wz * wz))
+            flat = norm < 1e-300
+            inv_norm = 1.0 / (1.0 if flat else norm)
+            cs2 = 1.0 if flat else cu * inv_norm
+            sn2 = su * inv_norm
+            c23 = cs2 * cs3 - sn2 * sn3
+            s23 = sn2 * cs3 + cs2 * sn3
+            r02 = c23 * M02 - s23 * R[2][2]
+            r22 = s23 * M02 + c23 * R[2][2]
+            r00 = c23 * M00 - s23 * R[2][0]
+            r01 = c23 * M01 - s23 * R[2][1]
+            h = math.sqrt(r02 * r02 + M12 * M12)
+            straight = h < sing
+            inv_h = 1.0 / (1.0 if straight else h)
+            cs4 = r02 * inv_h
+            sn4 = M12 * inv_h
+            if straight:
+                if has_ref:  # axis 4 keeps the reference's value, axis 6 takes the rest
+                    cs4, sn4 = math.cos(straight_ref), math.sin(straight_ref)
+                else:
+                    cs4 = 1.0
+            k = 4 * sh + 2 * el
+            t2q = _angle(ang, 1, sn2, cs2)
+            t3q = _angle(ang, 2, sn3, cs3)
+            n6, d6 = cs4 * M10 - sn4 * r00, cs4 * M11 - sn4 * r01
+            q[k, 0], q[k, 1], q[k, 2] = t1q, t2q, t3q
+            q[k, 3], q[k, 4], q[k, 5] = (_angle(ang, 3, sn4, cs4), _angle(ang, 4, h, r22),
+                                         _angle(ang, 5, n6, d6))
+            # The flipped wrist: t4 + pi, -t5, t6 + pi.
+            q[k + 1, 0], q[k + 1, 1], q[k + 1, 2] = t1q, t2q, t3q
+            q[k + 1, 3], q[k + 1, 4], q[k + 1, 5] = (_angle(ang, 3, -sn4, -cs4),
+                                                     _angle(ang, 4, -h, r22),
+                                                     _angle(ang, 5, -n6, -d6))
+            reach[k] = reach[k + 1] = ok
+            err[k] = err[k + 1] = e
+
+
+# -- Universal-Robots-type arm --------------------------------------------------------------------
+def ur_params(d1, a2, a3, d4, d5, d6, signs, offsets) -> NDArray[np.float64]:
+    """Parameters of :func:`_ur` (canonical lengths in m, signs, offsets in rad)."""
+    return np.concatenate([[d1, a2, a3, d4, d5, d6], _angles(signs, offsets)])
+
+
+@njit(**NUMBA_OPTIONS)
+def _free_t6(c0, c1, u0, u1, w0, w1, target, d5, rmin, rmax) -> float:
+    """Canonical t6 (rad) at the wrist singularity: nearest to ``target`` with axes 2/3 in reach.
+
+    At ``sin t5 = 0`` axis 6 is parallel to axes 2-4 and only the sum of the angles is fixed. Axis
+    6 then moves the wrist-1 point on a circle of radius ``d5`` around the planar position ``c``
+    of the wrist-2 point: ``p(t6) = c + d5 (sin t6 u + cos t6 w)`` (``u``, ``w`` the planar
+    directions of the flange's x and y axes). The planar problem of axes 2 and 3 is solvable where
+    ``rmin <= |p| <= rmax``, an arc of angles ``|theta| in [ta, tb]`` around the direction of ``c``;
+    the target angle is moved onto it (onto its nearest point to the reach when it is empty).
+    """
+    cn = math.hypot(c0, c1)
+    if not cn > 0:
+        return target
+    ex, ey = c0 / cn, c1 / cn
+    lo = (rmin * rmin - cn * cn - d5 * d5) / (2 * d5 * cn)
+    hi = (rmax * rmax - cn * cn - d5 * d5) / (2 * d5 * cn)
+    ta = math.acos(min(max(hi, -1.0), 1.0))
+    tb = math.acos(min(max(lo, -1.0), 1.0))
+    st, ct = math.sin(target), math.cos(target)
+    vx, vy = st * u0 + ct * w0, st * u1 + ct * w1
+    th = math.atan2(ex * vy - ey * vx, ex * vx + ey * vy)
+    th = (-1.0 if th < 0 else 1.0) * min(max(abs(th), ta), tb)
+    vx, vy = math.cos(th) * ex - math.sin(th) * ey, math.sin(th) * ex + math.cos(th) * ey
+    return math.atan2(vx * u0 + vy * u1, vx * w0 + vy * w1)
+
+
+@njit(**NUMBA_OPTIONS)
+def _ur(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
+    """All 8 branches of a UR-type arm for the target ``R_O_6``, ``p_O_6`` (see
+    :mod:`robotcell.ik.ur`), as :func:`_opw`. Branch ``k = 4 * shoulder + 2 * elbow + wrist``:
+    shoulder 1 = second solution of axis 1, wrist 1 = negative canonical t5, elbow 1 = negative
+    canonical t3. At the wrist singularity axis 6 is chosen nearest to the reference's (default:
+    canonical 0) among the values that keep axes 2 and 3 in reach.
+    """
+    d1, a2, a3, d4, d5, d6 = p[0], p[1], p[2], p[3], p[4], p[5]
+    ang = p[6:]
+    reach_tol = cfg[_REACH_TOL]
+    X0, X1, X2 = R[0][0], R[1][0], R[2][0]
+    Y0, Y1, Y2 = R[0][1], R[1][1], R[2][1]
+    Z0, Z1, Z2 = R[0][2], R[1][2], R[2][2]
+    p5x = P[0] - d6 * Z0
+    p5y = P[1] - d6 * Z1
+    p5z = P[2] - d6 * Z2
+    r2 = p5x * p5x + p5y * p5y
+    rmax, rmin = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
+    rnd = cfg[_ROUND] * 2 * (abs(d1) + rmax + abs(d4) + abs(d5) + abs(d6))
+    r = math.sqrt(r2)
+    # The wrist-2 point must not be nearer to axis 1 than d4.
+    err_sh = _excess(abs(d4) - r, rnd)
+    inv_r = 1.0 / (r if r2 > 0 else 1.0)
+    t = min(max(d4 * inv_r, -1.0), 1.0)
+    kk0 = math.sqrt(1.0 - t * t)
+    den3 = 1.0 / (2.0 * a2 * a3)
+    t6_ref = ang[5] * ref[5] + ang[11] if has_ref else 0.0
+    for sh in range(2):
+        kk = kk0 if sh == 0 else -kk0
+        cs1 = (p5x * kk - p5y * t) * inv_r
+        sn1 = (p5y * kk + p5x * t) * inv_r
+        t1q = _angle(ang, 0, sn1, cs1)
+        vx = X0 * sn1 - X1 * cs1
+        vy = Y0 * sn1 - Y1 * cs1
+        vz = Z0 * sn1 - Z1 * cs1
+        h = math.sqrt(vx * vx + vy * vy)
+        t6p = math.atan2(-vy, vx)
+        free6 = h < cfg[_SINGULAR_TOL]
+        for wr in range(2):
+            t6 = t6p if wr == 0 else t6p + math.pi
+            if free6:
+                target = t6_ref + wr * math.pi
+                t6 = target if d5 == 0 else _free_t6(
+                    cs1 * p5x + sn1 * p5y, p5z - d1, cs1 * X0 + sn1 * X1, X2,
+                    cs1 * Y0 + sn1 * Y1, Y2, target, d5, rmin, rmax)
+            s5 = h if wr == 0 else -h
+            c5 = vz
+            s6, c6 = math.sin(t6), math.cos(t6)
+            q5 = _angle(ang, 4, s5, c5)
+            q6 = _angle(ang, 5, s6, c6)
+            z4x, z4y, z4z = -s6 * X0 - c6 * Y0, -s6 * X1 - c6 * Y1, -s6 * X2 - c6 * Y2
+            # x4 = c5 c6 X6 - c5 s6 Y6 - s5 Z6 (c5, s5 scaled alike by the unit length of v)
+            x4x = c5 * (c6 * X0 - s6 * Y0) - s5 * Z0
+            x4y = c5 * (c6 * X1 - s6 * Y1) - s5 * Z1
+            x4z = c5 * (c6 * X2 - s6 * Y2) - s5 * Z2
+            p4x = p5x - d5 * z4x
+            p4y = p5y - d5 * z4y
+            p4z = p5z - d5 * z4z
+            px = cs1 * p4x + sn1 * p4y
+            py = p4z - d1
+            t234 = math.atan2(x4z, cs1 * x4x + sn1 * x4y)
+            pr = math.sqrt(px * px + py * py)
+            # The wrist-1 point must lie between the folded and the stretched elbow.
+            e = math.sqrt(err_sh + _excess(max(pr - rmax, rmin - pr), rnd))
+            ok = e <= reach_tol
+            D = min(max((pr * pr - a2 * a2 - a3 * a3) * den3, -1.0), 1.0)
+            S = math.sqrt(1.0 - D * D)
+            for el in range(2):
+                s3 = S if el == 0 else -S
+                wx = a2 + a3 * D
+                wy = a3 * s3
+                t2 = math.atan2(py * wx - px * wy, px * wx + py * wy)
+                t3 = math.atan2(s3, D)
+                k = 4 * sh + 2 * el + wr
+                q[k, 0] = t1q
+                q[k, 1] = _wrap((t2 - ang[7]) * ang[1])
+                q[k, 2] = _wrap((t3 - ang[8]) * ang[2])
+                q[k, 3] = _wrap((t234 - t2 - t3 - ang[9]) * ang[3])
+                q[k, 4] = q5
+                q[k, 5] = q6
+                reach[k] = ok
+                err[k] = e
+
+
+# -- 4-axis palletizer ----------------------------------------------------------------------------
+def palletizer_params(A_r, A_h, b, L2, L3, s1, s4, g22, o2, g32, g33, o3, v_n, R_n0
+                      ) -> NDArray[np.float64]:
+    """Parameters of :func:`_palletizer` (m, rad; ``v_n`` (3,), ``R_n0`` (3, 3))."""
+    return np.concatenate([[A_r, A_h, b, L2, L3, s1, s4, g22, o2, g32, g33, o3],
+                           np.ravel(v_n), np.ravel(R_n0)])
+
+
+@njit(**NUMBA_OPTIONS)
+def _palletizer(cfg, p, R, P, q, err, reach) -> None:
+    """All 4 branches of a palletizer for the target ``R_O_n``, ``p_O_n`` (see
+    :mod:`robotcell.ik.palletizer`), branch ``k = 2 * shoulder + elbow``: shoulder 1 = ``W``
+    behind axis 1, elbow 1 = the second solution of the two-link problem. A target that is not
+    level is reached by no branch; ``err`` is 0 where a branch reaches, inf where not.
+    """
+    A_r, A_h, b, L2, L3, s1, s4 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    g22, o2, g32, g33, o3 = p[7], p[8], p[9], p[10], p[11]
+    v, Rn = p[12:15], p[15:24]
+    # D = R @ R_n0.T must be Rz(psi); its entries D_ij = R_i . (R_n0)_j
+    D00 = R[0][0] * Rn[0] + R[0][1] * Rn[1] + R[0][2] * Rn[2]
+    D01 = R[0][0] * Rn[3] + R[0][1] * Rn[4] + R[0][2] * Rn[5]
+    D10 = R[1][0] * Rn[0] + R[1][1] * Rn[1] + R[1][2] * Rn[2]
+    D11 = R[1][0] * Rn[3] + R[1][1] * Rn[4] + R[1][2] * Rn[5]
+    D20 = R[2][0] * Rn[0] + R[2][1] * Rn[1] + R[2][2] * Rn[2]
+    D21 = R[2][0] * Rn[3] + R[2][1] * Rn[4] + R[2][2] * Rn[5]
+    level = abs(D20) <= cfg[_LEVEL_TOL] and abs(D21) <= cfg[_LEVEL_TOL]
+    psi = math.atan2(D10 - D01, D00 + D11)
+    wx = P[0] + (R[0][0] * v[0] + R[0][1] * v[1] + R[0][2] * v[2])
+    wy = P[1] + (R[1][0] * v[0] + R[1][1] * v[1] + R[1][2] * v[2])
+    wz = P[2] + (R[2][0] * v[0] + R[2][1] * v[1] + R[2][2] * v[2])
+    rho2 = wx * wx + wy * wy
+    n2 = rho2 - b * b
+    ok_sh = level and n2 >= -cfg[_AXIS_TOL] * cfg[_AXIS_TOL]
+    n = math.sqrt(max(n2, 0.0))
+    base = math.atan2(wy, wx)
+    h = wz - A_h
+    for sh in range(2):
+        r = n if sh == 0 else -n
+        phi1 = base - math.atan2(b, r)
+        q1 = _wrap(phi1 / s1)
+        q4 = _wrap((psi - s1 * q1) / s4)
+        tr = r - A_r
+        d2 = tr * tr + h * h
+        K = (d2 - L2 * L2 - L3 * L3) / (2.0 * L2 * L3)
+        ok = ok_sh and abs(K) <= 1.0 + cfg[_COS_TOL]
+        K = min(max(K, -1.0), 1.0)
+        S = math.sqrt(1.0 - K * K)
+        for el in range(2):
+            s = S if el == 0 else -S
+            phi2 = math.atan2(h, tr) - math.atan2(L3 * s, L2 + L3 * K)
+            phi3 = phi2 + math.atan2(s, K)
+            q2 = _wrap(phi2 - o2) / g22
+            q3 = _wrap(phi3 - o3 - g32 * q2) / g33
+            k = 2 * sh + el
+            q[k, 0], q[k, 1], q[k, 2], q[k, 3] = q1, q2, q3, q4
+            reach[k] = ok
+            err[k] = 0.0 if ok else np.inf
+
+
+# -- limits and the exact branches ----------------------------------------------------------------
+@njit(**NUMBA_OPTIONS)
+def _fold(q, modes, lower, upper, tol) -> bool:
+    """Fold the values ``q`` (n,) of one branch in place by the 2*pi rule of
+    :class:`robotcell.ik.limits.JointFolder`; whether every checked value is within its limits
+    up to ``tol`` (False for NaN; without a checked joint, whether ``q`` is not NaN)."""
+    inside = True
+    checked = False
+    for j in range(q.shape[0]):
+        mode = modes[j]
+        if mode == FOLD_NONE:
+            continue
+        checked = True
+        v, lo, hi = q[j], lower[j], upper[j]
+        if mode == FOLD_DOWN and v > hi + tol and v - TWO_PI >= lo - tol:
+            v = v - TWO_PI
+        elif mode == FOLD_UP and v < lo - tol and v + TWO_PI <= hi + tol:
+            v = v + TWO_PI
+        q[j] = v
+        if not (v >= lo - tol and v <= hi + tol):
+            inside = False
+    return inside if checked else not np.isnan(q[0])
+
+
+@njit(**NUMBA_OPTIONS)
+def _exact(valid, err, exact_tol) -> None:
+    """Keep in ``valid`` (branches,) only the exact branches when one is: a branch solved at the
+    boundary of its reach stands for the pose only when no valid branch reaches it exactly (see
+    :attr:`robotcell.ik.result.IKSolutions.reach_error`)."""
+    any_exact = False
+    for k in range(valid.shape[0]):
+        if valid[k] and err[k] <= exact_tol:
+            any_exact = True
+    if any_exact:
+        for k in range(valid.shape[0]):
+            valid[k] = valid[k] and err[k] <= exact_tol
+
+
+@njit(**NUMBA_OPTIONS)
+def fold_rows(q, modes, lower, upper, tol, inside) -> None:
+    """:func:`_fold` on every row of ``q`` (N, n) in place; ``inside`` (N,) receives the result."""
+    for i in range(q.shape[0]):
+        inside[i] = _fold(q[i], modes, lower, upper, tol)
+
+
+@njit(**NUMBA_OPTIONS)
+def exact_rows(valid, err, exact_tol) -> None:
+    """:func:`_exact` on every row of ``valid`` and ``err`` (N, branches), in place."""
+    for i in range(valid.shape[0]):
+        _exact(valid[i], err[i], exact_tol)
+
+
+# -- the loop over poses --------------------------------------------------------------------------
+@njit(**NUMBA_OPTIONS)
+def solve_poses(cfg, T, T_tcp_end, ref, q, err, reach, valid) -> None:
+    """Every branch of every target: the analytic IK of one solver (a batch or one pose).
+
+    Parameters
+    ----------
+    cfg : ndarray
+        The solver's configuration, :func:`pack`.
+    T : ndarray, shape (N, 4, 4) or (4, 4)
+        ``T_R_TCP``, target poses of the TCP in the robot base frame (m), already validated.
+    T_tcp_end : ndarray, shape (4, 4)
+        Pose of the solver's end frame in the TCP frame (m).
+    ref : ndarray, shape (N, 6) or (0, 6)
+        Reference values (rad) for free axes, per pose; none when empty.
+    q : ndarray, shape (N, branches, n) or (branches, n)
+        Receives the joint values (rad; NaN where a branch does not reach).
+    err : ndarray, shape (N, branches) or (branches,)
+        Receives the reach errors (m).
+    reach, valid : ndarray of bool, shape (N, branches) or (branches,)
+        Receive which branches reach, and (when the configuration says to finish) which are
+        within the limits and exact (see :func:`_exact`); else ``valid`` is left untouched.
+    """
+    T3 = T.reshape((-1, 4, 4))
+    nb, n = int(cfg[_BRANCHES]), int(cfg[_N])
+    q3 = q.reshape((-1, nb, n))
+    e2 = err.reshape((-1, nb))
+    r2 = reach.reshape((-1, nb))
+    va = valid.reshape((-1, nb))
+    method = cfg[_METHOD]
+    finish = cfg[_FINISH] != 0.0
+    A = cfg[_T_O_R:_T_O_R + 16].reshape((4, 4))
+    lower, upper = cfg[_LIMITS:_LIMITS + n], cfg[_LIMITS + n:_LIMITS + 2 * n]
+    modes = cfg[_LIMITS + 2 * n:_LIMITS + 3 * n]
+    p = cfg[_LIMITS + 3 * n:]
+    has_ref = ref.shape[0] > 0
+    B = T_tcp_end
+    for i in range(T3.shape[0]):
+        Ti = T3[i]
+        # R_O_end = A_rot (R_t B_rot), p_O_end = A_rot (R_t b + t) + a
+        m00 = Ti[0, 0] * B[0, 0] + Ti[0, 1] * B[1, 0] + Ti[0, 2] * B[2, 0]
+        m01 = Ti[0, 0] * B[0, 1] + Ti[0, 1] * B[1, 1] + Ti[0, 2] * B[2, 1]
+        m02 = Ti[0, 0] * B[0, 2] + Ti[0, 1] * B[1, 2] + Ti[0, 2] * B[2, 2]
+        m10 = Ti[1, 0] * B[0, 0] + Ti[1, 1] * B[1, 0] + Ti[1, 2] * B[2, 0]
+        m11 = Ti[1, 0] * B[0, 1] + Ti[1, 1] * B[1, 1] + Ti[1, 2] * B[2, 1]
+        m12 = Ti[1, 0] * B[0, 2] + Ti[1, 1] * B[1, 2] + Ti[1, 2] * B[2, 2]
+        m20 = Ti[2, 0] * B[0, 0] + Ti[2, 1] * B[1, 0] + Ti[2, 2] * B[2, 0]
+        m21 = Ti[2, 0] * B[0, 1] + Ti[2, 1] * B[1, 1] + Ti[2, 2] * B[2, 1]
+        m22 = Ti[2, 0] * B[0, 2] + Ti[2, 1] * B[1, 2] + Ti[2, 2] * B[2, 2]
+        v0 = (Ti[0, 0] * B[0, 3] + Ti[0, 1] * B[1, 3] + Ti[0, 2] * B[2, 3]) + Ti[0, 3]
+        v1 = (Ti[1, 0] * B[0, 3] + Ti[1, 1] * B[1, 3] + Ti[1, 2] * B[2, 3]) + Ti[1, 3]
+        v2 = (Ti[2, 0] * B[0, 3] + Ti[2, 1] * B[1, 3] + Ti[2, 2] * B[2, 3]) + Ti[2, 3]
+        R = ((A[0, 0] * m00 + A[0, 1] * m10 + A[0, 2] * m20,
+              A[0, 0] * m01 + A[0, 1] * m11 + A[0, 2] * m21,
+              A[0, 0] * m02 + A[0, 1] * m12 + A[0, 2] * m22),
+             (A[1, 0] * m00 + A[1, 1] * m10 + A[1, 2] * m20,
+              A[1, 0] * m01 + A[1, 1] * m11 + A[1, 2] * m21,
+              A[1, 0] * m02 + A[1, 1] * m12 + A[1, 2] * m22),
+             (A[2, 0] * m00 + A[2, 1] * m10 + A[2, 2] * m20,
+              A[2, 0] * m01 + A[2, 1] * m11 + A[2, 2] * m21,
+              A[2, 0] * m02 + A[2, 1] * m12 + A[2, 2] * m22))
+        P = ((v0 * A[0, 0] + v1 * A[0, 1] + v2 * A[0, 2]) + A[0, 3],
+             (v0 * A[1, 0] + v1 * A[1, 1] + v2 * A[1, 2]) + A[1, 3],
+             (v0 * A[2, 0] + v1 * A[2, 1] + v2 * A[2, 2]) + A[2, 3])
+        qi, ei, ri = q3[i], e2[i], r2[i]
+        refi = ref[i] if has_ref else ref[0:0].reshape(-1)
+        if method == 0.0:
+            _opw(cfg, p, R, P, refi, has_ref, qi, ei, ri)
+        elif method == 1.0:
+            _ur(cfg, p, R, P, refi, has_ref, qi, ei, ri)
+        else:
+            _palletizer(cfg, p, R, P, qi, ei, ri)
+        for k in range(nb):
+            if not ri[k]:
+                qi[k, :] = np.nan
+        if finish:
+            vi = va[i]
+            for k in range(nb):
+                vi[k] = ri[k] and _fold(qi[k], modes, lower, upper, cfg[_LIMIT_TOL])
+            _exact(vi, ei, cfg[_EXACT_TOL])
