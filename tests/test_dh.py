@@ -155,8 +155,9 @@ def test_one_pose_kernel_compiled_equals_python_and_the_batch():
         q = rng.uniform(-4, 4, 6)
         tail = r.flange @ make_pose(p=[0.1, -0.02, 0.3])
         python, compiled = np.empty((4, 4)), np.empty((4, 4))
-        assert dh.chain_kernel(r._chain.program, q, r.base, tail, python, None, None)
-        assert dh.CHAIN.compile()(r._chain.program, q, r.base, tail, compiled, None, None)
+        assert dh.chain_kernel(r._chain.program, q, r.base, dh.NO_SHIFT, tail, python, None, None)
+        assert dh.CHAIN.compile()(r._chain.program, q, r.base, dh.NO_SHIFT, tail, compiled, None,
+                                     None)
         assert np.array_equal(python, compiled)
         np.testing.assert_array_equal(r.fk(q, tool=make_pose(p=[0.1, -0.02, 0.3])), compiled)
         np.testing.assert_allclose(r.fk(q[None], tool=make_pose(p=[0.1, -0.02, 0.3]))[0],
@@ -164,5 +165,5 @@ def test_one_pose_kernel_compiled_equals_python_and_the_batch():
         np.testing.assert_allclose(r.frames(q), r.frames(q[None])[0], rtol=0, atol=1e-14)
         np.testing.assert_allclose(r.jacobian(q), r.jacobian(q[None])[0], rtol=0, atol=1e-14)
         # NaN is refused by the compiled kernel as by the batch
-        assert not dh.CHAIN.call(r._chain.program, np.full(6, np.nan), r.base, tail, compiled,
-                                 None, None)
+        assert not dh.CHAIN.call(r._chain.program, np.full(6, np.nan), r.base, dh.NO_SHIFT, tail,
+                                 compiled, None, None)

@@ -103,6 +103,7 @@ class AnalyticSolver:
         self._cfg = kernels.pack(self.method, self._packed_params(), invert(self.params.T_R_O),
                                  lower, upper, modes, coupling is None, tolerances)
         self._tcp_end = self._end(robot.tool)
+        self._last_tool: tuple[bytes | None, NDArray[np.float64]] = (None, self._tcp_end)
         self._no_ref = np.empty((0, 6))
         self._shape = (self.branches, robot.n_joints)
 
@@ -118,6 +119,17 @@ class AnalyticSolver:
     def _end(self, tool_T: NDArray[np.float64]) -> NDArray[np.float64]:
         """``T_TCP_end = inv(T_end_n @ flange @ tool)``: the solver's end frame seen from the TCP."""
         return np.ascontiguousarray(invert(self.params.T_e_n @ self.robot.flange @ tool_T))
+
+    def end(self, tool: ArrayLike | None) -> NDArray[np.float64]:
+        """:meth:`_end` of ``tool`` (``T_F_TCP``, validated; the robot's own tool when None); the
+        last tool's is kept, for a loop of single poses with one tool."""
+        if tool is None:
+            return self._tcp_end
+        arr = np.asarray(tool, dtype=float)
+        key = arr.tobytes()
+        if self._last_tool[0] != key:
+            self._last_tool = (key, self._end(validate_single_pose(arr, "tool")))
+        return self._last_tool[1]
 
     def _finish(self, q: NDArray[np.float64], reach: NDArray[np.bool_],
                 err: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -159,7 +171,7 @@ class AnalyticSolver:
             ``q`` of shape ``(..., 8, 6)`` (``(..., 4, 4)`` for a palletizer): controller values
             (rad); ``reach_error`` of shape ``(..., 8)`` (``(..., 4)``) (m).
         """
-        end = self._tcp_end if tool is None else self._end(validate_single_pose(tool, "tool"))
+        end = self.end(tool)
         if q_ref is None and type(T) is np.ndarray and T.shape == (4, 4):
             # One pose: one compiled check and one compiled solve (the per-call path).
             arr = validate_single_pose(T, "target pose")

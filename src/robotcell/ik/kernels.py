@@ -555,3 +555,433 @@ def solve_poses(cfg, T, T_tcp_end, ref, q, err, reach, valid) -> None:
             for k in range(nb):
                 vi[k] = ri[k] and _fold(qi[k], modes, lower, upper, cfg[_LIMIT_TOL])
             _exact(vi, ei, cfg[_EXACT_TOL])
+
+
+# -- the track value of an ortho-parallel arm on a linear track (robotcell.ik.trackchoice) --------
+# Layout of the track configuration of track_config().
+_TRACK_LO, _TRACK_HI, _PREFER, _SECOND, _SHRINK, _STAGES = 0, 1, 2, 3, 4, 5
+_W = 6
+_T_O_L = 9
+_CONES = 25  # axes 1, 2, 3, (4 unused), 5: (limited, cos mid, sin mid, cos half-range)
+_ROWS = 45  # number of coupled rows, then rows (axis, c1, c2, c3, constant, lower, upper)
+
+
+def track_config(lower: float, upper: float, w: NDArray[np.float64], T_O_L: NDArray[np.float64],
+                 cones: dict[int, tuple[float, float, float]],
+                 rows: list[tuple[int, NDArray[np.float64], float, float, float]],
+                 prefer_within: float, second_peak: float, refine_stages: int, refine: int
+                 ) -> NDArray[np.float64]:
+    """The track configuration of :func:`choose_poses` and :func:`scan_rows`.
+
+    Parameters
+    ----------
+    lower, upper : float
+        Track limits (m).
+    w : ndarray, shape (3,)
+        Displacement of the wrist centre in O per metre of track.
+    T_O_L : ndarray, shape (4, 4)
+        Pose of the track frame L in O at track value 0 (m).
+    cones : dict of int to (float, float, float)
+        Limits of axes 1, 2, 3, 5 (index 0, 1, 2, 4) as cones on the paper's angles:
+        ``cos(t - mid) >= cos(half)`` as ``(cos mid, sin mid, cos half)``.
+    rows : list of (int, ndarray (3,), float, float, float)
+        Coupled axes among 1..3: ``q_j = row . q_model[:3] + constant`` within ``[lower, upper]``.
+    prefer_within, second_peak : float
+        See :mod:`robotcell.ik.trackchoice`.
+    refine_stages, refine : int
+        Refinement stages and values per stage.
+    """
+    head = [lower, upper, 1.0 - prefer_within, second_peak, 2.0 / (refine - 1), refine_stages]
+    cone = np.zeros((5, 4))
+    for j, (cm, sm, ch) in cones.items():
+        cone[j] = (1.0, cm, sm, ch)
+    coupled = [[j, *row, const, lo, hi] for j, row, const, lo, hi in rows]
+    return np.concatenate([head, w, np.ravel(T_O_L), np.ravel(cone), [len(rows)],
+                           np.ravel(np.array(coupled, dtype=float))])
+
+
+@njit(**NUMBA_OPTIONS)
+def _cone(tc, j: int, c: float, s: float) -> bool:
+    """Axis ``j`` within its limits, given (cos, sin) of its paper angle (no arctangent)."""
+    i = _CONES + 4 * j
+    return tc[i] == 0.0 or c * tc[i + 1] + s * tc[i + 2] >= tc[i + 3]
+
+
+@njit(**NUMBA_OPTIONS)
+def _either_wrist(tc, c: float, h: float) -> bool:
+    """Axis 5 within its limits for ``t5`` or ``-t5`` (the two wrist flips), ``h = |sin t5|``."""
+    i = _CONES + 16
+    return tc[i] == 0.0 or c * tc[i + 1] + h * abs(tc[i + 2]) >= tc[i + 3]
+
+
+@njit(**NUMBA_OPTIONS)
+def _coupled_ok(cfg, p, tc, c1, s1, c2, s2, c3, s3) -> bool:
+    """Coupled axes among 1..3 within limits, given (cos, sin) of the paper's angles t1, t2, t3."""
+    nrows = int(tc[_ROWS])
+    if nrows == 0:
+        return True
+    qm0 = p[7] * (math.atan2(s1, c1) - p[13])
+    qm1 = p[8] * (math.atan2(s2, c2) - p[14])
+    qm2 = p[9] * (math.atan2(s3, c3) - p[15])
+    tol = cfg[_LIMIT_TOL]
+    for r in range(nrows):
+        i = _ROWS + 1 + 7 * r
+        q = tc[i + 1] * qm0 + tc[i + 2] * qm1 + tc[i + 3] * qm2 + tc[i + 4]
+        lo, hi = tc[i + 5], tc[i + 6]
+        if not np.mod(q - lo + tol, TWO_PI) <= hi - lo + 2 * tol:
+            return False
+    return True
+
+
+@njit(**NUMBA_OPTIONS)
+def _arm_constants(p):
+    """``(kappa, cos psi, sin psi, 1 / (2 c2 kappa), c2^2 + kappa^2)`` of an ortho-parallel arm."""
+    kappa = math.hypot(p[1], p[5])
+    return (kappa, p[5] / kappa, p[1] / kappa, 1.0 / (2.0 * p[4] * kappa),
+            p[4] * p[4] + kappa * kappa)
+
+
+@njit(**NUMBA_OPTIONS)
+def _manipulability_at(cfg, p, tc, k, R02, R12, R22, cx, cy, cz) -> float:
+    """Best ``|det J|`` (m^3) over the arm's branches that reach the wrist centre ``c`` (in O) with
+    axes 1, 2, 3 and 5 within their limits, for the target orientation's third column ``R_2``;
+    0 where none does (``k``: :func:`_arm_constants`). The closed form of
+    :mod:`robotcell.ik.trackchoice`."""
+    a1, b, c1_, c2 = p[0], p[2], p[3], p[4]
+    kappa, cpsi, spsi, denom, base = k
+    rho2 = cx * cx + cy * cy
+    n2 = rho2 - b * b
+    n = math.sqrt(max(n2, 0.0))
+    inv = 1.0 / max(rho2, 1e-300)
+    Z = cz - c1_
+    best = 0.0
+    for sh in range(2):
+        if sh == 0:
+            cs1, sn1, X = (cx * n + cy * b) * inv, (cy * n - cx * b) * inv, n - a1
+        else:
+            cs1, sn1, X = -(cx * n - cy * b) * inv, -(cy * n + cx * b) * inv, -(n + a1)
+        s_2 = X * X + Z * Z
+        K = (s_2 - base) * denom
+        if not (n2 >= 0 and abs(K) <= 1.0 and _cone(tc, 0, cs1, sn1)):
+            continue
+        S = math.sqrt(max(1.0 - K * K, 0.0))
+        M02 = cs1 * R02 + sn1 * R12
+        wz = c2 + kappa * K
+        kS = kappa * S
+        # Shared by both elbows (sphi = +-S): the norm of (cu, su) and the products below.
+        inv_norm = 1.0 / max(math.sqrt(s_2 * (kS * kS + wz * wz)), 1e-300)
+        kSX, kSZ = kS * X * inv_norm, kS * Z * inv_norm
+        wzX, wzZ = wz * X * inv_norm, wz * Z * inv_norm
+        Kc, Ks, Sc, Ss = K * cpsi, K * spsi, S * cpsi, S * spsi
+        nS = n * S
+        for sg in (1.0, -1.0):
+            cs2, sn2 = wzZ + sg * kSX, wzX - sg * kSZ
+            cs3, sn3 = Kc + sg * Ss, sg * Sc - Ks
+            r22 = (sn2 * cs3 + cs2 * sn3) * M02 + (cs2 * cs3 - sn2 * sn3) * R22  # cos(t5)
+            h = math.sqrt(max(1.0 - r22 * r22, 0.0))
+            if (_cone(tc, 1, cs2, sn2) and _cone(tc, 2, cs3, sn3) and _either_wrist(tc, r22, h)
+                    and _coupled_ok(cfg, p, tc, cs1, sn1, cs2, sn2, cs3, sn3)):
+                best = max(best, nS * h)
+    return best * (c2 * kappa)
+
+
+@njit(**NUMBA_OPTIONS)
+def _row_times(a0, a1, a2, a3, M):
+    """The row ``(a0, a1, a2, a3)`` times the 4x4 matrix ``M``."""
+    return (a0 * M[0, 0] + a1 * M[1, 0] + a2 * M[2, 0] + a3 * M[3, 0],
+            a0 * M[0, 1] + a1 * M[1, 1] + a2 * M[2, 1] + a3 * M[3, 1],
+            a0 * M[0, 2] + a1 * M[1, 2] + a2 * M[2, 2] + a3 * M[3, 2],
+            a0 * M[0, 3] + a1 * M[1, 3] + a2 * M[2, 3] + a3 * M[3, 3])
+
+
+@njit(**NUMBA_OPTIONS)
+def _wrist_line(cfg, tc, Ti, B):
+    """``R_O_e`` (3x3 tuple) and ``p_O_e`` at track value 0 of the target ``T_L_TCP`` ``Ti``
+    (``T_O_e = T_O_L Ti B``, ``B`` the end frame in the TCP frame), and the wrist centre there."""
+    t = tc[_T_O_L:_T_O_L + 12]
+    u0 = _row_times(t[0], t[1], t[2], t[3], Ti)
+    u1 = _row_times(t[4], t[5], t[6], t[7], Ti)
+    u2 = _row_times(t[8], t[9], t[10], t[11], Ti)
+    e0 = _row_times(u0[0], u0[1], u0[2], u0[3], B)
+    e1 = _row_times(u1[0], u1[1], u1[2], u1[3], B)
+    e2 = _row_times(u2[0], u2[1], u2[2], u2[3], B)
+    R = ((e0[0], e0[1], e0[2]), (e1[0], e1[1], e1[2]), (e2[0], e2[1], e2[2]))
+    P = (e0[3], e1[3], e2[3])
+    c4 = cfg_params(cfg)[6]
+    C = (P[0] - c4 * R[0][2], P[1] - c4 * R[1][2], P[2] - c4 * R[2][2])
+    return R, P, C
+
+
+@njit(**NUMBA_OPTIONS)
+def cfg_params(cfg):
+    """The structure's parameters in a solver configuration (:func:`pack`)."""
+    return cfg[_LIMITS + 3 * int(cfg[_N]):]
+
+
+@njit(**NUMBA_OPTIONS)
+def _interval(p, C, w0, w1, w2):
+    """Roots of ``|C + x w - S|^2 = (c2 + kappa + |a1|)^2 + b^2`` (m), NaN where the wrist
+    centre ``C`` (at track value 0, in O) never comes that close to the shoulder."""
+    D0, D1, D2 = C[0], C[1], C[2] - p[3]
+    r_max = p[4] + math.hypot(p[1], p[5]) + abs(p[0])
+    a = w0 * w0 + w1 * w1 + w2 * w2
+    half_b = D0 * w0 + D1 * w1 + D2 * w2
+    c = (D0 * D0 + D1 * D1 + D2 * D2) - (r_max * r_max + p[2] * p[2])
+    disc = half_b * half_b - a * c
+    root = math.sqrt(disc) if disc >= 0 else np.nan
+    return (-half_b - root) / a, (-half_b + root) / a
+
+
+@njit(**NUMBA_OPTIONS)
+def _scan_interval(cfg, p, tc, C):
+    """The interval of :func:`_interval` clipped to the track limits; NaN where empty."""
+    lo, hi = _interval(p, C, tc[_W], tc[_W + 1], tc[_W + 2])
+    lo, hi = np.maximum(lo, tc[_TRACK_LO]), np.minimum(hi, tc[_TRACK_HI])
+    if not lo <= hi:
+        return np.nan, np.nan
+    return lo, hi
+
+
+@njit(**NUMBA_OPTIONS)
+def _score(cfg, p, tc, k, R, C, x) -> float:
+    """:func:`_manipulability_at` at track value ``x`` (0 for NaN)."""
+    if np.isnan(x):
+        return 0.0
+    return _manipulability_at(cfg, p, tc, k, R[0][2], R[1][2], R[2][2], C[0] + tc[_W] * x,
+                              C[1] + tc[_W + 1] * x, C[2] + tc[_W + 2] * x)
+
+
+@njit(**NUMBA_OPTIONS)
+def _argmax(a, n: int) -> int:
+    """``np.argmax(a[:n])``: the first maximum, or the first NaN."""
+    k = 0
+    for i in range(n):
+        if np.isnan(a[i]):
+            return i
+        if a[i] > a[k]:
+            k = i
+    return k
+
+
+@njit(**NUMBA_OPTIONS)
+def _refine(cfg, p, tc, k, R, C, centre, half, lo, hi, lin_f, xs, ms, at) -> None:
+    """Grids of ``len(lin_f)`` values around ``centre``, +-``half``, shrinking around the best for
+    each stage; every value tried and its score into ``xs``, ``ms`` from index ``at``."""
+    nf = lin_f.shape[0]
+    for stage in range(int(tc[_STAGES])):
+        i0 = at + stage * nf
+        for j in range(nf):
+            f = np.minimum(np.maximum(centre + half * lin_f[j], lo), hi)
+            if np.isnan(f):
+                f = centre
+            xs[i0 + j] = f
+            ms[i0 + j] = _score(cfg, p, tc, k, R, C, f)
+        centre = xs[i0 + _argmax(ms[i0:], nf)]
+        half = half * tc[_SHRINK]
+
+
+@njit(**NUMBA_OPTIONS)
+def _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer, prefer, xs, ms):
+    """The track value of one target and whether the scan found one where the arm reaches it
+    (see :func:`robotcell.ik.trackchoice.choose_track`); ``xs``, ``ms`` are scratch."""
+    lo, hi = _scan_interval(cfg, p, tc, C)
+    ac = _arm_constants(p)
+    K = lin_c.shape[0]
+    for k in range(K):
+        xs[k] = lo + (hi - lo) * lin_c[k]
+        ms[k] = _score(cfg, p, tc, ac, R, C, xs[k])
+    step = (hi - lo) / (K - 1)
+    if np.isnan(step):
+        step = 0.0
+    k1 = _argmax(ms, K)
+    # A second peak: the best local maximum outside the first's neighbours, refined only where
+    # it comes within SECOND_PEAK of the first (a second mode that could win after refinement).
+    k2, m2 = 0, -1.0
+    for k in range(K):
+        left = ms[k - 1] if k > 0 else -1.0
+        right = ms[k + 1] if k < K - 1 else -1.0
+        if ms[k] >= left and ms[k] >= right and abs(k - k1) > 1 and ms[k] > m2:
+            k2, m2 = k, ms[k]
+    nr = int(tc[_STAGES]) * lin_f.shape[0]
+    c1 = xs[k1] if not np.isnan(xs[k1]) else 0.0
+    _refine(cfg, p, tc, ac, R, C, c1, step, lo, hi, lin_f, xs, ms, K)
+    total = K + nr
+    if m2 >= tc[_SECOND] * ms[k1]:
+        c2 = xs[k2] if not np.isnan(xs[k2]) else 0.0
+        _refine(cfg, p, tc, ac, R, C, c2, step, lo, hi, lin_f, xs, ms, total)
+    else:
+        for i in range(total, total + nr):
+            xs[i], ms[i] = np.nan, -1.0
+    total += nr
+    best = ms[_argmax(ms, total)]
+    if has_prefer:
+        # the value nearest to the preferred one among those within PREFER_WITHIN of the best
+        k, dk = 0, np.inf
+        for i in range(total):
+            d = abs(xs[i] - prefer) if ms[i] >= tc[_PREFER] * best else np.inf
+            if np.isnan(d):
+                k = i
+                break
+            if d < dk:
+                k, dk = i, d
+        x = xs[k]
+    else:
+        x = xs[_argmax(ms, total)]
+    found = best > 0
+    if not found and not np.isnan(lo):
+        # Nothing found on the scan although the interval is not empty: look again on a denser
+        # grid (a window of reach narrower than one step, or truly out of reach).
+        md, xd = -1.0, np.nan
+        for j in range(lin_d.shape[0]):
+            xj = lo + (hi - lo) * lin_d[j]
+            mj = _score(cfg, p, tc, ac, R, C, xj)
+            if mj > md:
+                md, xd = mj, xj
+        if md > 0:
+            x, found = xd, True
+    if not found:  # out of reach at every track value, or not within the limits of axes 1-3, 5
+        x = lo if not np.isnan(lo) else tc[_TRACK_LO]
+    return x, found
+
+
+@njit(**NUMBA_OPTIONS)
+def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q, err, reach,
+                 valid, manipulability) -> int:
+    """The track value of every target, and (for an arm without coupling) its branches there.
+
+    Parameters
+    ----------
+    cfg : ndarray
+        The arm's solver configuration (:func:`pack`, an ortho-parallel arm).
+    tc : ndarray
+        :func:`track_config`.
+    T : ndarray, shape (N, 4, 4)
+        ``T_L_TCP``, targets in the track frame (m), validated.
+    T_tcp_end : ndarray, shape (4, 4)
+        The solver's end frame seen from the TCP (m).
+    lin_c, lin_f, lin_d : ndarray
+        ``np.linspace`` of the coarse scan (0..1), of a refinement stage (-1..1) and of the dense
+        second look (0..1).
+    prefer : ndarray, shape (N,) or (0,)
+        Preferred track values (m), or none.
+    x : ndarray, shape (N,)
+        Receives the chosen track values (m).
+    found : ndarray of bool, shape (N,)
+        Receives whether the scan found a value where the arm reaches the target.
+    q, err, reach, valid : ndarray, shape (N, 8, 7), (N, 8), (N, 8), (N, 8)
+        Receive the branches at the chosen values (track value first; finished as by
+        :func:`solve_poses`) when the configuration finishes (an arm without coupling); else
+        untouched.
+    manipulability : ndarray, shape (N,)
+        Receives, with the branches, ``|det J|`` of the best valid one (:func:`best_valid_rows`).
+
+    Returns
+    -------
+    int
+        With the branches: how many targets the scan found but no branch there is valid (a limit
+        of axis 4 or 6), to be searched again; else 0.
+    """
+    p = cfg_params(cfg)
+    finish = cfg[_FINISH] != 0.0
+    has_prefer = prefer.shape[0] > 0
+    nbuf = lin_c.shape[0] + 2 * int(tc[_STAGES]) * lin_f.shape[0]
+    xs, ms = np.empty(nbuf), np.empty(nbuf)
+    lower, upper = cfg[_LIMITS:_LIMITS + 6], cfg[_LIMITS + 6:_LIMITS + 12]
+    modes = cfg[_LIMITS + 12:_LIMITS + 18]
+    no_ref = np.empty(0)
+    again = 0
+    for i in range(T.shape[0]):
+        R, P, C = _wrist_line(cfg, tc, T[i], T_tcp_end)
+        xi, fi = _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer,
+                         prefer[i] if has_prefer else 0.0, xs, ms)
+        x[i], found[i] = xi, fi
+        if not finish:
+            continue
+        Px = (P[0] + tc[_W] * xi, P[1] + tc[_W + 1] * xi, P[2] + tc[_W + 2] * xi)
+        qi = q[i]
+        _opw(cfg, p, R, Px, no_ref, False, qi[:, 1:], err[i], reach[i])
+        for k in range(8):
+            qi[k, 0] = xi
+            if not reach[i, k]:
+                qi[k, 1:] = np.nan
+            valid[i, k] = reach[i, k] and _fold(qi[k, 1:], modes, lower, upper, cfg[_LIMIT_TOL])
+        _exact(valid[i], err[i], cfg[_EXACT_TOL])
+        manipulability[i] = _best_valid(p, qi, valid[i])
+        if fi and not valid[i].any():
+            again += 1
+    return again
+
+
+@njit(**NUMBA_OPTIONS)
+def scan_rows(cfg, tc, T, T_tcp_end, lin, x, m, lower, upper) -> None:
+    """Manipulability of every target ``T_L_TCP`` (N, 4, 4) on the track values ``lin`` (K,)
+    of its interval into ``x``, ``m`` (N, K) (m, m^3), the interval into ``lower``, ``upper``."""
+    p = cfg_params(cfg)
+    ac = _arm_constants(p)
+    for i in range(T.shape[0]):
+        R, _, C = _wrist_line(cfg, tc, T[i], T_tcp_end)
+        lo, hi = _scan_interval(cfg, p, tc, C)
+        lower[i], upper[i] = lo, hi
+        for k in range(lin.shape[0]):
+            x[i, k] = lo + (hi - lo) * lin[k]
+            m[i, k] = _score(cfg, p, tc, ac, R, C, x[i, k])
+
+
+@njit(**NUMBA_OPTIONS)
+def wrist_rows(cfg, tc, T, T_tcp_end, R, C) -> None:
+    """``R_O_e`` (N, 3, 3) and the wrist centre (N, 3) in O at track value 0 of targets ``T``."""
+    for i in range(T.shape[0]):
+        Ri, _, Ci = _wrist_line(cfg, tc, T[i], T_tcp_end)
+        for r in range(3):
+            C[i, r] = Ci[r]
+            for c in range(3):
+                R[i, r, c] = Ri[r][c]
+
+
+@njit(**NUMBA_OPTIONS)
+def interval_rows(p, C, w, lower, upper) -> None:
+    """:func:`_interval` of wrist centres ``C`` (N, 3) moving along ``w`` (3,)."""
+    for i in range(C.shape[0]):
+        lower[i], upper[i] = _interval(p, (C[i, 0], C[i, 1], C[i, 2]), w[0], w[1], w[2])
+
+
+@njit(**NUMBA_OPTIONS)
+def _det_j(p, q) -> float:
+    """``|det J|`` of an ortho-parallel arm at controller values ``q`` (6,) in closed form (m^3):
+    ``n * c2 * kappa * |sin(gamma)| * |sin(t5)|`` (see :mod:`robotcell.ik.trackchoice`)."""
+    t2 = q[1] * p[8] + p[14]
+    t23 = t2 + (q[2] * p[9] + p[15])
+    t5 = q[4] * p[11] + p[17]
+    a1, a2, c2, c3 = p[0], p[1], p[4], p[5]
+    fx = a2 * math.cos(t23) + c3 * math.sin(t23)  # axis 3 to the wrist centre, in the plane
+    fz = c3 * math.cos(t23) - a2 * math.sin(t23)
+    n = abs(a1 + c2 * math.sin(t2) + fx)
+    cross = abs(math.sin(t2) * fz - math.cos(t2) * fx)  # kappa * |sin(gamma)|
+    return n * c2 * cross * abs(math.sin(t5))
+
+
+@njit(**NUMBA_OPTIONS)
+def manipulability_rows(p, q, out) -> None:
+    """:func:`_det_j` of every row of ``q`` (N, 6) into ``out`` (N,); NaN gives NaN."""
+    for i in range(q.shape[0]):
+        out[i] = _det_j(p, q[i])
+
+
+@njit(**NUMBA_OPTIONS)
+def _best_valid(p, q, valid) -> float:
+    """``|det J|`` of the best valid branch of the track solutions ``q`` (8, 7) of one target (0 if
+    none): the two wrists of an arm configuration (branches 2k, 2k + 1) have the same value."""
+    best = 0.0
+    for k in range(0, 8, 2):
+        if valid[k] or valid[k + 1]:
+            m = _det_j(p, q[k, 1:])
+            if not np.isnan(m):
+                best = max(best, m)
+    return best
+
+
+@njit(**NUMBA_OPTIONS)
+def best_valid_rows(p, q, valid, out) -> None:
+    """:func:`_best_valid` of every target: ``q`` (N, 8, 7), ``valid`` (N, 8), ``out`` (N,)."""
+    for i in range(q.shape[0]):
+        out[i] = _best_valid(p, q[i], valid[i])

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.dh import CHAIN, JACOBIAN, Chain, Convention
+from robotcell.kinematics.dh import CHAIN, JACOBIAN, NO_SHIFT, Chain, Convention
 from robotcell.kinematics.transforms import validate_pose, validate_single_pose
 
 __all__ = ["Arm", "Joint"]
@@ -219,8 +219,17 @@ class Arm:
 
     # -- validation -----------------------------------------------------------------------------
     def _tail_for(self, tool: ArrayLike | None) -> NDArray[np.float64]:
-        """``T_n_TCP = T_n_F @ T_F_TCP`` for ``tool`` (the default tool when None), metres."""
-        return self._tail if tool is None else self.flange @ validate_single_pose(tool, "tool")
+        """``T_n_TCP = T_n_F @ T_F_TCP`` for ``tool`` (the default tool when None), metres; the
+        last tool's is kept, for a loop of single poses with one tool."""
+        if tool is None:
+            return self._tail
+        arr = np.asarray(tool, dtype=float)
+        key = arr.tobytes()
+        last = self.__dict__.get("_last_tail")
+        if last is None or last[0] != key:
+            last = (key, self.flange @ validate_single_pose(arr, "tool"))
+            object.__setattr__(self, "_last_tail", last)
+        return last[1]
 
     def _one(self, q: ArrayLike) -> NDArray[np.float64] | None:
         """The chain's joint values of one configuration ``(m,)`` (a C-contiguous float array),
@@ -321,16 +330,42 @@ class Arm:
         ndarray, shape (..., 4, 4)
             Pose of the TCP in the robot base frame (metres).
         """
+        return self.fk_from(self.base, q, tool)
+
+    def fk_from(self, T_X_0: NDArray[np.float64], q: ArrayLike, tool: ArrayLike | None = None,
+                shift: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """Forward kinematics from a given pose of DH frame 0: ``T_X_TCP``.
+
+        The chain starts at ``T_X_0`` (``fk`` is ``fk_from(base, q)``): a cell places the robot's
+        frame 0 in the world, on a track, without one more product of poses.
+
+        Parameters
+        ----------
+        T_X_0 : ndarray, shape (4, 4)
+            Pose of DH frame 0 in a frame X (metres), a valid rigid transform (not checked).
+        q : array_like, shape (..., n)
+            Joint values (rad, m).
+        tool : array_like, shape (4, 4), optional
+            ``T_F_TCP`` to use instead of the robot's default tool (metres).
+        shift : ndarray, shape (3,), optional
+            Added to the translation of ``T_X_0`` (metres, in X): a linear track's motion.
+
+        Returns
+        -------
+        ndarray, shape (..., 4, 4)
+            Pose of the TCP in X (metres).
+        """
         tail = self._tail if tool is None else self._tail_for(tool)
         one = self._one(q)
         if one is not None:
             out = np.empty((4, 4))
-            if not CHAIN.call(self._chain.program, one, self.base, tail, out, None, None):
+            if not CHAIN.call(self._chain.program, one, T_X_0, NO_SHIFT if shift is None else shift,
+                              tail, out, None, None):
                 self._joints(q)  # raises: NaN or infinite values
             return out
         arr = self.model_values(q)
         batch = arr.shape[:-1]
-        T = self._chain.apply(self.base, arr.reshape(-1, len(self.joints)), tail=tail)
+        T = self._chain.apply(T_X_0, arr.reshape(-1, len(self.joints)), tail=tail, shift=shift)
         return T.reshape(batch + (4, 4))
 
     def frames(self, q: ArrayLike) -> NDArray[np.float64]:

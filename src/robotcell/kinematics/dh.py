@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.kinematics.jit import Kernel
 
-__all__ = ["Chain", "link_transform"]
+__all__ = ["CHAIN", "JACOBIAN", "NO_SHIFT", "Chain", "chain_kernel", "jacobian_kernel", "link_transform"]
 
 Convention = Literal["standard", "modified"]
 _HALF_PI = math.pi / 2
@@ -149,7 +149,8 @@ class Chain:
 
     # -- batched ------------------------------------------------------------------------------
     def apply(self, start: NDArray[np.float64], q: NDArray[np.float64], frames: bool = False,
-              tail: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+              tail: NDArray[np.float64] | None = None,
+              shift: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """Evaluate ``start @ T_0_n(q) @ tail`` for a batch.
 
         Parameters
@@ -162,20 +163,23 @@ class Chain:
             If True return every frame ``start @ T_0_i`` for ``i = 0..n`` (``tail`` is ignored).
         tail : ndarray, shape (4, 4), optional
             Constant pose appended after the last link (e.g. flange and tool).
+        shift : ndarray, shape (3,), optional
+            Added to the translation of ``start`` (m).
 
         Returns
         -------
         ndarray, shape (N, 4, 4), or (N, n + 1, 4, 4) when ``frames``.
         """
         N = q.shape[0]
+        shift = NO_SHIFT if shift is None else shift
         out = np.empty((N, self.n + 1, 4, 4) if frames else (N, 4, 4))
         ends = self.frame_ends if frames else None
         tail = _IDENTITY if tail is None else tail
         for lo in range(0, N, _BLOCK):
             hi = min(lo + _BLOCK, N)
             qT = q[lo:hi].T
-            chain_kernel(self.program, qT, start, tail, np.moveaxis(out[lo:hi], 0, -1), ends,
-                         self._cos_sin(qT))
+            chain_kernel(self.program, qT, start, shift, tail, np.moveaxis(out[lo:hi], 0, -1),
+                         ends, self._cos_sin(qT))
         return out
 
     def _cos_sin(self, qT: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -214,7 +218,8 @@ class Chain:
             hi = min(lo + _BLOCK, N)
             qT = q[lo:hi].T
             Fb = np.moveaxis(F[:hi - lo], 0, -1)
-            chain_kernel(self.program, qT, start, tail, Fb, self.frame_ends, self._cos_sin(qT))
+            chain_kernel(self.program, qT, start, NO_SHIFT, tail, Fb, self.frame_ends,
+                         self._cos_sin(qT))
             jacobian_kernel(Fb, tail, first, sign, prismatic, np.moveaxis(out[lo:hi], 0, -1))
         return out
 
@@ -238,15 +243,18 @@ class Chain:
         bool
             False (and ``out`` undefined) when ``q`` holds NaN or an infinite value.
         """
-        return CHAIN.call(self.program, q, start, tail, out,
+        return CHAIN.call(self.program, q, start, NO_SHIFT, tail, out,
                           self.frame_ends if frames else None, None)
 
 
 _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
+#: The ``shift`` of a chain that does not move (read-only).
+NO_SHIFT = np.zeros(3)
+NO_SHIFT.setflags(write=False)
 
 
-def chain_kernel(program, q, start, tail, out, ends, cs) -> bool:
+def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
     """``start @ T_0_n(q) @ tail``, or every frame, on a batch or on one pose.
 
     The one implementation of the chain: run by numpy on a batch (each variable below is then an
@@ -263,6 +271,8 @@ def chain_kernel(program, q, start, tail, out, ends, cs) -> bool:
         Joint values (rad, m) of one pose, or of N poses, one row per joint.
     start, tail : ndarray, shape (4, 4)
         Constant poses before and after the chain (``tail`` unused when ``ends`` is given).
+    shift : ndarray, shape (3,)
+        Added to the translation of ``start`` (m): a linear track's motion; zeros for none.
     out : ndarray, shape (4, 4) or (4, 4, N); with ``ends``: (n + 1, 4, 4) or (n + 1, 4, 4, N)
         Receives the pose, or the frames ``start @ T_0_i`` (a batch on the last axis, as ``q``).
     ends : ndarray of int, shape (n,), or None
@@ -280,9 +290,9 @@ def chain_kernel(program, q, start, tail, out, ends, cs) -> bool:
         for j in range(q.shape[0]):
             if not math.isfinite(q[j]):
                 return False
-    a0, b0, c0, p0 = start[0, 0], start[0, 1], start[0, 2], start[0, 3]
-    a1, b1, c1, p1 = start[1, 0], start[1, 1], start[1, 2], start[1, 3]
-    a2, b2, c2, p2 = start[2, 0], start[2, 1], start[2, 2], start[2, 3]
+    a0, b0, c0, p0 = start[0, 0], start[0, 1], start[0, 2], start[0, 3] + shift[0]
+    a1, b1, c1, p1 = start[1, 0], start[1, 1], start[1, 2], start[1, 3] + shift[1]
+    a2, b2, c2, p2 = start[2, 0], start[2, 1], start[2, 2], start[2, 3] + shift[2]
     f = 0
     r = 0
     for k in range(program.shape[0] + 1):

@@ -6,6 +6,8 @@ from b to a (see ``docs/conventions.md``). Lengths are in metres, angles in radi
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -35,6 +37,10 @@ POSE_TOL = 1e-6
 def finite_array(x: ArrayLike, name: str) -> NDArray[np.float64]:
     """``x`` as a float array, or an :class:`InputError` naming ``name`` if it is not numeric
     or holds NaN or infinite values."""
+    if isinstance(x, (float, int)) and not isinstance(x, bool):  # one number: no numpy reduction
+        if not math.isfinite(x):
+            raise InputError(f"{name} contains NaN or infinite values")
+        return np.array(x, dtype=float)
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError) as exc:
