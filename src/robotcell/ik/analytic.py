@@ -196,8 +196,9 @@ class AnalyticSolver:
         err = np.empty((N, self.branches))
         reach = np.empty((N, self.branches), dtype=bool)
         valid = np.empty((N, self.branches), dtype=bool)
-        self._kernels.solve_poses(self._cfg, flat, end, np.ascontiguousarray(ref), q, err, reach,
-                                  valid)
+        self._kernels.solve_poses(self._cfg, flat.reshape(-1, 4), end, np.ascontiguousarray(ref),
+                                  q.reshape(-1, q.shape[-1]), err.reshape(-1), reach.reshape(-1),
+                                  valid.reshape(-1))
         if self.robot.coupling is not None:
             valid = self._finish(q, reach, err)
         nb = (self.branches,)

@@ -99,17 +99,13 @@ def _wrap(a: float) -> float:
 
 
 @njit(**NUMBA_OPTIONS)
-def _angle(p, j: int, y: float, x: float) -> float:
-    """Controller value ``sign_j * (atan2(y, x) - offset_j)`` in ``(-pi, pi]`` by one atan2: the
-    pair ``(y, x)`` (any positive scale) is turned by ``-offset_j``, mirrored for sign -1.
-
-    ``p`` holds the signs, the offsets and their cosines and sines at ``p[0:6]``, ``p[6:12]``,
-    ``p[12:18]``, ``p[18:24]``.
-    """
-    if p[6 + j] != 0.0:
-        c, s = p[12 + j], p[18 + j]
+def _angle(sign: float, offset: float, c: float, s: float, y: float, x: float) -> float:
+    """Controller value ``sign * (atan2(y, x) - offset)`` in ``(-pi, pi]`` by one atan2: the pair
+    ``(y, x)`` (any positive scale) is turned by ``-offset`` (``c``, ``s`` its cosine and sine),
+    mirrored for sign -1."""
+    if offset != 0.0:
         y, x = y * c - x * s, x * c + y * s
-    return math.atan2(-y if p[j] < 0 else y, x)
+    return math.atan2(-y if sign < 0 else y, x)
 
 
 @njit(**NUMBA_OPTIONS)
@@ -201,7 +197,7 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
         M11 = cs1 * R[1][1] - sn1 * R[0][1]
         M12 = cs1 * R[1][2] - sn1 * R[0][2]
         wz = c2 + kappa * K
-        t1q = _angle(ang, 0, sn1, cs1)
+        t1q = _angle(ang[0], ang[6], ang[12], ang[18], sn1, cs1)
         for el in range(2):
             sphi = S if el == 0 else -S
             cs3 = K * cpsi + sphi * spsi
@@ -231,17 +227,18 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
                 else:
                     cs4 = 1.0
             k = 4 * sh + 2 * el
-            t2q = _angle(ang, 1, sn2, cs2)
-            t3q = _angle(ang, 2, sn3, cs3)
+            t2q = _angle(ang[1], ang[7], ang[13], ang[19], sn2, cs2)
+            t3q = _angle(ang[2], ang[8], ang[14], ang[20], sn3, cs3)
             n6, d6 = cs4 * M10 - sn4 * r00, cs4 * M11 - sn4 * r01
             q[k, 0], q[k, 1], q[k, 2] = t1q, t2q, t3q
-            q[k, 3], q[k, 4], q[k, 5] = (_angle(ang, 3, sn4, cs4), _angle(ang, 4, h, r22),
-                                         _angle(ang, 5, n6, d6))
+            q[k, 3] = _angle(ang[3], ang[9], ang[15], ang[21], sn4, cs4)
+            q[k, 4] = _angle(ang[4], ang[10], ang[16], ang[22], h, r22)
+            q[k, 5] = _angle(ang[5], ang[11], ang[17], ang[23], n6, d6)
             # The flipped wrist: t4 + pi, -t5, t6 + pi.
             q[k + 1, 0], q[k + 1, 1], q[k + 1, 2] = t1q, t2q, t3q
-            q[k + 1, 3], q[k + 1, 4], q[k + 1, 5] = (_angle(ang, 3, -sn4, -cs4),
-                                                     _angle(ang, 4, -h, r22),
-                                                     _angle(ang, 5, -n6, -d6))
+            q[k + 1, 3] = _angle(ang[3], ang[9], ang[15], ang[21], -sn4, -cs4)
+            q[k + 1, 4] = _angle(ang[4], ang[10], ang[16], ang[22], -h, r22)
+            q[k + 1, 5] = _angle(ang[5], ang[11], ang[17], ang[23], -n6, -d6)
             reach[k] = reach[k + 1] = ok
             err[k] = err[k + 1] = e
 
@@ -311,7 +308,7 @@ def _ur(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
         kk = kk0 if sh == 0 else -kk0
         cs1 = (p5x * kk - p5y * t) * inv_r
         sn1 = (p5y * kk + p5x * t) * inv_r
-        t1q = _angle(ang, 0, sn1, cs1)
+        t1q = _angle(ang[0], ang[6], ang[12], ang[18], sn1, cs1)
         vx = X0 * sn1 - X1 * cs1
         vy = Y0 * sn1 - Y1 * cs1
         vz = Z0 * sn1 - Z1 * cs1
@@ -328,8 +325,8 @@ def _ur(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
             s5 = h if wr == 0 else -h
             c5 = vz
             s6, c6 = math.sin(t6), math.cos(t6)
-            q5 = _angle(ang, 4, s5, c5)
-            q6 = _angle(ang, 5, s6, c6)
+            q5 = _angle(ang[4], ang[10], ang[16], ang[22], s5, c5)
+            q6 = _angle(ang[5], ang[11], ang[17], ang[23], s6, c6)
             z4x, z4y, z4z = -s6 * X0 - c6 * Y0, -s6 * X1 - c6 * Y1, -s6 * X2 - c6 * Y2
             # x4 = c5 c6 X6 - c5 s6 Y6 - s5 Z6 (c5, s5 scaled alike by the unit length of v)
             x4x = c5 * (c6 * X0 - s6 * Y0) - s5 * Z0
@@ -484,19 +481,22 @@ def solve_poses(cfg, T, T_tcp_end, ref, q, err, reach, valid) -> None:
     ----------
     cfg : ndarray
         The solver's configuration, :func:`pack`.
-    T : ndarray, shape (N, 4, 4) or (4, 4)
-        ``T_R_TCP``, target poses of the TCP in the robot base frame (m), already validated.
+    T : ndarray, shape (4 N, 4)
+        ``T_R_TCP``, target poses of the TCP in the robot base frame (m), already validated,
+        stacked (one pose is a (4, 4) array as it is; a batch ``(N, 4, 4)`` reshaped).
     T_tcp_end : ndarray, shape (4, 4)
         Pose of the solver's end frame in the TCP frame (m).
     ref : ndarray, shape (N, 6) or (0, 6)
         Reference values (rad) for free axes, per pose; none when empty.
-    q : ndarray, shape (N, branches, n) or (branches, n)
+    q : ndarray, shape (N branches, n)
         Receives the joint values (rad; NaN where a branch does not reach).
-    err : ndarray, shape (N, branches) or (branches,)
+    err : ndarray, shape (N branches,)
         Receives the reach errors (m).
-    reach, valid : ndarray of bool, shape (N, branches) or (branches,)
+    reach, valid : ndarray of bool, shape (N branches,)
         Receive which branches reach, and (when the configuration says to finish) which are
         within the limits and exact (see :func:`_exact`); else ``valid`` is left untouched.
+
+    One pose and a batch pass arrays of the same types, so that numba compiles this once.
     """
     T3 = T.reshape((-1, 4, 4))
     nb, n = int(cfg[_BRANCHES]), int(cfg[_N])
@@ -601,17 +601,16 @@ def track_config(lower: float, upper: float, w: NDArray[np.float64], T_O_L: NDAr
 
 
 @njit(**NUMBA_OPTIONS)
-def _cone(tc, j: int, c: float, s: float) -> bool:
-    """Axis ``j`` within its limits, given (cos, sin) of its paper angle (no arctangent)."""
-    i = _CONES + 4 * j
-    return tc[i] == 0.0 or c * tc[i + 1] + s * tc[i + 2] >= tc[i + 3]
+def _cone(cone, c: float, s: float) -> bool:
+    """An axis within its limits, given (cos, sin) of its paper angle (no arctangent): ``cone``
+    is ``(limited, cos mid, sin mid, cos half)`` of :func:`track_config`."""
+    return cone[0] == 0.0 or c * cone[1] + s * cone[2] >= cone[3]
 
 
 @njit(**NUMBA_OPTIONS)
-def _either_wrist(tc, c: float, h: float) -> bool:
+def _either_wrist(cone, c: float, h: float) -> bool:
     """Axis 5 within its limits for ``t5`` or ``-t5`` (the two wrist flips), ``h = |sin t5|``."""
-    i = _CONES + 16
-    return tc[i] == 0.0 or c * tc[i + 1] + h * abs(tc[i + 2]) >= tc[i + 3]
+    return cone[0] == 0.0 or c * cone[1] + h * abs(cone[2]) >= cone[3]
 
 
 @njit(**NUMBA_OPTIONS)
@@ -662,7 +661,7 @@ def _manipulability_at(cfg, p, tc, k, R02, R12, R22, cx, cy, cz) -> float:
             cs1, sn1, X = -(cx * n - cy * b) * inv, -(cy * n + cx * b) * inv, -(n + a1)
         s_2 = X * X + Z * Z
         K = (s_2 - base) * denom
-        if not (n2 >= 0 and abs(K) <= 1.0 and _cone(tc, 0, cs1, sn1)):
+        if not (n2 >= 0 and abs(K) <= 1.0 and _cone(tc[_CONES:_CONES + 4], cs1, sn1)):
             continue
         S = math.sqrt(max(1.0 - K * K, 0.0))
         M02 = cs1 * R02 + sn1 * R12
@@ -679,7 +678,8 @@ def _manipulability_at(cfg, p, tc, k, R02, R12, R22, cx, cy, cz) -> float:
             cs3, sn3 = Kc + sg * Ss, sg * Sc - Ks
             r22 = (sn2 * cs3 + cs2 * sn3) * M02 + (cs2 * cs3 - sn2 * sn3) * R22  # cos(t5)
             h = math.sqrt(max(1.0 - r22 * r22, 0.0))
-            if (_cone(tc, 1, cs2, sn2) and _cone(tc, 2, cs3, sn3) and _either_wrist(tc, r22, h)
+            if (_cone(tc[_CONES + 4:_CONES + 8], cs2, sn2) and _cone(tc[_CONES + 8:_CONES + 12], cs3, sn3)
+                    and _either_wrist(tc[_CONES + 16:_CONES + 20], r22, h)
                     and _coupled_ok(cfg, p, tc, cs1, sn1, cs2, sn2, cs3, sn3)):
                 best = max(best, nS * h)
     return best * (c2 * kappa)
@@ -889,6 +889,8 @@ def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q
     lower, upper = cfg[_LIMITS:_LIMITS + 6], cfg[_LIMITS + 6:_LIMITS + 12]
     modes = cfg[_LIMITS + 12:_LIMITS + 18]
     no_ref = np.empty(0)
+    has_ref = no_ref.shape[0] > 0  # False, typed as in solve_poses (one compiled _opw)
+    arm = np.empty((8, 6))  # the arm's values of one target (C-contiguous, as in solve_poses)
     again = 0
     for i in range(T.shape[0]):
         R, P, C = _wrist_line(cfg, tc, T[i], T_tcp_end)
@@ -898,15 +900,15 @@ def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q
         if not finish:
             continue
         Px = (P[0] + tc[_W] * xi, P[1] + tc[_W + 1] * xi, P[2] + tc[_W + 2] * xi)
-        qi = q[i]
-        _opw(cfg, p, R, Px, no_ref, False, qi[:, 1:], err[i], reach[i])
+        _opw(cfg, p, R, Px, no_ref, has_ref, arm, err[i], reach[i])
         for k in range(8):
-            qi[k, 0] = xi
             if not reach[i, k]:
-                qi[k, 1:] = np.nan
-            valid[i, k] = reach[i, k] and _fold(qi[k, 1:], modes, lower, upper, cfg[_LIMIT_TOL])
+                arm[k, :] = np.nan
+            valid[i, k] = reach[i, k] and _fold(arm[k], modes, lower, upper, cfg[_LIMIT_TOL])
+            q[i, k, 0] = xi
+            q[i, k, 1:] = arm[k]
         _exact(valid[i], err[i], cfg[_EXACT_TOL])
-        manipulability[i] = _best_valid(p, qi, valid[i])
+        manipulability[i] = _best_valid(p, arm, valid[i])
         if fi and not valid[i].any():
             again += 1
     return again
@@ -969,12 +971,12 @@ def manipulability_rows(p, q, out) -> None:
 
 @njit(**NUMBA_OPTIONS)
 def _best_valid(p, q, valid) -> float:
-    """``|det J|`` of the best valid branch of the track solutions ``q`` (8, 7) of one target (0 if
-    none): the two wrists of an arm configuration (branches 2k, 2k + 1) have the same value."""
+    """``|det J|`` of the best valid branch of one target's arm values ``q`` (8, 6) (0 if none):
+    the two wrists of an arm configuration (branches 2k, 2k + 1) have the same value."""
     best = 0.0
     for k in range(0, 8, 2):
         if valid[k] or valid[k + 1]:
-            m = _det_j(p, q[k, 1:])
+            m = _det_j(p, q[k])
             if not np.isnan(m):
                 best = max(best, m)
     return best
@@ -982,6 +984,6 @@ def _best_valid(p, q, valid) -> float:
 
 @njit(**NUMBA_OPTIONS)
 def best_valid_rows(p, q, valid, out) -> None:
-    """:func:`_best_valid` of every target: ``q`` (N, 8, 7), ``valid`` (N, 8), ``out`` (N,)."""
+    """:func:`_best_valid` of every target: ``q`` (N, 8, 6), ``valid`` (N, 8), ``out`` (N,)."""
     for i in range(q.shape[0]):
         out[i] = _best_valid(p, q[i], valid[i])

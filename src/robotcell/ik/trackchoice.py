@@ -341,7 +341,8 @@ def _best_valid(arm: Arm, q: NDArray[np.float64], valid: NDArray[np.bool_]) -> N
     if arm.coupling is None:
         s = analytic_solver(arm)
         out = np.empty(q.shape[0])
-        s._kernels.best_valid_rows(s._kernels.cfg_params(s._cfg), q, valid, out)
+        s._kernels.best_valid_rows(s._kernels.cfg_params(s._cfg), np.ascontiguousarray(q[..., 1:]),
+                                   valid, out)
         return out
     either = valid[..., ::2] | valid[..., 1::2]
     m = np.nan_to_num(arm_manipulability(arm, q[..., ::2, 1:]))

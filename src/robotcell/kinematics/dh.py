@@ -249,9 +249,9 @@ class Chain:
 
 _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
-#: The ``shift`` of a chain that does not move (read-only).
+#: The ``shift`` of a chain that does not move (writable like every array the kernels get, so
+#: that numba compiles one version; nothing writes it).
 NO_SHIFT = np.zeros(3)
-NO_SHIFT.setflags(write=False)
 
 
 def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
