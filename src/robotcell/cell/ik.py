@@ -307,9 +307,10 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
         method, reach_error = choice.solutions.method, choice.solutions.reach_error
     else:
         e = finite_array(0.0 if track is None else track, "track position")
-        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th), e.shape)
-        e = np.broadcast_to(e, batch)
-        T_world = frame_pose(cell, frame, e, th) @ arr
+        batch = _batch(arr.shape[:-2], table_batch(cell, th), e.shape)
+        if e.shape != batch:
+            e = np.broadcast_to(e, batch)
+        T_world = arr if frame == "world" else frame_pose(cell, frame, e, th) @ arr
         sol = cell.robot.ik(invert(robot_pose(cell, e)) @ T_world, tool=T_tool)
         q, valid, reachable, method = sol.q, sol.valid, sol.reachable, sol.method
         reach_error = sol.reach_error

@@ -102,8 +102,9 @@ class AnalyticSolver:
                       "COS_TOL": palletizer.COS_TOL, "AXIS_TOL": AXIS_TOL}
         self._cfg = kernels.pack(self.method, self._packed_params(), invert(self.params.T_R_O),
                                  lower, upper, modes, coupling is None, tolerances)
-        self._tcp_end = self._end(robot.tool)
-        self._last_tool: tuple[bytes | None, NDArray[np.float64]] = (None, self._tcp_end)
+        self._tcp_end = np.ascontiguousarray(invert(self.params.T_e_n @ robot._tail))
+        self._last_tail: tuple[NDArray[np.float64] | None, NDArray[np.float64]] = (None,
+                                                                                     self._tcp_end)
         self._no_ref = np.empty((0, 6))
         self._shape = (self.branches, robot.n_joints)
 
@@ -116,20 +117,16 @@ class AnalyticSolver:
         return k.palletizer_params(pa.A_r, pa.A_h, pa.b, pa.L2, pa.L3, pa.s1, pa.s4, pa.g22,
                                    pa.o2, pa.g32, pa.g33, pa.o3, pa.v_n, pa.R_n0)
 
-    def _end(self, tool_T: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``T_TCP_end = inv(T_end_n @ flange @ tool)``: the solver's end frame seen from the TCP."""
-        return np.ascontiguousarray(invert(self.params.T_e_n @ self.robot.flange @ tool_T))
-
     def end(self, tool: ArrayLike | None) -> NDArray[np.float64]:
-        """:meth:`_end` of ``tool`` (``T_F_TCP``, validated; the robot's own tool when None); the
-        last tool's is kept, for a loop of single poses with one tool."""
+        """``T_TCP_end = inv(T_end_n @ flange @ tool)``: the solver's end frame seen from the TCP,
+        for ``tool`` (``T_F_TCP``, validated; the robot's own tool when None). The last tool's is
+        kept (the arm keeps its ``flange @ tool``), for a loop of single poses with one tool."""
         if tool is None:
             return self._tcp_end
-        arr = np.asarray(tool, dtype=float)
-        key = arr.tobytes()
-        if self._last_tool[0] != key:
-            self._last_tool = (key, self._end(validate_single_pose(arr, "tool")))
-        return self._last_tool[1]
+        tail = self.robot._tail_for(tool)
+        if tail is not self._last_tail[0]:
+            self._last_tail = (tail, np.ascontiguousarray(invert(self.params.T_e_n @ tail)))
+        return self._last_tail[1]
 
     def _finish(self, q: NDArray[np.float64], reach: NDArray[np.bool_],
                 err: NDArray[np.float64]) -> NDArray[np.bool_]:

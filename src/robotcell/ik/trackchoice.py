@@ -26,11 +26,11 @@ centre and ``det J`` does not depend on the reference point):
 stretched or folded elbow), ``t5`` the wrist bend (0: wrist singularity). So it is evaluated on
 many track values for the price of a few arithmetic operations each, with the limits of the axes
 that do not turn a full circle (axes 1, 2, 3 and 5 where they are limited) checked on the way,
-in single precision (micrometres over the track: enough to choose). For an arm with a joint
+in compiled code (:mod:`robotcell.ik.kernels`, one target or a batch). For an arm with a joint
 coupling ``q_model = C q + offset`` (FANUC J2/J3, a parallel arm) the closed form holds for the
 model's angles and is multiplied by ``|det C|``, and a coupled axis's limits are checked on its
-controller value. The arm is then solved once, analytically, at the chosen value; where that has no valid branch
-(a limit of axis 4 or 6) the target falls back to the sampled search of
+controller value. The arm is then solved once, analytically, at the chosen value; where that
+has no valid branch (a limit of axis 4 or 6) the target falls back to the sampled search of
 :meth:`~robotcell.ik.TrackRobot.ik`. Every returned solution is exact and within all limits. A
 target the scan does not reach at all is scanned again on a grid 8 times finer. A best value
 inside a window of track values narrower than one step of the scan (1/23 of the interval by
