@@ -186,9 +186,9 @@ def _track_robot(cell: Cell) -> TrackRobot:
     return _track_setup(cell)[0]
 
 
-#: The last cell track's TrackRobot and ``T_L_world``, with what they were built from (a loop of
-#: single targets builds them once; a changed track or robot builds them anew).
-_LAST_TRACK: list = [None, None]
+#: ``(key, (TrackRobot, T_L_world))`` of the last cell track: what they were built from, and them
+#: (a loop of single targets builds them once; a changed track or robot builds them anew).
+_LAST_TRACK: list = [(None, None)]
 
 
 def _track_setup(cell: Cell) -> tuple[TrackRobot, NDArray[np.float64]]:
@@ -201,11 +201,12 @@ def _track_setup(cell: Cell) -> tuple[TrackRobot, NDArray[np.float64]]:
                          "cell file; or give the track position")
     key = (cell.robot, t.T_L_R0.tobytes(), t.T_world_L.tobytes(), t.axis, t.scale, t.lower,
            t.upper, t.name)
-    if _LAST_TRACK[0] != key:
+    last = _LAST_TRACK[0]  # one read: another thread may replace it
+    if last[0] != key:
         robot = TrackRobot(cell.robot, t.T_L_R0, t.direction, t.lower * t.scale,
                            t.upper * t.scale, t.name)
-        _LAST_TRACK[:] = [key, (robot, invert(t.T_world_L))]
-    return _LAST_TRACK[1]
+        last = _LAST_TRACK[0] = (key, (robot, invert(t.T_world_L)))
+    return last[1]
 
 
 def _check_track_choice(cell: Cell, frame: str) -> None:

@@ -286,9 +286,9 @@ def fk(cell: CellModel, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike =
     return invert(frame_pose(cell, frame, e, table)) @ T_world_TCP
 
 
-#: The last cell's placement of the robot and what it was computed from (a loop of single poses
-#: computes it once; another cell, robot or track computes it anew).
-_LAST_PLACEMENT: list = [None, None]
+#: ``(key, placement)`` of the last cell: what the robot's placement was computed from, and the
+#: placement (a loop of single poses computes it once; another cell, robot or track anew).
+_LAST_PLACEMENT: list = [(None, None)]
 
 
 def _placement(cell: CellModel) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
@@ -299,11 +299,12 @@ def _placement(cell: CellModel) -> tuple[NDArray[np.float64], NDArray[np.float64
         key = (robot, cell.T_world_R.tobytes())
     else:
         key = (robot, t.T_world_L.tobytes(), t.T_L_R0.tobytes(), t.axis, t.scale)
-    if _LAST_PLACEMENT[0] != key:
+    last = _LAST_PLACEMENT[0]  # one read: another thread may replace it
+    if last[0] != key:
         if t is None:
             value = (np.ascontiguousarray(cell.T_world_R @ robot.base), None)
         else:
             value = (np.ascontiguousarray(t.T_world_L @ t.T_L_R0 @ robot.base),
                      t.T_world_L[:3, :3] @ (t.direction * t.scale))
-        _LAST_PLACEMENT[:] = [key, value]
-    return _LAST_PLACEMENT[1]
+        last = _LAST_PLACEMENT[0] = (key, value)
+    return last[1]

@@ -124,9 +124,10 @@ class AnalyticSolver:
         if tool is None:
             return self._tcp_end
         tail = self.robot._tail_for(tool)
-        if tail is not self._last_tail[0]:
-            self._last_tail = (tail, np.ascontiguousarray(invert(self.params.T_e_n @ tail)))
-        return self._last_tail[1]
+        last = self._last_tail  # one read: another thread may replace it
+        if tail is not last[0]:
+            last = self._last_tail = (tail, np.ascontiguousarray(invert(self.params.T_e_n @ tail)))
+        return last[1]
 
     def _finish(self, q: NDArray[np.float64], reach: NDArray[np.bool_],
                 err: NDArray[np.float64]) -> NDArray[np.bool_]:
