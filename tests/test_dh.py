@@ -167,3 +167,22 @@ def test_one_pose_kernel_compiled_equals_python_and_the_batch():
         # NaN is refused by the compiled kernel as by the batch
         assert not dh.CHAIN.call(r._chain.program, np.full(6, np.nan), r.base, dh.NO_SHIFT, tail,
                                  compiled, None, None)
+
+
+def test_fk_from_a_placed_frame_0():
+    # fk_from(T_X_0, q, shift) starts the chain at T_X_0 moved by shift: T_X_R @ fk(q) where
+    # T_X_0 = T_X_R @ base (how a cell places its robot on a track, without a product of poses).
+    rng = np.random.default_rng(12)
+    r = random_standard_robot(rng)
+    T_X_R = make_pose(rot_x(0.4), [1.0, -2.0, 0.5])
+    shift = np.array([0.3, 0.0, -0.1])
+    moved = T_X_R.copy()
+    moved[:3, 3] += shift
+    q = rng.uniform(-3, 3, (5, 6))
+    tool = make_pose(p=[0.0, 0.05, 0.2])
+    want = moved @ r.fk(q, tool=tool)
+    np.testing.assert_allclose(r.fk_from(T_X_R @ r.base, q, tool=tool, shift=shift), want,
+                               rtol=0, atol=1e-12)
+    for i in range(5):
+        np.testing.assert_allclose(r.fk_from(T_X_R @ r.base, q[i], tool=tool, shift=shift),
+                                   want[i], rtol=0, atol=1e-12)

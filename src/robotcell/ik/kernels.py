@@ -7,7 +7,11 @@ modules describe the methods and derive the parameters. :func:`solve_poses` loop
 of a batch in compiled code (a single pose is a batch of one): it moves each target into the
 solver's frame, solves every branch, applies the 2*pi rule and the joint limits of
 :class:`robotcell.ik.limits.JointFolder` and the exact-branch rule of
-:class:`robotcell.ik.result.IKSolutions`.
+:class:`robotcell.ik.result.IKSolutions`. :func:`choose_poses` does the same for an
+ortho-parallel arm on a linear track after choosing the track value in closed form
+(:mod:`robotcell.ik.trackchoice` describes the method), with :func:`scan_rows`,
+:func:`wrist_rows`, :func:`interval_rows`, :func:`manipulability_rows` and
+:func:`best_valid_rows` for its parts.
 
 This module is imported when a solver is built (loading numba takes about 0.3 s, the cached
 machine code about 0.3 s more; the first process after an install compiles it). It holds every
@@ -25,8 +29,10 @@ from numpy.typing import NDArray
 
 from robotcell.kinematics.jit import NUMBA_OPTIONS
 
-__all__ = ["FOLD_CHECK", "FOLD_DOWN", "FOLD_NONE", "FOLD_UP", "METHODS", "exact_rows",
-           "fold_modes", "fold_rows", "pack", "solve_poses"]
+__all__ = ["FOLD_CHECK", "FOLD_DOWN", "FOLD_NONE", "FOLD_UP", "METHODS", "best_valid_rows",
+           "cfg_params", "choose_poses", "exact_rows", "fold_modes", "fold_rows", "interval_rows",
+           "manipulability_rows", "opw_params", "pack", "palletizer_params", "scan_rows",
+           "solve_poses", "track_config", "ur_params", "wrist_rows"]
 
 TWO_PI = 2.0 * math.pi
 #: Codes of the structures in :func:`pack`.
