@@ -48,8 +48,9 @@ def timed(f, repeats: int) -> tuple[float, float, object]:
     return float(np.min(ts)), float(np.min(cs)), out
 
 
-def main() -> None:
-    print(f"machine: {describe()}")
+def measure() -> dict:
+    """Per-target wall and CPU times (us) of the sampled search (``old``), the fast choice on the
+    same targets (``same``) and on many (``fast``), and how the two choices compare."""
     cell = Cell.load(CELL)
     rng = np.random.default_rng(0)
     arm = cell.robot
@@ -77,22 +78,27 @@ def main() -> None:
             elif key == "same":
                 fast = out
     count = {"old": N_SAME, "same": N_SAME, "fast": n}
+    ok_old = old.solutions.valid.any(-1)
+    ok_new = fast.valid.any(-1)
+    m_new = np.where(fast.valid, np.nan_to_num(arm_manipulability(arm, fast.q)), 0.0).max(-1)
+    return {"wall": {k: wall[k] / count[k] * 1e6 for k in wall},
+            "cpu": {k: cpu[k] / count[k] * 1e6 for k in cpu},
+            "ok_old": ok_old, "ok_new": ok_new, "ratio": m_new[ok_old] / old.manipulability[ok_old]}
+
+
+def main() -> None:
+    print(f"machine: {describe()}")
+    res = measure()
+    wall, cpu = res["wall"], res["cpu"]
     print("\ntrack position chosen per target, KR 16 on a 6 m track, torch tool "
           "(us/target, wall and CPU time; ratio to the sampled search):")
     for key, label in (("old", f"sampled search (before), {N_SAME} targets"),
                        ("same", f"fast choice, the same {N_SAME} targets"),
-                       ("fast", f"fast choice, {n} targets")):
-        uw, uc = wall[key] / count[key] * 1e6, cpu[key] / count[key] * 1e6
-        rw = wall["old"] / N_SAME * 1e6 / uw
-        rc = cpu["old"] / N_SAME * 1e6 / uc
-        print(f"  {label:40s} wall {uw:8.1f} ({rw:4.0f}x)   CPU {uc:8.1f} ({rc:4.0f}x)")
+                       ("fast", f"fast choice, {N_FAST} targets")):
+        print(f"  {label:40s} wall {wall[key]:8.1f} ({wall['old'] / wall[key]:4.0f}x)   "
+              f"CPU {cpu[key]:8.1f} ({cpu['old'] / cpu[key]:4.0f}x)")
     print("  target: <= 20 us/target and >= 150x")
-
-    ok_old = old.solutions.valid.any(-1)
-    ok_new = fast.valid.any(-1)
-    m_old = old.manipulability
-    m_new = np.where(fast.valid, np.nan_to_num(arm_manipulability(arm, fast.q)), 0.0).max(-1)
-    r = m_new[ok_old] / m_old[ok_old]
+    ok_old, ok_new, r = res["ok_old"], res["ok_new"], res["ratio"]
     print(f"\n  valid targets: before {ok_old.sum()}/{N_SAME}, fast {ok_new.sum()}/{N_SAME}, "
           f"valid before but not now: {np.count_nonzero(ok_old & ~ok_new)}")
     print(f"  manipulability |det J| fast / before: median {np.median(r):.6f}, "

@@ -19,7 +19,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
-from identification_helpers import configurations, measure, perturbed, truth_chain
+from identification_helpers import configurations, perturbed, truth_chain
+from identification_helpers import measure as measure_chain
 from machine import describe
 
 from robotcell.identification import identify
@@ -28,16 +29,22 @@ from robotcell.kinematics.models import load_robot
 N_CONFIGS, N_REFLECTORS, NOISE, REPEATS = 100, 3, 0.02e-3, 7
 
 
-def main() -> None:
+def measure(repeats: int = REPEATS):
+    """Wall times (s) of ``repeats`` identifications, and the last result."""
     rng = np.random.default_rng(0)
     nominal = load_robot("kuka_kr16")
     ch, x = truth_chain(perturbed(nominal, rng), N_REFLECTORS, False, rng)
-    meas = measure(ch, x, configurations(nominal, N_CONFIGS, rng), rng, NOISE)
+    meas = measure_chain(ch, x, configurations(nominal, N_CONFIGS, rng), rng, NOISE)
     times = []
-    for _ in range(REPEATS):
+    for _ in range(repeats):
         t0 = time.perf_counter()
         res = identify(nominal, meas, point_sigma=NOISE)
         times.append(time.perf_counter() - t0)
+    return times, res
+
+
+def main() -> None:
+    times, res = measure()
     print(describe())
     print(f"load average (1 min): {os.getloadavg()[0]:.1f}")
     print(f"identify: {N_CONFIGS} configurations x {N_REFLECTORS} reflectors, "

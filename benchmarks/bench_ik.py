@@ -3,7 +3,7 @@
 Run: ``python benchmarks/bench_ik.py``. Prints the machine, the batched analytic IK time per pose
 (all 8 solutions, including input validation, joint-limit and 2*pi handling) with its ratio to
 EAIK's batched C++ solver on one thread: measured in the same run when EAIK is installed
-(``pip install EAIK``), otherwise against 4.7 us/pose measured on a 2-core machine
+(``pip install ".[benchmark]"``), otherwise against 4.7 us/pose measured on a 2-core machine
 (docs/references.md); J2/J3-coupled arms against the same arm without its coupling, timed
 alternately in the same run; and the
 convergence of numeric IK for a 7-axis robot on a linear track over reachable random targets.
@@ -68,58 +68,74 @@ def median_time(f, repeats: int = 7) -> float:
     return float(np.median(ts))
 
 
-def main() -> None:
-    print(f"machine: {describe()}")
-    print(f"\nanalytic IK, all 8 solutions, batch of {N_POSES} poses:")
-    for name in ("kuka_kr6_r700_sixx", "abb_irb2400", "ur5e"):
+def batched_vs_eaik(names=("kuka_kr6_r700_sixx", "abb_irb2400", "ur5e"), n: int = N_POSES
+                    ) -> list[tuple[str, float, float, bool]]:
+    """Batched analytic IK of ``n`` reachable poses per robot: ``(name, us/pose, EAIK us/pose,
+    EAIK measured now)``; EAIK's batched C++ solver on one thread, interleaved, fastest of 7."""
+    out = []
+    for name in names:
         robot = load_robot(name)
         rng = np.random.default_rng(0)
         lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
-        T = robot.fk(rng.uniform(lo, hi, (N_POSES, 6)))
-        solve(robot, T[:10])  # derive and cache the parameters
+        T = robot.fk(rng.uniform(lo, hi, (n, 6)))
+        solve(robot, T[:10])  # derive and cache the parameters, load the kernels
         ours = partial(solve, robot, T)
         eaik = None if robot.convention != "standard" else eaik_solver(robot, T)
         if eaik is not None:
             t, t_eaik = interleaved_min(ours, eaik)
-            ref, how = t_eaik / N_POSES * 1e6, "EAIK measured now (fastest of 7, interleaved)"
+            out.append((name, t / n * 1e6, t_eaik / n * 1e6, True))
         else:
-            t = median_time(ours)
-            ref, how = EAIK_US_PER_POSE, "EAIK published"
-        us = t / N_POSES * 1e6
-        print(f"  {name:20s} {us:6.2f} us/pose   {how}: {ref:5.2f} us/pose, "
-              f"ratio {ref / us:4.2f}x   (target >= 2x)")
+            out.append((name, median_time(ours) / n * 1e6, EAIK_US_PER_POSE, False))
+    return out
 
-    coupled_vs_uncoupled()
 
+def numeric_track(n: int = N_TARGETS) -> tuple[float, int, int, int, float]:
+    """Numeric IK of a 7-axis KR 6 R700 sixx on a track over ``n`` reachable random targets:
+    ``(converged fraction, false successes, median iterations, max restarts, ms/target)``."""
     arm = load_robot("kuka_kr6_r700_sixx")
     track = TrackRobot(arm, make_pose(rot_z(0.3) @ rot_x(0.01), [0.1, 0.2, 0.3]),
                        np.array([1.0, 0.01, 0.0]), -1.0, 3.0)
     robot = track.as_robot()
     rng = np.random.default_rng(1)
-    q = np.column_stack([rng.uniform(-1.0, 3.0, N_TARGETS), rng.uniform(arm.lower, arm.upper, (N_TARGETS, 6))])
+    q = np.column_stack([rng.uniform(-1.0, 3.0, n), rng.uniform(arm.lower, arm.upper, (n, 6))])
     T = robot.fk(q)
     t = time.perf_counter()
     res = solve_numeric(robot, T, tol_position=1e-9, tol_orientation=1e-9)
     dt = time.perf_counter() - t
-    T2 = robot.fk(res.q)
-    pos = np.linalg.norm(T2[:, :3, 3] - T[:, :3, 3], axis=1)
+    pos = np.linalg.norm(robot.fk(res.q)[:, :3, 3] - T[:, :3, 3], axis=1)
     false = int(np.count_nonzero(res.success & (pos > 1e-9)))
+    return (float(res.success.mean()), false, int(np.median(res.iterations)),
+            int(res.restarts.max()), dt / n * 1e3)
+
+
+def main() -> None:
+    print(f"machine: {describe()}")
+    print(f"\nanalytic IK, all 8 solutions, batch of {N_POSES} poses:")
+    for name, us, ref, measured in batched_vs_eaik():
+        how = "EAIK measured now (fastest of 7, interleaved)" if measured else "EAIK published"
+        print(f"  {name:20s} {us:6.2f} us/pose   {how}: {ref:5.2f} us/pose, "
+              f"ratio {ref / us:4.2f}x   (target >= 2x)")
+    print(f"\nanalytic IK with a J2/J3 coupling, batch of {N_POSES // 2} poses, alternating:")
+    for name, uc, up in coupled_vs_uncoupled():
+        print(f"  {name:20s} coupled {uc:6.2f} us/pose, uncoupled {up:6.2f} us/pose, "
+              f"ratio {uc / up:4.2f}   (target <= 1.2)")
+    print(f"  {'abb_irb460':20s} palletizer, all 4 solutions: {palletizer():6.2f} us/pose")
+    ok, false, iters, restarts, ms = numeric_track()
     print(f"\nnumeric IK, 7-axis KR 6 R700 sixx on a track, {N_TARGETS} reachable random targets, "
           f"tolerance 1e-9 m / 1e-9 rad:")
-    print(f"  converged {res.success.mean() * 100:.1f} % (target >= 99.5 %), false successes {false}, "
-          f"median {int(np.median(res.iterations))} iterations, max {res.restarts.max()} restarts, "
-          f"{dt / N_TARGETS * 1e3:.2f} ms/target (batched)")
+    print(f"  converged {ok * 100:.1f} % (target >= 99.5 %), false successes {false}, "
+          f"median {iters} iterations, max {restarts} restarts, {ms:.2f} ms/target (batched)")
 
 
-def coupled_vs_uncoupled(n: int = N_POSES // 2, rounds: int = 7) -> None:
-    """Analytic IK of J2/J3-coupled arms against the same arm without its coupling.
+def coupled_vs_uncoupled(n: int = N_POSES // 2, rounds: int = 7) -> list[tuple[str, float, float]]:
+    """Analytic IK of J2/J3-coupled arms against the same arm without its coupling:
+    ``(name, coupled us/pose, uncoupled us/pose)``.
 
     The reference is the identical model (same chain, same limits) with ``coupling=None``, so the
     ratio is the cost of mapping model solutions to controller values. Both are timed alternately
-    in the same run (the machine is shared). Target: ratio <= 1.2. A palletizer (4 branches) is
-    reported for information.
+    in the same run (the machine is shared). Target: ratio <= 1.2.
     """
-    print(f"\nanalytic IK with a J2/J3 coupling, batch of {n} poses, alternating {rounds} rounds:")
+    out = []
     for name in ("fanuc_m20ia", "abb_irb2400"):
         coupled = load_robot(name)
         plain = replace(coupled, coupling=None)
@@ -131,15 +147,17 @@ def coupled_vs_uncoupled(n: int = N_POSES // 2, rounds: int = 7) -> None:
         for _ in range(rounds):
             tc.append(median_time(lambda c=coupled, T=T: solve(c, T), repeats=1))
             tp.append(median_time(lambda p=plain, T=T: solve(p, T), repeats=1))
-        uc, up = np.median(tc) / n * 1e6, np.median(tp) / n * 1e6
-        print(f"  {name:20s} coupled {uc:6.2f} us/pose, uncoupled {up:6.2f} us/pose, "
-              f"ratio {uc / up:4.2f}   (target <= 1.2)")
+        out.append((name, np.median(tc) / n * 1e6, np.median(tp) / n * 1e6))
+    return out
+
+
+def palletizer(n: int = N_POSES // 2, rounds: int = 7) -> float:
+    """Analytic IK of the ABB IRB 460 palletizer, all 4 solutions (us/pose, median)."""
     pal = load_robot("abb_irb460")
     rng = np.random.default_rng(0)
     T = pal.fk(rng.uniform(pal.lower, pal.upper, (n, 4)))
     solve(pal, T[:10])
-    t = median_time(lambda: solve(pal, T), repeats=rounds)
-    print(f"  {'abb_irb460':20s} palletizer, all 4 solutions: {t / n * 1e6:6.2f} us/pose")
+    return median_time(lambda: solve(pal, T), repeats=rounds) / n * 1e6
 
 
 if __name__ == "__main__":

@@ -175,3 +175,47 @@ def test_hayati_beta_is_a_rotation_about_y_after_the_twist(convention):
     # beta 0 is plain DH, at no cost: the compiled program has no rotation about y
     assert all(op.kind != "ry" for op in base._chain.ops)
     assert sum(op.kind == "ry" for op in r._chain.ops) == 6
+
+
+def test_one_pose_kernel_compiled_equals_python_and_the_batch():
+    # The chain is written once (robotcell.kinematics.dh.chain_kernel): run as Python on floats,
+    # compiled by numba for one pose, and by numpy on a batch. Compiled and Python give the same
+    # bits; the batch takes cos and sin from tan(theta/2) (SIMD), equal to rounding.
+    from robotcell.kinematics import dh
+
+    rng = np.random.default_rng(8)
+    for r in (random_standard_robot(rng), to_modified(random_standard_robot(rng))):
+        q = rng.uniform(-4, 4, 6)
+        tail = r.flange @ make_pose(p=[0.1, -0.02, 0.3])
+        python, compiled = np.empty((4, 4)), np.empty((4, 4))
+        assert dh.chain_kernel(r._chain.program, q, r.base, dh.NO_SHIFT, tail, python, None, None)
+        assert dh.CHAIN.compile()(r._chain.program, q, r.base, dh.NO_SHIFT, tail, compiled, None,
+                                     None)
+        assert np.array_equal(python, compiled)
+        np.testing.assert_array_equal(r.fk(q, tool=make_pose(p=[0.1, -0.02, 0.3])), compiled)
+        np.testing.assert_allclose(r.fk(q[None], tool=make_pose(p=[0.1, -0.02, 0.3]))[0],
+                                   compiled, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(r.frames(q), r.frames(q[None])[0], rtol=0, atol=1e-14)
+        np.testing.assert_allclose(r.jacobian(q), r.jacobian(q[None])[0], rtol=0, atol=1e-14)
+        # NaN is refused by the compiled kernel as by the batch
+        assert not dh.CHAIN.call(r._chain.program, np.full(6, np.nan), r.base, dh.NO_SHIFT, tail,
+                                 compiled, None, None)
+
+
+def test_fk_from_a_placed_frame_0():
+    # fk_from(T_X_0, q, shift) starts the chain at T_X_0 moved by shift: T_X_R @ fk(q) where
+    # T_X_0 = T_X_R @ base (how a cell places its robot on a track, without a product of poses).
+    rng = np.random.default_rng(12)
+    r = random_standard_robot(rng)
+    T_X_R = make_pose(rot_x(0.4), [1.0, -2.0, 0.5])
+    shift = np.array([0.3, 0.0, -0.1])
+    moved = T_X_R.copy()
+    moved[:3, 3] += shift
+    q = rng.uniform(-3, 3, (5, 6))
+    tool = make_pose(p=[0.0, 0.05, 0.2])
+    want = moved @ r.fk(q, tool=tool)
+    np.testing.assert_allclose(r.fk_from(T_X_R @ r.base, q, tool=tool, shift=shift), want,
+                               rtol=0, atol=1e-12)
+    for i in range(5):
+        np.testing.assert_allclose(r.fk_from(T_X_R @ r.base, q[i], tool=tool, shift=shift),
+                                   want[i], rtol=0, atol=1e-12)

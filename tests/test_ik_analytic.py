@@ -274,6 +274,44 @@ def test_batch_shape_and_input_errors():
         robot.ik(skewed)
 
 
+@pytest.mark.parametrize("name", ["kuka_kr16", "ur5e", "abb_irb460", "fanuc_m20ia"])
+def test_one_pose_is_the_batch_of_one(name):
+    # One pose (the per-call path: one compiled check, one compiled solve) gives the same bits
+    # as that pose in a batch: one kernel for both, opw, ur, palletizer and a J2/J3 coupling.
+    robot = load_robot(name)
+    rng = np.random.default_rng(11)
+    q = sample(robot, rng, 40)
+    q[:5, -2] = 0.0  # some wrist singularities (a palletizer: axis 3 at 0)
+    T = robot.fk(q)
+    T[-5:, :3, 3] *= 3.0  # out of reach
+    tool = make_pose(rot_x(0.2), [0.01, 0.02, 0.15])
+    for kw in ({}, {"tool": tool}):
+        batch = robot.ik(T, **kw)
+        for i in range(len(T)):
+            one = robot.ik(T[i], **kw)
+            assert one.method == batch.method
+            for field in ("q", "valid", "reachable", "reach_error"):
+                assert np.array_equal(getattr(one, field), getattr(batch, field)[i], equal_nan=True)
+
+
+def test_one_pose_refuses_bad_input_as_a_batch_does():
+    robot = load_robot("kuka_kr16")
+    skewed = np.eye(4)
+    skewed[0, 1] = 0.1
+    reflected = np.diag([1.0, 1.0, -1.0, 1.0])
+    nan = np.eye(4)
+    nan[2, 3] = np.nan
+    head = r"target pose is not a valid rigid transform: (pose \[0\]: )?"
+    for bad, match in ((skewed, r"rotation part is not orthonormal \(max \|R\^T R - I\| = 0.1\)"),
+                       (reflected, r"rotation part has determinant -1, not \+1 \(a reflection\)"),
+                       (nan, "contains NaN or infinite values")):
+        for T in (bad, bad[None]):
+            with pytest.raises(InputError, match=head + match):
+                robot.ik(T)
+    with pytest.raises(InputError, match=r"tool is not a valid rigid transform: .*determinant"):
+        robot.ik(np.eye(4), tool=reflected)
+
+
 def test_joint_folder_rule():
     lower = np.radians([-350, 100, -90, -np.inf, -190])
     upper = np.radians([350, 400, 90, np.inf, 45])

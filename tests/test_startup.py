@@ -34,7 +34,7 @@ def loaded_after(args):
     return set(json.loads(proc.stderr.strip().splitlines()[-1]))
 
 
-HEAVY = {"numpy", "scipy", "yaml", "matplotlib", "plotly"}
+HEAVY = {"numpy", "scipy", "yaml", "matplotlib", "plotly", "numba", "llvmlite"}
 
 
 @pytest.mark.parametrize("args", [[], ["--version"], ["--help"], ["-h"]],
@@ -57,6 +57,8 @@ def test_calibrate_tcp_imports_what_it_needs_only(tmp_path, capsys):
     # scipy.stats alone costs 0.2 s; matplotlib is for reports, plotly for 3D views; no other
     # command's module.
     assert "scipy.stats" not in modules and "matplotlib" not in modules
+    # numba (0.5 s) loads for the IK and for loops of single poses, not for a batch of FK
+    assert "numba" not in modules and "llvmlite" not in modules
     assert not {m for m in modules if m == "plotly" or m.startswith("plotly.")}
     others = {t.split(":")[0] for name, t in COMMANDS.items() if name != "calibrate"}
     assert not modules & others
@@ -99,6 +101,13 @@ def test_help_lists_each_command_with_its_own_help():
         for limit in (45, 80):
             assert _help_command(name).get_short_help_str(limit) == \
                 real.get_short_help_str(limit), name
+
+
+def test_one_pose_of_fk_does_not_load_numba():
+    # A command that computes one pose runs the kernels as Python (robotcell.kinematics.jit).
+    modules = loaded_after(["fk", "kuka_kr16", "--joints", "10,-80,90,0,45,0"])
+    assert "robotcell.cli.fk" in modules
+    assert "numba" not in modules
 
 
 def test_view_loads_plotly_only_to_draw():

@@ -1,9 +1,11 @@
+import re
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from robotcell import InputError, check_pose, compose, invert, make_pose, rot_x, rot_y, rot_z
-from robotcell.kinematics.transforms import transform_points, validate_pose
+from robotcell.kinematics.transforms import transform_points, validate_pose, validate_single_pose
 
 
 def random_poses(rng, n):
@@ -59,3 +61,28 @@ def test_validate_pose_errors():
         validate_pose(np.eye(3))
     with pytest.raises(InputError, match=r"p must have shape"):
         make_pose(np.eye(3), [1.0, 2.0])
+
+
+def test_the_one_pose_check_raises_what_validate_pose_raises():
+    # validate_single_pose (the per-call path: one compiled check) refuses each defect with the
+    # message of validate_pose, and returns a valid pose as a C-contiguous float array.
+    nan = np.eye(4)
+    nan[1, 3] = np.inf
+    lastrow = np.eye(4)
+    lastrow[3, 2] = 1e-3
+    tilted = make_pose(rot_x(0.3))
+    tilted[0, 1] += 1e-3
+    for bad in (np.diag([1.0, -1.0, 1.0, 1.0]), 2 * np.eye(4), nan, lastrow, tilted, np.eye(3),
+                [[1, 0, 0]]):
+        with pytest.raises(InputError) as want:
+            validate_pose(bad, "tool")
+        with pytest.raises(InputError, match=re.escape(str(want.value))):
+            validate_single_pose(bad, "tool")
+    with pytest.raises(InputError, match=r"tool must be a single pose of shape \(4, 4\), got \(2, 4, 4\)"):
+        validate_single_pose(np.stack([np.eye(4)] * 2), "tool")
+    T = make_pose(rot_x(0.3), [1.0, 2.0, 3.0])
+    out = validate_single_pose(T.T.T.copy(order="F"), "tool")
+    assert out.flags.c_contiguous and out.dtype == np.float64 and np.array_equal(out, T)
+    shifted = np.eye(4, dtype=int)
+    shifted[:3, 3] = [1, 2, 3]
+    assert np.array_equal(validate_single_pose(shifted), shifted)

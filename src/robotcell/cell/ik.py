@@ -48,7 +48,12 @@ from robotcell.ik.track import TrackChoice, TrackRobot
 from robotcell.ik.trackchoice import choose_track, scan_track
 from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.robot import Robot
-from robotcell.kinematics.transforms import finite_array, invert, validate_pose
+from robotcell.kinematics.transforms import (
+    finite_array,
+    invert,
+    validate_pose,
+    validate_single_pose,
+)
 
 __all__ = ["CellIKSolutions", "CellPath", "PathBreak", "PathSplit", "choose_track_value",
            "depends_on_track", "ik", "ik_path", "split_path"]
@@ -162,23 +167,46 @@ def depends_on_track(cell: Cell, frame: str) -> bool:
     return parent == "robot" or (parent == "turntable" and table_on_robot)
 
 
+def _batch(*shapes: tuple[int, ...]) -> tuple[int, ...]:
+    """``np.broadcast_shapes``, without its cost when the shapes are equal (one target)."""
+    return shapes[0] if all(sh == shapes[0] for sh in shapes) else np.broadcast_shapes(*shapes)
+
+
 def _limits_ok(cell: Cell, e: NDArray[np.float64], th: NDArray[np.float64]) -> NDArray[np.bool_]:
-    ok = np.ones(np.broadcast_shapes(e.shape, table_batch(cell, th)), dtype=bool)
+    ok: NDArray[np.bool_] | bool = True
     if cell.track is not None:
-        ok &= cell.track.within_limits(e)
+        ok = ok & cell.track.within_limits(e)
     if cell.turntable is not None:
-        ok &= cell.turntable.within_limits(th)
-    return ok
+        ok = ok & cell.turntable.within_limits(th)
+    shape = _batch(e.shape, table_batch(cell, th))
+    return np.asarray(ok) if np.shape(ok) == shape else np.broadcast_to(ok, shape)
 
 
 def _track_robot(cell: Cell) -> TrackRobot:
+    return _track_setup(cell)[0]
+
+
+#: ``(key, (TrackRobot, T_L_world))`` of the last cell track: what they were built from, and them
+#: (a loop of single targets builds them once; a changed track or robot builds them anew).
+_LAST_TRACK: list = [(None, None)]
+
+
+def _track_setup(cell: Cell) -> tuple[TrackRobot, NDArray[np.float64]]:
+    """The cell's arm on its track as a :class:`TrackRobot` (track values in metres of motion)
+    and ``T_L_world``."""
     t = cell.track
     assert t is not None
     if not (math.isfinite(t.lower) and math.isfinite(t.upper)):
         raise InputError("choosing the track position needs the track limits (min, max) in the "
                          "cell file; or give the track position")
-    return TrackRobot(cell.robot, t.T_L_R0, t.direction, t.lower * t.scale, t.upper * t.scale,
-                      t.name)
+    key = (cell.robot, t.T_L_R0.tobytes(), t.T_world_L.tobytes(), t.axis, t.scale, t.lower,
+           t.upper, t.name)
+    last = _LAST_TRACK[0]  # one read: another thread may replace it
+    if last[0] != key:
+        robot = TrackRobot(cell.robot, t.T_L_R0, t.direction, t.lower * t.scale,
+                           t.upper * t.scale, t.name)
+        last = _LAST_TRACK[0] = (key, (robot, invert(t.T_world_L)))
+    return last[1]
 
 
 def _check_track_choice(cell: Cell, frame: str) -> None:
@@ -261,24 +289,29 @@ def ik(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | None =
     >>> sol = cell.ik(T_W_TCP, frame="part", table=np.radians(90), tool="torch")  # doctest: +SKIP
     >>> sol.q[sol.valid]                                                          # doctest: +SKIP
     """
-    arr = validate_pose(T, "target pose")
+    arr = (validate_single_pose(T, "target pose") if type(T) is np.ndarray and T.shape == (4, 4)
+           else validate_pose(T, "target pose"))
     th = table_values(cell, table)
     T_tool = tool_pose(cell, tool)
     if track is None and cell.track is not None:
         _check_track_choice(cell, frame)
-        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th))
-        T_world = frame_pose(cell, frame, 0.0, th) @ arr
-        T_L = invert(cell.track.T_world_L) @ np.broadcast_to(T_world, batch + (4, 4))
-        choice = choose_track_value(_track_robot(cell), T_L, T_tool, samples)
+        batch = _batch(arr.shape[:-2], table_batch(cell, th))
+        # (in the world frame the frame pose is the identity: the product would be arr itself)
+        T_world = arr if frame == "world" else frame_pose(cell, frame, 0.0, th) @ arr
+        if T_world.shape[:-2] != batch:
+            T_world = np.broadcast_to(T_world, batch + (4, 4))
+        trk, T_L_world = _track_setup(cell)
+        choice = choose_track_value(trk, T_L_world @ T_world, T_tool, samples)
         e = choice.track / cell.track.scale
         q = choice.solutions.q[..., 1:]
         valid, reachable = choice.solutions.valid, choice.solutions.reachable
         method, reach_error = choice.solutions.method, choice.solutions.reach_error
     else:
         e = finite_array(0.0 if track is None else track, "track position")
-        batch = np.broadcast_shapes(arr.shape[:-2], table_batch(cell, th), e.shape)
-        e = np.broadcast_to(e, batch)
-        T_world = frame_pose(cell, frame, e, th) @ arr
+        batch = _batch(arr.shape[:-2], table_batch(cell, th), e.shape)
+        if e.shape != batch:
+            e = np.broadcast_to(e, batch)
+        T_world = arr if frame == "world" else frame_pose(cell, frame, e, th) @ arr
         sol = cell.robot.ik(invert(robot_pose(cell, e)) @ T_world, tool=T_tool)
         q, valid, reachable, method = sol.q, sol.valid, sol.reachable, sol.method
         reach_error = sol.reach_error

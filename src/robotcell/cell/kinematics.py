@@ -138,7 +138,8 @@ def table_batch(cell: CellModel, th: NDArray[np.float64]) -> tuple[int, ...]:
 def broadcast_table(cell: CellModel, th: NDArray[np.float64], batch: tuple[int, ...]
                     ) -> NDArray[np.float64]:
     """Values from :func:`table_values` broadcast to the batch shape ``batch``."""
-    return np.broadcast_to(th, batch + th.shape[len(table_batch(cell, th)):])
+    shape = batch + th.shape[len(table_batch(cell, th)):]
+    return th if th.shape == shape else np.broadcast_to(th, shape)
 
 
 def robot_pose(cell: CellModel, e: ArrayLike) -> NDArray[np.float64]:
@@ -269,7 +270,41 @@ def fk(cell: CellModel, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike =
     The lecture's track relation, for a cell ``c`` with a track along X_L at the world origin:
     ``c.fk(q, track=e, frame="track")[:3, 3] == e * X_L + L_Q_R @ robot.fk(q)[:3, 3]``.
     """
-    T_R_TCP = cell.robot.fk(np.asarray(q, dtype=float), tool=tool_pose(cell, tool))
+    q_arr = np.asarray(q, dtype=float)
+    T_tool = tool_pose(cell, tool)
     e = finite_array(track, "track position")
-    T_world_TCP = robot_pose(cell, e) @ T_R_TCP
+    if frame == "world" and e.ndim == 0:
+        th = table_values(cell, table)
+        if table_batch(cell, th) == ():
+            # One track position: the chain starts at the robot's frame 0 in the world.
+            if cell.track is None and e != 0:
+                raise InputError("the cell has no track; the track position must be 0")
+            T_world_0, d = _placement(cell)
+            return cell.robot.fk_from(T_world_0, q_arr, tool=T_tool,
+                                      shift=None if d is None else d * float(e))
+    T_world_TCP = robot_pose(cell, e) @ cell.robot.fk(q_arr, tool=T_tool)
     return invert(frame_pose(cell, frame, e, table)) @ T_world_TCP
+
+
+#: ``(key, placement)`` of the last cell: what the robot's placement was computed from, and the
+#: placement (a loop of single poses computes it once; another cell, robot or track anew).
+_LAST_PLACEMENT: list = [(None, None)]
+
+
+def _placement(cell: CellModel) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+    """``T_world_0``, the robot's DH frame 0 in the world at track position 0, and its
+    displacement per unit of track position (m, in the world; None without a track)."""
+    robot, t = cell.robot, cell.track
+    if t is None:
+        key = (robot, cell.T_world_R.tobytes())
+    else:
+        key = (robot, t.T_world_L.tobytes(), t.T_L_R0.tobytes(), t.axis, t.scale)
+    last = _LAST_PLACEMENT[0]  # one read: another thread may replace it
+    if last[0] != key:
+        if t is None:
+            value = (np.ascontiguousarray(cell.T_world_R @ robot.base), None)
+        else:
+            value = (np.ascontiguousarray(t.T_world_L @ t.T_L_R0 @ robot.base),
+                     t.T_world_L[:3, :3] @ (t.direction * t.scale))
+        last = _LAST_PLACEMENT[0] = (key, value)
+    return last[1]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 
 __all__ = ["AXIS_TOL", "angle_deg", "closest_point", "joint_axes", "line_distance"]
 
@@ -15,12 +15,12 @@ __all__ = ["AXIS_TOL", "angle_deg", "closest_point", "joint_axes", "line_distanc
 AXIS_TOL = 1e-9
 
 
-def joint_axes(robot: Robot) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def joint_axes(robot: Arm) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Axis lines of every joint at ``q = 0``, in the robot base frame R.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
 
     Returns
     -------
@@ -64,7 +64,7 @@ def angle_deg(u1: NDArray[np.float64], u2: NDArray[np.float64]) -> float:
     return math.degrees(math.acos(max(-1.0, min(1.0, float(u1 @ u2)))))
 
 
-def six_revolute_problems(robot: Robot) -> list[str]:
+def six_revolute_problems(robot: Arm) -> list[str]:
     """Why ``robot`` is not a chain of six revolute joints (empty if it is).
 
     The first check of every analytic solver: both need exactly six revolute axes.

@@ -39,7 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.opw import OPWParameters
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 
 __all__ = ["abb_confdata", "arm_sides", "kuka_status_turn"]
 
@@ -54,7 +54,7 @@ def _joint_values(q: ArrayLike) -> NDArray[np.float64]:
     return np.where(np.abs(arr) < ZERO_TOL, 0.0, arr)
 
 
-def _opw(robot: Robot) -> OPWParameters:
+def _opw(robot: Arm) -> OPWParameters:
     solver = analytic_solver(robot)
     if solver.method != "opw":
         raise InputError(f"configuration flags are defined for arms with a spherical wrist; "
@@ -63,12 +63,12 @@ def _opw(robot: Robot) -> OPWParameters:
     return solver.params
 
 
-def arm_sides(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+def arm_sides(robot: Arm, q: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """Which side of axis 1 and of the lower arm the wrist centre is on.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         An ortho-parallel arm with a spherical wrist.
     q : array_like, shape (..., 6)
         Controller axis values (rad); NaN gives False. A coupled robot's values are mapped to the
@@ -100,12 +100,12 @@ def arm_sides(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np
     return front, elbow_front
 
 
-def kuka_status_turn(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.int_], NDArray[np.int_]]:
+def kuka_status_turn(robot: Arm, q: ArrayLike) -> tuple[NDArray[np.int_], NDArray[np.int_]]:
     """KUKA Status and Turn of configurations.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
     q : array_like, shape (..., 6)
         Joint values A1..A6 (rad).
 
@@ -120,12 +120,12 @@ def kuka_status_turn(robot: Robot, q: ArrayLike) -> tuple[NDArray[np.int_], NDAr
     return status, turn
 
 
-def abb_confdata(robot: Robot, q: ArrayLike) -> NDArray[np.int_]:
+def abb_confdata(robot: Arm, q: ArrayLike) -> NDArray[np.int_]:
     """ABB ``confdata`` ``[cf1, cf4, cf6, cfx]`` of configurations.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
     q : array_like, shape (..., 6)
         Joint values of axes 1..6 (rad).
 

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.kinematics.bounds import LIMIT_TOL, within
+from robotcell.kinematics.bounds import LIMIT_TOL
 
 __all__ = ["TWO_PI", "JointFolder", "shift_into_interval", "wrap_to_pi"]
 
@@ -65,11 +65,8 @@ class JointFolder:
     """
 
     def __init__(self, lower: ArrayLike, upper: ArrayLike) -> None:
-        self.lower = np.asarray(lower, dtype=float)
-        self.upper = np.asarray(upper, dtype=float)
-        # Joints whose limits contain all of (-pi, pi] need no work at all.
-        self._checked = [j for j in range(self.lower.size)
-                         if not (self.lower[j] <= -math.pi and self.upper[j] >= math.pi)]
+        self.lower = np.ascontiguousarray(lower, dtype=float)
+        self.upper = np.ascontiguousarray(upper, dtype=float)
 
     def __call__(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
         """Fold ``q`` in place.
@@ -84,16 +81,11 @@ class JointFolder:
         ndarray of bool, shape (...)
             Whether every joint value is inside its limits (False where ``q`` has NaN).
         """
-        inside = ~np.isnan(q[..., 0]) if not self._checked else None
-        for j in self._checked:
-            lo, hi = self.lower[j], self.upper[j]
-            col = q[..., j]
-            if lo < -math.pi:
-                down = col - TWO_PI
-                col[...] = np.where((col > hi + LIMIT_TOL) & (down >= lo - LIMIT_TOL), down, col)
-            elif hi > math.pi:
-                up = col + TWO_PI
-                col[...] = np.where((col < lo - LIMIT_TOL) & (up <= hi + LIMIT_TOL), up, col)
-            ok = within(col, lo, hi)
-            inside = ok if inside is None else inside & ok
-        return inside
+        from robotcell.ik import kernels  # the rule is compiled with the solvers that apply it
+
+        flat = np.array(q, dtype=float).reshape(-1, self.lower.size)
+        inside = np.empty(flat.shape[0], dtype=bool)
+        kernels.fold_rows(flat, kernels.fold_modes(self.lower, self.upper), self.lower,
+                          self.upper, LIMIT_TOL, inside)
+        q[...] = flat.reshape(q.shape)
+        return inside.reshape(q.shape[:-1])

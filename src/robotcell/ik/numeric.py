@@ -1,6 +1,6 @@
 """Numeric inverse kinematics for any chain: damped least squares with Levenberg-Marquardt damping.
 
-Works for every :class:`~robotcell.kinematics.robot.Robot` (prismatic joints, 7 or more axes, calibrated
+Works for every :class:`~robotcell.kinematics.arm.Arm` (prismatic joints, 7 or more axes, calibrated
 models whose axes are no longer exactly parallel). For a batch of targets it iterates all
 unconverged targets together:
 
@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
 from robotcell.ik.result import NumericIKResult
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["solve_numeric"]
@@ -36,7 +36,7 @@ _LAMBDA_MIN = 1e-12
 _LAMBDA_MAX = 1e6
 
 
-def _error(robot: Robot, q: NDArray[np.float64], target: NDArray[np.float64],
+def _error(robot: Arm, q: NDArray[np.float64], target: NDArray[np.float64],
            tool: NDArray[np.float64] | None) -> NDArray[np.float64]:
     """6-vector error (m, rad) from the TCP at ``q`` (N, n) to ``target`` (N, 4, 4); (N, 6)."""
     T = robot.fk(q, tool=tool).reshape(-1, 4, 4)
@@ -45,14 +45,14 @@ def _error(robot: Robot, q: NDArray[np.float64], target: NDArray[np.float64],
     return np.concatenate([dp, Rotation.from_matrix(dR).as_rotvec()], axis=1)
 
 
-def _random_in_limits(robot: Robot, rng: np.random.Generator, m: int) -> NDArray[np.float64]:
+def _random_in_limits(robot: Arm, rng: np.random.Generator, m: int) -> NDArray[np.float64]:
     lo = np.where(np.isfinite(robot.lower), robot.lower, np.where(robot.prismatic, -1.0, -math.pi))
     hi = np.where(np.isfinite(robot.upper), robot.upper, np.where(robot.prismatic, 1.0, math.pi))
     return rng.uniform(lo, hi, (m, robot.n_joints))
 
 
 def solve_numeric(
-    robot: Robot,
+    robot: Arm,
     T: ArrayLike,
     q0: ArrayLike | None = None,
     *,
@@ -67,7 +67,7 @@ def solve_numeric(
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         Any chain.
     T : array_like, shape (..., 4, 4)
         ``T_R_TCP``: target poses of the TCP in the robot base frame (m).

@@ -36,17 +36,14 @@ from robotcell.ik.axes import (
     line_distance,
     six_revolute_problems,
 )
-from robotcell.ik.limits import shift_into_interval, wrap_to_pi
-from robotcell.ik.result import REACH_TOL
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.transforms import invert, rot_y, rot_z
 
-__all__ = ["OPWParameters", "clamp_circular", "opw_fk", "opw_kernel", "opw_parameters", "opw_problems",
-           "reach_distance"]
+__all__ = ["OPWParameters", "opw_fk", "opw_parameters", "opw_problems"]
 
 #: Below this distance (m) of the wrist centre from axis 1, and this sine of the paper's angle
 #: t5, the configuration is treated as exactly singular: axis 1, respectively axis 4, is free and
-#: chosen (see :func:`opw_kernel`; the pose error this admits is at most this size).
+#: chosen (see :func:`robotcell.ik.kernels._opw`; the pose error this admits is at most this size).
 SINGULAR_TOL = 1e-12
 #: Relative rounding of the wrist centre and the arm's lengths (times their size in m): a pose
 #: outside reach by less is inside up to rounding (reported with ``reach_error`` 0).
@@ -83,12 +80,12 @@ class OPWParameters:
     T_e_n: NDArray[np.float64]
 
 
-def opw_problems(robot: Robot) -> list[str]:
+def opw_problems(robot: Arm) -> list[str]:
     """Reasons why ``robot`` is not an ortho-parallel arm with a spherical wrist (empty if it is).
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
 
     Returns
     -------
@@ -128,7 +125,7 @@ def _pick(sign_source: float) -> float:
     return -1.0 if sign_source < -AXIS_TOL else 1.0
 
 
-def opw_parameters(robot: Robot) -> OPWParameters:
+def opw_parameters(robot: Arm) -> OPWParameters:
     """Derive the ortho-parallel parameters of a robot model.
 
     The frame O has its z axis along axis 1 (pointing to the same side as ``Z_R``), its y axis
@@ -138,7 +135,7 @@ def opw_parameters(robot: Robot) -> OPWParameters:
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         Six revolute joints: axis 1 perpendicular to axis 2, axes 2 and 3 parallel, axis 4
         perpendicular to axis 3, axes 4, 5, 6 mutually perpendicular and meeting in one point.
 
@@ -234,176 +231,3 @@ def opw_fk(params: OPWParameters, theta: NDArray[np.float64]) -> NDArray[np.floa
     T[..., :3, 3] = wrist + pa.c4 * R[..., :, 2]
     T[..., 3, 3] = 1.0
     return T
-
-
-def _controller_angle(signs: NDArray[np.float64], offsets: NDArray[np.float64]):
-    """``f(j, y, x) = sign_j * (atan2(y, x) - offset_j)`` wrapped to ``(-pi, pi]``, by one atan2.
-
-    The pair ``(y, x)`` (any positive scale) is turned by ``-offset_j`` and mirrored for a negative
-    sign, so no wrapping pass over the solutions is needed.
-    """
-    rot = [(math.cos(o), math.sin(o)) if o != 0.0 else None for o in offsets]
-
-    def f(j: int, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64]:
-        if rot[j] is not None:
-            c, s = rot[j]
-            y, x = y * c - x * s, x * c + y * s
-        return np.arctan2(-y if signs[j] < 0 else y, x)
-
-    return f
-
-
-def reach_distance(err_sq: NDArray[np.float64] | float, d: NDArray[np.float64],
-                   rnd: float) -> NDArray[np.float64]:
-    """Add the square of an excess distance ``d`` (m) to ``err_sq``; ``d <= rnd`` counts as 0."""
-    return err_sq + np.where(d > rnd, d * d, 0.0)
-
-
-def clamp_circular(q: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
-    """The 2*pi-equivalent of ``q`` (rad) inside ``[lo, hi]`` (up to rounding), else the nearer
-    limit (circularly)."""
-    up = shift_into_interval(q, lo, hi)  # smallest equivalent >= lo, NaN above hi
-    d_lo = np.abs(wrap_to_pi(q - lo))
-    d_hi = np.abs(wrap_to_pi(q - hi))
-    return np.where(np.isnan(up), np.where(d_lo <= d_hi, lo, hi), up)
-
-
-def opw_kernel(params: OPWParameters, R: NDArray[np.float64], P: NDArray[np.float64],
-               out: NDArray[np.float64], err: NDArray[np.float64],
-               ref: NDArray[np.float64] | None = None,
-               lower: NDArray[np.float64] | None = None,
-               upper: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
-    """All 8 solutions, as controller axis values, for poses already expressed in O.
-
-    Parameters
-    ----------
-    params : OPWParameters
-    R : ndarray, shape (N, 3, 3)
-        Rotations ``R_O_e``.
-    P : ndarray, shape (N, 3)
-        Positions ``p_O_e`` (m).
-    out : ndarray, shape (N, 8, 6)
-        Receives the controller values ``q = sign * (theta - offset)`` in ``(-pi, pi]`` (rad);
-        branch ``k = 4 * shoulder + 2 * elbow + wrist``:
-        shoulder 1 = wrist centre behind axis 1, elbow 1 = wrist centre behind the line of axes 2
-        and 3, wrist 1 = negative paper angle ``t5``. Unreachable branches are NaN.
-    err : ndarray, shape (N, 8)
-        Receives the distance (m) of the wrist centre outside the branch's reach (0 inside).
-    ref : ndarray, shape (N, 6), optional
-        Reference controller values (rad). Where axis 1 or axis 4 is free (wrist centre on axis 1,
-        wrist singularity), it takes the reference's value (axis 1: behind = reference + pi).
-    lower, upper : ndarray, shape (6,), optional
-        Joint limits (rad): a free axis 1 is chosen inside them.
-
-    Returns
-    -------
-    ndarray of bool, shape (N, 8)
-        Which branches reach the pose (``err <= REACH_TOL``).
-    """
-    pa = params
-    kappa = math.hypot(pa.a2, pa.c3)
-    cpsi, spsi = pa.c3 / kappa, pa.a2 / kappa
-    cx = P[:, 0] - pa.c4 * R[:, 0, 2]
-    cy = P[:, 1] - pa.c4 * R[:, 1, 2]
-    cz = P[:, 2] - pa.c4 * R[:, 2, 2]
-    rho2 = cx * cx + cy * cy
-    b = pa.b
-    # Rounding of the wrist centre and of the lengths (a reachable pose is within their sum of
-    # the origin): excesses below it count as 0.
-    rnd = ROUND * 2 * (abs(pa.c4) + abs(pa.a1) + abs(b) + abs(pa.c1) + pa.c2 + kappa)
-    # The wrist centre must not be nearer to axis 1 than the lateral offset |b| (Puma type).
-    err_sh = reach_distance(0.0, abs(b) - np.sqrt(rho2), rnd)
-    n = np.sqrt(np.maximum(rho2 - b * b, 0.0))
-    axial = rho2 < SINGULAR_TOL * SINGULAR_TOL
-    inv = 1.0 / np.where(axial, 1.0, rho2)
-    Z = cz - pa.c1
-    R00, R01, R02 = R[:, 0, 0], R[:, 0, 1], R[:, 0, 2]
-    R10, R11, R12 = R[:, 1, 0], R[:, 1, 1], R[:, 1, 2]
-    R20, R21, R22 = R[:, 2, 0], R[:, 2, 1], R[:, 2, 2]
-    denom = 1.0 / (2.0 * pa.c2 * kappa)
-    base = pa.c2 * pa.c2 + kappa * kappa
-    reach = np.empty((P.shape[0], 8), dtype=bool)
-    ang = _controller_angle(pa.signs, pa.offsets)
-    free1 = np.flatnonzero(axial)
-    if free1.size:
-        # Axis 1 is free: the reference's value, else the one that puts axis 6 in the arm plane
-        # (axis 4 at its zero, the wrist least bent), moved inside the limits.
-        if ref is not None:
-            q1_free = ref[free1, 0]
-        else:
-            q1_free = pa.signs[0] * np.arctan2(R12[free1], R02[free1])
-        lo1 = -math.inf if lower is None else float(lower[0])
-        hi1 = math.inf if upper is None else float(upper[0])
-    straight_ref = None if ref is None else pa.signs[3] * ref[:, 3] + pa.offsets[3]
-    for sh in (0, 1):
-        if sh == 0:
-            c1 = (cx * n + cy * b) * inv
-            s1 = (cy * n - cx * b) * inv
-            X = n - pa.a1
-        else:
-            c1 = -(cx * n - cy * b) * inv
-            s1 = -(cy * n + cx * b) * inv
-            X = -(n + pa.a1)
-        if free1.size:
-            t1 = pa.signs[0] * clamp_circular(q1_free + sh * math.pi, lo1, hi1) + pa.offsets[0]
-            c1[free1], s1[free1] = np.cos(t1), np.sin(t1)
-        s_2 = X * X + Z * Z
-        s = np.sqrt(s_2)
-        # The wrist centre must lie between the folded and the stretched elbow.
-        err_el = reach_distance(err_sh, np.maximum(s - (pa.c2 + kappa), abs(pa.c2 - kappa) - s), rnd)
-        e = np.sqrt(err_el)
-        ok = e <= REACH_TOL
-        K = np.clip((s_2 - base) * denom, -1.0, 1.0)
-        S = np.sqrt(1.0 - K * K)
-        M00 = c1 * R00 + s1 * R10
-        M01 = c1 * R01 + s1 * R11
-        M02 = c1 * R02 + s1 * R12
-        M10 = c1 * R10 - s1 * R00
-        M11 = c1 * R11 - s1 * R01
-        M12 = c1 * R12 - s1 * R02
-        wz = pa.c2 + kappa * K
-        t1q = ang(0, s1, c1)
-        for el in (0, 1):
-            sphi = S if el == 0 else -S
-            c3 = K * cpsi + sphi * spsi
-            s3 = sphi * cpsi - K * spsi
-            wx = kappa * sphi
-            cu = wx * X + wz * Z
-            su = wz * X - wx * Z
-            norm = np.sqrt(s_2 * (wx * wx + wz * wz))
-            flat = norm < 1e-300
-            inv_norm = 1.0 / np.where(flat, 1.0, norm)
-            c2 = np.where(flat, 1.0, cu * inv_norm)
-            s2 = su * inv_norm
-            c23 = c2 * c3 - s2 * s3
-            s23 = s2 * c3 + c2 * s3
-            r02 = c23 * M02 - s23 * R22
-            r22 = s23 * M02 + c23 * R22
-            r00 = c23 * M00 - s23 * R20
-            r01 = c23 * M01 - s23 * R21
-            h = np.sqrt(r02 * r02 + M12 * M12)
-            straight = h < SINGULAR_TOL
-            inv_h = 1.0 / np.where(straight, 1.0, h)
-            c4 = r02 * inv_h
-            s4 = M12 * inv_h
-            if straight_ref is None:
-                c4 = np.where(straight, 1.0, c4)
-            else:  # axis 4 keeps the reference's value, axis 6 takes the rest
-                c4 = np.where(straight, np.cos(straight_ref), c4)
-                s4 = np.where(straight, np.sin(straight_ref), s4)
-            k = 4 * sh + 2 * el
-            t2q = ang(1, s2, c2)
-            t3q = ang(2, s3, c3)
-            n6, d6 = c4 * M10 - s4 * r00, c4 * M11 - s4 * r01
-            for col, val in enumerate((t1q, t2q, t3q, ang(3, s4, c4), ang(4, h, r22), ang(5, n6, d6))):
-                out[:, k, col] = val
-            # The flipped wrist: t4 + pi, -t5, t6 + pi.
-            for col, val in enumerate((t1q, t2q, t3q, ang(3, -s4, -c4), ang(4, -h, r22),
-                                       ang(5, -n6, -d6))):
-                out[:, k + 1, col] = val
-            reach[:, k] = ok
-            reach[:, k + 1] = ok
-            err[:, k] = e
-            err[:, k + 1] = e
-    out[~reach] = np.nan
-    return reach

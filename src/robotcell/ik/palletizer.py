@@ -29,9 +29,9 @@ from scipy.spatial.transform import Rotation
 from robotcell.errors import InputError
 from robotcell.ik.axes import AXIS_TOL
 from robotcell.ik.limits import wrap_to_pi
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 
-__all__ = ["PalletizerParameters", "palletizer_kernel", "palletizer_parameters", "palletizer_problems"]
+__all__ = ["PalletizerParameters", "palletizer_parameters", "palletizer_problems"]
 
 #: Largest deviation of a target orientation from level (sine of the tilt) that still counts as
 #: reachable; a palletizer's flange cannot tilt.
@@ -81,7 +81,7 @@ class PalletizerParameters:
     T_e_n: NDArray[np.float64]
 
 
-def _end(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
+def _end(robot: Arm, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Pose of the last DH frame n in R at controller values ``q`` (..., 4)."""
     return robot.frames(q)[..., -1, :, :]
 
@@ -100,7 +100,7 @@ def _circle(p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
     return centre, float(np.linalg.norm(a - centre))
 
 
-def palletizer_problems(robot: Robot) -> list[str]:
+def palletizer_problems(robot: Arm) -> list[str]:
     """Why ``robot`` is not a 4-axis palletizer with a level flange (empty if it is)."""
     if robot.n_joints != 4:
         return [f"it has {robot.n_joints} controller axes, not 4"]
@@ -123,7 +123,7 @@ def palletizer_problems(robot: Robot) -> list[str]:
     return out
 
 
-def palletizer_parameters(robot: Robot) -> PalletizerParameters:
+def palletizer_parameters(robot: Arm) -> PalletizerParameters:
     """Identify the planar parameters of a palletizer from its forward kinematics.
 
     Raises
@@ -206,65 +206,3 @@ def palletizer_parameters(robot: Robot) -> PalletizerParameters:
     R_n0 = T_R_O[:3, :3].T @ T0[:3, :3]
     return PalletizerParameters(float(A[0]), float(A[1]), b, L2, L3, s1, s4, g22, o2, g32, g33,
                                 o3, v_n, R_n0, T_R_O, np.eye(4))
-
-
-def palletizer_kernel(params: PalletizerParameters, R: NDArray[np.float64], P: NDArray[np.float64],
-                      out: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """All 4 solutions, as controller axis values, for poses of frame n expressed in O.
-
-    Parameters
-    ----------
-    params : PalletizerParameters
-    R : ndarray, shape (N, 3, 3)
-        Rotations ``R_O_n``.
-    P : ndarray, shape (N, 3)
-        Positions ``p_O_n`` (m).
-    out : ndarray, shape (N, 4, 4)
-        Receives the controller values in ``(-pi, pi]`` (rad) of branch
-        ``k = 2 * shoulder + elbow``: shoulder 1 = ``W`` behind axis 1, elbow 1 = the second
-        solution of the two-link problem. Unreachable branches (and targets that are not level)
-        are NaN.
-
-    Returns
-    -------
-    ndarray of bool, shape (N, 4)
-    """
-    pa = params
-    D = R @ pa.R_n0.T  # must be Rz(psi)
-    level = (np.abs(D[:, 2, 0]) <= LEVEL_TOL) & (np.abs(D[:, 2, 1]) <= LEVEL_TOL)
-    psi = np.arctan2(D[:, 1, 0] - D[:, 0, 1], D[:, 0, 0] + D[:, 1, 1])
-    W = P + R @ pa.v_n
-    wx, wy, wz = W[:, 0], W[:, 1], W[:, 2]
-    rho2 = wx * wx + wy * wy
-    n2 = rho2 - pa.b * pa.b
-    ok_sh = level & (n2 >= -AXIS_TOL * AXIS_TOL)
-    n = np.sqrt(np.maximum(n2, 0.0))
-    base = np.arctan2(wy, wx)
-    h = wz - pa.A_h
-    L2, L3 = pa.L2, pa.L3
-    reach = np.empty((P.shape[0], 4), dtype=bool)
-    for sh in (0, 1):
-        r = n if sh == 0 else -n
-        phi1 = base - np.arctan2(pa.b, r)
-        q1 = wrap_to_pi(phi1 / pa.s1)
-        q4 = wrap_to_pi((psi - pa.s1 * q1) / pa.s4)
-        tr = r - pa.A_r
-        d2 = tr * tr + h * h
-        K = (d2 - L2 * L2 - L3 * L3) / (2.0 * L2 * L3)
-        ok = ok_sh & (np.abs(K) <= 1.0 + COS_TOL)
-        K = np.clip(K, -1.0, 1.0)
-        S = np.sqrt(1.0 - K * K)
-        for el in (0, 1):
-            s = S if el == 0 else -S
-            phi2 = np.arctan2(h, tr) - np.arctan2(L3 * s, L2 + L3 * K)
-            phi3 = phi2 + np.arctan2(s, K)
-            q2 = wrap_to_pi(phi2 - pa.o2) / pa.g22
-            q3 = wrap_to_pi(phi3 - pa.o3 - pa.g32 * q2) / pa.g33
-            k = 2 * sh + el
-            out[:, k, 0] = q1
-            out[:, k, 1] = q2
-            out[:, k, 2] = q3
-            out[:, k, 3] = q4
-            reach[:, k] = ok
-    out[~reach] = np.nan
-    return reach

@@ -10,8 +10,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.transforms import finite_array
 
-__all__ = ["EXACT_TOL", "REACH_TOL", "IKSolutions", "NumericIKResult", "exact_branches",
-           "flat_reference"]
+__all__ = ["EXACT_TOL", "REACH_TOL", "IKSolutions", "NumericIKResult", "flat_reference"]
 
 #: A pose outside a branch's reach by at most this distance (m) is solved at the boundary of the
 #: reach, as controllers do with rounded poses; the distance is reported in
@@ -19,29 +18,6 @@ __all__ = ["EXACT_TOL", "REACH_TOL", "IKSolutions", "NumericIKResult", "exact_br
 REACH_TOL = 1e-6
 #: A branch whose reach error is at most this (m) solves the pose exactly (up to rounding).
 EXACT_TOL = 1e-9
-
-
-def exact_branches(valid: NDArray[np.bool_], err: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """``valid`` without the branches that miss a pose another valid branch reaches exactly.
-
-    A branch solved at the boundary of its reach (``EXACT_TOL < err <= REACH_TOL``) misses the
-    pose by ``err``; it stands for the pose only when the robot cannot reach the pose otherwise,
-    i.e. when no valid branch (within the joint limits) of that pose is exact
-    (``err <= EXACT_TOL``): the pose is then out of the robot's reach by rounding.
-
-    Parameters
-    ----------
-    valid : ndarray of bool, shape (N, b)
-        Branches within ``REACH_TOL`` of their reach and within the joint limits.
-    err : ndarray, shape (N, b)
-        Their reach errors (m).
-
-    Returns
-    -------
-    ndarray of bool, shape (N, b)
-    """
-    exact = valid & (err <= EXACT_TOL)
-    return valid & (exact | ~np.any(exact, axis=-1, keepdims=True))
 
 
 @dataclass(frozen=True)
@@ -70,7 +46,7 @@ class IKSolutions:
         ``reach_error`` (the orientation is exact). ``reachable`` is
         ``reach_error <= REACH_TOL``; such a branch is ``valid`` only when it is exact
         (``reach_error <= EXACT_TOL``, 1 nm) or when no valid branch of the pose is (the pose
-        is out of the robot's reach by rounding), see :func:`exact_branches`. A palletizer's solver gives no
+        is out of the robot's reach by rounding). A palletizer's solver gives no
         distance: 0 where a branch reaches, ``inf`` where it does not.
     """
 

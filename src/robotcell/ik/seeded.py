@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.ik.numeric import solve_numeric
 from robotcell.ik.result import IKSolutions, flat_reference
-from robotcell.kinematics.robot import Robot
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.transforms import validate_pose
 
 __all__ = ["SEEDED_TOL", "SeededSolver"]
@@ -37,7 +37,7 @@ class SeededSolver:
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         The model to solve (e.g. an identified arm; its coupling, if any, is honoured).
     seed : AnalyticSolver
         Analytic solver of a nearby model with the same chain of joints (its nominal model); its
@@ -55,7 +55,7 @@ class SeededSolver:
         ``numeric, seeded by <seed> (<method>)``.
     """
 
-    def __init__(self, robot: Robot, seed: Any, tol: float = SEEDED_TOL) -> None:
+    def __init__(self, robot: Arm, seed: Any, tol: float = SEEDED_TOL) -> None:
         self.robot, self.seed, self.tol = robot, seed, tol
         self.method, self.branches, self.params = seed.method, seed.branches, seed.params
         self.description = f"numeric, seeded by {seed.robot.name} ({seed.method})"

@@ -16,8 +16,8 @@ from robotcell.errors import InputError
 from robotcell.ik.config import abb_confdata, kuka_status_turn
 from robotcell.ik.limits import TWO_PI, shift_into_interval
 from robotcell.ik.result import IKSolutions
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.bounds import within
-from robotcell.kinematics.robot import Robot
 
 __all__ = ["nearest", "select_abb", "select_kuka"]
 
@@ -33,7 +33,7 @@ def _pick(q: NDArray[np.float64], ok: NDArray[np.bool_], cost: NDArray[np.float6
     return out, found, np.where(found, k, -1)
 
 
-def nearest(robot: Robot, solutions: IKSolutions, q_ref: ArrayLike,
+def nearest(robot: Arm, solutions: IKSolutions, q_ref: ArrayLike,
             weights: ArrayLike | None = None
             ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.int_]]:
     """The valid solution nearest to a reference configuration.
@@ -43,7 +43,7 @@ def nearest(robot: Robot, solutions: IKSolutions, q_ref: ArrayLike,
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
         The robot that produced ``solutions`` (limits, joint types); for a track robot its
         :meth:`~robotcell.ik.track.TrackRobot.as_robot`.
     solutions : IKSolutions
@@ -94,13 +94,13 @@ def _signed(q: NDArray[np.float64], negative: NDArray[np.bool_], lo: NDArray[np.
     return np.where(within(out, lo, hi), out, np.nan)
 
 
-def select_kuka(robot: Robot, solutions: IKSolutions, status: ArrayLike, turn: ArrayLike
+def select_kuka(robot: Arm, solutions: IKSolutions, status: ArrayLike, turn: ArrayLike
                 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """The solution with the given KUKA Status and Turn (see :mod:`robotcell.ik.config`).
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
     solutions : IKSolutions
         From ``robot.ik``, ``q`` of shape ``(..., 8, 6)``.
     status, turn : array_like of int, shape broadcastable to (...)
@@ -121,13 +121,13 @@ def select_kuka(robot: Robot, solutions: IKSolutions, status: ArrayLike, turn: A
     return out, found
 
 
-def select_abb(robot: Robot, solutions: IKSolutions, confdata: ArrayLike
+def select_abb(robot: Arm, solutions: IKSolutions, confdata: ArrayLike
                ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """The solution with the given ABB ``confdata`` ``[cf1, cf4, cf6, cfx]``.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Arm
     solutions : IKSolutions
         From ``robot.ik``, ``q`` of shape ``(..., 8, 6)``.
     confdata : array_like of int, shape (..., 4)

@@ -28,8 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.ik.analytic import solve
 from robotcell.ik.result import IKSolutions
+from robotcell.kinematics.arm import Arm, Joint
 from robotcell.kinematics.bounds import within
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import invert, make_pose, rot_x, rot_y, validate_pose
 
 __all__ = ["TrackChoice", "TrackRobot"]
@@ -60,7 +60,7 @@ class TrackRobot:
 
     Attributes
     ----------
-    arm : Robot
+    arm : Arm
         The six-axis arm; its base frame R is the frame that slides.
     T_L_R0 : ndarray, shape (4, 4)
         Pose of the arm's base frame R in the track frame L at track value 0 (m).
@@ -71,7 +71,7 @@ class TrackRobot:
     name : str
     """
 
-    arm: Robot
+    arm: Arm
     T_L_R0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     direction: NDArray[np.float64] = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))
     lower: float = -math.inf
@@ -192,7 +192,7 @@ class TrackRobot:
         return grid[rows, k], score[rows, k]
 
     # -- the same system as one DH chain ----------------------------------------------------------
-    def as_robot(self) -> Robot:
+    def as_robot(self) -> Arm:
         """The arm and its track as one 7-joint DH robot (frame R of the result is L).
 
         Joint 1 is prismatic along ``direction``; DH frame 0 sits at the arm's first joint frame at
@@ -202,8 +202,9 @@ class TrackRobot:
 
         Returns
         -------
-        Robot
-            Joint values ``(x, q1, ..., q6)`` as in :meth:`fk` (controller values; an arm's
+        Arm
+            Of the arm's class (a :class:`~robotcell.kinematics.robot.Robot` for a robot); joint
+            values ``(x, q1, ..., q6)`` as in :meth:`fk` (controller values; an arm's
             coupling is carried over, extended by the uncoupled track axis); limits ``lower``,
             ``upper`` on x.
         """
@@ -236,7 +237,7 @@ class TrackRobot:
             mid = 0.5 * (self.lower + self.upper) if math.isfinite(self.lower + self.upper) else 0.0
             home = np.concatenate([[mid], arm.home])
         coupling = None if arm.coupling is None else arm.coupling.extended(1)
-        return Robot(f"{arm.name}_on_{self.name}", (track, first) + arm.joints[1:], arm.convention,
-                     base=base, flange=arm.flange, tool=arm.tool, home=home,
-                     title=f"{arm.title or arm.name} on a linear track", source=arm.source,
-                     coupling=coupling)
+        # The arm's own class (a Robot stays a Robot), without the arm's verification and seed.
+        return replace(arm, name=f"{arm.name}_on_{self.name}", joints=(track, first) + arm.joints[1:],
+                       base=base, home=home, title=f"{arm.title or arm.name} on a linear track",
+                       verified=False, verification="", coupling=coupling, ik_seed=None)

@@ -39,17 +39,14 @@ from robotcell.ik.axes import (
     line_distance,
     six_revolute_problems,
 )
-from robotcell.ik.limits import wrap_to_pi
-from robotcell.ik.opw import ROUND, _controller_angle, reach_distance
-from robotcell.ik.result import REACH_TOL
+from robotcell.kinematics.arm import Arm
 from robotcell.kinematics.dh import link_transform
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert
 
-__all__ = ["URParameters", "ur_fk", "ur_kernel", "ur_parameters", "ur_problems"]
+__all__ = ["URParameters", "ur_fk", "ur_parameters", "ur_problems"]
 
 #: Below this sine of the canonical t5 the wrist is treated as exactly singular: axis 6 is free and
-#: chosen by :func:`_free_t6` (axes 2-4 then take the rest of the rotation).
+#: chosen by :func:`robotcell.ik.kernels._free_t6` (axes 2-4 then take the rest of the rotation).
 SINGULAR_TOL = 1e-12
 _ALPHA = np.array([math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0])
 
@@ -82,7 +79,7 @@ class URParameters:
     T_e_n: NDArray[np.float64]
 
 
-def ur_problems(robot: Robot) -> list[str]:
+def ur_problems(robot: Arm) -> list[str]:
     """Reasons why ``robot`` is not a Universal-Robots-type arm (empty if it is)."""
     basic = six_revolute_problems(robot)
     if basic:
@@ -127,7 +124,7 @@ def ur_fk(params: URParameters, theta: NDArray[np.float64]) -> NDArray[np.float6
     return T
 
 
-def ur_parameters(robot: Robot) -> URParameters:
+def ur_parameters(robot: Arm) -> URParameters:
     """Derive the canonical UR parameters of a robot model.
 
     Frame O: z along axis 1 (its positive direction), y opposite to axis 2 (so that the canonical
@@ -196,150 +193,3 @@ def ur_fk_frames(params: URParameters, theta: NDArray[np.float64]) -> NDArray[np
     for i in range(4):
         T = T @ link_transform(theta[i], d[i], a[i], _ALPHA[i])
     return T
-
-
-def _free_t6(c: tuple[NDArray[np.float64], NDArray[np.float64]],
-             u: tuple[NDArray[np.float64], NDArray[np.float64]],
-             w: tuple[NDArray[np.float64], NDArray[np.float64]],
-             target: NDArray[np.float64], d5: float, rmin: float, rmax: float
-             ) -> NDArray[np.float64]:
-    """Canonical t6 (rad) at the wrist singularity: nearest to ``target`` with axes 2/3 in reach.
-
-    At ``sin t5 = 0`` axis 6 is parallel to axes 2-4 and only the sum of the angles is fixed. Axis
-    6 then moves the wrist-1 point on a circle of radius ``d5`` around the planar position ``c``
-    of the wrist-2 point: ``p(t6) = c + d5 (sin t6 u + cos t6 w)`` (``u``, ``w`` the planar
-    directions of the flange's x and y axes). The planar problem of axes 2 and 3 is solvable where
-    ``rmin <= |p| <= rmax``, an arc of angles ``|theta| in [ta, tb]`` around the direction of ``c``;
-    the target angle is moved onto it (onto its nearest point to the reach when it is empty).
-    """
-    cx, cy = c
-    cn = np.hypot(cx, cy)
-    safe = np.where(cn > 0, cn, 1.0)
-    ex, ey = cx / safe, cy / safe
-    lo = (rmin * rmin - cn * cn - d5 * d5) / (2 * d5 * safe)
-    hi = (rmax * rmax - cn * cn - d5 * d5) / (2 * d5 * safe)
-    ta = np.arccos(np.clip(hi, -1.0, 1.0))
-    tb = np.arccos(np.clip(lo, -1.0, 1.0))
-    st, ct = np.sin(target), np.cos(target)
-    vx, vy = st * u[0] + ct * w[0], st * u[1] + ct * w[1]
-    th = np.arctan2(ex * vy - ey * vx, ex * vx + ey * vy)
-    th = np.where(th < 0, -1.0, 1.0) * np.clip(np.abs(th), ta, tb)
-    vx, vy = np.cos(th) * ex - np.sin(th) * ey, np.sin(th) * ex + np.cos(th) * ey
-    t6 = np.arctan2(vx * u[0] + vy * u[1], vx * w[0] + vy * w[1])
-    return np.where(cn > 0, t6, target)
-
-
-def ur_kernel(params: URParameters, R: NDArray[np.float64], P: NDArray[np.float64],
-              out: NDArray[np.float64], err: NDArray[np.float64],
-              ref: NDArray[np.float64] | None = None,
-              lower: NDArray[np.float64] | None = None,
-              upper: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
-    """All 8 solutions, as controller axis values, for poses of frame 6 expressed in O.
-
-    Parameters
-    ----------
-    params : URParameters
-    R : ndarray, shape (N, 3, 3)
-        Rotations ``R_O_6``.
-    P : ndarray, shape (N, 3)
-        Positions ``p_O_6`` (m).
-    out : ndarray, shape (N, 8, 6)
-        Receives the controller values ``q = sign * (theta - offset)`` in ``(-pi, pi]`` (rad);
-        branch ``k = 4 * shoulder + 2 * elbow + wrist``:
-        shoulder 1 = second solution of axis 1, wrist 1 = negative canonical ``t5``, elbow 1 =
-        negative canonical ``t3``. Unreachable branches are NaN.
-    err : ndarray, shape (N, 8)
-        Receives the distance (m) of the wrist points outside the branch's reach (0 inside).
-    ref : ndarray, shape (N, 6), optional
-        Reference controller values (rad): at the wrist singularity axis 6 is chosen nearest to
-        the reference's axis 6 (default: canonical 0) among the values that keep axes 2 and 3 in
-        reach.
-    lower, upper : ndarray, shape (6,), optional
-        Not needed by this structure (same signature as the other kernels).
-
-    Returns
-    -------
-    ndarray of bool, shape (N, 8)
-        Which branches reach the pose (``err <= REACH_TOL``).
-    """
-    pa = params
-    X0, X1, X2 = R[:, 0, 0], R[:, 1, 0], R[:, 2, 0]
-    Y0, Y1, Y2 = R[:, 0, 1], R[:, 1, 1], R[:, 2, 1]
-    Z0, Z1, Z2 = R[:, 0, 2], R[:, 1, 2], R[:, 2, 2]
-    p5x = P[:, 0] - pa.d6 * Z0
-    p5y = P[:, 1] - pa.d6 * Z1
-    p5z = P[:, 2] - pa.d6 * Z2
-    r2 = p5x * p5x + p5y * p5y
-    a2, a3 = pa.a2, pa.a3
-    rmax, rmin = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
-    rnd = ROUND * 2 * (abs(pa.d1) + rmax + abs(pa.d4) + abs(pa.d5) + abs(pa.d6))
-    r = np.sqrt(r2)
-    # The wrist-2 point must not be nearer to axis 1 than d4.
-    err_sh = reach_distance(0.0, abs(pa.d4) - r, rnd)
-    inv_r = 1.0 / np.where(r2 > 0, r, 1.0)
-    t = np.clip(pa.d4 * inv_r, -1.0, 1.0)
-    k = np.sqrt(1.0 - t * t)
-    den3 = 1.0 / (2.0 * a2 * a3)
-    reach = np.empty((P.shape[0], 8), dtype=bool)
-    ang = _controller_angle(pa.signs, pa.offsets)
-    t6_ref = 0.0 if ref is None else pa.signs[5] * ref[:, 5] + pa.offsets[5]
-    for sh in (0, 1):
-        kk = k if sh == 0 else -k
-        c1 = (p5x * kk - p5y * t) * inv_r
-        s1 = (p5y * kk + p5x * t) * inv_r
-        t1q = ang(0, s1, c1)
-        vx = X0 * s1 - X1 * c1
-        vy = Y0 * s1 - Y1 * c1
-        vz = Z0 * s1 - Z1 * c1
-        h = np.sqrt(vx * vx + vy * vy)
-        t6p = np.arctan2(-vy, vx)
-        free6 = np.flatnonzero(h < SINGULAR_TOL)
-        for wr in (0, 1):
-            t6 = t6p if wr == 0 else t6p + math.pi
-            if free6.size:
-                t6 = t6.copy()
-                f, cf, sf = free6, c1[free6], s1[free6]
-                target = np.broadcast_to(t6_ref, t6.shape)[f] + wr * math.pi
-                t6[f] = (target if pa.d5 == 0 else
-                         _free_t6((cf * p5x[f] + sf * p5y[f], p5z[f] - pa.d1),
-                                  (cf * X0[f] + sf * X1[f], X2[f]), (cf * Y0[f] + sf * Y1[f], Y2[f]),
-                                  target, pa.d5, rmin, rmax))
-            s5 = h if wr == 0 else -h
-            c5 = vz
-            s6, c6 = np.sin(t6), np.cos(t6)
-            q5 = ang(4, s5, c5)
-            q6 = ang(5, s6, c6)
-            z4x, z4y, z4z = -s6 * X0 - c6 * Y0, -s6 * X1 - c6 * Y1, -s6 * X2 - c6 * Y2
-            # x4 = c5 c6 X6 - c5 s6 Y6 - s5 Z6 (c5, s5 scaled alike by the unit length of v)
-            x4x = c5 * (c6 * X0 - s6 * Y0) - s5 * Z0
-            x4y = c5 * (c6 * X1 - s6 * Y1) - s5 * Z1
-            x4z = c5 * (c6 * X2 - s6 * Y2) - s5 * Z2
-            p4x = p5x - pa.d5 * z4x
-            p4y = p5y - pa.d5 * z4y
-            p4z = p5z - pa.d5 * z4z
-            px = c1 * p4x + s1 * p4y
-            py = p4z - pa.d1
-            t234 = np.arctan2(x4z, c1 * x4x + s1 * x4y)
-            pr = np.sqrt(px * px + py * py)
-            # The wrist-1 point must lie between the folded and the stretched elbow.
-            e = np.sqrt(reach_distance(err_sh, np.maximum(pr - rmax, rmin - pr), rnd))
-            ok = e <= REACH_TOL
-            D = np.clip((pr * pr - a2 * a2 - a3 * a3) * den3, -1.0, 1.0)
-            S = np.sqrt(1.0 - D * D)
-            for el in (0, 1):
-                s3 = S if el == 0 else -S
-                wx = a2 + a3 * D
-                wy = a3 * s3
-                t2 = np.arctan2(py * wx - px * wy, px * wx + py * wy)
-                t3 = np.arctan2(s3, D)
-                kidx = 4 * sh + 2 * el + wr
-                out[:, kidx, 0] = t1q
-                out[:, kidx, 1] = wrap_to_pi((t2 - pa.offsets[1]) * pa.signs[1])
-                out[:, kidx, 2] = wrap_to_pi((t3 - pa.offsets[2]) * pa.signs[2])
-                out[:, kidx, 3] = wrap_to_pi((t234 - t2 - t3 - pa.offsets[3]) * pa.signs[3])
-                out[:, kidx, 4] = q5
-                out[:, kidx, 5] = q6
-                reach[:, kidx] = ok
-                err[:, kidx] = e
-    out[~reach] = np.nan
-    return reach

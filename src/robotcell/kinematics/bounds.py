@@ -38,4 +38,7 @@ def within(values: ArrayLike, lower: ArrayLike, upper: ArrayLike,
     ndarray of bool, shape (...)
     """
     v = np.asarray(values, dtype=float)
+    if v.ndim == 0 and type(lower) is float and type(upper) is float:  # one value: no ufuncs
+        x = float(v)
+        return np.bool_(x >= lower - tol and x <= upper + tol)
     return (v >= np.asarray(lower, dtype=float) - tol) & (v <= np.asarray(upper, dtype=float) + tol)

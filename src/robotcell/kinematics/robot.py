@@ -1,28 +1,19 @@
-"""A serial robot arm described by Denavit-Hartenberg parameters.
+"""A serial robot arm with its inverse kinematics.
 
-``T_R_TCP(q) = T_R_0 · T_0_1(q_1) ··· T_{n-1,n}(q_n) · T_n_F · T_F_TCP`` with the base transform
-``T_R_0``, the DH chain, the flange transform ``T_n_F`` and the tool ``T_F_TCP``. Joint values are
-controller axis values (see ``docs/conventions.md``): the DH variable is ``sign * q + offset``.
-A robot with a :class:`~robotcell.kinematics.coupling.Coupling` (parallel linkage, passive joints) maps its
-controller values to the chain's joint values first, ``q_model = C q + offset``; every method
-takes and returns controller values.
+:class:`Robot` is an :class:`~robotcell.kinematics.arm.Arm` (the DH model: forward kinematics,
+Jacobian, limits, coupling; see that module) with :meth:`Robot.ik`, which offers the analytic
+solvers of :mod:`robotcell.ik`. The solvers work on the :class:`~robotcell.kinematics.arm.Arm`
+below this module and never import it, so the robot stands above them and no import runs in a
+circle (docs/conventions.md, "Layout").
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from robotcell.errors import InputError
-from robotcell.kinematics.bounds import LIMIT_TOL, within
-from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.covariance import ParameterCovariance
-from robotcell.kinematics.dh import Chain, Convention
-from robotcell.kinematics.transforms import validate_pose
+from robotcell.kinematics.arm import Arm, Joint
 
 if TYPE_CHECKING:
     from robotcell.ik.result import IKSolutions
@@ -30,369 +21,14 @@ if TYPE_CHECKING:
 __all__ = ["Joint", "Robot"]
 
 
-@dataclass(frozen=True)
-class Joint:
-    """One joint of a DH chain, in SI units.
+class Robot(Arm):
+    """A serial arm: DH joints, base, flange and tool transforms, provenance, and its IK.
 
-    Attributes
-    ----------
-    type : {"revolute", "prismatic"}
-    a : float
-        Link length (m); Craig's ``a_{i-1}`` in the modified convention.
-    alpha : float
-        Link twist (rad); Craig's ``alpha_{i-1}`` in the modified convention.
-    d : float
-        Joint distance (m); for a prismatic joint the constant added to ``sign * q``.
-    theta : float
-        Joint angle (rad); for a revolute joint the constant added to ``sign * q``.
-    sign : float
-        +1 or -1, direction of the controller axis relative to the DH variable.
-    lower, upper : float
-        Limits of the controller axis value ``q`` (rad or m); infinite when unlimited.
-    name : str
-        Axis name as the controller shows it (``A1``, ``J1``, ...).
-    passive : bool
-        A joint without a controller axis, moved by a linkage (a palletizer's parallelogram);
-        its value comes from the robot's coupling and its limits are not used.
-    mass : float
-        Mass of the link this joint moves (kg); 0 when not stated. Used only for gravity
-        compliance in identification.
-    com : tuple of 3 float
-        Centre of mass of that link in its DH frame (m).
-    beta : float
-        Hayati's rotation about the link's y axis after the twist (rad; 0 for plain DH): standard
-        ``Tz(d) Rz(theta) Tx(a) Rx(alpha) Ry(beta)``, modified ``Rx(alpha) Ry(beta) Tx(a) Rz(theta)
-        Tz(d)``. An identified arm has it where two axes are nearly parallel (docs/models.md).
+    Build one with :func:`robotcell.load_robot` (library name or model file) or directly, with
+    the fields of :class:`~robotcell.kinematics.arm.Arm` (``name``, ``joints``, ``convention``,
+    ``base``, ``flange``, ``tool``, ``home``, ``title``, ``source``, ``verified``,
+    ``verification``, ``coupling``, ``ik_seed``, ``covariance``).
     """
-
-    type: Literal["revolute", "prismatic"]
-    a: float = 0.0
-    alpha: float = 0.0
-    d: float = 0.0
-    theta: float = 0.0
-    sign: float = 1.0
-    lower: float = -math.inf
-    upper: float = math.inf
-    name: str = ""
-    passive: bool = False
-    mass: float = 0.0
-    com: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    beta: float = 0.0
-
-    @property
-    def prismatic(self) -> bool:
-        """True for a prismatic (sliding) joint."""
-        return self.type == "prismatic"
-
-
-@dataclass(frozen=True, eq=False)
-class Robot:
-    """A serial arm: DH joints, base, flange and tool transforms, provenance.
-
-    Build one with :func:`robotcell.load_robot` (library name or model file) or directly.
-
-    Attributes
-    ----------
-    name : str
-    joints : tuple of Joint
-    convention : {"standard", "modified"}
-    base : ndarray, shape (4, 4)
-        ``T_R_0``, pose of DH frame 0 in the robot base frame R (metres).
-    flange : ndarray, shape (4, 4)
-        ``T_n_F``, pose of the flange frame in the last DH frame (metres).
-    tool : ndarray, shape (4, 4)
-        ``T_F_TCP``, the default tool: pose of the TCP in the flange frame (metres).
-    home : ndarray, shape (n,) or None
-        A typical home configuration (rad, m).
-    title, source, verification : str
-        Human name, citation of the parameters, and how they were checked.
-    verified : bool
-        True when the model was checked against an independent published value.
-    coupling : Coupling or None
-        Linear map from controller axis values to the chain's joint values (one row per joint,
-        one column per non-passive joint); None when every joint is its own controller axis.
-    ik_seed : Robot or None
-        A nearby model with a closed-form IK (an identified arm's nominal model): when this model
-        has none, :meth:`ik` refines the seed's analytic branches numerically (docs/ik.md).
-    covariance : ParameterCovariance or None
-        An identified model's: the covariance of the constants the identification moved
-        (docs/accuracy.md).
-    """
-
-    name: str
-    joints: tuple[Joint, ...]
-    convention: Convention = "standard"
-    base: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    flange: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    tool: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    home: NDArray[np.float64] | None = None
-    title: str = ""
-    source: str = ""
-    verified: bool = False
-    verification: str = ""
-    coupling: Coupling | None = None
-    ik_seed: Robot | None = None
-    covariance: ParameterCovariance | None = None
-
-    def __post_init__(self) -> None:
-        if self.convention not in ("standard", "modified"):
-            raise InputError(f"convention must be 'standard' or 'modified', got {self.convention!r}")
-        if not self.joints:
-            raise InputError("a robot needs at least one joint")
-        for i, j in enumerate(self.joints, start=1):
-            if j.type not in ("revolute", "prismatic"):
-                raise InputError(f"joint {i}: type must be 'revolute' or 'prismatic', got {j.type!r}")
-            if j.sign not in (1.0, -1.0):
-                raise InputError(f"joint {i}: sign must be +1 or -1, got {j.sign}")
-            if not j.lower < j.upper:
-                raise InputError(f"joint {i}: lower limit {j.lower} is not below upper limit {j.upper}")
-        axes = tuple(j for j in self.joints if not j.passive)
-        if self.coupling is None and len(axes) != len(self.joints):
-            raise InputError("passive joints need a coupling that says how they move")
-        if self.coupling is not None and self.coupling.matrix.shape != (len(self.joints), len(axes)):
-            raise InputError(
-                f"the coupling matrix must have one row per joint and one column per controller "
-                f"(non-passive) axis, shape ({len(self.joints)}, {len(axes)}); got "
-                f"{self.coupling.matrix.shape}"
-            )
-        if self.covariance is not None:
-            known = {j.name or f"A{i}" for i, j in enumerate(self.joints, start=1)}
-            bad = [n for n in self.covariance.names
-                   if n != "j23_factor" and n.rpartition(".")[0] not in known]
-            if bad:
-                raise InputError(f"covariance: parameter(s) {', '.join(bad)} of no joint of this "
-                                 f"robot (joints {', '.join(sorted(known))})")
-        object.__setattr__(self, "_axes", axes)
-        for key in ("base", "flange", "tool"):
-            object.__setattr__(self, key, validate_pose(getattr(self, key), key).copy())
-        if self.home is not None:
-            object.__setattr__(self, "home", self._joints(self.home, "home"))
-        js = self.joints
-        chain = Chain(self.convention, [j.a for j in js], [j.alpha for j in js], [j.d for j in js],
-                      [j.theta for j in js], [j.prismatic for j in js], [j.sign for j in js],
-                      [j.beta for j in js])
-        object.__setattr__(self, "_chain", chain)
-        tail = self.flange @ self.tool
-        object.__setattr__(self, "_tail", tail)
-        # Start pose of the single-pose kernel, as columns; the tail is applied afterwards.
-        object.__setattr__(self, "_start_cols", [self.base[:3, k].tolist() for k in range(4)])
-        object.__setattr__(self, "_tail_cols", tail[:3, :].tolist())
-        object.__setattr__(self, "_tail_is_identity", bool(np.array_equal(tail, np.eye(4))))
-
-    # -- properties -----------------------------------------------------------------------------
-    @property
-    def n_joints(self) -> int:
-        """Number of controller axes ``n`` (the chain's joints minus the passive ones)."""
-        return len(self._axes)
-
-    @property
-    def axes(self) -> tuple[Joint, ...]:
-        """The joints that are controller axes (all but the passive ones), in order."""
-        return self._axes
-
-    @property
-    def lower(self) -> NDArray[np.float64]:
-        """Lower limits of the controller axes, shape ``(n,)`` (rad or m)."""
-        return np.array([j.lower for j in self._axes])
-
-    @property
-    def upper(self) -> NDArray[np.float64]:
-        """Upper limits of the controller axes, shape ``(n,)`` (rad or m)."""
-        return np.array([j.upper for j in self._axes])
-
-    @property
-    def prismatic(self) -> NDArray[np.bool_]:
-        """Mask of prismatic controller axes, shape ``(n,)``."""
-        return np.array([j.prismatic for j in self._axes])
-
-    def uncoupled(self) -> Robot:
-        """The kinematic model alone: the same chain whose joint values are the model's.
-
-        For a robot without coupling this is the robot itself. Otherwise a robot with every joint
-        of the chain as an axis (passive ones included), no coupling and no joint limits (limits
-        are stated for controller values); ``uncoupled().fk(coupling.to_model(q)) == fk(q)``.
-        """
-        if self.coupling is None:
-            return self
-        model = self.__dict__.get("_uncoupled")
-        if model is None:
-            joints = tuple(replace(j, lower=-math.inf, upper=math.inf, passive=False) for j in self.joints)
-            home = None if self.home is None else self.coupling.to_model(self.home)
-            model = Robot(f"{self.name}_model", joints, self.convention, self.base, self.flange,
-                          self.tool, home, f"{self.title or self.name} (model joint values)",
-                          self.source)
-            object.__setattr__(self, "_uncoupled", model)
-        return model
-
-    def with_tool(self, tool: ArrayLike) -> Robot:
-        """Return a copy whose default tool is ``tool`` (``T_F_TCP``, shape (4, 4), metres)."""
-        return replace(self, tool=np.asarray(tool, dtype=float))
-
-    def with_base(self, base: ArrayLike) -> Robot:
-        """Return a copy whose base transform is ``base`` (``T_R_0``, shape (4, 4), metres).
-
-        An ``ik_seed`` moves with the chain (its frame 0 keeps its place relative to this one's).
-        """
-        new = validate_pose(base, "base")
-        seed = self.ik_seed
-        if seed is not None:
-            seed = seed.with_base(new @ np.linalg.inv(self.base) @ seed.base)
-        return replace(self, base=new, ik_seed=seed)
-
-    # -- validation -----------------------------------------------------------------------------
-    def _tail_for(self, tool: ArrayLike | None) -> NDArray[np.float64]:
-        """``T_n_TCP = T_n_F @ T_F_TCP`` for ``tool`` (the default tool when None), metres."""
-        return self._tail if tool is None else self.flange @ validate_pose(tool, "tool")
-
-    def _joints(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
-        try:
-            arr = np.asarray(q, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"{name} must be numeric: {exc}") from None
-        if arr.ndim == 0 or arr.shape[-1] != self.n_joints:
-            raise InputError(
-                f"{self.name} has {self.n_joints} joints; {name} must have shape (..., "
-                f"{self.n_joints}), got {arr.shape}"
-            )
-        if not np.all(np.isfinite(arr)):
-            raise InputError(f"{name} contains NaN or infinite values")
-        return arr
-
-    def within_limits(self, q: ArrayLike, tol: float = LIMIT_TOL) -> NDArray[np.bool_]:
-        """Whether controller values respect the joint limits and the coupling's interaction limits.
-
-        Parameters
-        ----------
-        q : array_like, shape (..., n)
-            Controller axis values (rad, m).
-        tol : float
-            Allowed excess beyond a limit (rad or m); default the rounding tolerance
-            :data:`robotcell.kinematics.bounds.LIMIT_TOL`, so that a value at a limit is inside.
-
-        Returns
-        -------
-        ndarray of bool, shape (...)
-        """
-        return self._inside(self._joints(q), tol)
-
-    def _inside(self, q: NDArray[np.float64], tol: float = LIMIT_TOL) -> NDArray[np.bool_]:
-        """:meth:`within_limits` of unchecked values ``(..., n)``: NaN values are outside."""
-        ok = np.all(within(q, self.lower, self.upper, tol), axis=-1)
-        if self.coupling is not None:
-            ok &= self.coupling.within_interaction(q, tol)
-        return ok
-
-    def model_values(self, q: ArrayLike) -> NDArray[np.float64]:
-        """Joint values of the chain for controller values ``q``.
-
-        Parameters
-        ----------
-        q : array_like, shape (..., n)
-            Controller axis values (rad, m).
-
-        Returns
-        -------
-        ndarray, shape (..., m)
-            ``C q + offset`` with the robot's coupling (a copy of ``q`` without one).
-        """
-        arr = self._joints(q)
-        return arr.copy() if self.coupling is None else self.coupling.to_model(arr)
-
-    def dh_variables(self, q: ArrayLike) -> NDArray[np.float64]:
-        """DH variables ``sign * q_model + offset`` (theta or d) of every joint, ``(..., m)``."""
-        arr = self.model_values(q)
-        sign = np.array([j.sign for j in self.joints])
-        off = np.array([j.d if j.prismatic else j.theta for j in self.joints])
-        return sign * arr + off
-
-    # -- kinematics -----------------------------------------------------------------------------
-    def fk(self, q: ArrayLike, tool: ArrayLike | None = None) -> NDArray[np.float64]:
-        """Forward kinematics: the arm matrix ``T_R_TCP``.
-
-        Parameters
-        ----------
-        q : array_like, shape (..., n)
-            Joint values (controller axis values; rad for revolute, m for prismatic joints).
-        tool : array_like, shape (4, 4), optional
-            ``T_F_TCP`` to use instead of the robot's default tool (metres).
-
-        Returns
-        -------
-        ndarray, shape (..., 4, 4)
-            Pose of the TCP in the robot base frame (metres).
-        """
-        tail = self._tail_for(tool)
-        # One pose: evaluate with Python floats, much cheaper than numpy calls on tiny arrays.
-        if isinstance(q, (list, tuple)) or (isinstance(q, np.ndarray) and q.ndim == 1):
-            vals = q.tolist() if isinstance(q, np.ndarray) else [float(v) for v in q]
-            if len(vals) != self.n_joints or not math.isfinite(sum(vals)):
-                self._joints(vals)  # raises the precise error
-            if self.coupling is not None:
-                vals = self.coupling.to_model_list(vals)
-            m = self._chain.apply_one(self._start_cols, vals)
-            if tool is None and self._tail_is_identity:
-                a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
-                return np.array(
-                    (a0, b0, c0, p0, a1, b1, c1, p1, a2, b2, c2, p2, 0.0, 0.0, 0.0, 1.0)
-                ).reshape(4, 4)
-            tc = self._tail_cols if tool is None else tail[:3, :].tolist()
-            return _compose_cols(m, tc)
-        arr = self.model_values(q)
-        batch = arr.shape[:-1]
-        T = self._chain.apply(self.base, arr.reshape(-1, len(self.joints)), tail=tail)
-        return T.reshape(batch + (4, 4))
-
-    def frames(self, q: ArrayLike) -> NDArray[np.float64]:
-        """Every DH frame in the robot base frame: ``T_R_i`` for ``i = 0..m``.
-
-        Parameters
-        ----------
-        q : array_like, shape (..., n)
-            Controller axis values (rad, m).
-
-        Returns
-        -------
-        ndarray, shape (..., m + 1, 4, 4)
-            ``frames[..., 0]`` is the base transform ``T_R_0``; ``frames[..., i]`` is ``T_R_i``
-            (``m`` joints in the chain, ``m = n`` without passive joints). The flange is
-            ``frames[..., m] @ robot.flange``.
-        """
-        arr = self.model_values(q)
-        batch = arr.shape[:-1]
-        m = len(self.joints)
-        F = self._chain.apply(self.base, arr.reshape(-1, m), frames=True)
-        return F.reshape(batch + (m + 1, 4, 4))
-
-    def jacobian(self, q: ArrayLike, tool: ArrayLike | None = None) -> NDArray[np.float64]:
-        """Geometric Jacobian in the robot base frame, for the TCP.
-
-        Parameters
-        ----------
-        q : array_like, shape (..., n)
-            Joint values (rad, m).
-        tool : array_like, shape (4, 4), optional
-            ``T_F_TCP`` to use instead of the default tool (metres).
-
-        Returns
-        -------
-        ndarray, shape (..., 6, n)
-            Rows ``(vx, vy, vz, wx, wy, wz)``: the TCP's linear velocity (m/s) and the angular
-            velocity (rad/s) per unit velocity of each controller axis (rad/s or m/s); with a
-            coupling ``J_model @ C`` (chain rule).
-        """
-        F = self.frames(q)
-        tail = self._tail_for(tool)
-        p_e = (F[..., -1, :, :] @ tail)[..., :3, 3]
-        # Joint i moves about Z_{i-1} (standard DH) or Z_i (modified DH).
-        axes = F[..., :-1, :, :] if self.convention == "standard" else F[..., 1:, :, :]
-        z = axes[..., :3, 2]
-        o = axes[..., :3, 3]
-        sign = np.array([j.sign for j in self.joints])[:, None]
-        pris = np.array([j.prismatic for j in self.joints])[:, None]
-        v = np.where(pris, z, np.cross(z, p_e[..., None, :] - o))
-        w = np.where(pris, 0.0, z)
-        J = np.swapaxes(np.concatenate([v * sign, w * sign], axis=-1), -1, -2)  # (..., 6, m)
-        return J if self.coupling is None else self.coupling.jacobian(J)
 
     def ik(self, T: ArrayLike, tool: ArrayLike | None = None) -> IKSolutions:
         """Analytic inverse kinematics: every solution, see :func:`robotcell.ik.solve`.
@@ -414,21 +50,10 @@ class Robot:
             (rad, NaN for unreachable branches) and ``valid`` ``(..., 8)`` (reachable and within
             the joint limits).
         """
-        from robotcell.ik import solve  # imported here: robotcell.ik depends on this module
+        solver = self.__dict__.get("_ik_solver")
+        if solver is None:
+            from robotcell.ik.analytic import analytic_solver  # loads when a pose is solved
 
-        return solve(self, T, tool)
-
-
-def _compose_cols(m: list[float], tail: list[list[float]]) -> NDArray[np.float64]:
-    """``[[R, p], [0, 1]] @ tail`` for a chain result given as columns and a 3x4 tail."""
-    a0, a1, a2, b0, b1, b2, c0, c1, c2, p0, p1, p2 = m
-    (t00, t01, t02, t03), (t10, t11, t12, t13), (t20, t21, t22, t23) = tail
-    return np.array((
-        a0 * t00 + b0 * t10 + c0 * t20, a0 * t01 + b0 * t11 + c0 * t21,
-        a0 * t02 + b0 * t12 + c0 * t22, a0 * t03 + b0 * t13 + c0 * t23 + p0,
-        a1 * t00 + b1 * t10 + c1 * t20, a1 * t01 + b1 * t11 + c1 * t21,
-        a1 * t02 + b1 * t12 + c1 * t22, a1 * t03 + b1 * t13 + c1 * t23 + p1,
-        a2 * t00 + b2 * t10 + c2 * t20, a2 * t01 + b2 * t11 + c2 * t21,
-        a2 * t02 + b2 * t12 + c2 * t22, a2 * t03 + b2 * t13 + c2 * t23 + p2,
-        0.0, 0.0, 0.0, 1.0,
-    )).reshape(4, 4)
+            solver = analytic_solver(self)
+            object.__setattr__(self, "_ik_solver", solver)
+        return solver.solve(T, tool)

@@ -6,10 +6,13 @@ from b to a (see ``docs/conventions.md``). Lengths are in metres, angles in radi
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
+from robotcell.kinematics.jit import Kernel
 
 __all__ = [
     "as_points",
@@ -18,11 +21,13 @@ __all__ = [
     "finite_array",
     "invert",
     "make_pose",
+    "pose_defects",
     "rot_x",
     "rot_y",
     "rot_z",
     "transform_points",
     "validate_pose",
+    "validate_single_pose",
 ]
 
 #: Default tolerance of :func:`check_pose` on orthonormality and the last row.
@@ -32,6 +37,10 @@ POSE_TOL = 1e-6
 def finite_array(x: ArrayLike, name: str) -> NDArray[np.float64]:
     """``x`` as a float array, or an :class:`InputError` naming ``name`` if it is not numeric
     or holds NaN or infinite values."""
+    if isinstance(x, (float, int)) and not isinstance(x, bool):  # one number: no numpy reduction
+        if not math.isfinite(x):
+            raise InputError(f"{name} contains NaN or infinite values")
+        return np.array(x, dtype=float)
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -82,12 +91,8 @@ def check_pose(T: ArrayLike, tol: float = POSE_TOL) -> tuple[NDArray[np.bool_], 
     if arr.ndim < 2 or arr.shape[-2:] != (4, 4):
         raise InputError(f"a pose must have shape (..., 4, 4), got {arr.shape}")
     finite = np.all(np.isfinite(arr), axis=(-2, -1))
-    R = np.where(finite[..., None, None], arr, 0.0)[..., :3, :3]
-    # Entries of 1e300 overflow to an infinite defect: refused, as they should be.
-    with np.errstate(over="ignore", invalid="ignore"):
-        ortho = np.max(np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)), axis=(-2, -1))
-        det = np.linalg.det(R)
-    last = np.max(np.abs(np.where(finite[..., None], arr[..., 3, :], 0.0) - [0, 0, 0, 1]), axis=-1)
+    with np.errstate(invalid="ignore", over="ignore"):  # NaN where not finite
+        ortho, det, last = (np.asarray(v) for v in pose_defects(np.moveaxis(arr, (-2, -1), (0, 1))))
     ok = finite & (ortho <= tol) & (np.abs(det - 1.0) <= tol) & (last <= tol)
     reasons = []
     for row in np.argwhere(~ok):
@@ -103,6 +108,64 @@ def check_pose(T: ArrayLike, tol: float = POSE_TOL) -> tuple[NDArray[np.bool_], 
             why = f"rotation part has determinant {det[idx]:.6g}, not +1 (a reflection)"
         reasons.append(where + why)
     return ok, reasons
+
+
+def pose_defects(T):
+    """How far matrices are from rigid transforms: the formula of :func:`check_pose`.
+
+    Written once for a batch (numpy) and one pose (compiled, :data:`POSE_DEFECTS`).
+
+    Parameters
+    ----------
+    T : ndarray, shape (4, 4) or (4, 4, N)
+        Candidate poses, a batch on the last axis (translation in metres).
+
+    Returns
+    -------
+    ortho : float or ndarray, shape (N,)
+        Largest ``|R^T R - I|`` of the rotation part.
+    det : float or ndarray, shape (N,)
+        ``det R``.
+    last : float or ndarray, shape (N,)
+        Largest ``|T[3] - (0, 0, 0, 1)|``; NaN, as the others, where ``T`` holds NaN or an
+        infinite value (the translation included), so that such a matrix passes no tolerance.
+    """
+    r00, r01, r02 = T[0, 0], T[0, 1], T[0, 2]
+    r10, r11, r12 = T[1, 0], T[1, 1], T[1, 2]
+    r20, r21, r22 = T[2, 0], T[2, 1], T[2, 2]
+    ortho = np.abs(r00 * r00 + r10 * r10 + r20 * r20 - 1.0)
+    ortho = np.maximum(ortho, np.abs(r01 * r01 + r11 * r11 + r21 * r21 - 1.0))
+    ortho = np.maximum(ortho, np.abs(r02 * r02 + r12 * r12 + r22 * r22 - 1.0))
+    ortho = np.maximum(ortho, np.abs(r00 * r01 + r10 * r11 + r20 * r21))
+    ortho = np.maximum(ortho, np.abs(r00 * r02 + r10 * r12 + r20 * r22))
+    ortho = np.maximum(ortho, np.abs(r01 * r02 + r11 * r12 + r21 * r22))
+    det = (r00 * (r11 * r22 - r12 * r21) - r01 * (r10 * r22 - r12 * r20)
+           + r02 * (r10 * r21 - r11 * r20))
+    last = np.maximum(np.maximum(np.abs(T[3, 0]), np.abs(T[3, 1])),
+                      np.maximum(np.abs(T[3, 2]), np.abs(T[3, 3] - 1.0)))
+    # x - x is 0 for a finite x and NaN for NaN or infinity
+    last = last + ((T[0, 3] - T[0, 3]) + (T[1, 3] - T[1, 3]) + (T[2, 3] - T[2, 3]))
+    return ortho, det, last
+
+
+#: :func:`pose_defects` of one pose (Python first, compiled once single-pose calls add up).
+POSE_DEFECTS = Kernel(pose_defects)
+
+
+def validate_single_pose(T: ArrayLike, name: str = "pose") -> NDArray[np.float64]:
+    """:func:`validate_pose` of one pose, shape ``(4, 4)``, cheaply: the per-call path.
+
+    Returns ``T`` as a C-contiguous float array of shape (4, 4) when it is a rigid transform
+    within :data:`POSE_TOL`; otherwise raises what :func:`validate_pose` raises (also for another
+    shape, or a batch of one pose).
+    """
+    arr = np.ascontiguousarray(T, dtype=float)
+    if arr.shape == (4, 4):
+        ortho, det, last = POSE_DEFECTS.call(arr)
+        if ortho <= POSE_TOL and abs(det - 1.0) <= POSE_TOL and last <= POSE_TOL:
+            return arr
+    validate_pose(arr, name)
+    raise InputError(f"{name} must be a single pose of shape (4, 4), got {arr.shape}")
 
 
 def validate_pose(T: ArrayLike, name: str = "pose", tol: float = POSE_TOL) -> NDArray[np.float64]:
