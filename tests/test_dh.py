@@ -183,8 +183,14 @@ def test_one_pose_kernel_compiled_equals_python_and_the_batch():
     # bits; the batch takes cos and sin from tan(theta/2) (SIMD), equal to rounding.
     from robotcell.kinematics import dh
 
+    from dataclasses import replace
+
     rng = np.random.default_rng(8)
-    for r in (random_standard_robot(rng), to_modified(random_standard_robot(rng))):
+    robots = [random_standard_robot(rng), to_modified(random_standard_robot(rng))]
+    # and both with Hayati's beta (a constant rotation about y, code 4 of the program)
+    robots += [replace(r, joints=tuple(replace(j, beta=rng.uniform(-0.3, 0.3)) for j in r.joints))
+               for r in robots]
+    for r in robots:
         q = rng.uniform(-4, 4, 6)
         tail = r.flange @ make_pose(p=[0.1, -0.02, 0.3])
         python, compiled = np.empty((4, 4)), np.empty((4, 4))
