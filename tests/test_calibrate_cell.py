@@ -147,6 +147,14 @@ def test_cli_writes_what_the_library_returns(tmp_path, capsys, fixed_time):
     code, out, _ = run(capsys, "calibrate", "cell", "--cell", cli_file)
     assert code == 0 and "changes (|position| mm" in out and out.splitlines()[-1].startswith(
         "verdict: ")
+    assert out.startswith("calibration: the whole cell, 3 calibrations fitted together (")
+
+
+def test_summary_counts_one_calibration_in_the_singular(tmp_path):
+    truth = Cell.load(EXAMPLE)
+    cell = chain_of_calibrations(tmp_path, truth, truth, seed=8, steps=STEPS[:1])
+    first = cellcal.calibrate_cell(cell).summary().splitlines()[0]
+    assert first.startswith("calibration: the whole cell, 1 calibration fitted (")
 
 
 def test_positioner_cell(tmp_path):

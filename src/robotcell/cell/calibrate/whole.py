@@ -162,8 +162,9 @@ class CellRecalibration:
                          float(np.degrees(np.linalg.norm(c.sigma[3:6]))),
                          float(np.max(np.abs(c.change_sigmas))),
                          float(np.linalg.norm(c.sigma_before[:3]) * 1e3)])
-        lines = [(f"calibration: the whole cell, {len(self.steps)} calibrations fitted together "
-                  f"({self.iterations} iterations)"), "",
+        n = len(self.steps)
+        fitted = "1 calibration fitted" if n == 1 else f"{n} calibrations fitted together"
+        lines = [f"calibration: the whole cell, {fitted} ({self.iterations} iterations)", "",
                  ("changes (|position| mm, |rotation| deg; largest change in 1-sigma; 1-sigma "
                   "before):"),
                  format_table(["item", "moved mm", "turned deg", "1-sigma mm", "1-sigma deg",
