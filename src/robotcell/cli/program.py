@@ -92,7 +92,8 @@ def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, fol
     speed mm/s, zone mm, track mm, table deg or e1..en) as a program of --format.
 
     The joints are solved through the cell with one arm configuration; the track follows the
-    path unless the file gives it. The tools and frames are the ones
+    path unless the file gives it, and the table's values are chosen along a path in a frame on
+    the table unless the file gives them (docs/programs.md). The tools and frames are the ones
     'robotcell export' writes, with the same numbers. A path that cannot be one program (reach,
     limit, singularity, a jump of the table) exits with status 3 naming the points, and nothing
     is written; --split writes one program per piece.

@@ -2,7 +2,8 @@
 
 :func:`write_program` reads a path (:mod:`robotcell.programs.path`), solves it as one joint
 trajectory through the cell (:func:`robotcell.cell.ik.ik_path`: one arm configuration, the track
-moving along the path where it is not given), builds the
+moving along the path where it is not given, the table's values chosen along a path on the table
+where they are not given: :func:`robotcell.cell.tablechoice.choose_table`), builds the
 :class:`~robotcell.programs.model.Program` of one format and writes its files, all or none. A
 path that cannot be one program (out of reach, a joint limit, a configuration change, a jump of
 the table) raises :class:`PathBreaks` naming the points and why; with ``split`` every
@@ -27,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import Cell
 from robotcell.cell.ik import MAX_STEP, CellPath, PathBreak, ik_path, split_path
 from robotcell.cell.kinematics import tool_pose
+from robotcell.cell.tablechoice import TableChoice, carried_by_table, choose_table
 from robotcell.errors import RobotcellError
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.axes import ExternalAxes, external_axes
@@ -130,6 +132,24 @@ def point_names(vendor: str, n: int) -> list[str]:
     return [f"C{i:05d}" for i in range(n)]
 
 
+def _with_table(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: float
+                ) -> tuple[PathTargets, TableChoice | None]:
+    """The targets with the table's values chosen where the file gives none and the path's
+    frame is on the table; and the choice (None when nothing was chosen)."""
+    if targets.table_given or not carried_by_table(cell, frame):
+        return targets, None
+    choice = choose_table(cell, targets.T, frame, targets.track, tool, max_step)
+    return replace(targets, table=choice.table, table_given=True), choice
+
+
+def _noted(breaks: list[PathBreak], choice: TableChoice | None) -> list[PathBreak]:
+    """Breaks out of reach at every table value the choice tried say so."""
+    if choice is None:
+        return breaks
+    return [replace(b, message=f"{b.message}, {note}")
+            if b.kind == "reach" and (note := choice.unreached(b.index)) else b for b in breaks]
+
+
 def _solve(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: float
            ) -> tuple[list[tuple[int, int]], list[PathBreak], list[CellPath]]:
     """Continuous pieces of the path, where it breaks, and each piece's joint trajectory."""
@@ -200,7 +220,10 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
     base_name = program_name(name, vendor)
     tool_ref, frame_ref, where = program_refs(cell, vendor, tool, frame)
     axes = external_axes(cell, vendor, pulses_per_degree)
+    targets, choice = _with_table(cell, targets, frame, tool, max_step)
+    targets = replace(targets, table=axes.held(targets.table))  # the point goes with the axis
     pieces, breaks, paths = _solve(cell, targets, frame, tool, max_step)
+    breaks = _noted(breaks, choice)
     n = len(targets)
     nt = targets.table.shape[1:] if targets.table.ndim > 1 else ()
     q = np.full((n, cell.robot.n_joints), np.nan)
