@@ -142,7 +142,7 @@ def test_a_path_out_of_reach_at_every_table_angle_exits_3_naming_the_points(cell
     args = ["program", "write", far, "--cell", CELL, "--tool", "torch", "--frame", "part",
             "--format", "kuka", "-o", tmp_path / "out"]
     code, out, err = run(capsys, *args)
-    assert code == 3 and "point 12 (reach)" in err and "at every table value" in err, err
+    assert code == 3 and "point 12 (reach)" in err and "no table value reaches it within the limits either" in err, err
     assert "it breaks at 1 point: " in err and "write 2 programs, one per piece, with --split" in err
     assert not (tmp_path / "out").exists()
     code, out, err = run(capsys, *args, "--split", "--json")
@@ -238,3 +238,22 @@ def test_bad_arguments_are_refused(cell, kw, match):
     T = read_path(SEAM, cell).T[:2]
     with pytest.raises(InputError, match=match):
         choose_table(cell, T, "part", tool="torch", **kw)
+
+
+def test_a_point_whose_normal_cannot_be_turned_up_is_named_so(tmp_path, capsys):
+    # the torch along +Z of the part (b = 0) welds the underside: its normal points down, and
+    # the tilt axis (+-95 deg) cannot turn it up
+    rows = np.array([[60.0, 0.0, 0.0, 0.0, 180.0, 0.0], [50.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                     [40.0, 0.0, 0.0, 0.0, 180.0, 0.0]])
+    path = _write_rows(tmp_path / "under.csv", rows)
+    code, _, err = run(capsys, "program", "write", path, "--cell", POSITIONER, "--tool", "torch",
+                       "--frame", "part", "--format", "kuka", "-o", tmp_path / "out")
+    # (at the values the path is then solved at it is reached with axis 5 outside its limits)
+    assert code == 3 and "point 2 (limit)" in err, err
+    assert "; no positioner values within the axis limits turn its normal up" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_targets_of_a_wrong_shape_are_refused(cell):
+    with pytest.raises(InputError, match=r"path targets must have shape \(N, 4, 4\)"):
+        choose_table(cell, np.eye(4), "part", tool="torch")

@@ -102,13 +102,13 @@ class TableChoice:
         return float(np.max(np.abs(np.diff(self.table, axis=0))))
 
     def unreached(self, i: int) -> str:
-        """Words to add to "target i is out of reach": at every candidate ("" where one
-        reaches it)."""
+        """Words to add to why target ``i`` breaks: no candidate reaches it ("" where one
+        does)."""
         if self.reachable[i]:
             return ""
         if self.candidates[i] == 0:
-            return "and no positioner values within the axis limits turn its normal up"
-        return "at every table value"
+            return "no positioner values within the axis limits turn its normal up"
+        return "no table value reaches it within the limits either"
 
 
 def carried_by_table(cell: Cell, frame: str) -> bool:

@@ -143,11 +143,12 @@ def _with_table(cell: Cell, targets: PathTargets, frame: str, tool: str, max_ste
 
 
 def _noted(breaks: list[PathBreak], choice: TableChoice | None) -> list[PathBreak]:
-    """Breaks out of reach at every table value the choice tried say so."""
+    """Breaks at a point no table value the choice tried reaches say so (whatever the values
+    the path is then solved at make of it: out of reach, or reached outside the limits)."""
     if choice is None:
         return breaks
-    return [replace(b, message=f"{b.message}, {note}")
-            if b.kind == "reach" and (note := choice.unreached(b.index)) else b for b in breaks]
+    return [replace(b, message=f"{b.message}; {note}")
+            if (note := choice.unreached(b.index)) else b for b in breaks]
 
 
 def _solve(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: float
