@@ -115,3 +115,19 @@ def test_moving_track_errors():
     with pytest.raises(InputError, match="track_motion must be one of fixed, moving"):
         cell.ik_path(seam(1.0, 2.0, 3), track_motion="sliding")
     assert TRACK_WINDOW >= 3
+
+
+def test_a_jump_of_the_table_breaks_the_path_even_where_the_arm_stays():
+    # A whole turn of the table brings the part back where it was: the arm does not move, but
+    # the table would turn 360 deg between two targets. It was one segment.
+    cell = track_cell()
+    q0 = np.radians([80, -80, 100, 10, 40, 20])
+    T_W = cell.fk(q0, 3.0, 0.0, tool="torch", frame="part")
+    th = np.array([-0.2, -0.15, -0.1, -0.1 + 2 * math.pi, -0.05 + 2 * math.pi])
+    split = split_path(cell, T_W, "part", track=3.0, table=th, tool="torch")
+    assert split.segments == [(0, 3), (3, 5)]
+    assert [(b.index, b.kind) for b in split.breaks] == [(3, "table")]
+    assert "target 4: the table turns by 360 deg from the previous target" in \
+        split.breaks[0].message
+    with pytest.raises(InputError, match="target 4: the table turns by 360 deg"):
+        cell.ik_path(T_W, "part", track=3.0, table=th, tool="torch")

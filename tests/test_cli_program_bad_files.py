@@ -34,7 +34,6 @@ def _write_args(path, out, vendor="kuka", *extra):
     ("x,y,z,a,b\n0,0,0,0,0\n", "missing column(s) c"),
     (SEAM.read_text().replace("\n197.0,", "\nabc,", 1), "must be numeric"),
     ("", "header line and at least one data line"),
-    ("x,y,z,a,b,c,table\n200,0,0,0,180,0,200\n", "at least 2 targets"),
     (SEAM.read_text().encode("utf-16"), "UTF-16"),
     (bytes(range(256)) * 2, "not a text file"),
 ])
@@ -168,3 +167,75 @@ def test_absurd_values_in_a_program_are_refused_naming_the_line(tmp_path, capsys
     code, out, err = run(capsys, "program", "check", tmp_path / src.name, "--cell", CELL)
     _check(code, out, err, match)
     assert "line" in err
+
+
+def test_a_path_no_point_of_which_is_reachable_has_nothing_to_split(tmp_path, capsys):
+    # it said "... or write 0 programs, one per piece, with --split", and --split wrote nothing
+    # with exit 0
+    path = tmp_path / "far.csv"
+    path.write_text("x,y,z,a,b,c\n5000,5000,5000,0,180,0\n5100,5000,5000,0,180,0\n")
+    for extra in ([], ["--split"]):
+        code, out, err = run(capsys, *_write_args(path, tmp_path / "out", "kuka", *extra))
+        _check(code, out, err, "no point of the path can be reached", 3)
+        assert "nothing to write" in err and "0 programs" not in err
+        assert not (tmp_path / "out").exists()
+
+
+def test_a_path_of_one_point_is_a_program_of_one_point(tmp_path, capsys):
+    # it was refused with "a path needs a sequence of at least 2 targets (shape (N, 4, 4) ...)"
+    path = tmp_path / "one.csv"
+    path.write_text("x,y,z,a,b,c,table\n200,0,0,0,180,0,200\n")
+    for vendor in EXT:
+        code, out, err = run(capsys, *_write_args(path, tmp_path / vendor, vendor))
+        assert code == 0, err
+        main = next(p for p in (tmp_path / vendor).iterdir() if p.suffix == EXT[vendor])
+        code, out, err = run(capsys, "program", "check", main, "--cell", CELL,
+                             "--pulses-per-degree", "100")
+        assert code == 0 and out.endswith(": 1 point, all good\n"), err
+
+
+def test_a_path_that_breaks_at_many_points_names_the_first_5(tmp_path, capsys):
+    # the seam in the fixed frame 'fixture': flips and points out of reach; with --split it was
+    # refused (exit 2, "no arm configuration follows the whole path") because a piece was
+    # solved with another track than the one it was split with
+    args = ["program", "write", SEAM, "--cell", CELL, "--tool", "torch", "--frame", "fixture",
+            "--format", "kuka", "-o", tmp_path / "out"]
+    code, out, err = run(capsys, *args)
+    _check(code, out, err, "breaks at 10 points:", 3)
+    message = err[err.index("error:"):]
+    assert message.count("(singularity)") + message.count("(reach)") == 5
+    assert "; and 5 more." in message and "--split" in message
+    assert "no other configuration reaches it nearer to target 3" in message
+    code, out, err = run(capsys, *args, "--split")
+    assert code == 0, err
+    written = [p for p in (tmp_path / "out").iterdir() if p.suffix == ".src"]
+    assert len(written) == 7
+    for src in written:
+        assert run(capsys, "program", "check", src, "--cell", CELL)[0] == 0
+
+
+def test_retarget_refuses_two_different_cells_and_a_program_without_points(tmp_path, capsys,
+                                                                           programs):
+    # another cell wrote a copy of the program with exit 0
+    positioner = CELL.parent / "cell_kr16_positioner.yaml"
+    code, out, err = run(capsys, "program", "retarget", programs["kuka"], "--from", CELL,
+                         "--to", positioner, "-o", tmp_path / "a")
+    _check(code, out, err, "the old and the new cell are not one cell before and after a "
+                           "recalibration: the old cell has a track, the new cell no track; the "
+                           "old cell has a turntable, the new cell a 2-axis positioner")
+    (tmp_path / "empty.src").write_text("DEF empty( )\nEND\n")
+    code, out, err = run(capsys, "program", "retarget", tmp_path / "empty.src", "--from", CELL,
+                         "--to", CELL, "-o", tmp_path / "b")
+    _check(code, out, err, "the program moves to no point robotcell reads: nothing to retarget")
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_a_robot_model_file_given_as_the_cell_is_named_so(tmp_path, capsys, programs):
+    # it said "key '' has unknown key(s) ['convention', ...]"
+    model = tmp_path / "arm.yaml"
+    model.write_text("name: arm\nconvention: standard\njoints: []\n")
+    code, out, err = run(capsys, "program", "check", programs["kuka"], "--cell", model)
+    _check(code, out, err, "this is a robot model file (it has 'joints'), not a cell file")
+    (tmp_path / "c.yaml").write_text("robot: {model: kuka_kr16}\nspeed: 3\n")
+    code, out, err = run(capsys, "program", "check", programs["kuka"], "--cell", tmp_path / "c.yaml")
+    _check(code, out, err, "the top level has unknown key(s) ['speed']")

@@ -136,6 +136,7 @@ def test_a_point_moved_3_m_away_fails_the_check_naming_it(cell, tmp_path, capsys
     code, _, err = run(capsys, "program", "check", result.files[0], "--cell", CELL)
     assert code == 3
     assert "XP7" in err and "out of reach" in err
+    assert "error: " in err and ": 1 of 36 points is bad" in err  # was "1 of 36 points are bad"
     assert [r for r in err.splitlines() if "out of reach" in r] == [
         r for r in err.splitlines() if "XP7" in r]  # only that point
 

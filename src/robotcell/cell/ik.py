@@ -19,7 +19,8 @@ on which every configuration would flip (cross a singularity) or leave the limit
 and why. Vectorised over the path: one batched IK call per candidate track value. With
 ``track_motion="moving"`` the track follows the path smoothly instead of standing still, and
 :func:`split_path` cuts a path that cannot be followed in one piece into continuous segments,
-naming each break (out of reach, a joint limit, a singularity).
+naming each break (out of reach, a joint limit, a singularity, a jump of the table's values).
+:mod:`robotcell.cell.tablechoice` chooses the table's values along a path in a frame it carries.
 """
 
 from __future__ import annotations
@@ -391,8 +392,8 @@ class PathBreak:
         Target (0-based) that no configuration of the preceding segment reaches continuously.
     kind : str
         ``"reach"`` (out of reach, or track/table outside its limits), ``"limit"`` (an arm axis
-        leaves its limits) or ``"singularity"`` (the configuration flips: an axis jumps by more
-        than ``max_step``).
+        leaves its limits), ``"singularity"`` (the configuration flips: an axis jumps by more
+        than ``max_step``) or ``"table"`` (the table's values jump by more than ``max_step``).
     message : str
         The cause in words, naming the branch and the axis (degrees).
     """
@@ -432,6 +433,7 @@ class _PathSolutions:
     inside: NDArray[np.bool_]
     smooth: NDArray[np.bool_]
     ee: NDArray[np.float64]  # (K, N) track positions
+    turn: NDArray[np.float64]  # (N,) largest table axis change from the previous target (rad)
 
     @property
     def ok(self) -> NDArray[np.bool_]:
@@ -481,8 +483,9 @@ def _path_solutions(cell: Cell, frame: str, arr: NDArray[np.float64], th: NDArra
     inside = robot._inside(q)  # (K, N, 8); interaction limits (e.g. FANUC J2/J3) too
     step = np.max(np.abs(np.diff(q, axis=1)), axis=-1)                      # (K, N-1, 8)
     first = np.ones((step.shape[0], 1, step.shape[2]), dtype=bool)
-    smooth = np.concatenate([first, step <= max_step], axis=1)
-    return _PathSolutions(q, reach, inside, smooth, ee)
+    turn = np.abs(np.diff(th, axis=0, prepend=th[:1])).reshape(th.shape[0], -1).max(axis=1)
+    smooth = np.concatenate([first, step <= max_step], axis=1) & (turn <= max_step)[:, None]
+    return _PathSolutions(q, reach, inside, smooth, ee, turn)
 
 
 def _path_setup(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None, table: ArrayLike,
@@ -531,9 +534,9 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     The targets are solved together for every branch; a branch is kept when it reaches every
     target, its unwrapped trajectory fits the joint limits (shifted by whole turns where a joint
     has more than one turn of range; one turn count per joint for the whole path), and no joint
-    moves more than ``max_step`` between two consecutive targets. Among the kept branches the
-    one nearest to ``q_start`` at the first target wins, or else the one with the largest
-    smallest manipulability along the path.
+    (nor a table axis) moves more than ``max_step`` between two consecutive targets. Among the
+    kept branches the one nearest to ``q_start`` at the first target wins, or else the one with
+    the largest smallest manipulability along the path.
 
     Parameters
     ----------
@@ -552,8 +555,8 @@ def ik_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike | N
     q_start : array_like, shape (n,), optional
         Current arm configuration (rad): the path starts in the configuration nearest to it.
     max_step : float
-        Largest joint change between consecutive targets (rad); sample the path more finely
-        when the motion between targets is larger.
+        Largest change of an arm or table axis between consecutive targets (rad); sample the
+        path more finely when the motion between targets is larger.
     samples : int
         Candidate track positions when the track position is chosen (>= 2).
     track_motion : {"fixed", "moving"}
@@ -606,8 +609,8 @@ def split_path(cell: Cell, T: ArrayLike, frame: str = "world", track: ArrayLike 
     """Cut a path into the fewest continuous segments, greedily, and say where and why it breaks.
 
     From the first target, the branch and track candidate that follow the path furthest (as
-    :func:`ik_path` checks it: reach, joint limits with one turn count per segment, no joint
-    step above ``max_step``) make a segment; the target where that branch fails starts the
+    :func:`ik_path` checks it: reach, joint limits with one turn count per segment, no arm or
+    table axis step above ``max_step``) make a segment; the target where that branch fails starts the
     next one, or is skipped when no branch reaches it at all.
 
     Parameters
@@ -665,6 +668,8 @@ def _break(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int, offset: int
     if not ps.reach[k, i].any():
         return PathBreak(offset + i, "reach", f"{where}: out of reach (or track/table outside "
                          "its limits) in every configuration")
+    if ps.turn[i] > max_step:
+        return PathBreak(offset + i, "table", f"{where}: {_table_turn(ps, i)}")
     if not usable.any():
         why = _failure_cause(ps, robot, k, int(np.argmax(ps.reach[k, i])), i)[1]
         return PathBreak(offset + i, "limit", f"{where}: every configuration that reaches it "
@@ -675,9 +680,12 @@ def _break(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int, offset: int
     step = float(jump[b2, j])
     how = (f"axis {j + 1} would jump by {math.degrees(step):.0f} deg (a flip)" if step > max_step
            else "the arm changes configuration through a singular one (det J = 0)")
+    cause = f"{where}: {BRANCH_NAMES[b]}: {_failure_cause(ps, robot, k, b, i)[1]}"
+    if b2 == b:  # the same configuration is the nearest: no other one continues
+        return PathBreak(offset + i, "singularity", f"{cause}; no other configuration reaches "
+                         f"it nearer to target {offset + i}")
     return PathBreak(offset + i, "singularity",
-                     f"{where}: {BRANCH_NAMES[b]}: {_failure_cause(ps, robot, k, b, i)[1]}; "
-                     f"the target is reached in {BRANCH_NAMES[b2]}, but {how}")
+                     f"{cause}; the target is reached in {BRANCH_NAMES[b2]}, but {how}")
 
 
 def _failure_cause(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int) -> tuple[str, str]:
@@ -688,10 +696,17 @@ def _failure_cause(ps: _PathSolutions, robot: Robot, k: int, b: int, i: int) -> 
     if not ps.inside[k, i, b]:
         j = int(np.argmax(~within(qi, robot.lower, robot.upper)))
         return "limit", f"axis {j + 1} leaves its limits ({math.degrees(qi[j]):.1f} deg)"
+    if i > 0 and not ps.smooth[k, i, b] and ps.turn[i] > np.max(np.abs(qi - ps.q[k, i - 1, b])):
+        return "table", _table_turn(ps, i)
     j = int(np.argmax(np.abs(qi - ps.q[k, i - 1, b])))
     jump = math.degrees(abs(qi[j] - ps.q[k, i - 1, b, j]))
     return "singularity", (f"axis {j + 1} jumps by {jump:.0f} deg (the configuration passes a "
                            "singularity)")
+
+
+def _table_turn(ps: _PathSolutions, i: int) -> str:
+    return (f"the table turns by {math.degrees(ps.turn[i]):.0f} deg from the previous target "
+            "(a jump, not a continuous motion)")
 
 
 def _path_failure(ps: _PathSolutions, robot: Robot, track_chosen: bool) -> str:

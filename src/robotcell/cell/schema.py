@@ -133,7 +133,7 @@ class _Reader:
         self.base_dir = Path(base_dir)
 
     def fail(self, key: str, msg: str) -> InputError:
-        return InputError(f"{self.origin}: key '{key}' {msg}")
+        return InputError(f"{self.origin}: {f'key {key!r}' if key else 'the top level'} {msg}")
 
     def mapping(self, value: Any, key: str, allowed: set[str], required: tuple[str, ...] = ()
                 ) -> dict:
@@ -279,11 +279,14 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
     Cell
     """
     rd = _Reader(origin, base_dir)
-    top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "positioner", "tools",
-                                "frames"}, ("robot",)) if isinstance(data, dict) else None
-    if top is None:
+    if not isinstance(data, dict):
         raise InputError(f"{origin}: a cell file must be a YAML mapping with keys robot, tools, "
                          "frames, ...")
+    if "joints" in data and "robot" not in data:
+        raise InputError(f"{origin}: this is a robot model file (it has 'joints'), not a cell "
+                         "file; a cell file names it as robot: {model: FILE} (docs/cell.md)")
+    top = rd.mapping(data, "", {"name", "robot", "track", "turntable", "positioner", "tools",
+                                "frames"}, ("robot",))
     rob = rd.mapping(top["robot"], "robot", {"model", "frame", "identified", "provenance"},
                      ("model",))
     model, robot = _robot(rd, rob["model"], "robot.model", base_dir)

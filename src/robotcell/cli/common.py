@@ -46,6 +46,22 @@ __all__ = [
 NOISE_MAX_MM = 1000.0
 
 
+def counted(n: int, noun: str) -> str:
+    """``n`` and the noun, plural unless ``n`` is 1: ``counted(1, "point")`` is ``"1 point"``.
+
+    Parameters
+    ----------
+    n : int
+    noun : str
+        Singular; the plural adds an ``s``.
+
+    Returns
+    -------
+    str
+    """
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:
     """Parse ``"1,2,3"`` into floats, with an error naming ``what`` on bad input."""
     parts = [p.strip() for p in text.split(",") if p.strip() != ""]

@@ -12,7 +12,7 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import format_table, parse_numbers
+from robotcell.cli.common import counted, format_table, parse_numbers
 from robotcell.cli.files import Group, OutputPath
 from robotcell.errors import InputError
 from robotcell.programs import VENDORS
@@ -92,10 +92,11 @@ def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, fol
     speed mm/s, zone mm, track mm, table deg or e1..en) as a program of --format.
 
     The joints are solved through the cell with one arm configuration; the track follows the
-    path unless the file gives it. The tools and frames are the ones 'robotcell export' writes,
-    with the same numbers. A path that cannot be one program (reach, limit, singularity) exits
-    with status 3 naming the points, and nothing is written; --split writes one program per
-    piece.
+    path unless the file gives it, and the table's values are chosen along a path in a frame on
+    the table unless the file gives them (docs/programs.md). The tools and frames are the ones
+    'robotcell export' writes, with the same numbers. A path that cannot be one program (reach,
+    limit, singularity, a jump of the table) exits with status 3 naming the points, and nothing
+    is written; --split writes one program per piece.
 
     \b
     Example:
@@ -176,10 +177,12 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
     n = len(report.points)
     if report.good:
         if not as_json:
-            click.echo(f"{program_file}: {n} points, all good")
+            click.echo(f"{program_file}: {counted(n, 'point')}, all good")
         return
     click.echo(format_table(["point", "line", "problem"], report.rows()), err=True)
-    raise BadPoints(f"{program_file}: {len(report.bad)} of {n} points are bad")
+    bad = len(report.bad)
+    verb = "is" if bad == 1 else "are"
+    raise BadPoints(f"{program_file}: {bad} of {counted(n, 'point')} {verb} bad")
 
 
 @program.command("retarget")
@@ -226,8 +229,9 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     if rows:
         click.echo(format_table(["point", "line", "largest change (deg)", "TCP error (mm)"],
                                 rows))
-    click.echo(f"{len(result.points)} joint points retargeted, {result.cartesian} Cartesian "
-               f"points kept; wrote {', '.join(result.files)}")
+    click.echo(f"{counted(len(result.points), 'joint point')} retargeted, "
+               f"{counted(result.cartesian, 'Cartesian point')} kept; wrote "
+               f"{', '.join(result.files)}")
 
 
 @program.command("compensate")
@@ -287,6 +291,7 @@ def compensate_cmd(program_file: str, cell_path: str, folder: str, joints: str,
     big = result.largest
     for s in result.skipped:
         click.echo(f"note: not filtered: {s}", err=True)
-    click.echo(f"{len(result.points)} points filtered, {result.kept} joint points kept; largest "
+    click.echo(f"{counted(len(result.points), 'point')} filtered, "
+               f"{counted(result.kept, 'joint point')} kept; largest "
                f"correction {big.dpos * 1e3:.4f} mm, {math.degrees(big.drot):.4f} deg at "
                f"{big.name}; wrote {', '.join(result.files)}")

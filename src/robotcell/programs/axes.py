@@ -93,6 +93,26 @@ class ExternalAxes:
             out[name] = float(v) * scale
         return out
 
+    def held(self, table: ArrayLike) -> NDArray[np.float64]:
+        """Table values as the file holds them: YASKAWA station axes in whole encoder pulses,
+        the other formats' degrees unchanged (they write 9 decimals).
+
+        Parameters
+        ----------
+        table : array_like, shape (N,) or (N, n)
+            Turntable angles or positioner axis values (rad).
+
+        Returns
+        -------
+        ndarray
+            The same shape (rad).
+        """
+        th = np.asarray(table, dtype=float)
+        if self.vendor != "yaskawa" or not self.table:
+            return th
+        scale = np.asarray(self.table_scale) if self.positioner else self.table_scale[0]
+        return np.round(th * scale) / scale
+
     def from_file(self, external: dict[str, float]
                   ) -> tuple[float, NDArray[np.float64] | float, list[str]]:
         """The cell's track (m) and table (rad) from a point's external axes.

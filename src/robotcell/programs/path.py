@@ -10,7 +10,11 @@ The path file is CSV with a header (millimetres, degrees; ``docs/programs.md``):
 | ``speed`` | optional | TCP speed of a linear motion (mm/s; default 100) |
 | ``zone`` | optional | corner distance (mm; default 0, an exact stop) |
 | ``track`` | optional | track position (mm); otherwise chosen along the path |
-| ``table`` | optional | turntable angle (deg); a positioner's axes are ``e1..en`` (default 0) |
+| ``table`` | optional | turntable angle (deg); a positioner's axes are ``e1..en`` (see below) |
+
+Without ``table`` (or ``e1..en``) the writer chooses the table's values along a path in a frame
+the table carries (:func:`robotcell.cell.tablechoice.choose_table`); a path in another frame
+keeps the table at 0.
 
 :func:`read_path` reads it into SI units and checks every value against the cell.
 """
@@ -57,6 +61,9 @@ class PathTargets:
         Track positions (m), or None to choose them.
     table : ndarray, shape (N,) or (N, n)
         Turntable angles or positioner axis values (rad).
+    table_given : bool
+        The file gives the table's values; False: ``table`` is 0, for the writer to choose
+        where the path's frame is on the table (:func:`robotcell.cell.tablechoice.choose_table`).
     source : str
         The file, for messages.
     warnings : list of str
@@ -69,6 +76,7 @@ class PathTargets:
     zone: NDArray[np.float64]
     track: NDArray[np.float64] | None
     table: NDArray[np.float64]
+    table_given: bool = True
     source: str = ""
     warnings: list[str] = field(default_factory=list)
 
@@ -159,7 +167,8 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
         track = _numeric(cols, "track", p) * 1e-3
         _limits(track, cell.track.lower, cell.track.upper, "track", 1e3, p, "track")
     table = _table(cols, cell, n, p)
-    return PathTargets(T, motion, speed, zone, track, table, p, warnings)
+    given = cell.turntable is None or any(c in cols for c in tcols)
+    return PathTargets(T, motion, speed, zone, track, table, given, p, warnings)
 
 
 def _table(cols: dict, cell: Cell, n: int, path: str) -> NDArray[np.float64]:

@@ -117,6 +117,21 @@ def _solve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
     return out, problems
 
 
+def _same_layout(old: Cell, new: Cell) -> None:
+    """Refuse two cells that are not one cell before and after a recalibration."""
+    def parts(cell: Cell) -> list[str]:
+        tt = cell.turntable
+        return [f"a {cell.robot.n_joints}-axis arm", "a track" if cell.track else "no track",
+                "no turntable" if tt is None else
+                ("a turntable" if np.ndim(tt.lower) == 0 else f"a {tt.n_axes}-axis positioner")]
+
+    differ = [(a, b) for a, b in zip(parts(old), parts(new)) if a != b]
+    if differ:
+        what = "; ".join(f"the old cell has {a}, the new cell {b}" for a, b in differ)
+        raise InputError(f"the old and the new cell are not one cell before and after a "
+                         f"recalibration: {what}")
+
+
 def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
                      pulses_per_degree: ArrayLike | None = None,
                      inputs: tuple[str | Path, ...] = ()) -> RetargetResult:
@@ -144,12 +159,17 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
     Raises
     ------
     InputError
-        An unreadable program or a folder that cannot be written.
+        An unreadable program, a program with no point, a folder that cannot be written, or
+        cells that differ in their axes (arm, track, turntable or positioner).
     RetargetFailed
         A joint point the new cell cannot reach or that names a tool the cells lack; nothing is
         written.
     """
+    _same_layout(old, new)
     program, _ = read_program(path)
+    if not program.points:
+        raise InputError(f"{path}: the program moves to no point robotcell reads: nothing to "
+                         "retarget")
     vendor = program.vendor
     joint = [p for p in program.points if p.joints is not None]
     result = RetargetResult(program, cartesian=len(program.points) - len(joint))

@@ -2,10 +2,13 @@
 
 :func:`write_program` reads a path (:mod:`robotcell.programs.path`), solves it as one joint
 trajectory through the cell (:func:`robotcell.cell.ik.ik_path`: one arm configuration, the track
-moving along the path where it is not given), builds the :class:`~robotcell.programs.model.Program`
-of one format and writes its files, all or none. A path that cannot be one program (out of reach,
-a joint limit, a configuration change) raises :class:`PathBreaks` naming the points and why;
-with ``split`` every continuous piece becomes its own program.
+moving along the path where it is not given, the table's values chosen along a path on the table
+where they are not given: :func:`robotcell.cell.tablechoice.choose_table`), builds the
+:class:`~robotcell.programs.model.Program` of one format and writes its files, all or none. A
+path that cannot be one program (out of reach, a joint limit, a configuration change, a jump of
+the table) raises :class:`PathBreaks` naming the points and why; with ``split`` every
+continuous piece becomes its own program (a path with no piece, no point reached, raises all
+the same).
 
 The Cartesian values a program holds come from one function, :func:`written_poses`: the pose of
 the TCP, computed from the joints by the FK of the cell's controller model (the nominal arm of a
@@ -25,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import Cell
 from robotcell.cell.ik import MAX_STEP, CellPath, PathBreak, ik_path, split_path
 from robotcell.cell.kinematics import tool_pose
+from robotcell.cell.tablechoice import TableChoice, carried_by_table, choose_table
 from robotcell.errors import RobotcellError
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.axes import ExternalAxes, external_axes
@@ -128,21 +132,47 @@ def point_names(vendor: str, n: int) -> list[str]:
     return [f"C{i:05d}" for i in range(n)]
 
 
+def _with_table(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: float
+                ) -> tuple[PathTargets, TableChoice | None]:
+    """The targets with the table's values chosen where the file gives none and the path's
+    frame is on the table; and the choice (None when nothing was chosen)."""
+    if targets.table_given or not carried_by_table(cell, frame):
+        return targets, None
+    choice = choose_table(cell, targets.T, frame, targets.track, tool, max_step)
+    return replace(targets, table=choice.table, table_given=True), choice
+
+
+def _noted(breaks: list[PathBreak], choice: TableChoice | None) -> list[PathBreak]:
+    """Breaks at a point no table value the choice tried reaches say so (whatever the values
+    the path is then solved at make of it: out of reach, or reached outside the limits)."""
+    if choice is None:
+        return breaks
+    return [replace(b, message=f"{b.message}; {note}")
+            if (note := choice.unreached(b.index)) else b for b in breaks]
+
+
 def _solve(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: float
            ) -> tuple[list[tuple[int, int]], list[PathBreak], list[CellPath]]:
     """Continuous pieces of the path, where it breaks, and each piece's joint trajectory."""
     motion = "moving" if targets.track is None and cell.track is not None else "fixed"
     kw = {"frame": frame, "tool": tool, "max_step": max_step, "track_motion": motion}
-    split = split_path(cell, targets.T, track=targets.track, table=targets.table, **kw)
+    # A path or a piece of one target is solved as two identical targets, then cut back to one.
+    n = len(targets)
+    rows = np.arange(n) if n > 1 else np.zeros(2, dtype=int)
+    split = split_path(cell, targets.T[rows], table=targets.table[rows],
+                       track=None if targets.track is None else targets.track[rows], **kw)
+    segments = split.segments if n > 1 else [(0, 1)] * len(split.segments)
+    breaks = split.breaks if n > 1 else split.breaks[:1]
     paths = []
-    for a, b in split.segments:
-        # A piece of one target is solved as two identical targets, then cut back to one.
+    for a, b in segments:
         idx = np.arange(a, b) if b - a > 1 else np.array([a, a])
-        track = None if targets.track is None else targets.track[idx]
+        # the piece at the track values split_path followed it with (a moving track chosen
+        # for the piece alone would differ at its ends)
+        track = None if cell.track is None else split.track[idx]
         path = ik_path(cell, targets.T[idx], track=track, table=targets.table[idx], **kw)
         paths.append(path if b - a > 1 else replace(path, q=path.q[:1], track=path.track[:1],
                                                     table=path.table[:1]))
-    return split.segments, split.breaks, paths
+    return segments, breaks, paths
 
 
 def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, tool: str,
@@ -185,19 +215,23 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
         A tool or frame the cell lacks, a bad name, a YASKAWA cell with a turntable and no
         ``pulses_per_degree``.
     PathBreaks
-        The path breaks (reach, limit, singularity) and ``split`` is False.
+        The path breaks (reach, limit, singularity, a jump of the table) and ``split`` is False,
+        or no point of it can be reached.
     """
     base_name = program_name(name, vendor)
     tool_ref, frame_ref, where = program_refs(cell, vendor, tool, frame)
     axes = external_axes(cell, vendor, pulses_per_degree)
+    targets, choice = _with_table(cell, targets, frame, tool, max_step)
+    targets = replace(targets, table=axes.held(targets.table))  # the point goes with the axis
     pieces, breaks, paths = _solve(cell, targets, frame, tool, max_step)
+    breaks = _noted(breaks, choice)
     n = len(targets)
     nt = targets.table.shape[1:] if targets.table.ndim > 1 else ()
     q = np.full((n, cell.robot.n_joints), np.nan)
     track, table = np.full(n, np.nan), np.full((n, *nt), np.nan)
     owner = np.full(n, -1)
-    if breaks and not split:
-        raise PathBreaks(_break_message(breaks, len(pieces)), breaks)
+    if breaks and (not split or not pieces):
+        raise PathBreaks(_break_message(breaks, pieces), breaks)
     programs = []
     for k, ((a, b), path) in enumerate(zip(pieces, paths)):
         q[a:b], track[a:b], table[a:b] = path.q, path.track, path.table
@@ -213,10 +247,27 @@ def _piece_name(name: str, k: int, vendor: str) -> str:
     return program_name(name[:NAME_LIMITS[vendor] - len(suffix)] + suffix, vendor)
 
 
-def _break_message(breaks: list[PathBreak], pieces: int) -> str:
-    where = "; ".join(f"point {b.index + 1} ({b.kind}): {b.message}" for b in breaks)
-    return (f"the path cannot be one program: it breaks at {len(breaks)} point(s): {where}. "
-            f"Change the path there, or write {pieces} programs, one per piece, with split")
+#: Breaks a :class:`PathBreaks` message names (``breaks`` holds them all).
+NAMED_BREAKS = 5
+
+
+def _break_message(breaks: list[PathBreak], pieces: list[tuple[int, int]]) -> str:
+    where = "; ".join(f"point {b.index + 1} ({b.kind}): {b.message}"
+                      for b in breaks[:NAMED_BREAKS])
+    if len(breaks) > NAMED_BREAKS:
+        where += f"; and {len(breaks) - NAMED_BREAKS} more"
+    if not pieces:
+        return (f"no point of the path can be reached: {where}. There is nothing to write, in "
+                "one program or in pieces: check the frame and the tool of the path, its units "
+                "(mm, deg) and where it lies in the cell")
+    if len(pieces) == 1:
+        (a, b), = pieces
+        todo = f"write its one good piece (points {a + 1} to {b}) with split"
+    else:
+        todo = f"write {len(pieces)} programs, one per piece, with split"
+    return (f"the path cannot be one program: it breaks at {len(breaks)} "
+            f"point{'' if len(breaks) == 1 else 's'}: {where}. "
+            f"Change the path there, or {todo}")
 
 
 def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, name: str, vendor: str,
@@ -272,7 +323,8 @@ def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: s
     InputError
         Bad path file, tool, frame, name or folder: nothing is written.
     PathBreaks
-        The path breaks and ``split`` is False: nothing is written.
+        The path breaks and ``split`` is False, or no point of it can be reached: nothing is
+        written.
     """
     check_folder(folder)
     targets = read_path(path, cell)

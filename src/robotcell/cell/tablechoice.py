@@ -1,0 +1,384 @@
+"""The table's values along a path: the turntable angle, or a positioner's axis values, per target.
+
+A path given in a frame the turntable (or positioner) carries does not say where the table stands:
+the same seam can be welded at many table angles, and at table 0 part of it may lie out of the
+arm's reach. :func:`choose_table` chooses the table values so that the whole path is one
+continuous motion where possible, as a dynamic programme (Viterbi) over candidate values per
+target:
+
+- **candidates**: a turntable's angle (and a 1-axis positioner's) on a grid of
+  :data:`TABLE_SAMPLES` values per turn over its whole range (every turn its limits allow, so
+  that the table can pass +-180 deg where it may); a 2-axis positioner in the welding position,
+  the axis values that turn the target's surface normal (the tool's ``-Z``) straight up
+  (:meth:`~robotcell.cell.model.Positioner.normal_up`, each solution also a whole turn away
+  within the limits), with the rotating axis also on the grid where the normal stays within
+  ``normal_tol`` of up as it turns (a seam on a face across the rotating axis: the rotation is
+  free there, as a turntable's);
+- **a state** is a candidate and an arm configuration (analytic branch) at which the target is
+  reached within every limit (:func:`robotcell.cell.ik.ik`, the track chosen per target where
+  the path gives none); its cost is ``1 - m / m_best * min(1, margin / LIMIT_MARGIN)`` (``m``
+  the manipulability ``|det J|``, ``m_best`` the target's best over all its states, ``margin``
+  the arm's distance to its joint limits), plus the normal's tilt ``(dev / normal_tol)^2`` of a
+  positioner and a small pull towards the middle of the table's range;
+- **a move** from one target to the next keeps the configuration, turns each table axis and each
+  arm axis by at most ``max_step``, and costs ``(table step / max_step)^2 + (arm step /
+  max_step)^2``: the table moves little and evenly, the arm continuously;
+- **a break** (any other change, or a target reached by no state) costs more than every move of
+  the path together: the choice has the fewest breaks first, then the smallest cost.
+
+The chosen values are then smoothed by a moving average along each continuous piece (over
+:data:`TABLE_WINDOW` targets, or more where the table turns by less than a grid step per
+target), kept where every target of the piece stays reached. :func:`robotcell.cell.ik.ik_path`
+solves the path at the chosen values (and :func:`~robotcell.cell.ik.split_path` names the
+breaks that remain). The programme runs over the targets in order (each step depends on the
+one before); each step is vectorised over the candidates and configurations.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robotcell.cell.ik import MAX_STEP, ik
+from robotcell.cell.kinematics import CellModel as Cell
+from robotcell.cell.kinematics import frame_pose, robot_pose, tool_pose
+from robotcell.errors import InputError
+from robotcell.ik.analytic import analytic_solver
+from robotcell.ik.limits import TWO_PI
+from robotcell.ik.trackchoice import arm_manipulability
+from robotcell.kinematics.bounds import within
+from robotcell.kinematics.transforms import finite_array, validate_pose
+
+__all__ = ["LIMIT_MARGIN", "NORMAL_TOL", "TABLE_SAMPLES", "TABLE_WINDOW", "TableChoice",
+           "carried_by_table", "choose_table"]
+
+#: Candidate table values per turn (10 deg apart).
+TABLE_SAMPLES = 36
+#: Largest angle (rad) between a target's surface normal and straight up that a 2-axis
+#: positioner's choice still counts as the welding position.
+NORMAL_TOL = math.radians(2.0)
+#: Distance of the arm's axes to their limits (rad) from which a state counts as clear of them.
+LIMIT_MARGIN = math.radians(10.0)
+#: Targets of the moving average that smooths the chosen values.
+TABLE_WINDOW = 5
+#: Weight of the pull towards the middle of the table's range (per axis, per half turn off it).
+_MIDDLE = 1e-2
+
+
+@dataclass(frozen=True)
+class TableChoice:
+    """Table values chosen along a path.
+
+    Attributes
+    ----------
+    table : ndarray, shape (N,) or (N, n)
+        Turntable angles, or a positioner's axis values (rad).
+    branch : ndarray of int, shape (N,)
+        Arm configuration (analytic branch) of the choice at each target (-1: none reaches it).
+    reachable : ndarray of bool, shape (N,)
+        Some candidate value reaches the target in some configuration.
+    candidates : ndarray of int, shape (N,)
+        Candidate values per target (0: a positioner that cannot turn the target's normal up
+        within its limits).
+    breaks : int
+        Places where the chosen values cannot keep one continuous motion.
+    """
+
+    table: NDArray[np.float64]
+    branch: NDArray[np.int_]
+    reachable: NDArray[np.bool_]
+    candidates: NDArray[np.int_]
+    breaks: int
+
+    @property
+    def max_step(self) -> float:
+        """Largest change of a table axis between consecutive targets (rad)."""
+        if self.table.shape[0] < 2:
+            return 0.0
+        return float(np.max(np.abs(np.diff(self.table, axis=0))))
+
+    def unreached(self, i: int) -> str:
+        """Words to add to why target ``i`` breaks: no candidate reaches it ("" where one
+        does)."""
+        if self.reachable[i]:
+            return ""
+        if self.candidates[i] == 0:
+            return "no positioner values within the axis limits turn its normal up"
+        return "no table value reaches it within the limits either"
+
+
+def carried_by_table(cell: Cell, frame: str) -> bool:
+    """Whether frame ``frame`` of the cell is carried by the turntable (or positioner).
+
+    Parameters
+    ----------
+    cell : Cell
+    frame : str
+
+    Returns
+    -------
+    bool
+        True for a frame of the cell with parent ``turntable``: its pose in the world changes
+        with the table's values. The table's root (``turntable``, ``B``) does not turn.
+    """
+    return cell.turntable is not None and frame in cell.frames and \
+        cell.frames[frame].parent == "turntable"
+
+
+def _axis_grid(lo: float, hi: float, samples: int) -> NDArray[np.float64]:
+    """Values of one table axis (rad), ``2 pi / samples`` apart on multiples of that step, over
+    its limits (two turns each way of an unlimited side)."""
+    if not math.isfinite(lo):
+        lo = (hi if math.isfinite(hi) else 0.0) - 2 * TWO_PI
+    if not math.isfinite(hi):
+        hi = lo + 4 * TWO_PI if not math.isfinite(lo) else max(hi, lo + 4 * TWO_PI)
+    step = TWO_PI / samples
+    k = np.arange(math.ceil(lo / step - 1e-9), math.floor(hi / step + 1e-9) + 1)
+    grid = k * step
+    return grid if grid.size >= 2 else np.linspace(lo, hi, 3)
+
+
+def _range(cell: Cell) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    tt = cell.turntable
+    return np.atleast_1d(np.asarray(tt.lower, dtype=float)), np.atleast_1d(np.asarray(tt.upper,
+                                                                                    dtype=float))
+
+
+def _compact(values: NDArray[np.float64], keep: NDArray[np.bool_], extra: NDArray[np.float64]
+             ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """Candidates ``values`` (N, K, n) with ``keep`` (N, K) packed to the front, padded with the
+    first kept one (or 0): (N, M, n), ok (N, M) and ``extra`` (N, K) packed alike."""
+    order = np.argsort(~keep, axis=1, kind="stable")
+    m = max(1, int(keep.sum(axis=1).max()))
+    idx = order[:, :m]
+    v = np.take_along_axis(values, idx[..., None], axis=1)
+    ok = np.take_along_axis(keep, idx, axis=1)
+    fill = np.where(ok[:, :1, None], v[:, :1], 0.0)
+    return np.where(ok[..., None], v, fill), ok, np.take_along_axis(extra, idx, axis=1)
+
+
+def _normal_deviation(cell: Cell, frame: str, arr: NDArray[np.float64], track: NDArray[np.float64],
+                      values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Angle (rad) between each target's surface normal (the tool's -Z) and straight up, at
+    positioner values ``values`` (N, K, n): (N, K)."""
+    Tw = frame_pose(cell, frame, track[:, None], values) @ arr[:, None]
+    return np.arccos(np.clip(-Tw[..., 2, 2], -1.0, 1.0))
+
+
+def _positioner_candidates(cell: Cell, frame: str, arr: NDArray[np.float64],
+                           track: NDArray[np.float64], samples: int, normal_tol: float
+                           ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """A 2-axis positioner's candidates: the welding position, the rotation free where the
+    normal stays up. Values (N, M, 2), ok (N, M), normal deviation (N, M)."""
+    pos = cell.turntable
+    lo, hi = _range(cell)
+    T_P = cell.frames[frame].pose @ arr
+    parent = None if pos.parent == "world" else robot_pose(cell, track)
+    sols, _ = pos.normal_up(-T_P[:, :3, 2], parent)                     # (N, 2, 2)
+    turns = TWO_PI * np.arange(-2, 3)
+    n = arr.shape[0]
+    tilt = sols[:, :, 0, None] + turns                                   # (N, 2, 5)
+    grid = _axis_grid(lo[1], hi[1], samples)
+    rot = np.concatenate([np.broadcast_to(grid, (n, 2, grid.size)),
+                          sols[:, :, 1, None] + turns], axis=-1)         # (N, 2, G + 5)
+    v = np.stack(np.broadcast_arrays(tilt[..., :, None], rot[..., None, :]), axis=-1)
+    v = v.reshape(n, -1, 2)
+    keep = np.all(within(v, lo, hi), axis=-1)
+    dev = np.full(keep.shape, np.inf)
+    safe = np.where(keep[..., None], v, 0.0)
+    dev[keep] = _normal_deviation(cell, frame, arr, track, safe)[keep]
+    keep &= dev <= normal_tol
+    return _compact(v, keep, dev)
+
+
+def _candidates(cell: Cell, frame: str, arr: NDArray[np.float64], track: NDArray[np.float64],
+                samples: int, normal_tol: float
+                ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """Candidate table values (N, M, n), whether each is one (N, M), and the normal's deviation
+    from up (N, M; 0 for a turntable)."""
+    n_axes = cell.turntable.n_axes
+    if n_axes == 2:
+        return _positioner_candidates(cell, frame, arr, track, samples, normal_tol)
+    if n_axes != 1:
+        raise InputError(f"the table values are chosen for a turntable and a positioner of 1 or "
+                         f"2 axes; positioner {cell.turntable.name!r} has {n_axes}: give its "
+                         f"axis values")
+    lo, hi = _range(cell)
+    grid = _axis_grid(lo[0], hi[0], samples)
+    n = arr.shape[0]
+    return (np.broadcast_to(grid[None, :, None], (n, grid.size, 1)), np.ones((n, grid.size), bool),
+            np.zeros((n, grid.size)))
+
+
+def _node_costs(cell: Cell, q: NDArray[np.float64], valid: NDArray[np.bool_],
+                values: NDArray[np.float64], dev: NDArray[np.float64], normal_tol: float,
+                tool: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """Cost of each state (N, M, 8): reach, manipulability, limit margin, normal, middle."""
+    robot = cell.robot
+    qz = np.where(valid[..., None], q, 0.0)
+    if analytic_solver(robot).method == "opw":
+        manip = arm_manipulability(robot, qz)
+    else:
+        manip = np.abs(np.linalg.det(robot.jacobian(qz, tool=tool)))
+    manip = np.where(valid, manip, 0.0)
+    best = manip.reshape(manip.shape[0], -1).max(axis=1)[:, None, None]
+    rel = np.divide(manip, best, out=np.zeros_like(manip), where=best > 0)
+    lo, hi = robot.lower, robot.upper
+    with np.errstate(invalid="ignore"):
+        gap = np.minimum(np.where(np.isfinite(lo), qz - lo, np.inf),
+                         np.where(np.isfinite(hi), hi - qz, np.inf)).min(axis=-1)
+    score = rel * np.minimum(1.0, gap / LIMIT_MARGIN)
+    tlo, thi = _range(cell)
+    mid = np.where(np.isfinite(tlo) & np.isfinite(thi), 0.5 * (tlo + thi), 0.0)
+    middle = _MIDDLE * np.sum(((values - mid) / math.pi) ** 2, axis=-1)       # (N, M)
+    extra = (np.where(np.isfinite(dev), dev, 0.0) / normal_tol) ** 2 + middle
+    return (1.0 - score) + extra[..., None]
+
+
+def _wrapped(d: NDArray[np.float64], rev: NDArray[np.bool_]) -> NDArray[np.float64]:
+    """Joint differences with the revolute ones wrapped into [-pi, pi)."""
+    return np.where(rev, (d + math.pi) % TWO_PI - math.pi, d)
+
+
+def _viterbi(node: NDArray[np.float64], ok: NDArray[np.bool_], values: NDArray[np.float64],
+             q: NDArray[np.float64], rev: NDArray[np.bool_], max_step: float
+             ) -> tuple[NDArray[np.int_], NDArray[np.int_], NDArray[np.bool_]]:
+    """The cheapest sequence of states (``ok`` (N, M, 8) the states that exist): candidate (N,),
+    branch (N,) and where it breaks (N,)."""
+    n, m = ok.shape[:2]
+    big = 10.0 * (n + 1) * 4.0  # more than every move and state of the path together
+    cost = np.where(ok[0], node[0], big)                                        # (M, 8)
+    back = np.zeros((n, m, 8), dtype=np.int64)
+    broke = np.zeros((n, m, 8), dtype=bool)
+    for i in range(1, n):
+        dt = np.max(np.abs(values[i][None, :, :] - values[i - 1][:, None, :]), axis=-1)  # (M, M)
+        jp, jn = np.nonzero(dt <= max_step + 1e-12)
+        dq = np.max(np.abs(_wrapped(q[i, jn] - q[i - 1, jp], rev)), axis=-1)  # (P, 8)
+        with np.errstate(invalid="ignore"):
+            move = cost[jp] + ((dt[jp, jn] / max_step) ** 2)[:, None] + (dq / max_step) ** 2
+            move = np.where(dq <= max_step, move, np.inf)                    # NaN: not reached
+        dense = np.full((m, m, 8), np.inf)
+        dense[jp, jn] = move
+        prev = np.argmin(dense, axis=0)                                      # (M, 8)
+        best = np.take_along_axis(dense, prev[None], axis=0)[0]
+        flat = int(np.argmin(cost))
+        restart = cost.flat[flat] + big
+        broke[i] = restart < best
+        back[i] = np.where(broke[i], flat, prev * 8 + np.arange(8))
+        cost = np.minimum(best, restart) + np.where(ok[i], node[i], big)
+    state = np.empty(n, dtype=np.int64)
+    state[-1] = int(np.argmin(cost))
+    cut = np.zeros(n, dtype=bool)
+    for i in range(n - 1, 0, -1):
+        j, b = divmod(int(state[i]), 8)
+        cut[i] = broke[i, j, b]
+        state[i - 1] = back[i, j, b]
+    return state // 8, state % 8, cut
+
+
+def _smoothed(values: NDArray[np.float64], cut: NDArray[np.bool_], grid: float
+              ) -> NDArray[np.float64]:
+    """The moving average of ``values`` (N, n) piece by piece between the breaks ``cut``, over
+    :data:`TABLE_WINDOW` targets or, where the table turns by less than a grid step ``grid``
+    (rad) per target, over the targets of two grid steps (the grid's stairs become a ramp)."""
+    from scipy.ndimage import uniform_filter1d
+
+    out = values.copy()
+    starts = [0, *np.flatnonzero(cut).tolist(), values.shape[0]]
+    for a, b in itertools.pairwise(starts):
+        turned = float(np.abs(np.diff(values[a:b], axis=0)).sum(axis=0).max(initial=0.0))
+        if b - a > 2 and turned > 0:
+            size = max(TABLE_WINDOW, math.ceil(2 * grid * (b - a - 1) / turned))
+            out[a:b] = uniform_filter1d(values[a:b], size=min(size, b - a), axis=0,
+                                        mode="nearest")
+    return out
+
+
+def choose_table(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None = None,
+                 tool: str | ArrayLike | None = None, max_step: float = MAX_STEP,
+                 samples: int = TABLE_SAMPLES, normal_tol: float = NORMAL_TOL) -> TableChoice:
+    """Table values along a path in a frame the table carries, for one continuous motion.
+
+    See the module docstring for the candidates, the costs and the dynamic programme.
+
+    Parameters
+    ----------
+    cell : Cell
+    T : array_like, shape (N, 4, 4)
+        Targets ``T_X_TCP`` in frame ``frame`` (m).
+    frame : str
+        A frame of the cell carried by the turntable or positioner.
+    track : array_like, shape (N,), optional
+        Track positions (m); default: chosen per target (:func:`robotcell.cell.ik.ik`), or 0
+        without a track.
+    tool : str or array_like of shape (4, 4), optional
+        A tool of the cell by name, or ``T_F_TCP`` (m).
+    max_step : float
+        Largest change of a table axis and of an arm axis between consecutive targets (rad).
+    samples : int
+        Candidate values per turn of a table axis (>= 4).
+    normal_tol : float
+        A 2-axis positioner: largest angle between a target's normal and straight up (rad).
+
+    Returns
+    -------
+    TableChoice
+
+    Raises
+    ------
+    InputError
+        A frame the table does not carry, a positioner of 3 axes, bad targets, ``track``,
+        ``max_step``, ``samples`` or ``normal_tol``.
+    """
+    if not carried_by_table(cell, frame):
+        raise InputError(f"frame {frame!r} is not carried by the turntable: the table values do "
+                         "not move its targets; give them")
+    arr = validate_pose(T, "path targets")
+    if arr.ndim != 3 or arr.shape[0] < 1:
+        raise InputError(f"path targets must have shape (N, 4, 4), got {arr.shape}")
+    n = arr.shape[0]
+    e = None if track is None else np.broadcast_to(finite_array(track, "track position"), (n,))
+    if not max_step > 0:
+        raise InputError(f"max_step must be positive (rad), got {max_step}")
+    if not samples >= 4:
+        raise InputError(f"samples must be at least 4, got {samples}")
+    if not 0 < normal_tol < math.pi:
+        raise InputError(f"normal_tol must be between 0 and pi (rad), got {normal_tol}")
+    values, ok, dev = _candidates(cell, frame, arr, np.zeros(n) if e is None else e, samples,
+                                  normal_tol)
+    m = values.shape[1]
+    turntable = np.ndim(cell.turntable.lower) == 0  # angles (N,), not axis values (N, n)
+    tab = values[..., 0] if turntable else values
+    sol = ik(cell, np.broadcast_to(arr[:, None], (n, m, 4, 4)), frame,
+             None if e is None else np.broadcast_to(e[:, None], (n, m)), tab, tool)
+    valid = sol.valid & ok[..., None]                                           # (N, M, 8)
+    node = _node_costs(cell, sol.q, valid, values, dev, normal_tol, tool_pose(cell, tool))
+    rev = ~cell.robot.prismatic
+    j, b, cut = _viterbi(node, valid, values, np.where(valid[..., None], sol.q, np.nan), rev,
+                         max_step)
+    rows = np.arange(n)
+    reached = valid[rows, j, b]
+    chosen = values[rows, j]
+    smooth = _smoothed(chosen, cut, TWO_PI / samples)
+    if not np.array_equal(smooth, chosen):
+        again = ik(cell, arr, frame, e, smooth[:, 0] if turntable else smooth, tool)
+        still = again.valid[rows, b] | ~reached
+        if n > 1:
+            still &= np.max(np.abs(np.diff(smooth, axis=0)), axis=-1).max() <= max_step
+        if cell.turntable.n_axes == 2:
+            still &= _normal_deviation(cell, frame, arr, np.zeros(n) if e is None else e,
+                                       smooth[:, None])[:, 0] <= normal_tol
+        chosen = np.where(_pieces_ok(still, cut)[:, None], smooth, chosen)
+    return TableChoice(chosen[:, 0] if turntable else chosen, np.where(reached, b, -1),
+                       valid.any(axis=(1, 2)), ok.sum(axis=1), int(cut.sum()))
+
+
+def _pieces_ok(good: NDArray[np.bool_], cut: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """``good`` (N,) made all-or-nothing on each piece between the breaks ``cut``."""
+    piece = np.cumsum(cut)
+    bad = np.unique(piece[~good])
+    return ~np.isin(piece, bad)
