@@ -18,17 +18,15 @@ SRC = str(Path(robotcell.__file__).resolve().parents[1])
 #: every old path a user may import today, with its new path (submodules of old packages too)
 OLD = {**ALIASES,
        **{f"robotcell.cellcal.{m}": f"robotcell.cell.calibrate.{m}"
-          for m in ("procedures", "touches")},
-       **{f"robotcell.export.{m}": f"robotcell.io.export.{m}"
-          for m in ("abb", "common", "fanuc", "kuka", "urdf", "yaskawa")}}
+          for m in ("procedures", "touches")}}
 
 
 def test_the_table_holds_every_moved_module():
     assert set(ALIASES) == {f"robotcell.{m}" for m in (
         "transforms", "dh", "robot", "coupling", "modelfile", "poseformats", "tables", "fileio",
-        "export", "axischain", "coupled", "cellik", "cellcal", "simulate", "plan", "demo",
+        "axischain", "coupled", "cellik", "cellcal", "simulate", "plan", "demo",
         "reach", "sweep")}
-    assert new_name("robotcell.export.kuka") == "robotcell.io.export.kuka"
+    assert new_name("robotcell.cellcal.touches") == "robotcell.cell.calibrate.touches"
     assert new_name("robotcell.cell") is None and new_name("robotcell.kinematics.dh") is None
 
 
@@ -46,15 +44,12 @@ def test_from_imports_and_monkeypatching_see_one_module(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         from robotcell.cellik import CellIKSolutions
-        from robotcell.export import kuka
         from robotcell.modelfile import load_robot
     import robotcell.cell.ik
-    import robotcell.io.export.kuka
     import robotcell.kinematics.models
     from robotcell.cell import Cell
 
     assert CellIKSolutions is robotcell.cell.ik.CellIKSolutions
-    assert kuka is robotcell.io.export.kuka
     assert load_robot is robotcell.kinematics.models.load_robot
     monkeypatch.setattr(sys.modules["robotcell.cellik"], "MAX_STEP", 1.25)
     assert robotcell.cell.ik.MAX_STEP == 1.25
@@ -95,12 +90,12 @@ MAY_NAME_OLD = {"src/robotcell/_aliases.py", "tests/test_aliases.py", "docs/conv
 
 def test_rewrite_maps_old_paths_only():
     text = ("from robotcell import cellcal\nfrom robotcell.robot import Robot\n"
-            "import robotcell.export.kuka  # src/robotcell/cellik.py, robotcell/export/urdf.py\n"
+            "import robotcell.cellik  # src/robotcell/cellik.py, robotcell/export/urdf.py\n"
             "robotcell.robots robotcell.dhprocedure robotcell.cli.export robotcell.cell.ik\n")
     assert rewrite(text) == (
         "from robotcell.cell import calibrate as cellcal\n"
         "from robotcell.kinematics.robot import Robot\n"
-        "import robotcell.io.export.kuka  # src/robotcell/cell/ik.py, robotcell/io/export/urdf.py\n"
+        "import robotcell.cell.ik  # src/robotcell/cell/ik.py, robotcell/export/urdf.py\n"
         "robotcell.robots robotcell.dhprocedure robotcell.cli.export robotcell.cell.ik\n")
 
 

@@ -142,7 +142,7 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
 #: package's ``__init__``, ``errors``, ``report`` (one concept, one module) and ``_aliases``.
 CONCEPTS = {"kinematics", "ik", "dhprocedure", "calibration", "identification", "cell", "io",
-            "programs", "accuracy", "studies", "view", "cli", "robots"}
+            "export", "programs", "accuracy", "studies", "view", "cli", "robots"}
 TOP_MODULES = {"__init__.py", "errors.py", "report.py", "_aliases.py"}
 
 
@@ -161,7 +161,7 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: (a module belongs to the longest prefix listed). The vendor-boundary helpers of ``io`` (files,
 #: tables, pose formats) and the pose algebra sit under the kinematics, which reads model files;
 #: the pose algebra compiles its one-pose check with ``robotcell.kinematics.jit``, below it;
-#: the controller exports of ``io`` sit over the cell they export; reports of results sit with the
+#: the controller exports (``robotcell.export``) sit over the cell they export; reports of results sit with the
 #: estimators whose results they show, and with them the 3D scenes and their plotly drawing
 #: (``robotcell.view.scene``, ``.shapes``, ``.arm``, ``.plot``) and the scenes of results
 #: (``.calibration``, ``.identification``), which the reports draw; the view of a cell, its
@@ -177,7 +177,7 @@ LAYERS = [
      "robotcell.report", "robotcell.view.scene", "robotcell.view.shapes", "robotcell.view.arm",
      "robotcell.view.plot", "robotcell.view.calibration", "robotcell.view.identification"},
     {"robotcell.cell"},
-    {"robotcell.io.export"},
+    {"robotcell.export"},
     {"robotcell.programs"},
     {"robotcell.accuracy"},
     {"robotcell.view"},
@@ -198,7 +198,7 @@ def layer(module: str) -> int:
 
 
 def test_every_module_is_in_a_layer():
-    assert layer("robotcell.io.export.kuka") == 4 and layer("robotcell.io.tables") == 0
+    assert layer("robotcell.export.kuka") == 4 and layer("robotcell.io.tables") == 0
     assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 9
     assert layer("robotcell.view.plot") == 2 and layer("robotcell.view.cellscene") == 7
     assert layer("robotcell.view.calibration") == 2 and layer("robotcell.view.program") == 7

@@ -4,7 +4,7 @@ Before 0.2 the modules stood at the top level (``robotcell.transforms``, ``robot
 ...). They now live in concept packages (``docs/conventions.md``, "Layout"). Importing an old path
 gives the SAME module object as the new path (so monkeypatching and ``isinstance`` see one
 module) and emits a :class:`DeprecationWarning` naming the new path. A submodule of an old
-package (``robotcell.export.kuka``) maps the same way.
+package (``robotcell.cellcal.touches``) maps the same way.
 
 :func:`install` puts the finder first on :data:`sys.meta_path`; ``robotcell/__init__.py`` calls
 it. The finder imports nothing until an old path is imported.
@@ -28,7 +28,6 @@ ALIASES = {
     "robotcell.poseformats": "robotcell.io.poseformats",
     "robotcell.tables": "robotcell.io.tables",
     "robotcell.fileio": "robotcell.io.fileio",
-    "robotcell.export": "robotcell.io.export",
     "robotcell.axischain": "robotcell.cell.axischain",
     "robotcell.coupled": "robotcell.cell.kinematics",
     "robotcell.cellik": "robotcell.cell.ik",

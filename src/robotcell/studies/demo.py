@@ -42,7 +42,7 @@ from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.history import backups
 from robotcell.errors import InputError, RobotcellError
-from robotcell.io.export import EXPORT_FORMATS, export_cell
+from robotcell.export import EXPORT_FORMATS, export_cell
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv, write_csv
 from robotcell.kinematics.models import load_robot
