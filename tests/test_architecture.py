@@ -140,10 +140,10 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 
 
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
-#: package's ``__init__``, ``errors``, ``report`` (one concept, one module) and ``_aliases``.
+#: package's ``__init__``, ``errors``, ``report`` (one concept, one module).
 CONCEPTS = {"kinematics", "ik", "dhprocedure", "calibration", "identification", "cell", "io",
             "export", "programs", "accuracy", "studies", "view", "cli", "robots"}
-TOP_MODULES = {"__init__.py", "errors.py", "report.py", "_aliases.py"}
+TOP_MODULES = {"__init__.py", "errors.py", "report.py"}
 
 
 def test_the_top_level_holds_only_the_concept_packages():
@@ -206,10 +206,9 @@ def test_every_module_is_in_a_layer():
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES
-                                        if n not in ("robotcell", "robotcell._aliases")))
+                                        if n != "robotcell"))
 def test_imports_go_down_the_layers(name):
-    up = sorted(t for t in internal(GRAPH[name]) - {"robotcell._aliases"}
-                if layer(t) > layer(name))
+    up = sorted(t for t in internal(GRAPH[name]) if layer(t) > layer(name))
     assert not up, f"{name} (layer {layer(name)}) imports {up} from a layer above"
 
 

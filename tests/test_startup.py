@@ -88,7 +88,6 @@ def test_every_public_name_is_importable_as_before():
     assert set(home) | {n for n in robotcell.__all__ if hasattr(transforms, n)} == set(
         robotcell.__all__)
     assert set(robotcell.__all__) <= set(dir(robotcell))
-    # The old submodule attributes are checked in tests/test_aliases.py.
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
         robotcell.no_such_name  # noqa: B018
 
