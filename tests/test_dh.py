@@ -181,9 +181,9 @@ def test_one_pose_kernel_compiled_equals_python_and_the_batch():
     # The chain is written once (robotcell.kinematics.dh.chain_kernel): run as Python on floats,
     # compiled by numba for one pose, and by numpy on a batch. Compiled and Python give the same
     # bits; the batch takes cos and sin from tan(theta/2) (SIMD), equal to rounding.
-    from robotcell.kinematics import dh
-
     from dataclasses import replace
+
+    from robotcell.kinematics import dh
 
     rng = np.random.default_rng(8)
     robots = [random_standard_robot(rng), to_modified(random_standard_robot(rng))]
