@@ -372,8 +372,8 @@ def test_the_predicted_sigma_agrees_with_a_monte_carlo_of_the_identification():
     2 tr(S^2)): the bounds 0.8 and 1.25 are more than 3 of it away."""
     from robotcell.identification import Measurements
     from robotcell.identification.uncertainty import position_jacobian, position_sigma
-    from robotcell.kinematics.robot import Joint, Robot
     from robotcell.kinematics.transforms import make_pose
+    from robotcell.robot.robot import Joint, Robot
 
     nominal = Robot("arm3", (Joint("revolute", a=0.15, alpha=-math.pi / 2, d=0.4, name="A1"),
                              Joint("revolute", a=0.5, name="A2"),

@@ -22,7 +22,7 @@ from robotcell.cell import Cell, Frame, Positioner, Tool, Turntable
 from robotcell.export import export_cell
 from robotcell.export.urdf import urdf_origin
 from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.robot import Joint, Robot
+from robotcell.robot.robot import Joint, Robot
 from robotcell.studies.demo import demo_cells
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "cell_kr16_track_turntable.yaml"

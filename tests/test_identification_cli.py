@@ -20,8 +20,8 @@ from identification_helpers import (
 from robotcell import load_robot, save_robot
 from robotcell.identification import Measurements
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose, rot_y
+from robotcell.robot.robot import Joint, Robot
 
 NOISE = 0.02e-3
 

@@ -17,7 +17,7 @@ from robotcell.cell import Cell, Frame, Positioner, Provenance, Tool, Turntable
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 from robotcell.studies.demo import demo_cells
 
 ROOT = Path(__file__).resolve().parent.parent

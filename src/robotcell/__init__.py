@@ -18,8 +18,6 @@ from robotcell.errors import IllPosedError, InputError, RobotcellError
 if TYPE_CHECKING:
     from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
     from robotcell.kinematics.coupling import Coupling
-    from robotcell.kinematics.models import list_robots, load_robot, robot_from_dict, save_robot
-    from robotcell.kinematics.robot import Joint, Robot
     from robotcell.kinematics.transforms import (
         check_pose,
         compose,
@@ -31,6 +29,8 @@ if TYPE_CHECKING:
         transform_points,
         validate_pose,
     )
+    from robotcell.robot.models import list_robots, load_robot, robot_from_dict, save_robot
+    from robotcell.robot.robot import Joint, Robot
 
 __version__ = "0.1.0"
 
@@ -38,9 +38,9 @@ __version__ = "0.1.0"
 _LAZY = {
     "Coupling": "robotcell.kinematics.coupling",
     **dict.fromkeys(["list_robots", "load_robot", "robot_from_dict", "save_robot"],
-                    "robotcell.kinematics.models"),
+                    "robotcell.robot.models"),
     **dict.fromkeys(["FORMATS", "pose_from_vendor", "pose_to_vendor"], "robotcell.io.poseformats"),
-    **dict.fromkeys(["Joint", "Robot"], "robotcell.kinematics.robot"),
+    **dict.fromkeys(["Joint", "Robot"], "robotcell.robot.robot"),
     **dict.fromkeys(["check_pose", "compose", "invert", "make_pose", "rot_x", "rot_y", "rot_z",
                      "transform_points", "validate_pose"], "robotcell.kinematics.transforms"),
 }

@@ -18,7 +18,7 @@ from robotcell.errors import InputError
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write, check_destination, read_text
-from robotcell.kinematics.models import save_robot
+from robotcell.robot.models import save_robot
 
 __all__ = ["adopt_identified", "identification_provenance"]
 

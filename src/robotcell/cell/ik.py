@@ -47,13 +47,13 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.track import TrackChoice, TrackRobot
 from robotcell.ik.trackchoice import choose_track, scan_track
 from robotcell.kinematics.bounds import LIMIT_TOL, within
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import (
     finite_array,
     invert,
     validate_pose,
     validate_single_pose,
 )
+from robotcell.robot.robot import Robot
 
 __all__ = ["CellIKSolutions", "CellPath", "PathBreak", "PathSplit", "choose_track_value",
            "depends_on_track", "ik", "ik_path", "split_path"]

@@ -15,7 +15,7 @@ angle) are in :mod:`robotcell.cell.kinematics`; :meth:`Cell.fk` and :meth:`Cell.
 
 External axes that carry the work are a :class:`Turntable` (one axis, the lecture's ``R_T_B
 Rz(theta)``) or a :class:`Positioner`: a chain of 1-3 revolute axes written as a DH
-:class:`~robotcell.kinematics.robot.Robot` whose ``base`` is the root pose, the form an identified chain
+:class:`~robotcell.robot.robot.Robot` whose ``base`` is the root pose, the form an identified chain
 takes. Both offer the same kinematic interface (:attr:`Turntable.chain`, ``T_root_P``,
 ``axis_values``, ``within_limits``), which is all coupled kinematics and the exports use.
 """
@@ -36,8 +36,8 @@ from robotcell.cell import axischain, kinematics
 from robotcell.cell.kinematics import RESERVED_FRAMES
 from robotcell.errors import InputError
 from robotcell.kinematics.bounds import within
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import finite_array, validate_pose
+from robotcell.robot.robot import Joint, Robot
 
 if TYPE_CHECKING:
     from robotcell.cell.ik import CellIKSolutions, CellPath
@@ -734,7 +734,7 @@ class Cell:
         """Write a calibrated positioner chain into the cell, keeping its parent and name.
 
         The hook of the positioner calibration (:func:`robotcell.identification.calibrate_positioner`
-        returns the identified chain as a :class:`~robotcell.kinematics.robot.Robot`): a turntable becomes a
+        returns the identified chain as a :class:`~robotcell.robot.robot.Robot`): a turntable becomes a
         :class:`Positioner` with that chain.
 
         Parameters

@@ -44,7 +44,7 @@ from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, check_destination, read_text
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.yamlfile import dump_yaml, parse_yaml, update_document
-from robotcell.kinematics.models import load_robot, robot_from_dict, robot_to_dict
+from robotcell.robot.models import load_robot, robot_from_dict, robot_to_dict
 
 __all__ = ["cell_from_dict", "cell_to_dict", "load_cell", "save_cell"]
 

@@ -20,8 +20,8 @@ from robotcell.dhprocedure import (
     symbolic_arm,
 )
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.models import load_robot, save_robot
-from robotcell.kinematics.robot import Joint, Robot
+from robotcell.robot.models import load_robot, save_robot
+from robotcell.robot.robot import Joint, Robot
 
 _CONVENTION = click.Choice(["standard", "modified"])
 

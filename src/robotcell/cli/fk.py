@@ -34,8 +34,8 @@ from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import outside_limits
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
 
 FORMAT_CHOICES = [*FORMATS, "matrix"]
 

@@ -32,8 +32,8 @@ from robotcell.identification.validation import (
     select_configurations,
 )
 from robotcell.io.tables import format_table, write_csv
-from robotcell.kinematics.models import load_robot, save_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot, save_robot
+from robotcell.robot.robot import Robot
 
 #: Columns of a measurement CSV (docs/identification.md): joints ``a1..aN``, one target ``x,y,z``
 #: or several ``x1,y1,z1,...``, an orientation ``qw,qx,qy,qz``.

@@ -43,8 +43,8 @@ from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
 from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
 
 BRANCHES = ["front up", "front up flip", "front down", "front down flip",
             "back up", "back up flip", "back down", "back down flip"]

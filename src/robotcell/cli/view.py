@@ -13,7 +13,7 @@ from robotcell.cli.common import output_of, parse_numbers
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 from robotcell.view.cellscene import cell_figure
 from robotcell.view.path import ordinal
 from robotcell.view.plot import MAX_PAGE_BYTES, write_html

@@ -23,7 +23,7 @@ from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError
 from robotcell.identification.chain import PARALLEL_TOL
 from robotcell.identification.measurements import Measurements, read_measurements
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["axis_lines", "first_estimate", "start_model"]
 

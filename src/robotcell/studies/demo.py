@@ -45,9 +45,9 @@ from robotcell.errors import InputError, RobotcellError
 from robotcell.export import EXPORT_FORMATS, export_cell
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv, write_csv
-from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_y
 from robotcell.programs import write_program
+from robotcell.robot.models import load_robot
 from robotcell.studies.demo_accuracy import accuracy_step
 from robotcell.studies.plan import pose_error
 from robotcell.studies.simulate import simulate

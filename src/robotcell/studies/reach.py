@@ -42,7 +42,7 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.trackchoice import arm_manipulability
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
 from robotcell.io.tables import read_csv, require_columns
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell

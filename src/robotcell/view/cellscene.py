@@ -31,8 +31,8 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import Cell, Positioner
 from robotcell.cell.kinematics import robot_pose
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import finite_array
+from robotcell.robot.robot import Robot
 from robotcell.view.arm import chain_items
 from robotcell.view.plot import scene_figure
 from robotcell.view.reach import ReachLike, reach_points
