@@ -25,13 +25,13 @@ from robotcell.identification import identify as run_identify
 from robotcell.identification import identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
 from robotcell.identification.offsets import joint_offsets
-from robotcell.identification.report import write_identification_report
 from robotcell.identification.validation import (
     compare_observability,
     cross_validate,
     select_configurations,
 )
 from robotcell.io.tables import format_table, write_csv
+from robotcell.report.identification import write_identification_report
 from robotcell.robot.models import load_robot, save_robot
 from robotcell.robot.robot import Robot
 

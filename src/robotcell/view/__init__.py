@@ -13,9 +13,10 @@
   :mod:`robotcell.view.program`: a robot program in it, its bad points marked;
   :mod:`robotcell.view.reach`: a reachability map in the cell.
 
-The names below are imported on first use (PEP 562): the scene and plotting modules sit below
-the cell in the layers (docs/conventions.md), with the calibration reports that use them, and
-importing them must not load the cell. plotly itself is imported only to draw.
+The views stand over the cell and the programs and under the reports (:mod:`robotcell.report`),
+which draw the scenes of results. The names below are imported on first use (PEP 562), so that
+importing a scene or plotting module (for a report) does not load the cell; plotly itself is
+imported only to draw.
 See docs/view.md.
 """
 
