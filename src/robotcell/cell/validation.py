@@ -18,7 +18,8 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robotcell.cell.model import Cell, Positioner, Track, Turntable
+from robotcell.cell.kinematics import CellModel
+from robotcell.cell.parts import Positioner, Track, Turntable
 from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM, MAX_ABS_VALUE, outside_limits
 
@@ -85,7 +86,7 @@ def _pose(key: str, T: np.ndarray) -> Iterator[tuple[str, float]]:
         yield f"{key}.{c}", float(T[i, 3])
 
 
-def _lengths(cell: Cell) -> Iterator[tuple[str, float]]:
+def _lengths(cell: CellModel) -> Iterator[tuple[str, float]]:
     """Every length of ``cell`` (m) with the key of the cell file that holds it."""
     if cell.track is None:
         yield from _pose("robot.frame", cell.T_world_R)
@@ -111,20 +112,15 @@ def _lengths(cell: Cell) -> Iterator[tuple[str, float]]:
         yield from _pose(f"frames.{name}.frame", fr.pose)
 
 
-def check_lengths(cell: Cell, origin: str = "cell") -> Cell:
+def check_lengths(cell: CellModel, origin: str = "cell") -> None:
     """Refuse a cell with a length beyond the size of any real cell, or an implausible scale.
 
     Parameters
     ----------
-    cell : Cell
-        A cell as read from a file (SI units).
+    cell : CellModel
+        A cell as read from a file (SI units): a :class:`~robotcell.cell.model.Cell`.
     origin : str
         The file, for the message.
-
-    Returns
-    -------
-    Cell
-        ``cell`` itself.
 
     Raises
     ------
@@ -151,4 +147,3 @@ def check_lengths(cell: Cell, origin: str = "cell") -> Cell:
                 if not abs(v) * 1e3 <= MAX_ABS_VALUE:
                     raise InputError(f"{origin}: key 'positioner.axes[{i}].{k}' is {v * 1e3:g} "
                                      f"mm, beyond {MAX_ABS_VALUE:.0e} mm: a typing error")
-    return cell
