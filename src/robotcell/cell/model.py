@@ -19,6 +19,7 @@ them, and :meth:`Cell.ik` and :meth:`Cell.ik_path` call :mod:`robotcell.cell.ik`
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -49,7 +50,10 @@ from robotcell.robot.robot import Robot
 if TYPE_CHECKING:
     from robotcell.cell.ik import CellIKSolutions, CellPath
 
-__all__ = ["RESERVED_FRAMES", "Cell", "cell_from_dict"]
+__all__ = ["IK_CHUNK", "RESERVED_FRAMES", "Cell", "cell_from_dict"]
+
+#: Targets per call of :meth:`Cell.ik` in :meth:`Cell.ik_batch`: bounds the memory of a long list.
+IK_CHUNK = 500
 
 
 # -- the cell -------------------------------------------------------------------------------------
@@ -331,6 +335,56 @@ class Cell:
             pick(first.q, other.q), pick(first.valid, other.valid),
             pick(first.reachable, other.reachable), pick(first.track, other.track),
             pick(first.table, other.table), first.method, err)
+
+    def ik_batch(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+                 table: ArrayLike | Literal["normal_up"] = 0.0,
+                 tool: str | ArrayLike | None = None, chunk: int = IK_CHUNK,
+                 progress: Callable[[int], None] | None = None) -> CellIKSolutions:
+        """:meth:`ik` of a long list of targets, ``chunk`` targets per call (bounded memory).
+
+        Parameters
+        ----------
+        T : array_like, shape (N, 4, 4)
+            Targets in ``frame`` (m).
+        frame : str
+        track : array_like, shape (N,) or (), optional
+            Track values (m), per target or one for all; None: chosen per target.
+        table : array_like, shape (N,), (N, n), () or (n,), or "normal_up"
+            Table angle or positioner axis values (rad), per target or one for all.
+        tool : str or array_like, optional
+        chunk : int
+            Targets per call of :meth:`ik` (at least 1).
+        progress : callable, optional
+            Called with the number of targets solved after each chunk.
+
+        Returns
+        -------
+        CellIKSolutions
+            Shapes ``(N, 8, n)``, ``(N, 8)``, track ``(N,)``, table ``(N,)`` or ``(N, n)``.
+        """
+        T = validate_pose(T, "T")
+        if T.ndim != 3:
+            raise InputError(f"T must be a list of poses, shape (N, 4, 4), got {T.shape}")
+        if not (isinstance(chunk, int) and chunk >= 1):
+            raise InputError(f"chunk must be an integer >= 1, got {chunk!r}")
+        n = len(T)
+        pos = self.turntable
+        table_shape = (pos.n_axes,) if isinstance(pos, Positioner) else ()
+        try:
+            e = None if track is None else np.broadcast_to(np.asarray(track, float), (n,))
+            th = (table if isinstance(table, str)
+                  else np.broadcast_to(np.asarray(table, float), (n, *table_shape)))
+        except ValueError:
+            raise InputError(f"track must have shape (N,) or (), and table shape "
+                             f"{(n, *table_shape)} or {table_shape}, for N = {n} targets") from None
+        parts = []
+        for start in range(0, max(n, 1), chunk):
+            sl = slice(start, min(start + chunk, n))
+            parts.append(self.ik(T[sl], frame, None if e is None else e[sl],
+                                 th if isinstance(th, str) else th[sl], tool))
+            if progress is not None:
+                progress(sl.stop - sl.start)
+        return parts[0].concatenate(parts, table_shape)
 
     def _normal_up(self, T: ArrayLike, frame: str, track: ArrayLike | None
                    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:

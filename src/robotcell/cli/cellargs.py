@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 import click
 import numpy as np
@@ -31,7 +32,7 @@ __all__ = [
     "cell_tool",
     "check_axis_columns",
     "check_normal_up",
-    "chunks",
+    "progress",
     "row_values",
     "setup_text",
     "table_angles",
@@ -47,8 +48,6 @@ NORMAL_UP = "normal-up"
 
 #: Batches of at least this many poses show a progress bar on stderr.
 PROGRESS_MIN = 2000
-#: Poses per call of the library while a progress bar is shown.
-CHUNK = 500
 
 
 def cell_tool(text: str | None) -> str | NDArray[np.float64] | None:
@@ -205,16 +204,14 @@ def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[n
     return None if option is None else np.full(n, float(option))
 
 
-def chunks(n: int, label: str) -> Iterator[slice]:
-    """Slices over ``n`` poses; with a progress bar on stderr for ``n >= PROGRESS_MIN``."""
+@contextmanager
+def progress(n: int, label: str) -> Iterator[Callable[[int], None] | None]:
+    """A progress bar on stderr for ``n >= PROGRESS_MIN`` items: its ``update``, or None."""
     if n < PROGRESS_MIN:
-        yield slice(0, n)
+        yield None
         return
-    with click.progressbar(length=n, label=label, file=sys.stderr,
-                           show_pos=True) as bar:
-        for s in range(0, n, CHUNK):
-            yield slice(s, min(s + CHUNK, n))
-            bar.update(min(CHUNK, n - s))
+    with click.progressbar(length=n, label=label, file=sys.stderr, show_pos=True) as bar:
+        yield bar.update
 
 
 def table_text(cell: Cell, values: NDArray[np.float64] | float, chosen: bool = False) -> str:
