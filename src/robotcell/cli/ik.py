@@ -13,6 +13,7 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
+    batch_outside,
     batch_table,
     batch_track,
     cell_tool,
@@ -249,8 +250,8 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     if pose is not None:
         T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
         th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-              else table_angles(cell, table_option(cell, table_deg)))
-        sol = cell.ik(T, frame, track_values(cell, track_mm), th, T_tool)
+              else table_angles(cell, table_option(cell, table_deg), "warn"))
+        sol = cell.ik(T, frame, track_values(cell, track_mm, "warn"), th, T_tool)
         valid = sol.valid
         if ref is not None:
             q, found, branch = sol.nearest(r, ref)
@@ -289,12 +290,13 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(input_path, known=[*names, "track", *table_names])
-    check_axis_columns(cell, cols, input_path)
+    check_axis_columns(cell, cols, input_path, warn=True)
     T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     n = len(T)
-    e = track_values(cell, row_values(cols, "track", track_mm, n))
+    e = track_values(cell, row_values(cols, "track", track_mm, n), batch_outside(cols, ["track"]))
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n)))
+          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n),
+                            batch_outside(cols, table_names)))
     click.echo(setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "chosen per pose"),
                           batch_table(cell, cols, table_deg)), err=True)
     with progress(n, "ik") as done:

@@ -13,6 +13,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
+    batch_outside,
     check_axis_columns,
     row_values,
     table_angles,
@@ -92,16 +93,18 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
-    check_axis_columns(cell, cols, path, track=track_column)
+    check_axis_columns(cell, cols, path, track=track_column, warn=True)
     T = target_poses(require_columns(cols, names, path), fmt, path)
     track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
-                         else track_mm)
+                         else track_mm, batch_outside(cols, ["track"] if track_column else []))
     if choose_table:
         given = [c for c in table_names if c in cols]
         if given:
             raise InputError(f"{path} has a '{given[0]}' column; leave it out to --choose-table")
         return T, None, track
-    return T, table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T))), track
+    th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T)),
+                      batch_outside(cols, table_names))
+    return T, th, track
 
 
 @click.command(cls=Command)
