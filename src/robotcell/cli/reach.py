@@ -14,8 +14,11 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     batch_outside,
+    batch_table,
+    batch_track,
     check_axis_columns,
     row_values,
+    setup_text,
     table_angles,
     table_columns,
     table_option,
@@ -85,11 +88,12 @@ def target_options(f: Callable[..., None]) -> Callable[..., None]:
 
 def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_table: bool,
                  track_mm: float | None = None, track_column: bool = True
-                 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
-    """Targets (m), table angles (rad; None: to be chosen) and track positions (m; None: to be
-    chosen) from the targets file, with the columns of ``ik --cell``: the pose columns of
-    ``fmt``, ``track`` (mm, when ``track_column``), ``table`` or a positioner's ``e1..en``
-    (deg). A column the command does not use is named in a warning."""
+                 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, str]:
+    """Targets (m), table angles (rad; None: to be chosen), track positions (m; None: to be
+    chosen) and how the track and table were set (``", track chosen per target, table 0 deg"``)
+    from the targets file, with the columns of ``ik --cell``: the pose columns of ``fmt``,
+    ``track`` (mm, when ``track_column``), ``table`` or a positioner's ``e1..en`` (deg). A
+    column the command does not use is named in a warning."""
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
@@ -101,10 +105,15 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
         given = [c for c in table_names if c in cols]
         if given:
             raise InputError(f"{path} has a '{given[0]}' column; leave it out to --choose-table")
-        return T, None, track
+    axes = (batch_track(cell, cols if track_column else {}, track_mm, "chosen per target")
+            + (", table chosen per target (--choose-table)"
+               if choose_table and cell.turntable is not None
+               else batch_table(cell, cols, table_deg)))
+    if choose_table:
+        return T, None, track, axes
     th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T)),
                       batch_outside(cols, table_names))
-    return T, th, track
+    return T, th, track, axes
 
 
 @click.command(cls=Command)
@@ -141,7 +150,8 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
         html_path = str(Path(output).with_suffix(".html"))
         refuse_overwriting_inputs(click.get_current_context(), [("the map written next to -o", html_path)])
     cell = Cell.load(cell_path)
-    T, th, track = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
+    T, th, track, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
+    click.echo(setup_text(cell, tool, frame, axes, ""), err=True)
     with ExitStack() as stack:
         rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
                        progress=DeferredProgress(stack, "targets"))

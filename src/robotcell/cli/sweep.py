@@ -10,6 +10,7 @@ import click
 import numpy as np
 
 from robotcell.cell import Cell
+from robotcell.cli.cellargs import setup_text
 from robotcell.cli.common import format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.progress import DeferredProgress
@@ -70,7 +71,10 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
     cell = Cell.load(cell_path)
-    T, th, _ = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
+    T, th, _, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
+    click.echo(setup_text(cell, tool, frame, axes.replace("track chosen per target",
+                                                          "track chosen per target and layout"),
+                          ""), err=True)
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)

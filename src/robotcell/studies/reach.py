@@ -187,6 +187,8 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
         grid = _table_grid(cell, table_samples)
         arr = np.broadcast_to(arr[:, None], (arr.shape[0], grid.size, 4, 4))
         table = np.broadcast_to(grid, arr.shape[:2])
+        if track is not None and np.ndim(track) == 1:  # one position per target: every angle
+            track = np.asarray(track, dtype=float)[:, None]
     sol = ik(cell, arr, frame=frame, track=track, table=table, tool=tool)
     robot = cell.robot
     T_tool = tool_pose(cell, tool)
