@@ -11,6 +11,7 @@ import click
 import numpy as np
 
 from robotcell.cli.common import (
+    as_flags,
     check_kind,
     check_not_folder,
     check_output,
@@ -193,9 +194,10 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
     _check_columns(measurements)
-    run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
-                        math.radians(angle_accuracy), scale, compliance, folds, report,
-                        offsets_for, output, force)
+    with as_flags({"the nominal model as robot": "the nominal model with --robot"}):
+        run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
+                            math.radians(angle_accuracy), scale, compliance, folds, report,
+                            offsets_for, output, force)
     result, cv, offsets = run.result, run.cross_stats, run.offsets
     verdict, why = result.verdict
     if as_json:
