@@ -19,6 +19,8 @@ def test_export_to_stdout_matches_library(capsys, fmt):
     code, out, err = run(capsys, "export", "--cell", str(EXAMPLE), "--format", fmt)
     assert code == 0 and err == ""
     assert out == export_cell(Cell.load(EXAMPLE), fmt)
+    # independently of the library: the torch as the cell file writes it, x, y, z in mm
+    assert all(f"{v:.6f}" in out for v in (312.5, -1.2, 95.0)), out
 
 
 def test_export_to_file_parses_back(capsys, tmp_path):

@@ -342,6 +342,9 @@ def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, 
     got.cell.save(lib_file)
     assert cli_file.read_bytes() == lib_file.read_bytes()
     assert json.loads(out) == got.result.to_json()
+    # independently of the library call: the root the command wrote is the simulated truth's
+    root = Cell.load(cli_file).turntable.T_parent_root
+    assert np.linalg.norm(root[:3, 3] - Cell.load(truth).turntable.T_parent_root[:3, 3]) < 2e-3
     assert "T_world_B" in got.result.values and "T_R_B" not in got.result.values
 
 

@@ -9,7 +9,6 @@ would). Every exported pose, read back from the controller text, must match the 
 import json
 import math
 import re
-import time
 
 import numpy as np
 from cli_helpers import run
@@ -106,12 +105,10 @@ def check_exports(cell_file, truth, results, tmp_path, capsys):
 
 
 def test_demo_track_cell_end_to_end(tmp_path, capsys):
-    """`robotcell demo`: the track-and-turntable cell, under 30 s, every file written."""
-    start = time.perf_counter()
+    """`robotcell demo`: the track-and-turntable cell, every file written (its time is measured
+    by benchmarks/, not here)."""
     code, out, err = run(capsys, "demo", "-o", tmp_path)
-    elapsed = time.perf_counter() - start
     assert code == 0, err
-    assert elapsed < 30
     assert "calibrated vs true cell" in out
     for name in ["cell.yaml", *(f"cell.yaml.{i}.bak" for i in range(1, 5)), "truth.yaml", *EXPORT_FILES.values(),
                  *(f"{p}.{ext}" for p in ("tcp", "track", "turntable", "workpiece")
