@@ -29,37 +29,13 @@ from robotcell.cli.common import (
     output_of,
     read_csv,
     target_poses,
-    write_output,
 )
 from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS
-from robotcell.io.tables import require_columns, write_columns
-from robotcell.studies.reach import ReachMap, reach_html, reach_map
-
-
-def reach_columns(rm: ReachMap, cell: Cell) -> dict[str, np.ndarray]:
-    """The CSV columns of a reachability map (mm, deg), each in its type.
-
-    The axis columns are named as ``fk --cell`` and ``ik --cell`` name them: ``track`` (mm),
-    ``table`` or a positioner's ``e1..en`` (deg), ``a1..an`` (deg), so the file can be fed to
-    ``robotcell fk --cell CELL --input``. ``target`` and ``branch`` are integers, ``reachable``
-    is ``true``/``false``; ``track_margin_mm`` only for a cell with a track.
-    """
-    table = np.degrees(rm.table).reshape(rm.reachable.size, -1)
-    columns: dict[str, np.ndarray] = {
-        "target": np.arange(rm.reachable.size), "reachable": rm.reachable.astype(bool),
-        "score": rm.score, "track": rm.track * 1e3,
-        **{name: table[:, i] for i, name in enumerate(table_columns(cell)[1])},
-        "branch": rm.branch.astype(int),
-        **{f"a{i + 1}": np.degrees(rm.q[:, i]) for i in range(cell.robot.n_joints)},
-        "limit_margin_deg": np.degrees(rm.limit_margin),
-    }
-    if cell.track is not None:
-        columns["track_margin_mm"] = rm.track_margin * 1e3
-    columns["manipulability_m3"] = rm.manipulability
-    return columns
+from robotcell.io.tables import require_columns
+from robotcell.studies.reach import write_reach_map
 
 
 def target_options(f: Callable[..., None]) -> Callable[..., None]:
@@ -153,13 +129,9 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
     T, th, track, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
     click.echo(setup_text(cell, tool, frame, axes, ""), err=True)
     with ExitStack() as stack:
-        rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
-                       progress=DeferredProgress(stack, "targets"))
-    write_columns(output if output else sys.stdout, reach_columns(rm, cell), 6)
-    if html_path:
-        page = reach_html(rm, T[:, :3, 3], title=f"Reachability: {Path(targets).name} in "
-                          f"{cell.name}", frame=frame)
-        write_output(html_path, page)
+        rm = write_reach_map(cell, T, output if output else sys.stdout, html_path,
+                             f"Reachability: {Path(targets).name} in {cell.name}", frame, tool,
+                             th, track, DeferredProgress(stack, "targets"))
     n_ok = int(np.count_nonzero(rm.reachable))
     margin = math.degrees(float(np.nanmin(rm.limit_margin))) if n_ok else float("nan")
     click.echo(f"{n_ok} of {rm.reachable.size} targets reachable, mean score "
