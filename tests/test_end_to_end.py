@@ -11,6 +11,7 @@ import math
 import re
 
 import numpy as np
+import pytest
 from cli_helpers import run
 from view_helpers import figure_from_page, triads
 
@@ -203,3 +204,15 @@ def test_turntable_cell_command_by_command(tmp_path, capsys):
         results[procedure] = json.loads(out)
     results["fixture"] = results["frame"]
     check_exports(cell_file, truth, results, tmp_path, capsys)
+
+
+def test_a_poor_demo_names_the_noise_parameter_in_python_and_the_option_in_the_cli(tmp_path,
+                                                                                   capsys):
+    from robotcell.errors import InputError
+    from robotcell.studies.demo import run_demo
+
+    with pytest.raises(InputError, match="tcp: poor calibration, nothing written: .*; try a "
+                                         "smaller noise$"):
+        run_demo(tmp_path / "lib", noise=0.05, echo=lambda *a, **k: None)
+    code, _, err = run(capsys, "demo", "-o", tmp_path / "cli", "--noise", "50")
+    assert code == 2 and err.rstrip().endswith("; try a smaller --noise")

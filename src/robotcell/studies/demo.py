@@ -217,7 +217,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
         verdict = done.result.verdict
         if verdict.level == "poor":  # the command refuses to write it (exit 3); so does the demo
             raise InputError(f"{procedure}: poor calibration, nothing written: "
-                             f"{'; '.join(verdict.reasons)}; try a smaller --noise")
+                             f"{'; '.join(verdict.reasons)}; try a smaller noise")
         if procedure == "turntable":
             turntable = cellcal.TurntablePose.from_result(done.result, str(out / "turntable.json"))
         done.cell.save(cell_file)
