@@ -24,7 +24,7 @@ from identification_helpers import measure as measure_chain
 from machine import describe
 
 from robotcell.identification import identify
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 
 N_CONFIGS, N_REFLECTORS, NOISE, REPEATS = 100, 3, 0.02e-3, 7
 

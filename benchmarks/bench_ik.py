@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from machine import describe
 
 from robotcell.ik import TrackRobot, solve, solve_numeric
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_x, rot_z
 
 EAIK_US_PER_POSE = 4.7  # all 8 solutions, batched C++, one thread (docs/references.md)

@@ -29,7 +29,7 @@ from machine import describe
 
 from robotcell.cell import Cell
 from robotcell.kinematics import jit
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 
 CELL = Path(__file__).parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 N_CALLS = 200

@@ -14,7 +14,7 @@ from identification_helpers import REFLECTORS, T_D_R
 
 from robotcell import load_robot
 from robotcell.kinematics.dh import link_transform
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 #: Tracker noise per coordinate (m).
 NOISE = 2e-5

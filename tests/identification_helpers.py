@@ -8,8 +8,8 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.identification import Measurements
 from robotcell.identification.chain import Chain
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import make_pose
+from robotcell.robot.robot import Robot
 
 #: Pose of the robot base in the tracker frame used by every synthetic test (m).
 T_D_R = make_pose(Rotation.from_euler("zyx", [30.0, 2.0, -1.0], degrees=True).as_matrix(),

@@ -269,7 +269,7 @@ def test_the_urdf_of_an_identified_arm_matches_its_fk_in_pinocchio(kr16):
     import pinocchio as pin
     from test_export_urdf import pinocchio_q, random_values, targets, urdf_joint_values
 
-    from robotcell.io.export import export_cell
+    from robotcell.export import export_cell
 
     _, _, res = kr16
     cell = Cell.load(Path(__file__).parents[1] / "examples" / "cell_kr16_track_turntable.yaml")
@@ -316,7 +316,7 @@ UR5E_DEFAULT = {"shoulder": (0, 0, 0.1625, 0, 0, 0), "upper_arm": (0, 0, 0, 1.57
 def test_the_ur_calibration_file_of_the_nominal_ur5e_is_the_descriptions_own():
     from test_library import urdf_origin
 
-    from robotcell.io.export.ur import ur_origins
+    from robotcell.export.ur import ur_origins
 
     O = ur_origins(load_robot("ur5e"))
     for T, (name, v) in zip(O, UR5E_DEFAULT.items()):
@@ -372,8 +372,8 @@ def test_the_predicted_sigma_agrees_with_a_monte_carlo_of_the_identification():
     2 tr(S^2)): the bounds 0.8 and 1.25 are more than 3 of it away."""
     from robotcell.identification import Measurements
     from robotcell.identification.uncertainty import position_jacobian, position_sigma
-    from robotcell.kinematics.robot import Joint, Robot
     from robotcell.kinematics.transforms import make_pose
+    from robotcell.robot.robot import Joint, Robot
 
     nominal = Robot("arm3", (Joint("revolute", a=0.15, alpha=-math.pi / 2, d=0.4, name="A1"),
                              Joint("revolute", a=0.5, name="A2"),

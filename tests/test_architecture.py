@@ -1,14 +1,11 @@
-"""The import graph of robotcell: no cycle, and the library never imports the CLI or click.
+"""The import graph of robotcell: no cycle, imports go down the layers, and the library never
+imports the CLI or click.
 
-Every module under ``src/robotcell`` is parsed with :mod:`ast`. For cycles, every import that runs
-when the module is imported counts, ``if TYPE_CHECKING:`` blocks included. An import inside a
-function counts too in the packages of :data:`LAZY_COUNTED` (the kinematics and the solvers:
-``Robot.ik`` imports :mod:`robotcell.ik` when it is called, and the solvers work on the
-``Arm`` below the robot, never on the robot); elsewhere it is not yet an edge of the import
-graph. For the CLI rule every import counts, wherever it is written. An import
-``from robotcell.a import b`` is an edge to the module ``robotcell.a.b`` when that is a module,
-else to ``robotcell.a`` (the convention of import-linter); the implicit import of a parent
-package is not an edge.
+Every module under ``src/robotcell`` is parsed with :mod:`ast`. Every import counts, wherever it
+is written: at the top, in ``if TYPE_CHECKING:`` blocks and inside functions (an import put off
+until a function runs is still a dependency). An import ``from robotcell.a import b`` is an edge
+to the module ``robotcell.a.b`` when that is a module, else to ``robotcell.a`` (the convention of
+import-linter); the implicit import of a parent package is not an edge.
 """
 
 import ast
@@ -28,26 +25,13 @@ def module_name(path: Path) -> str:
 MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
 
 
-def _nodes(tree: ast.AST, lazy: bool):
-    """Every node of ``tree``; with ``lazy=False`` not those inside functions."""
-    todo = [tree]
-    while todo:
-        node = todo.pop()
-        yield node
-        for child in ast.iter_child_nodes(node):
-            if lazy or not isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
-                todo.append(child)
-
-
-def imports_of(name: str, path: Path, lazy: bool) -> set[str]:
-    """Modules that ``path`` imports (robotcell modules by full name, others as written).
-
-    With ``lazy`` also the imports inside functions.
-    """
+def imports_of(name: str, path: Path) -> set[str]:
+    """Modules that ``path`` imports anywhere in it (robotcell modules by full name, others as
+    written)."""
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     out: set[str] = set()
-    for node in _nodes(tree, lazy):
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             out.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -61,16 +45,7 @@ def imports_of(name: str, path: Path, lazy: bool) -> set[str]:
     return out
 
 
-#: Packages whose imports inside functions are edges of the import graph like any other.
-LAZY_COUNTED = ("robotcell.kinematics", "robotcell.ik")
-
-
-def lazy_counted(name: str) -> bool:
-    return any(name == p or name.startswith(p + ".") for p in LAZY_COUNTED)
-
-
-GRAPH = {name: imports_of(name, path, lazy=lazy_counted(name)) for name, path in MODULES.items()}
-ALL_IMPORTS = {name: imports_of(name, path, lazy=True) for name, path in MODULES.items()}
+GRAPH = {name: imports_of(name, path) for name, path in MODULES.items()}
 
 
 def internal(targets: set[str]) -> set[str]:
@@ -106,19 +81,19 @@ def test_the_graph_sees_every_module_and_its_imports():
     assert "click" in GRAPH["robotcell.cli.calibrate"]
     assert "robotcell.cell.calibrate" in GRAPH["robotcell.cli.calibrate"]
     assert "robotcell.cell.kinematics" in GRAPH["robotcell.cell"]
-    # TYPE_CHECKING imports are edges; imports inside functions in the kinematics and the solvers
-    # (Robot.ik), elsewhere only for the CLI rule (Cell.load imports the schema when called)
-    assert "robotcell.ik.result" in GRAPH["robotcell.kinematics.robot"]
-    assert "robotcell.ik.analytic" in GRAPH["robotcell.kinematics.robot"]
-    assert "robotcell.cell.schema" not in GRAPH["robotcell.cell.model"]
-    assert "robotcell.cell.schema" in ALL_IMPORTS["robotcell.cell.model"]
+    # imports inside functions (Robot.ik imports the solvers when called) and under
+    # TYPE_CHECKING (the result type of Robot.ik) are edges
+    assert "robotcell.ik.analytic" in GRAPH["robotcell.robot.robot"]
+    assert "robotcell.ik.result" in GRAPH["robotcell.robot.robot"]
+    assert "robotcell.cell.ik" in GRAPH["robotcell.cell.model"]
 
 
 def test_the_solvers_stand_below_the_robot():
     # Robot.ik imports the solvers; no solver imports the robot, inside a function or not.
     for name in MODULES:
         if name == "robotcell.ik" or name.startswith("robotcell.ik."):
-            assert "robotcell.kinematics.robot" not in ALL_IMPORTS[name], name
+            assert not any(t == "robotcell.robot" or t.startswith("robotcell.robot.")
+                           for t in GRAPH[name]), name
 
 
 def test_find_cycle_finds_a_cycle():
@@ -131,19 +106,35 @@ def test_no_import_cycle():
     assert find_cycle(GRAPH) is None, " -> ".join(find_cycle(GRAPH) or [])
 
 
+def concept(module: str) -> str:
+    """The concept package (or top-level module) that ``module`` belongs to."""
+    return ".".join(module.split(".")[:2])
+
+
+def test_no_import_cycle_between_the_concept_packages():
+    # a package is one room: no two packages import each other, even through different modules
+    # (io's tables and the cell's file, say), so that each stands on a floor of its own
+    packages = {concept(n) for n in MODULES}
+    graph = {p: set() for p in packages}
+    for name, targets in GRAPH.items():
+        graph[concept(name)] |= {concept(t) for t in internal(targets)} - {concept(name)}
+    cycle = find_cycle(graph)
+    assert cycle is None, " -> ".join(cycle or [])
+
+
 @pytest.mark.parametrize("name", [n for n in MODULES
                                   if n != "robotcell.cli" and not n.startswith("robotcell.cli.")])
 def test_library_module_imports_neither_the_cli_nor_click(name):
-    bad = sorted(t for t in ALL_IMPORTS[name]
+    bad = sorted(t for t in GRAPH[name]
                  if t in ("click", "robotcell.cli") or t.startswith(("click.", "robotcell.cli.")))
     assert not bad, f"{name} imports {bad}"
 
 
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
-#: package's ``__init__``, ``errors``, ``report`` (one concept, one module) and ``_aliases``.
-CONCEPTS = {"kinematics", "ik", "dhprocedure", "calibration", "identification", "cell", "io",
-            "programs", "accuracy", "studies", "view", "cli", "robots"}
-TOP_MODULES = {"__init__.py", "errors.py", "report.py", "_aliases.py"}
+#: package's ``__init__`` and ``errors``.
+CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell", "io",
+            "export", "programs", "accuracy", "studies", "view", "report", "cli", "robots"}
+TOP_MODULES = {"__init__.py", "errors.py"}
 
 
 def test_the_top_level_holds_only_the_concept_packages():
@@ -159,28 +150,27 @@ def test_the_top_level_holds_only_the_concept_packages():
 
 #: The layers, bottom first: a module imports only modules of its own layer or of lower layers
 #: (a module belongs to the longest prefix listed). The vendor-boundary helpers of ``io`` (files,
-#: tables, pose formats) and the pose algebra sit under the kinematics, which reads model files;
-#: the pose algebra compiles its one-pose check with ``robotcell.kinematics.jit``, below it;
-#: the controller exports of ``io`` sit over the cell they export; reports of results sit with the
-#: estimators whose results they show, and with them the 3D scenes and their plotly drawing
-#: (``robotcell.view.scene``, ``.shapes``, ``.arm``, ``.plot``) and the scenes of results
-#: (``.calibration``, ``.identification``), which the reports draw; the view of a cell, its
-#: paths, programs and reach maps sits over the programs. Imports inside functions count as for
-#: cycles (in the packages of :data:`LAZY_COUNTED`).
+#: tables, pose formats, YAML) and the pose algebra sit under everything (the pose formats convert
+#: the poses of ``robotcell.kinematics.transforms``, which compiles its one-pose check with
+#: ``robotcell.kinematics.jit``); the solvers of ``robotcell.ik`` work on the arm of
+#: ``robotcell.kinematics`` and the robot (an arm with its IK, model files, the library) stands on
+#: both; the estimators stand on the robot, the cell on them (it holds an identified arm, and
+#: calibrates into itself); the controller exports and the programs over the cell; the 3D views
+#: of cells, paths, programs and results over the programs, and the HTML reports, which embed
+#: them, over the views; the accuracy (filtered poses and programs, with their report) over the
+#: reports.
 LAYERS = [
     {"robotcell.errors", "robotcell.kinematics.jit", "robotcell.kinematics.transforms",
-     "robotcell.io.fileio",
-     "robotcell.io.tables", "robotcell.io.poseformats", "robotcell.io.yamlfile",
-     "robotcell.ik.result"},
+     "robotcell.io"},
     {"robotcell.kinematics", "robotcell.ik"},
-    {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification",
-     "robotcell.report", "robotcell.view.scene", "robotcell.view.shapes", "robotcell.view.arm",
-     "robotcell.view.plot", "robotcell.view.calibration", "robotcell.view.identification"},
+    {"robotcell.robot"},
+    {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification"},
     {"robotcell.cell"},
-    {"robotcell.io.export"},
+    {"robotcell.export"},
     {"robotcell.programs"},
-    {"robotcell.accuracy"},
     {"robotcell.view"},
+    {"robotcell.report"},
+    {"robotcell.accuracy"},
     {"robotcell.studies"},
     {"robotcell.cli"},
 ]
@@ -198,18 +188,17 @@ def layer(module: str) -> int:
 
 
 def test_every_module_is_in_a_layer():
-    assert layer("robotcell.io.export.kuka") == 4 and layer("robotcell.io.tables") == 0
-    assert layer("robotcell.kinematics.robot") == 1 and layer("robotcell.cli.fk") == 9
-    assert layer("robotcell.view.plot") == 2 and layer("robotcell.view.cellscene") == 7
-    assert layer("robotcell.view.calibration") == 2 and layer("robotcell.view.program") == 7
-    assert layer("robotcell.programs.kuka") == 5 and layer("robotcell.accuracy.filter") == 6
+    assert layer("robotcell.export.kuka") == 5 and layer("robotcell.io.tables") == 0
+    assert layer("robotcell.kinematics.transforms") == 0 and layer("robotcell.kinematics.arm") == 1
+    assert layer("robotcell.robot.robot") == 2 and layer("robotcell.cli.fk") == 11
+    assert layer("robotcell.view.plot") == 7 and layer("robotcell.report.identification") == 8
+    assert layer("robotcell.programs.kuka") == 6 and layer("robotcell.accuracy.filter") == 9
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES
-                                        if n not in ("robotcell", "robotcell._aliases")))
+                                        if n != "robotcell"))
 def test_imports_go_down_the_layers(name):
-    up = sorted(t for t in internal(GRAPH[name]) - {"robotcell._aliases"}
-                if layer(t) > layer(name))
+    up = sorted(t for t in internal(GRAPH[name]) if layer(t) > layer(name))
     assert not up, f"{name} (layer {layer(name)}) imports {up} from a layer above"
 
 
@@ -217,7 +206,7 @@ def test_imports_go_down_the_layers(name):
                                         if n.startswith("robotcell.calibration")))
 def test_calibration_estimators_know_no_files(name):
     # arrays in, results out: no file reading or writing, no YAML, no paths
-    bad = sorted(t for t in ALL_IMPORTS[name]
+    bad = sorted(t for t in GRAPH[name]
                  if t in ("pathlib", "os", "io", "yaml", "csv", "json", "robotcell.io.fileio"))
     tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
     calls = {n.func.id for n in ast.walk(tree)

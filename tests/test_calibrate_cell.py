@@ -143,6 +143,12 @@ def test_cli_writes_what_the_library_returns(tmp_path, capsys, fixed_time):
     j = json.loads(out)
     assert j == json.loads(json.dumps(got.to_json()))
     assert [i["item"] for i in j["items"]] == ["tools.pointer", "track", "turntable"]
+    # independently of the library call: the items the command wrote are the simulated truth
+    cal = Cell.load(cli_file)
+    assert np.linalg.norm(cal.tools["pointer"].T_F_TCP[:3, 3]
+                          - truth.tools["pointer"].T_F_TCP[:3, 3]) < 1e-3
+    assert np.linalg.norm(cal.turntable.T_parent_B[:3, 3] - truth.turntable.T_parent_B[:3, 3]) \
+        < 2e-3
     assert f"updated {cli_file}: 3 item(s) fitted with the whole cell" in err
     code, out, _ = run(capsys, "calibrate", "cell", "--cell", cli_file)
     assert code == 0 and "changes (|position| mm" in out and out.splitlines()[-1].startswith(

@@ -27,10 +27,10 @@ from robotcell.calibration.verdict import (
 )
 from robotcell.cell import Cell, Tool, Track, Turntable
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 from robotcell.report import verdict as report_verdict
 from robotcell.report import write_report
+from robotcell.robot.models import load_robot
 
 NOISE = 1e-4  # m per coordinate
 TCP = np.array([0.01, -0.02, 0.2])

@@ -75,6 +75,12 @@ def test_cli_cell_results_equal_the_library_call_byte_for_byte(tmp_path, capsys,
         # the cell given is not changed: the result is a new cell
         assert got.cell is not before and cell_to_dict(before) == content
         assert cell_to_dict(got.cell) != content
+    # independently of the library call: the cell the command wrote is the simulated truth
+    cal = Cell.load(cli_file)
+    assert np.linalg.norm(cal.tools["torch"].T_F_TCP[:3, 3] - truth.tools["torch"].T_F_TCP[:3, 3]) \
+        < 1e-3
+    for name in ("part", "fixture"):
+        assert np.linalg.norm(cal.frame_pose(name)[:3, 3] - truth.frame_pose(name)[:3, 3]) < 2e-3
     kept = [sorted(p.name for p in (tmp_path / d).glob("cell.yaml.*.bak")) for d in ("cli", "lib")]
     assert kept[0] == kept[1] and kept[0]
     for name in kept[0]:

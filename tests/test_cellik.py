@@ -229,3 +229,29 @@ def test_errors():
         unbounded.ik(T)
     with pytest.raises(InputError, match="the cell has no track; the track position must be 0"):
         fixed_cell().ik(T, track=1.0)
+
+
+def test_ik_batch_in_chunks_is_the_one_call_and_reaches_the_targets():
+    # Cell.ik_batch solves a long list a chunk at a time: the same solutions as one call of
+    # Cell.ik, each valid branch reaching its target, and the nearest branch the one that made it.
+    rng = np.random.default_rng(12)
+    cell = track_cell()
+    q, th = random_arm(rng, 23), rng.uniform(-3, 3, 23)
+    T = cell.fk(q, 2.0, th, tool="torch", frame="part")
+    done = []
+    sol = cell.ik_batch(T, "part", None, th, "torch", chunk=5, progress=done.append)
+    assert done == [5, 5, 5, 5, 3]
+    one = cell.ik(T, "part", table=th, tool="torch")
+    assert np.array_equal(sol.valid, one.valid) and np.allclose(sol.track, one.track)
+    assert np.allclose(np.nan_to_num(sol.q), np.nan_to_num(one.q)) and sol.table.shape == (23,)
+    back = cell.fk(np.where(sol.valid[..., None], sol.q, 0.0), sol.track[:, None], th[:, None],
+                   tool="torch", frame="part")
+    assert np.max(np.where(sol.valid, np.abs(back - T[:, None]).max(axis=(-1, -2)), 0)) < 1e-9
+    fixed = cell.ik_batch(T, "part", 2.0, th, "torch", chunk=7)
+    qn, found, _ = fixed.nearest(ROBOT, q)
+    d = np.abs((qn - q + math.pi) % TWO_PI - math.pi)
+    assert np.all(found) and d.max() < 1e-7
+    with pytest.raises(InputError, match="chunk must be an integer >= 1"):
+        cell.ik_batch(T, "part", chunk=0)
+    with pytest.raises(InputError, match="table shape"):
+        cell.ik_batch(T, "part", table=np.zeros(4))

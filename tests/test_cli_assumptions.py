@@ -51,6 +51,31 @@ def test_ik_in_a_cell_names_the_tool(capsys):
                           "'world', track ")
 
 
+def test_reach_and_sweep_name_what_they_assumed_on_stderr(capsys, tmp_path):
+    # Issue 27.5: every printed result names the tool, frame, track and table it used.
+    seam = ROOT / "examples" / "seam_part.csv"
+    code, _, err = run(capsys, "reach", "--cell", CELL, seam, "--frame", "part", "--tool",
+                       "torch", "-o", tmp_path / "r.csv")
+    assert code == 0, err
+    assert err.splitlines()[0] == ("kr16_track_turntable: TCP of tool 'torch' in frame 'part', "
+                                   "track chosen per target, table from column(s) table (deg)")
+    targets = tmp_path / "t.csv"
+    targets.write_text("\n".join(seam.read_text().splitlines()[:4]).replace(",table", ",note")
+                       + "\n")
+    code, _, err = run(capsys, "reach", "--cell", CELL, targets, "--frame", "part",
+                       "--track", "1500", "--choose-table")
+    assert code == 0, err
+    assert ("kr16_track_turntable: TCP of the bare flange (no --tool) in frame 'part', track "
+            "1500 mm (given), table chosen per target (--choose-table)") in err
+    code, out, err = run(capsys, "sweep", "--cell", CELL, "--targets", seam, "--layouts",
+                         ROOT / "examples" / "layouts_kr16.yaml", "--frame", "part", "--tool",
+                         "torch", "--workers", "1", "--top", "2")
+    assert code == 0, err
+    assert ("TCP of tool 'torch' in frame 'part', track chosen per target and layout, table "
+            "from column(s) table (deg)") in err
+    assert out.startswith("the best 2 of 18 layouts") and len(out.splitlines()) == 3 + 2
+
+
 @pytest.mark.parametrize("argv,message", [
     (["identify", "--propose", "10", "--robot", "kuka_kr16", "-o", "{tmp}/x.json"],
      ("-o {tmp}/x.json: the name says JSON, but this writes the proposed configurations as CSV; "

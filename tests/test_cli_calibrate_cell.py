@@ -17,8 +17,8 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.cell import Cell, Track, Turntable
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.transforms import invert, make_pose, rot_z
+from robotcell.robot.models import load_robot
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "cell_kr16_track_turntable.yaml"
 NOISE = 5e-5  # m per coordinate, a good touch-up

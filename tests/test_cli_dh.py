@@ -87,3 +87,22 @@ def test_symbolic_text_latex_numeric(capsys, tmp_path):
 def test_help_has_an_example(capsys, sub):
     code, out, _ = run(capsys, "dh", sub, "--help")
     assert code == 0 and "Example" in out and f"robotcell dh {sub}" in out
+
+
+def test_a_branching_urdf_names_the_parameter_in_python_and_the_option_on_the_command_line(
+        capsys, tmp_path):
+    from robotcell.dhprocedure import dh_from_urdf
+    from robotcell.errors import InputError
+
+    joint = ('<joint name="{0}" type="revolute"><parent link="base_link"/><child link="{1}"/>'
+             '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+    urdf = tmp_path / "fork.urdf"
+    urdf.write_text('<robot name="fork"><link name="base_link"/><link name="b"/><link name="c"/>'
+                    + joint.format("j1", "b") + joint.format("j2", "c") + "</robot>")
+    with pytest.raises(InputError, match="branches into joints j1, j2; choose the end of the arm "
+                                         "with tip_link$"):
+        dh_from_urdf(urdf)
+    code, _, err = run(capsys, "dh", "from-urdf", urdf)
+    assert code == 2 and err.rstrip().endswith("choose the end of the arm with tip_link "
+                                               "(--tip-link)")
+    assert "'base_link' branches" in err  # a link's name is not taken for the option

@@ -6,8 +6,8 @@ import pytest
 from cli_helpers import run
 
 from robotcell.cell import Cell
-from robotcell.io.export import export_cell, parse_export
-from robotcell.io.export.common import collect
+from robotcell.export import export_cell, parse_export
+from robotcell.export.common import collect
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 
@@ -19,6 +19,8 @@ def test_export_to_stdout_matches_library(capsys, fmt):
     code, out, err = run(capsys, "export", "--cell", str(EXAMPLE), "--format", fmt)
     assert code == 0 and err == ""
     assert out == export_cell(Cell.load(EXAMPLE), fmt)
+    # independently of the library: the torch as the cell file writes it, x, y, z in mm
+    assert all(f"{v:.6f}" in out for v in (312.5, -1.2, 95.0)), out
 
 
 def test_export_to_file_parses_back(capsys, tmp_path):

@@ -716,7 +716,7 @@ def good(tmp_path_factory) -> dict[str, Path]:
     from robotcell.calibration.turntable import calibrate_turntable
     from robotcell.cell import Cell
     from robotcell.cell import calibrate as cellcal
-    from robotcell.kinematics.models import save_robot
+    from robotcell.robot.models import save_robot
     from robotcell.studies.simulate import simulate
 
     d = tmp_path_factory.mktemp("good")

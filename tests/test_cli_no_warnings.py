@@ -17,7 +17,7 @@ from cli_helpers import run
 
 from robotcell import load_robot
 from robotcell.io.tables import write_csv
-from robotcell.kinematics.models import save_robot
+from robotcell.robot.models import save_robot
 
 ROOT = Path(__file__).resolve().parents[1]
 URDF = ROOT / "src" / "robotcell" / "robots" / "urdf" / "ur5e.urdf"

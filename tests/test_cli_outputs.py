@@ -26,7 +26,7 @@ from robotcell.cell import calibrate as cellcal
 from robotcell.cli import COMMANDS
 from robotcell.cli.files import Command
 from robotcell.io.tables import write_csv
-from robotcell.kinematics.models import save_robot
+from robotcell.robot.models import save_robot
 from robotcell.studies.simulate import simulate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

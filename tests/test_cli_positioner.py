@@ -215,8 +215,6 @@ def test_fk_takes_one_table_value_per_positioner_axis(tmp_path, capsys):
 @pytest.mark.parametrize("args, message", [
     (["--table", "30"], "--table: positioner 'DKP_2' has 2 axes: give 2 comma-separated value(s)"),
     (["--table", "30,90,10"], "--table: positioner 'DKP_2' has 2 axes"),
-    (["--table", "30,500"], "positioner axis E2 value 500 deg is outside its limits [-400, 400]"),
-    (["--table", "-100,0"], "positioner axis E1 value -100 deg is outside its limits [-95, 95]"),
 ])
 def test_fk_and_ik_refuse_wrong_table_values(args, message, capsys):
     code, _, err = run(capsys, "fk", "--cell", EXAMPLE, "--joints", "0,-90,90,0,45,0", *args)
@@ -224,6 +222,18 @@ def test_fk_and_ik_refuse_wrong_table_values(args, message, capsys):
     code, _, err = run(capsys, "ik", "--cell", EXAMPLE, "--pose", "50,0,0,0,180,0", "--frame",
                        "part", *args)
     assert code == 2 and f"error: {message}" in err
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--table", "30,500"], "positioner axis E2 value 500 deg is outside its limits [-400, 400]"),
+    (["--table", "-100,0"], "positioner axis E1 value -100 deg is outside its limits [-95, 95]"),
+])
+def test_fk_and_ik_warn_about_table_values_outside_the_limits(args, message, capsys):
+    code, out, err = run(capsys, "fk", "--cell", EXAMPLE, "--joints", "0,-90,90,0,45,0", *args)
+    assert code == 0 and out and f"warning: {message} deg; computed anyway" in err
+    code, _, err = run(capsys, "ik", "--cell", EXAMPLE, "--pose", "50,0,0,0,180,0", "--frame",
+                       "part", *args, "--all")
+    assert code == 0 and f"warning: {message}" in err
 
 
 def test_batch_table_column_refusals(tmp_path, capsys):
@@ -332,6 +342,9 @@ def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, 
     got.cell.save(lib_file)
     assert cli_file.read_bytes() == lib_file.read_bytes()
     assert json.loads(out) == got.result.to_json()
+    # independently of the library call: the root the command wrote is the simulated truth's
+    root = Cell.load(cli_file).turntable.T_parent_root
+    assert np.linalg.norm(root[:3, 3] - Cell.load(truth).turntable.T_parent_root[:3, 3]) < 2e-3
     assert "T_world_B" in got.result.values and "T_R_B" not in got.result.values
 
 

@@ -24,8 +24,8 @@ from robotcell.ik import (
 )
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.models import robot_from_dict, robot_to_dict, save_robot
 from robotcell.kinematics.transforms import make_pose, rot_z
+from robotcell.robot.models import robot_from_dict, robot_to_dict, save_robot
 
 COUPLED = ["fanuc_lrmate200id", "fanuc_m20ia", "abb_irb2400", "abb_irb460"]
 

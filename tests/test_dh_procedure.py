@@ -164,9 +164,7 @@ def test_flange_on_last_axis_becomes_frame_n():
 
 
 def test_sign_corrections_flip_z_and_the_sign():
-    robot = rc.load_robot("kuka_kr6_r700_sixx") if "kuka_kr6_r700_sixx" in rc.list_robots() else None
-    if robot is None:
-        pytest.skip("kuka_kr6_r700_sixx not in the library")
+    robot = rc.load_robot("kuka_kr6_r700_sixx")  # a library model: its absence is a failure
     chain = AxisChain.from_robot(robot)
     plain = dh_from_axes(chain).robot
     corrected = dh_from_axes(chain, signs=[j.sign for j in robot.joints]).robot
@@ -229,10 +227,8 @@ def test_procedure_reproduces_textbook_tables():
     """PUMA 560 (Corke): every row; KR 6 R700 with its sign corrections: rows 1-5 (frame 6 is
     put on the flange approach axis here, the library puts it elsewhere)."""
     cases = {"puma560": 6, "kuka_kr6_r700_sixx": 5}
-    present = [name for name in cases if name in rc.list_robots()]
-    if not present:
-        pytest.skip("neither robot in the library")
-    for name in present:
+    assert set(cases) <= set(rc.list_robots())  # library models: their absence is a failure
+    for name in cases:
         robot = rc.load_robot(name)
         der = dh_from_axes(AxisChain.from_robot(robot), signs=[j.sign for j in robot.joints])
         for mine, theirs in list(zip(der.robot.joints, robot.joints))[:cases[name]]:

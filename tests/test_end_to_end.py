@@ -9,16 +9,16 @@ would). Every exported pose, read back from the controller text, must match the 
 import json
 import math
 import re
-import time
 
 import numpy as np
+import pytest
 from cli_helpers import run
 from view_helpers import figure_from_page, triads
 
 from robotcell import load_robot, make_pose
 from robotcell.cell import Cell, Frame, Tool, Turntable
-from robotcell.io.export import EXPORT_FORMATS, parse_export
-from robotcell.io.export.common import collect, flatten_table
+from robotcell.export import EXPORT_FORMATS, parse_export
+from robotcell.export.common import collect, flatten_table
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.programs.check import check_program_file
 from robotcell.studies.demo import EXPORT_FILES, VIEW_TABLE, demo_cells
@@ -106,12 +106,10 @@ def check_exports(cell_file, truth, results, tmp_path, capsys):
 
 
 def test_demo_track_cell_end_to_end(tmp_path, capsys):
-    """`robotcell demo`: the track-and-turntable cell, under 30 s, every file written."""
-    start = time.perf_counter()
+    """`robotcell demo`: the track-and-turntable cell, every file written (its time is measured
+    by benchmarks/, not here)."""
     code, out, err = run(capsys, "demo", "-o", tmp_path)
-    elapsed = time.perf_counter() - start
     assert code == 0, err
-    assert elapsed < 30
     assert "calibrated vs true cell" in out
     for name in ["cell.yaml", *(f"cell.yaml.{i}.bak" for i in range(1, 5)), "truth.yaml", *EXPORT_FILES.values(),
                  *(f"{p}.{ext}" for p in ("tcp", "track", "turntable", "workpiece")
@@ -206,3 +204,15 @@ def test_turntable_cell_command_by_command(tmp_path, capsys):
         results[procedure] = json.loads(out)
     results["fixture"] = results["frame"]
     check_exports(cell_file, truth, results, tmp_path, capsys)
+
+
+def test_a_poor_demo_names_the_noise_parameter_in_python_and_the_option_in_the_cli(tmp_path,
+                                                                                   capsys):
+    from robotcell.errors import InputError
+    from robotcell.studies.demo import run_demo
+
+    with pytest.raises(InputError, match="tcp: poor calibration, nothing written: .*; try a "
+                                         "smaller noise$"):
+        run_demo(tmp_path / "lib", noise=0.05, echo=lambda *a, **k: None)
+    code, _, err = run(capsys, "demo", "-o", tmp_path / "cli", "--noise", "50")
+    assert code == 2 and err.rstrip().endswith("; try a smaller --noise")

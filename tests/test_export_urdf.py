@@ -19,10 +19,10 @@ from test_positioner import tilt_rotate
 
 from robotcell import InputError, load_robot, pose_from_vendor
 from robotcell.cell import Cell, Frame, Positioner, Tool, Turntable
-from robotcell.io.export import export_cell
-from robotcell.io.export.urdf import urdf_origin
+from robotcell.export import export_cell
+from robotcell.export.urdf import urdf_origin
 from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.robot import Joint, Robot
+from robotcell.robot.robot import Joint, Robot
 from robotcell.studies.demo import demo_cells
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "cell_kr16_track_turntable.yaml"

@@ -13,8 +13,8 @@ from robotcell.errors import IllPosedError, InputError
 from robotcell.identification import Measurements, identify
 from robotcell.identification.chain import Chain
 from robotcell.identification.ik import solve_identified
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose, rot_y
+from robotcell.robot.robot import Joint, Robot
 
 NOISE = 0.02e-3
 

@@ -20,8 +20,8 @@ from identification_helpers import (
 from robotcell import load_robot, save_robot
 from robotcell.identification import Measurements
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose, rot_y
+from robotcell.robot.robot import Joint, Robot
 
 NOISE = 0.02e-3
 
@@ -320,3 +320,28 @@ def test_identify_names_an_unknown_column_in_a_warning(kr16_truth, tmp_path, cap
     code, _, err = run(capsys, "identify", path, "--robot", "kuka_kr16", "--json")
     assert code == 2 and "give the measured target as columns x,y,z" in err
     assert "warning: " in err and "'zl'" in err and "'temp'" in err
+
+
+def test_identify_file_is_the_workflow_of_the_command(kr16_truth, tmp_path):
+    # The library call behind `robotcell identify`: identification, cross-validation, offsets and
+    # the model file in one call, with messages that name its parameters.
+    from robotcell.errors import InputError
+    from robotcell.studies.identify import identify_file
+
+    nominal, ch, x, _ = kr16_truth
+    _, csv = tracker_csv(kr16_truth, tmp_path, 40)
+    out = tmp_path / "arm.yaml"
+    run_ = identify_file(csv, "kuka_kr16", point_sigma=0.02e-3, folds=4, offsets_for="kuka",
+                         output=out)
+    assert run_.written and out.exists() and run_.folds == 4
+    assert run_.cross_stats["after_rms_mm"] < 0.06 < run_.cross_stats["before_rms_mm"]
+    # the A2 zero against the truth it was simulated with (deg)
+    a2 = run_.offsets["axes"][1]
+    truth = math.degrees(nominal.joints[1].sign * (x[ch.index("A2.theta")] - nominal.joints[1].theta))
+    assert a2["unit"] == "deg" and abs(a2["delta"] - truth) <= 3 * a2["sigma"] + 1e-9
+    assert run_.to_json()["cross_validation"]["folds"] == 4
+    with pytest.raises(InputError, match="offsets_for needs robot") as exc:
+        identify_file(csv, offsets_for="abb")
+    assert "--" not in str(exc.value)
+    with pytest.raises(InputError, match="cell needs output"):
+        identify_file(csv, cell=tmp_path / "cell.yaml")

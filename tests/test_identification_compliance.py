@@ -13,8 +13,8 @@ from robotcell.errors import InputError
 from robotcell.identification import Measurements, identify
 from robotcell.identification.chain import Chain
 from robotcell.identification.gravity import gravity_torques
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose
+from robotcell.robot.robot import Joint, Robot
 
 NOISE = 0.02e-3
 #: Plausible link masses (kg) and centres of mass (m, link frame) of a 16 kg payload arm.

@@ -10,8 +10,8 @@ from identification_helpers import perturbed
 from robotcell.errors import InputError
 from robotcell.identification.chain import Chain
 from robotcell.identification.positioner import _geometry, calibrate_positioner
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose, rot_y, rot_z
+from robotcell.robot.robot import Joint, Robot
 
 NOISE = 0.05e-3
 #: A tilt-rotate positioner: tilt about a horizontal axis, the table 250 mm along the rotate axis.

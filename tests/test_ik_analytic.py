@@ -12,9 +12,9 @@ from robotcell.ik import opw_parameters, solve, ur_parameters
 from robotcell.ik.limits import JointFolder, wrap_to_pi
 from robotcell.ik.opw import opw_fk
 from robotcell.ik.ur import ur_fk
-from robotcell.kinematics.models import list_robots, load_robot
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose, rot_x, rot_y, rot_z
+from robotcell.robot.models import list_robots, load_robot
+from robotcell.robot.robot import Joint, Robot
 
 D = math.radians
 N_ROUND_TRIP = 100_000

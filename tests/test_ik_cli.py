@@ -9,7 +9,7 @@ import pytest
 
 from robotcell.cli import main
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 
 
 def run(argv, capsys):

@@ -11,9 +11,9 @@ from robotcell.errors import InputError
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.ik.numeric import solve_numeric
 from robotcell.ik.track import TrackRobot
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import make_pose, rot_x, rot_y, rot_z
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Joint, Robot
 
 
 def pose_errors(robot, q, T):

@@ -12,7 +12,7 @@ from robotcell.ik.config import abb_confdata, arm_sides, kuka_status_turn
 from robotcell.ik.limits import wrap_to_pi
 from robotcell.ik.select import nearest, select_abb, select_kuka
 from robotcell.ik.track import TrackRobot
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 
 D = np.radians
 

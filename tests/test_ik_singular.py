@@ -22,9 +22,9 @@ from robotcell.ik.result import REACH_TOL
 from robotcell.ik.ur import ur_fk_frames
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.kinematics.dh import link_transform
-from robotcell.kinematics.models import list_robots, load_robot
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import rot_z
+from robotcell.robot.models import list_robots, load_robot
+from robotcell.robot.robot import Robot
 
 ANALYTIC = [n for n in list_robots() if n != "stanford_arm"]
 N_RANDOM = 10_000

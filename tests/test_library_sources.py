@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Joint, Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Joint, Robot
 
 
 def urdf_chain(joints: list[tuple[tuple[float, float, float], tuple[float, float, float], int]],

@@ -17,7 +17,7 @@ from robotcell.cell import Cell, Frame, Positioner, Provenance, Tool, Turntable
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.kinematics.models import load_robot
+from robotcell.robot.models import load_robot
 from robotcell.studies.demo import demo_cells
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -215,7 +215,7 @@ def test_positioner_errors_name_the_cause(tmp_path):
 @pytest.mark.parametrize("convention, signs", [("standard", [1, 1]), ("modified", [1, -1]),
                                                ("standard", [-1, -1])])
 def test_kuka_and_abb_exports_hold_the_axis_chain(fmt, convention, signs):
-    from robotcell.io.export import export_cell, parse_export
+    from robotcell.export import export_cell, parse_export
 
     chain = dh_from_axes(AXES, convention, signs=signs).robot
     cell = tilt_rotate()
@@ -237,7 +237,7 @@ def test_kuka_and_abb_exports_hold_the_axis_chain(fmt, convention, signs):
 
 
 def test_kuka_positioner_next_to_a_linear_unit_is_et2():
-    from robotcell.io.export import export_cell
+    from robotcell.export import export_cell
 
     truth, _ = demo_cells()
     chain = dh_from_axes(AXES, "standard").robot
@@ -266,7 +266,7 @@ def test_one_axis_procedures_refuse_a_positioner_chain():
 
 @pytest.mark.parametrize("fmt", ["fanuc", "yaskawa"])
 def test_fanuc_and_yaskawa_write_frames_on_a_positioner_at_axis_zero(fmt):
-    from robotcell.io.export import export_cell, parse_export
+    from robotcell.export import export_cell, parse_export
 
     cell = tilt_rotate("modified")
     part = next(s for s in parse_export(export_cell(cell, fmt), fmt).frames if s.name == "part")

@@ -96,7 +96,7 @@ def test_cli_errors(capsys, tmp_path):
     code, _, err = run(capsys, "reach", "--cell", CELL, typo, "--frame", "part", "--tool", "torch")
     assert code == 0 and "warning: " in err and "'tabel' (did you mean 'table'?)" in err
     code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--track", "9000")
-    assert code == 2 and "track position 9000 mm is outside the track limits" in err
+    assert code == 0 and "warning: track position 9000 mm is outside the track limits" in err
     code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "robot")
     assert code == 2 and "moves with the track" in err
     with pytest.raises(InputError, match="unknown frame"):
@@ -143,4 +143,26 @@ def test_progress_in_blocks_gives_the_same_map(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr(cli_progress, "PROGRESS_AFTER", 0.0)
     code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--tool",
                        "torch", "-o", tmp_path / "r.csv")
-    assert code == 0 and err.startswith("targets")  # the bar (plain text off a terminal)
+    # what it assumed, then the bar (plain text off a terminal)
+    assert code == 0 and err.split("\n", 1)[1].startswith("targets")
+
+
+def test_write_reach_map_is_the_reach_command_as_one_call(tmp_path, capsys):
+    from robotcell.io.tables import read_csv
+    from robotcell.studies.reach import write_reach_map
+
+    cell = Cell.load(CELL)
+    T, table = read_targets(SEAM)
+    rm = write_reach_map(cell, T, tmp_path / "lib.csv", tmp_path / "lib.html", frame="part",
+                         tool="torch", table=table)
+    cols = read_csv(tmp_path / "lib.csv")
+    # the file holds the map: every target reached, and at its axis values the TCP is on it
+    assert np.all(rm.reachable) and list(cols["reachable"]) == ["true"] * len(T)
+    q = np.radians(np.column_stack([cols[f"a{i}"] for i in range(1, 7)]))
+    back = cell.fk(q, cols["track"] * 1e-3, np.radians(cols["table"]), "torch", "part")
+    assert np.abs(back[:, :3, 3] - T[:, :3, 3]).max() < 1e-7  # the file has 1e-6 deg, mm
+    assert (tmp_path / "lib.html").read_text().startswith("<!DOCTYPE html>")
+    code, _, err = run(capsys, "reach", "--cell", CELL, SEAM, "--frame", "part", "--tool",
+                       "torch", "-o", tmp_path / "cli.csv")
+    assert code == 0, err
+    assert (tmp_path / "cli.csv").read_bytes() == (tmp_path / "lib.csv").read_bytes()

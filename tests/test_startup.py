@@ -75,8 +75,9 @@ def test_calibrate_tcp_imports_what_it_needs_only(tmp_path, capsys):
 def test_every_public_name_is_importable_as_before():
     from robotcell import errors
     from robotcell.io import poseformats
-    from robotcell.kinematics import coupling, robot, transforms
-    from robotcell.kinematics import models as modelfile
+    from robotcell.kinematics import coupling, transforms
+    from robotcell.robot import models as modelfile
+    from robotcell.robot import robot
 
     home = {**{n: errors for n in ("IllPosedError", "InputError", "RobotcellError")},
             **{n: modelfile for n in ("list_robots", "load_robot", "robot_from_dict",
@@ -88,7 +89,6 @@ def test_every_public_name_is_importable_as_before():
     assert set(home) | {n for n in robotcell.__all__ if hasattr(transforms, n)} == set(
         robotcell.__all__)
     assert set(robotcell.__all__) <= set(dir(robotcell))
-    # The old submodule attributes are checked in tests/test_aliases.py.
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
         robotcell.no_such_name  # noqa: B018
 

@@ -214,3 +214,21 @@ def test_reach_cli_reads_and_writes_a_positioners_axes_as_fk_does(capsys, tmp_pa
     targets.write_text(targets.read_text().replace("e1,e2", "table,e2"))
     code, _, err = run(capsys, "reach", "--cell", path, targets, "--frame", "part")
     assert code == 2 and "column 'table' holds a turntable angle" in err
+
+
+def test_sweep_writes_its_ranking(tmp_path):
+    from robotcell.io.tables import read_csv
+
+    cell = Cell.load(CELL)
+    T, table = read_targets(SEAM)
+    layouts = read_layouts({"robot": {"y": [0, 300]}})
+    ranked = sweep(cell, T[:6], layouts, frame="part", tool="torch", table=table[:6],
+                   output=tmp_path / "rank.csv")
+    cols = read_csv(tmp_path / "rank.csv")
+    assert list(cols["rank"]) == [1, 2] and list(cols["layout"]) == [r.index for r in ranked]
+    assert sorted(cols["robot.y"]) == [0.0, 300.0]
+    assert np.allclose(cols["reachable_fraction"], [r.fraction for r in ranked])
+    # independently of the sweep: the best layout's fraction is the reach map of the moved cell
+    best = apply_layout(cell, ranked[0].layout)
+    assert cols["reachable_fraction"][0] == pytest.approx(
+        reach_map(best, T[:6], "part", "torch", table[:6]).fraction)

@@ -106,6 +106,20 @@ def test_the_page_holds_the_same_scene(tmp_path):
     assert max(len(d) for d in numbers) <= DECIMALS
 
 
+def test_write_cell_view_is_the_view_command_as_one_call(tmp_path):
+    from robotcell.view import write_cell_view
+
+    cell = Cell.load(EXAMPLE)
+    q, e, v = random_state(cell, 4)
+    written = write_cell_view(cell, tmp_path / "cell.html", q, e, v)
+    text = written.read_text(encoding="utf-8")
+    check_every_frame(figure_from_page(text), cell, q, e, v)
+    assert f"<title>{cell.name}: robotcell view</title>" in text
+    with pytest.raises(InputError, match="nowhere.csv"):
+        write_cell_view(cell, tmp_path / "r.html", reach=tmp_path / "nowhere.csv")
+    assert not (tmp_path / "r.html").exists()
+
+
 def test_hover_gives_each_frame_in_the_cell_convention():
     cell = Cell.load(EXAMPLE)
     fig = cell_figure(cell, np.radians([0, -90, 90, 0, 0, 0]), 1.5, np.radians(30)).to_plotly_json()

@@ -5,9 +5,7 @@ Conventions (pose naming ``T_a_b``, units, array shapes) are in ``docs/conventio
 The public names below are imported on first use (PEP 562), so ``import robotcell`` and the
 command line's ``--version`` and ``--help`` do not pay for numpy and scipy.
 
-The modules live in concept packages (``docs/conventions.md``, "Layout"); the old top-level
-module paths (``robotcell.transforms``, ``robotcell.cellik``, ...) still import, with a
-DeprecationWarning, for one release (:mod:`robotcell._aliases`).
+The modules live in concept packages (``docs/conventions.md``, "Layout").
 """
 
 from __future__ import annotations
@@ -15,16 +13,11 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from robotcell import _aliases
 from robotcell.errors import IllPosedError, InputError, RobotcellError
-
-_aliases.install()
 
 if TYPE_CHECKING:
     from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
     from robotcell.kinematics.coupling import Coupling
-    from robotcell.kinematics.models import list_robots, load_robot, robot_from_dict, save_robot
-    from robotcell.kinematics.robot import Joint, Robot
     from robotcell.kinematics.transforms import (
         check_pose,
         compose,
@@ -36,6 +29,8 @@ if TYPE_CHECKING:
         transform_points,
         validate_pose,
     )
+    from robotcell.robot.models import list_robots, load_robot, robot_from_dict, save_robot
+    from robotcell.robot.robot import Joint, Robot
 
 __version__ = "0.1.0"
 
@@ -43,16 +38,12 @@ __version__ = "0.1.0"
 _LAZY = {
     "Coupling": "robotcell.kinematics.coupling",
     **dict.fromkeys(["list_robots", "load_robot", "robot_from_dict", "save_robot"],
-                    "robotcell.kinematics.models"),
+                    "robotcell.robot.models"),
     **dict.fromkeys(["FORMATS", "pose_from_vendor", "pose_to_vendor"], "robotcell.io.poseformats"),
-    **dict.fromkeys(["Joint", "Robot"], "robotcell.kinematics.robot"),
+    **dict.fromkeys(["Joint", "Robot"], "robotcell.robot.robot"),
     **dict.fromkeys(["check_pose", "compose", "invert", "make_pose", "rot_x", "rot_y", "rot_z",
                      "transform_points", "validate_pose"], "robotcell.kinematics.transforms"),
 }
-#: Submodules that ``import robotcell`` used to load as a side effect, still reachable as
-#: attributes (``robotcell.transforms``, deprecated: :mod:`robotcell._aliases`) and loaded on
-#: first access.
-_SUBMODULES = {"coupling", "dh", "modelfile", "poseformats", "robot", "transforms"}
 
 __all__ = [
     "FORMATS",
@@ -82,8 +73,6 @@ __all__ = [
 
 def __getattr__(name: str) -> Any:
     """Import a public name from its module on first access (PEP 562)."""
-    if name in _SUBMODULES:
-        return importlib.import_module(f"robotcell.{name}")
     if name not in _LAZY:
         raise AttributeError(f"module 'robotcell' has no attribute {name!r}")
     value = getattr(importlib.import_module(_LAZY[name]), name)

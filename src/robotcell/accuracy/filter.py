@@ -37,10 +37,10 @@ from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.errors import InputError, RobotcellError
 from robotcell.identification.uncertainty import position_sigma
 from robotcell.ik.select import nearest
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, validate_pose
 from robotcell.programs.config import config_text, select
 from robotcell.programs.model import Config
+from robotcell.robot.robot import Robot
 
 __all__ = ["MAX_CORRECTION", "MAX_ROTATION", "FilterRefused", "FilteredPoses", "filter_poses",
            "identified_joints", "refuse", "too_large"]

@@ -20,7 +20,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_poses
-from robotcell.accuracy.report import write_accuracy_report
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
@@ -29,6 +28,7 @@ from robotcell.programs.config import CONFIG_FIELDS
 from robotcell.programs.fanuc import parse_config
 from robotcell.programs.model import Config
 from robotcell.programs.path import read_path, table_columns
+from robotcell.report.accuracy import write_accuracy_report
 
 __all__ = ["CONFIG_COLUMNS", "CompensatedPoses", "compensate_poses"]
 
@@ -131,7 +131,7 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
         Largest correction taken (m).
     report : str or Path, optional
         Also write the HTML page of the predicted errors and 1-sigma per pose
-        (:func:`robotcell.accuracy.report.write_accuracy_report`).
+        (:func:`robotcell.report.accuracy.write_accuracy_report`).
 
     Returns
     -------

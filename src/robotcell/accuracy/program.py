@@ -33,7 +33,6 @@ from robotcell.accuracy.filter import (
     refuse,
     too_large,
 )
-from robotcell.accuracy.report import write_accuracy_report
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose
 from robotcell.errors import InputError
@@ -48,6 +47,7 @@ from robotcell.programs.formats import read_program
 from robotcell.programs.frames import placement, tool_pose_of
 from robotcell.programs.model import Program
 from robotcell.programs.write import written_poses
+from robotcell.report.accuracy import write_accuracy_report
 
 __all__ = ["JOINTS", "CompensatedPoint", "CompensatedProgram", "compensate_program"]
 
@@ -167,7 +167,7 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
         Further files the run read (the cell file), which no output may replace.
     report : str or Path, optional
         Also write the HTML page of the predicted errors and 1-sigma per point
-        (:func:`robotcell.accuracy.report.write_accuracy_report`).
+        (:func:`robotcell.report.accuracy.write_accuracy_report`).
 
     Returns
     -------

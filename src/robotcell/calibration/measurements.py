@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import outside_limits
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = [
     "MM_LOOKS_LIKE_M",

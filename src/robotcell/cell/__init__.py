@@ -1,9 +1,11 @@
 """The robot cell: its data model, its file, coupled kinematics, and calibrating into it.
 
-- :mod:`robotcell.cell.model`: :class:`Cell`, :class:`Tool`, :class:`Frame`, :class:`Track`,
+- :mod:`robotcell.cell.parts`: :class:`Tool`, :class:`Frame`, :class:`Track`,
   :class:`Turntable`, :class:`Positioner`, :class:`Provenance`, :class:`IdentifiedArm` (SI units);
 - :mod:`robotcell.cell.schema`: the YAML cell file (millimetres, degrees), its reader and writer,
   and the atomic save that keeps comments and layout;
+- :mod:`robotcell.cell.validation`: values given for a cell checked against its limits and size;
+- :mod:`robotcell.cell.model`: :class:`Cell`, which holds the parts, reads and writes its file;
 - :mod:`robotcell.cell.history`: the numbered backups of a cell file and its history;
 - :mod:`robotcell.cell.kinematics`: coupled forward kinematics (arm, track, positioner, frames);
 - :mod:`robotcell.cell.ik`: inverse kinematics and paths in the cell;
@@ -14,9 +16,9 @@
 """
 
 from robotcell.cell.kinematics import RESERVED_FRAMES
-from robotcell.cell.model import (
+from robotcell.cell.model import Cell, cell_from_dict
+from robotcell.cell.parts import (
     NAME_RE,
-    Cell,
     Frame,
     IdentifiedArm,
     Positioner,
@@ -25,7 +27,7 @@ from robotcell.cell.model import (
     Track,
     Turntable,
 )
-from robotcell.cell.schema import cell_from_dict, cell_to_dict
+from robotcell.cell.schema import cell_to_dict
 
 __all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "IdentifiedArm", "Positioner",
            "Provenance", "Tool", "Track", "Turntable", "cell_from_dict", "cell_to_dict"]

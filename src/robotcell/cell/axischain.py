@@ -1,4 +1,4 @@
-"""Kinematics of a chain of joint axes given as a DH :class:`~robotcell.kinematics.robot.Robot`.
+"""Kinematics of a chain of joint axes given as a DH :class:`~robotcell.robot.robot.Robot`.
 
 Two things the exports and the positioner need beyond the chain's FK:
 
@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.dh import link_transform
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["axis_frames", "normal_up"]
 

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robotcell.cell.model import Cell, Provenance
-from robotcell.cell.schema import cell_to_dict, load_cell
+from robotcell.cell.model import Cell
+from robotcell.cell.parts import Provenance
+from robotcell.cell.schema import cell_to_dict
 from robotcell.errors import InputError
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write, check_destination, read_text
-from robotcell.kinematics.models import save_robot
+from robotcell.robot.models import save_robot
 
 __all__ = ["adopt_identified", "identification_provenance"]
 
@@ -74,7 +75,7 @@ def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_
         nominal the identification started from must be the cell's ``robot.model``), or a file
         cannot be written: nothing is changed then.
     """
-    cell = load_cell(cell_path)
+    cell = Cell.load(cell_path)
     try:
         cell.set_identified(result.robot, str(Path(model_path).resolve()), provenance)
     except InputError as exc:

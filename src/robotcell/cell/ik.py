@@ -45,16 +45,18 @@ from robotcell.cell.kinematics import CellModel as Cell  # what is read of a rob
 from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.limits import TWO_PI
+from robotcell.ik.result import IKSolutions
+from robotcell.ik.select import nearest
 from robotcell.ik.track import TrackChoice, TrackRobot
 from robotcell.ik.trackchoice import choose_track, scan_track
 from robotcell.kinematics.bounds import LIMIT_TOL, within
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import (
     finite_array,
     invert,
     validate_pose,
     validate_single_pose,
 )
+from robotcell.robot.robot import Robot
 
 __all__ = ["CellIKSolutions", "CellPath", "PathBreak", "PathSplit", "choose_track_value",
            "depends_on_track", "ik", "ik_path", "split_path"]
@@ -109,6 +111,50 @@ class CellIKSolutions:
     def count(self) -> NDArray[np.int_]:
         """Number of valid branches per target, shape ``(...)``."""
         return np.count_nonzero(self.valid, axis=-1)
+
+    @classmethod
+    def concatenate(cls, parts: list[CellIKSolutions], table_shape: tuple[int, ...] = ()
+                    ) -> CellIKSolutions:
+        """The solutions of consecutive batches ``(m_i,)`` of targets as one batch ``(sum m_i,)``.
+
+        Parameters
+        ----------
+        parts : list of CellIKSolutions
+            Solutions of 1-D batches, in order (at least one).
+        table_shape : tuple of int
+            Trailing shape of one target's table values: ``()`` for a turntable or none,
+            ``(n,)`` for a positioner of ``n`` axes.
+        """
+        def cat(key: str, tail: tuple[int, ...] = ()) -> NDArray:
+            return np.concatenate([np.broadcast_to(getattr(p, key), p.valid.shape[:-1] + tail)
+                                   for p in parts])
+
+        err = (None if any(p.reach_error is None for p in parts)
+               else np.concatenate([p.reach_error for p in parts]))
+        return cls(np.concatenate([p.q for p in parts]), np.concatenate([p.valid for p in parts]),
+                   np.concatenate([p.reachable for p in parts]), cat("track"),
+                   cat("table", table_shape), parts[0].method, err)
+
+    def nearest(self, robot: Robot, q_ref: ArrayLike
+                ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.int_]]:
+        """The valid branch nearest to a reference arm configuration, per target.
+
+        Parameters
+        ----------
+        robot : Robot
+            The cell's arm (its limits and joint types).
+        q_ref : array_like, shape (n,) or (..., n)
+            Reference arm configuration (rad, m).
+
+        Returns
+        -------
+        q : ndarray, shape (..., n)
+            Chosen arm configuration (NaN where none is valid).
+        found : ndarray of bool, shape (...)
+        branch : ndarray of int, shape (...)
+            The chosen branch, -1 where none (see :func:`robotcell.ik.nearest`).
+        """
+        return nearest(robot, IKSolutions(self.q, self.valid, self.reachable, self.method), q_ref)
 
 
 @dataclass(frozen=True)

@@ -32,8 +32,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import finite_array, invert, make_pose, rot_z, validate_pose
+from robotcell.robot.robot import Robot
 
 __all__ = ["RESERVED_FRAMES", "CellModel", "broadcast_table", "fk", "frame_pose", "robot_pose", "table_batch",
            "table_pose", "table_values", "tool_pose", "track_pose"]

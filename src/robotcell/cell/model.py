@@ -3,28 +3,23 @@
 A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the schema); a
 :class:`Cell` holds the same content in SI units. Poses in the file are mappings
 ``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention, as in robot model
-files). Every calibrated quantity carries its :class:`Provenance`.
+files). Every calibrated quantity carries its :class:`~robotcell.cell.parts.Provenance`; the
+parts of a cell are :mod:`robotcell.cell.parts`.
 
 The file (YAML schema, reader, writer, atomic save with numbered backups) is
-:mod:`robotcell.cell.schema`; :meth:`Cell.load` and :meth:`Cell.save` call it. :meth:`Cell.save`
-writes atomically: a process that dies during a save leaves either the old or the new file,
-never a partial one.
+:mod:`robotcell.cell.schema`, below this module: :func:`cell_from_dict` builds a cell from what
+it reads, and :meth:`Cell.load` and :meth:`Cell.save` call them. :meth:`Cell.save` writes
+atomically: a process that dies during a save leaves either the old or the new file, never a
+partial one.
 
 Coupled kinematics (TCP pose in any frame given the arm joints, the track position and the table
-angle) are in :mod:`robotcell.cell.kinematics`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call them.
-
-External axes that carry the work are a :class:`Turntable` (one axis, the lecture's ``R_T_B
-Rz(theta)``) or a :class:`Positioner`: a chain of 1-3 revolute axes written as a DH
-:class:`~robotcell.kinematics.robot.Robot` whose ``base`` is the root pose, the form an identified chain
-takes. Both offer the same kinematic interface (:attr:`Turntable.chain`, ``T_root_P``,
-``axis_values``, ``within_limits``), which is all coupled kinematics and the exports use.
+angle) are in :mod:`robotcell.cell.kinematics`; :meth:`Cell.fk` and :meth:`Cell.frame_pose` call
+them, and :meth:`Cell.ik` and :meth:`Cell.ik_path` call :mod:`robotcell.cell.ik`.
 """
 
 from __future__ import annotations
 
-import datetime as _dt
-import math
-import re
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -32,493 +27,33 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.cell import axischain, kinematics
+from robotcell.cell import kinematics
 from robotcell.cell.kinematics import RESERVED_FRAMES
+from robotcell.cell.parts import (
+    Frame,
+    IdentifiedArm,
+    Positioner,
+    Provenance,
+    Tool,
+    Track,
+    Turntable,
+    check_identified,
+    check_name,
+    single_pose,
+)
+from robotcell.cell.schema import cell_fields, read_cell_file, save_cell
+from robotcell.cell.validation import check_lengths
 from robotcell.errors import InputError
-from robotcell.kinematics.bounds import within
-from robotcell.kinematics.robot import Joint, Robot
-from robotcell.kinematics.transforms import finite_array, validate_pose
+from robotcell.kinematics.transforms import validate_pose
+from robotcell.robot.robot import Robot
 
 if TYPE_CHECKING:
     from robotcell.cell.ik import CellIKSolutions, CellPath
 
-__all__ = ["RESERVED_FRAMES", "Cell", "Frame", "IdentifiedArm", "Positioner", "Provenance", "Tool",
-           "Track", "Turntable"]
+__all__ = ["IK_CHUNK", "RESERVED_FRAMES", "Cell", "cell_from_dict"]
 
-#: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
-#: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
-NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,23}$")
-
-
-# -- provenance -----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Provenance:
-    """Where a calibrated value comes from, and how uncertain it is.
-
-    Attributes
-    ----------
-    source : str
-        ``"nominal"`` (design value), ``"manual"`` (typed in) or the calibration procedure that
-        produced the value (``"tcp"``, ``"frame"``, ``"track"``, ``"turntable"``,
-        ``"workpiece"``, ...).
-    time : str or None
-        When it was produced, ISO 8601 (``2025-03-14T09:30:00+01:00``).
-    rms_mm : float or None
-        Residual RMS of the calibration (mm).
-    note : str
-        Free text (operator, number of points, instrument).
-    id : str or None
-        Name of this calibration as an error source: the values calibrated later with this one
-        (a turntable touched with this tool) carry its share under this name.
-    measurements : str or None
-        The touch file the calibration read (a path; written relative to the cell file).
-    sha256 : str or None
-        SHA-256 of that file's bytes when it was read, to tell a changed file.
-    options : dict
-        The calibration's options, to repeat it (``robotcell calibrate cell``): units of the
-        command line (mm, deg), e.g. ``{"tool": "pointer", "sigma_mm": 0.1}``.
-    inputs : tuple of str
-        The items of the cell the calibration used (``tools.pointer``, ``track``,
-        ``turntable``), in the order of their parameters.
-    sources : dict of str to ndarray
-        Error sources of the value (see :class:`robotcell.calibration.uncertainty.Sources`):
-        per source a factor over the value's parameters (SI: origin m, rotation vector rad
-        about the parent's axes, then the scale of a track). Empty: no uncertainty recorded.
-    """
-
-    source: str = "nominal"
-    time: str | None = None
-    rms_mm: float | None = None
-    note: str = ""
-    id: str | None = None
-    measurements: str | None = None
-    sha256: str | None = None
-    options: dict[str, Any] = field(default_factory=dict)
-    inputs: tuple[str, ...] = ()
-    sources: dict[str, NDArray[np.float64]] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.source, str) or not self.source.strip():
-            raise InputError("provenance source must be a non-empty string")
-        if self.time is not None:
-            _iso_time(self.time, "provenance time")
-        if self.rms_mm is not None and not (math.isfinite(self.rms_mm) and self.rms_mm >= 0):
-            raise InputError(f"provenance rms_mm must be a finite number >= 0, got {self.rms_mm}")
-        sizes = {np.shape(f)[0] for f in self.sources.values()}
-        if len(sizes) > 1 or any(np.ndim(f) != 2 or not np.all(np.isfinite(f))
-                                 for f in self.sources.values()):
-            raise InputError("provenance sources must be finite matrices with one row per "
-                             "parameter of the value")
-
-    @classmethod
-    def now(cls, source: str, rms_mm: float | None = None, note: str = "",
-            **fields: Any) -> Provenance:
-        """Provenance stamped with the current local time (ISO 8601, seconds, with UTC offset)."""
-        stamp = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
-        return cls(source=source, time=stamp, rms_mm=rms_mm, note=note, **fields)
-
-
-def _iso_time(value: str, where: str) -> str:
-    try:
-        _dt.datetime.fromisoformat(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{where} must be an ISO 8601 time like 2025-03-14T09:30:00+01:00, "
-                         f"got {value!r}") from None
-    return value
-
-
-# -- components -----------------------------------------------------------------------------------
-def _pose(T: ArrayLike, name: str) -> NDArray[np.float64]:
-    arr = validate_pose(T, name)
-    if arr.shape != (4, 4):
-        raise InputError(f"{name} must be a single pose of shape (4, 4), got {arr.shape}")
-    return arr.copy()
-
-
-def _limits(lower: float, upper: float, what: str) -> None:
-    if not (isinstance(lower, (int, float)) and isinstance(upper, (int, float))):
-        raise InputError(f"{what} limits must be numbers")
-    if not lower < upper:
-        raise InputError(f"{what}: lower limit {lower} must be below upper limit {upper}")
-
-
-@dataclass
-class Track:
-    """A linear track carrying the robot.
-
-    ``T_L_R(e) = T_L_R0`` with its translation moved by ``e * scale * axis``: the lecture's
-    ``p = x + L_Q_R f`` with ``x = e * scale * axis`` and ``L_Q_R`` the rotation of ``T_L_R0``.
-
-    Attributes
-    ----------
-    T_world_L : ndarray, shape (4, 4)
-        Pose of the track frame L in the world (metres).
-    T_L_R0 : ndarray, shape (4, 4)
-        Pose of the robot base R in L at track position 0 (metres); its rotation is the
-        lecture's alignment error ``L_Q_R``, its translation the mounting offset.
-    axis : {"x", "y", "z"}
-        Axis of L the robot moves along (``x`` in the lecture; KUKA's linear units use ``z``).
-    scale : float
-        Displacement per unit of the controller's track value (1 for a true encoder).
-    lower, upper : float
-        Limits of the controller's track value (metres).
-    name : str
-        Name of the mechanical unit (used by controller exports, e.g. ABB ``TRACK_1``).
-    provenance : Provenance
-    """
-
-    T_world_L: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    T_L_R0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    axis: Literal["x", "y", "z"] = "x"
-    scale: float = 1.0
-    lower: float = -math.inf
-    upper: float = math.inf
-    name: str = "track"
-    provenance: Provenance = field(default_factory=Provenance)
-
-    def __post_init__(self) -> None:
-        self.T_world_L = _pose(self.T_world_L, "track T_world_L")
-        self.T_L_R0 = _pose(self.T_L_R0, "track T_L_R0")
-        if self.axis not in ("x", "y", "z"):
-            raise InputError(f"track axis must be 'x', 'y' or 'z', got {self.axis!r}")
-        if not (math.isfinite(self.scale) and self.scale > 0):
-            raise InputError(f"track scale must be a finite number > 0, got {self.scale}")
-        _limits(self.lower, self.upper, "track")
-
-    @property
-    def direction(self) -> NDArray[np.float64]:
-        """Unit vector of the motion in L, shape ``(3,)``."""
-        return np.eye(3)["xyz".index(self.axis)]
-
-    def T_L_R(self, e: ArrayLike) -> NDArray[np.float64]:
-        """Pose of the robot base in L at track positions ``e`` (shape ``(...)``, metres)."""
-        return kinematics.track_pose(self.T_L_R0, self.direction * self.scale, e)
-
-    def within_limits(self, e: ArrayLike) -> NDArray[np.bool_]:
-        """Whether track positions ``e`` (shape ``(...)``, metres) are within the limits (up to
-        rounding, :data:`robotcell.kinematics.bounds.LIMIT_TOL`)."""
-        return within(e, self.lower, self.upper)
-
-
-@dataclass
-class Turntable:
-    """A one-axis turntable (rotary positioner).
-
-    ``T_parent_W(theta) = T_parent_B Rz(theta) T_B_W`` for a frame W carried by the table: the
-    lecture's ``R_T_W(theta) = R_T_B Rz(theta) B_T_W``. Positive table values turn about +Z_B.
-
-    Attributes
-    ----------
-    T_parent_B : ndarray, shape (4, 4)
-        Pose of the table root frame B (origin on the axis, Z along it) in its parent (metres).
-    parent : {"world", "robot"}
-        ``world``: fixed in the cell; ``robot``: fixed to the robot base R (moves with a track).
-    lower, upper : float
-        Limits of the table angle (radians).
-    name : str
-        Name of the mechanical unit (KUKA ``MACHINE_DEF`` name, ABB ``ufmec``).
-    provenance : Provenance
-    """
-
-    T_parent_B: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    parent: Literal["world", "robot"] = "world"
-    lower: float = -math.inf
-    upper: float = math.inf
-    name: str = "turntable"
-    provenance: Provenance = field(default_factory=Provenance)
-
-    def __post_init__(self) -> None:
-        self.T_parent_B = _pose(self.T_parent_B, "turntable T_parent_B")
-        if self.parent not in ("world", "robot"):
-            raise InputError(f"turntable parent must be 'world' or 'robot', got {self.parent!r}")
-        _limits(self.lower, self.upper, "turntable")
-
-    def within_limits(self, theta: ArrayLike) -> NDArray[np.bool_]:
-        """Whether table angles ``theta`` (shape ``(...)``, radians) are within the limits (up to
-        rounding, :data:`robotcell.kinematics.bounds.LIMIT_TOL`)."""
-        return within(theta, self.lower, self.upper)
-
-    # -- the interface shared with Positioner ----------------------------------------------------
-    n_axes = 1
-
-    @property
-    def T_parent_root(self) -> NDArray[np.float64]:
-        """Pose of the root frame B in the parent (metres): ``T_parent_B``."""
-        return self.T_parent_B
-
-    @property
-    def chain(self) -> Robot:
-        """The table as a 1-axis DH chain: base ``T_parent_B``, one revolute joint about Z_B."""
-        return Robot(self.name, (Joint("revolute", lower=self.lower, upper=self.upper,
-                                       name=f"{self.name}_axis"),), base=self.T_parent_B)
-
-    def axis_values(self, theta: ArrayLike) -> NDArray[np.float64]:
-        """Table angles as an array of shape ``(...)`` (radians), refusing NaN and infinity."""
-        return finite_array(theta, "table angle")
-
-    def batch_shape(self, theta: NDArray[np.float64]) -> tuple[int, ...]:
-        """Batch shape of table angles: their shape."""
-        return theta.shape
-
-    def T_root_P(self, theta: ArrayLike) -> NDArray[np.float64]:
-        """The table's turn ``Rz(theta)``, shape ``(..., 4, 4)``: frames on the table move with it."""
-        return kinematics.table_pose(theta)
-
-
-@dataclass
-class Positioner:
-    """A positioner: a chain of 1-3 revolute axes carrying the work (tilt-rotate, L, drop-centre).
-
-    ``T_parent_P(v) = chain.fk(v)`` with the chain's ``base`` the root pose ``T_parent_0`` and its
-    ``flange`` the plate frame P on the last axis, which carries the frames with parent
-    ``turntable``. Axis values ``v`` have shape ``(..., n)``, radians, as the controller counts
-    them (``sign`` and offsets of the DH table apply). A turntable is the 1-axis case with
-    ``a = alpha = d = theta = 0``.
-
-    Attributes
-    ----------
-    chain : Robot
-        The axes as a DH chain (standard or modified), base = root pose in the parent (metres),
-        limits on each axis (radians); e.g. the result of a kinematic identification.
-    parent : {"world", "robot"}
-        ``world``: fixed in the cell; ``robot``: fixed to the robot base R (moves with a track).
-    name : str
-        Name of the mechanical unit (KUKA ``MACHINE_DEF`` name, ABB mechanical unit).
-    provenance : Provenance
-    """
-
-    chain: Robot
-    parent: Literal["world", "robot"] = "world"
-    name: str = "positioner"
-    provenance: Provenance = field(default_factory=Provenance)
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.chain, Robot):
-            raise InputError("positioner chain must be a robotcell.Robot (a DH chain)")
-        if not 1 <= self.chain.n_joints <= 3 or np.any(self.chain.prismatic):
-            raise InputError(f"a positioner is a chain of 1 to 3 revolute axes, got "
-                             f"{self.chain.n_joints} axes "
-                             f"({', '.join(j.type for j in self.chain.joints)})")
-        if self.parent not in ("world", "robot"):
-            raise InputError(f"positioner parent must be 'world' or 'robot', got {self.parent!r}")
-        self._axes = self.chain.with_base(np.eye(4))
-
-    @property
-    def n_axes(self) -> int:
-        """Number of axes (1 to 3)."""
-        return self.chain.n_joints
-
-    @property
-    def T_parent_root(self) -> NDArray[np.float64]:
-        """Pose of the root frame (frame 0 of the chain) in the parent (metres)."""
-        return self.chain.base
-
-    @property
-    def lower(self) -> NDArray[np.float64]:
-        """Lower axis limits, shape ``(n,)`` (radians)."""
-        return self.chain.lower
-
-    @property
-    def upper(self) -> NDArray[np.float64]:
-        """Upper axis limits, shape ``(n,)`` (radians)."""
-        return self.chain.upper
-
-    def axis_values(self, values: ArrayLike) -> NDArray[np.float64]:
-        """Axis values as an array of shape ``(..., n)`` (radians).
-
-        A single number is every axis of a 1-axis positioner; of a longer chain only 0 (every
-        axis at 0, the default of the kinematic functions) is taken, any other is refused.
-        """
-        v = finite_array(values, "positioner axis value")
-        if v.ndim == 0:
-            if self.n_axes > 1 and v != 0:
-                raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give one "
-                                 f"value per axis, shape (..., {self.n_axes}), not the single "
-                                 f"value {float(v):g} rad")
-            return np.broadcast_to(v, (self.n_axes,))
-        if v.shape[-1] != self.n_axes:
-            raise InputError(f"positioner {self.name!r} has {self.n_axes} axes: give its axis "
-                             f"values with shape (..., {self.n_axes}), got {v.shape}")
-        return v
-
-    def batch_shape(self, values: NDArray[np.float64]) -> tuple[int, ...]:
-        """Batch shape of axis values ``(..., n)``: ``(...)``."""
-        return values.shape[:-1]
-
-    def T_root_P(self, values: ArrayLike) -> NDArray[np.float64]:
-        """Pose of the plate P in the root at axis values ``(..., n)``, shape ``(..., 4, 4)``."""
-        return self._axes.fk(self.axis_values(values), np.eye(4))
-
-    def within_limits(self, values: ArrayLike) -> NDArray[np.bool_]:
-        """Whether axis values ``(..., n)`` are all within their limits (up to rounding,
-        :data:`robotcell.kinematics.bounds.LIMIT_TOL`), shape ``(...)``."""
-        return np.all(within(self.axis_values(values), self.lower, self.upper), axis=-1)
-
-    def normal_up(self, normal: ArrayLike, T_world_parent: ArrayLike | None = None
-                  ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-        """Axis values of a 2-axis positioner that turn a plate direction straight up.
-
-        Parameters
-        ----------
-        normal : array_like, shape (..., 3)
-            Direction in the plate frame P (e.g. a weld's surface normal).
-        T_world_parent : array_like, shape (..., 4, 4), optional
-            Pose of the positioner's parent in the world (the robot base for ``parent="robot"``);
-            default the world itself.
-
-        Returns
-        -------
-        values : ndarray, shape (..., 2, 2)
-            Up to two solutions (v_1, v_2), radians (NaN where none).
-        valid : ndarray of bool, shape (..., 2)
-            Solution exists and lies within the axis limits.
-        """
-        T = np.eye(4) if T_world_parent is None else np.asarray(T_world_parent, dtype=float)
-        R = T[..., :3, :3] @ self.chain.base[:3, :3]
-        return axischain.normal_up(self.chain, R, normal)
-
-
-@dataclass
-class Tool:
-    """A tool on the robot flange.
-
-    Attributes
-    ----------
-    T_F_TCP : ndarray, shape (4, 4)
-        Pose of the TCP in the flange frame F of the cell's robot model (metres).
-    number : int or None
-        Controller slot (KUKA ``TOOL_DATA[n]``, Fanuc ``UTOOL[n]``); None: numbered in file order.
-    mass : float or None
-        Mass of the tool (kg), for controllers that need load data (ABB ``tload``).
-    cog : ndarray, shape (3,), or None
-        Centre of gravity in the flange frame (metres).
-    provenance : Provenance
-    """
-
-    T_F_TCP: NDArray[np.float64]
-    number: int | None = None
-    mass: float | None = None
-    cog: NDArray[np.float64] | None = None
-    provenance: Provenance = field(default_factory=Provenance)
-
-    def __post_init__(self) -> None:
-        self.T_F_TCP = _pose(self.T_F_TCP, "tool T_F_TCP")
-        _check_number(self.number, "tool number")
-        if self.mass is not None and not (math.isfinite(self.mass) and self.mass > 0):
-            raise InputError(f"tool mass must be a finite number > 0 (kg), got {self.mass}")
-        if self.cog is not None:
-            cog = np.asarray(self.cog, dtype=float)
-            if cog.shape != (3,) or not np.all(np.isfinite(cog)):
-                raise InputError(f"tool cog must be 3 finite numbers, got {self.cog!r}")
-            self.cog = cog
-
-
-@dataclass
-class Frame:
-    """A named frame of the cell: a fixture, a base, a workpiece.
-
-    Attributes
-    ----------
-    pose : ndarray, shape (4, 4)
-        Pose of the frame in its parent (metres): ``T_world_X``, ``T_R_X`` or ``T_B_X`` (for a
-        frame on the turntable, at table angle 0).
-    parent : {"world", "robot", "turntable"}
-        What carries the frame: nothing (fixed in the world), the robot base (moves with the
-        track), or the turntable (turns with it).
-    number : int or None
-        Controller slot (KUKA ``BASE_DATA[n]``, Fanuc ``UFRAME[n]``); None: numbered in order.
-    provenance : Provenance
-    """
-
-    pose: NDArray[np.float64]
-    parent: Literal["world", "robot", "turntable"] = "world"
-    number: int | None = None
-    provenance: Provenance = field(default_factory=Provenance)
-
-    def __post_init__(self) -> None:
-        self.pose = _pose(self.pose, "frame pose")
-        if self.parent not in ("world", "robot", "turntable"):
-            raise InputError(f"frame parent must be 'world', 'robot' or 'turntable', "
-                             f"got {self.parent!r}")
-        _check_number(self.number, "frame number")
-
-
-def _check_number(n: Any, what: str) -> None:
-    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
-        raise InputError(f"{what} must be an integer >= 1, got {n!r}")
-
-
-#: Largest distance (m) and angle (rad) between the flange of an identified arm and its nominal's
-#: at any configuration: a real arm is a few mm and tenths of a degree off its drawing, so a larger
-#: difference is a model of another robot (or in other joint conventions).
-IDENTIFIED_MAX_OFFSET = 0.05
-IDENTIFIED_MAX_ANGLE = math.radians(5.0)
-
-
-@dataclass
-class IdentifiedArm:
-    """The arm as an identification found it, beside the model its controller computes with.
-
-    Attributes
-    ----------
-    nominal : Robot
-        The controller's model (``robot.model`` of the cell file): it turns joint values into the
-        Cartesian points a program is told.
-    model : str
-        The identified model file (absolute, or relative to the working directory).
-    provenance : Provenance
-        Where the identification comes from (``identify``, its time, RMS, held-out error).
-    """
-
-    nominal: Robot
-    model: str
-    provenance: Provenance = field(default_factory=lambda: Provenance("manual"))
-
-
-def check_identified(nominal: Robot, identified: Robot) -> None:
-    """Refuse an identified model that is not an identification of ``nominal``.
-
-    Parameters
-    ----------
-    nominal, identified : Robot
-
-    Raises
-    ------
-    InputError
-        Another number or type of joints, another joint coupling (a J2/J3 factor; a scale of an
-        axis may differ by up to 1 %), or a flange more than 50 mm or 5 deg from the nominal's
-        at a configuration within the limits (the name says which).
-    """
-    who = f"the identified model {identified.name!r} is not an identification of {nominal.name!r}"
-    if identified.n_joints != nominal.n_joints or len(identified.joints) != len(nominal.joints):
-        raise InputError(f"{who}: it has {identified.n_joints} axes, {nominal.name} has "
-                         f"{nominal.n_joints}")
-    kinds = [(j.type, j.passive) for j in nominal.joints]
-    if [(j.type, j.passive) for j in identified.joints] != kinds:
-        raise InputError(f"{who}: its joint types differ "
-                         f"({', '.join(j.type for j in identified.joints)})")
-    eye = np.eye(len(nominal.joints), nominal.n_joints)
-    C0 = eye if nominal.coupling is None else nominal.coupling.matrix
-    C1 = eye if identified.coupling is None else identified.coupling.matrix
-    if np.abs(C1 - C0).max() > 0.01:
-        i, j = np.unravel_index(np.argmax(np.abs(C1 - C0)), C0.shape)
-        raise InputError(f"{who}: its joint coupling differs (q_model = C q: C[{i + 1}, {j + 1}] is "
-                         f"{C1[i, j]:g}, the nominal's {C0[i, j]:g}; a J2/J3 factor?)")
-    lo = np.where(np.isfinite(nominal.lower), nominal.lower, -math.pi)
-    hi = np.where(np.isfinite(nominal.upper), nominal.upper, math.pi)
-    q = np.vstack([np.clip(np.zeros(nominal.n_joints), lo, hi),
-                   lo + (hi - lo) * np.random.default_rng(0).random((24, nominal.n_joints))])
-    T0, T1 = nominal.fk(q, tool=np.eye(4)), identified.fk(q, tool=np.eye(4))
-    dp = np.linalg.norm(T1[:, :3, 3] - T0[:, :3, 3], axis=-1)
-    cos = (np.trace(np.swapaxes(T0[:, :3, :3], -1, -2) @ T1[:, :3, :3], axis1=-2, axis2=-1) - 1) / 2
-    da = np.arccos(np.clip(cos, -1.0, 1.0))
-    k = int(np.argmax(np.maximum(dp / IDENTIFIED_MAX_OFFSET, da / IDENTIFIED_MAX_ANGLE)))
-    if dp[k] > IDENTIFIED_MAX_OFFSET or da[k] > IDENTIFIED_MAX_ANGLE:
-        raise InputError(f"{who}: its flange is {dp[k] * 1e3:.1f} mm and {math.degrees(da[k]):.2f} "
-                         f"deg from the nominal's at joints "
-                         f"{np.round(np.degrees(q[k]), 1).tolist()} deg (a real arm is a few mm "
-                         f"off; at most {IDENTIFIED_MAX_OFFSET * 1e3:g} mm and "
-                         f"{math.degrees(IDENTIFIED_MAX_ANGLE):g} deg are taken)")
+#: Targets per call of :meth:`Cell.ik` in :meth:`Cell.ik_batch`: bounds the memory of a long list.
+IK_CHUNK = 500
 
 
 # -- the cell -------------------------------------------------------------------------------------
@@ -560,7 +95,7 @@ class Cell:
     identified: IdentifiedArm | None = None
 
     def __post_init__(self) -> None:
-        self.T_world_R = _pose(self.T_world_R, "robot T_world_R")
+        self.T_world_R = single_pose(self.T_world_R, "robot T_world_R")
         if self.identified is not None:
             check_identified(self.identified.nominal, self.robot)
             if not np.array_equal(self.robot.tool, self.identified.nominal.tool):
@@ -569,9 +104,9 @@ class Cell:
             raise InputError("a robot on a track is placed by the track (track frame and "
                              "robot_at_zero); do not give the robot a frame as well")
         for name in self.tools:
-            _check_name(name, "tool")
+            check_name(name, "tool")
         for name, fr in self.frames.items():
-            _check_name(name, "frame")
+            check_name(name, "frame")
             self._check_parent(name, fr)
         _unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
         _unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
@@ -642,7 +177,7 @@ class Cell:
         -------
         Tool
         """
-        _check_name(name, "tool")
+        check_name(name, "tool")
         old = self.tools.get(name)
         tool = Tool(
             T_F_TCP=np.asarray(T_F_TCP, dtype=float),
@@ -678,7 +213,7 @@ class Cell:
         -------
         Frame
         """
-        _check_name(name, "frame")
+        check_name(name, "frame")
         old = self.frames.get(name)
         fr = Frame(
             pose=np.asarray(pose, dtype=float),
@@ -734,7 +269,7 @@ class Cell:
         """Write a calibrated positioner chain into the cell, keeping its parent and name.
 
         The hook of the positioner calibration (:func:`robotcell.identification.calibrate_positioner`
-        returns the identified chain as a :class:`~robotcell.kinematics.robot.Robot`): a turntable becomes a
+        returns the identified chain as a :class:`~robotcell.robot.robot.Robot`): a turntable becomes a
         :class:`Positioner` with that chain.
 
         Parameters
@@ -801,6 +336,56 @@ class Cell:
             pick(first.reachable, other.reachable), pick(first.track, other.track),
             pick(first.table, other.table), first.method, err)
 
+    def ik_batch(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
+                 table: ArrayLike | Literal["normal_up"] = 0.0,
+                 tool: str | ArrayLike | None = None, chunk: int = IK_CHUNK,
+                 progress: Callable[[int], None] | None = None) -> CellIKSolutions:
+        """:meth:`ik` of a long list of targets, ``chunk`` targets per call (bounded memory).
+
+        Parameters
+        ----------
+        T : array_like, shape (N, 4, 4)
+            Targets in ``frame`` (m).
+        frame : str
+        track : array_like, shape (N,) or (), optional
+            Track values (m), per target or one for all; None: chosen per target.
+        table : array_like, shape (N,), (N, n), () or (n,), or "normal_up"
+            Table angle or positioner axis values (rad), per target or one for all.
+        tool : str or array_like, optional
+        chunk : int
+            Targets per call of :meth:`ik` (at least 1).
+        progress : callable, optional
+            Called with the number of targets solved after each chunk.
+
+        Returns
+        -------
+        CellIKSolutions
+            Shapes ``(N, 8, n)``, ``(N, 8)``, track ``(N,)``, table ``(N,)`` or ``(N, n)``.
+        """
+        T = validate_pose(T, "T")
+        if T.ndim != 3:
+            raise InputError(f"T must be a list of poses, shape (N, 4, 4), got {T.shape}")
+        if not (isinstance(chunk, int) and chunk >= 1):
+            raise InputError(f"chunk must be an integer >= 1, got {chunk!r}")
+        n = len(T)
+        pos = self.turntable
+        table_shape = (pos.n_axes,) if isinstance(pos, Positioner) else ()
+        try:
+            e = None if track is None else np.broadcast_to(np.asarray(track, float), (n,))
+            th = (table if isinstance(table, str)
+                  else np.broadcast_to(np.asarray(table, float), (n, *table_shape)))
+        except ValueError:
+            raise InputError(f"track must have shape (N,) or (), and table shape "
+                             f"{(n, *table_shape)} or {table_shape}, for N = {n} targets") from None
+        parts = []
+        for start in range(0, max(n, 1), chunk):
+            sl = slice(start, min(start + chunk, n))
+            parts.append(self.ik(T[sl], frame, None if e is None else e[sl],
+                                 th if isinstance(th, str) else th[sl], tool))
+            if progress is not None:
+                progress(sl.stop - sl.start)
+        return parts[0].concatenate(parts, table_shape)
+
     def _normal_up(self, T: ArrayLike, frame: str, track: ArrayLike | None
                    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
         """Positioner axis values turning the targets' -Z up, for :meth:`ik`."""
@@ -840,7 +425,8 @@ class Cell:
         ----------
         path : str or Path
             YAML cell file (millimetres, degrees). A robot model path inside it is resolved
-            against the file's directory.
+            against the file's directory. The file is read as UTF-8, else as Windows-1252
+            (:mod:`robotcell.io.fileio`).
 
         Returns
         -------
@@ -852,9 +438,7 @@ class Cell:
             Missing or unreadable file, invalid YAML, or invalid content; the message names the
             file and the key.
         """
-        from robotcell.cell.schema import load_cell  # the schema builds on this module
-
-        return load_cell(path)
+        return cell_from_dict(*read_cell_file(path))
 
     def save(self, path: str | Path) -> Path | None:
         """Write the cell file atomically, keeping what the user wrote and every old version.
@@ -866,7 +450,7 @@ class Cell:
         same directory, flushed and fsynced, then moved over ``path`` with ``os.replace``: if
         the process dies at any point, ``path`` holds either the old or the new content in
         full. The file and its backups keep the permissions of the file replaced (a new file
-        gets ``0o666`` less the umask).
+        gets ``0o666`` less the umask). See :func:`robotcell.cell.schema.save_cell`.
 
         Parameters
         ----------
@@ -878,18 +462,39 @@ class Cell:
         Path or None
             The backup of the previous file, or None when there was no file.
         """
-        from robotcell.cell.schema import save_cell  # the schema builds on this module
-
-        return save_cell(self, path)
+        return save_cell(self, path, cell_from_dict)
 
 
-def _check_name(name: Any, what: str) -> None:
-    if not isinstance(name, str) or not NAME_RE.match(name):
-        raise InputError(f"{what} name {name!r} is invalid: use a letter, then letters, digits "
-                         "or '_', at most 24 characters")
-    if what == "frame" and name in RESERVED_FRAMES:
-        raise InputError(f"frame name {name!r} is reserved (reserved: "
-                         f"{', '.join(sorted(RESERVED_FRAMES))})")
+def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> Cell:
+    """Build a cell from the parsed content of a cell file.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed YAML (millimetres, degrees).
+    origin : str
+        What to call the source in error messages (a file name).
+    base_dir : str or Path
+        Directory against which a relative robot model path is resolved.
+
+    Returns
+    -------
+    Cell
+
+    Raises
+    ------
+    InputError
+        Invalid content, or a length beyond the size of any real cell
+        (:func:`robotcell.cell.validation.check_lengths`); the message names ``origin`` and the
+        key.
+    """
+    fields = cell_fields(data, origin, base_dir)
+    try:
+        cell = Cell(**fields)
+    except InputError as exc:
+        raise InputError(f"{origin}: {exc}") from None
+    check_lengths(cell, origin)
+    return cell
 
 
 def _unique_numbers(numbers: dict[str, int | None], what: str) -> None:

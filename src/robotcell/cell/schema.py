@@ -5,14 +5,20 @@ A cell file is written in millimetres and degrees (see ``docs/cell.md`` for the 
 the file are mappings ``{x, y, z, a, b, c}`` with ``R = Rz(a) Ry(b) Rx(c)`` (the KUKA convention,
 as in robot model files).
 
-:func:`save_cell` (what :meth:`Cell.save <robotcell.cell.model.Cell.save>` calls) updates an
-existing file as the user wrote it: the file is read as a round-trip YAML document
-(:mod:`robotcell.io.yamlfile`), the values the cell changed are put in place and the rest (comments,
-key order, layout, the spelling of unchanged numbers) stays as it was. It writes atomically: a
-temporary file in the same directory, flushed and fsynced, then ``os.replace``; the previous file
-is kept as a numbered backup ``<name>.<N>.bak`` that no later update overwrites
-(:mod:`robotcell.cell.history`). The file and its backups keep the permissions the file had (see
-:mod:`robotcell.io.fileio`, which also gives the encoding rule of :func:`load_cell`).
+This module knows the parts of a cell (:mod:`robotcell.cell.parts`) and reads of a cell what
+:class:`CellRecord` names; the cell (:mod:`robotcell.cell.model`) stands on it:
+:func:`~robotcell.cell.model.cell_from_dict` builds a :class:`~robotcell.cell.model.Cell` from
+the keyword arguments :func:`cell_fields` reads, and :meth:`Cell.save
+<robotcell.cell.model.Cell.save>` calls :func:`save_cell`.
+
+:func:`save_cell` updates an existing file as the user wrote it: the file is read as a round-trip
+YAML document (:mod:`robotcell.io.yamlfile`), the values the cell changed are put in place and
+the rest (comments, key order, layout, the spelling of unchanged numbers) stays as it was. It
+writes atomically: a temporary file in the same directory, flushed and fsynced, then
+``os.replace``; the previous file is kept as a numbered backup ``<name>.<N>.bak`` that no later
+update overwrites (:mod:`robotcell.cell.history`). The file and its backups keep the permissions
+the file had (see :mod:`robotcell.io.fileio`, which also gives the encoding rule of
+:func:`read_cell_file`).
 """
 
 from __future__ import annotations
@@ -20,15 +26,16 @@ from __future__ import annotations
 import datetime as _dt
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell.history import keep_version
-from robotcell.cell.model import (
-    Cell,
+from robotcell.cell.kinematics import CellModel
+from robotcell.cell.parts import (
     Frame,
     IdentifiedArm,
     Positioner,
@@ -36,17 +43,38 @@ from robotcell.cell.model import (
     Tool,
     Track,
     Turntable,
-    _check_name,
     check_identified,
+    check_name,
 )
-from robotcell.cell.validation import check_lengths
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, check_destination, read_text
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.yamlfile import dump_yaml, parse_yaml, update_document
-from robotcell.kinematics.models import load_robot, robot_from_dict, robot_to_dict
+from robotcell.robot.models import load_robot, robot_from_dict, robot_to_dict
 
-__all__ = ["cell_from_dict", "cell_to_dict", "load_cell", "save_cell"]
+__all__ = ["CellRecord", "cell_fields", "cell_to_dict", "read_cell_file", "save_cell"]
+
+
+class CellRecord(CellModel, Protocol):
+    """What the cell file holds of a cell; :class:`robotcell.cell.Cell` is one.
+
+    Attributes
+    ----------
+    robot_model : str
+        How the file names the robot: a library name or a model file.
+    identified : IdentifiedArm or None
+    name : str
+    (and those of :class:`~robotcell.cell.kinematics.CellModel`)
+    """
+
+    @property
+    def robot_model(self) -> str: ...
+
+    @property
+    def identified(self) -> IdentifiedArm | None: ...
+
+    @property
+    def name(self) -> str: ...
 
 _POSE_KEYS = ("x", "y", "z", "a", "b", "c")
 
@@ -62,34 +90,47 @@ _HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z,
            "# R = Rz(a) Ry(b) Rx(c). Schema: docs/cell.md\n")
 
 
-def load_cell(path: str | Path) -> Cell:
-    """Read a cell file (millimetres, degrees) into a :class:`Cell`: what :meth:`Cell.load` does.
+def read_cell_file(path: str | Path) -> tuple[Any, str, Path]:
+    """Read a cell file (millimetres, degrees) as a YAML document.
 
     Parameters
     ----------
     path : str or Path
-        YAML cell file; a robot model path inside it is resolved against the file's directory.
+        YAML cell file.
+
+    Returns
+    -------
+    data : mapping
+        The parsed content, for :func:`cell_fields`.
+    origin : str
+        ``path`` as given, for messages.
+    base_dir : Path
+        The file's directory, against which a robot model path inside it is resolved.
     """
     p = Path(path)
-    data = parse_yaml(read_text(p, "cell file"), str(path))
-    return cell_from_dict(data, str(path), p.resolve().parent)
+    return parse_yaml(read_text(p, "cell file"), str(path)), str(path), p.resolve().parent
 
 
-def save_cell(cell: Cell, path: str | Path) -> Path | None:
+def save_cell(cell: CellRecord, path: str | Path,
+              read: Callable[[Any, str, Path], CellRecord]) -> Path | None:
     """Write ``cell`` to a cell file atomically, keeping the file as the user wrote it.
 
     An existing file that reads as a cell is updated in place: only the values that differ from
     what the file says change, in their places; comments, key order, layout and keys this
     writer does not use are kept. Another file is replaced whole. Either way the previous file is
     first copied to the next numbered backup ``<name>.<N>.bak``, which no later save overwrites.
-    This is what :meth:`Cell.save` does.
+    This is what :meth:`Cell.save <robotcell.cell.model.Cell.save>` does.
 
     Parameters
     ----------
-    cell : Cell
+    cell : CellRecord
         The cell (SI units), written in millimetres and degrees.
     path : str or Path
         Destination; a robot model file is written relative to its directory.
+    read : callable
+        ``read(data, origin, base_dir)``: the cell that the content of a cell file is
+        (:func:`robotcell.cell.model.cell_from_dict`); an existing file that it reads is
+        updated in place.
 
     Returns
     -------
@@ -100,7 +141,7 @@ def save_cell(cell: Cell, path: str | Path) -> Path | None:
     base = p.resolve().parent
     new = cell_to_dict(cell, base)
     check_destination(p)  # a read-only file is refused before the backup is made
-    written = _as_written(p, base) if p.is_file() else None
+    written = _as_written(p, base, read) if p.is_file() else None
     if written is None:
         text = _HEADER + dump_yaml(new)
     else:
@@ -112,19 +153,20 @@ def save_cell(cell: Cell, path: str | Path) -> Path | None:
     return backup
 
 
-def _as_written(path: Path, base: Path) -> tuple[Any, dict[str, Any]] | None:
+def _as_written(path: Path, base: Path, read: Callable[[Any, str, Path], CellRecord]
+                ) -> tuple[Any, dict[str, Any]] | None:
     """The file's round-trip document and what it says in this writer's spelling, or None.
 
     None when the file does not read as a cell (it is then replaced whole; its backup keeps it).
     """
     try:
         doc = parse_yaml(read_text(path, "cell file"), str(path))
-        return doc, cell_to_dict(cell_from_dict(doc, str(path), base), base)
+        return doc, cell_to_dict(read(doc, str(path), base), base)
     except InputError:
         return None
 
 
-# -- file content <-> Cell ------------------------------------------------------------------------
+# -- file content <-> cell ------------------------------------------------------------------------
 class _Reader:
     """Typed access to the parsed YAML with errors naming the file and the key."""
 
@@ -262,8 +304,9 @@ def _relative(model: str, base_dir: str | Path) -> str:
     return model
 
 
-def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> Cell:
-    """Build a cell from the parsed content of a cell file.
+def cell_fields(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> dict[str, Any]:
+    """The keyword arguments of :class:`~robotcell.cell.model.Cell` that the content of a cell
+    file gives (:func:`robotcell.cell.model.cell_from_dict` builds the cell).
 
     Parameters
     ----------
@@ -276,7 +319,14 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
 
     Returns
     -------
-    Cell
+    dict
+        ``robot``, ``robot_model``, ``tools``, ``frames`` and those of ``T_world_R``, ``name``,
+        ``track``, ``turntable`` and ``identified`` the file gives (SI units).
+
+    Raises
+    ------
+    InputError
+        Naming ``origin`` and the key at fault.
     """
     rd = _Reader(origin, base_dir)
     if not isinstance(data, dict):
@@ -378,11 +428,7 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
             number=rd.integer(fd["number"], f"{key}.number") if "number" in fd else None,
             provenance=rd.provenance(fd.get("provenance"), f"{key}.provenance"),
         )
-    try:
-        cell = Cell(tools=tools, frames=frames, **kwargs)
-    except InputError as exc:
-        raise InputError(f"{origin}: {exc}") from None
-    return check_lengths(cell, origin)
+    return {**kwargs, "tools": tools, "frames": frames}
 
 
 _AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "beta", "sign", "min", "max"}
@@ -428,7 +474,7 @@ def _positioner_dict(pos: Positioner, base_dir: str | Path) -> dict[str, Any]:
 
 def _named(rd: _Reader, name: Any, key: str, what: str) -> None:
     try:
-        _check_name(name, what)
+        check_name(name, what)
     except InputError as exc:
         raise rd.fail(key, f"is not a valid name: {exc}") from None
 
@@ -479,12 +525,13 @@ def _prov_dict(p: Provenance, base_dir: str | Path = ".") -> dict[str, Any]:
     return out
 
 
-def cell_to_dict(cell: Cell, base_dir: str | Path = ".") -> dict[str, Any]:
+def cell_to_dict(cell: CellRecord, base_dir: str | Path = ".") -> dict[str, Any]:
     """The cell-file content of ``cell`` (millimetres, degrees).
 
     Parameters
     ----------
-    cell : Cell
+    cell : CellRecord
+        A :class:`~robotcell.cell.model.Cell` (SI units).
     base_dir : str or Path
         Directory of the file to be written; a robot model path is written relative to it.
 

@@ -18,11 +18,13 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robotcell.cell.model import Cell, Positioner, Track, Turntable
+from robotcell.cell.kinematics import CellModel
+from robotcell.cell.parts import Positioner, Track, Turntable
 from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM, MAX_ABS_VALUE, outside_limits
 
-__all__ = ["SCALE_RANGE", "axis_range", "check_axis_limits", "check_lengths"]
+__all__ = ["SCALE_RANGE", "axis_limit_violation", "axis_range", "check_axis_limits",
+           "check_lengths"]
 
 #: Track scales (displacement per unit of the controller's track value) a real track has: a
 #: factor 10 from 1 is a unit error.
@@ -37,6 +39,44 @@ def axis_range(axis: Track | Turntable | Positioner) -> tuple[np.ndarray, np.nda
         extent = CELL_EXTENT_MM * 1e-3
         return np.maximum(lower, -extent), np.minimum(upper, extent)
     return lower, upper
+
+
+def axis_limit_violation(axis: Track | Turntable | Positioner | None, values: ArrayLike,
+                         columns: Sequence[str], source: str, label: str = "the cell",
+                         limits: bool = True) -> str | None:
+    """What :func:`check_axis_limits` refuses, as a message, or None.
+
+    Parameters
+    ----------
+    axis, values, columns, source, label
+        As for :func:`check_axis_limits`.
+    limits : bool
+        True: the axis limits (:func:`axis_range`); False: only the 100 m within which any track
+        ends (:data:`~robotcell.io.tables.CELL_EXTENT_MM`), beyond which a value is a typing
+        error (a table or positioner has no such bound: None).
+
+    Returns
+    -------
+    str or None
+        ``"<source>: values outside the limits of the track 'KL1500' of <label>: line 3,
+        column 'track': 7000 mm (limits 0 .. 6000 mm)"``, or None when every value is within.
+    """
+    if axis is None or not (limits or isinstance(axis, Track)):
+        return None
+    track = isinstance(axis, Track)
+    scale, unit = (1e3, "mm") if track else (180.0 / math.pi, "deg")
+    k = len(columns)
+    lo, hi = axis_range(axis)
+    if not limits:
+        lo, hi = -CELL_EXTENT_MM * 1e-3, CELL_EXTENT_MM * 1e-3
+    lower = np.broadcast_to(lo * scale, (k,))
+    upper = np.broadcast_to(hi * scale, (k,))
+    v = np.asarray(values, dtype=float).reshape(-1, k) * scale
+    bad = outside_limits(v, columns, lower, upper, [unit] * k)
+    if bad is None:
+        return None
+    what = "track" if track else ("turntable" if isinstance(axis, Turntable) else "positioner")
+    return f"{source}: values outside the limits of the {what} {axis.name!r} of {label}: {bad}"
 
 
 def check_axis_limits(axis: Track | Turntable | Positioner | None, values: ArrayLike,
@@ -63,21 +103,10 @@ def check_axis_limits(axis: Track | Turntable | Positioner | None, values: Array
         Naming the line and column of the first values outside the limits (mm or deg), a
         track's within 100 m (:func:`axis_range`).
     """
-    if axis is None:
-        return
-    track = isinstance(axis, Track)
-    scale, unit = (1e3, "mm") if track else (180.0 / math.pi, "deg")
-    k = len(columns)
-    lo, hi = axis_range(axis)
-    lower = np.broadcast_to(lo * scale, (k,))
-    upper = np.broadcast_to(hi * scale, (k,))
-    v = np.asarray(values, dtype=float).reshape(-1, k) * scale
-    bad = outside_limits(v, columns, lower, upper, [unit] * k)
+    bad = axis_limit_violation(axis, values, columns, source, label)
     if bad is not None:
-        what = "track" if track else ("turntable" if isinstance(axis, Turntable) else "positioner")
-        raise InputError(f"{source}: values outside the limits of the {what} {axis.name!r} of "
-                         f"{label}: {bad}. The axis cannot move there: correct the value "
-                         "(a typing or unit error?), or the limits in the cell file")
+        raise InputError(f"{bad}. The axis cannot move there: correct the value (a typing or "
+                         "unit error?), or the limits in the cell file")
 
 
 def _pose(key: str, T: np.ndarray) -> Iterator[tuple[str, float]]:
@@ -85,7 +114,7 @@ def _pose(key: str, T: np.ndarray) -> Iterator[tuple[str, float]]:
         yield f"{key}.{c}", float(T[i, 3])
 
 
-def _lengths(cell: Cell) -> Iterator[tuple[str, float]]:
+def _lengths(cell: CellModel) -> Iterator[tuple[str, float]]:
     """Every length of ``cell`` (m) with the key of the cell file that holds it."""
     if cell.track is None:
         yield from _pose("robot.frame", cell.T_world_R)
@@ -111,20 +140,15 @@ def _lengths(cell: Cell) -> Iterator[tuple[str, float]]:
         yield from _pose(f"frames.{name}.frame", fr.pose)
 
 
-def check_lengths(cell: Cell, origin: str = "cell") -> Cell:
+def check_lengths(cell: CellModel, origin: str = "cell") -> None:
     """Refuse a cell with a length beyond the size of any real cell, or an implausible scale.
 
     Parameters
     ----------
-    cell : Cell
-        A cell as read from a file (SI units).
+    cell : CellModel
+        A cell as read from a file (SI units): a :class:`~robotcell.cell.model.Cell`.
     origin : str
         The file, for the message.
-
-    Returns
-    -------
-    Cell
-        ``cell`` itself.
 
     Raises
     ------
@@ -151,4 +175,3 @@ def check_lengths(cell: Cell, origin: str = "cell") -> Cell:
                 if not abs(v) * 1e3 <= MAX_ABS_VALUE:
                     raise InputError(f"{origin}: key 'positioner.axes[{i}].{k}' is {v * 1e3:g} "
                                      f"mm, beyond {MAX_ABS_VALUE:.0e} mm: a typing error")
-    return cell

@@ -33,8 +33,8 @@ from robotcell.cli.common import check_kind, check_output, parse_numbers, read_c
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
 
 
 class CalibrateGroup(Group):

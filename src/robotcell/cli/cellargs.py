@@ -11,27 +11,30 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 import click
 import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Positioner, Track, Turntable
-from robotcell.cell.validation import axis_range, check_axis_limits
+from robotcell.cell.validation import axis_limit_violation, axis_range, check_axis_limits
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
+from robotcell.io.tables import CELL_EXTENT_MM
 
 __all__ = [
     "NORMAL_UP",
     "PROGRESS_MIN",
+    "batch_outside",
     "batch_table",
     "batch_track",
     "cell_tool",
     "check_axis_columns",
     "check_normal_up",
-    "chunks",
+    "progress",
     "row_values",
     "setup_text",
     "table_angles",
@@ -47,8 +50,6 @@ NORMAL_UP = "normal-up"
 
 #: Batches of at least this many poses show a progress bar on stderr.
 PROGRESS_MIN = 2000
-#: Poses per call of the library while a progress bar is shown.
-CHUNK = 500
 
 
 def cell_tool(text: str | None) -> str | NDArray[np.float64] | None:
@@ -61,9 +62,14 @@ def cell_tool(text: str | None) -> str | NDArray[np.float64] | None:
 
 
 def _checked(values: NDArray[np.float64], unit_scale: float, unit: str, axis: Track | Turntable | None,
-             what: str, option: str) -> NDArray[np.float64]:
+             what: str, option: str, outside: str = "refuse") -> NDArray[np.float64]:
     """``values`` (SI) if the cell has the axis and they are within its limits, else an error
-    naming the first offending value in ``unit`` (``unit_scale`` units per SI unit)."""
+    naming the first offending value in ``unit`` (``unit_scale`` units per SI unit).
+
+    ``outside``: ``"warn"``: a value outside the limits is named in a warning line instead (the
+    result is computed, the axis cannot move there); ``"said"``: the values come from a column
+    that :func:`check_axis_columns` has named already. A track position beyond 100 m is refused
+    either way."""
     if axis is None:
         if np.any(values != 0):
             raise InputError(f"the cell has no {option}; leave out --{option} (or the {option} column)")
@@ -72,9 +78,20 @@ def _checked(values: NDArray[np.float64], unit_scale: float, unit: str, axis: Tr
     bad = np.atleast_1d((values < lower) | (values > upper))
     if np.any(bad):
         first = float(np.atleast_1d(values)[bad][0]) * unit_scale
-        raise InputError(f"{what} {first:g} {unit} is outside the {axis_name(axis)} limits "
-                         f"[{lower * unit_scale:g}, {upper * unit_scale:g}] {unit}")
+        text = (f"{what} {first:g} {unit} is outside the {axis_name(axis)} limits "
+                f"[{lower * unit_scale:g}, {upper * unit_scale:g}] {unit}")
+        extent = CELL_EXTENT_MM * 1e-3
+        if outside != "refuse" and not (isinstance(axis, Track)
+                                        and np.any(np.abs(values) > extent)):
+            if outside == "warn":
+                click.echo(f"warning: {text}; {OUTSIDE}", err=True)
+        else:
+            raise InputError(text)
     return values
+
+
+#: What a warning about a track or table value outside its limits adds.
+OUTSIDE = "computed anyway, but the axis cannot move there"
 
 
 def axis_name(axis: Track | Turntable) -> str:
@@ -82,25 +99,28 @@ def axis_name(axis: Track | Turntable) -> str:
     return "track" if isinstance(axis, Track) else "turntable"
 
 
-def track_values(cell: Cell, mm: NDArray[np.float64] | float | None
+def track_values(cell: Cell, mm: NDArray[np.float64] | float | None, outside: str = "refuse"
                  ) -> NDArray[np.float64] | None:
-    """Track positions in m from mm, checked against the cell's track and its limits."""
+    """Track positions in m from mm, checked against the cell's track and its limits (a
+    position outside them: ``outside`` of :func:`_checked`)."""
     if mm is None:
         return None
     return _checked(np.asarray(mm, dtype=float) * 1e-3, 1e3, "mm", cell.track, "track position",
-                    "track")
+                    "track", outside)
 
 
-def table_angles(cell: Cell, deg: NDArray[np.float64] | float) -> NDArray[np.float64]:
+def table_angles(cell: Cell, deg: NDArray[np.float64] | float, outside: str = "refuse"
+                 ) -> NDArray[np.float64]:
     """Table angles in rad from deg, checked against the cell's turntable and its limits.
 
     For a positioner chain ``deg`` holds the axis values, shape ``(..., n)`` (0: every axis at 0),
-    each checked against its axis's limits.
+    each checked against its axis's limits (a value outside them: ``outside`` of
+    :func:`_checked`).
     """
     pos = cell.turntable
     if not isinstance(pos, Positioner):
         return _checked(np.radians(np.asarray(deg, dtype=float)), 180.0 / math.pi, "deg",
-                        cell.turntable, "table angle", "table")
+                        cell.turntable, "table angle", "table", outside)
     v = np.radians(np.asarray(deg, dtype=float))
     if v.ndim == 0 and v == 0:
         v = np.zeros(pos.n_axes)
@@ -112,8 +132,12 @@ def table_angles(cell: Cell, deg: NDArray[np.float64] | float) -> NDArray[np.flo
         i = int(np.nonzero(bad)[-1][0])
         first = math.degrees(float(v[bad][0]))
         name = pos.chain.joints[i].name or f"e{i + 1}"
-        raise InputError(f"positioner axis {name} value {first:g} deg is outside its limits "
-                         f"[{math.degrees(pos.lower[i]):g}, {math.degrees(pos.upper[i]):g}] deg")
+        text = (f"positioner axis {name} value {first:g} deg is outside its limits "
+                f"[{math.degrees(pos.lower[i]):g}, {math.degrees(pos.upper[i]):g}] deg")
+        if outside == "refuse":
+            raise InputError(text)
+        if outside == "warn":
+            click.echo(f"warning: {text}; {OUTSIDE}", err=True)
     return v
 
 
@@ -183,16 +207,37 @@ def table_rows(cell: Cell, cols: dict, option: NDArray[np.float64] | float, n: i
     return np.column_stack([row_values(cols, c, None, n) for c in names])
 
 
-def check_axis_columns(cell: Cell, cols: dict, source: str, track: bool = True) -> None:
+def check_axis_columns(cell: Cell, cols: dict, source: str, track: bool = True,
+                       warn: bool = False) -> None:
     """Refuse the ``track`` (unless ``track`` is False: a column the command does not use) and
     table columns (``table``, or a positioner's ``e1..en``) of a batch file whose values are
-    outside the limits of the cell's axes, naming line and column."""
+    outside the limits of the cell's axes, naming line and column. With ``warn`` they are named
+    in a warning line instead; a track position beyond 100 m is refused still."""
+    label = f"cell {cell.name!r}"
+    checks = []
     if track and cell.track is not None and isinstance(cols.get("track"), np.ndarray):
-        check_axis_limits(cell.track, cols["track"] * 1e-3, ["track"], source, f"cell {cell.name!r}")
+        checks.append((cell.track, cols["track"] * 1e-3, ["track"]))
     _, names = table_columns(cell)
     if cell.turntable is not None and all(isinstance(cols.get(c), np.ndarray) for c in names):
-        values = np.radians(np.column_stack([cols[c] for c in names]))
-        check_axis_limits(cell.turntable, values, names, source, f"cell {cell.name!r}")
+        checks.append((cell.turntable, np.radians(np.column_stack([cols[c] for c in names])),
+                       names))
+    for axis, values, columns in checks:
+        if not warn:
+            check_axis_limits(axis, values, columns, source, label)
+            continue
+        beyond = axis_limit_violation(axis, values, columns, source, label, limits=False)
+        if beyond is not None:
+            raise InputError(f"{beyond}: beyond 100 m, a typing or unit error; correct the value")
+        bad = axis_limit_violation(axis, values, columns, source, label)
+        if bad is not None:
+            click.echo(f"warning: {bad}; {OUTSIDE}", err=True)
+
+
+def batch_outside(cols: dict, names: list[str]) -> str:
+    """``outside`` of :func:`track_values` and :func:`table_angles` for a batch whose columns
+    ``names`` :func:`check_axis_columns` checked with ``warn``: ``"said"`` when the file has
+    them, else ``"warn"`` (the option's value, named once)."""
+    return "said" if any(c in cols for c in names) else "warn"
 
 
 def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[np.float64] | None:
@@ -205,16 +250,14 @@ def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[n
     return None if option is None else np.full(n, float(option))
 
 
-def chunks(n: int, label: str) -> Iterator[slice]:
-    """Slices over ``n`` poses; with a progress bar on stderr for ``n >= PROGRESS_MIN``."""
+@contextmanager
+def progress(n: int, label: str) -> Iterator[Callable[[int], None] | None]:
+    """A progress bar on stderr for ``n >= PROGRESS_MIN`` items: its ``update``, or None."""
     if n < PROGRESS_MIN:
-        yield slice(0, n)
+        yield None
         return
-    with click.progressbar(length=n, label=label, file=sys.stderr,
-                           show_pos=True) as bar:
-        for s in range(0, n, CHUNK):
-            yield slice(s, min(s + CHUNK, n))
-            bar.update(min(CHUNK, n - s))
+    with click.progressbar(length=n, label=label, file=sys.stderr, show_pos=True) as bar:
+        yield bar.update
 
 
 def table_text(cell: Cell, values: NDArray[np.float64] | float, chosen: bool = False) -> str:

@@ -8,13 +8,15 @@ degrees.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
+import re
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 
 import click
 import numpy as np
 
-from robotcell.errors import InputError
+from robotcell.errors import InputError, RobotcellError
 from robotcell.io import tables
 from robotcell.io.fileio import atomic_write, check_destination
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
@@ -27,11 +29,15 @@ from robotcell.io.tables import (
 )
 
 __all__ = [
+    "MAX_CORRECTION_MM",
     "NOISE_MAX_MM",
+    "BadPoints",
+    "as_flags",
     "check_kind",
     "check_not_folder",
     "check_output",
     "format_table",
+    "in_range",
     "output_of",
     "parse_numbers",
     "read_csv",
@@ -44,6 +50,50 @@ __all__ = [
 
 #: Largest touch-up error (``--noise`` of simulate, plan and demo; mm): 1 m is none.
 NOISE_MAX_MM = 1000.0
+
+#: Range of ``--max-correction`` (``compensate``, ``program compensate``; mm): a real arm is 0.1
+#: to a few mm off its drawing.
+MAX_CORRECTION_MM = (0.001, 100.0)
+
+
+class BadPoints(click.ClickException):
+    """Points that cannot be computed, one program, or filtered; a program with bad points:
+    exit status 3."""
+
+    exit_code = 3
+
+    def show(self, file: object = None) -> None:
+        click.echo(f"error: {self.message}", err=True)
+
+
+@contextmanager
+def as_flags(flags: Mapping[str, str]) -> Iterator[None]:
+    """Re-raise the library's errors with the command line's option names for its parameters.
+
+    Library messages name Python parameters (``max_correction``); a command maps those it passes
+    from an option to the option (``{"max_correction": "--max-correction"}``).
+    """
+    try:
+        yield
+    except RobotcellError as exc:
+        text = str(exc)
+        for param, flag in flags.items():
+            text = re.sub(rf"(?<![\w-]){re.escape(param)}\b", flag, text)
+        if text == str(exc):
+            raise
+        exc.args = (text,)
+        raise
+
+
+def in_range(lo: float, hi: float, unit: str) -> Callable[[click.Context, click.Parameter, float],
+                                                         float]:
+    """Callback of a number option: refuse a value outside ``lo .. hi`` (``unit``)."""
+    def callback(ctx: click.Context, param: click.Parameter, value: float) -> float:
+        if value is not None and not lo <= value <= hi:
+            raise InputError(f"{param.opts[0]} must be from {lo:g} to {hi:g} {unit}, got "
+                             f"{value:g}")
+        return value
+    return callback
 
 
 def counted(n: int, noun: str) -> str:

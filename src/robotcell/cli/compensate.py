@@ -8,13 +8,15 @@ import sys
 import click
 
 from robotcell.cell import Cell
-from robotcell.cli.common import format_table, output_of
+from robotcell.cli.common import (
+    MAX_CORRECTION_MM,
+    BadPoints,
+    as_flags,
+    format_table,
+    in_range,
+    output_of,
+)
 from robotcell.cli.files import OUTPUT, Command
-from robotcell.cli.program import BadPoints
-from robotcell.errors import InputError
-
-#: Range of --max-correction (mm): a real arm is 0.1 to a few mm off its drawing.
-MAX_CORRECTION_MM = (0.001, 100.0)
 
 
 @click.command(cls=Command)
@@ -28,6 +30,7 @@ MAX_CORRECTION_MM = (0.001, 100.0)
               callback=output_of("CSV", "the commanded poses"),
               help="CSV of the poses to command, atomically (default: standard output).")
 @click.option("--max-correction", "max_correction", type=float, default=5.0, show_default=True,
+              callback=in_range(*MAX_CORRECTION_MM, "mm"),
               help="Largest correction taken (mm); above it the identified model is wrong.")
 @click.option("--report", "report", type=OUTPUT, callback=output_of("HTML", "the accuracy report"),
               help="Also write an HTML page: predicted error without filtering and 1-sigma "
@@ -59,17 +62,14 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
     from robotcell.accuracy.poses import DECIMALS, compensate_poses
     from robotcell.io.tables import write_csv
 
-    lo, hi = MAX_CORRECTION_MM
-    if not lo <= max_correction <= hi:
-        raise InputError(f"--max-correction must be from {lo:g} to {hi:g} mm, got "
-                         f"{max_correction:g}")
     cell = Cell.load(cell_path)
     try:
-        result = compensate_poses(poses, cell, tool, frame, output, max_correction * 1e-3, report)
+        with as_flags({"max_correction": "--max-correction"}):
+            result = compensate_poses(poses, cell, tool, frame, output, max_correction * 1e-3,
+                                      report)
     except FilterRefused as exc:
         click.echo(format_table(["pose", "why"], [list(p) for p in exc.points]), err=True)
-        raise BadPoints(f"{poses}: {exc}".replace("max_correction", "--max-correction")) \
-            from None
+        raise BadPoints(f"{poses}: {exc}") from None
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     if as_json:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from robotcell.cli.common import NOISE_MAX_MM
+from robotcell.cli.common import NOISE_MAX_MM, as_flags
 from robotcell.cli.files import Command, OutputPath
 from robotcell.errors import InputError
 from robotcell.studies.demo import DEMO_NOISE, run_demo
@@ -36,4 +36,5 @@ def demo(output: str, noise: float, seed: int) -> None:
     if not 0 < noise <= NOISE_MAX_MM:
         raise InputError(f"--noise must be a positive number of millimetres, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
-    run_demo(output, noise=noise * 1e-3, seed=seed, echo=click.echo)
+    with as_flags({"a smaller noise": "a smaller --noise"}):
+        run_demo(output, noise=noise * 1e-3, seed=seed, echo=click.echo)

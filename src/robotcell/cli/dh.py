@@ -9,7 +9,7 @@ import math
 
 import click
 
-from robotcell.cli.common import format_table, output_of, parse_numbers
+from robotcell.cli.common import as_flags, format_table, output_of, parse_numbers
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.dhprocedure import (
     AxisChain,
@@ -20,8 +20,8 @@ from robotcell.dhprocedure import (
     symbolic_arm,
 )
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.models import load_robot, save_robot
-from robotcell.kinematics.robot import Joint, Robot
+from robotcell.robot.models import load_robot, save_robot
+from robotcell.robot.robot import Joint, Robot
 
 _CONVENTION = click.Choice(["standard", "modified"])
 
@@ -65,7 +65,10 @@ def from_urdf(file: str, convention: str, base_link: str | None, tip_link: str |
       robotcell dh from-urdf kr6.urdf --tip-link flange --signs=-1,1,1,-1,1,-1
     """
     sign_list = parse_numbers(signs, "--signs") if signs is not None else None
-    der = dh_from_urdf(file, convention, base_link=base_link, tip_link=tip_link, signs=sign_list)
+    with as_flags({"give base_link": "give base_link (--base-link)",
+                   "with tip_link": "with tip_link (--tip-link)"}):
+        der = dh_from_urdf(file, convention, base_link=base_link, tip_link=tip_link,
+                           signs=sign_list)
     click.echo(_report(der))
     if output:
         save_robot(der.robot, output)

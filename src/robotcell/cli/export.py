@@ -7,7 +7,7 @@ import click
 from robotcell.cell import Cell
 from robotcell.cli.common import check_kind, check_output, write_output
 from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
-from robotcell.io.export import WRITE_FORMATS, export_cell, export_files, ur_kinematics_path
+from robotcell.export import WRITE_FORMATS, export_cell, export_files, ur_kinematics_path
 
 
 @click.command(cls=Command)

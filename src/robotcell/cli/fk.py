@@ -10,6 +10,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
+    batch_outside,
     batch_table,
     batch_track,
     cell_tool,
@@ -34,8 +35,8 @@ from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import outside_limits
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
 
 FORMAT_CHOICES = [*FORMATS, "matrix"]
 
@@ -177,7 +178,8 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
     track = 0.0 if track_mm is None else track_mm
     if joints is not None:
         q = joints_to_si(r, np.array(parse_numbers(joints, "--joints", r.n_joints)))
-        e, th = track_values(cell, track), table_angles(cell, table_option(cell, table_deg))
+        e = track_values(cell, track, "warn")
+        th = table_angles(cell, table_option(cell, table_deg), "warn")
         setup = setup_text(cell, tool, frame, "" if cell.track is None else
                            f", track {track:g} mm" + (" (default)" if track_mm is None else ""),
                            table_text(cell, th) + (" (default)" if table_deg is None and
@@ -185,10 +187,11 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
     else:
         names = [f"a{i}" for i in range(1, r.n_joints + 1)]
         cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
-        check_axis_columns(cell, cols, input_path)
+        check_axis_columns(cell, cols, input_path, warn=True)
         q = joints_to_si(r, require_columns(cols, names, input_path))
-        e = track_values(cell, row_values(cols, "track", track, len(q)))
-        th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)))
+        e = track_values(cell, row_values(cols, "track", track, len(q)), batch_outside(cols, ["track"]))
+        th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)),
+                          batch_outside(cols, table_columns(cell)[1]))
         setup = setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "0 mm (default)"),
                            batch_table(cell, cols, table_deg))
     T = cell.fk(q, e, th, T_tool, frame)

@@ -10,9 +10,8 @@ import sys
 import click
 import numpy as np
 
-from robotcell.cell import Cell
-from robotcell.cell.identified import adopt_identified, identification_provenance
 from robotcell.cli.common import (
+    as_flags,
     check_kind,
     check_not_folder,
     check_output,
@@ -21,19 +20,11 @@ from robotcell.cli.common import (
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
-from robotcell.identification import identify as run_identify
-from robotcell.identification import identify_with_coupling, read_measurements
-from robotcell.identification.circles import first_estimate
-from robotcell.identification.offsets import joint_offsets
-from robotcell.identification.report import write_identification_report
-from robotcell.identification.validation import (
-    compare_observability,
-    cross_validate,
-    select_configurations,
-)
+from robotcell.identification.validation import select_configurations
 from robotcell.io.tables import format_table, write_csv
-from robotcell.kinematics.models import load_robot, save_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
+from robotcell.studies.identify import identify_file
 
 #: Columns of a measurement CSV (docs/identification.md): joints ``a1..aN``, one target ``x,y,z``
 #: or several ``x1,y1,z1,...``, an orientation ``qw,qx,qy,qz``.
@@ -45,17 +36,6 @@ def _check_columns(path: str) -> None:
     cols = read_csv(path)
     warn_unknown_columns(path, cols, [*(c for c in cols if MEASUREMENT_COLUMN.fullmatch(c)),
                                       "x", "y", "z", "qw", "qx", "qy", "qz"])
-
-
-def _offsets(result, vendor: str) -> dict:
-    """Joint zero offsets in the controller's units: KUKA deg (mm), ABB rad (m)."""
-    rows = []
-    for o in joint_offsets(result):
-        f = (1e3 if o.prismatic else 180 / math.pi) if vendor == "kuka" else 1.0
-        unit = ("mm" if o.prismatic else "deg") if vendor == "kuka" else ("m" if o.prismatic else "rad")
-        rows.append({"axis": o.axis, "delta": o.delta * f, "sigma": o.sigma * f, "unit": unit,
-                     "why": o.why})
-    return {"controller": vendor, "axes": rows}
 
 
 def _print_offsets(offsets: dict, vendor: str) -> None:
@@ -214,57 +194,26 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
     _check_columns(measurements)
-    options = {"point_sigma": accuracy * 1e-3, "angle_sigma": math.radians(angle_accuracy), "scale": scale,
-               "compliance": compliance}
-    if robot is not None or cell_path is not None:
-        nominal = load_robot(robot) if robot is not None else Cell.load(cell_path).nominal_robot
-        meas = read_measurements(measurements, nominal.prismatic)
-    else:
-        nominal, meas = first_estimate(measurements, j23_factor=j23 or 0.0)
-    if j23 is not None:
-        result = identify_with_coupling(nominal, meas, j23, **options)
-    else:
-        result = run_identify(nominal, meas, **options)
+    with as_flags({"the nominal model as robot": "the nominal model with --robot"}):
+        run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
+                            math.radians(angle_accuracy), scale, compliance, folds, report,
+                            offsets_for, output, force)
+    result, cv, offsets = run.result, run.cross_stats, run.offsets
     verdict, why = result.verdict
-    cv = cross = None
-    if (report is not None or cell_path is not None) and folds is None:
-        folds = min(5, meas.n_rows)
-    if folds is not None:
-        if j23 is not None:
-            options["coupling"] = j23
-        cross = cross_validate(nominal, meas, folds=folds, **options)
-        cv = cross.stats()
-    if report is not None:
-        obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
-                                    pose=meas.rotations is not None, point_sigma=options["point_sigma"],
-                                    angle_sigma=options["angle_sigma"])
-        write_identification_report(result, report, cross, obs, meas)
-    offsets = None if offsets_for is None else _offsets(result, offsets_for)
     if as_json:
-        data = result.to_json()
-        if cv is not None:
-            data["cross_validation"] = {"folds": folds, **cv}
-        if offsets is not None:
-            data["joint_offsets"] = offsets
-        click.echo(json.dumps(data))
+        click.echo(json.dumps(run.to_json()))
     else:
         click.echo(result.summary())
         if offsets is not None:
             _print_offsets(offsets, offsets_for)
         if cv is not None:
-            click.echo(f"cross-validation, {folds} folds (held-out rows, mm): nominal mean "
+            click.echo(f"cross-validation, {run.folds} folds (held-out rows, mm): nominal mean "
                        f"{cv['before_mean_mm']:.4f} RMS {cv['before_rms_mm']:.4f} max "
                        f"{cv['before_max_mm']:.4f}; identified mean {cv['after_mean_mm']:.4f} RMS "
                        f"{cv['after_rms_mm']:.4f} max {cv['after_max_mm']:.4f}")
-    if output is not None and (verdict != "poor" or force):
-        if cell_path is None:
-            save_robot(result.robot, output)
-        else:
-            adopt_identified(cell_path, result, output, identification_provenance(result, cross))
-        if not as_json:
-            click.echo(f"identified model written to {output}"
-                       + (f"; {cell_path} computes with it (robot.identified)" if cell_path
-                          else ""))
+    if run.written and not as_json:
+        click.echo(f"identified model written to {output}"
+                   + (f"; {cell_path} computes with it (robot.identified)" if cell_path else ""))
     if report is not None and not as_json:
         click.echo(f"report written to {report}")
     if verdict == "poor":

@@ -13,12 +13,13 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
+    batch_outside,
     batch_table,
     batch_track,
     cell_tool,
     check_axis_columns,
     check_normal_up,
-    chunks,
+    progress,
     row_values,
     setup_text,
     table_angles,
@@ -41,10 +42,10 @@ from robotcell.cli.common import (
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
-from robotcell.ik import IKSolutions, abb_confdata, analytic_solver, kuka_status_turn, nearest
+from robotcell.ik import abb_confdata, analytic_solver, kuka_status_turn, nearest
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
 
 BRANCHES = ["front up", "front up flip", "front down", "front down flip",
             "back up", "back up flip", "back down", "back down flip"]
@@ -249,11 +250,11 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
     if pose is not None:
         T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
         th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-              else table_angles(cell, table_option(cell, table_deg)))
-        sol = cell.ik(T, frame, track_values(cell, track_mm), th, T_tool)
+              else table_angles(cell, table_option(cell, table_deg), "warn"))
+        sol = cell.ik(T, frame, track_values(cell, track_mm, "warn"), th, T_tool)
         valid = sol.valid
         if ref is not None:
-            q, found, branch = nearest(r, IKSolutions(sol.q, valid, sol.reachable, sol.method), ref)
+            q, found, branch = sol.nearest(r, ref)
             ks, qs = ([int(branch)], q[None]) if found else ([], q[None])
         else:
             ks = [k for k in range(8) if show_all or valid[k]]
@@ -287,32 +288,26 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
                      f"{sol.method} solver; angles in degrees\n{format_table(headers, rows)}\n")
         return
     names = [f.lower() for f in FORMATS[fmt].fields]
-    n_table, table_names = table_columns(cell)
+    _, table_names = table_columns(cell)
     cols = read_csv(input_path, known=[*names, "track", *table_names])
-    check_axis_columns(cell, cols, input_path)
+    check_axis_columns(cell, cols, input_path, warn=True)
     T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     n = len(T)
-    e = track_values(cell, row_values(cols, "track", track_mm, n))
+    e = track_values(cell, row_values(cols, "track", track_mm, n), batch_outside(cols, ["track"]))
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n)))
+          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n),
+                            batch_outside(cols, table_names)))
     click.echo(setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "chosen per pose"),
                           batch_table(cell, cols, table_deg)), err=True)
-    parts = []
-    for sl in chunks(n, "ik"):
-        parts.append(cell.ik(T[sl], frame, None if e is None else e[sl],
-                             th if isinstance(th, str) else th[sl], T_tool))
-    q = np.concatenate([p.q for p in parts])
-    valid = np.concatenate([p.valid for p in parts])
-    reach = np.concatenate([p.reachable for p in parts])
-    off = (None if any(p.reach_error is None for p in parts)
-           else _reach_error_mm(np.concatenate([p.reach_error for p in parts]), reach))
-    track = np.concatenate([np.broadcast_to(p.track, p.valid.shape[:-1]) for p in parts]) * 1e3
-    table = np.concatenate([np.broadcast_to(p.table, p.valid.shape[:-1] + n_table)
-                            for p in parts]).reshape(n, -1) * deg
-    method = parts[0].method
+    with progress(n, "ik") as done:
+        sol = cell.ik_batch(T, frame, e, th, T_tool, progress=done)
+    q, valid, reach, method = sol.q, sol.valid, sol.reachable, sol.method
+    off = _reach_error_mm(sol.reach_error, reach)
+    track = sol.track * 1e3
+    table = sol.table.reshape(n, -1) * deg
     axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
     if ref is not None:
-        qn, found, branch = nearest(r, IKSolutions(q, valid, reach, method), ref)
+        qn, found, branch = sol.nearest(r, ref)
         names_f, flags = _cell_flag_columns(r, method, fmt, qn)
         header = ["pose", "found", "track", *table_names, *axes, *names_f]
         out_rows = [[i, int(found[i]), track[i], *table[i].tolist(), *(qn[i] * deg).tolist(),

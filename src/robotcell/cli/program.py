@@ -4,43 +4,27 @@ from __future__ import annotations
 
 import json
 import math
-import re
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 
 import click
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cli.common import counted, format_table, parse_numbers
+from robotcell.cli.common import (
+    MAX_CORRECTION_MM,
+    BadPoints,
+    as_flags,
+    counted,
+    format_table,
+    in_range,
+    parse_numbers,
+)
 from robotcell.cli.files import Group, OutputPath
-from robotcell.errors import InputError
 from robotcell.programs import VENDORS
 
 #: Library parameters as the command line names them.
-_FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split",
-          "max_correction": "--max-correction", "joints": "--joints"}
-
-
-class BadPoints(click.ClickException):
-    """A path that cannot be one program, or a program with bad points: exit status 3."""
-
-    exit_code = 3
-
-    def show(self, file: object = None) -> None:
-        click.echo(f"error: {self.message}", err=True)
-
-
-@contextmanager
-def _flags() -> Iterator[None]:
-    """Re-raise library errors with the command line's option names instead of parameters."""
-    try:
-        yield
-    except InputError as exc:
-        text = str(exc)
-        for param, flag in _FLAGS.items():
-            text = re.sub(rf"\b{param}\b", flag, text)
-        raise InputError(text) from None
+FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split",
+         "max_correction": "--max-correction", "joints": "--joints"}
 
 
 def _ppd(text: str | None) -> list[float] | None:
@@ -105,7 +89,7 @@ def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, fol
     from robotcell.programs import PathBreaks, write_program
 
     cell = Cell.load(cell_path)
-    with _flags():
+    with as_flags(FLAGS):
         try:
             result = write_program(path, cell, tool, frame, vendor, folder, name, split,
                                    pulses_per_degree=_ppd(ppd), inputs=(cell_path,))
@@ -168,7 +152,7 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
     from robotcell.programs.check import check_program_file
 
     cell = Cell.load(cell_path)
-    with _flags():
+    with as_flags(FLAGS):
         report = check_program_file(program_file, cell, _ppd(ppd))
     if as_json:
         click.echo(json.dumps(report.to_json(cell), indent=2))
@@ -211,7 +195,7 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     from robotcell.programs.retarget import RetargetFailed, retarget_program
 
     old, new = Cell.load(old_path), Cell.load(new_path)
-    with _flags():
+    with as_flags(FLAGS):
         try:
             result = retarget_program(program_file, old, new, folder, _ppd(ppd),
                                       inputs=(old_path, new_path))
@@ -243,6 +227,7 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
               show_default=True, help="Joint points taught on the real arm (kept) or computed "
                                       "offline with the nominal model (filtered too).")
 @click.option("--max-correction", "max_correction", type=float, default=5.0, show_default=True,
+              callback=in_range(*MAX_CORRECTION_MM, "mm"),
               help="Largest correction taken (mm); above it the identified model is wrong.")
 @click.option("--report", "report", type=OutputPath(dir_okay=False),
               help="Also write an HTML page: predicted error without filtering and 1-sigma "
@@ -269,15 +254,10 @@ def compensate_cmd(program_file: str, cell_path: str, folder: str, joints: str,
     from robotcell.accuracy.filter import FilterRefused
     from robotcell.accuracy.program import compensate_program
     from robotcell.cli.common import check_kind
-    from robotcell.cli.compensate import MAX_CORRECTION_MM
 
-    lo, hi = MAX_CORRECTION_MM
-    if not lo <= max_correction <= hi:
-        raise InputError(f"--max-correction must be from {lo:g} to {hi:g} mm, got "
-                         f"{max_correction:g}")
     check_kind(report, "HTML", "the accuracy report", "--report")
     cell = Cell.load(cell_path)
-    with _flags():
+    with as_flags(FLAGS):
         try:
             result = compensate_program(program_file, cell, folder, joints, _ppd(ppd),
                                         max_correction * 1e-3, inputs=(cell_path,),

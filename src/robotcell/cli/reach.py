@@ -13,8 +13,12 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
+    batch_outside,
+    batch_table,
+    batch_track,
     check_axis_columns,
     row_values,
+    setup_text,
     table_angles,
     table_columns,
     table_option,
@@ -25,37 +29,13 @@ from robotcell.cli.common import (
     output_of,
     read_csv,
     target_poses,
-    write_output,
 )
 from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS
-from robotcell.io.tables import require_columns, write_columns
-from robotcell.studies.reach import ReachMap, reach_html, reach_map
-
-
-def reach_columns(rm: ReachMap, cell: Cell) -> dict[str, np.ndarray]:
-    """The CSV columns of a reachability map (mm, deg), each in its type.
-
-    The axis columns are named as ``fk --cell`` and ``ik --cell`` name them: ``track`` (mm),
-    ``table`` or a positioner's ``e1..en`` (deg), ``a1..an`` (deg), so the file can be fed to
-    ``robotcell fk --cell CELL --input``. ``target`` and ``branch`` are integers, ``reachable``
-    is ``true``/``false``; ``track_margin_mm`` only for a cell with a track.
-    """
-    table = np.degrees(rm.table).reshape(rm.reachable.size, -1)
-    columns: dict[str, np.ndarray] = {
-        "target": np.arange(rm.reachable.size), "reachable": rm.reachable.astype(bool),
-        "score": rm.score, "track": rm.track * 1e3,
-        **{name: table[:, i] for i, name in enumerate(table_columns(cell)[1])},
-        "branch": rm.branch.astype(int),
-        **{f"a{i + 1}": np.degrees(rm.q[:, i]) for i in range(cell.robot.n_joints)},
-        "limit_margin_deg": np.degrees(rm.limit_margin),
-    }
-    if cell.track is not None:
-        columns["track_margin_mm"] = rm.track_margin * 1e3
-    columns["manipulability_m3"] = rm.manipulability
-    return columns
+from robotcell.io.tables import require_columns
+from robotcell.studies.reach import write_reach_map
 
 
 def target_options(f: Callable[..., None]) -> Callable[..., None]:
@@ -84,24 +64,32 @@ def target_options(f: Callable[..., None]) -> Callable[..., None]:
 
 def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_table: bool,
                  track_mm: float | None = None, track_column: bool = True
-                 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
-    """Targets (m), table angles (rad; None: to be chosen) and track positions (m; None: to be
-    chosen) from the targets file, with the columns of ``ik --cell``: the pose columns of
-    ``fmt``, ``track`` (mm, when ``track_column``), ``table`` or a positioner's ``e1..en``
-    (deg). A column the command does not use is named in a warning."""
+                 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, str]:
+    """Targets (m), table angles (rad; None: to be chosen), track positions (m; None: to be
+    chosen) and how the track and table were set (``", track chosen per target, table 0 deg"``)
+    from the targets file, with the columns of ``ik --cell``: the pose columns of ``fmt``,
+    ``track`` (mm, when ``track_column``), ``table`` or a positioner's ``e1..en`` (deg). A
+    column the command does not use is named in a warning."""
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
-    check_axis_columns(cell, cols, path, track=track_column)
+    check_axis_columns(cell, cols, path, track=track_column, warn=True)
     T = target_poses(require_columns(cols, names, path), fmt, path)
     track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
-                         else track_mm)
+                         else track_mm, batch_outside(cols, ["track"] if track_column else []))
     if choose_table:
         given = [c for c in table_names if c in cols]
         if given:
             raise InputError(f"{path} has a '{given[0]}' column; leave it out to --choose-table")
-        return T, None, track
-    return T, table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T))), track
+    axes = (batch_track(cell, cols if track_column else {}, track_mm, "chosen per target")
+            + (", table chosen per target (--choose-table)"
+               if choose_table and cell.turntable is not None
+               else batch_table(cell, cols, table_deg)))
+    if choose_table:
+        return T, None, track, axes
+    th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T)),
+                      batch_outside(cols, table_names))
+    return T, th, track, axes
 
 
 @click.command(cls=Command)
@@ -138,15 +126,12 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
         html_path = str(Path(output).with_suffix(".html"))
         refuse_overwriting_inputs(click.get_current_context(), [("the map written next to -o", html_path)])
     cell = Cell.load(cell_path)
-    T, th, track = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
+    T, th, track, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
+    click.echo(setup_text(cell, tool, frame, axes, ""), err=True)
     with ExitStack() as stack:
-        rm = reach_map(cell, T, frame=frame, tool=tool, table=th, track=track,
-                       progress=DeferredProgress(stack, "targets"))
-    write_columns(output if output else sys.stdout, reach_columns(rm, cell), 6)
-    if html_path:
-        page = reach_html(rm, T[:, :3, 3], title=f"Reachability: {Path(targets).name} in "
-                          f"{cell.name}", frame=frame)
-        write_output(html_path, page)
+        rm = write_reach_map(cell, T, output if output else sys.stdout, html_path,
+                             f"Reachability: {Path(targets).name} in {cell.name}", frame, tool,
+                             th, track, DeferredProgress(stack, "targets"))
     n_ok = int(np.count_nonzero(rm.reachable))
     margin = math.degrees(float(np.nanmin(rm.limit_margin))) if n_ok else float("nan")
     click.echo(f"{n_ok} of {rm.reachable.size} targets reachable, mean score "

@@ -10,8 +10,8 @@ import numpy as np
 from robotcell.cli.common import format_table
 from robotcell.cli.files import NAME_OR_FILE, Group
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.models import list_robots, load_robot
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.models import list_robots, load_robot
+from robotcell.robot.robot import Robot
 
 
 @click.group(cls=Group, invoke_without_command=True)

@@ -7,15 +7,14 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import ExitStack
 
 import click
-import numpy as np
 
 from robotcell.cell import Cell
+from robotcell.cli.cellargs import setup_text
 from robotcell.cli.common import format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
 from robotcell.errors import InputError
-from robotcell.io.tables import write_columns
 from robotcell.studies.sweep import read_layouts, sweep
 
 
@@ -70,20 +69,15 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
     cell = Cell.load(cell_path)
-    T, th, _ = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
+    T, th, _, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
+    click.echo(setup_text(cell, tool, frame, axes.replace("track chosen per target",
+                                                          "track chosen per target and layout"),
+                          ""), err=True)
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
         ranked = sweep(cell, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
-                       progress=DeferredProgress(stack, "layouts"))
-    names = list(layouts[0].values) if layouts else []
-    if output:
-        write_columns(output, {
-            "rank": np.arange(1, len(ranked) + 1), "layout": np.array([r.index for r in ranked]),
-            **{n: np.array([r.layout.values[n] for r in ranked], dtype=float) for n in names},
-            "reachable_fraction": np.array([r.fraction for r in ranked]),
-            "mean_score": np.array([r.mean_score for r in ranked]),
-            "min_score": np.array([r.min_score for r in ranked])}, 6)
+                       progress=DeferredProgress(stack, "layouts"), output=output)
     shown = ranked[:max(top, 0)]
     rows_out = [[rank + 1, r.layout.label, f"{100 * r.fraction:.1f}", f"{r.mean_score:.3f}",
                  f"{r.min_score:.3f}"] for rank, r in enumerate(shown)]

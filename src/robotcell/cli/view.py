@@ -13,12 +13,11 @@ from robotcell.cli.common import output_of, parse_numbers
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
-from robotcell.view.cellscene import cell_figure
+from robotcell.robot.robot import Robot
+from robotcell.view.cellscene import write_cell_view
 from robotcell.view.path import ordinal
-from robotcell.view.plot import MAX_PAGE_BYTES, write_html
+from robotcell.view.plot import MAX_PAGE_BYTES
 from robotcell.view.program import write_program_view
-from robotcell.view.reach import read_reach
 
 
 def joint_option(robot: Robot, text: str | None) -> np.ndarray | None:
@@ -106,8 +105,6 @@ def view(cell_path: str, joints: str | None, track_mm: float | None, table_deg: 
     q = joint_option(cell.robot, joints)
     e = float(track_values(cell, track_mm or 0.0))
     th = table_angles(cell, table_option(cell, table_deg))
-    reach = read_reach(reach_path, cell) if reach_path is not None else None
-    fig = cell_figure(cell, q, e, th, reach, cell_tool(tool))
-    path = write_html(fig, output, title=f"{cell.name}: robotcell view")
+    path = write_cell_view(cell, output, q, e, th, reach_path, cell_tool(tool))
     click.echo(f"{path}: 3D view of {cell.name}, {path.stat().st_size / 1e6:.1f} MB; open it "
                "in a browser", err=True)

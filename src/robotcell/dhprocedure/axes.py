@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import validate_pose
+from robotcell.robot.robot import Robot
 
 __all__ = ["AxisChain"]
 

@@ -23,8 +23,8 @@ from numpy.typing import NDArray
 
 from robotcell.errors import InputError
 from robotcell.kinematics.dh import Convention
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import make_pose, rot_x
+from robotcell.robot.robot import Robot
 
 __all__ = ["convert_convention"]
 

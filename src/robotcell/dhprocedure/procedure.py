@@ -41,8 +41,8 @@ from numpy.typing import NDArray
 from robotcell.dhprocedure.axes import AxisChain
 from robotcell.errors import InputError
 from robotcell.kinematics.dh import Convention
-from robotcell.kinematics.robot import Joint, Robot
 from robotcell.kinematics.transforms import invert, make_pose
+from robotcell.robot.robot import Joint, Robot
 
 __all__ = ["DHDerivation", "FrameNote", "dh_from_axes"]
 

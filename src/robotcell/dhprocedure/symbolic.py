@@ -15,7 +15,7 @@ from typing import Any
 
 from robotcell.errors import InputError, RobotcellError
 from robotcell.kinematics.dh import Convention
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["SymbolicArm", "symbolic_arm", "symbolic_link"]
 

@@ -193,7 +193,7 @@ def read_urdf(
     roots = sorted(link for link in links if link not in model.parent_map)
     if base_link is None and len(roots) != 1:
         raise InputError(f"{origin}: the links do not form one tree (root links: "
-                         f"{', '.join(roots)}); give base_link (--base-link)")
+                         f"{', '.join(roots)}); give base_link")
     start = base_link or roots[0]
     path = _path(model, start, tip_link, origin)
     joints: list[UrdfJoint] = []
@@ -205,7 +205,7 @@ def read_urdf(
         if j.type not in _MOVABLE:
             raise InputError(
                 f"{origin}: joint {j.name!r} is {j.type}: a DH chain has revolute, continuous, "
-                "prismatic and fixed joints only; end the chain before it with tip_link (--tip-link)"
+                "prismatic and fixed joints only; end the chain before it with tip_link"
             )
         axis = _finite(j.axis if j.axis is not None else (1.0, 0.0, 0.0), origin, j, "axis xyz")
         axis = axis / max(float(np.abs(axis).max()), 1e-300)  # only the direction counts
@@ -292,7 +292,7 @@ def _path(model: Any, start: str, tip: str | None, origin: str) -> list[Any]:
             names = ", ".join(j for j, _ in children)
             raise InputError(
                 f"{origin}: not a serial chain: link {link!r} branches into joints {names}; "
-                "choose the end of the arm with tip_link (--tip-link)"
+                "choose the end of the arm with tip_link"
             )
         jname, link = children[0]
         out.append(model.joint_map[jname])

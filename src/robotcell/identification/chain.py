@@ -41,8 +41,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.identification.gravity import gravity_torques
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import make_pose, rot_x, rot_y, rot_z
+from robotcell.robot.robot import Robot
 
 __all__ = ["COMPLIANT_JOINTS", "PARALLEL_TOL", "Chain", "Op"]
 

@@ -23,7 +23,7 @@ from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError
 from robotcell.identification.chain import PARALLEL_TOL
 from robotcell.identification.measurements import Measurements, read_measurements
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["axis_lines", "first_estimate", "start_model"]
 
@@ -129,7 +129,7 @@ def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
                 f"joint {j + 1}: no rows move it alone; the circle point analysis needs at least 3 "
                 f"rows that differ only in a{j + 1}, spread over at least "
                 f"{math.degrees(MIN_SPAN):.0f} deg or {MIN_STROKE * 1e3:.0f} mm (or give the nominal "
-                "model with --robot)")
+                "model as robot)")
         fits = []
         for rows in groups:
             # Undo the motion of the axes before j (their lines are known at q = 0).

@@ -45,7 +45,7 @@ from robotcell.ik import analytic_solver
 from robotcell.ik.seeded import SeededSolver
 from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.covariance import ParameterCovariance
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["identify", "identify_with_coupling"]
 

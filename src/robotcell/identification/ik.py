@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 from robotcell.ik import analytic_solver
 from robotcell.ik.result import IKSolutions
 from robotcell.ik.seeded import SeededSolver
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["solve_identified"]
 

@@ -53,8 +53,8 @@ from robotcell.identification.circles import start_model
 from robotcell.identification.engine import identify
 from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import as_points
+from robotcell.robot.robot import Robot
 
 __all__ = ["PositionerCalibration", "calibrate_positioner"]
 

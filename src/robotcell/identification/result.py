@@ -12,7 +12,7 @@ from scipy.stats import chi2
 
 from robotcell.calibration.result import CONDITION_LIMIT, to_jsonable
 from robotcell.io.tables import format_table
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["IdentificationResult", "Parameter"]
 

@@ -18,8 +18,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
 from robotcell.identification.chain import Chain
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import validate_pose
+from robotcell.robot.robot import Robot
 
 __all__ = ["position_covariance", "position_jacobian", "position_sigma"]
 

@@ -26,7 +26,7 @@ from robotcell.errors import InputError
 from robotcell.identification.chain import Chain
 from robotcell.identification.engine import _identifiable, _Problem, identify
 from robotcell.identification.measurements import Measurements
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["CrossValidation", "PoseSelection", "compare_observability", "cross_validate", "observability",
            "select_configurations"]

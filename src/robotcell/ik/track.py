@@ -14,7 +14,7 @@ the lecture; KUKA external axes move along their Z.
 
 :meth:`TrackRobot.as_robot` writes the same system as one 7-joint DH chain whose first, prismatic
 joint slides along ``u`` (a DH frame placed at the track), for numeric IK or anything that takes a
-:class:`~robotcell.kinematics.robot.Robot`.
+:class:`~robotcell.robot.robot.Robot`.
 """
 
 from __future__ import annotations
@@ -203,7 +203,7 @@ class TrackRobot:
         Returns
         -------
         Arm
-            Of the arm's class (a :class:`~robotcell.kinematics.robot.Robot` for a robot); joint
+            Of the arm's class (a :class:`~robotcell.robot.robot.Robot` for a robot); joint
             values ``(x, q1, ..., q6)`` as in :meth:`fk` (controller values; an arm's
             coupling is carried over, extended by the uncoupled track axis); limits ``lower``,
             ``upper`` on x.

@@ -1,8 +1,9 @@
-"""Input and output at the vendor boundary: measurement tables, vendor pose formats, safe file
-writing and controller exports (millimetres and degrees live here, SI inside the library).
+"""Input and output at the vendor boundary: measurement tables, vendor pose formats, YAML and
+safe file writing (millimetres and degrees live here, SI inside the library). Every other package
+stands on it; controller exports are the package :mod:`robotcell.export`, over the cell.
 
 - :mod:`robotcell.io.tables`: CSV measurement tables with named columns;
 - :mod:`robotcell.io.poseformats`: vendor pose conventions (KUKA, ABB, FANUC, YASKAWA);
 - :mod:`robotcell.io.fileio`: reading text and writing files atomically;
-- :mod:`robotcell.io.export`: controller exports and URDF.
+- :mod:`robotcell.io.yamlfile`: YAML read strictly and updated keeping comments.
 """

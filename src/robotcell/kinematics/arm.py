@@ -87,7 +87,7 @@ class Arm:
     """A serial arm: DH joints, base, flange and tool transforms, provenance.
 
     The model the inverse kinematics solvers (:mod:`robotcell.ik`) work on; users build a
-    :class:`~robotcell.kinematics.robot.Robot`, the same model with its inverse kinematics
+    :class:`~robotcell.robot.robot.Robot`, the same model with its inverse kinematics
     (:func:`robotcell.load_robot`, a library name or model file, or directly).
 
     Attributes

@@ -13,7 +13,7 @@ and invertible when every model joint has a motor, and has full column rank ``n 
 joints are passive. Units follow the joints: radians for revolute, metres for prismatic joints, so
 an entry of ``C`` that links a revolute row to a prismatic column is in rad/m.
 
-:class:`Coupling` is the one place that maps between the two: :class:`~robotcell.kinematics.robot.Robot` uses
+:class:`Coupling` is the one place that maps between the two: :class:`~robotcell.robot.robot.Robot` uses
 it for forward kinematics, the Jacobian (chain rule ``J_controller = J_model @ C``) and the limits,
 and the analytic solvers map their model solutions back with :meth:`Coupling.to_controller`.
 """

@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from robotcell.errors import InputError
-from robotcell.io.export import abb as export_abb
-from robotcell.io.export.common import MM_DECIMALS, QUAT_DECIMALS
+from robotcell.export import abb as export_abb
+from robotcell.export.common import MM_DECIMALS, QUAT_DECIMALS
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.programs.config import config_text
 from robotcell.programs.model import Config, Program, ProgramPoint, Ref

@@ -40,7 +40,6 @@ from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.axes import ExternalAxes, external_axes
 from robotcell.programs.config import candidates, config_text, config_values, select
@@ -48,6 +47,7 @@ from robotcell.programs.formats import read_program
 from robotcell.programs.frames import Placement, placement, tool_pose_of
 from robotcell.programs.model import Config, Program, ProgramPoint
 from robotcell.programs.path import table_columns
+from robotcell.robot.robot import Robot
 
 __all__ = ["CheckReport", "CheckedPoint", "check_program", "check_program_file"]
 

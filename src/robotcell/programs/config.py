@@ -34,8 +34,8 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.ik.config import ZERO_TOL, abb_confdata, arm_sides, kuka_status_turn
 from robotcell.ik.limits import TWO_PI
-from robotcell.kinematics.robot import Robot
 from robotcell.programs.model import VENDORS, Config
+from robotcell.robot.robot import Robot
 
 __all__ = ["CONFIG_FIELDS", "candidates", "config_text", "config_values", "configs", "select"]
 

@@ -24,7 +24,7 @@ import re
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS, QUAT_DECIMALS
+from robotcell.export.common import DEG_DECIMALS, MM_DECIMALS, QUAT_DECIMALS
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.programs.config import config_text
 from robotcell.programs.model import Config

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from robotcell.errors import InputError
-from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
+from robotcell.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.programs.config import config_text
 from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref

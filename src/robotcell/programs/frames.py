@@ -3,7 +3,7 @@
 A program names its tool and the frame of its Cartesian points by a number (KUKA ``TOOL_DATA``,
 ``BASE_DATA``; FANUC ``UT``, ``UF``; YASKAWA tool and user frame numbers) or a name (ABB
 ``tooldata``, ``wobjdata``). The numbers and names are the ones the export of the cell writes
-(:func:`robotcell.io.export.common.collect`), so a program and the export of the same cell refer
+(:func:`robotcell.export.common.collect`), so a program and the export of the same cell refer
 to the same data. Each format measures a frame in its own reference (``docs/export.md``): KUKA
 and ABB in the cell's world (a frame on the turntable through the turntable's kinematic, KUKA
 ``EK``, ABB ``ufmec``), FANUC and YASKAWA at the robot base at track position 0 (a frame on the
@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import RESERVED_FRAMES, Cell, Positioner
 from robotcell.cell.kinematics import frame_pose, robot_pose
 from robotcell.errors import InputError
-from robotcell.io.export.common import ControllerData, Slot, collect, flatten_table
+from robotcell.export.common import ControllerData, Slot, collect, flatten_table
 from robotcell.programs.model import Ref
 
 __all__ = ["Placement", "placement", "program_refs", "tool_pose_of"]

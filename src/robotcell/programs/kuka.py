@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from robotcell.errors import InputError
-from robotcell.io.export.common import DEG_DECIMALS, MM_DECIMALS
-from robotcell.io.export.kuka import MACHINE_INDEX
+from robotcell.export.common import DEG_DECIMALS, MM_DECIMALS
+from robotcell.export.kuka import MACHINE_INDEX
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.programs.config import config_text

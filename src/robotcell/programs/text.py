@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 
 from robotcell.errors import InputError
-from robotcell.io.export.common import fmt_num, parse_float
+from robotcell.export.common import fmt_num, parse_float
 from robotcell.io.fileio import read_text
 from robotcell.io.tables import MAX_ABS_VALUE
 

@@ -42,12 +42,12 @@ from robotcell.cell import Cell, Frame, Provenance, Tool, Track, Turntable
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.history import backups
 from robotcell.errors import InputError, RobotcellError
-from robotcell.io.export import EXPORT_FORMATS, export_cell
+from robotcell.export import EXPORT_FORMATS, export_cell
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv, write_csv
-from robotcell.kinematics.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_y
 from robotcell.programs import write_program
+from robotcell.robot.models import load_robot
 from robotcell.studies.demo_accuracy import accuracy_step
 from robotcell.studies.plan import pose_error
 from robotcell.studies.simulate import simulate
@@ -217,7 +217,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
         verdict = done.result.verdict
         if verdict.level == "poor":  # the command refuses to write it (exit 3); so does the demo
             raise InputError(f"{procedure}: poor calibration, nothing written: "
-                             f"{'; '.join(verdict.reasons)}; try a smaller --noise")
+                             f"{'; '.join(verdict.reasons)}; try a smaller noise")
         if procedure == "turntable":
             turntable = cellcal.TurntablePose.from_result(done.result, str(out / "turntable.json"))
         done.cell.save(cell_file)

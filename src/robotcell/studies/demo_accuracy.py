@@ -27,9 +27,9 @@ from robotcell.identification import cross_validate, identify, read_measurements
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import write_csv
-from robotcell.kinematics.models import load_robot
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import make_pose, rot_y
+from robotcell.robot.models import load_robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["TRACKER_NOISE", "accuracy_step", "virtual_arm"]
 

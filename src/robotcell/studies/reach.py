@@ -30,25 +30,27 @@ import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell.ik import ik
 from robotcell.cell.kinematics import tool_pose
+from robotcell.cell.parts import Positioner
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.trackchoice import arm_manipulability
+from robotcell.io.fileio import atomic_write
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
-from robotcell.io.tables import read_csv, require_columns
-from robotcell.kinematics.robot import Robot
+from robotcell.io.tables import read_csv, require_columns, write_columns
+from robotcell.robot.robot import Robot
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
 
-__all__ = ["LIMIT_REF", "ReachMap", "manipulability_scale", "reach_html", "reach_map",
-           "read_targets"]
+__all__ = ["LIMIT_REF", "ReachMap", "manipulability_scale", "reach_columns", "reach_html",
+           "reach_map", "read_targets", "write_reach_map"]
 
 #: Distance to the joint limits (rad) from which a target counts as fully clear of them.
 LIMIT_REF = math.radians(10.0)
@@ -187,6 +189,8 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
         grid = _table_grid(cell, table_samples)
         arr = np.broadcast_to(arr[:, None], (arr.shape[0], grid.size, 4, 4))
         table = np.broadcast_to(grid, arr.shape[:2])
+        if track is not None and np.ndim(track) == 1:  # one position per target: every angle
+            track = np.asarray(track, dtype=float)[:, None]
     sol = ik(cell, arr, frame=frame, track=track, table=table, tool=tool)
     robot = cell.robot
     T_tool = tool_pose(cell, tool)
@@ -296,6 +300,66 @@ def reach_html(rm: ReachMap, points: ArrayLike, title: str = "Reachability map",
             f"<h1>{html.escape(title)}</h1>\n<p>{html.escape(summary)}</p>\n"
             f"<img alt=\"reachability map\" src=\"data:image/png;base64,{png}\">\n"
             "</body></html>\n")
+
+
+def reach_columns(rm: ReachMap, cell: Cell) -> dict[str, NDArray]:
+    """The CSV columns of a reachability map (mm, deg), each in its type.
+
+    The axis columns are named as ``fk --cell`` and ``ik --cell`` name them: ``track`` (mm),
+    ``table`` or a positioner's ``e1..en`` (deg), ``a1..an`` (deg), so the file can be fed to
+    ``robotcell fk --cell CELL --input``. ``target`` and ``branch`` are integers, ``reachable``
+    is ``true``/``false``; ``track_margin_mm`` only for a cell with a track.
+    """
+    pos = cell.turntable
+    names = ([f"e{i + 1}" for i in range(pos.n_axes)] if isinstance(pos, Positioner)
+             else ["table"])
+    table = np.degrees(rm.table).reshape(rm.reachable.size, -1)
+    columns: dict[str, NDArray] = {
+        "target": np.arange(rm.reachable.size), "reachable": rm.reachable.astype(bool),
+        "score": rm.score, "track": rm.track * 1e3,
+        **{name: table[:, i] for i, name in enumerate(names)},
+        "branch": rm.branch.astype(int),
+        **{f"a{i + 1}": np.degrees(rm.q[:, i]) for i in range(cell.robot.n_joints)},
+        "limit_margin_deg": np.degrees(rm.limit_margin),
+    }
+    if cell.track is not None:
+        columns["track_margin_mm"] = rm.track_margin * 1e3
+    columns["manipulability_m3"] = rm.manipulability
+    return columns
+
+
+def write_reach_map(cell: Cell, T: ArrayLike, output: str | Path | TextIO,
+                    html_path: str | Path | None = None, title: str = "Reachability map",
+                    frame: str = "world", tool: str | ArrayLike | None = None,
+                    table: ArrayLike | None = 0.0, track: ArrayLike | None = None,
+                    progress: Callable[[int, int], None] | None = None) -> ReachMap:
+    """:func:`reach_map` of the targets, written as CSV (:func:`reach_columns`) and HTML.
+
+    Parameters
+    ----------
+    cell : Cell
+    T : array_like, shape (N, 4, 4)
+        Targets in ``frame`` (m).
+    output : str or Path or text stream
+        The CSV (written atomically to a path).
+    html_path : str or Path, optional
+        The page of :func:`reach_html`, atomically.
+    title : str
+        Its title.
+    frame, tool, table, track, progress
+        As for :func:`reach_map`.
+
+    Returns
+    -------
+    ReachMap
+    """
+    arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
+    rm = reach_map(cell, arr, frame=frame, tool=tool, table=table, track=track,
+                   progress=progress)
+    write_columns(output, reach_columns(rm, cell), 6)
+    if html_path is not None:
+        atomic_write(html_path, reach_html(rm, arr[:, :3, 3], title=title, frame=frame))
+    return rm
 
 
 def read_targets(path: str | Path, fmt: str = "kuka"

@@ -35,8 +35,8 @@ from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.io.fileio import atomic_write
 from robotcell.kinematics.bounds import within
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
+from robotcell.robot.robot import Robot
 
 __all__ = ["MAX_TOUCHES", "PROCEDURES", "Touches", "check_counts", "simulate"]
 

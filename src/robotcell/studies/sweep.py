@@ -43,7 +43,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
-from robotcell.io.tables import CELL_EXTENT_MM
+from robotcell.io.tables import CELL_EXTENT_MM, write_columns
 from robotcell.io.yamlfile import parse_yaml
 from robotcell.kinematics.transforms import make_pose
 from robotcell.studies.reach import reach_map
@@ -51,7 +51,8 @@ from robotcell.studies.reach import reach_map
 if TYPE_CHECKING:
     from robotcell.cell import Cell
 
-__all__ = ["Layout", "LayoutScore", "apply_layout", "evaluate_layout", "read_layouts", "sweep"]
+__all__ = ["Layout", "LayoutScore", "apply_layout", "evaluate_layout", "ranking_columns",
+           "read_layouts", "sweep"]
 
 _AXES = ("x", "y", "z", "a", "b", "c")
 #: Largest grid a layout file may span: each layout is one reach map of every target.
@@ -245,7 +246,8 @@ def evaluate_layout(cell: Cell, layout: Layout, index: int, T: NDArray[np.float6
 def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
           tool: str | ArrayLike | None = None, table: ArrayLike | None = 0.0,
           executor: Executor | None = None,
-          progress: Callable[[int, int], None] | None = None) -> list[LayoutScore]:
+          progress: Callable[[int, int], None] | None = None,
+          output: str | Path | None = None) -> list[LayoutScore]:
     """Score every layout on the targets and rank them, best first.
 
     Parameters
@@ -263,6 +265,8 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
         ``distributed.Client(address).get_executor()``); default: serially in this process.
     progress : callable, optional
         Called as ``progress(done, total)`` after each finished layout.
+    output : str or Path, optional
+        Also write the ranking as CSV, atomically (:func:`ranking_columns`).
 
     Returns
     -------
@@ -287,4 +291,19 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
             results.append(fut.result())
             if progress:
                 progress(done, total)
-    return sorted(results, key=lambda r: r.key)
+    ranked = sorted(results, key=lambda r: r.key)
+    if output is not None:
+        write_columns(output, ranking_columns(ranked, layouts), 6)
+    return ranked
+
+
+def ranking_columns(ranked: list[LayoutScore], layouts: list[Layout]) -> dict[str, NDArray]:
+    """The CSV columns of a ranking: ``rank``, ``layout`` (its index), the offsets of each
+    component (mm, deg), ``reachable_fraction``, ``mean_score``, ``min_score``."""
+    names = list(layouts[0].values) if layouts else []
+    return {
+        "rank": np.arange(1, len(ranked) + 1), "layout": np.array([r.index for r in ranked]),
+        **{n: np.array([r.layout.values[n] for r in ranked], dtype=float) for n in names},
+        "reachable_fraction": np.array([r.fraction for r in ranked]),
+        "mean_score": np.array([r.mean_score for r in ranked]),
+        "min_score": np.array([r.min_score for r in ranked])}

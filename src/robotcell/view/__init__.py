@@ -8,14 +8,16 @@
 - :mod:`robotcell.view.calibration`: the scene of a calibration result (its touches, the fitted
   geometry, the residuals magnified); :mod:`robotcell.view.identification`: the scene of a
   kinematic identification (the measured targets, the identified arm beside the nominal one).
-- :mod:`robotcell.view.cellscene`: the view of a cell (:func:`cell_figure`);
+- :mod:`robotcell.view.cellscene`: the view of a cell (:func:`cell_figure`, written as a page by
+  :func:`write_cell_view`);
   :mod:`robotcell.view.path`: a path with the arm at each point, on a slider;
   :mod:`robotcell.view.program`: a robot program in it, its bad points marked;
   :mod:`robotcell.view.reach`: a reachability map in the cell.
 
-The names below are imported on first use (PEP 562): the scene and plotting modules sit below
-the cell in the layers (docs/conventions.md), with the calibration reports that use them, and
-importing them must not load the cell. plotly itself is imported only to draw.
+The views stand over the cell and the programs and under the reports (:mod:`robotcell.report`),
+which draw the scenes of results. The names below are imported on first use (PEP 562), so that
+importing a scene or plotting module (for a report) does not load the cell; plotly itself is
+imported only to draw.
 See docs/view.md.
 """
 
@@ -26,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from robotcell.view.calibration import calibration_scene
-    from robotcell.view.cellscene import cell_figure, cell_scene
+    from robotcell.view.cellscene import cell_figure, cell_scene, write_cell_view
     from robotcell.view.identification import identification_scene
     from robotcell.view.path import path_scene
     from robotcell.view.plot import page, scene_figure, write_html
@@ -37,7 +39,7 @@ if TYPE_CHECKING:
 #: public name -> module that defines it
 _LAZY = {
     "calibration_scene": "robotcell.view.calibration",
-    **dict.fromkeys(["cell_figure", "cell_scene"], "robotcell.view.cellscene"),
+    **dict.fromkeys(["cell_figure", "cell_scene", "write_cell_view"], "robotcell.view.cellscene"),
     "identification_scene": "robotcell.view.identification",
     "path_scene": "robotcell.view.path",
     **dict.fromkeys(["page", "scene_figure", "write_html"], "robotcell.view.plot"),
@@ -49,7 +51,8 @@ _LAZY = {
 
 __all__ = ["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads", "calibration_scene",
            "cell_figure", "cell_scene", "identification_scene", "page", "path_scene",
-           "program_scene", "read_reach", "scene_figure", "write_html", "write_program_view"]
+           "program_scene", "read_reach", "scene_figure", "write_cell_view", "write_html",
+           "write_program_view"]
 
 
 def __getattr__(name: str) -> Any:

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 from robotcell.view.scene import Arrows, Lines, Triads, pose_text
 
 __all__ = ["ChainPose", "chain_items", "chain_pose"]

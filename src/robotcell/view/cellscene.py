@@ -23,6 +23,7 @@ Rx(c)``).
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,11 +32,11 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import Cell, Positioner
 from robotcell.cell.kinematics import robot_pose
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import finite_array
+from robotcell.robot.robot import Robot
 from robotcell.view.arm import chain_items
-from robotcell.view.plot import scene_figure
-from robotcell.view.reach import ReachLike, reach_points
+from robotcell.view.plot import scene_figure, write_html
+from robotcell.view.reach import ReachLike, reach_points, read_reach
 from robotcell.view.scene import Item, Lines, Scene, Triads, pose_text
 from robotcell.view.shapes import disk
 
@@ -43,7 +44,7 @@ if TYPE_CHECKING:
     import plotly.graph_objects as go
 
 __all__ = ["axes_text", "cell_figure", "cell_items", "cell_scene", "degrees", "fixed_items",
-           "frame_size", "joint_values"]
+           "frame_size", "joint_values", "write_cell_view"]
 
 #: Margin of the drawn plate beyond the farthest frame it carries (m).
 PLATE_MARGIN = 0.1
@@ -264,3 +265,31 @@ def cell_figure(cell: Cell, joints: ArrayLike | None = None, track: float = 0.0,
     plotly.graph_objects.Figure
     """
     return scene_figure(cell_scene(cell, joints, track, table, reach, tool))
+
+
+def write_cell_view(cell: Cell, path: str | Path, joints: ArrayLike | None = None,
+                    track: float = 0.0, table: ArrayLike = 0.0,
+                    reach: ReachLike | str | Path | None = None,
+                    tool: str | ArrayLike | None = None) -> Path:
+    """Write the interactive 3D view of a cell as one self-contained HTML page, atomically.
+
+    Parameters
+    ----------
+    cell : Cell
+    path : str or Path
+        The HTML file.
+    joints, track, table, tool
+        As for :func:`cell_scene` (rad, m).
+    reach : ReachLike or str or Path, optional
+        A reachability map, or the CSV of one (:func:`robotcell.view.reach.read_reach`), whose
+        reached targets are drawn.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    if isinstance(reach, (str, Path)):
+        reach = read_reach(reach, cell)
+    figure = cell_figure(cell, joints, track, table, reach, tool)
+    return write_html(figure, path, title=f"{cell.name}: robotcell view")

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
 from robotcell.identification.result import IdentificationResult
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 from robotcell.view.arm import ChainPose, chain_pose
 from robotcell.view.calibration import DECIMALS, LABELLED
 from robotcell.view.scene import Item, Lines, Scene, Triads

@@ -65,8 +65,8 @@ from robotcell.cell.validation import check_axis_limits
 from robotcell.errors import IllPosedError, InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import require_columns
-from robotcell.kinematics.robot import Robot
 from robotcell.kinematics.transforms import invert, transform_points, validate_pose
+from robotcell.robot.robot import Robot
 
 __all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "positioner",
            "positioner_touches", "tcp", "track", "turntable", "workpiece"]

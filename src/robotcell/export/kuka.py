@@ -30,7 +30,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.io.export.common import (
+from robotcell.export.common import (
     DEG_DECIMALS,
     MM_DECIMALS,
     ControllerData,

@@ -3,7 +3,7 @@
 ``export_cell(cell, "kuka")`` returns the text (``"urdf"``: the cell as a URDF kinematic tree, for
 ROS tools, not a controller format); ``export_files(cell, fmt, path)`` writes it (and, for the
 URDF of an identified Universal Robots arm, the UR description's calibration file beside it); ``parse_export(text, "kuka")`` reads it back into
-:class:`~robotcell.io.export.common.ControllerData` (poses in metres). Formats, units, reference
+:class:`~robotcell.export.common.ControllerData` (poses in metres). Formats, units, reference
 frames and sources: ``docs/export.md``.
 """
 
@@ -14,9 +14,9 @@ from types import ModuleType
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.io.export import abb, fanuc, kuka, urdf, yaskawa
-from robotcell.io.export.common import ControllerData, Slot
-from robotcell.io.export.ur import cell_ur_kinematics
+from robotcell.export import abb, fanuc, kuka, urdf, yaskawa
+from robotcell.export.common import ControllerData, Slot
+from robotcell.export.ur import cell_ur_kinematics
 from robotcell.io.fileio import atomic_write, check_destination
 
 __all__ = ["EXPORT_FORMATS", "WRITE_FORMATS", "ControllerData", "Slot", "export_cell",
@@ -53,7 +53,7 @@ def export_files(cell: Cell, fmt: str, output: str | Path) -> list[Path]:
     """Write the export of ``cell`` to ``output`` (atomically), and what goes with it.
 
     The URDF of a cell whose identified arm is a Universal Robots arm comes with the UR
-    description's calibration file (:func:`robotcell.io.export.ur.ur_kinematics`), written to
+    description's calibration file (:func:`robotcell.export.ur.ur_kinematics`), written to
     :func:`ur_kinematics_path` of ``output``, so that the UR description (and MoveIt) build the
     arm as it is.
 

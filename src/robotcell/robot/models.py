@@ -31,7 +31,7 @@ from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.io.yamlfile import dump_yaml, parse_yaml
 from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.covariance import ParameterCovariance, parameter_kind
-from robotcell.kinematics.robot import Joint, Robot
+from robotcell.robot.robot import Joint, Robot
 
 __all__ = ["list_robots", "load_robot", "robot_from_dict", "robot_to_dict", "save_robot"]
 

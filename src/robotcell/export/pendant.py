@@ -5,8 +5,8 @@ deg), with comment lines around them. FANUC and YASKAWA write the same layout an
 the wording held by :class:`PendantListing`: line keys, comment marker, field names (from
 :data:`robotcell.io.poseformats.FORMATS`) and the names of the reference frame, the track and the
 turntable axis. Both refer the frames to the robot base at track position 0
-(:func:`robotcell.io.export.common.collect` with ``reference="robot"``) and have no frames on a
-turntable (:func:`robotcell.io.export.common.flatten_table`).
+(:func:`robotcell.export.common.collect` with ``reference="robot"``) and have no frames on a
+turntable (:func:`robotcell.export.common.flatten_table`).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.errors import InputError
-from robotcell.io.export.common import (
+from robotcell.export.common import (
     DEG_DECIMALS,
     MM_DECIMALS,
     ControllerData,

@@ -51,7 +51,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.cell import Cell, Turntable
 from robotcell.cell.axischain import axis_frames
 from robotcell.errors import InputError
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["chain_elements", "export", "urdf_origin"]
 

@@ -7,7 +7,7 @@ interactive 3D scene of them (:mod:`robotcell.view.identification`: the measured
 residuals magnified, the identified arm beside the nominal one), the K-fold cross-validated
 error, the parameters held and why, every parameter with its 1-sigma and the largest
 correlations, and the observability index O1 of the measured configurations against random
-ones. Figures are PNG ``data:`` URIs made with the helpers of :mod:`robotcell.report`, the scene
+ones. Figures are PNG ``data:`` URIs made with the helpers of :mod:`robotcell.report.calibration`, the scene
 a plotly figure with plotly.js inlined (matplotlib and plotly imported only when a report is
 written).
 """
@@ -25,7 +25,7 @@ from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
-from robotcell.report import _CSS, _SCRIPT, SCENE_SLOT, _fmt, _png, scene_figure
+from robotcell.report.calibration import _CSS, _SCRIPT, SCENE_SLOT, _fmt, _png, scene_figure
 from robotcell.view.identification import identification_scene
 from robotcell.view.plot import MAX_PAGE_BYTES
 

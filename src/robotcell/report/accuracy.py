@@ -4,7 +4,7 @@ One self-contained page (``robotcell compensate ... --report FILE.html``, ``robo
 compensate ... --report FILE.html``): per point the predicted TCP error without filtering (the
 identified arm at the joints the controller computes for the point as written, against it), the
 correction, and the 1-sigma of the filtered position from the identification's covariance, as a
-figure and a table. Figures are PNG ``data:`` URIs (:mod:`robotcell.report`; matplotlib imported
+figure and a table. Figures are PNG ``data:`` URIs (:mod:`robotcell.report.calibration`; matplotlib imported
 only when a report is written).
 """
 
@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robotcell.identification.report import _pyplot, _table
 from robotcell.io.fileio import atomic_write
-from robotcell.report import _CSS, _SCRIPT, _png
+from robotcell.report.calibration import _CSS, _SCRIPT, _png
+from robotcell.report.identification import _pyplot, _table
 
 __all__ = ["write_accuracy_report"]
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
-from robotcell.io.export.common import (
+from robotcell.export.common import (
     MM_DECIMALS,
     QUAT_DECIMALS,
     ControllerData,

@@ -44,7 +44,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.kinematics.dh import link_transform
-from robotcell.kinematics.robot import Robot
+from robotcell.robot.robot import Robot
 
 __all__ = ["SEGMENTS", "cell_ur_kinematics", "is_ur_arm", "ur_kinematics", "ur_origins"]
 

@@ -13,8 +13,8 @@ one more user frame, the next free number. See ``docs/export.md``.
 from __future__ import annotations
 
 from robotcell.cell import Cell
-from robotcell.io.export.common import ControllerData, collect
-from robotcell.io.export.pendant import PendantListing, format_listing, parse_pendant_listing
+from robotcell.export.common import ControllerData, collect
+from robotcell.export.pendant import PendantListing, format_listing, parse_pendant_listing
 
 __all__ = ["LISTING", "export", "format_data", "parse"]
 

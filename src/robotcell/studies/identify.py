@@ -1,0 +1,184 @@
+"""The identification of an arm or positioner from a measurement file, as one call.
+
+:func:`identify_file` reads the measurements, builds or loads the nominal model, identifies (with
+a stated J2/J3 coupling or not), cross-validates, compares the observability of the measured
+configurations with random ones for the report, computes the joint zero offsets for a controller,
+and writes the identified model file, the HTML report and the cell's ``robot.identified``. The
+command ``robotcell identify`` prints what it returns.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+from robotcell.cell import Cell
+from robotcell.cell.identified import adopt_identified, identification_provenance
+from robotcell.errors import InputError
+from robotcell.identification import identify, identify_with_coupling, read_measurements
+from robotcell.identification.circles import first_estimate
+from robotcell.identification.offsets import JointOffset, joint_offsets
+from robotcell.identification.result import IdentificationResult
+from robotcell.identification.validation import (
+    CrossValidation,
+    compare_observability,
+    cross_validate,
+)
+from robotcell.report.identification import write_identification_report
+from robotcell.robot.models import load_robot, save_robot
+
+__all__ = ["IdentificationRun", "controller_offsets", "identify_file"]
+
+#: Folds of the cross-validation a report or a cell's provenance asks for when none is given.
+DEFAULT_FOLDS = 5
+
+
+def controller_offsets(offsets: list[JointOffset], vendor: Literal["kuka", "abb"]
+                       ) -> dict[str, Any]:
+    """Joint zero offsets in the controller's units: KUKA deg (mm), ABB rad (m).
+
+    Parameters
+    ----------
+    offsets : list of JointOffset
+        :func:`~robotcell.identification.offsets.joint_offsets` (rad, m).
+    vendor : {"kuka", "abb"}
+
+    Returns
+    -------
+    dict
+        ``{"controller": vendor, "axes": [{"axis", "delta", "sigma", "unit", "why"}, ...]}``.
+    """
+    rows = []
+    for o in offsets:
+        f = (1e3 if o.prismatic else 180 / math.pi) if vendor == "kuka" else 1.0
+        unit = (("mm" if o.prismatic else "deg") if vendor == "kuka"
+                else ("m" if o.prismatic else "rad"))
+        rows.append({"axis": o.axis, "delta": o.delta * f, "sigma": o.sigma * f, "unit": unit,
+                     "why": o.why})
+    return {"controller": vendor, "axes": rows}
+
+
+@dataclass(frozen=True)
+class IdentificationRun:
+    """What :func:`identify_file` did.
+
+    Attributes
+    ----------
+    result : IdentificationResult
+    cross : CrossValidation or None
+        The cross-validation, when asked for (``folds``, a report or a cell).
+    folds : int or None
+        Its number of folds.
+    offsets : dict or None
+        :func:`controller_offsets` of the result, when ``offsets_for`` was given.
+    written : bool
+        Whether the model file (and the cell) was written.
+    """
+
+    result: IdentificationResult
+    cross: CrossValidation | None
+    folds: int | None
+    offsets: dict[str, Any] | None
+    written: bool
+
+    @property
+    def cross_stats(self) -> dict[str, float] | None:
+        """Held-out errors (mm) of the cross-validation (:meth:`CrossValidation.stats`)."""
+        return None if self.cross is None else self.cross.stats()
+
+    def to_json(self) -> dict[str, Any]:
+        """The result's JSON (mm, deg) with the cross-validation and the joint offsets."""
+        data = self.result.to_json()
+        if self.cross is not None:
+            data["cross_validation"] = {"folds": self.folds, **self.cross_stats}
+        if self.offsets is not None:
+            data["joint_offsets"] = self.offsets
+        return data
+
+
+def identify_file(measurements: str | Path, robot: str | Path | None = None,
+                  cell: str | Path | None = None, j23_factor: float | None = None,
+                  point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
+                  scale: bool = False, compliance: bool = False, folds: int | None = None,
+                  report: str | Path | None = None, offsets_for: Literal["kuka", "abb"] | None = None,
+                  output: str | Path | None = None, force: bool = False) -> IdentificationRun:
+    """Identify the kinematic model of an arm or positioner from a measurement CSV.
+
+    Parameters
+    ----------
+    measurements : str or Path
+        CSV of joint values and measured targets (docs/identification.md).
+    robot : str or Path, optional
+        Nominal model (library name or model file). Without it and without ``cell`` the circle
+        point analysis builds the start model.
+    cell : str or Path, optional
+        A cell file: its ``robot.model`` is the nominal when ``robot`` is not given, and the
+        identified model written to ``output`` becomes its ``robot.identified``.
+    j23_factor : float, optional
+        A stated J2/J3 coupling ``q3_model = J3 + k J2``.
+    point_sigma : float
+        Accuracy of a measured coordinate (m).
+    angle_sigma : float
+        Accuracy of a measured orientation (rad).
+    scale, compliance : bool
+        Also identify a scale per axis; the gravity compliance of axes 2 and 3.
+    folds : int, optional
+        Folds of a cross-validation; with a report or a cell and none given,
+        ``min(5, rows)``.
+    report : str or Path, optional
+        HTML report to write.
+    offsets_for : {"kuka", "abb"}, optional
+        Also compute the joint zero offsets in that controller's units.
+    output : str or Path, optional
+        Identified model file (YAML) to write, unless the verdict is poor and not ``force``.
+    force : bool
+        Write ``output`` even when the verdict is poor.
+
+    Returns
+    -------
+    IdentificationRun
+
+    Raises
+    ------
+    InputError
+        ``cell`` without ``output``; ``offsets_for`` without a nominal ``robot``; bad measurements.
+    """
+    if cell is not None and output is None:
+        raise InputError("cell needs output: the identified model file the cell will name")
+    if offsets_for is not None and robot is None:
+        raise InputError("offsets_for needs robot (the nominal model): the offsets correct the "
+                         "nominal model the controller uses")
+    options: dict[str, Any] = {"point_sigma": point_sigma, "angle_sigma": angle_sigma,
+                               "scale": scale, "compliance": compliance}
+    if robot is not None or cell is not None:
+        nominal = load_robot(robot) if robot is not None else Cell.load(cell).nominal_robot
+        meas = read_measurements(measurements, nominal.prismatic)
+    else:
+        nominal, meas = first_estimate(measurements, j23_factor=j23_factor or 0.0)
+    if j23_factor is not None:
+        result = identify_with_coupling(nominal, meas, j23_factor, **options)
+    else:
+        result = identify(nominal, meas, **options)
+    cross = None
+    if (report is not None or cell is not None) and folds is None:
+        folds = min(DEFAULT_FOLDS, meas.n_rows)
+    if folds is not None:
+        if j23_factor is not None:
+            options["coupling"] = j23_factor
+        cross = cross_validate(nominal, meas, folds=folds, **options)
+    if report is not None:
+        obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
+                                    pose=meas.rotations is not None, point_sigma=point_sigma,
+                                    angle_sigma=angle_sigma)
+        write_identification_report(result, report, cross, obs, meas)
+    offsets = (None if offsets_for is None
+               else controller_offsets(joint_offsets(result), offsets_for))
+    written = output is not None and (result.verdict[0] != "poor" or force)
+    if written:
+        if cell is None:
+            save_robot(result.robot, output)
+        else:
+            adopt_identified(cell, result, output, identification_provenance(result, cross))
+    return IdentificationRun(result, cross, folds, offsets, written)
