@@ -144,7 +144,7 @@ def test_library_errors_name_the_cause():
     truth, nominal = demo_cells()
     table = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch").to_table()
     with pytest.raises(InputError, match=r"measurements: column 'track' \(track position of each "
-                                         r"touch\) needs --cell CELL.yaml \(in Python: a Cell\)"):
+                                         r"touch\) needs a cell \(parameter cell\)"):
         cellcal.frame(None, {**table, "track": np.ones(len(table["a1"])) * 1000,
                              "point": ["origin"] * len(table["a1"])}, robot=nominal.robot)
     with pytest.raises(InputError, match=r"give a cell or a robot, not both"):
@@ -166,7 +166,8 @@ def test_joint_value_touches_in_a_cell_with_tools_need_the_tool_said():
     truth, nominal = demo_cells()
     table = simulate(truth, "turntable", noise=1e-4, seed=3, tool="torch").to_table()
     with pytest.raises(InputError, match=r"touches given as joint values: say which tool "
-                                         r"touched, --tool NAME \(the cell has: torch\)"):
+                                         r"touched, tool=NAME \(the cell has: torch\), or "
+                                         r"tool=numpy.eye\(4\) for the bare flange"):
         cellcal.turntable(nominal, table)
     flange = cellcal.turntable(nominal, table, tool=np.eye(4))  # said: the bare flange
     assert flange.result.verdict.level == "poor"  # and the flange did not touch: the fit says so

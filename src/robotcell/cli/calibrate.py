@@ -23,13 +23,11 @@ import click
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
-from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
-from robotcell.cli.common import check_kind, check_output, parse_numbers, read_csv, write_output
+from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
@@ -231,12 +229,6 @@ def require_name(name: str | None, target: CellTarget | None, what: str) -> None
                          f"to (existing: {known})")
 
 
-def refuse_track_column(cols: dict, source: str, why: str) -> None:
-    """Refuse column ``track`` where it is not used; ``why`` says what to do instead."""
-    if "track" in cols:
-        raise InputError(f"{source}: column 'track' (track position of each touch) {why}")
-
-
 def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | None = None
                    ) -> tuple[Robot | None, str | np.ndarray | None]:
     """The robot model and the tool for joint-value input.
@@ -360,9 +352,8 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     require_name(name, target, "tool")
     prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None, target)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     cell, label = cell_of(target)
-    out = cellcal.tcp(cell, cols, name, robot=None if cell else model, world_mode=world_mode,
+    out = cellcal.tcp(cell, measurements, name, robot=None if cell else model, world_mode=world_mode,
                       sigma=prior, source=measurements, cell_label=label, on_note=echo_note,
                       **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
@@ -406,10 +397,8 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
                          "CELL.yaml")
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track", "nominal_x",
-                                                        "nominal_y", "nominal_z"])
     cell, label = cell_of(target)
-    out = cellcal.frame(cell, cols, name, parent=parent, robot=None if cell else model,
+    out = cellcal.frame(cell, measurements, name, parent=parent, robot=None if cell else model,
                         tool=T_tool, sigma=prior, source=measurements, cell_label=label,
                         on_note=echo_note, **chain_options(measurements))
     gate(out.result, as_json, accept_poor)
@@ -435,23 +424,12 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     Example:
       robotcell calibrate external-tcp gun.csv --robot kuka_kr16 --tool 250,0,0,0,0,0
     """
-    from robotcell.calibration.frame import external_tcp
-
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
-    refuse_track_column(cols, measurements, "is not used by 'calibrate external-tcp': touch the "
-                        "fixed tool with the track at one position and remove the column")
-    p = tcp_positions(cols, measurements, model, T_tool)
-    if "point" in cols:
-        roles = [str(v).strip().lower() for v in cols["point"]]
-    else:
-        roles = ["tcp"] * len(p)
-    for note in repeat_notes(cols, POSE_COLUMNS, measurements):
-        echo_note(note)
-    result = external_tcp(p, roles, prior, line_labels(len(roles), roles))
-    gate(result, as_json, accept_poor)
-    emit(result, as_json)
+    out = cellcal.external_tcp(None, measurements, robot=model, tool=T_tool, sigma=prior,
+                               source=measurements, on_note=echo_note)
+    gate(out.result, as_json, accept_poor)
+    emit(out.result, as_json)
 
 
 @calibrate.command("cell")
