@@ -15,6 +15,8 @@ import pytest
 from cli_helpers import run
 
 from robotcell.cell import Cell, Positioner
+from robotcell.cli.terms import CLI_TERMS
+from robotcell.errors import terms
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "cell_kr16_positioner.yaml"
@@ -327,11 +329,12 @@ def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, 
     code, out, err = run(capsys, "calibrate", "positioner", csv, "--cell", cli_file, "--tool",
                          "pointer", "--json")
     assert code == 0, err
-    got = cellcal.positioner(Cell.load(EXAMPLE), read_csv(csv), tool="pointer", source=str(csv),
-                             file=csv)
-    got.cell.save(lib_file)
-    assert cli_file.read_bytes() == lib_file.read_bytes()
-    assert json.loads(out) == got.result.to_json()
+    with terms(CLI_TERMS):  # the library's messages in the command line's words
+        got = cellcal.positioner(Cell.load(EXAMPLE), read_csv(csv), tool="pointer",
+                                 source=str(csv), file=csv)
+        got.cell.save(lib_file)
+        assert cli_file.read_bytes() == lib_file.read_bytes()
+        assert json.loads(out) == got.result.to_json()
     assert "T_world_B" in got.result.values and "T_R_B" not in got.result.values
 
 

@@ -504,8 +504,9 @@ class CalibrationResult:
     def _noise_line(self) -> str:
         """The touch accuracy, the residuals' check against it and the noise the 1-sigma uses."""
         s = self.touch_sigma * 1e3
-        text = (f"{s:.3f} mm per coordinate, as given (--sigma)" if self.accuracy_source == "stated"
-                else f"{s:.3f} mm per coordinate, the default (state yours with --sigma)")
+        given = term("sigma", "sigma")
+        text = (f"{s:.3f} mm per coordinate, as given ({given})" if self.accuracy_source == "stated"
+                else f"{s:.3f} mm per coordinate, the default (state yours with {given})")
         if self.chi2 is None or not math.isfinite(self.residual_sigma):
             return text + "; no redundant touches check it"
         text += (f"; the residuals need {self.residual_sigma * 1e3:.3f} mm (chi-square "

@@ -12,6 +12,9 @@ __all__ = ["CLI_TERMS"]
 #: Key of a message's input (see the calls of :func:`robotcell.errors.term`) to the options.
 CLI_TERMS = {
     "the calibration": "this command",
+    "sigma": "--sigma",
+    "nominal": "--nominal-accuracy",
+    "tool": "--tool",
     "tool=NAME": "--tool NAME",
     "tool=flange": "--tool 0,0,0,0,0,0",
     "tool=X,Y,Z,A,B,C": "--tool X,Y,Z,A,B,C",
