@@ -317,6 +317,19 @@ def gate(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool,
                           "measurements, or pass --accept-poor to use the result anyway")
 
 
+def finish(out: cellcal.CellCalibration, target: CellTarget | None, as_json: bool,
+           accept_poor: bool) -> None:
+    """The end of a calibration command: :func:`gate`, the cell file saved (with ``--cell``),
+    what the calibration assumed on stderr (``assumed: tool ..., result ... in frame ...,
+    track ..., table ...``), and the result (:func:`emit`)."""
+    gate(out.result, as_json, accept_poor)
+    if out.cell is not None and target is not None:
+        target.save(out.cell, out.item, out.update_notes)
+    if out.assumed:
+        click.echo(f"assumed: {out.assumed}", err=True)
+    emit(out.result, as_json)
+
+
 @calibrate.command("tcp")
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--world", "world_mode", type=click.Choice(["6d", "5d"]), default="6d",
@@ -356,10 +369,7 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     out = cellcal.tcp(cell, measurements, name, robot=None if cell else model, world_mode=world_mode,
                       sigma=prior, source=measurements, cell_label=label, on_note=echo_note,
                       **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @calibrate.command("frame")
@@ -401,10 +411,7 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
     out = cellcal.frame(cell, measurements, name, parent=parent, robot=None if cell else model,
                         tool=T_tool, sigma=prior, source=measurements, cell_label=label,
                         on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @calibrate.command("external-tcp")
@@ -428,8 +435,7 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     model, T_tool = robot_and_tool(robot, tool)
     out = cellcal.external_tcp(None, measurements, robot=model, tool=T_tool, sigma=prior,
                                source=measurements, on_note=echo_note)
-    gate(out.result, as_json, accept_poor)
-    emit(out.result, as_json)
+    finish(out, None, as_json, accept_poor)
 
 
 @calibrate.command("cell")
@@ -472,8 +478,8 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
 # A module listed here is imported only when its subcommand is used; an entry whose module does
 # not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m, gate, emit, and for --cell cell_option, CellTarget, cell_of and echo_note, from this
-# module.
+# sigma_m, gate, emit, finish, and for --cell cell_option, CellTarget, cell_of and echo_note, from
+# this module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",

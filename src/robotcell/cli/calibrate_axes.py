@@ -19,8 +19,7 @@ from robotcell.cli.calibrate import (
     cell_option,
     chain_options,
     echo_note,
-    emit,
-    gate,
+    finish,
     measurement_options,
     require_name,
     robot_and_tool,
@@ -73,10 +72,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
                         robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
                         source=measurements, cell_label=label, on_note=echo_note,
                         **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @click.command("turntable", cls=Command)
@@ -112,10 +108,7 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     out = cellcal.turntable(cell, measurements, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
                             cell_label=label, on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @click.command("positioner", cls=Command)
@@ -146,10 +139,7 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     out = cellcal.positioner(cell, measurements, robot=None if cell else model, tool=T_tool,
                              sigma=sigma_m(sigma), source=measurements, cell_label=label,
                              on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @click.command("workpiece", cls=Command)
@@ -188,7 +178,4 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     out = cellcal.workpiece(cell, measurements, name, turntable=given, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
                             cell_label=label, on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
