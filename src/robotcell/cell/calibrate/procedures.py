@@ -757,6 +757,21 @@ def _table_touches(cell: Cell | None, m: Measurements, f: NDArray[np.float64],
     return f
 
 
+def _on_table(cell: Cell | None, m: Measurements, tool: str | ArrayLike | None, label: str,
+              nominal: NominalAccuracy, notes: _Notes, check: Callable[[], None]
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64], Chained]:
+    """Touches of a point on a turntable: its angles (rad), the touches in its parent frame
+    (m) and the inputs they rest on; ``check`` refuses what the procedure cannot use once the
+    angles are within the table's limits."""
+    f_R = m.tcp(tool_transform(cell, tool, m))
+    theta = m.axes[:, 0]
+    if cell is not None:
+        check_axis_limits(cell.turntable, theta, ["e1"], m.source, label)
+    check()
+    f = _table_touches(cell, m, f_R, label)
+    return theta, f, _chained(cell, m, f_R, tool, _world_track(cell, m), nominal, notes)
+
+
 def _world_track(cell: Cell | None, m: Measurements) -> NDArray[np.float64] | None:
     """Track positions of touches mapped to the world through the track of a turntable cell."""
     if not _in_world(cell):
@@ -941,13 +956,7 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     parent = _cell_turntable(cell, label).parent if cell is not None else None
     notes = _Notes(on_note)
     m = read_touches("turntable", measurements, source, _arm(cell, robot), notes.one)
-    f_R = m.tcp(tool_transform(cell, tool, m))
-    theta = m.axes[:, 0]
-    if cell is not None:
-        check_axis_limits(cell.turntable, theta, ["e1"], m.source, label)
-    m.check_count()
-    f = _table_touches(cell, m, f_R, label)
-    chained = _chained(cell, m, f_R, tool, _world_track(cell, m), nominal, notes)
+    theta, f, chained = _on_table(cell, m, tool, label, nominal, notes, m.check_count)
     result = calibrate_turntable(theta, f, height=height, labels=m.labels(),
                                  prior_sigma=sigma, inputs=chained.inputs)
     key = "T_world_B" if parent == "world" else "T_R_B"
@@ -1089,13 +1098,7 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
     tt, where = _workpiece_turntable(cell, turntable, label, nominal)
     notes.add(where)
     m = read_touches("workpiece", measurements, source, model, notes.one)
-    f_R = m.tcp(tool_transform(cell, tool, m))
-    theta = m.axes[:, 0]
-    if cell is not None:
-        check_axis_limits(cell.turntable, theta, ["e1"], m.source, label)
-    m.check_points()
-    f = _table_touches(cell, m, f_R, label)
-    chained = _chained(cell, m, f_R, tool, _world_track(cell, m), nominal, notes)
+    theta, f, chained = _on_table(cell, m, tool, label, nominal, notes, m.check_points)
     result = calibrate_workpiece(theta, f, m.point, tt.T, T_R_B_covariance=tt.covariance,
                                  inputs=chained.inputs, prior_sigma=sigma,
                                  labels=m.labels(points=True))
