@@ -10,6 +10,7 @@ from cli_helpers import run
 
 from robotcell.calibration import spec
 from robotcell.calibration.measurements import read_measurements
+from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.studies.simulate import simulate
@@ -69,3 +70,5 @@ def test_the_minimum_is_the_specs(monkeypatch, touches):
     m = read_measurements("turntable", touches.to_table(), "t.csv", cell.robot)
     with pytest.raises(InputError, match=r"t.csv: touches: 6 given, at least 7 needed"):
         m.check_count()
+    with pytest.raises(InputError, match=r"touches: 6 given, at least 7 needed at different"):
+        calibrate_turntable(m.axes[:, 0], m.tcp(cell.tools[touches.tool].T_F_TCP))

@@ -38,6 +38,7 @@ from robotcell.calibration.fitting import (
 )
 from robotcell.calibration.propagate import jacobian, propagate
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, fit_fields
+from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError, term
 from robotcell.kinematics.transforms import as_points, make_pose
@@ -275,8 +276,9 @@ def calibrate_track(
     if not np.all(np.isfinite(e)):
         raise InputError("track positions contain NaN or infinite values")
     n = len(f)
-    if n < 3:
-        raise InputError(f"touches: {n} given, at least 3 needed (3 touches at different track "
+    if n < SPECS["track"].minimum:
+        raise InputError(f"touches: {n} given, at least {SPECS['track'].minimum} needed (3 "
+                         "touches at different track "
                          "positions give the direction and a straightness check; use 5 or more)")
     d = _axis_vector(axis)
     if roll not in (None, "zero"):
