@@ -224,5 +224,5 @@ def test_external_tcp_is_a_cell_calibration_call():
     np.testing.assert_allclose(out.result.values["T_R_TCP"], T_R_X, atol=2e-3)
     assert out.cell is None and out.value == "T_R_TCP"
     with pytest.raises(InputError, match=r"measurements: column 'track' \(track position of each "
-                                         r"touch\) is not used by 'calibrate external-tcp'"):
+                                         r"touch\) is not used by the external-tcp calibration"):
         cellcal.external_tcp(None, {**table, "track": np.zeros(6)})

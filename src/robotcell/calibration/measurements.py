@@ -292,7 +292,8 @@ def read_measurements(procedure: Procedure | str, cols: Columns, source: str,
         note(unused)
     for name, why in spec.unused.items():
         if name in cols:
-            raise InputError(f"{source}: column '{name}' {why}")
+            procedure = term(f"calibrate {spec.name}", f"the {spec.name} calibration")
+            raise InputError(f"{source}: column '{name}' {why.format(procedure=procedure)}")
     touches = _touches(cols, source, spec.pose, robot)
     n = len(next(v for v in touches.values() if v is not None))
     axes = spec.role("axis")

@@ -96,7 +96,8 @@ class Procedure:
         Only touches of this point count.
     unused : mapping of str to str
         Columns the procedure refuses rather than ignores, each with the rest of the message
-        after ``column 'NAME'`` (what it is and why it is refused).
+        after ``column 'NAME'`` (what it is and why it is refused; ``{procedure}`` stands for
+        the procedure as the caller names it).
     """
 
     name: str
@@ -168,13 +169,13 @@ _SPECS = {
         "external-tcp", "tcp", (_point("tcp, x or xy"),), points=("tcp", "x", "xy"),
         default_point="tcp", counted_point="tcp", counted="touches of the fixed TCP",
         unused=MappingProxyType({"track": (
-            "(track position of each touch) is not used by 'calibrate external-tcp': touch the "
+            "(track position of each touch) is not used by {procedure}: touch the "
             "fixed tool with the track at one position and remove the column")})),
     "track": Procedure(
         "track", "tcp", (Column("e1", "axis", "mm", "track position at each touch"),
                          _point("number 1..K of the reference point touched", "reference")),
         unused=MappingProxyType({"track": (
-            "(track position of each touch) is not used by 'calibrate track': its track "
+            "(track position of each touch) is not used by {procedure}: its track "
             "positions are column e1")})),
     "turntable": Procedure(
         "turntable", "tcp", (Column("e1", "axis", "deg", _E1_TABLE, 4, "table"),

@@ -25,6 +25,8 @@ CLI_TERMS = {
     "cell (Cell)": "--cell (in Python: a Cell)",
     "with cell": "with --cell",
     "calibrate workpiece": "'robotcell calibrate workpiece'",
+    "calibrate external-tcp": "'calibrate external-tcp'",
+    "calibrate track": "'calibrate track'",
     "calibrate turntable --cell": "calibrate turntable --cell",
     "parent=world": "--parent world",
     "parent=robot": "--parent robot",
