@@ -73,7 +73,7 @@ def test_one_rule_for_terminal_json_and_report(tmp_path):
     assert v.level == "good" and j["verdict"] == v.to_json() == verdict(j).to_json()
     assert r.summary().splitlines()[-1] == v.line() == (
         f"verdict: GOOD: RMS {r.rms * 1e3:.3f} mm within the default touch accuracy 0.5 mm "
-        f"(state yours with --sigma), condition number {r.condition:.1f}, no warnings")
+        f"(state yours with sigma), condition number {r.condition:.1f}, no warnings")
     assert f"condition number: {r.condition:.1f} (below 100" in r.summary()
     # The HTML report calls the same function: same level, same reasons, same condition number.
     assert report_verdict(j) == (v.level, v.reasons)

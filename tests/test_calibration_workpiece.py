@@ -156,4 +156,4 @@ def test_three_points_rest_on_the_stated_accuracy_and_carry_the_turntable_source
                                named.covariance, atol=1e-20)
     default = calibrate_workpiece(theta, f, roles, T_R_B)
     assert default.noise_source == "default" and default.noise_sigma == pytest.approx(5e-4)
-    assert "the default (state yours with --sigma)" in default.summary()
+    assert "the default (state yours with sigma)" in default.summary()

@@ -12,8 +12,10 @@ from cli_helpers import run
 
 from robotcell.cell import Cell, Frame, Provenance, cell_to_dict
 from robotcell.cell import calibrate as cellcal
-from robotcell.errors import InputError
+from robotcell.cli.terms import CLI_TERMS
+from robotcell.errors import InputError, terms
 from robotcell.io.tables import read_csv
+from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 from robotcell.studies.demo import demo_cells
 from robotcell.studies.simulate import simulate
 
@@ -62,11 +64,12 @@ def test_cli_cell_results_equal_the_library_call_byte_for_byte(tmp_path, capsys,
         before = Cell.load(lib_file)
         content = cell_to_dict(before)
         call = getattr(cellcal, procedure)
-        got = call(before, read_csv(csv), source=str(csv), file=csv,
-                   **lib_kw, **touches.keywords())
-        got.cell.save(lib_file)
-        assert cli_file.read_bytes() == lib_file.read_bytes(), procedure
-        assert json.loads(out) == got.result.to_json(), procedure
+        with terms(CLI_TERMS):  # the library's messages in the command line's words
+            got = call(before, read_csv(csv), source=str(csv), file=csv,
+                       **lib_kw, **touches.keywords())
+            got.cell.save(lib_file)
+            assert cli_file.read_bytes() == lib_file.read_bytes(), procedure
+            assert json.loads(out) == got.result.to_json(), procedure
         assert f"updated {cli_file}: {got.item}" in err
         assert all(note in err for note in (n.replace("cell 'demo_kr16_track_turntable'",
                                                        str(cli_file))
@@ -150,7 +153,7 @@ def test_library_errors_name_the_cause():
     truth, nominal = demo_cells()
     table = simulate(truth, "tcp", noise=1e-4, seed=2, tool="torch").to_table()
     with pytest.raises(InputError, match=r"measurements: column 'track' \(track position of each "
-                                         r"touch\) needs --cell CELL.yaml \(in Python: a Cell\)"):
+                                         r"touch\) needs a cell \(parameter cell\)"):
         cellcal.frame(None, {**table, "track": np.ones(len(table["a1"])) * 1000,
                              "point": ["origin"] * len(table["a1"])}, robot=nominal.robot)
     with pytest.raises(InputError, match=r"give a cell or a robot, not both"):
@@ -172,7 +175,8 @@ def test_joint_value_touches_in_a_cell_with_tools_need_the_tool_said():
     truth, nominal = demo_cells()
     table = simulate(truth, "turntable", noise=1e-4, seed=3, tool="torch").to_table()
     with pytest.raises(InputError, match=r"touches given as joint values: say which tool "
-                                         r"touched, --tool NAME \(the cell has: torch\)"):
+                                         r"touched, tool=NAME \(the cell has: torch\), or "
+                                         r"tool=numpy.eye\(4\) for the bare flange"):
         cellcal.turntable(nominal, table)
     flange = cellcal.turntable(nominal, table, tool=np.eye(4))  # said: the bare flange
     assert flange.result.verdict.level == "poor"  # and the flange did not touch: the fit says so
@@ -189,3 +193,42 @@ def test_notes_reach_on_note_before_a_refusal():
         cellcal.tcp(nominal, short, "torch", on_note=seen.append)
     assert len(seen) == 1 and seen[0].startswith("note: measurements: line 2, line 3 are "
                                                  "identical")
+
+
+def test_library_messages_name_parameters_and_the_command_line_its_options(tmp_path, capsys):
+    """The same refusal names the Python parameter from the library and the option from the
+    command line."""
+    truth, nominal = demo_cells()
+    touches = simulate(truth, "track", noise=1e-4, seed=6, tool="torch")
+    table = touches.to_table()
+    table["point"] = np.ones(len(table["e1"]))
+    lib = r"column 'point' names reference points, but no references was given"
+    with pytest.raises(InputError, match=lib):
+        cellcal.track(None, table, robot=nominal.robot, tool=nominal.tools["torch"].T_F_TCP)
+    with terms(CLI_TERMS), pytest.raises(InputError, match=lib.replace("references", "--reference")):
+        cellcal.track(None, table, robot=nominal.robot, tool=nominal.tools["torch"].T_F_TCP)
+    del table["point"]
+    result = cellcal.track(None, table, robot=nominal.robot, roll="zero",
+                           tool=nominal.tools["torch"].T_F_TCP, sigma=1e-4).result
+    assert "(references)" in result.next_step and "--" not in result.next_step
+    assert "as given (sigma)" in result.summary()
+    csv = tmp_path / "track.csv"
+    touches.write_csv(csv)
+    code, _, err = run(capsys, "calibrate", "track", csv, "--robot", "kuka_kr16", "--roll",
+                       "zero")
+    assert code == 2 and lib.replace("references", "--reference") in err
+
+
+def test_external_tcp_is_a_cell_calibration_call():
+    """A fixed TCP from touches of a robot-held pointer: the truth recovered, as the command."""
+    rng = np.random.default_rng(7)
+    T_R_X = make_pose(rot_z(0.4), [1.2, -0.3, 0.6])
+    local = np.array([[0, 0, 0]] * 4 + [[0.08, 0, 0], [0.03, 0.07, 0]])
+    p = transform_points(T_R_X, local) * 1e3 + rng.normal(scale=0.02, size=(6, 3))
+    table = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2], "point": ["tcp"] * 4 + ["x", "xy"]}
+    out = cellcal.external_tcp(None, table, sigma=2e-5)
+    np.testing.assert_allclose(out.result.values["T_R_TCP"], T_R_X, atol=2e-3)
+    assert out.cell is None and out.value == "T_R_TCP"
+    with pytest.raises(InputError, match=r"measurements: column 'track' \(track position of each "
+                                         r"touch\) is not used by the external-tcp calibration"):
+        cellcal.external_tcp(None, {**table, "track": np.zeros(6)})

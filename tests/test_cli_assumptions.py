@@ -102,3 +102,27 @@ def test_an_output_named_as_another_kind_of_file_is_refused(capsys, tmp_path, ar
     assert code == 2 and out == ""
     assert err.startswith("error: ") and message.format(tmp=tmp_path) in err
     assert not [p for p in tmp_path.iterdir() if p.suffix in (".json", ".yaml")]
+
+
+def test_calibrate_names_the_tool_frame_track_and_table_it_used(tmp_path, capsys):
+    from robotcell.cell import Cell
+    from robotcell.studies.simulate import simulate
+
+    truth = Cell.load(CELL)
+    cell = tmp_path / "cell.yaml"
+    truth.save(cell)
+    table = tmp_path / "table.csv"
+    touches = simulate(truth, "turntable", noise=1e-4, seed=2, tool="torch")
+    touches.write_csv(table)
+    code, _, err = run(capsys, "calibrate", "turntable", table, "--cell", cell, "--tool", "torch",
+                       *touches.options)
+    assert code == 0, err
+    assert ("assumed: kr16_track_turntable: tool 'torch' (joint values a1..a6); result T_world_B "
+            "in frame 'world'; track from column 'track' (mm); table from column 'e1' (deg)"
+            ) in err.splitlines()
+    tcp = tmp_path / "tcp.csv"
+    tcp.write_text("x,y,z,a,b,c\n1000,0,500,0,90,0\n1000,0,500,30,90,0\n"
+                   "1000,0,500,60,80,0\n1000,0,500,90,70,10\n")
+    code, _, err = run(capsys, "calibrate", "tcp", tcp, "--json")
+    assert ("assumed: no tool (flange poses x, y, z, a, b, c); result T_F_TCP on the flange"
+            in err.splitlines()), err

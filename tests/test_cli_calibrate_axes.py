@@ -94,7 +94,7 @@ def test_turntable_then_workpiece(tmp_path, capsys):
     code, out, _ = run(capsys, "calibrate", "turntable", table, "--height", "-20")
     assert code == 0 and "radius (mm): 350" in out
     code, _, err = run(capsys, "calibrate", "workpiece", wp, "--turntable", table)
-    assert code == 2 and "not JSON" in err
+    assert code == 2 and "not valid JSON" in err
     tt.write_text(json.dumps({"procedure": "track"}))
     code, _, err = run(capsys, "calibrate", "workpiece", wp, "--turntable", tt)
     assert code == 2 and "not a turntable result" in err

@@ -15,6 +15,8 @@ import pytest
 from cli_helpers import run
 
 from robotcell.cell import Cell, Positioner
+from robotcell.cli.terms import CLI_TERMS
+from robotcell.errors import terms
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "cell_kr16_positioner.yaml"
@@ -337,11 +339,12 @@ def test_cli_positioner_equals_the_library_call_byte_for_byte(tmp_path, capsys, 
     code, out, err = run(capsys, "calibrate", "positioner", csv, "--cell", cli_file, "--tool",
                          "pointer", "--json")
     assert code == 0, err
-    got = cellcal.positioner(Cell.load(EXAMPLE), read_csv(csv), tool="pointer", source=str(csv),
-                             file=csv)
-    got.cell.save(lib_file)
-    assert cli_file.read_bytes() == lib_file.read_bytes()
-    assert json.loads(out) == got.result.to_json()
+    with terms(CLI_TERMS):  # the library's messages in the command line's words
+        got = cellcal.positioner(Cell.load(EXAMPLE), read_csv(csv), tool="pointer",
+                                 source=str(csv), file=csv)
+        got.cell.save(lib_file)
+        assert cli_file.read_bytes() == lib_file.read_bytes()
+        assert json.loads(out) == got.result.to_json()
     # independently of the library call: the root the command wrote is the simulated truth's
     root = Cell.load(cli_file).turntable.T_parent_root
     assert np.linalg.norm(root[:3, 3] - Cell.load(truth).turntable.T_parent_root[:3, 3]) < 2e-3

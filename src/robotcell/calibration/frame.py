@@ -26,6 +26,7 @@ from robotcell.calibration.result import (
     fit_fields,
     pose_fields,
 )
+from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points
@@ -247,9 +248,10 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
     q = as_points(nominal, "nominal points").reshape(-1, 3)
     if q.shape != p.shape:
         raise InputError(f"{len(q)} nominal points for {len(p)} touched points")
-    if len(p) < 3:
-        raise IllPosedError(f"points: {len(p)} given; a best-fit frame needs at least 3 points that "
-                            "are not on one line (4 or more give a check of the fit)")
+    least = SPECS["frame"].minimum
+    if len(p) < least:
+        raise IllPosedError(f"points: {len(p)} given; a best-fit frame needs at least {least} "
+                            "points that are not on one line (4 or more give a check of the fit)")
     s = np.linalg.svd(q - q.mean(axis=0), compute_uv=False)
     if s[0] == 0 or s[1] / s[0] < COLLINEAR_SIN:
         raise IllPosedError("the nominal points are collinear (all on one line), so the rotation "
@@ -318,9 +320,11 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
     if bad:
         raise InputError(f"external TCP touches must have role tcp, x or xy; found {', '.join(bad)}")
     n_tcp = roles.count("tcp")
-    if n_tcp < 3:
-        raise IllPosedError(f"touches of the fixed TCP: {n_tcp} given; touch it at least 3 times "
-                            "(4 recommended) with the reference tool from different directions")
+    least = SPECS["external-tcp"].minimum
+    if n_tcp < least:
+        raise IllPosedError(f"touches of the fixed TCP: {n_tcp} given; touch it at least {least} "
+                            "times (4 recommended) with the reference tool from different "
+                            "directions")
     labs = _labels(len(p), labels, roles)
     next_step = ("enter matrix/xyzabc as the external tool (KUKA: fixed tool as BASE, ABB: stationary "
                  "tool) and check by moving a workpiece point to the fixed TCP in two orientations")

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.calibration.fitting import Fit
+from robotcell.calibration.resultcheck import PROCEDURES, REQUIRED, malformed
 from robotcell.calibration.uncertainty import Estimate
 from robotcell.calibration.verdict import (
     CONDITION_GOOD,
@@ -24,15 +25,19 @@ from robotcell.calibration.verdict import (
     format_condition,
 )
 from robotcell.calibration.verdict import verdict as judge
-from robotcell.errors import InputError
+from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import format_table
 
-__all__ = ["PROCEDURES", "CalibrationResult", "fit_fields", "pose_fields", "to_jsonable"]
+__all__ = ["PROCEDURES", "CalibrationResult", "fit_fields", "pose_covariance", "pose_fields",
+           "result_json", "to_jsonable"]
 
-#: The ``procedure`` of every result robotcell's calibrations write (``--json``).
-PROCEDURES = ("tcp", "frame-3point", "frame-npoint", "external-tcp", "track", "turntable",
-              "workpiece", "positioner-2axis")
+#: A key of a result's pose ``T_a_b`` in its JSON (its sigma or covariance), giving ``T_a_b``.
+_POSE_KEY = re.compile(r"(T_[A-Za-z]+_[A-Za-z0-9]+?)_(?:position_mm|rotation_deg|covariance_mm_rad)")
+
+#: The JSON's lists of touches (labels) and the fields of a result that hold their indices.
+_TOUCH_LISTS = {"excluded": "excluded", "unchecked": "unchecked", "outliers": "outliers",
+                "disagreeing": "disagreeing", "gross_outliers": "gross"}
 
 #: Conditioning figure above which a result is flagged: Schroer's threshold of about 100 for
 #: a trustworthy identification, as cited by Nahvi and Hollerbach (ICRA 1996).
@@ -365,6 +370,108 @@ class CalibrationResult:
         out["verdict"] = judge(out).to_json()
         return out
 
+    @classmethod
+    def from_json(cls, data: Any, source: str = "the result", procedure: str | None = None,
+                  required: tuple[str, ...] = REQUIRED) -> CalibrationResult:
+        """A result from its JSON (:meth:`to_json`, mm and deg), checked; ``to_json`` of it
+        gives that JSON back.
+
+        The quantities come back in SI: the residuals and the measured points, the noise and
+        accuracy figures, the touches named in ``excluded`` and the other lists, the 1-sigma
+        (``sigma``, keys without their unit), and the result's pose ``T_a_b`` (``matrix``, the
+        pose its sigma or covariance names) in ``values`` with its 6x6 covariance
+        ``T_a_b_covariance_mm_rad`` as ``covariance`` (origin in m, rotation vector in rad).
+        Every field read is kept in ``json_fields`` as it was, so that :meth:`to_json` writes
+        what was read (its verdict judged again). A file is read by
+        :func:`robotcell.report.load_result` or :meth:`TurntablePose.load
+        <robotcell.cell.calibrate.TurntablePose.load>`.
+
+        Parameters
+        ----------
+        data : dict
+            The result as JSON.
+        source : str
+            Its name in messages (the file).
+        procedure : str, optional
+            The procedure the result must come from (e.g. ``"turntable"``).
+        required : tuple of str
+            The fields it must have: by default those of every result
+            (:data:`~robotcell.calibration.resultcheck.REQUIRED`); a reader that uses only its
+            pose asks for ``("procedure", "matrix")``.
+
+        Returns
+        -------
+        CalibrationResult
+
+        Raises
+        ------
+        InputError
+            Not a result of ``procedure``, a field missing or malformed
+            (:func:`~robotcell.calibration.resultcheck.malformed`), or a covariance that is not
+            a 6x6 symmetric positive semi-definite matrix of finite numbers.
+        """
+        given = result_json()
+        if procedure is not None and (not isinstance(data, dict)
+                                      or data.get("procedure") != procedure):
+            raise InputError(f"{source}: not a {procedure} result; pass the {given}")
+        missing = [k for k in required if not isinstance(data, dict) or k not in data]
+        if missing:
+            raise InputError(f"{source}: not a calibration result (missing {', '.join(missing)}); "
+                             f"give the {given}")
+        bad = malformed(data)
+        if bad:
+            raise InputError(f"{source}: not a calibration result: {bad}; give the unchanged "
+                             f"{given}")
+        mm = np.array(data.get("residuals_xyz_mm") or
+                      [[r, 0.0, 0.0] for r in data.get("residuals_mm", [])],
+                      dtype=float).reshape(-1, 3)
+        labels = [str(v) for v in data.get("labels") or range(1, len(mm) + 1)]
+
+        def si(key: str, default: float = float("nan")) -> float:
+            v = data.get(key)
+            return default if v is None else float(v) * 1e-3
+
+        def touches(key: str) -> list[int]:
+            return [labels.index(str(v)) for v in data.get(key) or [] if str(v) in labels]
+
+        sigma_json = data.get("sigma") or {}
+        sigma: dict[str, Any] = {}
+        for key, v in sigma_json.items():
+            for unit, scale in (("_mm", 1e-3), ("_deg", math.pi / 180)):
+                if key.endswith(unit):
+                    sigma[key[:-len(unit)]] = np.asarray(v, dtype=float) * scale
+                    break
+            else:
+                sigma[key] = np.asarray(v, dtype=float)
+        values: dict[str, Any] = {}
+        covariance = None
+        poses = {m.group(1) for m in map(_POSE_KEY.fullmatch, [*data, *sigma_json]) if m}
+        if data.get("matrix") is not None and len(poses) == 1:
+            key = poses.pop()
+            T = np.array(data["matrix"], dtype=float)
+            T[:3, 3] *= 1e-3
+            values[key] = T
+            cov = data.get(f"{key}_covariance_mm_rad")
+            if cov is not None:
+                to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+                covariance = (pose_covariance(cov, f"{source}: '{key}_covariance_mm_rad'")
+                              * np.outer(to_si, to_si))
+        points = data.get("points_mm")
+        return cls(
+            str(data["procedure"]), values, sigma, mm * 1e-3,
+            condition=float(data.get("condition", float("nan"))), dof=int(data.get("dof", 0)),
+            noise_sigma=si("noise_sigma_mm"), noise_source=str(data.get("noise_source", "")),
+            labels=labels, undetermined=list(data.get("undetermined") or []),
+            warnings=list(data.get("warnings", [])), next_step=str(data.get("next_step", "")),
+            kinds={k: "pose" for k in values},
+            json_fields={k: v for k, v in data.items() if k != "verdict"},
+            covariance=covariance, parameter_names=list(values),
+            points=None if points is None else np.array(points, dtype=float) * 1e-3,
+            touch_sigma=si("touch_sigma_mm"),
+            accuracy_source=str(data.get("accuracy_source", "default")),
+            residual_sigma=si("residual_sigma_mm"), chi2=data.get("chi2"),
+            **{field_: touches(key) for key, field_ in _TOUCH_LISTS.items()})
+
     @property
     def verdict(self) -> Verdict:
         """The verdict (good / check / poor, and why): :func:`robotcell.calibration.verdict.verdict`
@@ -397,8 +504,9 @@ class CalibrationResult:
     def _noise_line(self) -> str:
         """The touch accuracy, the residuals' check against it and the noise the 1-sigma uses."""
         s = self.touch_sigma * 1e3
-        text = (f"{s:.3f} mm per coordinate, as given (--sigma)" if self.accuracy_source == "stated"
-                else f"{s:.3f} mm per coordinate, the default (state yours with --sigma)")
+        given = term("sigma", "sigma")
+        text = (f"{s:.3f} mm per coordinate, as given ({given})" if self.accuracy_source == "stated"
+                else f"{s:.3f} mm per coordinate, the default (state yours with {given})")
         if self.chi2 is None or not math.isfinite(self.residual_sigma):
             return text + "; no redundant touches check it"
         text += (f"; the residuals need {self.residual_sigma * 1e3:.3f} mm (chi-square "
@@ -467,3 +575,44 @@ def fit_fields(res: Fit) -> dict[str, Any]:
             "excluded": list(res.excluded), "unchecked": list(res.unchecked),
             "outliers": res.outliers, "disagreeing": res.disagreeing, "gross": list(res.gross),
             "fit": res}
+
+
+def result_json() -> str:
+    """What a result given as JSON must be, for messages: the output of :meth:`to_json
+    <CalibrationResult.to_json>` (on the command line: of ``calibrate ... --json``)."""
+    return term("result=output", "output of CalibrationResult.to_json()")
+
+
+def pose_covariance(value: object, where: str) -> NDArray[np.float64]:
+    """A pose's 6x6 covariance read from JSON: symmetric, positive semi-definite, finite.
+
+    Parameters
+    ----------
+    value : object
+        The JSON value (nested lists).
+    where : str
+        What it is, for messages (file and key).
+
+    Returns
+    -------
+    ndarray, shape (6, 6)
+        As given (units unchanged).
+
+    Raises
+    ------
+    InputError
+        Not a 6x6 array of finite numbers, or not a covariance.
+    """
+    advice = f"; pass the unchanged {result_json()}"
+    try:
+        cov = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where} must be a 6x6 array of numbers{advice}") from None
+    if cov.shape != (6, 6) or not np.all(np.isfinite(cov)):
+        raise InputError(f"{where} must be a 6x6 array of finite numbers, got shape "
+                         f"{cov.shape}{advice}")
+    scale = max(float(np.abs(cov).max()), 1e-300)
+    if np.abs(cov - cov.T).max() > 1e-9 * scale or np.linalg.eigvalsh(cov).min() < -1e-9 * scale:
+        raise InputError(f"{where} is not a covariance (symmetric, no negative variance)"
+                         f"{advice}")
+    return cov

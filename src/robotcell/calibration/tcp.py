@@ -36,6 +36,7 @@ from robotcell.calibration.result import (
     fit_fields,
     pose_fields,
 )
+from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import OWN, Estimate, Inputs, Sources
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import validate_pose
@@ -171,8 +172,9 @@ def calibrate_tool(
     Tw = _poses(world_touches, "ABC World flange poses")
     if world_mode not in ("6d", "5d"):
         raise InputError(f"world_mode must be '6d' or '5d', got {world_mode!r}")
-    if len(T) < 3:
-        raise IllPosedError(f"touches of the reference point: {len(T)} given; the TCP needs at least 3 "
+    if len(T) < SPECS["tcp"].minimum:
+        raise IllPosedError(f"touches of the reference point: {len(T)} given; the TCP needs at least "
+                            f"{SPECS['tcp'].minimum} "
                             f"(4 recommended, 5 or more let a wrong touch be singled out): {ADVICE}")
     if (len(Ta) > 0) != (len(Tp) > 0):
         raise IllPosedError("ABC 2-point needs both a touch with the reference point on the tool's -X "

@@ -38,8 +38,9 @@ from robotcell.calibration.fitting import (
 )
 from robotcell.calibration.propagate import jacobian, propagate
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, fit_fields
+from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import Inputs, estimate
-from robotcell.errors import IllPosedError, InputError
+from robotcell.errors import IllPosedError, InputError, term
 from robotcell.kinematics.transforms import as_points, make_pose
 
 __all__ = ["TRACK_AXES", "calibrate_track", "zero_roll_rotation"]
@@ -275,8 +276,9 @@ def calibrate_track(
     if not np.all(np.isfinite(e)):
         raise InputError("track positions contain NaN or infinite values")
     n = len(f)
-    if n < 3:
-        raise InputError(f"touches: {n} given, at least 3 needed (3 touches at different track "
+    if n < SPECS["track"].minimum:
+        raise InputError(f"touches: {n} given, at least {SPECS['track'].minimum} needed (3 "
+                         "touches at different track "
                          "positions give the direction and a straightness check; use 5 or more)")
     d = _axis_vector(axis)
     if roll not in (None, "zero"):
@@ -347,13 +349,15 @@ def calibrate_track(
             estimates["T_L_R"] = estimate(res.sources, res.input_gain, A, determined)
             source, offset = "convention: zero roll", None
             next_step = ("the rotation about the track axis is a convention, not a measurement; to "
-                         "measure it, touch reference points with known coordinates in L (--reference)")
+                         "measure it, touch reference points with known coordinates in L "
+                         f"({term('reference', 'references')})")
         else:
             Q, source, offset = None, None, None
             next_step = ("enter the direction and scale in the track's machine data; for the full "
                          "rotation L_Q_R touch one reference point with known coordinates in L off "
                          "the track axis (two or more also give the carriage offset) and pass them "
-                         "with --reference, or accept the zero-roll convention (--roll zero)")
+                         f"with {term('reference', 'references')}, or accept the zero-roll "
+                         f"convention ({term('roll=zero', 'roll=' + repr('zero'))})")
     else:
         res, unpack = _fit_known_points(e, f, refs, groups, d, prior_sigma, inputs)
         Q, scale, c = unpack(res.x)

@@ -29,6 +29,7 @@ from robotcell.calibration.result import (
     fit_fields,
     pose_fields,
 )
+from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points, make_pose, rot_z
@@ -160,8 +161,9 @@ def calibrate_turntable(
     if not np.all(np.isfinite(theta)) or not np.isfinite(height):
         raise InputError("table angles or height contain NaN or infinite values")
     n = len(f)
-    if n < 3:
-        raise InputError(f"touches: {n} given, at least 3 needed at different table angles (6 or "
+    if n < SPECS["turntable"].minimum:
+        raise InputError(f"touches: {n} given, at least {SPECS['turntable'].minimum} needed at "
+                         "different table angles (6 or "
                          "more let a wrong touch be singled out)")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
     spread = _check_angles(theta)

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 from scipy.special import chdtri
 
+from robotcell.errors import term
 from robotcell.io.tables import CELL_EXTENT_MM
 
 __all__ = [
@@ -241,7 +242,8 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
     s = stated or DEFAULT_TOUCH_SIGMA_MM
     source = "stated" if stated else "default"
     what = (f"the stated touch accuracy {s:g} mm" if stated
-            else f"the default touch accuracy {s:g} mm (state yours with --sigma)")
+            else f"the default touch accuracy {s:g} mm (state yours with "
+                 f"{term('sigma', 'sigma')})")
 
     for name, size in _lengths(result):
         if not size <= CELL_EXTENT_MM:

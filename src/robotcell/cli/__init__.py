@@ -18,7 +18,8 @@ from pathlib import Path
 import click
 
 from robotcell import __version__
-from robotcell.errors import RobotcellError
+from robotcell.cli.terms import CLI_TERMS
+from robotcell.errors import RobotcellError, terms
 
 #: command name -> "module:attribute" of its click command
 COMMANDS = {
@@ -125,7 +126,7 @@ def main(argv: list[str] | None = None) -> None:
     is one ``warning:`` line, without the source file and line a developer would want.
     """
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), terms(CLI_TERMS):
             warnings.showwarning = _one_line_warning
             cli.main(args=argv, prog_name="robotcell", standalone_mode=False)
     except click.exceptions.Abort:

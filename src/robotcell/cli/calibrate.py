@@ -23,13 +23,11 @@ import click
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.calibration.measurements import tcp_positions
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
-from robotcell.cell.calibrate.touches import POSE_COLUMNS, line_labels, repeat_notes
-from robotcell.cli.common import check_kind, check_output, parse_numbers, read_csv, write_output
+from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
@@ -231,12 +229,6 @@ def require_name(name: str | None, target: CellTarget | None, what: str) -> None
                          f"to (existing: {known})")
 
 
-def refuse_track_column(cols: dict, source: str, why: str) -> None:
-    """Refuse column ``track`` where it is not used; ``why`` says what to do instead."""
-    if "track" in cols:
-        raise InputError(f"{source}: column 'track' (track position of each touch) {why}")
-
-
 def robot_and_tool(robot: str | None, tool: str | None, target: CellTarget | None = None
                    ) -> tuple[Robot | None, str | np.ndarray | None]:
     """The robot model and the tool for joint-value input.
@@ -325,6 +317,19 @@ def gate(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool,
                           "measurements, or pass --accept-poor to use the result anyway")
 
 
+def finish(out: cellcal.CellCalibration, target: CellTarget | None, as_json: bool,
+           accept_poor: bool) -> None:
+    """The end of a calibration command: :func:`gate`, the cell file saved (with ``--cell``),
+    what the calibration assumed on stderr (``assumed: tool ..., result ... in frame ...,
+    track ..., table ...``), and the result (:func:`emit`)."""
+    gate(out.result, as_json, accept_poor)
+    if out.cell is not None and target is not None:
+        target.save(out.cell, out.item, out.update_notes)
+    if out.assumed:
+        click.echo(f"assumed: {out.assumed}", err=True)
+    emit(out.result, as_json)
+
+
 @calibrate.command("tcp")
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--world", "world_mode", type=click.Choice(["6d", "5d"]), default="6d",
@@ -360,15 +365,11 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     require_name(name, target, "tool")
     prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None, target)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
     cell, label = cell_of(target)
-    out = cellcal.tcp(cell, cols, name, robot=None if cell else model, world_mode=world_mode,
+    out = cellcal.tcp(cell, measurements, name, robot=None if cell else model, world_mode=world_mode,
                       sigma=prior, source=measurements, cell_label=label, on_note=echo_note,
                       **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @calibrate.command("frame")
@@ -406,16 +407,11 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
                          "CELL.yaml")
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track", "nominal_x",
-                                                        "nominal_y", "nominal_z"])
     cell, label = cell_of(target)
-    out = cellcal.frame(cell, cols, name, parent=parent, robot=None if cell else model,
+    out = cellcal.frame(cell, measurements, name, parent=parent, robot=None if cell else model,
                         tool=T_tool, sigma=prior, source=measurements, cell_label=label,
                         on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @calibrate.command("external-tcp")
@@ -435,23 +431,11 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     Example:
       robotcell calibrate external-tcp gun.csv --robot kuka_kr16 --tool 250,0,0,0,0,0
     """
-    from robotcell.calibration.frame import external_tcp
-
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["point", "track"])
-    refuse_track_column(cols, measurements, "is not used by 'calibrate external-tcp': touch the "
-                        "fixed tool with the track at one position and remove the column")
-    p = tcp_positions(cols, measurements, model, T_tool)
-    if "point" in cols:
-        roles = [str(v).strip().lower() for v in cols["point"]]
-    else:
-        roles = ["tcp"] * len(p)
-    for note in repeat_notes(cols, POSE_COLUMNS, measurements):
-        echo_note(note)
-    result = external_tcp(p, roles, prior, line_labels(len(roles), roles))
-    gate(result, as_json, accept_poor)
-    emit(result, as_json)
+    out = cellcal.external_tcp(None, measurements, robot=model, tool=T_tool, sigma=prior,
+                               source=measurements, on_note=echo_note)
+    finish(out, None, as_json, accept_poor)
 
 
 @calibrate.command("cell")
@@ -494,8 +478,8 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
 # A module listed here is imported only when its subcommand is used; an entry whose module does
 # not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m, gate, emit, and for --cell cell_option, CellTarget, cell_of and echo_note, from this
-# module.
+# sigma_m, gate, emit, finish, and for --cell cell_option, CellTarget, cell_of and echo_note, from
+# this module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",

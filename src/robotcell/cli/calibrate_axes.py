@@ -9,33 +9,26 @@ turntable, positioner and workpiece.
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import click
 import numpy as np
 
 from robotcell.cell import calibrate as cellcal
-from robotcell.cell.calibrate.touches import POSE_COLUMNS
 from robotcell.cli.calibrate import (
     CellTarget,
     cell_of,
     cell_option,
     chain_options,
     echo_note,
-    emit,
-    gate,
+    finish,
     measurement_options,
     require_name,
     robot_and_tool,
     sigma_m,
 )
-from robotcell.cli.common import parse_numbers, read_csv
+from robotcell.cli.common import parse_numbers
 from robotcell.cli.files import Command
 from robotcell.errors import InputError
-from robotcell.io.fileio import read_text
 from robotcell.io.tables import CELL_EXTENT_MM
-from robotcell.kinematics.transforms import validate_pose
 
 
 @click.command("track", cls=Command)
@@ -74,16 +67,12 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     refs = np.array([parse_numbers(r, "--reference", 3) for r in references]).reshape(-1, 3) * 1e-3
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
     cell, label = cell_of(target)
-    out = cellcal.track(cell, cols, references=refs, axis=axis, roll=roll,
+    out = cellcal.track(cell, measurements, references=refs, axis=axis, roll=roll,
                         robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
                         source=measurements, cell_label=label, on_note=echo_note,
                         **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @click.command("turntable", cls=Command)
@@ -115,15 +104,11 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
                          f"(100 m, the size of any real cell), got {height:g}")
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "track"])
     cell, label = cell_of(target)
-    out = cellcal.turntable(cell, cols, height=height * 1e-3, robot=None if cell else model,
+    out = cellcal.turntable(cell, measurements, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
                             cell_label=label, on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)
 
 
 @click.command("positioner", cls=Command)
@@ -150,68 +135,11 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     """
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "e2", "track"])
     cell, label = cell_of(target)
-    out = cellcal.positioner(cell, cols, robot=None if cell else model, tool=T_tool,
+    out = cellcal.positioner(cell, measurements, robot=None if cell else model, tool=T_tool,
                              sigma=sigma_m(sigma), source=measurements, cell_label=label,
                              on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
-
-
-def _load_turntable(path: str) -> cellcal.TurntablePose:
-    """The turntable pose (m), its 6x6 covariance (SI) and its frame.
-
-    Reads the ``--json`` output of ``calibrate turntable``: ``T_R_B`` (frame ``"robot"``), or
-    ``T_world_B`` (frame ``"world"``) when it was calibrated with ``--cell`` in the world.
-    """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: no such file")
-    try:
-        data = json.loads(read_text(p))
-    except (json.JSONDecodeError, RecursionError) as exc:
-        raise InputError(f"{path}: not JSON ({exc}); pass the --json output of "
-                         "'robotcell calibrate turntable'") from None
-    if not isinstance(data, dict) or data.get("procedure") != "turntable" or "matrix" not in data:
-        raise InputError(f"{path}: not a turntable result; pass the --json output of "
-                         "'robotcell calibrate turntable'")
-    try:
-        T = np.array(data["matrix"], dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{path}: 'matrix' must be a 4x4 array of numbers") from None
-    if T.shape != (4, 4):
-        raise InputError(f"{path}: 'matrix' must be 4x4, got shape {T.shape}")
-    T[:3, 3] *= 1e-3
-    T = validate_pose(T, f"{path}: matrix")
-    sigma = data.get("sigma") if isinstance(data.get("sigma"), dict) else {}
-    frame = "world" if any(str(k).startswith("T_world_B") for k in [*data, *sigma]) else "robot"
-    key = "T_world_B_covariance_mm_rad" if frame == "world" else "T_R_B_covariance_mm_rad"
-    cov = data.get(key)
-    if cov is not None:
-        cov = _covariance(cov, f"{path}: {key!r}")
-        to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
-        cov = cov * np.outer(to_si, to_si)
-    return cellcal.TurntablePose(T, cov, frame, path)
-
-
-def _covariance(value: object, where: str) -> np.ndarray:
-    """A 6x6 symmetric positive semi-definite covariance (mm, rad) from JSON, or refused."""
-    advice = "; pass the unchanged --json output of 'robotcell calibrate turntable'"
-    try:
-        cov = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{where} must be a 6x6 array of numbers{advice}") from None
-    if cov.shape != (6, 6) or not np.all(np.isfinite(cov)):
-        raise InputError(f"{where} must be a 6x6 array of finite numbers, got shape "
-                         f"{cov.shape}{advice}")
-    scale = max(float(np.abs(cov).max()), 1e-300)
-    if np.abs(cov - cov.T).max() > 1e-9 * scale or np.linalg.eigvalsh(cov).min() < -1e-9 * scale:
-        raise InputError(f"{where} is not a covariance (symmetric, no negative variance)"
-                         f"{advice}")
-    return cov
+    finish(out, target, as_json, accept_poor)
 
 
 @click.command("workpiece", cls=Command)
@@ -245,13 +173,9 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     target = CellTarget.open(cell_path, robot)
     require_name(name, target, "frame")
     model, T_tool = robot_and_tool(robot, tool, target)
-    given = None if turntable_json is None else _load_turntable(turntable_json)
-    cols = read_csv(measurements, known=POSE_COLUMNS + ["e1", "point", "track"])
+    given = None if turntable_json is None else cellcal.TurntablePose.load(turntable_json)
     cell, label = cell_of(target)
-    out = cellcal.workpiece(cell, cols, name, turntable=given, robot=None if cell else model,
+    out = cellcal.workpiece(cell, measurements, name, turntable=given, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
                             cell_label=label, on_note=echo_note, **chain_options(measurements))
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None:
-        target.save(out.cell, out.item, out.update_notes)
-    emit(out.result, as_json)
+    finish(out, target, as_json, accept_poor)

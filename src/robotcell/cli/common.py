@@ -160,10 +160,9 @@ def read_csv(path: str, known: Iterable[str] | None = None) -> dict:
 
 def warn_unknown_columns(path: str, cols: dict, known: Iterable[str]) -> None:
     """A ``warning:`` line on stderr naming the columns of ``cols`` not in ``known``, if any."""
-    unknown = tables.unknown_columns(cols, known)
-    if unknown:
-        click.echo(f"warning: {path}: column(s) {', '.join(unknown)} not used by this command "
-                   "and ignored; check the spelling", err=True)
+    warning = tables.unknown_columns_warning(path, cols, known)
+    if warning:
+        click.echo(warning, err=True)
 
 
 def check_output(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:

@@ -26,16 +26,18 @@ folder, is refused with :class:`~robotcell.errors.InputError` naming it.
 from __future__ import annotations
 
 import codecs
+import json
 import os
 import shutil
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from robotcell.errors import InputError
 
-__all__ = ["atomic_copy", "atomic_write", "check_destination", "decode_text", "read_text"]
+__all__ = ["atomic_copy", "atomic_write", "check_destination", "decode_text", "read_json",
+           "read_text"]
 
 
 def _as_latin1(exc: UnicodeError) -> tuple[str, int]:
@@ -110,6 +112,34 @@ def read_text(path: str | Path, what: str = "file") -> str:
     except OSError as exc:
         raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
     return decode_text(data, str(path))
+
+
+def read_json(path: str | Path, advice: str) -> Any:
+    """Read a JSON file (:func:`read_text`), refusing a missing file and text that is not JSON.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    advice : str
+        What to give instead, for the messages (``"give the output of ..."``).
+
+    Returns
+    -------
+    Any
+        The parsed JSON.
+
+    Raises
+    ------
+    InputError
+        ``"<path>: no such file"`` or ``"<path>: not valid JSON (<why>); <advice>"``.
+    """
+    if not Path(path).is_file():
+        raise InputError(f"{path}: no such file")
+    try:
+        return json.loads(read_text(path))
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise InputError(f"{path}: not valid JSON ({exc}); {advice}") from None
 
 
 def check_destination(path: str | Path) -> Path:

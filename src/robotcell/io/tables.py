@@ -30,6 +30,7 @@ __all__ = [
     "read_csv",
     "require_columns",
     "unknown_columns",
+    "unknown_columns_warning",
     "write_columns",
     "write_csv",
 ]
@@ -188,6 +189,34 @@ def unknown_columns(cols: dict, known: Iterable[str]) -> list[str]:
         close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
         out.append(f"{name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
     return out
+
+
+def unknown_columns_warning(source: str | Path, cols: dict, known: Iterable[str],
+                            reader: str = "this command") -> str | None:
+    """A ``warning:`` naming the columns of ``cols`` that ``reader`` does not use, or None.
+
+    Parameters
+    ----------
+    source : str or Path
+        The table's name (its file), for the message.
+    cols : dict
+        Columns from :func:`read_csv`.
+    known : iterable of str
+        Lower-case names the reader uses.
+    reader : str
+        What reads the table, for the message.
+
+    Returns
+    -------
+    str or None
+        E.g. ``"warning: t.csv: column(s) 'piont' (did you mean 'point'?) not used by this
+        command and ignored; check the spelling"``; None when every column is known.
+    """
+    unknown = unknown_columns(cols, known)
+    if not unknown:
+        return None
+    return (f"warning: {source}: column(s) {', '.join(unknown)} not used by {reader} and "
+            "ignored; check the spelling")
 
 
 def outside_limits(values: np.ndarray, columns: Sequence[str], lower: Sequence[float],

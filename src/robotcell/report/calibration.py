@@ -15,7 +15,6 @@ from __future__ import annotations
 import base64
 import html
 import io
-import json
 import math
 import re
 from pathlib import Path
@@ -23,143 +22,32 @@ from typing import Any
 
 import numpy as np
 
-from robotcell.calibration.result import PROCEDURES
+from robotcell.calibration.result import CalibrationResult, result_json
+from robotcell.calibration.resultcheck import is_points
 from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
-from robotcell.errors import InputError
-from robotcell.io.fileio import atomic_write, read_text
+from robotcell.io.fileio import atomic_write, read_json
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.io.tables import MAX_ABS_VALUE
-from robotcell.kinematics.transforms import check_pose
 from robotcell.view.calibration import calibration_scene, outliers
 from robotcell.view.plot import MAX_PAGE_BYTES, embed_within
 from robotcell.view.scene import Scene
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 
-_REQUIRED = ("procedure", "residuals_mm", "rms_mm", "max_mm", "warnings")
-
-
 def load_result(path: str | Path) -> dict[str, Any]:
-    """Read a calibration result written by ``robotcell calibrate ... --json``.
+    """Read a calibration result written by ``robotcell calibrate ... --json``, as the JSON it
+    was written as, checked by :meth:`CalibrationResult.from_json
+    <robotcell.calibration.result.CalibrationResult.from_json>`.
 
     Raises
     ------
     InputError
-        The file is missing, not JSON, or not a calibration result as ``calibrate`` writes it:
-        a field missing or of the wrong type, an unknown ``procedure``, a number that is not
-        finite (anywhere), a length (a key ending in ``_mm``, the translation of ``matrix``)
-        beyond :data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, or a ``matrix`` (a track's
-        ``rotation``) that is not a rigid transform (a proper rotation).
+        As :meth:`CalibrationResult.from_json
+        <robotcell.calibration.result.CalibrationResult.from_json>`, and for a file that is
+        missing or not JSON.
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: no such file")
-    try:
-        data = json.loads(read_text(p))
-    except (json.JSONDecodeError, RecursionError) as exc:
-        raise InputError(f"{path}: not valid JSON ({exc}); give the output of "
-                         "'robotcell calibrate ... --json'") from None
-    missing = [k for k in _REQUIRED if not isinstance(data, dict) or k not in data]
-    if missing:
-        raise InputError(f"{path}: not a calibration result (missing {', '.join(missing)}); give "
-                         "the output of 'robotcell calibrate ... --json'")
-    bad = _malformed(data)
-    if bad:
-        raise InputError(f"{path}: not a calibration result: {bad}; give the unchanged output "
-                         "of 'robotcell calibrate ... --json'")
-    return data
-
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _not_finite(v: Any, where: str) -> str | None:
-    """Where in ``v`` (parsed JSON) a number is not finite (NaN, Infinity, an integer of 400
-    digits), or None."""
-    if isinstance(v, dict):
-        return next((w for k, x in v.items() if (w := _not_finite(x, f"{where}.{k}"))), None)
-    if isinstance(v, list):
-        return next((w for i, x in enumerate(v) if (w := _not_finite(x, f"{where}[{i}]"))), None)
-    if isinstance(v, (int, float)) and not isinstance(v, bool):
-        try:
-            ok = math.isfinite(float(v))
-        except OverflowError:
-            ok = False
-        return None if ok else where
-    return None
-
-
-def _lengths(v: Any) -> list[float]:
-    """The numbers in ``v`` (a number or nested lists of them)."""
-    if isinstance(v, list):
-        return [x for item in v for x in _lengths(item)]
-    return [v] if isinstance(v, (int, float)) and not isinstance(v, bool) else []
-
-
-def _is_points(v: Any, n: int | None) -> bool:
-    """A list of ``n`` (any number when None) lists of 3 finite numbers."""
-    return (isinstance(v, list) and (n is None or len(v) == n)
-            and all(isinstance(p, list) and len(p) == 3 and all(map(_is_number, p)) for p in v))
-
-
-def _malformed(data: dict[str, Any]) -> str | None:
-    """What is wrong with the fields of a result that the report uses, or None."""
-    if not isinstance(data["procedure"], str):
-        return "'procedure' must be a text"
-    if data["procedure"] not in PROCEDURES:
-        return (f"'procedure' {data['procedure']!r} is none robotcell calibrates "
-                f"({', '.join(PROCEDURES)})")
-    where = _not_finite(data, "")
-    if where is not None:
-        return f"{where.lstrip('.')!r} is not a finite number"
-    for key, value in data.items():
-        if key.endswith("_mm") and any(abs(v) > MAX_ABS_VALUE for v in _lengths(value)):
-            return (f"{key!r} holds a length beyond {MAX_ABS_VALUE:.0e} mm, which no "
-                    "calibration measures")
-    res = data["residuals_mm"]
-    if not isinstance(res, list) or not all(map(_is_number, res)):
-        return "'residuals_mm' must be a list of numbers"
-    n = len(res)
-    for key in ("rms_mm", "max_mm"):
-        if not _is_number(data[key]):
-            return f"{key!r} must be a number"
-    for key in ("warnings", "undetermined"):
-        v = data.get(key, [])
-        if (v is not None or key == "warnings") and (
-                not isinstance(v, list) or not all(isinstance(w, str) for w in v)):
-            return f"{key!r} must be a list of texts"
-    checks = {
-        "condition": lambda v: _is_number(v),
-        "labels": lambda v: isinstance(v, list) and len(v) == n
-        and all(isinstance(x, (str, int)) for x in v),
-        "residuals_xyz_mm": lambda v: _is_points(v, n),
-        "points_mm": lambda v: _is_points(v, None),
-        "pivot_mm": lambda v: _is_points([v], 1),
-        "sigma": lambda v: isinstance(v, dict),
-        "matrix": lambda v: isinstance(v, list) and len(v) == 4
-        and all(isinstance(r, list) and len(r) == 4 and all(map(_is_number, r)) for r in v),
-        "rotation": lambda v: _is_points(v, 3),
-    }
-    for key, ok in checks.items():
-        if data.get(key) is not None and not ok(data[key]):
-            return f"{key!r} has the wrong type or size"
-    if data.get("matrix") is not None:
-        T = np.array(data["matrix"], dtype=float)
-        if np.abs(T[:3, 3]).max() > MAX_ABS_VALUE:
-            return f"'matrix' holds a translation beyond {MAX_ABS_VALUE:.0e} mm"
-        T[:3, 3] *= 1e-3
-        ok, reasons = check_pose(T)
-        if not ok:
-            return f"'matrix' is not a rigid transform (R orthonormal, det R = 1): {reasons[0]}"
-    if data.get("rotation") is not None:  # the track's L_Q_R
-        T = np.eye(4)
-        T[:3, :3] = data["rotation"]
-        ok, reasons = check_pose(T)
-        if not ok:
-            return f"'rotation' is not a proper rotation (orthonormal, det = 1): {reasons[0]}"
-    return None
+    data = read_json(path, f"give the {result_json()}")
+    return CalibrationResult.from_json(data, str(path)).to_json()
 
 
 def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
@@ -364,7 +252,7 @@ def _result_rows(result: dict[str, Any]) -> tuple[str, set[str], set[str]]:
     rows = []
     match = next((m for m in map(_POSE_KEY.fullmatch, [*result, *sigma]) if m), None)
     xyzabc = result.get("xyzabc")
-    if xyzabc is None and _is_points(result.get("rotation"), 3) and _is_points(
+    if xyzabc is None and is_points(result.get("rotation"), 3) and is_points(
             [result.get("offset_mm")], 1):  # the track: the robot base on the carriage
         R = np.array(result["rotation"], dtype=float)
         if np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0:

@@ -33,6 +33,7 @@ from robotcell.calibration.workpiece import calibrate_workpiece
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.errors import InputError, RobotcellError
+from robotcell.kinematics.transforms import transform_points
 from robotcell.studies.simulate import Touches, check_counts, simulate
 
 __all__ = ["DESIGNS", "LEVER", "Candidate", "MonteCarlo", "Plan", "calibrate_touches",
@@ -92,32 +93,30 @@ def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = 
     -------
     CalibrationResult
     """
-    robot = cell.robot
+    m = touches.measurements(cell.robot)
     if touches.procedure == "tcp":
-        F = robot.fk(touches.q, np.eye(4))
-        r = np.array(touches.roles)
+        F = m.flange()
+        r = np.array(m.point)
         return calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=prior_sigma)
-    T_R_TCP = robot.fk(touches.q, tool_pose(cell, touches.tool))
-    e = np.zeros(len(touches.q)) if touches.track is None else touches.track
+    p_R = m.tcp(tool_pose(cell, touches.tool))
     if touches.procedure == "track":
-        pt = np.array([int(p) - 1 for p in touches.roles])
-        refs = touches.truth["references"]
         t = cell.track
         assert t is not None
-        return calibrate_track(e, T_R_TCP[:, :3, 3], references=refs, point=pt, axis=t.axis,
+        return calibrate_track(m.axes[:, 0], p_R, references=touches.truth["references"],
+                               point=m.reference.astype(int) - 1, axis=t.axis,
                                prior_sigma=prior_sigma)
     parent = touches.truth["parent"]
     if parent == "turntable":
         parent = cell.turntable.parent if cell.turntable is not None else "world"
-    T_P_R = np.eye(4) if parent == "robot" else robot_pose(cell, e)
-    f = (T_P_R @ T_R_TCP)[..., :3, 3]
+    e = np.zeros(m.n) if m.track is None else m.track
+    f = p_R if parent == "robot" else transform_points(robot_pose(cell, e), p_R)
     if touches.procedure == "frame":
-        return frame_3point(f, touches.roles, prior_sigma)
+        return frame_3point(f, m.point, prior_sigma)
     if touches.procedure == "turntable":
-        return calibrate_turntable(touches.table, f, height=-touches.truth["height"],
+        return calibrate_turntable(m.axes[:, 0], f, height=-touches.truth["height"],
                                    prior_sigma=prior_sigma)
     assert cell.turntable is not None
-    return calibrate_workpiece(touches.table, f, touches.roles, cell.turntable.T_parent_B,
+    return calibrate_workpiece(m.axes[:, 0], f, m.point, cell.turntable.T_parent_B,
                                prior_sigma=prior_sigma)
 
 

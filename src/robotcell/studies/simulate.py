@@ -29,6 +29,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from robotcell.calibration.measurements import Measurements, columns_of
+from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell, Turntable
 from robotcell.cell.kinematics import frame_pose, robot_pose, tool_pose
 from robotcell.errors import InputError
@@ -56,10 +58,6 @@ TRACK_SAMPLES = 25
 
 #: Most touches one simulation places (memory of the configuration search grows with them).
 MAX_TOUCHES = 200
-
-#: Fewest touches each procedure's calibration accepts, as ``robotcell calibrate`` checks them.
-MIN_TOUCHES = {"turntable": 3, "track": 3}
-
 
 def _down_orientations() -> NDArray[np.float64]:
     """Candidate TCP orientations in the world: tool Z down, tilted 0/15/30 deg, 12 turns."""
@@ -115,6 +113,38 @@ class Touches:
     tool: str | None = None
     noise: float = 0.0
 
+    def measurements(self, robot: Robot | None = None) -> Measurements:
+        """The touches as the procedure's measurements (SI), which write the measurement CSV.
+
+        Each column of the procedure's specification (:data:`~robotcell.calibration.spec.SPECS`)
+        that the simulation has values for is written: the joint values, the external axis
+        (``e1``: the track position of the track procedure, else the table's axis values), the
+        robot's track position (``track``; not for ``tcp``, whose flange poses are taken in the
+        robot base, nor for ``track``, whose positions are ``e1``) and column ``point``.
+
+        Parameters
+        ----------
+        robot : Robot, optional
+            The arm that touched, for the touches' flange and TCP poses (the written table
+            needs none: the simulated arms have revolute joints, in degrees).
+
+        Returns
+        -------
+        Measurements
+        """
+        spec = SPECS[self.procedure]
+        axes = self.track if self.procedure == "track" else self.table
+        reference = point = None
+        if self.roles is not None and spec.role("reference"):
+            reference = np.array([float(r) for r in self.roles])
+        elif self.roles is not None:
+            point = tuple(self.roles)
+        return Measurements(
+            spec, "simulated touches", joints=self.q, robot=robot,
+            axes=None if axes is None else np.reshape(axes, (len(self.q), -1)),
+            track=None if self.procedure in ("tcp", "track") else self.track,
+            point=point, reference=reference)
+
     def columns(self) -> tuple[list[str], list[list[str]]]:
         """Header and rows of the measurement CSV (degrees, millimetres).
 
@@ -123,23 +153,7 @@ class Touches:
         header : list of str
         rows : list of list of str
         """
-        n = self.q.shape[1]
-        header = [f"a{i + 1}" for i in range(n)]
-        cols: list[list[str]] = [[f"{v:.6f}" for v in np.degrees(self.q[:, i])] for i in range(n)]
-        if self.procedure == "track":
-            header.append("e1")
-            cols.append([f"{v * 1e3:.3f}" for v in self.track])
-        elif self.table is not None:
-            values = self.table.reshape(len(self.q), -1)
-            header += [f"e{i + 1}" for i in range(values.shape[1])]
-            cols += [[f"{math.degrees(v):.4f}" for v in values[:, i]] for i in range(values.shape[1])]
-        if self.track is not None and self.procedure not in ("track", "tcp"):
-            header.append("track")
-            cols.append([f"{v * 1e3:.3f}" for v in self.track])
-        if self.roles is not None:
-            header.append("point")
-            cols.append(list(self.roles))
-        return header, [list(r) for r in zip(*cols)]
+        return self.measurements().text()
 
     def to_table(self) -> dict[str, Any]:
         """The measurement table as :func:`robotcell.io.tables.read_csv` reads the CSV (mm, deg).
@@ -150,10 +164,8 @@ class Touches:
             Column name to a float array (or a list of strings), the input of
             :mod:`robotcell.cell.calibrate`.
         """
-        from robotcell.cell.calibrate.touches import load_table
-
         header, rows = self.columns()
-        return load_table(dict(zip(header, map(list, zip(*rows)))))[0]
+        return columns_of(dict(zip(header, map(list, zip(*rows)))), "simulated touches")
 
     def keywords(self) -> dict[str, Any]:
         """The :mod:`robotcell.cell.calibrate` keywords equal to :attr:`options` (SI, same rounding).
@@ -352,8 +364,10 @@ def _tcp(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
          orientation: bool = True) -> Touches:
     name = _tool_name(cell, tool)
     T_F_TCP = cell.tools[name].T_F_TCP
-    if touches < 3:
-        raise InputError(f"the TCP needs at least 3 touches of the reference point, got {touches}")
+    least = SPECS["tcp"].minimum
+    if touches < least:
+        raise InputError(f"the TCP needs at least {least} touches of the reference point, got "
+                         f"{touches}")
     if not 0 < tilt < math.pi / 2:
         raise InputError(f"tilt must be between 0 and 90 deg, got {math.degrees(tilt):g} deg")
     p_R = np.asarray(point, dtype=float)
@@ -455,8 +469,9 @@ def _track(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
     offsets = np.linspace(-travel / 2, travel / 2, positions) / t.scale
     e_all = np.clip(centre[:, None] + offsets, t.lower, t.upper)
     point = np.repeat(np.arange(len(refs)), positions)
-    if len(point) < MIN_TOUCHES["track"]:
-        raise InputError(f"the track calibration needs at least {MIN_TOUCHES['track']} touches; "
+    least = SPECS["track"].minimum
+    if len(point) < least:
+        raise InputError(f"the track calibration needs at least {least} touches; "
                          f"{len(refs)} reference point(s) x {positions} positions give "
                          f"{len(point)}: add positions or reference points")
     e_all = e_all.ravel()
@@ -519,7 +534,7 @@ def _turntable(cell: Cell, rng: np.random.Generator, noise: float, tool: str | N
         raise InputError(f"radius must be positive (m), got {radius}")
     if not math.isfinite(height):
         raise InputError(f"height must be a finite length (m), got {height}")
-    least = MIN_TOUCHES["turntable"]
+    least = SPECS["turntable"].minimum
     if angles is None and touches < least:
         raise InputError(f"the turntable calibration needs at least {least} table angles "
                          f"(touches), got {touches}")

@@ -37,7 +37,7 @@ from robotcell.calibration.fitting import perturb_pose
 from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.uncertainty import OWN, Estimate, Inputs, Sources, joined
 from robotcell.cell import Cell
-from robotcell.errors import InputError
+from robotcell.errors import InputError, term
 
 __all__ = ["NOMINAL_ACCURACY", "NominalAccuracy", "item_pose", "item_sources", "perturbed",
            "touch_inputs", "written_sources"]
@@ -116,7 +116,7 @@ def item_sources(cell: Cell, key: str, nominal: NominalAccuracy = NOMINAL_ACCURA
             f"{math.degrees(nominal.rotation):g} deg per axis"
             + (f" and {nominal.scale:g} in scale" if size == 7 else "")
             + " (state it as covariance_mm_rad in the cell file's provenance, or with "
-              "--nominal-accuracy)")
+              f"{term('nominal', 'nominal (NominalAccuracy)')})")
     return Sources(size, {f"{key} nominal": np.diag(nominal.sigma(size))}), note
 
 
@@ -208,7 +208,7 @@ def touch_inputs(cell: Cell, points_R: ArrayLike, *, flange: ArrayLike | None = 
     elif cell.tools:
         notes.append("note: the touches are TCP positions x, y, z (the controller applied its "
                      "tool): the uncertainty of that tool is not included; record joint values "
-                     "a1..a6 with --tool to include it")
+                     f"a1..a6 with {term('tool', 'tool')} to include it")
     if track is not None and cell.track is not None:
         e = np.asarray(track, dtype=float).reshape(n)
         mapped = _track_mapped(cell, e, p)

@@ -1,17 +1,19 @@
 """Calibrating into a cell: one call per procedure, from a measurement table to an updated Cell.
 
 Each function takes a :class:`~robotcell.cell.Cell` (or None for a plain calibration in the robot
-base), a measurement table (column name to values in the units of the measurement CSV, mm and
-deg, as :func:`robotcell.io.tables.read_csv` returns it; or the CSV's path) and the procedure's
-options in SI units. It maps the touches into the frames of the cell (through column ``track``
+base), the measurements (the CSV's path; a table, column name to values in the units of the
+measurement CSV, mm and deg, as :func:`robotcell.io.tables.read_csv` returns it; or touches read
+before, :class:`~robotcell.calibration.measurements.Measurements`), read once by the procedure's
+specification (:data:`~robotcell.calibration.spec.SPECS`), and the procedure's options in SI
+units. It maps the touches into the frames of the cell (through column ``track``
 when the robot is on a track), runs the estimator of :mod:`robotcell.calibration` and returns a
 :class:`CellCalibration`: the :class:`~robotcell.calibration.result.CalibrationResult`, a new
 :class:`~robotcell.cell.Cell` with the calibrated value written in, stamped with its
 :class:`~robotcell.cell.Provenance` (the cell given is not changed), and notes: on the
-measurements (identical rows, touches mapped to the world, where the turntable comes from), each
-also passed to ``on_note`` as soon as it arises (so that a caller shows them even when the
-measurements are then refused), and on the update (a value kept because the touches do not
-measure it).
+measurements (columns not used, identical rows, touches mapped to the world, where the turntable
+comes from), each also passed to ``on_note`` as soon as it arises (so that a caller shows them
+even when the measurements are then refused), and on the update (a value kept because the
+touches do not measure it); and what it assumed (tool, frame of the result, track and table).
 Nothing is written to a file: save the new cell with :meth:`Cell.save`.
 
 The 2-axis positioner is calibrated by :func:`robotcell.identification.calibrate_positioner` on
@@ -31,16 +33,9 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import (
-    check_count,
-    external_axis,
-    flange_poses,
-    joint_columns,
-    nominal_points,
-    point_roles,
-    tcp_positions,
-)
-from robotcell.calibration.result import CalibrationResult
+from robotcell.calibration.measurements import Measurements
+from robotcell.calibration.result import CalibrationResult, result_json
+from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import OWN, Sources
 from robotcell.cell import Cell, Positioner, Provenance, Turntable
 from robotcell.cell.calibrate.chain import (
@@ -52,23 +47,20 @@ from robotcell.cell.calibrate.chain import (
     written_sources,
 )
 from robotcell.cell.calibrate.touches import (
-    POSE_COLUMNS,
-    Table,
-    line_labels,
-    load_table,
-    repeat_notes,
+    MeasurementInput,
+    read_touches,
     robot_in_world,
     tool_transform,
     track_positions,
 )
 from robotcell.cell.validation import check_axis_limits
-from robotcell.errors import IllPosedError, InputError
+from robotcell.errors import IllPosedError, InputError, term
+from robotcell.io.fileio import read_json
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.io.tables import require_columns
 from robotcell.kinematics.transforms import invert, transform_points, validate_pose
 from robotcell.robot.robot import Robot
 
-__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "frame", "positioner",
+__all__ = ["SAME_POSE", "CellCalibration", "TurntablePose", "external_tcp", "frame", "positioner",
            "positioner_touches", "tcp", "track", "turntable", "workpiece"]
 
 #: Largest difference between a given turntable pose and the cell's that counts as the same
@@ -105,6 +97,11 @@ class CellCalibration:
     inputs : tuple of str
         The items of the cell the calibration used, in the order of the input parameters of
         ``result.fit`` (see :mod:`robotcell.cell.calibrate.chain`).
+    assumed : str
+        What the calibration took the touches with, defaults included: the tool that touched,
+        the frame of the result, the track and the table, e.g. ``"kr16: tool 'torch' (joint
+        values a1..a6); result T_world_B in frame 'world'; track from column 'track' (mm);
+        table from column 'e1' (deg)"``.
     """
 
     result: CalibrationResult
@@ -116,6 +113,7 @@ class CellCalibration:
     key: str = ""
     value: str = ""
     inputs: tuple[str, ...] = ()
+    assumed: str = ""
 
 
 class _Notes(list):
@@ -127,9 +125,12 @@ class _Notes(list):
 
     def add(self, notes: list[str]) -> None:
         for note in notes:
-            self.append(note)
-            if self.on_note is not None:
-                self.on_note(note)
+            self.one(note)
+
+    def one(self, note: str) -> None:
+        self.append(note)
+        if self.on_note is not None:
+            self.on_note(note)
 
 
 @dataclass(frozen=True)
@@ -164,10 +165,27 @@ class TurntablePose:
         if result.procedure != "turntable":
             raise InputError(f"{source}: not a turntable result (procedure {result.procedure!r})")
         key = "T_world_B" if "T_world_B" in result.values else "T_R_B"
+        if key not in result.values:
+            raise InputError(f"{source}: the turntable result has no pose T_R_B or T_world_B")
         est = result.estimates.get(key)
         cov = (est.sources.renamed(OWN, f"turntable of {source}") if est is not None
                else None if result.covariance is None else np.array(result.covariance[:6, :6]))
         return cls(result.values[key], cov, "world" if key == "T_world_B" else "robot", source)
+
+    @classmethod
+    def load(cls, path: str | Path) -> TurntablePose:
+        """The turntable pose of a turntable result's JSON file (the output of
+        :meth:`CalibrationResult.to_json`, read by :meth:`CalibrationResult.from_json`).
+
+        Raises
+        ------
+        InputError
+            A missing file, not JSON, not a turntable result, or a malformed one.
+        """
+        data = read_json(path, f"give the {result_json()}")
+        result = CalibrationResult.from_json(data, str(path), "turntable",
+                                             required=("procedure", "matrix"))
+        return cls.from_result(result, str(path))
 
 
 @dataclass(frozen=True)
@@ -217,7 +235,7 @@ def _provenance(procedure: str, result: CalibrationResult, n: int, source: str,
                       inputs=record.chained.keys if inputs is None else inputs, sources=sources)
 
 
-def _file(measurements: Table | str | Path, file: str | Path | None) -> str | None:
+def _file(measurements: MeasurementInput, file: str | Path | None) -> str | None:
     """The touch file behind a calibration: ``file``, or ``measurements`` when it is a path."""
     if file is not None:
         return str(file)
@@ -244,20 +262,13 @@ def _options(sigma: float | None, tool: str | ArrayLike | None = None, **more: A
     return out
 
 
-def _flange(cols: Table, source: str, robot: Robot | None) -> NDArray[np.float64] | None:
-    """Flange poses of touches given as joint values (None for x, y, z touches)."""
-    if robot is None or "a1" not in cols or "x" in cols:
-        return None
-    return robot.fk(joint_columns(cols, robot, source), np.eye(4))
-
-
-def _chained(cell: Cell | None, cols: Table, source: str, p_R: NDArray[np.float64],
+def _chained(cell: Cell | None, m: Measurements, p_R: NDArray[np.float64],
              tool: str | ArrayLike | None, track: NDArray[np.float64] | None,
              nominal: NominalAccuracy, notes: _Notes) -> Chained:
     """The tool and track the touches rest on (nothing without a cell); notes go to ``notes``."""
     if cell is None:
         return Chained()
-    chained = touch_inputs(cell, p_R, flange=_flange(cols, source, cell.robot),
+    chained = touch_inputs(cell, p_R, flange=None if m.joints is None else m.flange(),
                            tool=tool if isinstance(tool, str) else None, track=track,
                            nominal=nominal)
     notes.add(list(chained.notes))
@@ -273,9 +284,9 @@ def _label(cell: Cell | None, cell_label: str | None) -> str:
     return cell_label or (f"cell {cell.name!r}" if cell is not None else "the cell")
 
 
-def _refuse_track_column(cols: Table, source: str, why: str) -> None:
-    if "track" in cols:
-        raise InputError(f"{source}: column 'track' (track position of each touch) {why}")
+def _refuse_track_column(m: Measurements, why: str) -> None:
+    if m.track is not None:
+        raise InputError(f"{m.source}: column 'track' (track position of each touch) {why}")
 
 
 #: Note of a tool calibrated from touches at several track positions.
@@ -283,15 +294,59 @@ MAPPED_NOTE = ("note: the flange poses were mapped to the world through column '
                "reference point (pivot) is in world coordinates, and ABC World alignments refer "
                "to the world axes")
 
-#: Why column ``track`` is refused without a cell.
-_NO_CELL_TRACK = ("needs --cell CELL.yaml (in Python: a Cell), which says where the track is; "
-                  "remove the column or pass --cell")
+def _no_cell_track() -> str:
+    """Why column ``track`` is refused without a cell."""
+    return (f"needs {term('cell=FILE (Cell)', 'a cell (parameter cell)')}, which says where the "
+            f"track is; remove the column or pass {term('cell', 'the cell')}")
 
 
 def _arm(cell: Cell | None, robot: Robot | None) -> Robot | None:
     if cell is not None and robot is not None:
         raise InputError("the robot is the cell's: give a cell or a robot, not both")
     return cell.robot if cell is not None else robot
+
+
+#: The frames of a result's value ``T_a_b`` by ``a``, as :func:`_assumed` names them.
+_FRAMES = {"F": "on the flange", "R": "in the robot base", "world": "in frame 'world'",
+           "L": "in the track frame L", "B": "in the turntable frame B",
+           "P": "in the positioner's plate P"}
+
+
+def _tool_text(m: Measurements, tool: str | ArrayLike | None) -> str:
+    """Which tool touched, as the touches say it."""
+    if m.points is not None:
+        return "the controller's tool (TCP positions x, y, z)"
+    if m.procedure.pose == "flange":
+        given = "flange poses x, y, z, a, b, c" if m.poses is not None else "joint values a1..a6"
+        return f"no tool ({given})"
+    if tool is None:
+        return f"the tool of robot model {m.robot.name!r} (none given; joint values a1..a6)"
+    if isinstance(tool, str):
+        return f"tool {tool!r} (joint values a1..a6)"
+    xyzabc = ",".join(f"{round(float(v), 3) + 0.0:g}"
+                      for v in pose_to_vendor(np.asarray(tool, dtype=float), "kuka"))
+    return f"tool {xyzabc} (X,Y,Z,A,B,C mm, deg; joint values a1..a6)"
+
+
+def _assumed(cell: Cell | None, m: Measurements, tool: str | ArrayLike | None, value: str,
+             mapped: bool = False) -> str:
+    """What a calibration took the touches with: tool, frame of the result, track, table.
+
+    ``value`` is the result's pose ``T_a_b``; ``mapped`` says that the touches were mapped to
+    the world through the track (the track's own calibration reads its positions from ``e1``).
+    """
+    who = cell.name if cell is not None else (m.robot.name if m.robot is not None else "")
+    parts = [_tool_text(m, tool), f"result {value} {_FRAMES[value.split('_')[1]]}"]
+    if cell is not None and cell.track is not None:
+        parts.append("track from column 'e1' (mm)" if m.procedure.name == "track"
+                     else "track from column 'track' (mm)" if m.track is not None
+                     else "track not used (touches in the robot base)" if not mapped
+                     else "track 0 mm (no column 'track')")
+    if m.axes is not None and m.procedure.name != "track":
+        names = ", ".join(f"'e{i + 1}'" for i in range(m.axes.shape[1]))
+        what = "table" if m.axes.shape[1] == 1 else "positioner"
+        parts.append(f"{what} from column{'s' * (m.axes.shape[1] > 1)} {names} (deg)")
+    return (f"{who}: " if who else "") + "; ".join(parts)
 
 
 # -- tool ------------------------------------------------------------------------------------------
@@ -318,7 +373,7 @@ def _write_tool(cell: Cell, name: str, result: CalibrationResult, prov: Provenan
     return [note]
 
 
-def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
+def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = None, *,
         robot: Robot | None = None, world_mode: Literal["6d", "5d"] = "6d",
         sigma: float | None = None, source: str | None = None, cell_label: str | None = None,
         time: str | None = None, on_note: Callable[[str], None] | None = None,
@@ -331,7 +386,7 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     cell : Cell or None
         The cell whose tool ``name`` is calibrated; its robot computes flange poses from joint
         values. None: a plain calibration (flange poses in the robot base).
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         Flange poses ``x,y,z,a,b,c`` (KUKA, mm/deg, no tool active) or joint values ``a1..an``
         (deg); optional column ``point`` (``tcp``, ``-x``, ``xy``, ``world``) and, in a cell with
         a track, ``track`` (mm): the touches are then mapped to the world.
@@ -366,27 +421,22 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
     """
     from robotcell.calibration.tcp import calibrate_tool
 
-    cols, source = load_table(measurements, source)
     label = _label(cell, cell_label)
-    T = flange_poses(cols, source, _arm(cell, robot))
-    roles = [str(r).strip().lower() for r in cols["point"]] if "point" in cols else ["tcp"] * len(T)
-    bad = sorted(set(roles) - {"tcp", "-x", "xy", "world"})
-    if bad:
-        raise InputError(f"{source}: column 'point' must hold tcp, -x, xy or world; "
-                         f"found {', '.join(bad)}")
     notes = _Notes(on_note)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + ["track"], source))
-    check_count(roles.count("tcp"), 3, "touches of the reference point (point=tcp)", source)
+    m = read_touches("tcp", measurements, source, _arm(cell, robot), notes.one)
+    T = m.flange()
+    m.check_points()
+    m.check_count()
     e = None
     if cell is None:
-        _refuse_track_column(cols, source, _NO_CELL_TRACK)
+        _refuse_track_column(m, _no_cell_track())
     else:
-        e = track_positions(cell, cols, source, label)
+        e = track_positions(cell, m, label)
         if e is not None and cell.track is not None:
             T = cell.frame_pose("robot", track=e) @ T
             notes.add([MAPPED_NOTE])
-    r = np.array(roles)
-    labels = line_labels(len(roles), roles)
+    r = np.array(m.point)
+    labels = m.labels(points=True)
     order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
                             world_mode=world_mode, prior_sigma=sigma,
@@ -402,16 +452,57 @@ def tcp(cell: Cell | None, measurements: Table | str | Path, name: str | None = 
                                 world_mode=world_mode, prior_sigma=sigma,
                                 labels=[labels[i] for i in order], inputs=chained.inputs)
     key = f"tools.{name}" if cell is not None and name is not None else ""
+    assumed = _assumed(cell, m, None, "T_F_TCP")
     if cell is None or name is None:
         return CellCalibration(result, notes=tuple(notes), key=key, value="T_F_TCP",
-                               inputs=chained.keys)
+                               inputs=chained.keys, assumed=assumed)
     record = _Record(_file(measurements, file), _options(sigma, world=world_mode), chained,
                      nominal)
-    prov = _provenance("tcp", result, len(T), source, time, cell, key, "T_F_TCP", record)
+    prov = _provenance("tcp", result, m.n, m.source, time, cell, key, "T_F_TCP", record)
     new = copied(cell)
     kept = _write_tool(new, name, result, prov, label)
     return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes), tuple(kept),
-                           key, "T_F_TCP", chained.keys)
+                           key, "T_F_TCP", chained.keys, assumed)
+
+
+def external_tcp(cell: Cell | None, measurements: MeasurementInput, *,
+                 robot: Robot | None = None, tool: str | ArrayLike | None = None,
+                 sigma: float | None = None, source: str | None = None,
+                 cell_label: str | None = None, on_note: Callable[[str], None] | None = None
+                 ) -> CellCalibration:
+    """A fixed (external) tool touched with a robot-held reference tool of known TCP.
+
+    Parameters
+    ----------
+    cell : Cell or None
+        A cell whose robot and tools the touches were taken with (the result is in its robot
+        base and is not written into it); None: ``robot`` and ``tool`` give them.
+    measurements : Measurements, mapping, str or Path
+        Reference-tool TCP positions ``x,y,z`` (mm) or joint values ``a1..an`` (deg); column
+        ``point``: ``tcp`` (the fixed TCP, the default), ``x`` (a point on its +X axis), ``xy``
+        (a point in its XY plane with +Y).
+    robot : Robot, optional
+        Robot model for joint values when no cell is given.
+    tool : str or array_like of shape (4, 4), optional
+        The reference tool: a tool of the cell by name, or ``T_F_TCP`` (m); default the robot
+        model's tool.
+    sigma, source, cell_label, on_note
+        As for :func:`tcp`.
+
+    Returns
+    -------
+    CellCalibration
+        ``result.values["T_R_TCP"]``: the fixed tool in the robot base (see
+        :func:`robotcell.calibration.frame.external_tcp`); no cell.
+    """
+    from robotcell.calibration.frame import external_tcp as calibrate_external_tcp
+
+    notes = _Notes(on_note)
+    m = read_touches("external-tcp", measurements, source, _arm(cell, robot), notes.one)
+    p = m.tcp(tool_transform(cell, tool, m))
+    result = calibrate_external_tcp(p, m.point, sigma, m.labels(points=True))
+    return CellCalibration(result, notes=tuple(notes), value="T_R_TCP",
+                           assumed=_assumed(cell, m, tool, "T_R_TCP"))
 
 
 # -- frame -----------------------------------------------------------------------------------------
@@ -426,13 +517,16 @@ def _frame_parent(cell: Cell, name: str | None, parent: str | None, label: str) 
     if old is None:
         return "world"
     if old.parent == "turntable":
-        raise InputError(f"frame {name!r} of {label} is carried by the turntable: "
-                         "calibrate it with 'robotcell calibrate workpiece', or pass --parent "
-                         "world or --parent robot to replace it by a frame fixed there")
+        raise InputError(
+            f"frame {name!r} of {label} is carried by the turntable: calibrate it with "
+            f"{term('calibrate workpiece', 'robotcell.cell.calibrate.workpiece')}, or pass "
+            f"{term('parent=world', 'parent=' + repr('world'))} or "
+            f"{term('parent=robot', 'parent=' + repr('robot'))} to replace it by a frame fixed "
+            "there")
     return old.parent
 
 
-def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
+def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = None, *,
           parent: Literal["world", "robot"] | None = None, robot: Robot | None = None,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
           source: str | None = None, cell_label: str | None = None,
@@ -445,7 +539,7 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
     ----------
     cell : Cell or None
         The cell whose frame ``name`` is calibrated; None: a plain calibration in the robot base.
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         TCP positions ``x,y,z`` (mm, robot base) or joint values ``a1..an`` (deg); column
         ``point`` (``origin``, ``x``, ``xy``) or ``nominal_x, nominal_y, nominal_z`` (mm); in a
         cell with a track, for a frame in the world, ``track`` (mm).
@@ -472,48 +566,45 @@ def frame(cell: Cell | None, measurements: Table | str | Path, name: str | None 
 
     if cell is None and parent is not None:
         raise InputError("the parent of a frame is a cell's notion; give the cell too")
-    cols, source = load_table(measurements, source)
     label = _label(cell, cell_label)
-    p = tcp_positions(cols, source, _arm(cell, robot), tool_transform(cell, tool, cols))
     notes = _Notes(on_note)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + ["track", "nominal_x", "nominal_y", "nominal_z"],
-                           source))
+    m = read_touches("frame", measurements, source, _arm(cell, robot), notes.one)
+    p = m.tcp(tool_transform(cell, tool, m))
     in_world = False
     p_R, e = p, None
     if cell is None:
-        _refuse_track_column(cols, source, _NO_CELL_TRACK)
+        _refuse_track_column(m, _no_cell_track())
     else:
         parent = _frame_parent(cell, name, parent, label)  # type: ignore[assignment]
         if parent == "world":
-            p = transform_points(robot_in_world(cell, cols, source, len(p), label), p)
-            e = track_positions(cell, cols, source, label)
-            e = np.zeros(len(p)) if e is None else e
+            p = transform_points(robot_in_world(cell, m, label), p)
+            e = np.zeros(m.n) if m.track is None else m.track
             in_world = True
         else:
-            track_positions(cell, cols, source, label)
-    chained = _chained(cell, cols, source, p_R, tool, e, nominal, notes)
-    if "nominal_x" in cols:
-        check_count(len(p), 3, "points", source)
-        result = frame_npoint(p, nominal_points(cols, source), sigma, line_labels(len(p)),
-                              inputs=chained.inputs)
+            track_positions(cell, m, label)
+    chained = _chained(cell, m, p_R, tool, e, nominal, notes)
+    if m.nominal is not None:
+        m.check_count()
+        result = frame_npoint(p, m.nominal, sigma, m.labels(), inputs=chained.inputs)
     else:
-        roles = point_roles(cols, source)
-        result = frame_3point(p, roles, sigma, line_labels(len(roles), roles),
-                              inputs=chained.inputs)
+        m.check_points()
+        result = frame_3point(p, m.point, sigma, m.labels(points=True), inputs=chained.inputs)
     item = f"frames.{name}" if cell is not None and name is not None else ""
+    key = f"T_world_{name}" if in_world else "T_R_W"
+    assumed = _assumed(cell, m, tool, f"T_world_{name or 'W'}" if in_world else key,
+                       mapped=in_world)
     if cell is None or name is None:
         return CellCalibration(result, notes=tuple(notes), key=item, value="T_R_W",
-                               inputs=chained.keys)
-    key = f"T_world_{name}" if in_world else "T_R_W"
+                               inputs=chained.keys, assumed=assumed)
     if in_world:
         result = result.renamed("T_R_W", key)
     record = _Record(_file(measurements, file), _options(sigma, tool, parent=parent), chained,
                      nominal)
-    prov = _provenance("frame", result, len(p), source, time, cell, item, key, record)
+    prov = _provenance("frame", result, m.n, m.source, time, cell, item, key, record)
     new = copied(cell)
     new.update_frame(name, result.values[key], prov, parent=parent)
     return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov, tuple(notes),
-                           key=item, value=key, inputs=chained.keys)
+                           key=item, value=key, inputs=chained.keys, assumed=assumed)
 
 
 # -- track -----------------------------------------------------------------------------------------
@@ -529,35 +620,38 @@ def _cell_track_axis(cell: Cell, axis: str | None, references: NDArray[np.float6
                          "calibration supports x and z: describe the track frame with the motion "
                          "along x or z")
     if axis is not None and axis != tr.axis:
-        raise InputError(f"--axis {axis} differs from the track axis {tr.axis} of {label}; "
-                         "drop --axis (it defaults to the cell's) or correct the cell file")
+        raise InputError(f"{term('axis', 'axis')} {axis} differs from the track axis {tr.axis} "
+                         f"of {label}; drop {term('axis', 'axis')} (it defaults to the cell's) or "
+                         "correct the cell file")
     if not len(references) and roll is None:
+        points = term("reference=X,Y,Z", "references (touched points with known coordinates "
+                      "in L, m)")
         raise InputError("touches of one unknown point do not measure the rotation of the robot "
                          "base about the track axis, so the track's robot_at_zero cannot be "
-                         "updated: pass --reference X,Y,Z (a touched point with known "
-                         "coordinates in L, mm) or accept the zero-roll convention with --roll "
-                         "zero")
+                         f"updated: pass {points} or accept the zero-roll convention with "
+                         f"{term('roll=zero', 'roll=' + repr('zero'))}")
     return tr.axis
 
 
-def _reference_indices(cols: Table, n_refs: int, source: str) -> NDArray[np.int_] | None:
+def _reference_indices(m: Measurements, n_refs: int) -> NDArray[np.int_] | None:
     """0-based reference index per touch from column ``point`` (1-based in the table)."""
-    if "point" not in cols:
+    if m.reference is None:
         if n_refs > 1:
-            raise InputError(f"{source}: {n_refs} --reference points given; add a column 'point' "
-                             f"saying which one (1..{n_refs}) each touch is")
+            raise InputError(f"{m.source}: {n_refs} {term('reference', 'reference')} points "
+                             f"given; add a column 'point' saying which one (1..{n_refs}) each "
+                             "touch is")
         return None
     if n_refs == 0:
-        raise InputError(f"{source}: column 'point' names reference points, but no --reference "
-                         "was given")
-    idx = require_columns(cols, ["point"], source)[:, 0]
+        raise InputError(f"{m.source}: column 'point' names reference points, but no "
+                         f"{term('reference', 'references')} was given")
+    idx = m.reference
     if not np.all(idx == np.round(idx)) or idx.min() < 1 or idx.max() > n_refs:
-        raise InputError(f"{source}: column 'point' must hold reference numbers 1..{n_refs} "
-                         "(in the order of the --reference options)")
+        raise InputError(f"{m.source}: column 'point' must hold reference numbers 1..{n_refs} "
+                         f"(in the order of the {term('reference options', 'references')})")
     return idx.astype(int) - 1
 
 
-def track(cell: Cell | None, measurements: Table | str | Path, *,
+def track(cell: Cell | None, measurements: MeasurementInput, *,
           references: ArrayLike | None = None, axis: Literal["x", "z"] | None = None,
           roll: Literal["zero"] | None = None, robot: Robot | None = None,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
@@ -572,7 +666,7 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
     cell : Cell or None
         The cell whose track's ``robot_at_zero`` (``T_L_R0``) and scale are calibrated; None: a
         plain calibration.
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) of fixed reference point(s) at track
         positions ``e1`` (mm); column ``point`` (1, 2, ...) with several references.
     references : array_like, shape (K, 3), optional
@@ -598,44 +692,42 @@ def track(cell: Cell | None, measurements: Table | str | Path, *,
     label = _label(cell, cell_label)
     if cell is not None:
         axis = _cell_track_axis(cell, axis, refs, roll, label)  # type: ignore[assignment]
-    model = _arm(cell, robot)
-    cols, source = load_table(measurements, source)
-    _refuse_track_column(cols, source, "is not used by 'calibrate track': its track "
-                         "positions are column e1")
-    f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
-    e = external_axis(cols, source, "track")
-    if cell is not None:
-        check_axis_limits(cell.track, e, ["e1"], source, label)
-    check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "point"], source))
-    idx = _reference_indices(cols, len(refs), source)
+    m = read_touches("track", measurements, source, _arm(cell, robot), notes.one)
+    f = m.tcp(tool_transform(cell, tool, m))
+    e = m.axes[:, 0]
+    if cell is not None:
+        check_axis_limits(cell.track, e, ["e1"], m.source, label)
+    m.check_count()
+    idx = _reference_indices(m, len(refs))
     options = _options(sigma, tool, references_mm=(refs * 1e3).tolist() if len(refs) else None,
                        axis=axis, roll=roll)
     keep_offset = cell is not None and len(refs) < 2
     if keep_offset:
         # The fit takes the unmeasured carriage offset as zero; the cell knows it.
         refs = refs - cell.track.T_L_R0[:3, 3]
-    chained = _chained(cell, cols, source, f, tool, None, nominal, notes)
+    chained = _chained(cell, m, f, tool, None, nominal, notes)
     result = calibrate_track(e, f, references=refs if len(refs) else None, point=idx,
-                             axis=axis or "x", roll=roll, labels=line_labels(len(f)),
+                             axis=axis or "x", roll=roll, labels=m.labels(),
                              prior_sigma=sigma, inputs=chained.inputs)
+    assumed = _assumed(cell, m, tool, "T_L_R")
     if cell is None:
-        return CellCalibration(result, notes=tuple(notes))
+        return CellCalibration(result, notes=tuple(notes), assumed=assumed)
     tr = cell.track
     T_L_R0 = result.values["T_L_R"].copy()
     kept = []
     if keep_offset:
         T_L_R0[:3, 3] = tr.T_L_R0[:3, 3]
         offset = ", ".join(f"{v:.3f}" for v in tr.T_L_R0[:3, 3] * 1e3 + 0.0)
-        kept.append(f"note: the carriage offset is not measured (two or more --reference "
-                     f"points measure it): kept the offset of {label} ({offset} mm)")
+        kept.append(f"note: the carriage offset is not measured (two or more "
+                    f"{term('reference', 'reference')} points measure it): kept the offset of "
+                    f"{label} ({offset} mm)")
     record = _Record(_file(measurements, file), options, chained, nominal)
-    prov = _provenance("track", result, len(f), source, time, cell, "track", "T_L_R", record)
+    prov = _provenance("track", result, m.n, m.source, time, cell, "track", "T_L_R", record)
     new = copied(cell)
     new.update_track(prov, T_L_R0=T_L_R0, scale=float(result.values["scale"]))
     return CellCalibration(result, new, f"track {tr.name!r} (robot_at_zero, scale)", prov,
-                           tuple(notes), tuple(kept), "track", "T_L_R", chained.keys)
+                           tuple(notes), tuple(kept), "track", "T_L_R", chained.keys, assumed)
 
 
 # -- turntable -------------------------------------------------------------------------------------
@@ -653,29 +745,62 @@ def _cell_turntable(cell: Cell, label: str) -> Turntable:
     return cell.turntable
 
 
-def _table_touches(cell: Cell | None, cols: Table, source: str, f: NDArray[np.float64],
+def _table_touches(cell: Cell | None, m: Measurements, f: NDArray[np.float64],
                    label: str) -> NDArray[np.float64]:
     """Touches in the turntable's parent frame: mapped to the world for a table in the world."""
     if cell is None:
-        _refuse_track_column(cols, source, _NO_CELL_TRACK)
+        _refuse_track_column(m, _no_cell_track())
         return f
     if _cell_turntable(cell, label).parent == "world":
-        return transform_points(robot_in_world(cell, cols, source, len(f), label), f)
-    track_positions(cell, cols, source, label)
+        return transform_points(robot_in_world(cell, m, label), f)
+    track_positions(cell, m, label)
     return f
 
 
-def _world_track(cell: Cell | None, cols: Table, source: str, n: int
-                 ) -> NDArray[np.float64] | None:
+def _on_table(cell: Cell | None, m: Measurements, tool: str | ArrayLike | None, label: str,
+              nominal: NominalAccuracy, notes: _Notes, check: Callable[[], None]
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64], Chained]:
+    """Touches of a point on a turntable: its angles (rad), the touches in its parent frame
+    (m) and the inputs they rest on; ``check`` refuses what the procedure cannot use once the
+    angles are within the table's limits."""
+    f_R = m.tcp(tool_transform(cell, tool, m))
+    theta = m.axes[:, 0]
+    if cell is not None:
+        check_axis_limits(cell.turntable, theta, ["e1"], m.source, label)
+    check()
+    f = _table_touches(cell, m, f_R, label)
+    return theta, f, _chained(cell, m, f_R, tool, _world_track(cell, m), nominal, notes)
+
+
+def _world_track(cell: Cell | None, m: Measurements) -> NDArray[np.float64] | None:
     """Track positions of touches mapped to the world through the track of a turntable cell."""
-    if cell is None or cell.track is None or cell.turntable is None or (
-            cell.turntable.parent != "world"):
+    if not _in_world(cell):
         return None
-    e = track_positions(cell, cols, source)
-    return np.zeros(n) if e is None else e
+    e = track_positions(cell, m)
+    return np.zeros(m.n) if e is None else e
 
 
-def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
+def _in_world(cell: Cell | None) -> bool:
+    """A cell whose robot is on a track beside a turntable or positioner in the world: its
+    touches of the table are mapped to the world through the track."""
+    return (cell is not None and cell.track is not None and cell.turntable is not None
+            and cell.turntable.parent == "world")
+
+
+def _positioner_points(cell: Cell, m: Measurements, tool: str | ArrayLike | None, label: str
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The axis values (rad) of touches of a point on a positioner and the point in its parent
+    frame (m), checked against the axes' limits (:func:`positioner_touches`)."""
+    f = m.tcp(tool_transform(cell, tool, m))
+    names = [f"e{i + 1}" for i in range(m.axes.shape[1])]
+    check_axis_limits(cell.turntable, m.axes, names, m.source, label)
+    if cell.turntable.parent == "world":
+        return m.axes, transform_points(robot_in_world(cell, m, label), f)
+    track_positions(cell, m, label)
+    return m.axes, f
+
+
+def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
                        tool: str | ArrayLike | None = None, source: str | None = None,
                        cell_label: str | None = None
                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -690,7 +815,7 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
     ----------
     cell : Cell
         A cell with a positioner (or a turntable, the 1-axis case).
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg), the axis values ``e1..en`` (deg, one
         column per positioner axis) and, for a positioner in the world of a cell with a track,
         ``track`` (mm).
@@ -708,15 +833,9 @@ def positioner_touches(cell: Cell, measurements: Table | str | Path, *,
     if cell.turntable is None:
         raise InputError(f"{label} has no positioner; add a 'positioner' section to the cell "
                          "file first")
-    cols, source = load_table(measurements, source)
-    f = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
-    names = [f"e{i + 1}" for i in range(cell.turntable.n_axes)]
-    values = np.radians(require_columns(cols, names, source))
-    check_axis_limits(cell.turntable, values, names, source, label)
-    if cell.turntable.parent == "world":
-        return values, transform_points(robot_in_world(cell, cols, source, len(f), label), f)
-    track_positions(cell, cols, source, label)
-    return values, f
+    spec = SPECS["positioner"].with_axes(cell.turntable.n_axes)
+    return _positioner_points(cell, read_touches(spec, measurements, source, cell.robot), tool,
+                              label)
 
 
 def _check_alone(values: NDArray[np.float64], source: str) -> None:
@@ -725,19 +844,20 @@ def _check_alone(values: NDArray[np.float64], source: str) -> None:
     ``values`` (N, 2) are tilt and rotate (rad); the circle point analysis that starts the fit
     without a nominal chain needs such a group per axis.
     """
+    least = SPECS["positioner"].minimum
     for k, name in enumerate(("e1 (tilt)", "e2 (rotate)")):
         other = np.round(values[:, 1 - k], 9)
-        if not any(len(np.unique(np.round(values[other == o, k], 9))) >= 3
+        if not any(len(np.unique(np.round(values[other == o, k], 9))) >= least
                    and np.ptp(values[other == o, k]) >= math.radians(10.0) * 0.999
                    for o in np.unique(other)):
             raise IllPosedError(
-                f"{source}: no 3 touches turn {name} alone over 10 deg or more; without --cell "
-                "(in Python: a Cell) the positioner calibration starts from the circles of such "
-                "touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give the cell with the "
-                "positioner's nominal chain")
+                f"{source}: no {least} touches turn {name} alone over 10 deg or more; without "
+                f"{term('cell (Cell)', 'a cell')} the positioner calibration starts from the "
+                "circles of such touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give "
+                "the cell with the positioner's nominal chain")
 
 
-def positioner(cell: Cell | None, measurements: Table | str | Path, *,
+def positioner(cell: Cell | None, measurements: MeasurementInput, *,
                robot: Robot | None = None, tool: str | ArrayLike | None = None,
                sigma: float | None = None, source: str | None = None,
                cell_label: str | None = None, time: str | None = None,
@@ -757,7 +877,7 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
         A cell with a positioner of 2 axes. None: a plain calibration in the robot base, started
         from the circle point analysis of the touches (which then need, for each axis, at least
         3 that move that axis alone, e.g. a grid of 3 tilt by 4 rotate values); nothing written.
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         As for :func:`positioner_touches`: one point on the table touched at several (tilt,
         rotate) values ``e1``, ``e2`` (deg).
     robot : Robot, optional
@@ -775,39 +895,37 @@ def positioner(cell: Cell | None, measurements: Table | str | Path, *,
     from robotcell.identification import calibrate_positioner
 
     label = _label(cell, cell_label)
-    cols, source = load_table(measurements, source)
     notes = _Notes(on_note)
     if cell is None:
-        _refuse_track_column(cols, source, _NO_CELL_TRACK)
-        points = tcp_positions(cols, source, robot, tool_transform(None, tool))
-        values = np.radians(require_columns(cols, ["e1", "e2"], source))
-        notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2"], source))
-        _check_alone(values, source)
-        done = calibrate_positioner(values, points, prior_sigma=sigma,
-                                    labels=line_labels(len(points)))
-        return CellCalibration(done.result, notes=tuple(notes))
+        m = read_touches("positioner", measurements, source, robot, notes.one)
+        _refuse_track_column(m, _no_cell_track())
+        points = m.tcp(tool_transform(None, tool))
+        _check_alone(m.axes, m.source)
+        done = calibrate_positioner(m.axes, points, prior_sigma=sigma, labels=m.labels())
+        return CellCalibration(done.result, notes=tuple(notes),
+                               assumed=_assumed(None, m, tool, "T_R_B"))
     pos = cell.turntable
     if pos is None or pos.n_axes != 2:
         raise InputError(f"{label} has no positioner of 2 axes (tilt, rotate) to calibrate")
-    _arm(cell, robot)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "e2", "track"], source))
-    values, points = positioner_touches(cell, cols, tool=tool, source=source, cell_label=label)
-    p_R = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
-    chained = _chained(cell, cols, source, p_R, tool, _world_track(cell, cols, source, len(p_R)),
-                       nominal, notes)
+    m = read_touches("positioner", measurements, source, _arm(cell, robot), notes.one)
+    values, points = _positioner_points(cell, m, tool, label)
+    chained = _chained(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
+                       _world_track(cell, m), nominal, notes)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
-                                labels=line_labels(len(points)), inputs=chained.inputs)
-    result = done.result.renamed("T_R_B", "T_world_B") if pos.parent == "world" else done.result
+                                labels=m.labels(), inputs=chained.inputs)
+    key = "T_world_B" if pos.parent == "world" else "T_R_B"
+    result = done.result.renamed("T_R_B", key)
     record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
-    prov = _provenance("positioner", result, len(points), source, time, cell, "positioner",
-                       "", record)
+    prov = _provenance("positioner", result, m.n, m.source, time, cell, "positioner", "",
+                       record)
     new = copied(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
     return CellCalibration(result, new, f"positioner {pos.name!r} (axes, root)", prov,
-                           tuple(notes), key="positioner", inputs=chained.keys)
+                           tuple(notes), key="positioner", inputs=chained.keys,
+                           assumed=_assumed(cell, m, tool, key, mapped=pos.parent == "world"))
 
 
-def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: float = 0.0,
+def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: float = 0.0,
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
               sigma: float | None = None, source: str | None = None,
               cell_label: str | None = None, time: str | None = None,
@@ -819,7 +937,7 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
     ----------
     cell : Cell or None
         The cell whose turntable frame (``T_parent_B``) is calibrated; None: ``T_R_B`` only.
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) with the table angle ``e1`` (deg); for a
         turntable in the world of a cell with a track, ``track`` (mm).
     height : float
@@ -836,34 +954,23 @@ def turntable(cell: Cell | None, measurements: Table | str | Path, *, height: fl
 
     label = _label(cell, cell_label)
     parent = _cell_turntable(cell, label).parent if cell is not None else None
-    model = _arm(cell, robot)
-    cols, source = load_table(measurements, source)
-    f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
-    theta = external_axis(cols, source, "table")
-    if cell is not None:
-        check_axis_limits(cell.turntable, theta, ["e1"], source, label)
-    check_count(len(f), 3, "touches", source)
     notes = _Notes(on_note)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
-    f_R = f
-    f = _table_touches(cell, cols, source, f, label)
-    chained = _chained(cell, cols, source, f_R, tool, _world_track(cell, cols, source, len(f)),
-                       nominal, notes)
-    result = calibrate_turntable(theta, f, height=height, labels=line_labels(len(f)),
+    m = read_touches("turntable", measurements, source, _arm(cell, robot), notes.one)
+    theta, f, chained = _on_table(cell, m, tool, label, nominal, notes, m.check_count)
+    result = calibrate_turntable(theta, f, height=height, labels=m.labels(),
                                  prior_sigma=sigma, inputs=chained.inputs)
+    key = "T_world_B" if parent == "world" else "T_R_B"
+    assumed = _assumed(cell, m, tool, key, mapped=parent == "world")
     if cell is None:
-        return CellCalibration(result, notes=tuple(notes))
-    key = "T_R_B"
-    if parent == "world":
-        key = "T_world_B"
-        result = result.renamed("T_R_B", key)
+        return CellCalibration(result, notes=tuple(notes), assumed=assumed)
+    result = result.renamed("T_R_B", key)
     record = _Record(_file(measurements, file), _options(sigma, tool, height_mm=height * 1e3),
                      chained, nominal)
-    prov = _provenance("turntable", result, len(f), source, time, cell, "turntable", key, record)
+    prov = _provenance("turntable", result, m.n, m.source, time, cell, "turntable", key, record)
     new = copied(cell)
     tt = new.update_turntable(prov, T_parent_B=result.values[key])
     return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov, tuple(notes),
-                           key="turntable", value=key, inputs=chained.keys)
+                           key="turntable", value=key, inputs=chained.keys, assumed=assumed)
 
 
 # -- workpiece -------------------------------------------------------------------------------------
@@ -872,13 +979,15 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
     """The turntable root in the frame of the touches, and notes on where it comes from."""
     if cell is None:
         if given is None:
-            raise InputError("the workpiece needs the turntable: pass --turntable TURNTABLE.json "
-                             "(the --json output of 'robotcell calibrate turntable'), or --cell "
-                             "CELL.yaml to use the cell's turntable")
+            result = term("turntable=JSON", "turntable (a TurntablePose, or the result of "
+                          "robotcell.cell.calibrate.turntable)")
+            raise InputError(f"the workpiece needs the turntable: pass {result}, or "
+                             f"{term('cell=FILE', 'a cell')} to use the cell's turntable")
         if given.frame != "robot":
             raise InputError(f"{given.source} holds the turntable in the world (T_world_B, "
-                             "calibrated with --cell), but touches without --cell are in the "
-                             "robot base: pass the same --cell CELL.yaml")
+                             f"calibrated with {term('cell', 'a cell')}), but touches without "
+                             f"{term('cell', 'a cell')} are in the robot base: pass the same "
+                             f"{term('cell=FILE', 'cell')}")
         return given, []
     tt = _cell_turntable(cell, label)
     if given is None:
@@ -889,7 +998,8 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
         raise InputError(f"{given.source} holds the turntable in the "
                          f"{'world' if given.frame == 'world' else 'robot base'}, but the "
                          f"turntable of {label} has parent {tt.parent}: calibrate the turntable "
-                         f"with --cell {label}, or omit --turntable to use the cell's turntable")
+                         f"{term('with cell', 'into')} {label}, or omit "
+                         f"{term('turntable', 'turntable')} to use the cell's turntable")
     dT = invert(tt.T_parent_B) @ given.T
     dist = float(np.linalg.norm(dT[:3, 3]))
     angle = float(np.arccos(np.clip((np.trace(dT[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)))
@@ -898,52 +1008,46 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
         notes.append(f"warning: the turntable of {given.source} differs from the one in "
                      f"{label} by {dist * 1e3:.3f} mm and {np.degrees(angle):.4f} deg; "
                      f"T_B_W is relative to {given.source}'s. Write that turntable into the "
-                     "cell (calibrate turntable --cell) so that the two agree")
+                     f"cell ({term('calibrate turntable --cell', 'robotcell.cell.calibrate.turntable')}"
+                     ") so that the two agree")
     return given, notes
 
 
-def _positioner_workpiece(cell: Cell, measurements: Table | str | Path, name: str | None, *,
-                          tool: str | ArrayLike | None, sigma: float | None, source: str | None,
-                          label: str, time: str | None,
-                          on_note: Callable[[str], None] | None, file: str | Path | None,
+def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None, *,
+                          tool: str | ArrayLike | None, sigma: float | None, label: str,
+                          time: str | None, notes: _Notes, file: str | None,
                           nominal: NominalAccuracy) -> CellCalibration:
     """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P."""
     from robotcell.calibration.frame import frame_3point
 
-    values, points = positioner_touches(cell, measurements, tool=tool, source=source,
-                                        cell_label=label)
-    record_file = _file(measurements, file)
-    cols, source = load_table(measurements, source)
+    values, points = _positioner_points(cell, m, tool, label)
+    m.check_points()
     pos = cell.turntable
-    notes = _Notes(on_note)
     notes.add([(f"note: the touches are taken into the plate of positioner {pos.name!r} "
                 f"through its chain in {label}: the 1-sigma of T_P_W does not include the "
                 "positioner's uncertainty")])
-    roles = point_roles(cols, source)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + [f"e{i + 1}" for i in range(pos.n_axes)]
-                           + ["track"], source))
     T_P_parent = invert(pos.T_parent_root @ pos.T_root_P(values))
     p_P = transform_points(T_P_parent, points)
-    p_R = tcp_positions(cols, source, cell.robot, tool_transform(cell, tool, cols))
-    chained = _chained(cell, cols, source, p_R, tool,
-                       _world_track(cell, cols, source, len(p_R)), nominal, notes)
+    chained = _chained(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
+                       _world_track(cell, m), nominal, notes)
     if chained.inputs is not None:
         chained = replace(chained, inputs=chained.inputs.rotated(T_P_parent[:, :3, :3]))
-    result = frame_3point(p_P, roles, sigma, line_labels(len(roles), roles),
+    result = frame_3point(p_P, m.point, sigma, m.labels(points=True),
                           inputs=chained.inputs).renamed("T_R_W", "T_P_W")
     item = "" if name is None else f"frames.{name}"
+    assumed = _assumed(cell, m, tool, "T_P_W", mapped=pos.parent == "world")
     if name is None:
-        return CellCalibration(result, notes=tuple(notes), value="T_P_W", inputs=chained.keys)
-    record = _Record(record_file, _options(sigma, tool), chained, nominal)
-    prov = _provenance("workpiece", result, len(points), source, time, cell, item, "T_P_W",
-                       record)
+        return CellCalibration(result, notes=tuple(notes), value="T_P_W", inputs=chained.keys,
+                               assumed=assumed)
+    record = _Record(file, _options(sigma, tool), chained, nominal)
+    prov = _provenance("workpiece", result, m.n, m.source, time, cell, item, "T_P_W", record)
     new = copied(cell)
     new.update_frame(name, result.values["T_P_W"], prov, parent="turntable")
     return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
-                           key=item, value="T_P_W", inputs=chained.keys)
+                           key=item, value="T_P_W", inputs=chained.keys, assumed=assumed)
 
 
-def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | None = None, *,
+def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | None = None, *,
               turntable: TurntablePose | CalibrationResult | None = None,
               robot: Robot | None = None, tool: str | ArrayLike | None = None,
               sigma: float | None = None, source: str | None = None,
@@ -958,7 +1062,7 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
         The cell whose frame ``name`` on the turntable is calibrated; None: needs ``turntable``.
         On a positioner chain the touches, with its axis values ``e1..en`` (deg), are taken
         into its plate frame P through the cell's chain and give ``T_P_W`` (3-point).
-    measurements : mapping or str or Path
+    measurements : Measurements, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) with the table angle ``e1`` (deg) and
         column ``point`` (``origin``, ``x``, ``xy``); for a turntable in the world of a cell with
         a track, ``track`` (mm).
@@ -978,43 +1082,37 @@ def workpiece(cell: Cell | None, measurements: Table | str | Path, name: str | N
     from robotcell.calibration.workpiece import calibrate_workpiece
 
     label = _label(cell, cell_label)
+    notes = _Notes(on_note)
     if cell is not None and isinstance(cell.turntable, Positioner):
         if turntable is not None:
             raise InputError(f"{label} has a positioner chain, which carries its own "
                              "calibration: give no turntable result")
-        return _positioner_workpiece(cell, measurements, name, tool=tool, sigma=sigma,
-                                     source=source, label=label, time=time, on_note=on_note,
-                                     file=file, nominal=nominal)
+        spec = SPECS["workpiece"].with_axes(cell.turntable.n_axes)
+        m = read_touches(spec, measurements, source, _arm(cell, robot), notes.one)
+        return _positioner_workpiece(cell, m, name, tool=tool, sigma=sigma, label=label,
+                                     time=time, notes=notes, file=_file(measurements, file),
+                                     nominal=nominal)
     if isinstance(turntable, CalibrationResult):
         turntable = TurntablePose.from_result(turntable)
     model = _arm(cell, robot)
     tt, where = _workpiece_turntable(cell, turntable, label, nominal)
-    notes = _Notes(on_note)
     notes.add(where)
-    cols, source = load_table(measurements, source)
-    f = tcp_positions(cols, source, model, tool_transform(cell, tool, cols))
-    theta = external_axis(cols, source, "workpiece")
-    if cell is not None:
-        check_axis_limits(cell.turntable, theta, ["e1"], source, label)
-    roles = point_roles(cols, source)
-    notes.add(repeat_notes(cols, POSE_COLUMNS + ["e1", "track"], source))
-    f_R = f
-    f = _table_touches(cell, cols, source, f, label)
-    chained = _chained(cell, cols, source, f_R, tool, _world_track(cell, cols, source, len(f)),
-                       nominal, notes)
-    result = calibrate_workpiece(theta, f, roles, tt.T, T_R_B_covariance=tt.covariance,
+    m = read_touches("workpiece", measurements, source, model, notes.one)
+    theta, f, chained = _on_table(cell, m, tool, label, nominal, notes, m.check_points)
+    result = calibrate_workpiece(theta, f, m.point, tt.T, T_R_B_covariance=tt.covariance,
                                  inputs=chained.inputs, prior_sigma=sigma,
-                                 labels=line_labels(len(roles), roles))
+                                 labels=m.labels(points=True))
     inputs = chained.keys + (("turntable",) if cell is not None and turntable is None else ())
     item = "" if cell is None or name is None else f"frames.{name}"
+    assumed = _assumed(cell, m, tool, "T_B_W", mapped=tt.frame == "world")
     if cell is None or name is None:
         return CellCalibration(result, notes=tuple(notes), key=item, value="T_B_W",
-                               inputs=inputs)
+                               inputs=inputs, assumed=assumed)
     record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
-    prov = _provenance("workpiece", result, len(f), source, time, cell, item, "T_B_W", record,
+    prov = _provenance("workpiece", result, m.n, m.source, time, cell, item, "T_B_W", record,
                        inputs)
     new = copied(cell)
     new.update_frame(name, result.values["T_B_W"], prov, parent="turntable")
     return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
-                           key=item, value="T_B_W", inputs=inputs)
+                           key=item, value="T_B_W", inputs=inputs, assumed=assumed)
 

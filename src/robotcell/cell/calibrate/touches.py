@@ -1,36 +1,40 @@
-"""Measurement tables of a cell: where the robot base was at each touch, and which tool touched.
+"""Measurement tables of a cell: read once, where the robot base was at each touch, which tool.
 
-The mapping that turns touches taken in a cell into the robot base and world frames: column
-``track`` (the robot's track position at each touch, mm) gives ``T_world_R`` per touch through the
-cell's track (:func:`robot_in_world`). Tables are mappings of column name to values in the units
-of the measurement CSV (mm, deg), as :func:`robotcell.io.tables.read_csv` returns them.
+A calibration reads its measurements once (:func:`read_touches`): a CSV file through
+:func:`robotcell.io.tables.read_csv`, or a table given in Python (column name to values in the
+units of the measurement CSV, mm and deg), by the procedure's specification into
+:class:`~robotcell.calibration.measurements.Measurements` (SI). The mapping that turns touches
+taken in a cell into the robot base and world frames: the robot's track position at each touch
+(column ``track``) gives ``T_world_R`` per touch through the cell's track (:func:`robot_in_world`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import repeated_rows, track_column
+from robotcell.calibration.measurements import Measurements, columns_of, read_measurements
+from robotcell.calibration.spec import SPECS, Procedure
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import tool_pose
 from robotcell.cell.validation import check_axis_limits
-from robotcell.errors import InputError
+from robotcell.errors import InputError, term
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import validate_pose
+from robotcell.robot.robot import Robot
 
-__all__ = ["POSE_COLUMNS", "Table", "line_labels", "load_table", "raw_rows", "repeat_notes",
-           "robot_in_world", "tool_transform", "track_positions"]
+__all__ = ["MeasurementInput", "Table", "load_table", "read_touches", "robot_in_world",
+           "tool_transform", "track_positions"]
 
 #: A measurement table: column name (lower case) to numbers (mm, deg) or strings, one per touch.
 Table = Mapping[str, Any]
 
-#: Columns that make a touch: a flange or TCP pose (mm, deg) or the arm's joint values.
-POSE_COLUMNS = ["x", "y", "z", "a", "b", "c"] + [f"a{i}" for i in range(1, 10)]
+#: What a calibration takes as its measurements: read touches, a table, or a CSV file.
+MeasurementInput = Measurements | Table | str | Path
 
 
 def load_table(measurements: Table | str | Path, source: str | None = None
@@ -54,60 +58,60 @@ def load_table(measurements: Table | str | Path, source: str | None = None
     if isinstance(measurements, (str, Path)):
         return read_csv(measurements), source or str(measurements)
     source = source or "measurements"
-    if not isinstance(measurements, Mapping) or not measurements:
-        raise InputError(f"{source}: measurements must be a non-empty mapping of column name to "
-                         "values (mm, deg), or the path of a CSV file")
-    cols: dict[str, Any] = {}
-    for name, values in measurements.items():
-        if isinstance(values, str) or np.ndim(values) != 1:
-            raise InputError(f"{source}: column {name!r} must be a sequence, one value per touch")
-        values = list(values)
-        try:
-            arr = np.asarray(values, dtype=float)
-        except (TypeError, ValueError):
-            cols[str(name).strip().lower()] = [str(v) for v in values]
-            continue
-        if arr.ndim != 1 or not np.all(np.isfinite(arr)):
-            raise InputError(f"{source}: column {name!r} must be one finite number per touch")
-        cols[str(name).strip().lower()] = arr
-    lengths = {len(v) for v in cols.values()}
-    if len(lengths) != 1:
-        raise InputError(f"{source}: the columns have different lengths {sorted(lengths)}")
-    return cols, source
+    return columns_of(measurements, source), source
 
 
-def raw_rows(cols: Table, names: Sequence[str]) -> NDArray[np.float64]:
-    """The numeric columns among ``names`` as an (N, k) array, for the repeated-row note; no
-    rows when none of them is there (the procedure then names the missing columns)."""
-    use = [n for n in names if n in cols and isinstance(cols[n], np.ndarray)]
-    return np.stack([cols[n] for n in use], axis=1) if use else np.zeros((0, 0))
+def read_touches(procedure: Procedure | str, measurements: MeasurementInput,
+                 source: str | None = None, robot: Robot | None = None,
+                 on_note: Callable[[str], None] | None = None) -> Measurements:
+    """The measurements of a calibration, read once by the procedure's specification.
 
+    Parameters
+    ----------
+    procedure : Procedure or str
+        The procedure (:data:`~robotcell.calibration.spec.SPECS`).
+    measurements : Measurements, mapping, str or Path
+        Touches read before (returned as they are; their notes go to ``on_note`` again), a
+        table, or a CSV file.
+    source : str, optional
+        As for :func:`load_table`.
+    robot : Robot, optional
+        The arm, for joint values.
+    on_note : callable, optional
+        Receives each note on the table as it arises
+        (:func:`~robotcell.calibration.measurements.read_measurements`).
 
-def repeat_notes(cols: Table, names: Sequence[str], source: str) -> list[str]:
-    """``note: ...`` per group of identical rows: repeated touches are data, each one used."""
-    return [f"note: {n}" for n in repeated_rows(raw_rows(cols, names), source)]
-
-
-def line_labels(n: int, roles: Sequence[str] | None = None) -> list[str]:
-    """Names of the touches as lines of the CSV (``line 2``, ``line 3 (x)``, ...)."""
-    if roles is None:
-        return [f"line {i + 2}" for i in range(n)]
-    return [f"line {i + 2} ({r})" for i, r in enumerate(roles)]
+    Returns
+    -------
+    Measurements
+    """
+    spec = SPECS[procedure] if isinstance(procedure, str) else procedure
+    if isinstance(measurements, Measurements):
+        if measurements.procedure.name != spec.name:
+            raise InputError(f"{measurements.source}: touches of the "
+                             f"{measurements.procedure.name} procedure, not of {spec.name}")
+        for note in measurements.notes:
+            if on_note is not None:
+                on_note(note)
+        return measurements
+    cols, source = load_table(measurements, source)
+    return read_measurements(spec, cols, source, robot, on_note)
 
 
 def tool_transform(cell: Cell | None, tool: str | ArrayLike | None,
-                   cols: Table | None = None) -> NDArray[np.float64] | None:
+                   touches: Measurements | None = None) -> NDArray[np.float64] | None:
     """``T_F_TCP`` (m) of the tool that touched: a tool of the cell by name, a pose, or None.
 
-    With ``cols``, the measurement columns: touches given as joint values in a cell that has
-    tools need the tool said, since the wrong tool (or none) moves every touch by its length,
-    which no fit can tell from a bad cell.
+    With ``touches``: touches given as joint values in a cell that has tools need the tool said,
+    since the wrong tool (or none) moves every touch by its length, which no fit can tell from a
+    bad cell.
     """
-    if (tool is None and cell is not None and cell.tools and cols is not None
-            and "a1" in cols and "x" not in cols):
+    if (tool is None and cell is not None and cell.tools and touches is not None
+            and touches.joints is not None):
         known = ", ".join(sorted(cell.tools))
-        raise InputError(f"touches given as joint values: say which tool touched, --tool NAME "
-                         f"(the cell has: {known}), or --tool 0,0,0,0,0,0 for the bare flange")
+        raise InputError(f"touches given as joint values: say which tool touched, "
+                         f"{term('tool=NAME', 'tool=NAME')} (the cell has: {known}), or "
+                         f"{term('tool=flange', 'tool=numpy.eye(4)')} for the bare flange")
     if isinstance(tool, str):
         if cell is None:
             raise InputError(f"tool {tool!r} names a tool of a cell, but no cell was given; give "
@@ -116,58 +120,52 @@ def tool_transform(cell: Cell | None, tool: str | ArrayLike | None,
     return None if tool is None else validate_pose(tool, "tool")
 
 
-def track_positions(cell: Cell, cols: Table, source: str, label: str = "the cell"
+def track_positions(cell: Cell, touches: Measurements, label: str = "the cell"
                     ) -> NDArray[np.float64] | None:
     """Column ``track`` (m), or None; refused with non-zero values in a cell without track.
 
     Parameters
     ----------
     cell : Cell
-    cols : mapping
-        Measurement columns; ``track`` in mm.
-    source : str
-        Name of the measurements, for messages.
+    touches : Measurements
+        The touches; ``track`` the robot's track position at each (m).
     label : str
         Name of the cell in messages (its file name).
 
     Returns
     -------
     ndarray, shape (N,), or None
-        Track position of the robot at each touch (m).
+        Track position of the robot at each touch (m), within the track's limits.
     """
-    e = track_column(cols, source)
+    e = touches.track
     if cell.track is None and e is not None and np.any(e != 0):
-        raise InputError(f"{source}: column 'track' has non-zero values, but the cell "
+        raise InputError(f"{touches.source}: column 'track' has non-zero values, but the cell "
                          f"{label} has no track; remove the column or add the track to "
                          "the cell file")
     if e is not None:
-        check_axis_limits(cell.track, e, ["track"], source, label)
+        check_axis_limits(cell.track, e, ["track"], touches.source, label)
     return e
 
 
-def robot_in_world(cell: Cell, cols: Table, source: str, n: int, label: str = "the cell"
+def robot_in_world(cell: Cell, touches: Measurements, label: str = "the cell"
                    ) -> NDArray[np.float64]:
-    """``T_world_R`` at each of ``n`` touches, shape (n, 4, 4) (m), from column ``track``.
+    """``T_world_R`` at each touch, shape (N, 4, 4) (m), from column ``track``.
 
     Parameters
     ----------
     cell : Cell
-    cols : mapping
-        Measurement columns; ``track`` in mm, required when the robot is on a track.
-    source : str
-        Name of the measurements, for messages.
-    n : int
-        Number of touches.
+    touches : Measurements
+        The touches; their track positions are required when the robot is on a track.
     label : str
         Name of the cell in messages (its file name).
     """
-    e = track_positions(cell, cols, source, label)
+    e = track_positions(cell, touches, label)
     if e is None:
         if cell.track is not None:
             raise InputError(
-                f"{source}: missing column 'track' (track position of the robot at each "
+                f"{touches.source}: missing column 'track' (track position of the robot at each "
                 f"touch, mm): the robot of {label} is on a track, and the touches are "
                 "mapped to the world through it; add the column (0 where the track did not "
                 "move)")
-        e = np.zeros(n)
+        e = np.zeros(touches.n)
     return cell.frame_pose("robot", track=e)

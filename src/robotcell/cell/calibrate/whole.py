@@ -47,7 +47,7 @@ from robotcell.cell.calibrate.chain import (
     item_sources,
     perturbed,
 )
-from robotcell.errors import InputError
+from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import format_table
 
@@ -205,7 +205,8 @@ def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
                          + ". Restore the files, or calibrate those items again")
     if not out:
         raise InputError(f"{label} records no calibration with its touch file: calibrate its "
-                         "items with --cell first (each calibration then records its file)")
+                         f"items {term('with cell', 'into the cell')} first (each calibration "
+                         "then records its file)")
     return out
 
 

@@ -1,0 +1,119 @@
+"""Checks of a calibration result given as JSON (mm, deg), before it is read back.
+
+What :meth:`robotcell.calibration.result.CalibrationResult.from_json` refuses: a field missing
+(:data:`REQUIRED`) or of the wrong type, an unknown ``procedure``, a number that is not finite
+(anywhere), a length (a key ending in ``_mm``, the translation of ``matrix``) beyond
+:data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, or a ``matrix`` (a track's ``rotation``) that is
+not a rigid transform (a proper rotation).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from robotcell.io.tables import MAX_ABS_VALUE
+from robotcell.kinematics.transforms import check_pose
+
+__all__ = ["PROCEDURES", "REQUIRED", "is_points", "malformed"]
+
+#: The ``procedure`` of every result robotcell's calibrations write (``--json``).
+PROCEDURES = ("tcp", "frame-3point", "frame-npoint", "external-tcp", "track", "turntable",
+              "workpiece", "positioner-2axis")
+
+#: Fields every result as JSON has.
+REQUIRED = ("procedure", "residuals_mm", "rms_mm", "max_mm", "warnings")
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _not_finite(v: Any, where: str) -> str | None:
+    """Where in ``v`` (parsed JSON) a number is not finite (NaN, Infinity, an integer of 400
+    digits), or None."""
+    if isinstance(v, dict):
+        return next((w for k, x in v.items() if (w := _not_finite(x, f"{where}.{k}"))), None)
+    if isinstance(v, list):
+        return next((w for i, x in enumerate(v) if (w := _not_finite(x, f"{where}[{i}]"))), None)
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        try:
+            ok = math.isfinite(float(v))
+        except OverflowError:
+            ok = False
+        return None if ok else where
+    return None
+
+
+def _lengths(v: Any) -> list[float]:
+    """The numbers in ``v`` (a number or nested lists of them)."""
+    if isinstance(v, list):
+        return [x for item in v for x in _lengths(item)]
+    return [v] if isinstance(v, (int, float)) and not isinstance(v, bool) else []
+
+
+def is_points(v: Any, n: int | None) -> bool:
+    """A list of ``n`` (any number when None) lists of 3 finite numbers."""
+    return (isinstance(v, list) and (n is None or len(v) == n)
+            and all(isinstance(p, list) and len(p) == 3 and all(map(_is_number, p)) for p in v))
+
+
+def malformed(data: dict[str, Any]) -> str | None:
+    """What is wrong with the fields of a result that the report uses, or None; a field that
+    is not there is not checked (:data:`REQUIRED` says which must be)."""
+    if not isinstance(data["procedure"], str):
+        return "'procedure' must be a text"
+    if data["procedure"] not in PROCEDURES:
+        return (f"'procedure' {data['procedure']!r} is none robotcell calibrates "
+                f"({', '.join(PROCEDURES)})")
+    where = _not_finite(data, "")
+    if where is not None:
+        return f"{where.lstrip('.')!r} is not a finite number"
+    for key, value in data.items():
+        if key.endswith("_mm") and any(abs(v) > MAX_ABS_VALUE for v in _lengths(value)):
+            return (f"{key!r} holds a length beyond {MAX_ABS_VALUE:.0e} mm, which no "
+                    "calibration measures")
+    res = data.get("residuals_mm", [])
+    if not isinstance(res, list) or not all(map(_is_number, res)):
+        return "'residuals_mm' must be a list of numbers"
+    n = len(res) if "residuals_mm" in data else None
+    for key in ("rms_mm", "max_mm"):
+        if key in data and not _is_number(data[key]):
+            return f"{key!r} must be a number"
+    for key in ("warnings", "undetermined"):
+        v = data.get(key, [])
+        if (v is not None or key == "warnings") and (
+                not isinstance(v, list) or not all(isinstance(w, str) for w in v)):
+            return f"{key!r} must be a list of texts"
+    checks = {
+        "condition": lambda v: _is_number(v),
+        "labels": lambda v: isinstance(v, list) and (n is None or len(v) == n)
+        and all(isinstance(x, (str, int)) for x in v),
+        "residuals_xyz_mm": lambda v: is_points(v, n),
+        "points_mm": lambda v: is_points(v, None),
+        "pivot_mm": lambda v: is_points([v], 1),
+        "sigma": lambda v: isinstance(v, dict),
+        "matrix": lambda v: isinstance(v, list) and len(v) == 4
+        and all(isinstance(r, list) and len(r) == 4 and all(map(_is_number, r)) for r in v),
+        "rotation": lambda v: is_points(v, 3),
+    }
+    for key, ok in checks.items():
+        if data.get(key) is not None and not ok(data[key]):
+            return f"{key!r} has the wrong type or size"
+    if data.get("matrix") is not None:
+        T = np.array(data["matrix"], dtype=float)
+        if np.abs(T[:3, 3]).max() > MAX_ABS_VALUE:
+            return f"'matrix' holds a translation beyond {MAX_ABS_VALUE:.0e} mm"
+        T[:3, 3] *= 1e-3
+        ok, reasons = check_pose(T)
+        if not ok:
+            return f"'matrix' is not a rigid transform (R orthonormal, det R = 1): {reasons[0]}"
+    if data.get("rotation") is not None:  # the track's L_Q_R
+        T = np.eye(4)
+        T[:3, :3] = data["rotation"]
+        ok, reasons = check_pose(T)
+        if not ok:
+            return f"'rotation' is not a proper rotation (orthonormal, det = 1): {reasons[0]}"
+    return None
