@@ -204,7 +204,7 @@ _QUANTITIES: dict[str, tuple[str, str]] = {
     "axis": ("rotation axis Z_B (unit vector X, Y, Z)", "1"),
     "radius_mm": ("radius of the touched point about the axis", "mm"),
     "tilt_deg": ("tilt of the axis from vertical", "deg"),
-    "height_mm": ("origin above the touched point (--height)", "mm"),
+    "height_mm": ("origin above the touched point (height)", "mm"),
     "spread_deg": ("arc covered by the touches", "deg"),
     "tilt_point_mm": ("point of the tilt axis at the common normal (X, Y, Z)", "mm"),
     "tilt_axis": ("tilt axis direction (unit vector X, Y, Z)", "1"),

@@ -170,8 +170,9 @@ def write_identification_report(
                     f"identification Jacobian): measured configurations {o1:.4g}; "
                     f"{len(rand)} random sets of as many configurations within the joint limits: "
                     f"median {np.median(rand):.4g}, best {rand.max():.4g}. The measured set is "
-                    f"better than {better:.0f} % of them. <code>robotcell identify --propose N</code> "
-                    f"proposes configurations that maximise O1.</p>"
+                    f"better than {better:.0f} % of them. <code>select_configurations</code> "
+                    f"(<code>robotcell identify --propose N</code>) proposes configurations that "
+                    f"maximise O1.</p>"
                     f'<figure><img src="{_figure_observability(o1, rand)}" alt="observability"></figure>')
     scene_html = "" if measurements is None else f"<h2>3D view of the measurements</h2>{SCENE_SLOT}"
     name = html.escape(result.nominal.name)
