@@ -72,3 +72,22 @@ def test_report_and_workpiece_read_a_result_alike(tmp_path, capsys):
     code, _, err = run(capsys, "calibrate", "workpiece", wp, "--turntable", tt)
     assert code == 2 and reason in err
     assert "give the unchanged output of 'robotcell calibrate ... --json'" in err
+
+
+def test_a_condition_number_written_as_null_reads_back_as_nan():
+    """``to_json`` writes a number that is not finite as null; reading it back is no error."""
+    data = json.loads(json.dumps(_turntable().to_json()))
+    data["condition"] = None
+    back = CalibrationResult.from_json(data, "tt.json")
+    assert np.isnan(back.condition) and back.to_json()["condition"] is None
+
+
+@pytest.mark.parametrize("matrix, match", [
+    ([[2.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "'turntable_matrix' is not a rigid"),
+    ([[1, 2]], "'turntable_matrix' has the wrong type or size"),
+])
+def test_the_turntable_of_a_workpiece_result_is_checked_as_a_pose(matrix, match):
+    data = {"procedure": "workpiece", "residuals_mm": [0.1], "rms_mm": 0.1, "max_mm": 0.1,
+            "warnings": [], "turntable_matrix": matrix}
+    with pytest.raises(InputError, match=match):
+        CalibrationResult.from_json(data, "wp.json")

@@ -346,6 +346,16 @@ def test_non_utf8_binary_csv_and_yaml_refused_without_traceback(tmp_path, capsys
     (lambda d: d.update(labels=[1]), "'labels' has the wrong type or size"),
     (lambda d: d.update(warnings=0), "'warnings' must be a list of texts"),
     (lambda d: d.update(residuals_xyz_mm=[[1, 2]]), "'residuals_xyz_mm' has the wrong type"),
+    (lambda d: d.update(unchecked=True), "'unchecked' has the wrong type or size"),
+    (lambda d: d.update(outliers=-1.0), "'outliers' has the wrong type or size"),
+    (lambda d: d.update(dof=[1, 2]), "'dof' has the wrong type or size"),
+    (lambda d: d.update(noise_sigma_mm="x"), "'noise_sigma_mm' has the wrong type or size"),
+    (lambda d: d.update(accuracy_source=3), "'accuracy_source' has the wrong type or size"),
+    (lambda d: d.update(height_mm=[[1, 2], [3]]), "'height_mm' must be a number"),
+    (lambda d: d.update(axis=[0, 1]), "'axis' must be a list of 3 numbers"),
+    (lambda d: d.update(matrix=None), "'matrix' must be a 4x4 list of numbers"),
+    (lambda d: d.update(axis=[1e300, 0, 0]), "'axis' must be a unit vector"),
+    (lambda d: d["sigma"].update(radius_mm=[[1, 2], [3]]), "'sigma' has the wrong type or size"),
 ])
 def test_report_on_malformed_result_json(tmp_path, capsys, change, message):
     table = _turntable_csv(tmp_path)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.calibration.fitting import Fit
-from robotcell.calibration.resultcheck import PROCEDURES, REQUIRED, malformed
+from robotcell.calibration.resultcheck import PROCEDURES, REQUIRED, TOUCH_LISTS, malformed
 from robotcell.calibration.uncertainty import Estimate
 from robotcell.calibration.verdict import (
     CONDITION_GOOD,
@@ -36,8 +36,8 @@ __all__ = ["PROCEDURES", "CalibrationResult", "fit_fields", "pose_covariance", "
 _POSE_KEY = re.compile(r"(T_[A-Za-z]+_[A-Za-z0-9]+?)_(?:position_mm|rotation_deg|covariance_mm_rad)")
 
 #: The JSON's lists of touches (labels) and the fields of a result that hold their indices.
-_TOUCH_LISTS = {"excluded": "excluded", "unchecked": "unchecked", "outliers": "outliers",
-                "disagreeing": "disagreeing", "gross_outliers": "gross"}
+_TOUCH_LISTS = dict(zip(TOUCH_LISTS, ("excluded", "unchecked", "outliers", "disagreeing", "gross"),
+                        strict=True))
 
 #: Conditioning figure above which a result is flagged: Schroer's threshold of about 100 for
 #: a trustworthy identification, as cited by Nahvi and Hollerbach (ICRA 1996).
@@ -459,7 +459,8 @@ class CalibrationResult:
         points = data.get("points_mm")
         return cls(
             str(data["procedure"]), values, sigma, mm * 1e-3,
-            condition=float(data.get("condition", float("nan"))), dof=int(data.get("dof", 0)),
+            condition=float(data["condition"]) if data.get("condition") is not None
+            else float("nan"), dof=int(data.get("dof") or 0),
             noise_sigma=si("noise_sigma_mm"), noise_source=str(data.get("noise_source", "")),
             labels=labels, undetermined=list(data.get("undetermined") or []),
             warnings=list(data.get("warnings", [])), next_step=str(data.get("next_step", "")),

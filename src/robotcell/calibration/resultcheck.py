@@ -2,10 +2,10 @@
 
 What :meth:`robotcell.calibration.result.CalibrationResult.from_json` refuses: a field missing
 (:data:`REQUIRED`) or of the wrong type, an unknown ``procedure``, a number that is not finite
-(anywhere), a length (a key ending in ``_mm``, the translation of ``matrix``) beyond
-:data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, or a ``matrix`` (a track's ``rotation``) that is
-not a rigid transform (a proper rotation).
-"""
+(anywhere), a length (a key ending in ``_mm``, the translation of a pose) beyond
+:data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, a pose (:data:`POSES`; a track's ``rotation``)
+that is not a rigid transform (a proper rotation), or a quantity the report draws
+(:data:`GEOMETRY`) that is not a finite number or 3 of them."""
 
 from __future__ import annotations
 
@@ -17,11 +17,29 @@ import numpy as np
 from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.kinematics.transforms import check_pose
 
-__all__ = ["PROCEDURES", "REQUIRED", "is_points", "malformed"]
+__all__ = ["GEOMETRY", "POSES", "PROCEDURES", "REQUIRED", "TOUCH_LISTS", "UNIT_VECTORS", "is_points",
+           "malformed"]
 
 #: The ``procedure`` of every result robotcell's calibrations write (``--json``).
 PROCEDURES = ("tcp", "frame-3point", "frame-npoint", "external-tcp", "track", "turntable",
               "workpiece", "positioner-2axis")
+
+#: Fields of a result that name touches (by their labels).
+TOUCH_LISTS = ("excluded", "unchecked", "outliers", "disagreeing", "gross_outliers")
+
+#: Fields that hold a pose (4x4, translation in mm): the result's own, and a workpiece's turntable.
+POSES = ("matrix", "turntable_matrix")
+
+#: Fields that give the geometry a result draws (the report's 3D scene), each a finite number
+#: (1) or 3 of them (3) wherever it is written.
+GEOMETRY = {**dict.fromkeys(["radius_mm", "height_mm", "spread_deg", "tilt_deg", "scale",
+                             "normal_length_mm", "axis_angle_deg", "tilt_zero_deg",
+                             "rotate_zero_deg"], 1),
+            **dict.fromkeys(["tcp_mm", "offset_mm", "axis", "direction", "tilt_point_mm",
+                             "tilt_axis", "rotate_point_mm", "rotate_axis"], 3)}
+
+#: Fields of :data:`GEOMETRY` that are directions (unit vectors).
+UNIT_VECTORS = ("axis", "direction", "tilt_axis", "rotate_axis")
 
 #: Fields every result as JSON has.
 REQUIRED = ("procedure", "residuals_mm", "rms_mm", "max_mm", "warnings")
@@ -52,6 +70,11 @@ def _lengths(v: Any) -> list[float]:
     if isinstance(v, list):
         return [x for item in v for x in _lengths(item)]
     return [v] if isinstance(v, (int, float)) and not isinstance(v, bool) else []
+
+
+def _is_sigma(v: Any) -> bool:
+    """A finite number, or None (a 1-sigma the touches do not determine, written as null)."""
+    return v is None or _is_number(v)
 
 
 def is_points(v: Any, n: int | None) -> bool:
@@ -94,22 +117,39 @@ def malformed(data: dict[str, Any]) -> str | None:
         "residuals_xyz_mm": lambda v: is_points(v, n),
         "points_mm": lambda v: is_points(v, None),
         "pivot_mm": lambda v: is_points([v], 1),
-        "sigma": lambda v: isinstance(v, dict),
-        "matrix": lambda v: isinstance(v, list) and len(v) == 4
-        and all(isinstance(r, list) and len(r) == 4 and all(map(_is_number, r)) for r in v),
+        "sigma": lambda v: isinstance(v, dict) and all(
+            _is_sigma(x) or (isinstance(x, list) and all(map(_is_sigma, x))) for x in v.values()),
+        **dict.fromkeys(POSES, lambda v: isinstance(v, list) and len(v) == 4 and all(
+            isinstance(r, list) and len(r) == 4 and all(map(_is_number, r)) for r in v)),
         "rotation": lambda v: is_points(v, 3),
+        "dof": lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0,
+        **dict.fromkeys(["noise_sigma_mm", "touch_sigma_mm", "residual_sigma_mm", "chi2"],
+                        _is_number),
+        **dict.fromkeys(["noise_source", "accuracy_source", "next_step"],
+                        lambda v: isinstance(v, str)),
+        **dict.fromkeys(TOUCH_LISTS, lambda v: isinstance(v, list) and all(
+            isinstance(x, (str, int)) and not isinstance(x, bool) for x in v)),
     }
+    if "matrix" in data and data["matrix"] is None:
+        return "'matrix' must be a 4x4 list of numbers"
     for key, ok in checks.items():
         if data.get(key) is not None and not ok(data[key]):
             return f"{key!r} has the wrong type or size"
-    if data.get("matrix") is not None:
-        T = np.array(data["matrix"], dtype=float)
+    for key, size in GEOMETRY.items():
+        if key in data and not (_is_number(data[key]) if size == 1 else is_points([data[key]], 1)):
+            return (f"{key!r} must be a number" if size == 1 else
+                    f"{key!r} must be a list of 3 numbers")
+    for key in (k for k in UNIT_VECTORS if k in data):
+        if abs(math.hypot(*data[key]) - 1.0) > 1e-6:
+            return f"{key!r} must be a unit vector (a direction), its length is not 1"
+    for key in (k for k in POSES if data.get(k) is not None):
+        T = np.array(data[key], dtype=float)
         if np.abs(T[:3, 3]).max() > MAX_ABS_VALUE:
-            return f"'matrix' holds a translation beyond {MAX_ABS_VALUE:.0e} mm"
+            return f"{key!r} holds a translation beyond {MAX_ABS_VALUE:.0e} mm"
         T[:3, 3] *= 1e-3
         ok, reasons = check_pose(T)
         if not ok:
-            return f"'matrix' is not a rigid transform (R orthonormal, det R = 1): {reasons[0]}"
+            return f"{key!r} is not a rigid transform (R orthonormal, det R = 1): {reasons[0]}"
     if data.get("rotation") is not None:  # the track's L_Q_R
         T = np.eye(4)
         T[:3, :3] = data["rotation"]
