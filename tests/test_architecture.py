@@ -212,3 +212,15 @@ def test_calibration_estimators_know_no_files(name):
     calls = {n.func.id for n in ast.walk(tree)
              if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
     assert not bad and "open" not in calls, f"{name} imports {bad} or calls open()"
+
+
+def test_the_command_line_is_a_thin_layer():
+    """A command parses, calls one library function and prints: cli/ holds at most 12 % of the
+    package's lines (the whole package counted, docstrings included)."""
+    package = SRC / "robotcell"
+
+    def lines(files):
+        return sum(len(f.read_text(encoding="utf-8").splitlines()) for f in files)
+
+    share = lines((package / "cli").rglob("*.py")) / lines(package.rglob("*.py"))
+    assert 0.02 < share <= 0.12, f"cli/ holds {share:.1%} of the package's lines"

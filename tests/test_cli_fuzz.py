@@ -668,11 +668,11 @@ def _cell_history(rng, d, good, out):
     backup is left)."""
     text = EXAMPLE.read_text(encoding="utf-8")
     cell, what = _cell_for("cell-history", rng, d)
-    inputs = [cell]
-    if rng.random() < 0.15:
+    inputs, backups = [cell], int(rng.integers(0, 4))
+    if rng.random() < 0.2:  # half of them with no backup either: the one refusal of the command
         cell.unlink()
-        what, inputs = "no cell file", []
-    for k in range(1, int(rng.integers(0, 4)) + 1):
+        what, inputs, backups = "no cell file", [], backups * int(rng.integers(0, 2))
+    for k in range(1, backups + 1):
         backup = d / f"cell.yaml.{k}.bak"
         if rng.random() < 0.3:
             backup, w = _mutated(text, rng, d, backup.name)
