@@ -9,6 +9,7 @@ would). Every exported pose, read back from the controller text, must match the 
 import json
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -154,6 +155,10 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
     scale_sigma = results["track"]["sigma"]["scale"]
     assert abs(cell.track.scale - truth.track.scale) <= 4 * scale_sigma
     check_exports(tmp_path / "cell.yaml", truth, results, tmp_path, capsys)
+    # Each calibration recorded its touch file, so the whole cell can be fitted again in one go.
+    assert Path(cell.tools["torch"].provenance.measurements) == tmp_path / "tcp.csv"
+    code, out, err = run(capsys, "calibrate", "cell", "--cell", tmp_path / "cell.yaml")
+    assert code == 0 and "4 calibrations fitted together" in out, err
 
 
 def turntable_cells():
