@@ -41,7 +41,11 @@ TARGETS = {"robot.fk": ("fwdKin", 1.5), "robot.jacobian": None, "robot.ik": ("IK
 
 def eaik_robot(robot):
     """EAIK's DH robot of the same chain (its own joint zero: the timing needs the geometry)."""
-    from eaik.IK_DH import DhRobot
+    try:
+        from eaik.IK_DH import DhRobot
+    except ImportError:
+        sys.exit("bench_percall.py compares with EAIK in the same run: install the benchmark "
+                 "extra first (pip install \".[benchmark]\")")
 
     js = robot.joints
     return DhRobot(np.array([j.alpha for j in js]), np.array([j.a for j in js]),
