@@ -23,8 +23,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 from machine import describe
 
 from robotcell.ik import TrackRobot, solve, solve_numeric
-from robotcell.robot.models import load_robot
 from robotcell.kinematics.transforms import make_pose, rot_x, rot_z
+from robotcell.robot.models import load_robot
 
 EAIK_US_PER_POSE = 4.7  # all 8 solutions, batched C++, one thread (docs/references.md)
 N_POSES = 100_000
