@@ -12,13 +12,16 @@ is then 3 times its 1-sigma) cannot pass. Of the GOOD verdicts fewer than 1 % ma
 sigma off (a correct 1-sigma puts 6e-5 of a Gaussian there).
 """
 
+import json
 from dataclasses import replace
 
 import numpy as np
 from touch_helpers import pose_error, retouched
 
+from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import Cell
 from robotcell.cell import calibrate as cellcal
+from robotcell.kinematics.transforms import make_pose
 from robotcell.studies.simulate import simulate
 
 NOISE = 1e-4
@@ -88,3 +91,32 @@ def test_each_step_carries_the_error_of_the_steps_before_it():
     for name, spread in spreads.items():
         assert np.all((spread > 0.8) & (spread < 1.25)), (name, np.round(spread, 3))
     assert good >= TRIALS and off < 0.01 * good, (good, off)
+
+
+def test_a_turntable_result_that_is_the_cells_keeps_what_it_shares_with_the_tool():
+    """``workpiece(turntable=...)`` with the result the cell's turntable came from, read from its
+    JSON (which holds its total covariance only): the cell's recorded error sources are used (the
+    tool's error is then counted once, and largely cancels in T_B_W), so the 1-sigma is the one
+    without the result; a different turntable stays a source of its own."""
+    _, fixed = cells()
+    tool = fixed.tools["pointer"].T_F_TCP
+    rng = np.random.default_rng(3)
+    t = cellcal.tcp(fixed, retouched(simulate(fixed, "tcp", noise=0.0, tool="pointer"), fixed,
+                                     tool, rng, NOISE), "pointer", sigma=NOISE)
+    tt = cellcal.turntable(t.cell, retouched(simulate(fixed, "turntable", noise=0.0,
+                                                      tool="pointer"), fixed, tool, rng, NOISE),
+                           tool="pointer", sigma=NOISE, height=-0.05)
+    touches = retouched(simulate(fixed, "workpiece", noise=0.0, tool="pointer", frame="part"),
+                        fixed, tool, rng, NOISE)
+    alone = cellcal.workpiece(tt.cell, touches, "part", tool="pointer", sigma=NOISE).result
+    written = json.loads(json.dumps(tt.result.to_json()))  # as `--turntable turntable.json`
+    given = cellcal.TurntablePose.from_result(CalibrationResult.from_json(written),
+                                              "turntable.json")
+    same = cellcal.workpiece(tt.cell, touches, "part", tool="pointer", sigma=NOISE,
+                             turntable=given).result
+    for key in ("T_B_W_position", "T_B_W_rotation"):
+        np.testing.assert_allclose(same.sigma[key], alone.sigma[key], rtol=1e-9)
+    moved = replace(given, T=given.T @ make_pose(np.eye(3), [1e-3, 0.0, 0.0]))
+    other = cellcal.workpiece(tt.cell, touches, "part", tool="pointer", sigma=NOISE,
+                              turntable=moved).result
+    assert np.all(other.sigma["T_B_W_position"] > same.sigma["T_B_W_position"])

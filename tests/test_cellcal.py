@@ -133,18 +133,26 @@ def test_workpiece_takes_the_turntable_result_and_propagates_its_uncertainty():
     from_cell = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch",
                                   sigma=1e-4)
     cov = tt.result.estimates["T_world_B"].covariance
-    apart = cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch", sigma=1e-4,
-                              turntable=cellcal.TurntablePose(tt.result.values["T_world_B"], cov,
-                                                              "world"))
+    T = tt.result.values["T_world_B"]
+
+    def bare(T):  # the turntable as a pose and a covariance only, as its JSON file gives it
+        return cellcal.workpiece(tt.cell, wp_touches.to_table(), "part", tool="torch",
+                                 sigma=1e-4, turntable=cellcal.TurntablePose(T, cov, "world"))
+
+    same, apart = bare(T), bare(T @ make_pose(np.eye(3), [1e-5, 0.0, 0.0]))
     # The cell records the turntable's uncertainty (sources shared with the torch included):
     # from the cell or from the result, the workpiece carries the same.
     assert not any("turntable" in n for n in with_tt.notes + from_cell.notes)
     s_with = np.linalg.norm(with_tt.result.sigma["T_B_W_position"])
     np.testing.assert_allclose(np.linalg.norm(from_cell.result.sigma["T_B_W_position"]), s_with,
                                rtol=1e-9)
+    # A bare pose that is the cell's turntable is taken with the cell's sources.
+    np.testing.assert_allclose(np.linalg.norm(same.result.sigma["T_B_W_position"]), s_with,
+                               rtol=1e-9)
     # The torch's error moved the turntable and the workpiece touches alike, and largely
-    # cancels in T_B_W: the same turntable covariance taken as independent of the torch
-    # (a bare matrix) overstates the workpiece's uncertainty.
+    # cancels in T_B_W: another turntable's covariance, taken as independent of the torch
+    # (nothing says what it shares), gives the workpiece a larger uncertainty.
+    assert any("differs from the one in" in n for n in apart.notes)
     assert np.linalg.norm(apart.result.sigma["T_B_W_position"]) > 1.5 * s_with
     assert with_tt.cell.frames["part"].parent == "turntable"
 

@@ -1003,14 +1003,16 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
     dT = invert(tt.T_parent_B) @ given.T
     dist = float(np.linalg.norm(dT[:3, 3]))
     angle = float(np.arccos(np.clip((np.trace(dT[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)))
-    notes = []
-    if max(dist, angle) > SAME_POSE:
-        notes.append(f"warning: the turntable of {given.source} differs from the one in "
-                     f"{label} by {dist * 1e3:.3f} mm and {np.degrees(angle):.4f} deg; "
-                     f"T_B_W is relative to {given.source}'s. Write that turntable into the "
-                     f"cell ({term('calibrate turntable --cell', 'robotcell.cell.calibrate.turntable')}"
-                     ") so that the two agree")
-    return given, notes
+    if max(dist, angle) <= SAME_POSE:
+        # The calibration the cell holds: its recorded error sources say what it shares with the
+        # tool and the track, which the given result's covariance alone cannot.
+        sources, note = item_sources(cell, "turntable", nominal)
+        return replace(given, covariance=sources), [note] if note else []
+    return given, [f"warning: the turntable of {given.source} differs from the one in "
+                    f"{label} by {dist * 1e3:.3f} mm and {np.degrees(angle):.4f} deg; "
+                    f"T_B_W is relative to {given.source}'s. Write that turntable into the "
+                    "cell (" + term("calibrate turntable --cell",
+                                    "robotcell.cell.calibrate.turntable") + ") so that the two agree"]
 
 
 def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None, *,
