@@ -41,7 +41,6 @@ from robotcell.calibration.uncertainty import OWN, Estimate, Inputs, Sources, jo
 from robotcell.cell import Cell
 from robotcell.cell.parts import Positioner
 from robotcell.errors import InputError, term
-from robotcell.identification.positioner import AXIS_CONSTANTS, perturbed_chain
 from robotcell.kinematics.transforms import invert, transform_points
 
 __all__ = ["NOMINAL_ACCURACY", "NominalAccuracy", "item_pose", "item_size", "item_sources",
@@ -137,6 +136,8 @@ def item_size(cell: Cell, key: str) -> int:
     if key == "track":
         return 7
     if key == "turntable" and isinstance(cell.turntable, Positioner):
+        from robotcell.identification.positioner import AXIS_CONSTANTS
+
         return 6 + len(AXIS_CONSTANTS) * cell.turntable.n_axes
     return 6
 
@@ -278,6 +279,8 @@ def plate_inputs(cell: Cell, values: ArrayLike, points: ArrayLike, chained: Chai
     Chained
         The inputs turned into P, with the positioner (key ``turntable``) appended.
     """
+    from robotcell.identification.positioner import AXIS_CONSTANTS, perturbed_chain
+
     pos = cell.turntable
     v = pos.axis_values(values)
     p = np.asarray(points, dtype=float).reshape(-1, 3)
