@@ -83,8 +83,12 @@ _PROVENANCE_KEYS = {"source", "time", "rms_mm", "note", "id", "measurements", "s
 
 
 def _mm_rad(size: int) -> NDArray[np.float64]:
-    """Per parameter of a calibrated value (origin, rotation vector, scale): SI to the file."""
-    return np.r_[np.full(min(size, 3), 1e3), np.ones(max(size - 3, 0))]
+    """Per parameter of a calibrated value (origin, rotation vector; a track's scale; a
+    positioner's ``a``, ``alpha``, ``d``, ``theta`` of each axis after its root): SI to the file."""
+    pose = np.r_[np.full(min(size, 3), 1e3), np.ones(min(max(size - 3, 0), 3))]
+    if size == 7:
+        return np.r_[pose, 1.0]
+    return np.r_[pose, np.tile([1e3, 1.0, 1e3, 1.0], max(size - 6, 0) // 4)]
 
 _HEADER = ("# robotcell cell file: lengths in mm, angles in deg; poses {x, y, z, a, b, c} with\n"
            "# R = Rz(a) Ry(b) Rx(c). Schema: docs/cell.md\n")

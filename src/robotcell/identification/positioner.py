@@ -38,6 +38,7 @@ from robotcell.calibration.fitting import (
     Fit,
     keeps_out,
     outlier_warnings,
+    perturb_pose,
     solution_fit,
 )
 from robotcell.calibration.propagate import jacobian
@@ -47,7 +48,7 @@ from robotcell.calibration.result import (
     fit_fields,
     pose_fields,
 )
-from robotcell.calibration.uncertainty import Inputs, estimate
+from robotcell.calibration.uncertainty import Estimate, Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.circles import start_model
 from robotcell.identification.engine import identify
@@ -56,7 +57,10 @@ from robotcell.identification.result import IdentificationResult
 from robotcell.kinematics.transforms import as_points
 from robotcell.robot.robot import Robot
 
-__all__ = ["PositionerCalibration", "calibrate_positioner"]
+__all__ = ["AXIS_CONSTANTS", "PositionerCalibration", "calibrate_positioner", "perturbed_chain"]
+
+#: The constants of each axis among a positioner chain's parameters, after its root pose.
+AXIS_CONSTANTS = ("a", "alpha", "d", "theta")
 
 
 @dataclass(frozen=True, eq=False)
@@ -180,6 +184,62 @@ def nearest_writing(robot: Robot, nominal: Robot) -> Robot:
     return replace(robot, base=base, joints=tuple(joints))
 
 
+def perturbed_chain(chain: Robot, w: ArrayLike) -> Robot:
+    """A positioner chain moved by its parameters (the positioner's error sources are over them).
+
+    Parameters
+    ----------
+    chain : Robot
+        The chain, ``base`` its root pose in the parent (m).
+    w : array_like, shape (6 + 4 n,)
+        The root origin moved by ``w[:3]`` (m) and its rotation by the rotation vector ``w[3:6]``
+        about the parent's axes (rad, ``exp([w]x) R``), then per axis the change of its DH
+        constants ``a`` (m), ``alpha`` (rad), ``d`` (m) and ``theta`` (rad).
+
+    Returns
+    -------
+    Robot
+    """
+    w = np.asarray(w, dtype=float)
+    T = chain.base
+    rows = w[6:].reshape(chain.n_joints, len(AXIS_CONSTANTS))
+    joints = tuple(replace(j, a=j.a + r[0], alpha=j.alpha + r[1], d=j.d + r[2],
+                           theta=j.theta + r[3]) for j, r in zip(chain.joints, rows))
+    return replace(chain, base=perturb_pose(T, np.r_[T[:3, 3] + w[:3], w[3:6]]), joints=joints)
+
+
+def _chain_estimate(ident: IdentificationResult, res: Fit, robot: Robot,
+                    q: NDArray[np.float64]) -> Estimate:
+    """The error of the written chain's parameters (:func:`perturbed_chain`).
+
+    The written chain (``robot``, in the nominal's conventions) moves the plate frame as the
+    identified one does. A change of the identified parameters moves the plate at the touched
+    axis values ``q``; the change of the written parameters that moves it the same way (least
+    squares, the smallest where the parameters overlap) is its image. The constants that one
+    touched point cannot separate from its place on the plate define the plate frame: they get
+    no error (a frame on the plate is touched into that frame).
+    """
+    ch, x = ident._chain, ident._x
+    kept = np.array([ch.index(nm) for nm in ident.free])
+    chain = robot.with_tool(np.eye(4))
+
+    def identified(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        xx = x.copy()
+        xx[kept] = v
+        pts, R = ch.predict(xx, q)
+        origin = pts[:, 0] - np.einsum("nij,j->ni", R, ch.targets(xx)[0])
+        return np.concatenate([origin, R.reshape(len(q), 9)], axis=1)
+
+    def written(w: NDArray[np.float64]) -> NDArray[np.float64]:
+        T = perturbed_chain(chain, w).fk(q, np.eye(4))
+        return np.concatenate([T[:, :3, 3], T[:, :3, :3].reshape(len(q), 9)], axis=1)
+
+    size = 6 + len(AXIS_CONSTANTS) * chain.n_joints
+    A = np.linalg.lstsq(jacobian(written, np.zeros(size)), jacobian(identified, x[kept]),
+                        rcond=1e-10)[0]
+    return estimate(res.sources, res.input_gain, A)
+
+
 def _imputed(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
              keep: NDArray[np.bool_]) -> NDArray[np.float64]:
     """The touches with those left out replaced by the chain fitted to the others.
@@ -271,7 +331,9 @@ def calibrate_positioner(
         normal and unit directions), ``normal_length`` (m), ``axis_angle`` (rad, 90 deg for a
         perpendicular pair), ``tilt_zero``, ``rotate_zero`` (rad), ``radius`` (m, of the
         reference point about the rotate axis); ``sigma`` for each (first order, from the
-        identification's covariance), ``T_R_B_position`` and ``T_R_B_rotation``.
+        identification's covariance), ``T_R_B_position`` and ``T_R_B_rotation``;
+        ``estimates`` of ``T_R_B`` and of ``chain``, the parameters of the returned chain
+        (:func:`perturbed_chain`: root pose, then ``a``, ``alpha``, ``d``, ``theta`` of each axis).
 
     Raises
     ------
@@ -367,7 +429,8 @@ def calibrate_positioner(
         covariance=C, parameter_names=[f"{k}[{i}]" if np.size(geo[k]) > 1 else k for k in keys
                                        for i in range(np.size(geo[k]))]
         + ["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z"],
-        points=f, estimates={"T_R_B": estimate(res.sources, res.input_gain, A[-6:])},
+        points=f, estimates={"T_R_B": estimate(res.sources, res.input_gain, A[-6:]),
+                             "chain": _chain_estimate(ident, res, robot, q)},
         **fit_fields(res),
     )
     return PositionerCalibration(result=result, robot=robot, identification=ident)

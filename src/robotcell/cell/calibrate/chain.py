@@ -16,6 +16,8 @@ item                      parameters
 ``tools.NAME``            ``T_F_TCP``: 6
 ``frames.NAME``           the frame's pose in its parent: 6
 ``turntable``             ``T_parent_B``: 6
+``turntable`` (chain)     a positioner of n axes: the root pose ``T_parent_0``, then
+                          ``a``, ``alpha``, ``d``, ``theta`` of each axis: 6 + 4 n
 ``track``                 ``T_L_R0`` and ``scale``: 7
 ========================  ==========================================================
 
@@ -37,10 +39,12 @@ from robotcell.calibration.fitting import perturb_pose
 from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.uncertainty import OWN, Estimate, Inputs, Sources, joined
 from robotcell.cell import Cell
+from robotcell.cell.parts import Positioner
 from robotcell.errors import InputError, term
+from robotcell.kinematics.transforms import invert, transform_points
 
-__all__ = ["NOMINAL_ACCURACY", "NominalAccuracy", "item_pose", "item_sources", "perturbed",
-           "touch_inputs", "written_sources"]
+__all__ = ["NOMINAL_ACCURACY", "NominalAccuracy", "item_pose", "item_size", "item_sources",
+           "perturbed", "plate_inputs", "touch_inputs", "written_sources"]
 
 
 @dataclass(frozen=True)
@@ -68,9 +72,13 @@ class NominalAccuracy:
                 raise InputError(f"nominal accuracy {name} must be a positive number, got {v!r}")
 
     def sigma(self, size: int) -> NDArray[np.float64]:
-        """1-sigma of each parameter of an item with ``size`` parameters (6 or 7)."""
-        return np.r_[np.full(3, self.position), np.full(3, self.rotation),
-                     np.full(size - 6, self.scale)]
+        """1-sigma of each parameter of an item with ``size`` parameters (6, 7 for a track, or
+        6 + 4 n for a positioner of n axes: ``a``, ``alpha``, ``d``, ``theta`` of each)."""
+        pose = np.r_[np.full(3, self.position), np.full(3, self.rotation)]
+        if size == 7:
+            return np.r_[pose, self.scale]
+        axis = [self.position, self.rotation, self.position, self.rotation]
+        return np.r_[pose, np.tile(axis, (size - 6) // 4)]
 
 
 #: The default: a tool from its drawing, a frame or an axis from the cell layout, a track's gear
@@ -106,18 +114,32 @@ def item_sources(cell: Cell, key: str, nominal: NominalAccuracy = NOMINAL_ACCURA
         Assumed where the cell records no uncertainty.
     """
     _, owner = item_pose(cell, key)
-    size = 7 if key == "track" else 6
+    size = item_size(cell, key)
     prov = owner.provenance
     if prov.sources:
         return Sources(size, dict(prov.sources)), None
     what = "a nominal value" if prov.source in ("nominal", "manual") else (
         "calibrated without a recorded uncertainty")
-    note = (f"note: {key} is {what}: its accuracy is taken as {nominal.position * 1e3:g} mm and "
-            f"{math.degrees(nominal.rotation):g} deg per axis"
+    shown = key if size < 10 else (f"positioner {owner.name!r} (root pose and the constants "
+                                   "of each axis)")
+    note = (f"note: {shown} is {what}: its accuracy is taken as {nominal.position * 1e3:g} mm "
+            f"and {math.degrees(nominal.rotation):g} deg per axis"
             + (f" and {nominal.scale:g} in scale" if size == 7 else "")
             + " (state it as covariance_mm_rad in the cell file's provenance, or with "
               f"{term('nominal', 'nominal (NominalAccuracy)')})")
     return Sources(size, {f"{key} nominal": np.diag(nominal.sigma(size))}), note
+
+
+def item_size(cell: Cell, key: str) -> int:
+    """Number of parameters of an item (see the module): 7 for the track, 6 + 4 n for a
+    positioner chain of n axes, else 6 (a pose)."""
+    if key == "track":
+        return 7
+    if key == "turntable" and isinstance(cell.turntable, Positioner):
+        from robotcell.identification.positioner import AXIS_CONSTANTS
+
+        return 6 + len(AXIS_CONSTANTS) * cell.turntable.n_axes
+    return 6
 
 
 def perturbed(T: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
@@ -224,6 +246,59 @@ def touch_inputs(cell: Cell, points_R: ArrayLike, *, flange: ArrayLike | None = 
 
 
 _POSE_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def plate_inputs(cell: Cell, values: ArrayLike, points: ArrayLike, chained: Chained,
+                 nominal: NominalAccuracy = NOMINAL_ACCURACY
+                 ) -> tuple[NDArray[np.float64], Chained]:
+    """Touches carried into the plate frame P of a positioner chain, and the items they rest on.
+
+    Each point goes into P through the chain at its axis values, so the positioner's error moves
+    it: the derivative with respect to the chain's parameters (root pose and the constants of
+    each axis, :func:`robotcell.identification.positioner.perturbed_chain`; central
+    differences, over all touches at once) joins the inputs, with the positioner's recorded
+    error sources (or the nominal accuracy, said in a note).
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell whose ``turntable`` is a :class:`~robotcell.cell.Positioner`.
+    values : array_like, shape (N, n)
+        Axis values of the touches (rad).
+    points : array_like, shape (N, 3)
+        The touched points in the positioner's parent frame (m).
+    chained : Chained
+        The tool and track the touches rest on, in the parent frame.
+    nominal : NominalAccuracy
+        Accuracy of items with none recorded.
+
+    Returns
+    -------
+    points_P : ndarray, shape (N, 3)
+        The touches in P (m).
+    Chained
+        The inputs turned into P, with the positioner (key ``turntable``) appended.
+    """
+    from robotcell.identification.positioner import AXIS_CONSTANTS, perturbed_chain
+
+    pos = cell.turntable
+    v = pos.axis_values(values)
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    size = item_size(cell, "turntable")
+
+    def carried(w: NDArray[np.float64]) -> NDArray[np.float64]:
+        return transform_points(invert(perturbed_chain(pos.chain, w).fk(v, np.eye(4))), p)
+
+    T_P_parent = invert(pos.T_parent_root @ pos.T_root_P(v))
+    inputs = None if chained.inputs is None else chained.inputs.rotated(T_P_parent[:, :3, :3])
+    sources, note = item_sources(cell, "turntable", nominal)
+    names = [f"turntable {c}" for c in _POSE_NAMES] + [
+        f"turntable {j.name or k + 1} {c}" for k, j in enumerate(pos.chain.joints)
+        for c in AXIS_CONSTANTS]
+    sens = jacobian(carried, np.zeros(size)).reshape(len(p), 3, size)
+    inputs = joined(inputs, sens, sources, names)
+    return transform_points(T_P_parent, p), Chained(
+        inputs, chained.keys + ("turntable",), chained.notes + ((note,) if note else ()))
 
 
 def written_sources(est: Estimate, old: Sources, name: str) -> dict[str, NDArray[np.float64]]:

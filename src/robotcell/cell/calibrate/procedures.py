@@ -43,6 +43,7 @@ from robotcell.cell.calibrate.chain import (
     Chained,
     NominalAccuracy,
     item_sources,
+    plate_inputs,
     touch_inputs,
     written_sources,
 )
@@ -869,7 +870,9 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     :func:`robotcell.identification.calibrate_positioner` with the cell's chain as the nominal
     model; the identified chain (axis lines, common normal, zeros and root; the touched point is
     not part of it) replaces the cell's, keeping the plate frame of its parameterisation, so
-    frames carried by the positioner keep their poses on the plate.
+    frames carried by the positioner keep their poses on the plate. Its error sources are
+    recorded over the root pose and the DH constants of each axis (the result's estimate
+    ``chain``), for the workpiece touched on the plate.
 
     Parameters
     ----------
@@ -916,7 +919,7 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     key = "T_world_B" if pos.parent == "world" else "T_R_B"
     result = done.result.renamed("T_R_B", key)
     record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
-    prov = _provenance("positioner", result, m.n, m.source, time, cell, "positioner", "",
+    prov = _provenance("positioner", result, m.n, m.source, time, cell, "turntable", "chain",
                        record)
     new = copied(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
@@ -1019,21 +1022,17 @@ def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None, *,
                           tool: str | ArrayLike | None, sigma: float | None, label: str,
                           time: str | None, notes: _Notes, file: str | None,
                           nominal: NominalAccuracy) -> CellCalibration:
-    """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P."""
+    """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P, with
+    the chain's recorded error sources (:func:`robotcell.cell.calibrate.chain.plate_inputs`)."""
     from robotcell.calibration.frame import frame_3point
 
     values, points = _positioner_points(cell, m, tool, label)
     m.check_points()
     pos = cell.turntable
-    notes.add([(f"note: the touches are taken into the plate of positioner {pos.name!r} "
-                f"through its chain in {label}: the 1-sigma of T_P_W does not include the "
-                "positioner's uncertainty")])
-    T_P_parent = invert(pos.T_parent_root @ pos.T_root_P(values))
-    p_P = transform_points(T_P_parent, points)
-    chained = _chained(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
+    touched = _chained(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
                        _world_track(cell, m), nominal, notes)
-    if chained.inputs is not None:
-        chained = replace(chained, inputs=chained.inputs.rotated(T_P_parent[:, :3, :3]))
+    p_P, chained = plate_inputs(cell, values, points, touched, nominal)
+    notes.add([n for n in chained.notes if n not in touched.notes])
     result = frame_3point(p_P, m.point, sigma, m.labels(points=True),
                           inputs=chained.inputs).renamed("T_R_W", "T_P_W")
     item = "" if name is None else f"frames.{name}"
@@ -1063,7 +1062,8 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
     cell : Cell or None
         The cell whose frame ``name`` on the turntable is calibrated; None: needs ``turntable``.
         On a positioner chain the touches, with its axis values ``e1..en`` (deg), are taken
-        into its plate frame P through the cell's chain and give ``T_P_W`` (3-point).
+        into its plate frame P through the cell's chain and give ``T_P_W`` (3-point), whose
+        uncertainty includes the chain's (its recorded error sources, or the nominal accuracy).
     measurements : Measurements, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) with the table angle ``e1`` (deg) and
         column ``point`` (``origin``, ``x``, ``xy``); for a turntable in the world of a cell with
