@@ -122,6 +122,11 @@ def _geometry(ident: IdentificationResult, x: NDArray[np.float64],
             "radius": np.array(np.linalg.norm(r)), "R": R, "origin": f0}
 
 
+def _free_index(ident: IdentificationResult) -> NDArray[np.intp]:
+    """Indices of the identified (free) parameters in the chain's full parameter vector."""
+    return np.array([ident._chain.index(nm) for nm in ident.free])
+
+
 def _normal_side(nominal: Robot) -> float:
     """+1 when the nominal's DH frame between its two axes has X along ``z_1 x z_2`` (the axes
     of motion), else -1: the nominal's way of writing the common normal, whatever its place."""
@@ -220,7 +225,7 @@ def _chain_estimate(ident: IdentificationResult, res: Fit, robot: Robot,
     no error (a frame on the plate is touched into that frame).
     """
     ch, x = ident._chain, ident._x
-    kept = np.array([ch.index(nm) for nm in ident.free])
+    kept = _free_index(ident)
     chain = robot.with_tool(np.eye(4))
 
     def identified(v: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -250,7 +255,7 @@ def _imputed(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.
     reliably) has the same optimum as the fit without the touch.
     """
     ch = ident._chain
-    kept = np.array([ch.index(nm) for nm in ident.free])
+    kept = _free_index(ident)
     x = ident._x.copy()
 
     def model(v: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -281,7 +286,7 @@ def _fit_of(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.f
     touches (those left out of the identification too), and the residuals.
     """
     ch, x = ident._chain, ident._x
-    kept = np.array([ch.index(nm) for nm in ident.free])
+    kept = _free_index(ident)
     pts = ch.predict(x, q)[0]
     J = -ch.point_jacobian(x, q, ch.evaluate(x, q), pts)[:, 0][..., kept]
     return solution_fit(x[kept], J, f - pts[:, 0], used=used, prior_sigma=prior_sigma,
@@ -371,8 +376,8 @@ def calibrate_positioner(
             res_other = _fit_of(other, q, f, keep, prior_sigma, inputs)
             if keeps_out(res_other, worst):
                 ident, res = other, res_other
-    ch, x = ident._chain, ident._x
-    kept = np.array([ch.index(nm) for nm in ident.free])
+    x = ident._x
+    kept = _free_index(ident)
 
     def at(v: NDArray[np.float64]) -> NDArray[np.float64]:
         xx = x.copy()
