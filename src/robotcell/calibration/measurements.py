@@ -463,7 +463,7 @@ def repeated_rows(rows: NDArray[np.float64], source: str,
     list of str
         One note per group of identical rows (empty when every row differs).
     """
-    names = labels if labels is not None else [f"line {i + 2}" for i in range(len(rows))]
+    names = labels if labels is not None else line_labels(len(rows))
     groups: dict[bytes, list[int]] = {}
     for i, r in enumerate(np.asarray(rows, dtype=float)):
         groups.setdefault((np.round(r, 9) + 0.0).tobytes(), []).append(i)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.calibration.fitting import Fit
-from robotcell.calibration.resultcheck import PROCEDURES, REQUIRED, TOUCH_LISTS, malformed
+from robotcell.calibration.resultcheck import REQUIRED, TOUCH_LISTS, malformed
 from robotcell.calibration.uncertainty import Estimate
 from robotcell.calibration.verdict import (
     CONDITION_GOOD,
@@ -29,7 +29,7 @@ from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import format_table
 
-__all__ = ["PROCEDURES", "CalibrationResult", "fit_fields", "pose_covariance", "pose_fields",
+__all__ = ["CalibrationResult", "fit_fields", "pose_covariance", "pose_fields",
            "result_json", "to_jsonable"]
 
 #: A key of a result's pose ``T_a_b`` in its JSON (its sigma or covariance), giving ``T_a_b``.
