@@ -4,7 +4,7 @@ One self-contained page (``robotcell compensate ... --report FILE.html``, ``robo
 compensate ... --report FILE.html``): per point the predicted TCP error without filtering (the
 identified arm at the joints the controller computes for the point as written, against it), the
 correction, and the 1-sigma of the filtered position from the identification's covariance, as a
-figure and a table. Figures are PNG ``data:`` URIs (:mod:`robotcell.report.calibration`; matplotlib imported
+figure and a table. Figures are PNG ``data:`` URIs (:mod:`robotcell.report.page`; matplotlib imported
 only when a report is written).
 """
 
@@ -18,15 +18,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from robotcell.io.fileio import atomic_write
-from robotcell.report.calibration import _CSS, _SCRIPT, _png
-from robotcell.report.identification import _pyplot, _table
+from robotcell.report.page import CSS, SCRIPT, png, pyplot, table
 
 __all__ = ["write_accuracy_report"]
 
 
 def _figure(error_mm: np.ndarray, dpos_mm: np.ndarray, sigma_mm: np.ndarray) -> str:
     """Per point: predicted error without filtering, correction, 1-sigma after (mm, log)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(9, 3.4))
     k = np.arange(1, len(error_mm) + 1)
     ax.semilogy(k, np.maximum(error_mm, 1e-6), "o", color="tab:red", ms=4,
@@ -39,7 +38,7 @@ def _figure(error_mm: np.ndarray, dpos_mm: np.ndarray, sigma_mm: np.ndarray) -> 
     ax.set_ylabel("TCP position [mm]")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return _png(fig)
+    return png(fig)
 
 
 def write_accuracy_report(path: str | Path, title: str, names: list[str], error: ArrayLike,
@@ -71,16 +70,16 @@ def write_accuracy_report(path: str | Path, title: str, names: list[str], error:
             + (f"uncertainty: 1-sigma {s.max():.4f} mm at most.</p>" if known else
                "uncertainty (the identified model carries no covariance to state it).</p>"))
     rows = [[n, float(a), float(b), float(c) if known else "-"] for n, a, b, c in zip(names, e, d, s)]
-    table = _table(["point", "error without filtering (mm)", "correction (mm)",
+    rows_html = table(["point", "error without filtering (mm)", "correction (mm)",
                     "1-sigma filtered (mm)"], rows)
     name = html.escape(title)
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell accuracy: {name}</title>
-<style>{_CSS}</style><script>{_SCRIPT}</script></head>
+<style>{CSS}</style><script>{SCRIPT}</script></head>
 <body>
 <h1>Absolute accuracy of {name}</h1>{head}
 <figure><img src="{_figure(e, d, s)}" alt="errors per point"></figure>
-<h2>Per point</h2>{table}
+<h2>Per point</h2>{rows_html}
 </body></html>
 """
     out = Path(path)

@@ -5,17 +5,14 @@ A report is made from the JSON a calibration writes (``robotcell calibrate ... -
 whether the calibration is good (a verdict with its reasons), the result, the 1-sigma
 uncertainties, residuals per touch, and an interactive 3D scene of the touches, the fitted
 geometry and the residual vectors magnified (:mod:`robotcell.view.calibration`, drawn with
-plotly). The residual figure is a PNG image embedded in the page (a ``data:`` URI) and plotly.js
+plotly). The residual figure is a PNG image (:mod:`robotcell.report.page`) embedded in the page (a ``data:`` URI) and plotly.js
 is inlined, so the HTML file alone is the whole report (about 4.9 MB): it can be mailed or copied
 anywhere and opens offline. matplotlib and plotly are imported only when a report is written.
 """
 
 from __future__ import annotations
 
-import base64
 import html
-import io
-import math
 import re
 from pathlib import Path
 from typing import Any
@@ -28,9 +25,9 @@ from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
 from robotcell.io.fileio import atomic_write, read_json
 from robotcell.io.poseformats import pose_to_vendor
+from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, fmt, png, pyplot, scene_figure
 from robotcell.view.calibration import calibration_scene, outliers
-from robotcell.view.plot import MAX_PAGE_BYTES, embed_within
-from robotcell.view.scene import Scene
+from robotcell.view.plot import MAX_PAGE_BYTES
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 
@@ -108,35 +105,6 @@ def _frames(result: dict[str, Any]) -> tuple[str, list[tuple[str, np.ndarray]]]:
     return a, [(a, np.eye(4)), (b, np.array(result["matrix"], dtype=float))]
 
 
-def _png(fig: Any) -> str:
-    """A matplotlib figure as a ``data:image/png;base64,...`` URI; the figure is closed."""
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    plt.close(fig)
-    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
-
-
-#: Where the 3D scene goes in a page, until the room it has is known.
-SCENE_SLOT = "<!-- the 3D scene -->"
-
-
-def scene_figure(scenes: list[Scene], room: int, what: str) -> str:
-    """An interactive 3D scene as a ``<figure>`` of a report, with its caption, in at most
-    ``room`` bytes: the first of ``scenes`` (the full one, then lighter ones) that fits
-    (:func:`robotcell.view.plot.embed_within`); a paragraph that says it is left out when none
-    does."""
-    fragment, drawn = embed_within(scenes, room - 2_000, height="620px")
-    if drawn is None:
-        return (f"<p>The 3D scene of {what} is left out: it would make this page larger than "
-                f"{MAX_PAGE_BYTES / 1e6:g} MB.</p>")
-    return (f'<figure class="view">{fragment}<figcaption>{html.escape(what[0].upper() + what[1:])} '
-            f"in the {html.escape(drawn.frame)} frame (mm), on equal axes: drag to turn, scroll "
-            "to zoom, hover for names and values, click a legend entry to hide or show it; "
-            f"{html.escape('; '.join(drawn.notes))}.</figcaption></figure>")
-
-
 def _scene(result: dict[str, Any], room: int) -> str:
     """The interactive 3D scene of the result (:func:`robotcell.view.calibration
     .calibration_scene`) as a figure of the page, plotly.js inlined."""
@@ -146,11 +114,7 @@ def _scene(result: dict[str, Any], room: int) -> str:
 
 
 def _figure_residuals(result: dict[str, Any]) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     r = np.array(result["residuals_mm"], dtype=float)
     labels = result.get("labels") or [str(i + 1) for i in range(len(r))]
     fig, ax = plt.subplots(figsize=(7, 3.2))
@@ -165,23 +129,7 @@ def _figure_residuals(result: dict[str, Any]) -> str:
     ax.set_title("Residual per touch (measured - model)", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return _png(fig)
-
-
-def _fmt(v: Any) -> str:
-    if isinstance(v, float):
-        if not math.isfinite(v):
-            return "n/a"
-        # Four decimals for everyday magnitudes; significant digits for tiny or huge ones (a
-        # covariance in rad^2, a sigma of 1e-7), which four decimals would show as 0.0000.
-        return f"{v:.4f}" if v == 0 or 1e-3 <= abs(v) < 1e7 else f"{v:.4g}"
-    if isinstance(v, list):
-        if v and isinstance(v[0], list):
-            return "<br>".join(_fmt(row) for row in v)
-        return "[" + ", ".join(_fmt(x) for x in v) + "]"
-    if v is None:
-        return "not determined"
-    return html.escape(str(v))
+    return png(fig)
 
 
 #: Units of the fields whose name does not end with one.
@@ -230,12 +178,12 @@ _DECIMALS = {"mm": 3, "deg": 4, "": 1}
 def _numbers(v: Any, unit: str) -> str:
     """A value or list of values with the decimals of its unit (mm 3, deg 4, none 1, else 6)."""
     if isinstance(v, bool) or not isinstance(v, (int, float, list)):
-        return _fmt(v)
+        return fmt(v)
     values = v if isinstance(v, list) else [v]
     if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in values):
-        return _fmt(v)
+        return fmt(v)
     d = _DECIMALS.get(unit, 6)
-    return ", ".join(_fmt(float(x)) if x != 0 and abs(x) < 10.0 ** -d else f"{x:.{d}f}"
+    return ", ".join(fmt(float(x)) if x != 0 and abs(x) < 10.0 ** -d else f"{x:.{d}f}"
                      for x in values)
 
 
@@ -301,25 +249,6 @@ def _quality_rows(result: dict[str, Any]) -> str:
     return "".join(rows)
 
 
-_CSS = """
-body { font-family: sans-serif; max-width: 960px; margin: 2em auto; color: #222; }
-.verdict { padding: 0.8em 1em; border-radius: 6px; font-size: 1.2em; }
-.good { background: #d8f3dc; } .check { background: #fff3bf; } .poor { background: #ffd6d6; }
-table { border-collapse: collapse; margin: 0.5em 0 1.5em; }
-td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
-img { max-width: 100%; border: 1px solid #ddd; margin: 0.5em 0; }
-"""
-
-# Marks the page once every figure has loaded with a size, so a browser test can read it.
-_SCRIPT = """
-window.addEventListener('load', function () {
-  var imgs = Array.prototype.slice.call(document.images);
-  var ok = imgs.length > 0 && imgs.every(function (i) { return i.complete && i.naturalWidth > 0; });
-  document.body.setAttribute('data-figures', ok ? 'loaded' : 'missing');
-});
-"""
-
-
 def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
     """Write an HTML report: one self-contained file, its figures embedded as PNG data URIs.
 
@@ -353,12 +282,12 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
     given = result.get("verdict")
     internals.update({f"verdict.{k}": v for k, v in (given if isinstance(given, dict) else {})
                       .items() if k not in ("level", "reasons")})
-    appendix = "".join(f"<tr><th>{head(k)}</th><td>{_fmt(v)}</td></tr>"
+    appendix = "".join(f"<tr><th>{head(k)}</th><td>{fmt(v)}</td></tr>"
                        for k, v in internals.items())
     labels = result.get("labels") or [str(i + 1) for i in range(len(result["residuals_mm"]))]
     xyz = result.get("residuals_xyz_mm") or [[float("nan")] * 3] * len(labels)
     touches = "".join(
-        f"<tr><td>{html.escape(str(lab))}</td><td>{r:.4f}</td><td>{_fmt(list(v))}</td></tr>"
+        f"<tr><td>{html.escape(str(lab))}</td><td>{r:.4f}</td><td>{fmt(list(v))}</td></tr>"
         for lab, r, v in zip(labels, result["residuals_mm"], xyz))
     def items(key: str) -> str:
         vals = result.get(key) or []
@@ -366,7 +295,7 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
 
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell report: {proc}</title>
-<style>{_CSS}</style><script>{_SCRIPT}</script></head>
+<style>{CSS}</style><script>{SCRIPT}</script></head>
 <body>
 <h1>Calibration report: {proc}</h1>
 <div class="verdict {grade}"><b>{grade.upper()}</b>: {html.escape('; '.join(reasons))}</div>

@@ -7,7 +7,7 @@ interactive 3D scene of them (:mod:`robotcell.view.identification`: the measured
 residuals magnified, the identified arm beside the nominal one), the K-fold cross-validated
 error, the parameters held and why, every parameter with its 1-sigma and the largest
 correlations, and the observability index O1 of the measured configurations against random
-ones. Figures are PNG ``data:`` URIs made with the helpers of :mod:`robotcell.report.calibration`, the scene
+ones. Figures are PNG ``data:`` URIs made with :mod:`robotcell.report.page`, the scene
 a plotly figure with plotly.js inlined (matplotlib and plotly imported only when a report is
 written).
 """
@@ -25,7 +25,7 @@ from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
-from robotcell.report.calibration import _CSS, _SCRIPT, SCENE_SLOT, _fmt, _png, scene_figure
+from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, pyplot, scene_figure, table
 from robotcell.view.identification import identification_scene
 from robotcell.view.plot import MAX_PAGE_BYTES
 
@@ -35,18 +35,9 @@ __all__ = ["write_identification_report"]
 N_CORRELATIONS = 10
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _figure_errors(before: NDArray[np.float64], after: NDArray[np.float64], title: str) -> str:
     """Histogram of the per-row errors of both models, and the errors per row (mm)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.4))
     both = np.maximum(np.concatenate([before, after]), 1e-6)
     bins = np.geomspace(both.min(), both.max() * 1.001 + 1e-9, 30)  # log: both models visible
@@ -63,28 +54,22 @@ def _figure_errors(before: NDArray[np.float64], after: NDArray[np.float64], titl
     ax2.set_ylabel("position error [mm]")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    return _png(fig)
+    return png(fig)
 
 
 def _figure_observability(o1: float, o1_random: NDArray[np.float64]) -> str:
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 2.8))
     ax.hist(o1_random, bins=12, color="tab:gray", label=f"{len(o1_random)} random sets")
     ax.axvline(o1, color="tab:blue", linewidth=2, label="measured configurations")
     ax.set_xlabel("observability index O1")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return _png(fig)
+    return png(fig)
 
 
 def _stats(e: NDArray[np.float64]) -> list[float]:
     return [float(e.mean()), float(math.sqrt(np.mean(e**2))), float(e.max())]
-
-
-def _table(head: list[str], rows: list[list[object]]) -> str:
-    th = "".join(f"<th>{html.escape(h)}</th>" for h in head)
-    body = "".join("<tr>" + "".join(f"<td>{_fmt(v)}</td>" for v in r) + "</tr>" for r in rows)
-    return f"<table><tr>{th}</tr>{body}</table>"
 
 
 def write_identification_report(
@@ -122,13 +107,13 @@ def write_identification_report(
     e1 = result.row_errors * 1e3
     all0 = np.linalg.norm(result.residuals_before, axis=-1).ravel() * 1e3
     all1 = np.linalg.norm(result.residuals, axis=-1).ravel() * 1e3
-    errors = _table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
+    errors = table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
                     [["nominal (base and targets fitted)", *_stats(all0)],
                      ["identified", *_stats(all1)]])
     if result.rotation_residuals is not None:
         r0 = np.degrees(np.linalg.norm(result.rotation_residuals_before, axis=-1))
         r1 = np.degrees(np.linalg.norm(result.rotation_residuals, axis=-1))
-        errors += _table(["model", "orientation mean (deg)", "RMS (deg)", "max (deg)"],
+        errors += table(["model", "orientation mean (deg)", "RMS (deg)", "max (deg)"],
                          [["nominal (base and target fitted)", *_stats(r0)], ["identified", *_stats(r1)]])
     extra = ""
     if result.coupling_check:
@@ -136,7 +121,7 @@ def write_identification_report(
         extra = (f"<h2>J2/J3 coupling</h2><p>k = {c['k']:g}: RMS {c['rms_with_mm']:.4f} mm with it, "
                  f"{c['rms_without_mm']:.4f} mm without; {html.escape(c['verdict'])}.</p>")
     fig_fit = _figure_errors(e0, e1, "Position error on the measured rows (largest target per row)")
-    per_row = _table(["row", "nominal (mm)", "identified (mm)", "outlier"],
+    per_row = table(["row", "nominal (mm)", "identified (mm)", "outlier"],
                      [[lab, float(a), float(b), "yes" if i in result.outliers else ""]
                       for i, (lab, a, b) in enumerate(zip(result.labels, e0, e1))])
     cv_html = "<p>not run (<code>--folds K</code>)</p>"
@@ -145,7 +130,7 @@ def write_identification_report(
         b, a = cv.before.max(axis=1) * 1e3, cv.after.max(axis=1) * 1e3
         fig_cv = _figure_errors(b, a, f"Held-out position error, {cv.folds}-fold cross-validation")
         cv_html = (f"<p>Every row predicted by the models fitted without its fold ({cv.folds} folds).</p>"
-                   + _table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
+                   + table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
                             [["nominal (base and targets fitted)", *_stats(cv.before.ravel() * 1e3)],
                              ["identified", *_stats(cv.after.ravel() * 1e3)]])
                    + f'<figure><img src="{fig_cv}" alt="cross-validated errors"></figure>')
@@ -156,11 +141,11 @@ def write_identification_report(
         v, nom, s, unit = p.vendor()
         prows.append([p.name, unit, nom if math.isfinite(nom) else "", v,
                       v - nom if math.isfinite(nom) else "", s if p.free else "fixed"])
-    params = _table(["name", "unit", "nominal", "identified", "change", "1-sigma"], prows)
+    params = table(["name", "unit", "nominal", "identified", "change", "1-sigma"], prows)
     C = result.correlation
     iu = np.triu_indices(len(result.free), 1)
     order = np.argsort(-np.abs(C[iu]))[:N_CORRELATIONS]
-    corr = _table(["parameter", "parameter", "correlation"],
+    corr = table(["parameter", "parameter", "correlation"],
                   [[result.free[iu[0][k]], result.free[iu[1][k]], float(C[iu][k])] for k in order])
     obs_html = "<p>not computed</p>"
     if observability is not None:
@@ -178,7 +163,7 @@ def write_identification_report(
     name = html.escape(result.nominal.name)
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell identification: {name}</title>
-<style>{_CSS}</style><script>{_SCRIPT}</script></head>
+<style>{CSS}</style><script>{SCRIPT}</script></head>
 <body>
 <h1>Kinematic identification of {name}</h1>
 <p>{len(result.labels)} rows, {result.residuals.shape[1]} target(s) per row; stated accuracy
