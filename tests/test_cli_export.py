@@ -7,7 +7,7 @@ from cli_helpers import run
 
 from robotcell.cell import Cell
 from robotcell.export import export_cell, parse_export
-from robotcell.export.common import collect
+from robotcell.controllers.data import collect
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 
