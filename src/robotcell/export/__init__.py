@@ -49,8 +49,8 @@ def other_kinds(fmt: str) -> dict[str, str]:
     every controller (``.src``: ``a KUKA program``), but the export's own ending (a KUKA export
     is saved as ``.dat``)."""
     own = output_ending(fmt)
-    return {s: f"a {c.label} program" for c in CONTROLLERS.values() for s in c.program_suffixes
-            if s != own}
+    return {s: f"{'an' if c.label[:1] in 'AEIOU' else 'a'} {c.label} program"
+            for c in CONTROLLERS.values() for s in c.program_suffixes if s != own}
 
 
 def export_cell(cell: Cell, fmt: str) -> str:
