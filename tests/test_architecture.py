@@ -13,6 +13,9 @@ from pathlib import Path
 
 import pytest
 
+from robotcell.controllers.registry import names
+from robotcell.io.poseformats import FORMATS
+
 SRC = Path(__file__).resolve().parent.parent / "src"
 PACKAGE = SRC / "robotcell"
 
@@ -133,7 +136,8 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
 #: package's ``__init__`` and ``errors``.
 CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell", "io",
-            "export", "programs", "accuracy", "studies", "view", "report", "cli", "robots"}
+            "controllers", "export", "programs", "accuracy", "studies", "view", "report", "cli",
+            "robots"}
 TOP_MODULES = {"__init__.py", "errors.py"}
 
 
@@ -155,7 +159,8 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: ``robotcell.kinematics.jit``); the solvers of ``robotcell.ik`` work on the arm of
 #: ``robotcell.kinematics`` and the robot (an arm with its IK, model files, the library) stands on
 #: both; the estimators stand on the robot, the cell on them (it holds an identified arm, and
-#: calibrates into itself); the controller exports and the programs over the cell; the 3D views
+#: calibrates into itself); the controllers (one package per vendor: its export, its programs,
+#: its limits) and the exports beside them over the cell, the programs over both; the 3D views
 #: of cells, paths, programs and results over the programs, and the HTML reports, which embed
 #: them, over the views; the accuracy (filtered poses and programs, with their report) over the
 #: reports.
@@ -166,7 +171,7 @@ LAYERS = [
     {"robotcell.robot"},
     {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification"},
     {"robotcell.cell"},
-    {"robotcell.export"},
+    {"robotcell.controllers", "robotcell.export"},
     {"robotcell.programs"},
     {"robotcell.view"},
     {"robotcell.report"},
@@ -188,11 +193,12 @@ def layer(module: str) -> int:
 
 
 def test_every_module_is_in_a_layer():
-    assert layer("robotcell.export.kuka") == 5 and layer("robotcell.io.tables") == 0
+    assert layer("robotcell.export.urdf") == 5 and layer("robotcell.io.tables") == 0
+    assert layer("robotcell.controllers.kuka.program") == 5
     assert layer("robotcell.kinematics.transforms") == 0 and layer("robotcell.kinematics.arm") == 1
     assert layer("robotcell.robot.robot") == 2 and layer("robotcell.cli.fk") == 11
     assert layer("robotcell.view.plot") == 7 and layer("robotcell.report.identification") == 8
-    assert layer("robotcell.programs.kuka") == 6 and layer("robotcell.accuracy.filter") == 9
+    assert layer("robotcell.programs.write") == 6 and layer("robotcell.accuracy.filter") == 9
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES
@@ -224,3 +230,56 @@ def test_the_command_line_is_a_thin_layer():
 
     share = lines((package / "cli").rglob("*.py")) / lines(package.rglob("*.py"))
     assert 0.02 < share <= 0.12, f"cli/ holds {share:.1%} of the package's lines"
+
+
+#: The vendors' names: every registered controller's and every pose format's. ``ur`` is also the
+#: name of the inverse kinematics of arms with three parallel axes (``robotcell.ik``), a solver
+#: and not a vendor, which those modules compare with.
+VENDOR_NAMES = set(names()) | set(FORMATS)
+SOLVER_NAMES = {"robotcell.ik": {"ur"}}
+
+
+def vendor_branches(name: str, tree: ast.AST) -> list[str]:
+    """Comparisons with a vendor's name (``vendor == "yaskawa"``, ``fmt in ("kuka", "abb")``)
+    and tables keyed by one (``{"kuka": ...}``) in a module's syntax tree, as ``line: name``."""
+    allowed = set().union(*(v for k, v in SOLVER_NAMES.items()
+                            if name == k or name.startswith(k + ".")))
+
+    def named(node: ast.AST | None) -> list[str]:
+        values = node.elts if isinstance(node, (ast.Tuple, ast.List, ast.Set)) else [node]
+        return [v.value for v in values if isinstance(v, ast.Constant)
+                and isinstance(v.value, str) and v.value.lower() in VENDOR_NAMES - allowed]
+
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            hits = [h for operand in (node.left, *node.comparators) for h in named(operand)]
+        elif isinstance(node, ast.Dict):
+            hits = [h for key in node.keys for h in named(key)]
+        elif isinstance(node, ast.MatchValue):
+            hits = named(node.value)
+        else:
+            continue
+        found += [f"{node.lineno}: {h}" for h in hits]
+    return found
+
+
+def test_vendor_branches_are_found():
+    # a guard that the check below sees the branches it is meant to forbid
+    code = ('if vendor == "yaskawa": pass\nok = fmt in ("kuka", "abb")\n'
+            'T = {"fanuc": 1}\nm = method == "ur"\n')
+    tree = ast.parse(code)
+    assert vendor_branches("robotcell.programs.x", tree) == [
+        "1: yaskawa", "2: kuka", "2: abb", "3: fanuc", "4: ur"]
+    assert vendor_branches("robotcell.ik.analytic", tree)[-1] == "3: fanuc"
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if not n.startswith("robotcell.controllers")))
+def test_no_module_outside_the_controllers_branches_on_a_vendor_name(name):
+    """What differs between controllers is an attribute or a method of the controller object
+    (docs/conventions.md, "How to add a controller"); a module outside robotcell.controllers
+    that compares with a vendor's name, or keys a table by one, would miss a controller added
+    later."""
+    tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
+    assert not vendor_branches(name, tree), f"{name} branches on {vendor_branches(name, tree)}"

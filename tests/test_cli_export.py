@@ -6,8 +6,8 @@ import pytest
 from cli_helpers import run
 
 from robotcell.cell import Cell
+from robotcell.controllers.data import collect
 from robotcell.export import export_cell, parse_export
-from robotcell.export.common import collect
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 

@@ -799,3 +799,87 @@ def test_cli_fuzz(command, tmp_path, capsys, monkeypatch, good):
 
 def _diff(before: dict[str, bytes], after: dict[str, bytes]) -> set[str]:
     return {k for k in before.keys() | after.keys() if before.get(k) != after.get(k)}
+
+
+
+# -- controllers: numbers, names and outputs a controller cannot hold -----------------------------
+# Fixed cases, each checked as every fuzz run is: a documented exit status, the refusal named on
+# an 'error:' line, no traceback or Python warning, and a refused run changes no file.
+def _tool_99(d: Path) -> Path:
+    text = EXAMPLE.read_text(encoding="utf-8").replace("  torch:\n    number: 1",
+                                                         "  torch:\n    number: 99")
+    return _write(d / "cell.yaml", text)
+
+
+def _seam_written(d: Path, name: str, fmt: str) -> Path:
+    """The example seam as ``d/name``, its program already written into ``d/prog``."""
+    from robotcell.cell import Cell
+    from robotcell.programs import write_program
+
+    path = Path(shutil.copy(SEAM, d / name))
+    write_program(path, Cell.load(EXAMPLE), "torch", "part", fmt, d / "prog",
+                  pulses_per_degree=100)
+    return path
+
+
+def _program_write(path: Path, cell: Path, fmt: str, folder: Path) -> list:
+    return ["program", "write", path, "--cell", cell, "--tool", "torch", "--frame", "part",
+            "--format", fmt, "--pulses-per-degree", "100", "-o", folder]
+
+
+def _export_tool_99(fmt: str, out: str):
+    return lambda d: (["export", "--cell", _tool_99(d), "--format", fmt, "-o", d / out])
+
+
+def _two_jobs_of_one_name(d: Path) -> list:
+    _seam_written(d, "seam_part_a.csv", "yaskawa")
+    return _program_write(Path(shutil.copy(SEAM, d / "seam_part_b.csv")), EXAMPLE, "yaskawa",
+                          d / "prog")
+
+
+def _over_a_hand_made_program(d: Path) -> list:
+    _write(d / "SEAM_PART.ls", "/PROG SEAM_PART\n/MN\n/END\n")
+    return _program_write(SEAM, EXAMPLE, "fanuc", d)
+
+
+def _beside_its_name_in_capitals(d: Path) -> list:
+    _write(d / "SEAM_PART.SRC", "DEF SEAM_PART()\nEND\n")
+    return _program_write(SEAM, EXAMPLE, "kuka", d)
+
+
+def _src_without_dat(d: Path) -> list:
+    _seam_written(d, "seam.csv", "kuka")
+    (d / "prog" / "seam.dat").unlink()
+    return ["program", "check", d / "prog" / "seam.src", "--cell", EXAMPLE]
+
+
+#: case -> (builder of its arguments in a folder, exit status, words of the refusal)
+CONTROLLER_CASES = {
+    "export kuka, tool 99": (_export_tool_99("kuka", "k.dat"), 2, "TOOL_DATA[1..16]"),
+    "export fanuc, tool 99": (_export_tool_99("fanuc", "f.txt"), 2, "UTOOL[1..9]"),
+    "export yaskawa, tool 99": (_export_tool_99("yaskawa", "y.txt"), 2, "TOOL[0..23]"),
+    "export abb, tool 99": (_export_tool_99("abb", "a.mod"), 0, ""),
+    "program write kuka, tool 99": (lambda d: _program_write(SEAM, _tool_99(d), "kuka",
+                                                             d / "prog"), 2, "TOOL_DATA[1..16]"),
+    "export kuka -o x.src": (lambda d: ["export", "--cell", EXAMPLE, "--format", "kuka", "-o",
+                                        d / "x.src"], 2, "the name says a KUKA program"),
+    "two yaskawa jobs of one name": (_two_jobs_of_one_name, 2, "it is a program written from"),
+    "a program over a hand-made one": (_over_a_hand_made_program, 2, "robotcell did not write"),
+    "a program beside its name in capitals": (_beside_its_name_in_capitals, 2,
+                                              "takes the two names for one program"),
+    "program check, .src without its .dat": (_src_without_dat, 2, "the .dat is missing"),
+}
+
+
+@pytest.mark.parametrize("name", list(CONTROLLER_CASES))
+def test_cli_fuzz_controller_limits(name, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    build, expected, message = CONTROLLER_CASES[name]
+    args = build(tmp_path)
+    before = _files(tmp_path)
+    code, out, err = run(capsys, *args)
+    assert code == expected, err
+    assert "Traceback" not in out + err and not PYTHON_WARNING.search(out + err)
+    if code == 2:
+        assert "error:" in err and message in err, err
+        assert _files(tmp_path) == before

@@ -18,8 +18,8 @@ from view_helpers import figure_from_page, triads
 
 from robotcell import load_robot, make_pose
 from robotcell.cell import Cell, Frame, Tool, Turntable
+from robotcell.controllers.data import collect, flatten_table
 from robotcell.export import EXPORT_FORMATS, parse_export
-from robotcell.export.common import collect, flatten_table
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.programs.check import check_program_file
 from robotcell.studies.demo import EXPORT_FILES, VIEW_TABLE, demo_cells

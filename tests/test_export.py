@@ -11,9 +11,9 @@ from scipy.spatial.transform import Rotation
 
 from robotcell import InputError, load_robot, pose_from_vendor
 from robotcell.cell import Cell, Frame, Tool, Track, Turntable
+from robotcell.controllers.data import collect
+from robotcell.controllers.kuka.export import frame_text
 from robotcell.export import EXPORT_FORMATS, export_cell, parse_export
-from robotcell.export.common import collect
-from robotcell.export.kuka import frame_text
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cell_kr16_track_turntable.yaml"
 ROBOT = load_robot("kuka_kr16")

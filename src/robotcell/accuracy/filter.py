@@ -34,12 +34,12 @@ from scipy.spatial.transform import Rotation
 from robotcell.cell import Cell
 from robotcell.cell.ik import CellIKSolutions
 from robotcell.cell.kinematics import robot_pose, tool_pose
+from robotcell.controllers.model import Config
 from robotcell.errors import InputError, RobotcellError
 from robotcell.identification.uncertainty import position_sigma
 from robotcell.ik.select import nearest
 from robotcell.kinematics.transforms import invert, validate_pose
 from robotcell.programs.config import config_text, select
-from robotcell.programs.model import Config
 from robotcell.robot.robot import Robot
 
 __all__ = ["MAX_CORRECTION", "MAX_ROTATION", "FilterRefused", "FilteredPoses", "filter_poses",
@@ -223,7 +223,7 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
     table : array_like, shape (N,) or (N, k)
         Table angles or positioner axis values (rad).
     config : list of Config, optional
-        Configuration flags per pose (:class:`robotcell.programs.model.Config`, one vendor);
+        Configuration flags per pose (:class:`robotcell.controllers.model.Config`, one vendor);
         default the nominal arm's solution nearest to the robot's home.
     max_correction, max_rotation : float
         Largest correction taken (m, rad; default 5 mm and 1 deg).

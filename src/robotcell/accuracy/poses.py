@@ -21,19 +21,15 @@ from numpy.typing import NDArray
 
 from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_poses
 from robotcell.cell import Cell
+from robotcell.controllers.model import Config
+from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import read_csv, write_csv
-from robotcell.programs.config import CONFIG_FIELDS
-from robotcell.programs.fanuc import parse_config
-from robotcell.programs.model import Config
 from robotcell.programs.path import read_path, table_columns
 from robotcell.report.accuracy import write_accuracy_report
 
-__all__ = ["CONFIG_COLUMNS", "CompensatedPoses", "compensate_poses"]
-
-#: Configuration columns of a poses file, per vendor.
-CONFIG_COLUMNS = {"kuka": ("s", "t"), "abb": CONFIG_FIELDS["abb"], "fanuc": ("config",)}
+__all__ = ["CompensatedPoses", "compensate_poses"]
 #: Decimals of the output (mm, deg): 1e-9 mm and deg, as the program formats.
 DECIMALS = 9
 
@@ -78,36 +74,24 @@ class CompensatedPoses:
 
 def _configs(path: str, cols: dict) -> list[Config] | None:
     """The configuration columns of the poses file, as flags of one vendor, or None."""
-    given = [v for v, names in CONFIG_COLUMNS.items() if any(c in cols for c in names)]
+    given = [c for c in CONTROLLERS.values() if any(k in cols for k in c.csv_config)]
     if not given:
         return None
     if len(given) > 1:
-        raise InputError(f"{path}: configuration columns of {' and '.join(given)}: give one "
-                         "vendor's (s, t; cf1, cf4, cf6, cfx; or config)")
-    vendor = given[0]
-    names = CONFIG_COLUMNS[vendor]
-    missing = [c for c in names if c not in cols]
+        sets = [", ".join(c.csv_config) for c in _with_columns()]
+        raise InputError(f"{path}: configuration columns of {' and '.join(c.name for c in given)}"
+                         f": give one vendor's ({'; '.join(sets[:-1])}; or {sets[-1]})")
+    ctl = given[0]
+    missing = [c for c in ctl.csv_config if c not in cols]
     if missing:
-        raise InputError(f"{path}: missing column(s) {', '.join(missing)} of the {vendor} "
+        raise InputError(f"{path}: missing column(s) {', '.join(missing)} of the {ctl.name} "
                          "configuration")
-    if vendor == "fanuc":
-        out = []
-        for i, text in enumerate(cols["config"]):
-            try:
-                out.append(parse_config(str(text)))
-            except InputError as exc:
-                raise InputError(f"{path}: line {i + 2}: column 'config': {exc}") from None
-        return out
-    values = []
-    for c in names:
-        v = cols[c]
-        bad = [i for i, x in enumerate(v) if not isinstance(x, (float, np.floating))
-               or not float(x).is_integer()]
-        if bad:
-            raise InputError(f"{path}: line {bad[0] + 2}: column '{c}' must be an integer, got "
-                             f"{v[bad[0]]!r}")
-        values.append(np.asarray(v, dtype=int))
-    return [Config(vendor, tuple(int(x) for x in row)) for row in np.column_stack(values)]
+    return ctl.configs_from_columns(path, cols)
+
+
+def _with_columns() -> list:
+    """The controllers whose flags a poses file may give in columns."""
+    return [c for c in CONTROLLERS.values() if c.csv_config]
 
 
 def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "world",
@@ -147,7 +131,7 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
     p = str(path)
     cols = read_csv(path)
     config = _configs(p, cols)
-    extra = tuple(c for names in CONFIG_COLUMNS.values() for c in names)
+    extra = tuple(k for c in _with_columns() for k in c.csv_config)
     targets = read_path(path, cell, extra)
     if tool not in cell.tools:
         raise InputError(f"tool {tool!r} is not a tool of the cell (tools: "

@@ -8,7 +8,8 @@ joints the controller uses (:func:`robotcell.programs.check.check_program` with 
 the configuration as written, or the previous point's), solves the identified arm for the same
 pose on the same branch (:func:`robotcell.accuracy.filter.identified_joints`) and writes the
 pose the nominal model computes for those joints, with their flags, in the point's frame. The
-program's text is changed only there (:mod:`robotcell.programs.edit`); every other line stays.
+program's text is changed only there (the controller's ``set_pose`` and ``set_joints``);
+every other line stays.
 
 Joint points stay as they are: taught on the real arm, they already put it where the operator
 saw it. With ``joints="offline"`` they were computed with the nominal model, mean the TCP where
@@ -35,17 +36,17 @@ from robotcell.accuracy.filter import (
 )
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose
+from robotcell.controllers.model import Program
+from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.identification.uncertainty import position_sigma
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.check import check_program
 from robotcell.programs.config import configs
-from robotcell.programs.edit import set_joints, set_pose
 from robotcell.programs.files import check_folder, write_all
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import placement, tool_pose_of
-from robotcell.programs.model import Program
 from robotcell.programs.write import written_poses
 from robotcell.report.accuracy import write_accuracy_report
 
@@ -191,6 +192,7 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     check_folder(folder)
     program, skipped = read_program(path)
     vendor = program.vendor
+    ctl = get(vendor, "program format")
     ctrl = cell.controller()
     checked = check_program(program, ctrl, pulses_per_degree)
     pts = program.points
@@ -231,9 +233,10 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
             new[k] = written_poses(ctrl, where, q[k:k + 1], track[k:k + 1], table[k:k + 1],
                                    T_tool[k])[0]
             before, after = p.pose, new[k]
-            if vendor == "yaskawa" and p.config is not None and flags[k] != p.config:
-                refused.append((i, ("its filtered joints need other RCONF flags than the job "
-                                    "writes for it; change the point")))
+            if ctl.shared_config and p.config is not None and flags[k] != p.config:
+                refused.append((i, (f"its filtered joints need other configuration flags than "
+                                    f"the program writes for it ({ctl.label} flags hold for the "
+                                    "points after it too); change the point")))
         else:
             before = ctrl.fk(p.joints, track[k], table[k], tool=T_tool[k])
             after = ctrl.fk(q[k], track[k], table[k], tool=T_tool[k])
@@ -252,9 +255,9 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     for k, i in enumerate(todo):
         p = pts[i]
         file, _, line = p.where.rpartition(":")
-        ok = (set_pose(vendor, texts[file], int(line) - 1, new[k],
-                       flags[k] if p.config is not None and vendor != "yaskawa" else None)
-              if p.pose is not None else set_joints(vendor, texts[file], int(line) - 1, q[k]))
+        ok = (ctl.set_pose(texts[file], int(line) - 1, new[k],
+                           flags[k] if p.config is not None and not ctl.shared_config else None)
+              if p.pose is not None else ctl.set_joints(texts[file], int(line) - 1, q[k]))
         if not ok:
             refused.append((i, f"cannot find its values on {file} line {line}"))
         result.points.append(CompensatedPoint(

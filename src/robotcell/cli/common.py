@@ -179,7 +179,8 @@ _ENDING = {"JSON": ".json", "YAML": ".yaml", "CSV": ".csv", "HTML": ".html", "UR
            "text": ".txt"}
 
 
-def check_kind(path: str | None, kind: str, what: str, option: str = "-o") -> None:
+def check_kind(path: str | None, kind: str, what: str, option: str = "-o",
+               named: Mapping[str, str] | None = None, ending: str | None = None) -> None:
     """Refuse an output file whose name says another kind of file than the one written.
 
     ``-o`` writes what the command produces; a name ending in ``.json`` for a YAML model file
@@ -196,13 +197,19 @@ def check_kind(path: str | None, kind: str, what: str, option: str = "-o") -> No
         What the file holds, for the message (``"the identified model file"``).
     option : str
         The option, for the message.
+    named : mapping of str to str, optional
+        Further endings that say another kind of file, and what they say (``.src``: ``a KUKA
+        program``).
+    ending : str, optional
+        The ending to suggest (default: the one of ``kind``).
     """
     if path is None:
         return
-    named = _KINDS.get(Path(path).suffix.lower())
-    if named is not None and named != kind:
-        raise InputError(f"{option} {path}: the name says {named}, but this writes {what} as "
-                         f"{kind}; name it {Path(path).stem}{_ENDING[kind]}")
+    suffix = Path(path).suffix.lower()
+    said = _KINDS.get(suffix) or (named or {}).get(suffix)
+    if said is not None and said != kind:
+        raise InputError(f"{option} {path}: the name says {said}, but this writes {what} as "
+                         f"{kind}; name it {Path(path).stem}{ending or _ENDING[kind]}")
 
 
 def output_of(kind: str, what: str) -> Callable[[click.Context, click.Parameter, str | None],

@@ -6,14 +6,22 @@ import click
 
 from robotcell.cell import Cell
 from robotcell.cli.common import check_kind, check_output, write_output
-from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
-from robotcell.export import WRITE_FORMATS, export_cell, export_files, ur_kinematics_path
+from robotcell.cli.files import OUTPUT, Command, LiveChoice, refuse_overwriting_inputs
+from robotcell.export import (
+    URDF,
+    export_cell,
+    export_files,
+    other_kinds,
+    output_ending,
+    ur_kinematics_path,
+    write_formats,
+)
 
 
 @click.command(cls=Command)
 @click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file (YAML, mm/deg).")
-@click.option("--format", "fmt", required=True, type=click.Choice(list(WRITE_FORMATS)),
+@click.option("--format", "fmt", required=True, type=LiveChoice(write_formats),
               help="Controller format.")
 @click.option("-o", "--output", "output", type=OUTPUT, callback=check_output,
               help="File to write, atomically (default: standard output).")
@@ -36,12 +44,13 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
       robotcell export --cell cell.yaml --format kuka
       robotcell export --cell cell.yaml --format abb -o cell_frames.mod
     """
-    check_kind(output, "URDF" if fmt == "urdf" else "text", f"the {fmt} export")
+    check_kind(output, "URDF" if fmt == URDF else "text", f"the {fmt} export",
+               named=other_kinds(fmt), ending=output_ending(fmt))
     cell = Cell.load(cell_path)
     if output is None:
         write_output(None, export_cell(cell, fmt))
         return
-    if fmt == "urdf":
+    if fmt == URDF:
         refuse_overwriting_inputs(click.get_current_context(),
                                   [("the UR calibration file written next to -o",
                                     str(ur_kinematics_path(output)))])

@@ -13,7 +13,7 @@ identity (hard links).
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -21,8 +21,8 @@ import click
 
 from robotcell.errors import InputError
 
-__all__ = ["NAME_OR_FILE", "OUTPUT", "Command", "Group", "NameOrFile", "OutputPath",
-           "refuse_overwriting_inputs"]
+__all__ = ["NAME_OR_FILE", "OUTPUT", "Command", "Group", "LiveChoice", "NameOrFile",
+           "OutputPath", "refuse_overwriting_inputs"]
 
 #: Key of ``click.Context.meta`` under which :class:`OutputPath` keeps the output files given.
 _OUTPUTS = "robotcell.files.outputs"
@@ -49,6 +49,30 @@ class NameOrFile(click.ParamType):
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         return value
+
+
+class LiveChoice(click.Choice):
+    """A choice among names read when the command line is parsed or its help shown, not when
+    the command is defined: the registered controllers (``--format``), so that one registered
+    later is a choice too.
+
+    Parameters
+    ----------
+    names : callable
+        Returns the names to choose from.
+    """
+
+    def __init__(self, names: Callable[[], Iterable[str]]) -> None:
+        self._names = names
+        super().__init__(())
+
+    @property
+    def choices(self) -> tuple[str, ...]:  # type: ignore[override]
+        return tuple(self._names())
+
+    @choices.setter
+    def choices(self, value: Iterable[str]) -> None:
+        """Set by :class:`click.Choice` to the empty tuple; the names are read when needed."""
 
 
 #: An output file (``-o FILE``); the callbacks of :mod:`robotcell.cli.common` check its folder.

@@ -149,9 +149,9 @@ def _echo_pose(T: np.ndarray, fmt: str) -> None:
             click.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
         return
     v = pose_to_vendor(T, fmt)
-    fields = FORMATS[fmt].fields
-    click.echo(" ".join(f"{n} {x:.4f}" if fmt != "abb" or i < 3 else f"{n} {x:.6f}"
-                        for i, (n, x) in enumerate(zip(fields, v))))
+    f = FORMATS[fmt]
+    click.echo(" ".join(f"{n} {x:.4f}" if f.rotation != "quaternion" or i < 3 else f"{n} {x:.6f}"
+                        for i, (n, x) in enumerate(zip(f.fields, v))))
 
 
 def _write_poses(T: np.ndarray, fmt: str, output_path: str | None) -> None:

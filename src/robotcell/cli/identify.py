@@ -18,13 +18,14 @@ from robotcell.cli.common import (
     read_csv,
     warn_unknown_columns,
 )
-from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, LiveChoice
+from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.identification.validation import select_configurations
 from robotcell.io.tables import format_table, write_csv
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
-from robotcell.studies.identify import identify_file
+from robotcell.studies.identify import identify_file, zero_offset_controllers
 
 #: Columns of a measurement CSV (docs/identification.md): joints ``a1..aN``, one target ``x,y,z``
 #: or several ``x1,y1,z1,...``, an orientation ``qw,qx,qy,qz``.
@@ -39,14 +40,9 @@ def _check_columns(path: str) -> None:
 
 
 def _print_offsets(offsets: dict, vendor: str) -> None:
-    if vendor == "kuka":
-        click.echo("\njoint zero corrections for KUKA: add to the current $MAMES[i] in $machine.dat "
-                   "(deg; mm for linear axes)")
-        head = ["axis", "add to $MAMES[i]", "1-sigma", "unit", "note"]
-    else:
-        click.echo("\njoint zero offsets for ABB, arm side (rad; m for linear axes); robotcell writes "
-                   "no MOC.cfg line: apply them with ABB's calibration tools (docs/identification.md)")
-        head = ["axis", "offset", "1-sigma", "unit", "note"]
+    z = get(vendor).zero_offsets
+    click.echo(f"\n{z.heading}")
+    head = ["axis", z.column, "1-sigma", "unit", "note"]
     rows = [[a["axis"], "-" if math.isnan(a["delta"]) else f"{a['delta']:+.6f}",
              "-" if math.isnan(a["sigma"]) else f"{a['sigma']:.6f}", a["unit"],
              "not determined: " + a["why"] if a["why"] else ""] for a in offsets["axes"]]
@@ -122,7 +118,7 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               "by the models identified without it (mean, RMS, max before and after).")
 @click.option("--report", "report", type=OUTPUT, callback=check_not_folder, help="Also write a "
               "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
-@click.option("--offsets-for", "offsets_for", type=click.Choice(["kuka", "abb"]), help="Also print "
+@click.option("--offsets-for", "offsets_for", type=LiveChoice(zero_offset_controllers), help="Also print "
               "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "
               "ABB arm-side offsets (rad). Needs --robot.")
 @click.option("--propose", "propose", type=int, metavar="N", help="Instead of identifying: propose "

@@ -41,8 +41,10 @@ from robotcell.cli.common import (
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
+from robotcell.controllers.base import IkFlags
+from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
-from robotcell.ik import abb_confdata, analytic_solver, kuka_status_turn, nearest
+from robotcell.ik import analytic_solver, nearest
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
@@ -53,16 +55,18 @@ BRANCHES = ["front up", "front up flip", "front down", "front down flip",
 BRANCHES_4 = ["front up", "front down", "back up", "back down"]
 
 
+def _ik_flags(method: str, fmt: str) -> IkFlags | None:
+    """The flags ``ik`` prints for pose format ``fmt`` (a controller's), for an OPW arm."""
+    controller = next((c for c in CONTROLLERS.values() if c.pose_format.name == fmt), None)
+    return None if method != "opw" or controller is None else controller.ik_flags
+
+
 def _flags(robot: Robot, method: str, fmt: str, q: np.ndarray) -> list[str] | None:
     """KUKA 'S 6 T 2' or ABB '[0,0,0,0]' per row of ``q`` (rad), or None when not applicable."""
-    if method != "opw" or fmt not in ("kuka", "abb"):
+    flags = _ik_flags(method, fmt)
+    if flags is None:
         return None
-    qq = np.nan_to_num(q)
-    if fmt == "kuka":
-        s, t = kuka_status_turn(robot, qq)
-        return [f"S {a} T {b}" for a, b in zip(np.atleast_1d(s), np.atleast_1d(t))]
-    cf = np.atleast_2d(abb_confdata(robot, qq))
-    return ["[" + ",".join(str(v) for v in row) + "]" for row in cf]
+    return [flags.text(row) for row in flags.values(robot, np.nan_to_num(q))]
 
 
 def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
@@ -169,7 +173,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         flags = _flags(r, solver.method, fmt, q)
         headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.axes)], "valid"]
         if flags is not None:
-            headers.append("S/T" if fmt == "kuka" else "confdata")
+            headers.append(_ik_flags(solver.method, fmt).label)
         rows = []
         for i, k in enumerate(ks):
             row_i = 0 if ref is not None else k
@@ -227,13 +231,10 @@ def _reach_error_mm(reach_error: np.ndarray | None, reachable: np.ndarray) -> np
 def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
                        ) -> tuple[list[str], np.ndarray]:
     """Batch columns of the configuration flags (KUKA status,turn; ABB cf1..cfx) per row of q."""
-    if method != "opw" or fmt not in ("kuka", "abb"):
+    flags = _ik_flags(method, fmt)
+    if flags is None:
         return [], np.empty((len(q), 0), dtype=int)
-    qq = np.nan_to_num(q)
-    if fmt == "kuka":
-        s, t = kuka_status_turn(robot, qq)
-        return ["status", "turn"], np.column_stack([s, t])
-    return ["cf1", "cf4", "cf6", "cfx"], np.atleast_2d(abb_confdata(robot, qq))
+    return list(flags.columns), flags.values(robot, np.nan_to_num(q))
 
 
 def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_path: str | None,
@@ -267,7 +268,7 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
         off_shown = off is not None and bool(np.any(off[ks] > 0))
         headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
         if flags is not None:
-            headers.append("S/T" if fmt == "kuka" else "confdata")
+            headers.append(_ik_flags(sol.method, fmt).label)
         if off_shown:
             headers.append("reach error mm")
         rows = []

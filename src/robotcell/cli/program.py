@@ -19,8 +19,8 @@ from robotcell.cli.common import (
     in_range,
     parse_numbers,
 )
-from robotcell.cli.files import Group, OutputPath
-from robotcell.programs import VENDORS
+from robotcell.cli.files import Group, LiveChoice, OutputPath
+from robotcell.controllers.registry import names
 
 #: Library parameters as the command line names them.
 FLAGS = {"pulses_per_degree": "--pulses-per-degree", "split": "--split",
@@ -60,7 +60,7 @@ def program() -> None:
 @click.option("--tool", required=True, help="Tool of the cell.")
 @click.option("--frame", default="world", show_default=True,
               help="Frame of the path: world or a frame of the cell.")
-@click.option("--format", "vendor", required=True, type=click.Choice(VENDORS),
+@click.option("--format", "vendor", required=True, type=LiveChoice(names),
               help="Program format.")
 @click.option("-o", "--output", "folder", required=True, type=OutputPath(file_okay=False),
               help="Folder for the program files (created; its parent must exist).")
@@ -100,6 +100,8 @@ def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, fol
             raise BadPoints(f"{path}: {exc}".replace("with split", "with --split")) from None
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
+    for f in result.replaced:
+        click.echo(f"note: replaced {f}, an earlier program of the same path file", err=True)
     if as_json:
         click.echo(json.dumps(_write_json(cell, result), indent=2))
     else:

@@ -1,46 +1,73 @@
-"""Controller exports: what a user pastes into a KUKA, ABB, FANUC or YASKAWA controller.
+"""Controller exports: what a user pastes into a KUKA, ABB, FANUC or YASKAWA controller (or any
+registered one, :mod:`robotcell.controllers`).
 
 ``export_cell(cell, "kuka")`` returns the text (``"urdf"``: the cell as a URDF kinematic tree, for
 ROS tools, not a controller format); ``export_files(cell, fmt, path)`` writes it (and, for the
-URDF of an identified Universal Robots arm, the UR description's calibration file beside it); ``parse_export(text, "kuka")`` reads it back into
-:class:`~robotcell.export.common.ControllerData` (poses in metres). Formats, units, reference
+URDF of an identified Universal Robots arm, the UR description's calibration file beside it);
+``parse_export(text, "kuka")`` reads it back into
+:class:`~robotcell.controllers.data.ControllerData` (poses in metres). Formats, units, reference
 frames and sources: ``docs/export.md``.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from types import ModuleType
 
 from robotcell.cell import Cell
+from robotcell.controllers.data import ControllerData, Slot
+from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
-from robotcell.export import abb, fanuc, kuka, urdf, yaskawa
-from robotcell.export.common import ControllerData, Slot
+from robotcell.export import urdf
 from robotcell.export.ur import cell_ur_kinematics
 from robotcell.io.fileio import atomic_write, check_destination
 
-__all__ = ["EXPORT_FORMATS", "WRITE_FORMATS", "ControllerData", "Slot", "export_cell",
-           "export_files", "parse_export", "ur_kinematics_path"]
+__all__ = ["EXPORT_FORMATS", "URDF", "ControllerData", "Slot", "export_cell", "export_files",
+           "other_kinds", "output_ending", "parse_export", "ur_kinematics_path", "write_formats"]
 
-#: format name -> module with ``export(cell) -> str`` and ``parse(text) -> ControllerData``
-EXPORT_FORMATS: dict[str, ModuleType] = {"kuka": kuka, "abb": abb, "fanuc": fanuc,
-                                         "yaskawa": yaskawa}
+#: format name -> controller (``export``, ``parse_export``): the registered controllers, live
+EXPORT_FORMATS = CONTROLLERS
 
-#: every format :func:`export_cell` writes: the controller formats and ``urdf``
-WRITE_FORMATS: dict[str, ModuleType] = {**EXPORT_FORMATS, "urdf": urdf}
+#: The format of the whole cell as a URDF tree: not a controller.
+URDF = "urdf"
 
 
-def _module(fmt: str, formats: dict[str, ModuleType] = EXPORT_FORMATS) -> ModuleType:
-    try:
-        return formats[fmt.lower()]
-    except KeyError:
-        raise InputError(f"unknown export format {fmt!r}; choose one of: "
-                         f"{', '.join(formats)}") from None
+def write_formats() -> list[str]:
+    """Every format :func:`export_cell` writes: the registered controllers and ``urdf``."""
+    return [*CONTROLLERS, URDF]
+
+
+def output_ending(fmt: str) -> str:
+    """The file ending an export of ``fmt`` is saved with (``.dat``, ``.mod``, ``.txt``,
+    ``.urdf``)."""
+    if fmt.lower() == URDF:
+        return ".urdf"
+    return Path(get(fmt, "export format").export_name).suffix
+
+
+def other_kinds(fmt: str) -> dict[str, str]:
+    """File endings that say another kind of file than the export of ``fmt``: the programs of
+    every controller (``.src``: ``a KUKA program``), but the export's own ending (a KUKA export
+    is saved as ``.dat``)."""
+    own = output_ending(fmt)
+    return {s: f"{'an' if c.label[:1] in 'AEIOU' else 'a'} {c.label} program"
+            for c in CONTROLLERS.values() for s in c.program_suffixes if s != own}
 
 
 def export_cell(cell: Cell, fmt: str) -> str:
-    """Text for ``cell`` in format ``fmt`` (``kuka``, ``abb``, ``fanuc``, ``yaskawa``, ``urdf``)."""
-    return _module(fmt, WRITE_FORMATS).export(cell)
+    """Text for ``cell`` in format ``fmt`` (a registered controller, or ``urdf``).
+
+    Raises
+    ------
+    InputError
+        An unknown format, a tool or frame number the controller does not have, or a cell it
+        cannot hold.
+    """
+    if fmt.lower() == URDF:
+        return urdf.export(cell)
+    if fmt.lower() not in CONTROLLERS:
+        raise InputError(f"unknown export format {fmt!r}; choose one of: "
+                         f"{', '.join(write_formats())}")
+    return get(fmt).export(cell)
 
 
 def ur_kinematics_path(output: str | Path) -> Path:
@@ -63,7 +90,7 @@ def export_files(cell: Cell, fmt: str, output: str | Path) -> list[Path]:
         The files written.
     """
     text = export_cell(cell, fmt)
-    extra = cell_ur_kinematics(cell) if fmt.lower() == "urdf" else None
+    extra = cell_ur_kinematics(cell) if fmt.lower() == URDF else None
     files = [Path(output)]
     if extra is not None:
         files.append(ur_kinematics_path(output))
@@ -76,4 +103,4 @@ def export_files(cell: Cell, fmt: str, output: str | Path) -> list[Path]:
 
 def parse_export(text: str, fmt: str) -> ControllerData:
     """Read text written by :func:`export_cell` back into poses (metres)."""
-    return _module(fmt).parse(text)
+    return get(fmt, "export format").parse_export(text)

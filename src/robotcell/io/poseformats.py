@@ -43,6 +43,9 @@ class PoseFormat:
         Index into the vendor's three angles giving the order scipy's ``euler`` sequence expects.
     length_scale : float
         Metres per vendor length unit.
+    rotation : {"euler", "quaternion", "rotvec"}
+        How the orientation is written: three Euler angles in degrees (``euler``), a unit
+        quaternion scalar first, or a rotation vector in radians.
     """
 
     name: str
@@ -51,6 +54,7 @@ class PoseFormat:
     euler: str | None = None
     angle_order: tuple[int, int, int] = (0, 1, 2)
     length_scale: float = 1e-3
+    rotation: str = "euler"
 
     @property
     def size(self) -> int:
@@ -68,14 +72,17 @@ FORMATS: dict[str, PoseFormat] = {
         PoseFormat("yaskawa", ("X", "Y", "Z", "Rx", "Ry", "Rz"), "mm, deg", "ZYX", (2, 1, 0)),
         # R = Rx(Rx) Ry(Ry) Rz(Rz): intrinsic X-Y'-Z''.
         PoseFormat("staubli", ("X", "Y", "Z", "Rx", "Ry", "Rz"), "mm, deg", "XYZ"),
-        PoseFormat("abb", ("x", "y", "z", "q1", "q2", "q3", "q4"), "mm, unit quaternion"),
+        PoseFormat("abb", ("x", "y", "z", "q1", "q2", "q3", "q4"), "mm, unit quaternion",
+                   rotation="quaternion"),
         PoseFormat("ur", ("x", "y", "z", "rx", "ry", "rz"), "m, rad (rotation vector)",
-                   length_scale=1.0),
+                   length_scale=1.0, rotation="rotvec"),
     )
 }
 
 
-def _format(fmt: str) -> PoseFormat:
+def _format(fmt: str | PoseFormat) -> PoseFormat:
+    if isinstance(fmt, PoseFormat):
+        return fmt
     try:
         return FORMATS[fmt.lower()]
     except KeyError:
@@ -132,7 +139,7 @@ def _euler(rot: Rotation, R: NDArray[np.float64], seq: str) -> NDArray[np.float6
     return e
 
 
-def pose_from_vendor(values: ArrayLike, fmt: str) -> NDArray[np.float64]:
+def pose_from_vendor(values: ArrayLike, fmt: str | PoseFormat) -> NDArray[np.float64]:
     """Convert poses written in a vendor format to 4x4 matrices.
 
     Parameters
@@ -140,8 +147,9 @@ def pose_from_vendor(values: ArrayLike, fmt: str) -> NDArray[np.float64]:
     values : array_like, shape (..., k)
         Poses as the vendor writes them: ``k = 6`` (``k = 7`` for ``abb``), in the vendor's units
         (millimetres and degrees; metres and radians for ``ur``).
-    fmt : str
-        One of ``kuka``, ``fanuc``, ``yaskawa``, ``staubli``, ``abb``, ``ur``.
+    fmt : str or PoseFormat
+        One of ``kuka``, ``fanuc``, ``yaskawa``, ``staubli``, ``abb``, ``ur``, or a
+        :class:`PoseFormat` of its own.
 
     Returns
     -------
@@ -164,16 +172,17 @@ def pose_from_vendor(values: ArrayLike, fmt: str) -> NDArray[np.float64]:
         raise InputError(f"{f.name} pose contains NaN or infinite values")
     batch = v.shape[:-1]
     flat = v.reshape(-1, f.size)
-    if f.name == "abb":
+    if f.rotation == "quaternion":
         q = flat[:, 3:]
         norm = np.linalg.norm(q, axis=1)
         bad = np.abs(norm - 1.0) > QUAT_NORM_TOL
         if np.any(bad):
             raise InputError(
-                f"ABB quaternion q1..q4 must be normalised (|q| = 1); got |q| = {norm[bad][0]:.6g}"
+                f"{f.name.upper()} quaternion {f.fields[3]}..{f.fields[-1]} must be normalised "
+                f"(|q| = 1); got |q| = {norm[bad][0]:.6g}"
             )
         rot = Rotation.from_quat(q, scalar_first=True)
-    elif f.name == "ur":
+    elif f.rotation == "rotvec":
         rot = Rotation.from_rotvec(flat[:, 3:])
     else:
         rot = Rotation.from_euler(f.euler, flat[:, 3:][:, list(f.angle_order)], degrees=True)
@@ -184,15 +193,15 @@ def pose_from_vendor(values: ArrayLike, fmt: str) -> NDArray[np.float64]:
     return T.reshape(batch + (4, 4))
 
 
-def pose_to_vendor(T: ArrayLike, fmt: str) -> NDArray[np.float64]:
+def pose_to_vendor(T: ArrayLike, fmt: str | PoseFormat) -> NDArray[np.float64]:
     """Convert 4x4 poses to a vendor format.
 
     Parameters
     ----------
     T : array_like, shape (..., 4, 4)
         Poses with translation in metres; must be proper rigid transforms.
-    fmt : str
-        One of ``kuka``, ``fanuc``, ``yaskawa``, ``staubli``, ``abb``, ``ur``.
+    fmt : str or PoseFormat
+        As for :func:`pose_from_vendor`.
 
     Returns
     -------
@@ -205,10 +214,10 @@ def pose_to_vendor(T: ArrayLike, fmt: str) -> NDArray[np.float64]:
     batch = arr.shape[:-2]
     flat = arr.reshape(-1, 4, 4)
     rot = Rotation.from_matrix(flat[:, :3, :3])
-    if f.name == "abb":
+    if f.rotation == "quaternion":
         q = rot.as_quat(scalar_first=True, canonical=True)
         ang = q / np.linalg.norm(q, axis=1, keepdims=True)
-    elif f.name == "ur":
+    elif f.rotation == "rotvec":
         ang = rot.as_rotvec()
     else:
         e = np.degrees(_euler(rot, flat[:, :3, :3], f.euler))

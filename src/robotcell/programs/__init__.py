@@ -1,7 +1,5 @@
 """Robot programs: from a path through the calibrated cell to the controller, and back.
 
-- :mod:`robotcell.programs.model`: :class:`Program`, :class:`ProgramPoint`, :class:`Ref`,
-  :class:`Config`: what every reader returns and every writer takes;
 - :mod:`robotcell.programs.path`: the path file (CSV, mm and deg) in SI units;
 - :mod:`robotcell.programs.write`: :func:`write_program`, a path solved through the cell and
   written as a program;
@@ -9,18 +7,19 @@
   cell;
 - :mod:`robotcell.programs.retarget`: :func:`retarget_program`, joint points recomputed after a
   recalibration;
-- :mod:`robotcell.programs.config`, :mod:`.frames`, :mod:`.axes`: configuration flags, tools and
-  frames, external axes as each format holds them;
-- one module per format: :mod:`.kuka`, :mod:`.abb`, :mod:`.fanuc`, :mod:`.yaskawa`.
+- :mod:`robotcell.programs.config`, :mod:`.frames`: configuration flags, tools and frames as a
+  controller holds them;
+- :mod:`robotcell.programs.formats`: :func:`read_program`, a program file of any controller.
 
-Formats, units and sources: ``docs/programs.md``.
+What a program holds (:class:`Program`, :class:`ProgramPoint`, :class:`Ref`, :class:`Config`)
+and each controller's reader and writer are in :mod:`robotcell.controllers`. Formats, units and
+sources: ``docs/programs.md``.
 """
 
+from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
 from robotcell.programs.formats import read_program, vendor_of
-from robotcell.programs.model import VENDORS, Config, Program, ProgramPoint, Ref
 from robotcell.programs.path import PathTargets, read_path
 from robotcell.programs.write import PathBreaks, WriteResult, build_programs, write_program
 
-__all__ = ["VENDORS", "Config", "PathBreaks", "PathTargets", "Program", "ProgramPoint", "Ref",
-           "WriteResult", "build_programs", "read_path", "read_program", "vendor_of",
-           "write_program"]
+__all__ = ["Config", "PathBreaks", "PathTargets", "Program", "ProgramPoint", "Ref", "WriteResult",
+           "build_programs", "read_path", "read_program", "vendor_of", "write_program"]

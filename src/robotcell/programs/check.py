@@ -36,16 +36,17 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import Cell
 from robotcell.cell.ik import MAX_STEP
 from robotcell.cell.kinematics import robot_pose
+from robotcell.controllers.axes import ExternalAxes
+from robotcell.controllers.model import Config, Program, ProgramPoint
+from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.transforms import invert
-from robotcell.programs.axes import ExternalAxes, external_axes
 from robotcell.programs.config import candidates, config_text, config_values, select
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import Placement, placement, tool_pose_of
-from robotcell.programs.model import Config, Program, ProgramPoint
 from robotcell.programs.path import table_columns
 from robotcell.robot.robot import Robot
 
@@ -271,7 +272,7 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     """
     ctrl = cell.controller()
     robot = ctrl.robot
-    axes = external_axes(cell, program.vendor, pulses_per_degree)
+    axes = get(program.vendor, "program format").external_axes(cell, pulses_per_degree)
     pts = program.points
     n = len(pts)
     res = [_resolve(cell, p, axes) for p in pts]

@@ -3,11 +3,11 @@
 A program names its tool and the frame of its Cartesian points by a number (KUKA ``TOOL_DATA``,
 ``BASE_DATA``; FANUC ``UT``, ``UF``; YASKAWA tool and user frame numbers) or a name (ABB
 ``tooldata``, ``wobjdata``). The numbers and names are the ones the export of the cell writes
-(:func:`robotcell.export.common.collect`), so a program and the export of the same cell refer
-to the same data. Each format measures a frame in its own reference (``docs/export.md``): KUKA
-and ABB in the cell's world (a frame on the turntable through the turntable's kinematic, KUKA
-``EK``, ABB ``ufmec``), FANUC and YASKAWA at the robot base at track position 0 (a frame on the
-turntable as it is at table axis 0).
+(:func:`robotcell.controllers.data.collect`), so a program and the export of the same cell refer
+to the same data. Each controller measures a frame in its own reference (its ``reference`` and
+``table_frames``, ``docs/export.md``): KUKA and ABB in the cell's world (a frame on the turntable
+through the turntable's kinematic, KUKA ``EK``, ABB ``ufmec``), FANUC and YASKAWA at the robot
+base at track position 0 (a frame on the turntable as it is at table axis 0).
 
 :func:`program_refs` gives the references a program writes for a tool and a frame of the cell;
 :func:`tool_pose_of` and :func:`placement` tie the references a file writes back to the cell.
@@ -22,15 +22,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell import RESERVED_FRAMES, Cell, Positioner
 from robotcell.cell.kinematics import frame_pose, robot_pose
+from robotcell.controllers.model import Ref
+from robotcell.controllers.registry import get
 from robotcell.errors import InputError
-from robotcell.export.common import ControllerData, Slot, collect, flatten_table
-from robotcell.programs.model import Ref
 
 __all__ = ["Placement", "placement", "program_refs", "tool_pose_of"]
-
-#: Names of the controller's own references, which no cell frame can take.
-WORLD_NAMES = {"kuka": "$WORLD", "abb": "wobj0", "fanuc": "UF 0 (WORLD)",
-               "yaskawa": "base coordinates"}
 
 
 @dataclass(frozen=True)
@@ -70,27 +66,14 @@ def _table_batch(cell: Cell, table: ArrayLike) -> tuple[int, ...]:
     return shape[:-1] if isinstance(cell.turntable, Positioner) and shape else shape
 
 
-def _reference(vendor: str) -> str:
-    return "world" if vendor in ("kuka", "abb") else "robot"
-
-
-def _data(cell: Cell, vendor: str) -> ControllerData:
-    return collect(cell, _reference(vendor))
-
-
-def _frames(cell: Cell, vendor: str) -> list[Slot]:
-    """The frames as the format numbers them (FANUC/YASKAWA: flattened, the table root added)."""
-    data = _data(cell, vendor)
-    return data.frames if vendor in ("kuka", "abb") else flatten_table(data)
-
-
 def program_refs(cell: Cell, vendor: str, tool: str, frame: str) -> tuple[Ref, Ref, Placement]:
     """The tool and frame references a program writes, and where the frame is.
 
     Parameters
     ----------
     cell : Cell
-    vendor : {"kuka", "abb", "fanuc", "yaskawa"}
+    vendor : str
+        A registered controller.
     tool : str
         A tool of the cell.
     frame : str
@@ -106,19 +89,20 @@ def program_refs(cell: Cell, vendor: str, tool: str, frame: str) -> tuple[Ref, R
     ------
     InputError
         A tool or frame the cell lacks; a frame no controller holds (fixed to a robot on a
-        track, or one of the reserved frames other than ``world``).
+        track, or one of the reserved frames other than ``world``); a tool or frame number the
+        controller does not have.
     """
-    data = _data(cell, vendor)
+    controller = get(vendor, "program format")
+    data = controller.data(cell)
     tools = {s.name: s for s in data.tools}
     if tool not in tools:
         known = ", ".join(sorted(tools)) or "none"
         raise InputError(f"tool {tool!r} is not in the cell; the cell has: {known}")
     t = tools[tool]
+    controller.check_tool(t)
     tool_ref = Ref(number=t.number, name=t.name)
     if frame == "world":
-        kind = "world" if vendor in ("kuka", "abb") else "base"
-        ref = Ref(number=0 if vendor != "abb" else None, name="wobj0" if vendor == "abb" else None,
-                  kind=kind)
+        ref = controller.world_ref
         return tool_ref, ref, placement(cell, vendor, ref)
     if frame in RESERVED_FRAMES:
         raise InputError(f"frame {frame!r}: a program's points are in 'world' or in a frame of "
@@ -130,10 +114,9 @@ def program_refs(cell: Cell, vendor: str, tool: str, frame: str) -> tuple[Ref, R
     if frame not in slots:
         known = ", ".join(sorted(cell.frames)) or "none"
         raise InputError(f"frame {frame!r} is not in the cell; the cell has: world, {known}")
-    s = slots[frame]
-    on_table = s.on_table and vendor in ("kuka", "abb")
-    kind = "world" if vendor in ("kuka", "abb") else "base"
-    ref = Ref(number=s.number, name=s.name, on_table=on_table, kind=kind)
+    s = next(f for f in controller.frames(data) if f.name == frame)
+    controller.check_frame(s)
+    ref = Ref(number=s.number, name=s.name, on_table=s.on_table, kind=controller.frame_kind)
     return tool_ref, ref, placement(cell, vendor, ref)
 
 
@@ -150,7 +133,7 @@ def tool_pose_of(cell: Cell, vendor: str, ref: Ref) -> NDArray[np.float64]:
     """
     if ref.pose is not None:
         return ref.pose
-    tools = _data(cell, vendor).tools
+    tools = get(vendor, "program format").data(cell).tools
     if ref.name is not None:
         if ref.name.lower() == "tool0":
             return np.eye(4)
@@ -176,6 +159,7 @@ def placement(cell: Cell, vendor: str, ref: Ref) -> Placement:
     ----------
     cell : Cell
     vendor : str
+        A registered controller.
     ref : Ref
         As a reader or :func:`program_refs` gives it.
 
@@ -188,6 +172,7 @@ def placement(cell: Cell, vendor: str, ref: Ref) -> Placement:
     InputError
         The cell has no frame of that number or name, or a frame on a turntable the cell lacks.
     """
+    controller = get(vendor, "program format")
     base = robot_pose(cell, 0.0)
     if ref.pose is not None:
         if ref.on_table:
@@ -202,8 +187,8 @@ def placement(cell: Cell, vendor: str, ref: Ref) -> Placement:
         if ref.kind == "robot":
             return Placement("robot", np.eye(4), "robot coordinates")
         pose = np.eye(4) if ref.kind == "world" else base
-        return Placement("fixed", pose, WORLD_NAMES.get(vendor, "world"))
-    slots = _frames(cell, vendor)
+        return Placement("fixed", pose, controller.world_name)
+    slots = controller.frames(controller.data(cell))
     slot = None
     for s in slots:
         if (ref.name is not None and s.name.lower() == ref.name.lower()) or (
@@ -214,11 +199,8 @@ def placement(cell: Cell, vendor: str, ref: Ref) -> Placement:
         known = ", ".join(f"{s.number} {s.name}" for s in slots) or "none"
         raise InputError(f"frame {ref.label()} is not in the cell (the cell's frames as "
                          f"{vendor} numbers them: {known})")
-    if ref.on_table is not None and ref.on_table != slot.on_table and vendor == "kuka":
-        raise InputError(f"base {ref.label()} ({slot.name}) is "
-                         + ("carried by the turntable: set it with $BASE=EK(...)" if slot.on_table
-                            else "fixed in the cell, but the program sets it through EK(...)"))
+    controller.check_table_ref(ref, slot)
     if slot.on_table:
         return Placement("table", slot.pose, slot.name)
-    return Placement("fixed", slot.pose if vendor in ("kuka", "abb") else base @ slot.pose,
+    return Placement("fixed", slot.pose if controller.reference == "world" else base @ slot.pose,
                      slot.name)

@@ -28,10 +28,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Positioner
+from robotcell.controllers.model import MOTIONS
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv, require_columns, unknown_columns
-from robotcell.programs.model import MOTIONS
 
 __all__ = ["DEFAULT_SPEED", "PathTargets", "read_path", "table_columns"]
 

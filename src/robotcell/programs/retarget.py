@@ -20,16 +20,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose
+from robotcell.controllers.model import Program, ProgramPoint
+from robotcell.controllers.registry import get
 from robotcell.errors import InputError, RobotcellError
 from robotcell.ik.select import nearest
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
-from robotcell.programs.axes import external_axes
-from robotcell.programs.edit import set_joints
 from robotcell.programs.files import write_all
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import tool_pose_of
-from robotcell.programs.model import Program, ProgramPoint
 
 __all__ = ["RetargetFailed", "RetargetResult", "RetargetedPoint", "retarget_program"]
 
@@ -87,8 +86,9 @@ class RetargetResult:
 
 def _solve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
            pulses_per_degree: ArrayLike | None) -> tuple[list[RetargetedPoint], list[str]]:
-    axes_old = external_axes(old, vendor, pulses_per_degree)
-    axes_new = external_axes(new, vendor, pulses_per_degree)
+    ctl = get(vendor, "program format")
+    axes_old = ctl.external_axes(old, pulses_per_degree)
+    axes_new = ctl.external_axes(new, pulses_per_degree)
     out, problems = [], []
     for p in points:
         track, table, missing = axes_old.from_file(p.external)
@@ -171,9 +171,10 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
         raise InputError(f"{path}: the program moves to no point robotcell reads: nothing to "
                          "retarget")
     vendor = program.vendor
+    ctl = get(vendor, "program format")
     joint = [p for p in program.points if p.joints is not None]
     result = RetargetResult(program, cartesian=len(program.points) - len(joint))
-    if joint and vendor not in ("kuka", "abb", "fanuc"):
+    if joint and not ctl.edits_joints:
         raise InputError(f"{path}: {vendor} joint points are not retargeted")
     moved, problems = _solve(old, new, joint, vendor, pulses_per_degree)
     if problems:
@@ -183,7 +184,7 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
                                    for f in program.files}
     for p, r in zip(joint, moved):
         file, _, line = p.where.rpartition(":")
-        if not set_joints(vendor, texts[file], int(line) - 1, r.q_new):
+        if not ctl.set_joints(texts[file], int(line) - 1, r.q_new):
             raise RetargetFailed(f"nothing written: {p.name}: cannot find its six axis values "
                                  f"on {file} line {line}")
     out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}

@@ -4,7 +4,7 @@
 trajectory through the cell (:func:`robotcell.cell.ik.ik_path`: one arm configuration, the track
 moving along the path where it is not given, the table's values chosen along a path on the table
 where they are not given: :func:`robotcell.cell.tablechoice.choose_table`), builds the
-:class:`~robotcell.programs.model.Program` of one format and writes its files, all or none. A
+:class:`~robotcell.controllers.model.Program` of one format and writes its files, all or none. A
 path that cannot be one program (out of reach, a joint limit, a configuration change, a jump of
 the table) raises :class:`PathBreaks` naming the points and why; with ``split`` every
 continuous piece becomes its own program (a path with no piece, no point reached, raises all
@@ -29,19 +29,19 @@ from robotcell.cell import Cell
 from robotcell.cell.ik import MAX_STEP, CellPath, PathBreak, ik_path, split_path
 from robotcell.cell.kinematics import tool_pose
 from robotcell.cell.tablechoice import TableChoice, carried_by_table, choose_table
-from robotcell.errors import RobotcellError
+from robotcell.controllers.axes import ExternalAxes
+from robotcell.controllers.base import Controller
+from robotcell.controllers.model import Program, ProgramPoint, Ref
+from robotcell.controllers.registry import get
+from robotcell.errors import InputError, RobotcellError
+from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
-from robotcell.programs.axes import ExternalAxes, external_axes
 from robotcell.programs.config import configs
 from robotcell.programs.files import check_folder, write_all
-from robotcell.programs.formats import format_module
 from robotcell.programs.frames import Placement, program_refs
-from robotcell.programs.model import Program, ProgramPoint, Ref
 from robotcell.programs.path import PathTargets, read_path
-from robotcell.programs.text import NAME_LIMITS, program_name
 
-__all__ = ["PathBreaks", "WriteResult", "build_programs", "point_names", "write_program",
-           "written_poses"]
+__all__ = ["PathBreaks", "WriteResult", "build_programs", "write_program", "written_poses"]
 
 class PathBreaks(RobotcellError):
     """A path that cannot be one program; ``breaks`` say where and why.
@@ -78,6 +78,8 @@ class WriteResult:
     program_of : ndarray of int, shape (N,)
         Index into ``programs`` of each target (-1: in none).
     warnings : list of str
+    replaced : list of str
+        Files written over: earlier programs of the same path file, under the same names.
     """
 
     files: list[str]
@@ -88,6 +90,7 @@ class WriteResult:
     breaks: list[PathBreak] = field(default_factory=list)
     program_of: NDArray[np.int_] = field(default_factory=lambda: np.zeros(0, dtype=int))
     warnings: list[str] = field(default_factory=list)
+    replaced: list[str] = field(default_factory=list)
 
 
 def written_poses(cell: Cell, where: Placement, q: ArrayLike, track: ArrayLike,
@@ -119,17 +122,6 @@ def written_poses(cell: Cell, where: Placement, q: ArrayLike, track: ArrayLike,
     """
     T_world_TCP = cell.fk(q, track, table, tool=np.asarray(tool, dtype=float))
     return invert(where.world(cell, track, table)) @ T_world_TCP
-
-
-def point_names(vendor: str, n: int) -> list[str]:
-    """Names of ``n`` points as each format numbers them (``XP1``, ``p1``, ``P[1]``, ``C00000``)."""
-    if vendor == "kuka":
-        return [f"XP{i + 1}" for i in range(n)]
-    if vendor == "abb":
-        return [f"p{i + 1}" for i in range(n)]
-    if vendor == "fanuc":
-        return [f"P[{i + 1}]" for i in range(n)]
-    return [f"C{i:05d}" for i in range(n)]
 
 
 def _with_table(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: float
@@ -186,7 +178,8 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
     cell : Cell
         The cell the joints are solved in.
     targets : PathTargets
-    vendor : {"kuka", "abb", "fanuc", "yaskawa"}
+    vendor : str
+        A registered controller (:func:`robotcell.controllers.registry.names`).
     name : str
         Program name (``NAME_1``, ``NAME_2``, ... with ``split``).
     tool : str
@@ -212,15 +205,16 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
     Raises
     ------
     InputError
-        A tool or frame the cell lacks, a bad name, a YASKAWA cell with a turntable and no
-        ``pulses_per_degree``.
+        A tool or frame the cell lacks, a tool or frame number or a name the controller cannot
+        hold, a YASKAWA cell with a turntable and no ``pulses_per_degree``.
     PathBreaks
         The path breaks (reach, limit, singularity, a jump of the table) and ``split`` is False,
         or no point of it can be reached.
     """
-    base_name = program_name(name, vendor)
-    tool_ref, frame_ref, where = program_refs(cell, vendor, tool, frame)
-    axes = external_axes(cell, vendor, pulses_per_degree)
+    ctl = get(vendor, "program format")
+    base_name = ctl.program_name(name)
+    tool_ref, frame_ref, where = program_refs(cell, ctl.name, tool, frame)
+    axes = ctl.external_axes(cell, pulses_per_degree)
     targets, choice = _with_table(cell, targets, frame, tool, max_step)
     targets = replace(targets, table=axes.held(targets.table))  # the point goes with the axis
     pieces, breaks, paths = _solve(cell, targets, frame, tool, max_step)
@@ -236,15 +230,10 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
     for k, ((a, b), path) in enumerate(zip(pieces, paths)):
         q[a:b], track[a:b], table[a:b] = path.q, path.track, path.table
         owner[a:b] = k
-        pname = base_name if len(pieces) == 1 else _piece_name(base_name, k + 1, vendor)
+        pname = base_name if len(pieces) == 1 else ctl.piece_name(base_name, k + 1)
         programs.append(_program(controller or cell.controller(), targets, a, b, path, pname,
-                                 vendor, tool_ref, frame_ref, where, axes))
+                                 ctl, tool_ref, frame_ref, where, axes))
     return WriteResult([], programs, q, track, table, breaks, owner, list(targets.warnings))
-
-
-def _piece_name(name: str, k: int, vendor: str) -> str:
-    suffix = f"_{k}"
-    return program_name(name[:NAME_LIMITS[vendor] - len(suffix)] + suffix, vendor)
 
 
 #: Breaks a :class:`PathBreaks` message names (``breaks`` holds them all).
@@ -270,12 +259,13 @@ def _break_message(breaks: list[PathBreak], pieces: list[tuple[int, int]]) -> st
             f"Change the path there, or {todo}")
 
 
-def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, name: str, vendor: str,
-             tool_ref: Ref, frame_ref: Ref, where: Placement, axes: ExternalAxes) -> Program:
+def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, name: str,
+             ctl: Controller, tool_ref: Ref, frame_ref: Ref, where: Placement, axes: ExternalAxes
+             ) -> Program:
     T_tool = tool_pose(cell, tool_ref.name)
     poses = written_poses(cell, where, path.q, path.track, path.table, T_tool)
-    flags = configs(cell.robot, path.q, vendor)
-    names = point_names(vendor, b - a)
+    flags = configs(cell.robot, path.q, ctl.name)
+    names = ctl.point_names(b - a)
     points = []
     for i in range(b - a):
         j = a + i
@@ -285,7 +275,7 @@ def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, n
             external=axes.to_file(path.track[i], path.table[i]),
             speed=float(targets.speed[j]),
             zone=float(targets.zone[j])))
-    return Program(name, vendor, points)
+    return Program(name, ctl.name, points)
 
 
 def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: str,
@@ -304,9 +294,13 @@ def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: s
         A tool of the cell.
     frame : str
         ``world`` or a frame of the cell: the frame of the path's poses.
-    vendor : {"kuka", "abb", "fanuc", "yaskawa"}
+    vendor : str
+        A registered controller (:func:`robotcell.controllers.registry.names`).
     folder : str or Path
-        Output folder (created when missing; its parent must exist).
+        Output folder (created when missing; its parent must exist). A program of the same
+        path file written there before under the same name is replaced (and listed in
+        ``replaced``); any other file of that name, or of that name in other capitals (a
+        controller does not tell them apart), is refused.
     name : str, optional
         Program name; default: the path file's name, shortened to what the format allows.
     split, controller, pulses_per_degree, max_step
@@ -321,29 +315,79 @@ def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: s
     Raises
     ------
     InputError
-        Bad path file, tool, frame, name or folder: nothing is written.
+        Bad path file, tool, frame, name or folder, or a file of the program's name in the
+        folder that is not an earlier program of this path file: nothing is written.
     PathBreaks
         The path breaks and ``split`` is False, or no point of it can be reached: nothing is
         written.
     """
     check_folder(folder)
+    ctl = get(vendor, "program format")
     targets = read_path(path, cell)
+    default = name is None
     if name is None:
-        name = _default_name(Path(path).stem, vendor)
-    result = build_programs(cell, targets, vendor, name, tool, frame, split, controller,
+        name = ctl.default_name(Path(path).stem)
+    result = build_programs(cell, targets, ctl.name, name, tool, frame, split, controller,
                             pulses_per_degree, max_step)
     header = [(f"robotcell program of path {Path(path).name}: cell {cell.name!r}, "
                f"tool {tool!r}, frame {frame!r}")]
-    module = format_module(vendor)
     texts: dict[str, str] = {}
     for prog in result.programs:
-        texts.update(module.write(prog, header))
+        texts.update(ctl.write_program(prog, header))
+    cut = (f" ({ctl.label} program names hold {ctl.name_limit} characters, so "
+           f"{Path(path).name} is written as {result.programs[0].name})"
+           if default and len(Path(path).stem) > ctl.name_limit else "")
+    result.replaced = _replaced(Path(folder), texts, ctl, Path(path).name, cut, (path, *inputs))
     result.files = write_all(folder, texts, (path, *inputs))
     return result
 
 
-def _default_name(stem: str, vendor: str) -> str:
-    clean = "".join(ch if ch.isalnum() and ch.isascii() else "_" for ch in stem)
-    if not clean[:1].isalpha():
-        clean = "P" + clean
-    return clean[:NAME_LIMITS[vendor]]
+#: The start of the header line of a program written from a path file, then its name and ':'.
+_SOURCE = "robotcell program of path "
+
+
+def _squeezed(text: str) -> str:
+    return "".join(text.split())
+
+
+def _replaced(folder: Path, texts: dict[str, str], ctl: Controller, source: str, cut: str,
+              inputs: tuple[str | Path, ...]) -> list[str]:
+    """The files of ``texts`` that are in ``folder`` already: earlier programs of the path file
+    ``source``. Any other file of one of the names, or of one in other capitals, is refused
+    (the ``inputs`` of the run are left to :func:`~robotcell.programs.files.write_all`, which
+    refuses them).
+
+    Raises
+    ------
+    InputError
+        A file the program would replace that is not a program of ``source``; the message
+        names it, and the source it was written from where it says so.
+    """
+    if not folder.is_dir():
+        return []
+    read = {Path(i).resolve() for i in inputs}
+    present = {p.name: p for p in folder.iterdir() if p.resolve() not in read}
+    replaced = []
+    for name in texts:
+        other = next((p for n, p in present.items() if n.lower() == name.lower() and n != name),
+                     None)
+        if other is not None:
+            raise InputError(f"cannot write {folder / name}: {other} is there, and a controller "
+                             "takes the two names for one program; remove or rename it, or give "
+                             "this program another name or folder")
+        if name not in present or present[name].is_dir():
+            continue
+        try:
+            said = _squeezed("".join(ctl.comments(read_text(present[name], "program file"))))
+        except InputError:  # not text: not a program robotcell wrote
+            said = ""
+        if _squeezed(f"{_SOURCE}{source}:") in said:
+            replaced.append(str(present[name]))
+            continue
+        start = said.find(_squeezed(_SOURCE))
+        origin = (f"a program written from {said[start:].split(':')[0][len(_squeezed(_SOURCE)):]}"
+                  if start >= 0 else f"a file robotcell did not write from {source}")
+        raise InputError(f"cannot write {folder / name}: it is {origin}, and this program of "
+                         f"{source} would replace it{cut}; give this program another name or "
+                         "folder, or remove that file first")
+    return replaced

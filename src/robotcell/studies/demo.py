@@ -74,9 +74,13 @@ def seam_rows() -> NDArray[np.float64]:
                             np.full_like(ang, 180.0), np.zeros_like(ang), 200.0 - 9.0 * k])
 
 
-#: Export file names per format.
-EXPORT_FILES = {"kuka": "kuka_config.dat", "abb": "abb_cell.mod", "fanuc": "fanuc_frames.txt",
-                "yaskawa": "yaskawa_frames.txt"}
+def export_file(fmt: str) -> str:
+    """The name the demo gives the export of a controller: ``kuka_config.dat``, ..."""
+    return f"{fmt}_{EXPORT_FORMATS[fmt].export_name}"
+
+
+#: Export file names of the controllers robotcell registers itself.
+EXPORT_FILES = {fmt: export_file(fmt) for fmt in EXPORT_FORMATS}
 
 
 def _pose(x: float, y: float, z: float, a: float, b: float, c: float) -> NDArray[np.float64]:
@@ -293,7 +297,7 @@ def _write_outputs(out: Path, cell: Cell, results: dict[str, dict[str, Any]],
         except RobotcellError as exc:
             echo(f"  {fmt}: not written: {exc}")
             continue
-        path = out / EXPORT_FILES[fmt]
+        path = out / export_file(fmt)
         path.write_text(text, encoding="utf-8")
         echo(f"  {path.name}")
     page = _write_view(out, cell)

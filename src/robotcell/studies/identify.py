@@ -12,10 +12,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 from robotcell.cell import Cell
 from robotcell.cell.identified import adopt_identified, identification_provenance
+from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
 from robotcell.identification import identify, identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
@@ -29,35 +30,48 @@ from robotcell.identification.validation import (
 from robotcell.report.identification import write_identification_report
 from robotcell.robot.models import load_robot, save_robot
 
-__all__ = ["IdentificationRun", "controller_offsets", "identify_file"]
+__all__ = ["IdentificationRun", "controller_offsets", "identify_file", "zero_offset_controllers"]
 
 #: Folds of the cross-validation a report or a cell's provenance asks for when none is given.
 DEFAULT_FOLDS = 5
 
 
-def controller_offsets(offsets: list[JointOffset], vendor: Literal["kuka", "abb"]
-                       ) -> dict[str, Any]:
+def controller_offsets(offsets: list[JointOffset], vendor: str) -> dict[str, Any]:
     """Joint zero offsets in the controller's units: KUKA deg (mm), ABB rad (m).
 
     Parameters
     ----------
     offsets : list of JointOffset
         :func:`~robotcell.identification.offsets.joint_offsets` (rad, m).
-    vendor : {"kuka", "abb"}
+    vendor : str
+        A registered controller that takes zero offsets (its ``zero_offsets``: KUKA, ABB).
 
     Returns
     -------
     dict
         ``{"controller": vendor, "axes": [{"axis", "delta", "sigma", "unit", "why"}, ...]}``.
+
+    Raises
+    ------
+    InputError
+        A controller robotcell has no zero offsets for.
     """
+    z = get(vendor).zero_offsets
+    if z is None:
+        raise InputError(f"robotcell has no joint zero offsets for {vendor}; choose one of: "
+                         f"{', '.join(zero_offset_controllers())}")
     rows = []
     for o in offsets:
-        f = (1e3 if o.prismatic else 180 / math.pi) if vendor == "kuka" else 1.0
-        unit = (("mm" if o.prismatic else "deg") if vendor == "kuka"
-                else ("m" if o.prismatic else "rad"))
+        f = z.length_scale if o.prismatic else z.angle_scale
+        unit = z.length_unit if o.prismatic else z.angle_unit
         rows.append({"axis": o.axis, "delta": o.delta * f, "sigma": o.sigma * f, "unit": unit,
                      "why": o.why})
     return {"controller": vendor, "axes": rows}
+
+
+def zero_offset_controllers() -> list[str]:
+    """The registered controllers that take joint zero offsets."""
+    return [name for name, c in CONTROLLERS.items() if c.zero_offsets is not None]
 
 
 @dataclass(frozen=True)
@@ -102,7 +116,7 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
                   cell: str | Path | None = None, j23_factor: float | None = None,
                   point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
                   scale: bool = False, compliance: bool = False, folds: int | None = None,
-                  report: str | Path | None = None, offsets_for: Literal["kuka", "abb"] | None = None,
+                  report: str | Path | None = None, offsets_for: str | None = None,
                   output: str | Path | None = None, force: bool = False) -> IdentificationRun:
     """Identify the kinematic model of an arm or positioner from a measurement CSV.
 
@@ -129,7 +143,8 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         ``min(5, rows)``.
     report : str or Path, optional
         HTML report to write.
-    offsets_for : {"kuka", "abb"}, optional
+    offsets_for : str, optional
+        A controller of :func:`zero_offset_controllers` (``kuka``, ``abb``).
         Also compute the joint zero offsets in that controller's units.
     output : str or Path, optional
         Identified model file (YAML) to write, unless the verdict is poor and not ``force``.

@@ -20,22 +20,24 @@ over the cell's of the same name), statements over several lines, optional argum
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
+from robotcell.controllers.abb import export as export_abb
+from robotcell.controllers.data import MM_DECIMALS, QUAT_DECIMALS
+from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
+from robotcell.controllers.text import JOINT_DECIMALS, Lines, fmt_num, strip_comment
 from robotcell.errors import InputError
-from robotcell.export import abb as export_abb
-from robotcell.export.common import MM_DECIMALS, QUAT_DECIMALS
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.programs.config import config_text
-from robotcell.programs.model import Config, Program, ProgramPoint, Ref
-from robotcell.programs.text import Lines, fmt_num, strip_comment
 
-__all__ = ["read", "write"]
+__all__ = ["EAX", "config_text", "read", "set_joints", "set_pose", "write"]
 
-_EAX = ("eax_a", "eax_b", "eax_c", "eax_d", "eax_e", "eax_f")
+#: The logical external axes of a robtarget, in order.
+EAX = ("eax_a", "eax_b", "eax_c", "eax_d", "eax_e", "eax_f")
 #: ABB's value of an external axis that is not connected.
 NO_AXIS = "9E9"
 #: Predefined speeddata (mm/s) and zonedata (mm) of the RAPID reference.
@@ -45,6 +47,11 @@ ZONES = (0, 1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200)
 
 
 # -- writing -------------------------------------------------------------------------------------
+def config_text(values: tuple[int, ...]) -> str:
+    """``confdata`` as a ``robtarget`` writes it: ``[0,-1,0,1]``."""
+    return "[" + ",".join(str(x) for x in values) + "]"
+
+
 def _speed_text(v: float) -> str:
     mm = v * 1e3
     for s in SPEEDS:
@@ -71,8 +78,8 @@ def _robtarget(p: ProgramPoint) -> str:
     trans = ",".join(fmt_num(x, MM_DECIMALS) for x in v[:3])
     quat = ",".join(fmt_num(x, QUAT_DECIMALS) for x in v[3:])
     eax = ",".join(fmt_num(p.external[k], MM_DECIMALS) if k in p.external else NO_AXIS
-                   for k in _EAX)
-    return f"[[{trans}],[{quat}],{config_text(p.config)},[{eax}]]"
+                   for k in EAX)
+    return f"[[{trans}],[{quat}],{config_text(p.config.values)},[{eax}]]"
 
 
 def write(program: Program, header: list[str]) -> dict[str, str]:
@@ -178,7 +185,7 @@ def _numbers(text: str, count: int, lines: Lines, lineno: int) -> list[float]:
 
 def _external(text: str, lines: Lines, lineno: int) -> dict[str, float]:
     values = _numbers(text, 6, lines, lineno)
-    return {k: v for k, v in zip(_EAX, values) if abs(v) < 9e8}
+    return {k: v for k, v in zip(EAX, values) if abs(v) < 9e8}
 
 
 class _Target:
@@ -316,3 +323,33 @@ def _zone(text: str, data: dict, lines: Lines, lineno: int) -> float | None:
         parts = _split(t[1:-1])
         return 0.0 if parts[0].upper() == "TRUE" else lines.number(parts[1], lineno) * 1e-3
     return None
+
+
+# -- editing in place ----------------------------------------------------------------------------
+def set_joints(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
+    """Write the robot axes (``q``, rad) of the ``jointtarget`` on line ``idx``."""
+    line = lines[idx]
+    m = re.search(r"\[\s*\[([^\[\]]*)\]", line)
+    if not m or len(m.group(1).split(",")) != 6:
+        return False
+    values = ",".join(fmt_num(math.degrees(v), JOINT_DECIMALS) for v in q)
+    lines[idx] = line[:m.start(1)] + values + line[m.end(1):]
+    return True
+
+
+def set_pose(lines: list[str], idx: int, T: NDArray[np.float64], config: Config | None) -> bool:
+    """Write the position and quaternion (``T``, m) and, unless None, the ``confdata`` of the
+    ``robtarget`` on line ``idx``."""
+    line = lines[idx]
+    m = re.search(r"\[\s*\[([^\[\]]*)\]\s*,\s*\[([^\[\]]*)\]\s*,\s*\[([^\[\]]*)\]", line)
+    if not m or len(m.group(1).split(",")) != 3 or len(m.group(2).split(",")) != 4:
+        return False
+    v = pose_to_vendor(T, "abb")
+    parts = [(m.start(1), m.end(1), ",".join(fmt_num(x, MM_DECIMALS) for x in v[:3])),
+             (m.start(2), m.end(2), ",".join(fmt_num(x, QUAT_DECIMALS) for x in v[3:]))]
+    if config is not None:
+        parts.append((m.start(3), m.end(3), ",".join(str(x) for x in config.values)))
+    for start, end, text in reversed(parts):
+        line = line[:start] + text + line[end:]
+    lines[idx] = line
+    return True

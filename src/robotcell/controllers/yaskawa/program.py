@@ -27,13 +27,15 @@ import re
 import textwrap
 from pathlib import Path
 
+import numpy as np
+from numpy.typing import NDArray
+
+from robotcell.controllers.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.controllers.text import Lines, fmt_num
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.programs.config import config_text
-from robotcell.programs.model import PTP_SPEED, Config, Program, ProgramPoint, Ref
-from robotcell.programs.text import Lines, fmt_num
 
-__all__ = ["read", "write"]
+__all__ = ["config_text", "read", "set_pose", "write"]
 
 #: Decimals written: mm, deg.
 MM_PLACES, DEG_PLACES = 3, 4
@@ -42,6 +44,11 @@ COMMENT_CHARS = 32
 
 
 # -- writing -------------------------------------------------------------------------------------
+def config_text(values: tuple[int, ...]) -> str:
+    """``RCONF`` values as written, without the unused trailing ones: ``0,0,0,0,0,0``."""
+    return ",".join(str(x) for x in values)
+
+
 def _pl(zone: float) -> str:
     mm = zone * 1e3
     return "" if mm <= 0 else f" PL={min(8, max(1, round(mm)))}"
@@ -77,7 +84,7 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
     rconf = None
     for i, p in enumerate(pts):
         assert p.pose is not None and p.config is not None
-        text = config_text(p.config) + ",0,0"
+        text = config_text(p.config.values) + ",0,0"
         if text != rconf:
             pos.append(f"///RCONF {text}")
             rconf = text
@@ -234,3 +241,16 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
             lines.number(speed.group(1), lineno) * 1e-3 if speed and motion == "lin" else None,
             lines.number(zone.group(1), lineno) * 1e-3 if zone else 0.0, c.where))
     return Program(name, "yaskawa", points, (str(path),)), skipped
+
+
+# -- editing in place ----------------------------------------------------------------------------
+def set_pose(lines: list[str], idx: int, T: NDArray[np.float64], config: Config | None) -> bool:
+    """Write X..Rz (``T``, m) of the ``Cnnnnn`` on line ``idx``; its ``///RCONF`` is shared by
+    the points after it and never written (``config`` is not used)."""
+    m = re.match(r"^(\s*C\d+\s*=\s*)([^,]*(?:,[^,]*){5})(.*)$", lines[idx])
+    if not m:
+        return False
+    v = pose_to_vendor(T, "yaskawa")
+    text = ",".join(fmt_num(x, MM_PLACES if i < 3 else DEG_PLACES) for i, x in enumerate(v))
+    lines[idx] = m.group(1) + text + m.group(3)
+    return True

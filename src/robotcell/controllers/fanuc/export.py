@@ -12,11 +12,10 @@ one more user frame, the next free number. See ``docs/export.md``.
 
 from __future__ import annotations
 
-from robotcell.cell import Cell
-from robotcell.export.common import ControllerData, collect
-from robotcell.export.pendant import PendantListing, format_listing, parse_pendant_listing
+from robotcell.controllers.data import ControllerData
+from robotcell.controllers.pendant import PendantListing, format_listing, parse_pendant_listing
 
-__all__ = ["LISTING", "export", "format_data", "parse"]
+__all__ = ["LISTING", "format_data", "parse"]
 
 #: FANUC wording of the pendant listing
 LISTING = PendantListing(
@@ -31,10 +30,6 @@ def format_data(data: ControllerData, cell_name: str) -> str:
     """Direct Entry listing for :class:`ControllerData` collected with ``reference="robot"``."""
     return format_listing(data, cell_name, LISTING)
 
-
-def export(cell: Cell) -> str:
-    """FANUC Direct Entry listing of the tools and user frames of ``cell``."""
-    return format_data(collect(cell, "robot"), cell.name)
 
 
 def parse(text: str) -> ControllerData:

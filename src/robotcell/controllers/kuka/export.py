@@ -28,20 +28,18 @@ import re
 
 import numpy as np
 
-from robotcell.cell import Cell
-from robotcell.errors import InputError
-from robotcell.export.common import (
+from robotcell.controllers.data import (
     DEG_DECIMALS,
     MM_DECIMALS,
     ControllerData,
     Slot,
-    collect,
     fmt_num,
     parse_float,
 )
+from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 
-__all__ = ["MACHINE_INDEX", "export", "format_data", "parse"]
+__all__ = ["MACHINE_INDEX", "format_data", "parse"]
 
 #: ``MACHINE_DEF`` index of the turntable (``MACHINE_DEF[1]`` is the robot).
 MACHINE_INDEX = 2
@@ -120,10 +118,6 @@ def format_data(data: ControllerData, cell_name: str) -> str:
         L.append(f"; frame {name!r} moves with the robot on the track: no KUKA base holds it")
     return "\n".join(L) + "\n"
 
-
-def export(cell: Cell) -> str:
-    """KUKA ``$config.dat`` / ``$machine.dat`` lines for ``cell``."""
-    return format_data(collect(cell, "world"), cell.name)
 
 
 _FRAME_RE = r"\{([^{}]*)\}"

@@ -23,20 +23,18 @@ import re
 
 import numpy as np
 
-from robotcell.cell import Cell
-from robotcell.errors import InputError
-from robotcell.export.common import (
+from robotcell.controllers.data import (
     MM_DECIMALS,
     QUAT_DECIMALS,
     ControllerData,
     Slot,
-    collect,
     fmt_num,
     parse_float,
 )
+from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 
-__all__ = ["export", "format_data", "parse"]
+__all__ = ["format_data", "parse"]
 
 #: ABB's ``load0``: the load written for a tool whose mass the cell does not know.
 LOAD0 = "[0.001,[0,0,0.001],[1,0,0,0],0,0,0]"
@@ -118,10 +116,6 @@ def format_data(data: ControllerData, cell_name: str) -> str:
     L.append("ENDMODULE")
     return "\n".join(L) + "\n"
 
-
-def export(cell: Cell) -> str:
-    """ABB RAPID module with the tools, work objects and base frames of ``cell``."""
-    return format_data(collect(cell, "world"), cell.name)
 
 
 _NUM = r"\s*([-+0-9.eE]+)\s*"

@@ -1,22 +1,11 @@
-"""How each program format holds the cell's external axes: the track and the turntable.
+"""External axes in a program: the names and units under which a controller writes the cell's
+track and turntable (or positioner) axes beside each point, both ways.
 
-A program writes the external axes beside each point under the names of its format; this module
-says which name is the cell's track and which the turntable's (or a positioner's) axes, and in
-which unit, both ways. Sources: ``docs/programs.md``.
-
-| format | track | turntable / positioner axes |
-|---|---|---|
-| KUKA | ``E1`` (mm) | the next ``E`` axes (deg): ``E2..`` beside a track, else ``E1..`` |
-| ABB | ``eax_a`` (mm) | the next logical axes (deg): ``eax_b..`` beside a track, else ``eax_a..`` |
-| FANUC | ``E1`` of group 1 (mm, an integrated rail) | ``J1..`` of group 2 (deg) |
-| YASKAWA | base axis ``BC1`` (mm) | station axes ``EC1..`` (encoder pulses) |
-
-KUKA numbers the external axes of the linear unit first (``$ET1_AX={TR_A1 #E1}``) and the
-turntable's kinematic after it (``docs/export.md``); ABB maps mechanical units to logical axes
-``a..f`` in the system parameters, and robotcell assumes the track on ``a`` and the turntable
-after it. YASKAWA jobs hold station axes in pulses only (DX100 manual, "Configuration of Position
-Data": "The position of a station axis is represented by a pulse number"), so they need the
-station's pulses per degree.
+Each controller says which name is the track and which the table's axes, and in which unit
+(its :meth:`~robotcell.controllers.base.Controller.external_axes`; the table of the four is in
+``docs/programs.md``). :class:`ExternalAxes` converts between the cell's values (m, rad) and the
+file's; :func:`numbered_axes` serves a controller that numbers its external axes in one row,
+the track first.
 """
 
 from __future__ import annotations
@@ -30,10 +19,10 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import Cell, Positioner
 from robotcell.errors import InputError
 
-__all__ = ["ExternalAxes", "external_axes"]
+__all__ = ["DEG", "ExternalAxes", "numbered_axes", "table_count"]
 
-_ABB = ("eax_a", "eax_b", "eax_c", "eax_d", "eax_e", "eax_f")
-_DEG = 180.0 / math.pi
+#: Degrees per radian: the file unit of a table axis written in degrees.
+DEG = 180.0 / math.pi
 
 
 @dataclass(frozen=True)
@@ -43,6 +32,7 @@ class ExternalAxes:
     Attributes
     ----------
     vendor : str
+        The controller's name.
     track : str or None
         Name of the track axis (None: the cell has no track).
     table : tuple of str
@@ -56,6 +46,9 @@ class ExternalAxes:
     unused : tuple of str
         Further names of the format's external axes, written as 0 (KUKA ``E6POS`` holds
         ``E1..E6``) or as ABB's 9E9 (``eax_a..eax_f``).
+    whole_units : bool
+        The file holds the table's values in whole file units (YASKAWA station axes in encoder
+        pulses), so a value is rounded to one before the point is solved.
     """
 
     vendor: str
@@ -65,6 +58,7 @@ class ExternalAxes:
     table_scale: tuple[float, ...]
     positioner: bool = False
     unused: tuple[str, ...] = ()
+    whole_units: bool = False
 
     def names(self) -> list[str]:
         """Track and table names, in that order."""
@@ -94,8 +88,9 @@ class ExternalAxes:
         return out
 
     def held(self, table: ArrayLike) -> NDArray[np.float64]:
-        """Table values as the file holds them: YASKAWA station axes in whole encoder pulses,
-        the other formats' degrees unchanged (they write 9 decimals).
+        """Table values as the file holds them: rounded to whole file units where
+        :attr:`whole_units` (YASKAWA encoder pulses), else unchanged (degrees, written with 9
+        decimals).
 
         Parameters
         ----------
@@ -108,7 +103,7 @@ class ExternalAxes:
             The same shape (rad).
         """
         th = np.asarray(table, dtype=float)
-        if self.vendor != "yaskawa" or not self.table:
+        if not self.whole_units or not self.table:
             return th
         scale = np.asarray(self.table_scale) if self.positioner else self.table_scale[0]
         return np.round(th * scale) / scale
@@ -153,25 +148,25 @@ class ExternalAxes:
         return track, table, problems
 
 
-def _table_count(cell: Cell) -> tuple[int, bool]:
-    """Number of table axes and whether they are a positioner chain."""
+def table_count(cell: Cell) -> tuple[int, bool]:
+    """Number of table axes of ``cell`` and whether they are a positioner chain."""
     tt = cell.turntable
     if tt is None:
         return 0, False
     return (tt.n_axes, True) if isinstance(tt, Positioner) else (1, False)
 
 
-def external_axes(cell: Cell, vendor: str, pulses_per_degree: ArrayLike | None = None
-                  ) -> ExternalAxes:
-    """The names and units of ``cell``'s external axes in format ``vendor``.
+def numbered_axes(cell: Cell, vendor: str, names: tuple[str, ...]) -> ExternalAxes:
+    """External axes written under one row of names: the track (mm) first, then the table's
+    axes (deg), the rest unused.
 
     Parameters
     ----------
     cell : Cell
-    vendor : {"kuka", "abb", "fanuc", "yaskawa"}
-    pulses_per_degree : float or array_like of float, optional
-        YASKAWA only: encoder pulses per degree of each station axis (one value for all). Needed
-        when the cell has a turntable or positioner.
+    vendor : str
+        The controller's name.
+    names : tuple of str
+        Every external axis name of the format, in order (KUKA ``E1..E6``).
 
     Returns
     -------
@@ -180,36 +175,12 @@ def external_axes(cell: Cell, vendor: str, pulses_per_degree: ArrayLike | None =
     Raises
     ------
     InputError
-        A YASKAWA program for a cell with a turntable and no ``pulses_per_degree``, or more
-        external axes than the format holds.
+        The cell has more external axes than ``names``.
     """
-    n, chain = _table_count(cell)
-    has_track = cell.track is not None
-    deg = (_DEG,) * n
-    if vendor == "kuka":
-        names = [f"E{i + 1}" for i in range(6)]
-    elif vendor == "abb":
-        names = list(_ABB)
-    elif vendor == "fanuc":
-        return ExternalAxes(vendor, "E1" if has_track else None,
-                            tuple(f"GP2:J{i + 1}" for i in range(n)), 1e3, deg, chain)
-    elif vendor == "yaskawa":
-        if n and pulses_per_degree is None:
-            raise InputError("YASKAWA jobs hold station axes in encoder pulses: give "
-                             "pulses_per_degree, the pulses per degree of the turntable's axis "
-                             "(from the station's parameters)")
-        ppd = np.broadcast_to(np.asarray(pulses_per_degree if n else 1.0, dtype=float), (n,))
-        if n and not np.all(np.isfinite(ppd) & (ppd > 0)):
-            raise InputError(f"pulses_per_degree must be positive numbers, got "
-                             f"{pulses_per_degree!r}")
-        return ExternalAxes(vendor, "BC1" if has_track else None,
-                            tuple(f"EC{i + 1}" for i in range(n)), 1e3,
-                            tuple(float(p) * _DEG for p in ppd), chain)
-    else:
-        raise InputError(f"unknown program format {vendor!r}")
-    k = int(has_track)
+    n, chain = table_count(cell)
+    k = int(cell.track is not None)
     if k + n > len(names):
         raise InputError(f"{vendor} programs hold {len(names)} external axes; the cell has "
                          f"{k + n}")
-    return ExternalAxes(vendor, names[0] if has_track else None, tuple(names[k:k + n]), 1e3, deg,
+    return ExternalAxes(vendor, names[0] if k else None, tuple(names[k:k + n]), 1e3, (DEG,) * n,
                         chain, tuple(names[k + n:]))

@@ -17,26 +17,27 @@ Read: the same, and the common subset that pendants and offline tools write: the
 ``AXIS``, declared in the ``.dat`` or written inline (``PTP {A1 0,...}``), typed aggregates
 (``{E6POS: X 1,...}``), lower-case fields, ``S``/``T`` as decimals or as ``'B110'``, missing
 ``S``/``T``, ``SPTP``/``SLIN``, and Latin-1 text. ``PTP HOME`` and ``PTP $AXIS_ACT`` move to
-points the program does not hold and are skipped (named in :attr:`KukaProgram.skipped`).
+points the program does not hold and are skipped (named in what :func:`read` returns).
 """
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
+from robotcell.controllers.data import DEG_DECIMALS, MM_DECIMALS
+from robotcell.controllers.kuka.export import MACHINE_INDEX
+from robotcell.controllers.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.controllers.text import JOINT_DECIMALS, NUMBER, Lines, fmt_num, strip_comment
 from robotcell.errors import InputError
-from robotcell.export.common import DEG_DECIMALS, MM_DECIMALS
-from robotcell.export.kuka import MACHINE_INDEX
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import MAX_ABS_VALUE
-from robotcell.programs.config import config_text
-from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
-from robotcell.programs.text import Lines, fmt_num, strip_comment
 
-__all__ = ["read", "write"]
+__all__ = ["config_text", "read", "set_joints", "set_pose", "write"]
 
 _POSE_KEYS = ("X", "Y", "Z", "A", "B", "C")
 _AXIS_KEYS = tuple(f"A{i}" for i in range(1, 7))
@@ -46,12 +47,17 @@ _JOINT = {"E6AXIS", "AXIS"}
 
 
 # -- writing -------------------------------------------------------------------------------------
+def config_text(values: tuple[int, ...]) -> str:
+    """Status and Turn as an ``E6POS`` writes them: ``S 6,T 50``."""
+    return f"S {values[0]},T {values[1]}"
+
+
 def _aggregate(p: ProgramPoint) -> str:
     assert p.pose is not None and p.config is not None
     v = pose_to_vendor(p.pose, "kuka")
     parts = [f"{k} {fmt_num(x, MM_DECIMALS if i < 3 else DEG_DECIMALS)}"
              for i, (k, x) in enumerate(zip(_POSE_KEYS, v))]
-    parts.append(config_text(p.config))
+    parts.append(config_text(p.config.values))
     parts += [f"{k} {fmt_num(p.external.get(k, 0.0), DEG_DECIMALS)}" for k in _EXT_KEYS]
     return "{" + ",".join(parts) + "}"
 
@@ -344,7 +350,7 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         elif m := _APO_RE.match(line):
             zone = lines.number(m.group(1), lineno) * 1e-3
         elif m := _MOVE_RE.match(line):
-            point = _move(m, lines, lineno, points, tool, base, speed, zone, motion_data)
+            point = _move(m, lines, lineno, points, dat, tool, base, speed, zone, motion_data)
             if isinstance(point, str):
                 skipped.append(point)
             else:
@@ -381,8 +387,8 @@ def _base_ref(value: str, lines: Lines, lineno: int) -> Ref:
     raise lines.error(lineno, f"$BASE={value}: give BASE_DATA[n], EK(...) or a frame")
 
 
-def _move(m: re.Match, lines: Lines, lineno: int, points: dict[str, _Point], tool: Ref,
-          base: Ref, speed: float | None, zone: float, motion_data: dict[str, str]
+def _move(m: re.Match, lines: Lines, lineno: int, points: dict[str, _Point], dat: Path | None,
+          tool: Ref, base: Ref, speed: float | None, zone: float, motion_data: dict[str, str]
           ) -> ProgramPoint | str:
     """The point of a ``PTP``/``LIN`` line, or why it is skipped."""
     motion = "lin" if m.group(1).upper().endswith("LIN") else "ptp"
@@ -397,6 +403,11 @@ def _move(m: re.Match, lines: Lines, lineno: int, points: dict[str, _Point], too
         key = target.upper()
         if key in ("$AXIS_ACT", "$POS_ACT") or "HOME" in key:
             return f"line {lineno}: {m.group(1).upper()} {target} (not held by the program)"
+        if dat is None:
+            raise lines.error(lineno, f"the .dat is missing: {target} is a point of the "
+                                      f"program's .dat, and there is no "
+                                      f"{Path(lines.path).stem}.dat beside the .src; copy it "
+                                      "there with the .src")
         if key not in points:
             raise lines.error(lineno, f"{target} is not declared in the program's .dat")
         value, pname = points[key], target
@@ -409,3 +420,44 @@ def _move(m: re.Match, lines: Lines, lineno: int, points: dict[str, _Point], too
     return ProgramPoint(pname, lineno, motion, tool, base, value.pose, value.joints,
                         value.config, dict(value.external), v if motion == "lin" else None, z,
                         value.where)
+
+
+# -- editing in place ----------------------------------------------------------------------------
+def set_joints(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
+    """Write the axis values ``A1..A6`` (``q``, rad) of the ``E6AXIS``/``AXIS`` on line ``idx``."""
+    line = lines[idx]
+    for i in range(6):
+        line, n = re.subn(rf"(\bA{i + 1}\s+){NUMBER}", lambda m, v=q[i]: m.group(1)
+                          + fmt_num(math.degrees(v), JOINT_DECIMALS), line, count=1,
+                          flags=re.IGNORECASE)
+        if n != 1:
+            return False
+    lines[idx] = line
+    return True
+
+
+def _replace_fields(line: str, values: dict[str, str], pattern: str) -> tuple[str, int]:
+    """Replace the number after each key of ``values`` (``pattern`` has {key} and {num})."""
+    done = 0
+    for key, text in values.items():
+        line, n = re.subn(pattern.format(key=key, num=NUMBER), lambda m, t=text: m.group(1) + t,
+                          line, count=1, flags=re.IGNORECASE)
+        done += n
+    return line, done
+
+
+def set_pose(lines: list[str], idx: int, T: NDArray[np.float64], config: Config | None) -> bool:
+    """Write X..C (``T``, m) and, unless None, S and T of the ``E6POS``/``POS`` on line ``idx``."""
+    v = pose_to_vendor(T, "kuka")
+    values = {k: fmt_num(x, MM_DECIMALS if i < 3 else DEG_DECIMALS)
+              for i, (k, x) in enumerate(zip(_POSE_KEYS, v))}
+    line, done = _replace_fields(lines[idx], values, r"([{{,]\s*{key}\s+){num}")
+    if done != 6:
+        return False
+    if config is not None:
+        flags = {"S": str(config.values[0]), "T": str(config.values[1])}
+        line, n = _replace_fields(line, flags, r"([{{,]\s*{key}\s+)(?:'B[01]+'|{num})")
+        if n != 2:
+            return False
+    lines[idx] = line
+    return True

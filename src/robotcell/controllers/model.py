@@ -1,11 +1,12 @@
 """What a robot program holds, whatever the vendor: points, their motions, tools and frames.
 
-Every reader of :mod:`robotcell.programs` returns a :class:`Program` and every writer takes one.
+Every controller's program reader returns a :class:`Program` and every writer takes one
+(:mod:`robotcell.controllers`).
 A program knows nothing of a cell: a point keeps the values as the file writes them (a Cartesian
 pose in the point's reference frame, joint values, the vendor's configuration flags, the external
 axes by the name the file gives them) and how the file names its tool and frame (a number, a
 name, or a pose written in the file itself). :mod:`robotcell.programs.frames` and
-:mod:`robotcell.programs.axes` tie those names to a cell.
+:mod:`robotcell.controllers.axes` tie those names to a cell.
 
 Units are SI (metres, radians) except the external axes, which stay in the units the file writes
 (mm, deg, encoder pulses) until a cell says which axis each one is.
@@ -18,11 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["FLAG_LIMIT", "MOTIONS", "PTP_SPEED", "VENDORS", "Config", "Program", "ProgramPoint",
-           "Ref"]
-
-#: Program formats: one per controller family.
-VENDORS = ("kuka", "abb", "fanuc", "yaskawa")
+__all__ = ["FLAG_LIMIT", "MOTIONS", "PTP_SPEED", "Config", "Program", "ProgramPoint", "Ref"]
 
 #: Largest size of a configuration value (a flag, a quadrant or turn count) a file may write: a
 #: larger one is a typing error, not a configuration of an arm.
@@ -85,7 +82,7 @@ class Config:
     Attributes
     ----------
     vendor : str
-        ``kuka``, ``abb``, ``fanuc`` or ``yaskawa``.
+        The controller's name (:func:`robotcell.controllers.registry.names`).
     values : tuple of int
         KUKA ``(status, turn)``; ABB ``(cf1, cf4, cf6, cfx)``; FANUC ``(flip, down, back,
         turn1, turn4, turn6)`` (flags 1 for F, D, B); YASKAWA ``RCONF`` ``(l, m, n, o, p, q)``
@@ -153,7 +150,7 @@ class Program:
     name : str
         Program name (KUKA ``DEF``, ABB module, FANUC ``/PROG``, YASKAWA ``//NAME``).
     vendor : str
-        One of :data:`VENDORS`.
+        The controller's name (:func:`robotcell.controllers.registry.names`).
     points : list of ProgramPoint
     files : tuple of str
         The files it was read from (empty for a program built in memory).

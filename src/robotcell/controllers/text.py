@@ -1,42 +1,25 @@
-"""Reading and writing the text of program files: lines, comments, numbers, names.
+"""Reading and writing the text of program files: lines, comments, numbers.
 
-Shared by the four formats. A reader reports every problem as an
+Shared by the program formats of every controller. A reader reports every problem as an
 :class:`~robotcell.errors.InputError` that names the file and the line, so that a truncated or
 corrupt program is refused with the place to look at.
 """
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
+from robotcell.controllers.data import fmt_num, parse_float
 from robotcell.errors import InputError
-from robotcell.export.common import fmt_num, parse_float
 from robotcell.io.fileio import read_text
 from robotcell.io.tables import MAX_ABS_VALUE
 
-__all__ = ["NAME_LIMITS", "Lines", "fmt_num", "program_name", "strip_comment"]
+__all__ = ["JOINT_DECIMALS", "NUMBER", "Lines", "fmt_num", "strip_comment"]
 
-#: Longest program name per format: KUKA and ABB identifiers; FANUC program names as RoboDK's
-#: FANUC post shortens them; YASKAWA job names ("up to 8 characters", NX100 job data format).
-NAME_LIMITS = {"kuka": 24, "abb": 32, "fanuc": 10, "yaskawa": 8}
-
-_IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
-
-
-def program_name(name: str, vendor: str) -> str:
-    """``name`` as a program name of ``vendor`` (FANUC and YASKAWA in capitals).
-
-    Raises
-    ------
-    InputError
-        Not a letter followed by letters, digits or ``_``, or longer than the format allows.
-    """
-    limit = NAME_LIMITS[vendor]
-    if not _IDENT.match(name) or len(name) > limit:
-        raise InputError(f"program name {name!r} is not a {vendor} program name: a letter, then "
-                         f"letters, digits or '_', at most {limit} characters; give another name")
-    return name.upper() if vendor in ("fanuc", "yaskawa") else name
+#: Decimals of the joint values written (deg): 1e-9 deg.
+JOINT_DECIMALS = 9
+#: A number as program files write it (``12``, ``-0.5``, ``1.5e-3``), for editing one in place.
+NUMBER = r"[-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?"
 
 
 def strip_comment(line: str, marker: str) -> str:

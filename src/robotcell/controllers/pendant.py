@@ -5,8 +5,8 @@ deg), with comment lines around them. FANUC and YASKAWA write the same layout an
 the wording held by :class:`PendantListing`: line keys, comment marker, field names (from
 :data:`robotcell.io.poseformats.FORMATS`) and the names of the reference frame, the track and the
 turntable axis. Both refer the frames to the robot base at track position 0
-(:func:`robotcell.export.common.collect` with ``reference="robot"``) and have no frames on a
-turntable (:func:`robotcell.export.common.flatten_table`).
+(:func:`robotcell.controllers.data.collect` with ``reference="robot"``) and have no frames on a
+turntable (:func:`robotcell.controllers.data.flatten_table`).
 """
 
 from __future__ import annotations
@@ -17,8 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.errors import InputError
-from robotcell.export.common import (
+from robotcell.controllers.data import (
     DEG_DECIMALS,
     MM_DECIMALS,
     ControllerData,
@@ -27,6 +26,7 @@ from robotcell.export.common import (
     fmt_num,
     parse_float,
 )
+from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 
 __all__ = ["PendantListing", "format_listing", "listing_line", "parse_listing",

@@ -21,20 +21,21 @@ position registers and circular motions (skipped and named).
 
 from __future__ import annotations
 
+import math
 import re
 import textwrap
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
+from robotcell.controllers.data import DEG_DECIMALS, MM_DECIMALS
+from robotcell.controllers.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
+from robotcell.controllers.text import JOINT_DECIMALS, NUMBER, Lines, fmt_num
 from robotcell.errors import InputError
-from robotcell.export.common import DEG_DECIMALS, MM_DECIMALS
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.programs.config import config_text
-from robotcell.programs.model import FLAG_LIMIT, PTP_SPEED, Config, Program, ProgramPoint, Ref
-from robotcell.programs.text import Lines, fmt_num
 
-__all__ = ["parse_config", "read", "write"]
+__all__ = ["config_text", "parse_config", "read", "set_joints", "set_pose", "write"]
 
 _POSE_KEYS = ("X", "Y", "Z", "W", "P", "R")
 #: Longest comment line of the TP editor (characters after ``!``).
@@ -42,6 +43,12 @@ COMMENT_CHARS = 29
 
 
 # -- writing -------------------------------------------------------------------------------------
+def config_text(values: tuple[int, ...]) -> str:
+    """``CONFIG`` as a position writes it: ``'N U T, 0, 0, 0'``."""
+    flags = ("NF"[values[0]], "UD"[values[1]], "TB"[values[2]])
+    return f"'{' '.join(flags)}, {values[3]}, {values[4]}, {values[5]}'"
+
+
 def _cnt(zone: float) -> str:
     mm = zone * 1e3
     return "FINE" if mm <= 0 else f"CNT{min(100, max(1, round(mm)))}"
@@ -52,7 +59,7 @@ def _position(p: ProgramPoint) -> list[str]:
     v = pose_to_vendor(p.pose, "fanuc")
     uf, ut = p.frame.number or 0, p.tool.number or 0
     L = [f"{p.name}{{", "   GP1:",
-         f"\tUF : {uf}, UT : {ut},\t\tCONFIG : {config_text(p.config)},",
+         f"\tUF : {uf}, UT : {ut},\t\tCONFIG : {config_text(p.config.values)},",
          "\t" + ",\t".join(f"{k} = {fmt_num(x, MM_DECIMALS)}  mm" for k, x in
                            zip(_POSE_KEYS[:3], v[:3])) + ","]
     rot = ",\t".join(f"{k} = {fmt_num(x, DEG_DECIMALS)} deg" for k, x in
@@ -313,3 +320,49 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
             p.joints, p.config, dict(p.external), _speed(rest, motion, lines, lineno),
             _zone(rest, lines, lineno), p.where))
     return Program(name, "fanuc", points, (str(path),)), skipped
+
+
+# -- editing in place ----------------------------------------------------------------------------
+def _gp1(lines: list[str], idx: int) -> range:
+    """The lines of a position block's group 1, from its header line ``idx``."""
+    end = idx
+    for k in range(idx, len(lines)):
+        if k > idx and re.match(r"^\s*GP[2-9]\s*:", lines[k]):
+            break
+        end = k
+        if "};" in lines[k]:
+            break
+    return range(idx, end + 1)
+
+
+def set_joints(lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
+    """Write ``J1..J6`` (``q``, rad) of the joint position whose ``P[n]{`` is line ``idx``."""
+    done = 0
+    for k in _gp1(lines, idx):
+        for i in range(6):
+            lines[k], n = re.subn(rf"(\bJ{i + 1}\s*=\s*){NUMBER}",
+                                  lambda m, v=q[i]: m.group(1)
+                                  + fmt_num(math.degrees(v), JOINT_DECIMALS), lines[k], count=1)
+            done += n
+    return done == 6
+
+
+def set_pose(lines: list[str], idx: int, T: NDArray[np.float64], config: Config | None) -> bool:
+    """Write X..R (``T``, m) and, unless None, ``CONFIG`` of the position whose ``P[n]{`` is
+    line ``idx``."""
+    v = pose_to_vendor(T, "fanuc")
+    values = {k: fmt_num(x, MM_DECIMALS if i < 3 else DEG_DECIMALS)
+              for i, (k, x) in enumerate(zip(_POSE_KEYS, v))}
+    done = 0
+    for k in _gp1(lines, idx):
+        line = lines[k]
+        for key, text in values.items():
+            line, n = re.subn(rf"(\b{key}\s*=\s*){NUMBER}", lambda m, t=text: m.group(1) + t,
+                              line, count=1)
+            done += n
+        if config is not None:
+            line, n = re.subn(r"(CONFIG\s*:\s*)'[^']*'",
+                              lambda m: m.group(1) + config_text(config.values), line, count=1)
+            done += 10 * n
+        lines[k] = line
+    return done == (16 if config is not None else 6)
