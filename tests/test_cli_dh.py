@@ -1,5 +1,6 @@
 """The dh command group, in process through the CLI entry point."""
 
+import re
 from importlib import resources
 
 import numpy as np
@@ -106,3 +107,31 @@ def test_a_branching_urdf_names_the_parameter_in_python_and_the_option_on_the_co
     assert code == 2 and err.rstrip().endswith("choose the end of the arm with tip_link "
                                                "(--tip-link)")
     assert "'base_link' branches" in err  # a link's name is not taken for the option
+
+
+NEARLY_PARALLEL = (
+    '<robot name="np"><link name="a"/><link name="b"/><link name="c"/><link name="d"/>'
+    '<joint name="j1" type="revolute"><parent link="a"/><child link="b"/>'
+    '<origin xyz="0 0 0.4" rpy="1.5708 0 0"/><axis xyz="0 0 1"/></joint>'
+    '<joint name="j2" type="revolute"><parent link="b"/><child link="c"/>'
+    '<origin xyz="0.3 0 0" rpy="0.000001 0.0000004 0"/><axis xyz="0 0 1"/></joint>'
+    '<joint name="j3" type="revolute"><parent link="c"/><child link="d"/>'
+    '<origin xyz="0.25 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/></joint></robot>')
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_nearly_parallel_axes_show_hayati_beta_and_the_check(capsys, tmp_path, convention):
+    urdf, out = tmp_path / "np.urdf", tmp_path / "np.yaml"
+    urdf.write_text(NEARLY_PARALLEL, encoding="utf-8")
+    code, stdout, err = run(capsys, "dh", "from-urdf", urdf, "--convention", convention, "-o", out)
+    assert code == 0, err
+    assert "Rot(y, beta)" in stdout and "beta [deg]" in stdout and "Hayati's beta" in stdout
+    assert re.search(r"check: as a model file holds it \(mm, degrees\), the model moves like its "
+                     r"source to \d\.\de-\d\d m and rad \(at most 1e-09\)", stdout)
+    model = rc.load_robot(out)
+    assert sum(j.beta != 0 for j in model.joints) == 1
+    code, stdout, _ = run(capsys, "dh", "explain", out)
+    assert code == 0 and "The derived table equals the table of np" in stdout
+    code, _, err = run(capsys, "dh", "convert", out, "--to", "standard" if convention == "modified"
+                       else "modified")
+    assert code == 2 and "have a Hayati beta" in err

@@ -38,13 +38,18 @@ def random_chain(rng, n):
     types.append(rng.choice(["revolute", "prismatic"]))
     for _ in range(1, n):
         p, z = pts[-1], dirs[-1]
-        case = rng.choice(["skew", "intersecting", "parallel", "coincident", "coincident-ish"])
+        case = rng.choice(["skew", "intersecting", "parallel", "coincident", "coincident-ish",
+                           "nearly parallel"])
         if case == "skew":
             q, w = rng.normal(size=3) * 0.3, unit(rng.normal(size=3))
         elif case == "intersecting":
             q, w = p + rng.normal() * 0.3 * z, unit(rng.normal(size=3))
         elif case == "parallel":
             q, w = p + perp(rng, z) * rng.uniform(0.05, 0.5), z * rng.choice([1, -1])
+        elif case == "nearly parallel":  # or antiparallel, by 1e-9..1e-6 rad
+            tilt = 10 ** rng.uniform(-9, -6)
+            q = p + perp(rng, z) * rng.uniform(0.05, 0.5) + rng.normal() * 0.3 * z
+            w = unit(z + tilt * perp(rng, z)) * rng.choice([1, -1])
         elif case == "coincident":
             q, w = p + rng.normal() * z, z * rng.choice([1, -1])
         else:  # within 1e-13 of coincident: treated as coincident at tol 1e-9
@@ -75,10 +80,11 @@ def test_library_robots_round_trip_through_their_axes(convention):
         dp, dr = pose_error(chain.fk(q), robot.fk(q, tool=np.eye(4)))
         assert dp < TOL and dr < TOL, name
         # ...and the derived model reproduces it.
-        derived = dh_from_axes(chain, convention).robot
-        dp, dr = pose_error(derived.fk(q), chain.fk(q))
+        der = dh_from_axes(chain, convention)
+        dp, dr = pose_error(der.robot.fk(q), chain.fk(q))
         assert dp < TOL and dr < TOL, name
-        assert derived.convention == convention
+        assert der.robot.convention == convention
+        assert der.deviation < TOL  # and so does its model file
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])
@@ -101,7 +107,8 @@ def test_random_chains_all_cases(convention):
 
 
 def test_frames_satisfy_the_procedure():
-    """Each Z along its joint axis, X perpendicular to and meeting both Z axes (standard)."""
+    """Each Z along its joint axis, X perpendicular to and meeting both Z axes (standard), but
+    where nearly parallel axes take Hayati's beta."""
     rng = np.random.default_rng(3)
     for _ in range(30):
         chain, _ = random_chain(rng, 6)
@@ -114,14 +121,23 @@ def test_frames_satisfy_the_procedure():
             r = F[i, :3, 3] - chain.points[i]
             assert np.linalg.norm(r - r @ chain.directions[i] * chain.directions[i]) < 1e-9
             x = F[i + 1, :3, 0]
-            assert abs(x @ z) < 1e-9
+            if der.robot.joints[i].beta == 0:
+                assert abs(x @ z) < 1e-9
+            else:  # Hayati's beta only where the common normal would lie beyond the chain
+                assert "as nearly parallel axes, they take the parallel rule" in der.notes[i + 1].text
+                assert abs(x @ z) < 0.5  # less than 30 degrees
         assert np.allclose(der.robot.base, F[0])
 
 
 def test_standard_and_modified_share_theta_and_d():
+    # (A nearly parallel pair's normal is perpendicular to Z_k in standard DH and to Z_{k+1} in
+    # modified DH: there the two tables differ. The first chain without one.)
     rng = np.random.default_rng(4)
-    chain, _ = random_chain(rng, 6)
-    std, mod = dh_from_axes(chain, "standard").robot, dh_from_axes(chain, "modified").robot
+    while True:
+        chain, _ = random_chain(rng, 6)
+        std, mod = dh_from_axes(chain, "standard").robot, dh_from_axes(chain, "modified").robot
+        if not any(j.beta for j in std.joints + mod.joints):
+            break
     for js, jm in zip(std.joints, mod.joints):
         assert js.theta == pytest.approx(jm.theta, abs=1e-12)
         assert js.d == pytest.approx(jm.d, abs=1e-12)
@@ -234,3 +250,43 @@ def test_procedure_reproduces_textbook_tables():
         for mine, theirs in list(zip(der.robot.joints, robot.joints))[:cases[name]]:
             assert (mine.a, mine.d, mine.alpha, mine.theta, mine.sign) == pytest.approx(
                 (theirs.a, theirs.d, theirs.alpha, theirs.theta, theirs.sign), abs=1e-12), name
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+@pytest.mark.parametrize("degrees, case", [(40.0, "skew"), (20.0, "skew"), (1.0, "parallel"),
+                                           (1e-7, "parallel")])
+def test_axes_whose_common_normal_lies_beyond_the_chain_take_the_parallel_rule(convention,
+                                                                               degrees, case):
+    # Z_0 along Z; the next axis 0.36 m away, turned about X: their common normal lies 0.2 m /
+    # sin(angle) along them, 0.6 m at 20 degrees (within twice the chain's extent of 0.5 m),
+    # 11 m at 1 degree and 1e5 km at 1e-7 degrees (beyond it).
+    phi = math.radians(degrees)
+    chain = AxisChain(points=[[0, 0, 0], [0.3, 0.2, 0.1]],
+                      directions=[[0, 0, 1], [0, math.sin(phi), math.cos(phi)]],
+                      types=("revolute", "prismatic"), flange=make_pose(p=[0.3, 0.4, 0.3]))
+    der = dh_from_axes(chain, convention)
+    assert der.notes[1].case == case
+    link = der.robot.joints[0 if convention == "standard" else 1]
+    assert (link.beta != 0) == (case == "parallel")
+    if case == "parallel":
+        assert f"the axes are {degrees:.3g} deg from parallel" in der.notes[1].text
+        # the normal in the plane of the previous one (d = 0), from Z_0 to the next axis
+        assert link.d == 0 and link.a == pytest.approx(math.hypot(0.3, 0.2), rel=1e-2)
+    assert max(max(abs(j.a), abs(j.d)) for j in der.robot.joints) < 2.0
+    q = np.random.default_rng(5).uniform(-1, 1, (50, 2))
+    dp, dr = pose_error(der.robot.fk(q), chain.fk(q))
+    assert dp < TOL and dr < TOL and der.deviation < TOL
+
+
+def test_a_chain_too_far_away_for_a_model_file_is_refused_with_the_reason():
+    # A chain 10,000 km from the origin of R: neither double precision (1e-16 of 1e7 m) nor its
+    # model file, in mm and degrees (a rounding of 1e-14 rad moves it by 1e-7 m), holds it to
+    # 1e-9 m.
+    far = 1e7
+    chain = AxisChain(points=[[far, 0, 0], [far + 0.3, 0, 0.4]],
+                      directions=[[0.1, 0.2, 0.9], [0.3, 1, 0]], types=("revolute", "revolute"),
+                      flange=make_pose(p=[far + 0.5, 0, 0.4]))
+    with pytest.raises(InputError, match=r"the chain: the DH model as written differs .* by up "
+                       r"to .* m or rad \(more than 1e-09\): moving joint\(s\) J1.* with constants "
+                       r"up to 9.\d+e\+06 m, the arithmetic .* no DH model exact to 1e-9 m"):
+        dh_from_axes(chain)

@@ -19,6 +19,7 @@ from robotcell.dhprocedure import (
     dh_from_urdf,
     symbolic_arm,
 )
+from robotcell.dhprocedure.exactness import EXACT_TOL
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.robot.models import load_robot, save_robot
 from robotcell.robot.robot import Joint, Robot
@@ -160,21 +161,26 @@ def _same_row(a: Joint, b: Joint, tol: float = 1e-9) -> bool:
     def ang(x: float, y: float) -> bool:
         return abs(math.remainder(x - y, 2 * math.pi)) < tol
     return (abs(a.a - b.a) < tol and abs(a.d - b.d) < tol and ang(a.alpha, b.alpha)
-            and ang(a.theta, b.theta) and a.sign == b.sign)
+            and ang(a.theta, b.theta) and ang(a.beta, b.beta) and a.sign == b.sign)
 
 
 def _table(robot: Robot) -> str:
-    """The DH table, base and flange of ``robot`` in mm and degrees."""
+    """The DH table, base and flange of ``robot`` in mm and degrees (a beta column if any)."""
+    beta = any(j.beta for j in robot.joints)
+    ry = " Rot(y, beta)" if beta else ""
     if robot.convention == "standard":
-        lines = ["standard DH: T_{i-1,i} = Trans(z, d) Rot(z, theta) Trans(x, a) Rot(x, alpha)"]
-        heads = ("i", "joint", "type", "a [mm]", "alpha [deg]", "d [mm]", "theta [deg]", "sign")
+        lines = [f"standard DH: T_{{i-1,i}} = Trans(z, d) Rot(z, theta) Trans(x, a) Rot(x, alpha){ry}"]
+        heads = ("i", "joint", "type", "a [mm]", "alpha [deg]", "d [mm]", "theta [deg]")
     else:
-        lines = [("modified DH: T_{i-1,i} = Rot(x, alpha_{i-1}) Trans(x, a_{i-1}) Rot(z, theta) "
-                  "Trans(z, d)")]
+        lines = [(f"modified DH: T_{{i-1,i}} = Rot(x, alpha_{{i-1}}){ry} Trans(x, a_{{i-1}}) "
+                  "Rot(z, theta) Trans(z, d)")]
         heads = ("i", "joint", "type", "a_{i-1} [mm]", "alpha_{i-1} [deg]", "d [mm]",
-                 "theta [deg]", "sign")
+                 "theta [deg]")
+    heads += ("beta [deg]",) * beta + ("sign",)
+    # beta with its significant digits: a tilt of 1e-7 deg is what makes the model exact
     rows = [(i, j.name, j.type, _z(j.a * 1e3), _z(math.degrees(j.alpha)), _z(j.d * 1e3),
-             _z(math.degrees(j.theta)), f"{j.sign:+.0f}") for i, j in enumerate(robot.joints, 1)]
+             _z(math.degrees(j.theta))) + (f"{math.degrees(j.beta):.6g}",) * beta
+            + (f"{j.sign:+.0f}",) for i, j in enumerate(robot.joints, 1)]
     lines.append(format_table(heads, rows))
     for key, label in (("base", "base   T_R_0"), ("flange", "flange T_n_F")):
         v = [_z(x) for x in pose_to_vendor(getattr(robot, key), "kuka")]
@@ -191,8 +197,9 @@ def _z(v: float) -> float:
 
 def _report(der: DHDerivation) -> str:
     """Table plus one explanation per frame."""
-    lines = [f"{der.robot.title or der.robot.name}: DH procedure", _table(der.robot), "",
-             "frames:"]
+    lines = [f"{der.robot.title or der.robot.name}: DH procedure", _table(der.robot),
+             (f"check: as a model file holds it (mm, degrees), the model moves like its source "
+              f"to {der.deviation:.1e} m and rad (at most {EXACT_TOL:g})"), "", "frames:"]
     for note in der.notes:
         lines.append(f"  {note.index} [{note.case}] {note.text}")
     return "\n".join(lines)

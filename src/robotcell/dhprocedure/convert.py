@@ -52,7 +52,8 @@ def convert_convention(robot: Robot, to: Convention) -> Robot:
     if tilted:
         raise InputError(f"{robot.name}: joint(s) {', '.join(tilted)} have a Hayati beta, which "
                          "has no equivalent row in the other convention; keep the model in its "
-                         "own convention")
+                         "own convention, or derive the other one from the robot's axes by the DH "
+                         "procedure")
     js = robot.joints
     if to == "modified":
         shifted = [(0.0, 0.0)] + [(j.a, j.alpha) for j in js[:-1]]

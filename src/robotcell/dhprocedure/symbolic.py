@@ -156,8 +156,9 @@ def symbolic_arm(robot: Robot, numeric: bool = False, unit: str = "m",
     if unit not in _UNITS:
         raise InputError(f"unit must be 'm' or 'mm', got {unit!r}")
     if any(j.beta != 0.0 for j in robot.joints):
-        raise InputError(f"{robot.name} has a Hayati beta (an identified arm): its links are not "
-                         "plain DH rows; write the symbolic matrices of its nominal model")
+        raise InputError(f"{robot.name} has a Hayati beta (an identified arm, or nearly parallel "
+                         "axes): its links are not plain DH rows; write the symbolic matrices of "
+                         "its nominal model")
     scale = _UNITS[unit]
     constants: dict[Any, float] = {}
 

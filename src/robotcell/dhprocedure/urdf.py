@@ -14,7 +14,7 @@ child link's frame is the joint frame moved by the joint value.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +23,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.dhprocedure.axes import AxisChain
-from robotcell.dhprocedure.procedure import DHDerivation, dh_from_axes
+from robotcell.dhprocedure.exactness import check_exact
+from robotcell.dhprocedure.procedure import DHDerivation, derive
 from robotcell.errors import InputError, RobotcellError
 from robotcell.io.fileio import read_text
 from robotcell.io.tables import CELL_EXTENT_MM
@@ -236,7 +237,7 @@ def read_urdf(
 
 def dh_from_urdf(
     source: str | Path, convention: Convention = "standard", base_link: str | None = None,
-    tip_link: str | None = None, signs: Sequence[float] | None = None, tol: float = 1e-9,
+    tip_link: str | None = None, signs: Sequence[float] | None = None, tol: float = 1e-12,
 ) -> DHDerivation:
     """The DH model of a URDF chain, by the DH procedure on its joint axes at zero.
 
@@ -250,19 +251,29 @@ def dh_from_urdf(
     signs : sequence of float, shape (n,), optional
         Sign corrections, see :func:`robotcell.dhprocedure.dh_from_axes`.
     tol : float
-        Tolerance (m, rad) of the case tests.
+        Tolerance (m, rad) of the case tests, see :func:`robotcell.dhprocedure.dh_from_axes`.
 
     Returns
     -------
     DHDerivation
+        ``deviation`` compares the model as written with the URDF's own FK
+        (:meth:`UrdfChain.fk`).
+
+    Raises
+    ------
+    InputError
+        See :func:`read_urdf`; and a model whose file form would not reproduce the URDF's FK to
+        1e-9 m and rad (the message says by how much, which joints show it and why).
     """
     chain = read_urdf(source, base_link, tip_link)
     where = str(source) if not str(source).lstrip().startswith("<") else "URDF text"
-    return dh_from_axes(
-        chain.axes(), convention, signs=signs, tol=tol, name=chain.name, title=chain.name,
-        source=(f"derived by the DH procedure (robotcell dh from-urdf) from {where}, chain "
-                f"{chain.base_link} -> {chain.tip_link}"),
+    axes = chain.axes()
+    der = derive(
+        axes, convention, signs, tol, chain.name, chain.name,
+        f"derived by the DH procedure (robotcell dh from-urdf) from {where}, chain "
+        f"{chain.base_link} -> {chain.tip_link}",
     )
+    return replace(der, deviation=check_exact(der.robot, chain.fk, axes, where, tol))
 
 
 def _text(source: str | Path) -> tuple[str, str]:
