@@ -3,7 +3,8 @@
 A change of the package's layout (moving code between modules, registries, context objects) must
 leave what a user sees alone. This test runs the README's commands, as tests/test_docs_commands.py
 and tests/test_commissioning.py do, and compares their output, normalised for what changes from
-run to run (the folder, timings, dates, file checksums), with ``tests/data/readme_golden.json``.
+run to run (the folder, timings, dates, file checksums, the sign of a printed zero), with
+``tests/data/readme_golden.json``.
 
 A deliberate change of output is recorded by running ``ROBOTCELL_GOLDEN=write pytest
 tests/test_readme_golden.py`` and committing the new file with the reason in the commit message.
@@ -32,6 +33,8 @@ VARIABLE = [
     (re.compile(r"\b\d+(\.\d+)? ?(s|ms|seconds)\b"), "<time>"),
     (re.compile(r"\d{4}-\d\d-\d\d[T ]\d\d:\d\d(:\d\d(\.\d+)?)?([+-]\d\d:?\d\d|Z)?"), "<date>"),
     (re.compile(r"\b[0-9a-f]{12,64}\b"), "<hash>"),
+    # A zero printed with the sign of a rounding error (-0.0000) is the same number.
+    (re.compile(r"-(0\.0+)(?![0-9])"), r" \1"),
 ]
 
 
