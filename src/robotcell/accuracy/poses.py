@@ -23,7 +23,7 @@ from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_pose
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.io.tables import read_csv, write_csv
+from robotcell.io.tables import read_csv, refuse_empty, write_csv
 from robotcell.programs.config import CONFIG_FIELDS
 from robotcell.programs.fanuc import parse_config
 from robotcell.programs.model import Config
@@ -90,6 +90,7 @@ def _configs(path: str, cols: dict) -> list[Config] | None:
     if missing:
         raise InputError(f"{path}: missing column(s) {', '.join(missing)} of the {vendor} "
                          "configuration")
+    refuse_empty(cols, names, path, optional=True)  # no configuration of one pose alone
     if vendor == "fanuc":
         out = []
         for i, text in enumerate(cols["config"]):
