@@ -186,7 +186,9 @@ def test_measurement_refusals():
                       "c": np.ones(2), "zz": np.ones(2)}, "m.csv")
     with pytest.raises(InputError, match="needs TCP positions"):
         tcp_positions({"u": np.ones(2)}, "m.csv")
-    with pytest.raises(InputError, match="NaN"):
+    # NaN in a column as read_csv gives it is an empty cell (a NaN written in the file is
+    # refused by read_csv itself), refused naming its line.
+    with pytest.raises(InputError, match="m.csv: line 2: empty value in column 'x'"):
         tcp_positions({"x": np.array([np.nan, 900.0]), "y": np.ones(2), "z": np.ones(2)}, "m.csv")
     # Identical rows are data (averaged by the fit), and only earn a note.
     note = ("m.csv: line 2, line 4 are identical; each is used as a measurement of its own (if "

@@ -115,11 +115,13 @@ def test_no_redundancy_is_said_with_the_touches_that_would_check():
     assert touches_for_outlier_check(4, 6) == 5 and touches_for_outlier_check(5, 9) is None
     v = calibrate_tool(flange_poses(np.random.default_rng(4), 4)).verdict
     assert v.level == "check" and v.touches_needed == 5
-    assert "redundancy 6 is too little to single out a wrong touch; take 5 or more touches" in v.reasons
+    assert ("redundancy 6 is too little to single out a wrong touch; take 5 or more touches (4 "
+            "given: 1 more touch)") in v.reasons
     theta = np.radians([0.0, 90.0, 180.0, 270.0])
     v = calibrate_turntable(theta, table_touches(np.random.default_rng(5), theta)).verdict
     assert v.touches_needed == 6
-    assert "redundancy 5 is too little to single out a wrong touch; take 6 or more touches" in v.reasons
+    assert ("redundancy 5 is too little to single out a wrong touch; take 6 or more touches (4 "
+            "given: 2 more touches)") in v.reasons
     pts = transform_points(T_R_B, [[0, 0, 0], [0.3, 0, 0], [0.1, 0.2, 0]])
     v = frame_3point(pts, ["origin", "x", "xy"]).verdict
     assert v.level == "check" and v.reasons[-1].startswith(

@@ -150,9 +150,11 @@ def test_the_history_lists_every_version_with_its_provenance(tmp_path, capsys):
     assert versions[2].provenance["tool torch"]["rms_mm"] == 0.04
     code, out, err = run(capsys, "cell", "history", str(path))
     assert code == 0, err
-    assert out.startswith(f"3 version(s) of {path}, oldest first:")
-    assert f"{path}.1.bak  written" in out and f"{path} (current)  written" in out
-    assert "tool torch: tcp, 2026-01-04T08:00:00+01:00, rms 0.040 mm, touches.csv" in out
+    assert out.startswith(f"3 version(s) of {path}, oldest first")
+    lines = out.splitlines()[1:]
+    assert lines[0].startswith(f"{path}.1.bak") and "first kept version, 6 item(s)" in lines[0]
+    assert lines[2].startswith(f"{path} (current)")
+    assert lines[2].endswith("tool torch (tcp, RMS 0.040 mm)")
     code, _, err = run(capsys, "cell", "history", str(tmp_path / "none.yaml"))
     assert code == 2 and "does not exist, and no backup of it" in err
 

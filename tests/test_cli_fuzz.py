@@ -883,3 +883,193 @@ def test_cli_fuzz_controller_limits(name, tmp_path, capsys, monkeypatch):
     if code == 2:
         assert "error:" in err and message in err, err
         assert _files(tmp_path) == before
+
+
+# -- spreadsheet cells, numbers, comment lines, folder outputs, history, touches left out ---------
+# Each case is checked as the cases above are (documented exit status, no traceback, no Python
+# warning, nothing changed by a refused run) and for what its input must give: an empty cell
+# where the command has a default, a trailing separator or a note column is read as the valid
+# file is (same exit status); an empty cell where a value is needed, a value under a column
+# without a name, a number with "_" or digits of another script, a comment or title line are
+# refused (exit 2) naming their line; a folder output given a file is refused saying so.
+
+#: Cases per kind: (in ``pytest -q``, in the full set).
+CELL_CASES = {"empty-cells": (8, 80), "numbers": (4, 40), "comment-lines": (4, 40),
+              "folder-output": (2, 16), "history": (2, 20), "left-out": (2, 12)}
+
+
+def _seam_with_defaults(rng: np.random.Generator) -> str:
+    """The example seam with the columns that have a default per line: motion, speed, zone."""
+    lines = SEAM.read_text(encoding="utf-8").splitlines()
+    rows = [lines[0] + ",motion,speed,zone"]
+    rows += [f"{line},{'lin' if k else 'ptp'},{int(rng.integers(20, 200))},"
+             f"{int(rng.integers(0, 3))}" for k, line in enumerate(lines[1:])]
+    return "\n".join(rows) + "\n"
+
+
+#: Per command: the valid CSV, the arguments (the file as ``{csv}``), and the columns that must
+#: have a value on every line, and those with a default per line.
+_CELL_COMMANDS = {
+    "tcp": (_tcp_csv, ["calibrate", "tcp", "{csv}"], list("xyzabc"), []),
+    "frame": (_frame_csv, ["calibrate", "frame", "{csv}"], ["point", *"xyz"], ["note"]),
+    "turntable": (_turntable_csv, ["calibrate", "turntable", "{csv}"], [*"xyz", "e1"], []),
+    "fk": (_joints_csv, ["fk", "kuka_kr16", "--input", "{csv}"], [f"a{i}" for i in range(1, 7)],
+           []),
+    "fk-cell": (lambda rng: _cell_joints_csv(rng, False),
+                ["fk", "--cell", EXAMPLE, "--input", "{csv}", "--tool", "torch"],
+                [*(f"a{i}" for i in range(1, 7)), "track"], []),
+    "program": (_seam_with_defaults,
+                ["program", "write", "{csv}", "--cell", EXAMPLE, "--tool", "torch", "--frame",
+                 "part", "--format", "kuka", "-o", "prog"],
+                [*"xyzabc", "table"], ["motion", "speed", "zone"]),
+}
+
+
+def _empty_cells(rows: list[list[str]], rng: np.random.Generator, needed: list[str],
+                 defaults: list[str]) -> tuple[list[list[str]], str, str]:
+    """One mutation about empty cells: (rows, what, expected: ``"same"`` or an error text)."""
+    kind = str(rng.choice(["trailing-separator", "empty-note", "empty-default", "empty-needed",
+                           "unnamed-value", "unused-empty"]))
+    header = rows[0]
+    i = int(rng.integers(1, len(rows)))
+    if kind == "trailing-separator":
+        return [r + [""] * int(rng.integers(1, 3)) for r in rows], kind, "same"
+    if kind in ("empty-note", "unused-empty"):
+        name = "note" if kind == "empty-note" else "operator"
+        if name not in header:
+            rows = [header + [name]] + [r + ["Prüfung 3"] for r in rows[1:]]
+        j = rows[0].index(name)
+        for r in rows[1:]:
+            r[j] = r[j] if rng.random() < 0.3 else ""
+        return rows, kind, "same"
+    if kind == "empty-default" and defaults:
+        j = header.index(str(rng.choice(defaults)))
+        rows[i][j] = ""
+        return rows, f"{kind} {header[j]} line {i + 1}", "same"
+    if kind == "unnamed-value":
+        rows = [header + [""]] + [r + (["7"] if k == i else [""])
+                                  for k, r in enumerate(rows[1:], 1)]
+        return rows, f"{kind} line {i + 1}", f"line {i + 1}: value '7' in column {len(header) + 1}"
+    j = header.index(str(rng.choice(needed)))
+    rows[i][j] = ""
+    return rows, f"empty {header[j]} line {i + 1}", f"line {i + 1}: empty value in column"
+
+
+def _numbers(rows: list[list[str]], rng: np.random.Generator) -> tuple[list[list[str]], str, str]:
+    """A number rewritten: with "_" or digits of another script (refused naming the line), or
+    in another form a spreadsheet writes (``1.500000E+03``: read as the valid file)."""
+    cells = [(i, j) for i in range(1, len(rows)) for j, c in enumerate(rows[i])
+             if re.fullmatch(r"-?\d{2,}\.\d+", c)]
+    i, j = cells[int(rng.integers(0, len(cells)))]
+    value = rows[i][j]
+    kind = str(rng.choice(["grouped", "script", "exponent"]))
+    if kind == "exponent":
+        rows[i][j] = f"{float(value):.9E}"
+        return rows, f"{kind} line {i + 1}", "same"
+    sign, digits = ("-", value[1:]) if value.startswith("-") else ("", value)
+    rows[i][j] = (sign + digits[0] + "_" + digits[1:] if kind == "grouped"
+                  else sign + digits.translate(str.maketrans("0123456789", "٠١٢٣٤٥٦٧٨٩")))
+    return rows, f"{kind} {rows[i][j]} line {i + 1}", f"line {i + 1}: column"
+
+
+def _comment_lines(rows: list[list[str]], rng: np.random.Generator
+                   ) -> tuple[list[list[str]], str, str]:
+    """A comment line above the header or among the data, or a title line above the header."""
+    kind = str(rng.choice(["comment-above", "comment-among", "title"]))
+    if kind == "comment-above":
+        return [["# touches of cell 3", " KR 16"]] + rows, kind, "is a comment above the header"
+    if kind == "title":
+        return [["Touches of cell 3"]] + rows, kind, "a title above the header?"
+    i = int(rng.integers(1, len(rows)))
+    return rows[:i] + [["# re-touched", " see below"]] + rows[i:], f"{kind} line {i + 1}", \
+        f"line {i + 1} starts with '#'"
+
+
+def _cell_case(kind: str, rng: np.random.Generator, d: Path) -> tuple[Case, str]:
+    """A case of ``kind`` in folder ``d``, and what it must give: ``"same"`` (the exit status of
+    the valid input), ``"history"`` or a text the error must hold."""
+    if kind == "folder-output":
+        f = _write(d / "prog", "my notes\n")
+        out = str(rng.choice([str(f), str(f / "sub")]))
+        args = (["demo", "-o", out] if rng.random() < 0.3 else
+                ["program", "write", SEAM, "--cell", EXAMPLE, "--tool", "torch", "--frame",
+                 "part", "--format", "kuka", "-o", out])
+        expect = "is a file, not a folder" if out.endswith("sub") else "exists and is a file"
+        return Case(args, f"-o {out}"), expect
+    if kind == "history":
+        build = _cell_history(rng, d, {}, d / "out.txt")
+        args = build[0] + (["--json"] if rng.random() < 0.5 else [])
+        return Case(args, build[1]), "history"
+    if kind == "left-out":
+        rows = _split(_turntable_csv(rng))
+        k = int(rng.integers(1, len(rows)))
+        rows[k][0] = f"{float(rows[k][0]) + float(rng.uniform(3.0, 30.0)):.6f}"
+        path = _write(d / "t.csv", _join(rows))
+        return Case(["calibrate", "turntable", path], f"line {k + 1} off"), "left-out"
+    command = str(rng.choice(sorted(_CELL_COMMANDS)))
+    valid, argv, needed, defaults = _CELL_COMMANDS[command]
+    rows = _split(valid(rng))
+    (d / "valid.csv").write_text(_join(rows))
+    if kind == "empty-cells":
+        rows, what, expect = _empty_cells(rows, rng, needed, defaults)
+    elif kind == "numbers":
+        rows, what, expect = _numbers(rows, rng)
+    else:
+        rows, what, expect = _comment_lines(rows, rng)
+    path = _write(d / "m.csv", _join(rows))
+    writes = (d / "prog",) if command == "program" else ()
+    return Case([str(path) if a == "{csv}" else a for a in argv], f"{command}: {what}",
+                writes), expect
+
+
+def _expected(expect: str, case: Case, d: Path, code: int, out: str, err: str,
+              capsys) -> list[str]:
+    """What is wrong with the outcome of a case against what its input must give."""
+    if expect == "same":
+        valid = [str(d / "valid.csv") if a.endswith("m.csv") else a for a in case.args]
+        shutil.rmtree(d / "prog", ignore_errors=True)
+        want = run(capsys, *valid)[0]
+        return [] if code == want else [f"exit {code}, the valid file gives {want}"]
+    if expect == "history":
+        if code != 0 or "--json" not in case.args:
+            return [] if code in (0, 2) else [f"exit {code}"]
+        json.loads(out)
+        return []
+    if expect == "left-out":
+        wrong = "left out as" in out and "take 6 or more touches" in out
+        return ["the verdict counts the touches as if none were left out"] if wrong else []
+    return [] if code == 2 and expect in err else [f"exit {code} without {expect!r}"]
+
+
+@pytest.mark.parametrize("kind", list(CELL_CASES))
+def test_cli_fuzz_spreadsheet_cells(kind, tmp_path, capsys, monkeypatch):
+    rng = np.random.default_rng([SEED, 100 + list(CELL_CASES).index(kind)])
+    monkeypatch.chdir(tmp_path)
+    failures = []
+    for k in range(CELL_CASES[kind][1 if FULL else 0]):
+        d = tmp_path / f"case{k}"
+        d.mkdir()
+        monkeypatch.chdir(d)
+        case, expect = _cell_case(kind, rng, d)
+        before = _files(d)
+        code, out, err = run(capsys, *case.args)
+        after = _files(d)
+        problems = []
+        if code not in DOCUMENTED:
+            problems.append(f"exit status {code}")
+        if "Traceback" in out + err or PYTHON_WARNING.search(out + err):
+            problems.append("a traceback or a Python warning")
+        if code != 0 and after != before:
+            problems.append(f"a refused run changed files {_diff(before, after)}")
+        owned = {str(p.relative_to(d)) for w in case.writes
+                 for p in ([w, *w.rglob("*")] if w.is_dir() else [w])}
+        if code == 0 and _diff(before, after) - owned:
+            problems.append(f"changed inputs {sorted(_diff(before, after) - owned)}")
+        problems += _expected(expect, case, d, code, out, err, capsys)
+        if problems:
+            failures.append(f"case {k} ({case.what}): {', '.join(problems)}; robotcell "
+                            f"{' '.join(case.args)}\n  stderr: {err.strip()[-300:]}")
+        monkeypatch.chdir(tmp_path)
+        shutil.rmtree(d)
+    assert not failures, (f"seed {SEED}, {len(failures)} cases failed:\n"
+                          + "\n".join(failures[:8]))

@@ -25,7 +25,7 @@ from robotcell.controllers.model import Config
 from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.io.tables import read_csv, write_csv
+from robotcell.io.tables import read_csv, refuse_empty, write_csv
 from robotcell.programs.path import read_path, table_columns
 from robotcell.report.accuracy import write_accuracy_report
 
@@ -86,6 +86,7 @@ def _configs(path: str, cols: dict) -> list[Config] | None:
     if missing:
         raise InputError(f"{path}: missing column(s) {', '.join(missing)} of the {ctl.name} "
                          "configuration")
+    refuse_empty(cols, list(ctl.csv_config), path, optional=True)  # no configuration of one pose alone
     return ctl.configs_from_columns(path, cols)
 
 

@@ -35,7 +35,13 @@ from numpy.typing import NDArray
 from robotcell.calibration.spec import JOINT_COLUMNS, SPECS, Column, Procedure
 from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.io.tables import outside_limits, unknown_columns_warning
+from robotcell.io.tables import (
+    empty_rows,
+    outside_limits,
+    refuse_empty,
+    spreadsheet_number,
+    unknown_columns_warning,
+)
 from robotcell.robot.robot import Robot
 
 __all__ = [
@@ -291,7 +297,7 @@ def read_measurements(procedure: Procedure | str, cols: Columns, source: str,
     if unused:
         note(unused)
     for name, why in spec.unused.items():
-        if name in cols:
+        if name in cols and len(empty_rows(cols[name])) < len(cols[name]):  # a value given
             procedure = term(f"calibrate {spec.name}", f"the {spec.name} calibration")
             raise InputError(f"{source}: column '{name}' {why.format(procedure=procedure)}")
     touches = _touches(cols, source, spec.pose, robot)
@@ -301,10 +307,10 @@ def read_measurements(procedure: Procedure | str, cols: Columns, source: str,
     nominal = None
     if spec.role("nominal") and "nominal_x" in cols:
         nominal = nominal_points(cols, source)
-    point = _points(spec, cols, n) if spec.points else None
+    point = _points(spec, cols, n, source) if spec.points else None
     reference = None
     if spec.role("reference") and "point" in cols:
-        reference = _numeric(cols, ("point",), source)[:, 0]
+        reference = _numeric(cols, ("point",), source, optional=True)[:, 0]
     track = track_column(cols, source) if spec.role("track") else None
     for text in repeated_rows(raw_rows(cols, spec.names), source):
         note(f"note: {text}")
@@ -316,6 +322,9 @@ def _touches(cols: Columns, source: str, pose: str, robot: Robot | None
              ) -> dict[str, NDArray[np.float64] | None]:
     """The touches of a table: ``points`` (x, y, z), ``poses`` (x..c) or ``joints`` (SI)."""
     out: dict[str, NDArray[np.float64] | None] = {"points": None, "poses": None, "joints": None}
+    filled = {k for k, v in cols.items() if len(empty_rows(v)) < len(v)}
+    if "a1" in filled:  # pose columns left empty beside the joint values are not given
+        cols = {k: v for k, v in cols.items() if k in filled or k not in tuple("xyzabc")}
     if pose == "tcp" and ("x" in cols or "a1" not in cols and ("y" in cols or "z" in cols)):
         p = _numeric(cols, ("x", "y", "z"), source)
         _check_mm(p, "x, y, z", source)
@@ -350,12 +359,17 @@ def _axis(cols: Columns, source: str, column: Column) -> NDArray[np.float64]:
     return np.radians(_numeric(cols, (column.name,), source)[:, 0])
 
 
-def _points(spec: Procedure, cols: Columns, n: int) -> tuple[str, ...] | None:
-    """Column ``point`` in lower case, the procedure's default point, or None; checked by
-    :func:`_check_points`."""
+def _points(spec: Procedure, cols: Columns, n: int, source: str) -> tuple[str, ...] | None:
+    """Column ``point`` in lower case, the procedure's default point (also for a line that
+    leaves the cell empty), or None; checked by :func:`_check_points`. A procedure without a
+    default point refuses an empty cell."""
     if "point" not in cols:
         return None if spec.default_point is None else (spec.default_point,) * n
-    return tuple(str(v).strip().lower() for v in cols["point"])
+    if spec.default_point is None:
+        refuse_empty(cols, ("point",), source)
+    names = ["" if isinstance(v, float) and np.isnan(v) else str(v).strip().lower()
+             for v in cols["point"]]
+    return tuple(name or str(spec.default_point) for name in names)
 
 
 def _check_points(spec: Procedure, roles: Sequence[str] | None, source: str) -> None:
@@ -391,30 +405,27 @@ def raw_rows(cols: Columns, names: Sequence[str]) -> NDArray[np.float64]:
     return np.stack([cols[n] for n in use], axis=1) if use else np.zeros((0, 0))
 
 
-def _numeric(cols: Columns, names: Sequence[str], source: str) -> NDArray[np.float64]:
+def _numeric(cols: Columns, names: Sequence[str], source: str, optional: bool = False
+             ) -> NDArray[np.float64]:
+    """Columns ``names`` as an (N, k) float array, refused when one is missing, empty on a
+    line (``optional``: a column that may be left out as a whole), or not numeric."""
     missing = [n for n in names if n not in cols]
     if missing:
         raise InputError(f"{source}: missing column(s) {', '.join(missing)} "
                          f"(have: {', '.join(cols) or 'none'})")
+    refuse_empty(cols, names, source, optional)
     out = []
     for n in names:
         v = cols[n]
         if not isinstance(v, np.ndarray):
-            bad = next((c for c in v if not _is_number(c)), v[0] if v else "")
-            raise InputError(f"{source}: column '{n}' must be numeric, found {bad!r}")
+            bad = next((i for i, c in enumerate(v) if spreadsheet_number(str(c)) is None), 0)
+            raise InputError(f"{source}: line {bad + 2}: column '{n}' must be numeric, found "
+                             f"{v[bad] if v else ''!r}")
         if not np.all(np.isfinite(v)):
             raise InputError(f"{source}: column '{n}' contains NaN or infinite values; "
                              "re-record or delete that touch")
         out.append(np.asarray(v, dtype=float))
     return np.stack(out, axis=1)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _check_mm(values: NDArray[np.float64], what: str, source: str) -> None:
@@ -608,7 +619,7 @@ def point_roles(cols: Columns, source: str) -> list[str]:
         once; repeated roles are averaged by the procedure.
     """
     spec = SPECS["frame"]
-    roles = _points(spec, cols, len(cols.get("point", ())))
+    roles = _points(spec, cols, len(cols.get("point", ())), source)
     _check_points(spec, roles, source)
     return list(roles)
 
@@ -627,7 +638,7 @@ def nominal_points(cols: Columns, source: str) -> NDArray[np.float64]:
     ndarray, shape (N, 3)
         Metres.
     """
-    return _numeric(cols, ("nominal_x", "nominal_y", "nominal_z"), source) * 1e-3
+    return _numeric(cols, ("nominal_x", "nominal_y", "nominal_z"), source, optional=True) * 1e-3
 
 
 def track_column(cols: Columns, source: str) -> NDArray[np.float64] | None:
@@ -647,6 +658,6 @@ def track_column(cols: Columns, source: str) -> NDArray[np.float64] | None:
     """
     if "track" not in cols:
         return None
-    e = _numeric(cols, ("track",), source)[:, 0]
+    e = _numeric(cols, ("track",), source, optional=True)[:, 0]
     _check_mm(e[e != 0], "track (track position)", source)
     return e * 1e-3

@@ -202,6 +202,43 @@ def _names(value: Any) -> list[str]:
     return [str(v) for v in value] if isinstance(value, list) else []
 
 
+def _too_few(used: int, left_out: int, dof: int, needed: int) -> str:
+    """The reason of a verdict whose touches cannot single out a wrong one.
+
+    Parameters
+    ----------
+    used : int
+        Touches the result was computed from.
+    left_out : int
+        Touches given but left out as outliers.
+    dof : int
+        Redundancy of the fit from the touches used.
+    needed : int
+        Touches to use that would single out a wrong one (:func:`touches_for_outlier_check`).
+
+    Returns
+    -------
+    str
+        E.g. ``"redundancy 5 is too little to single out a wrong touch; take 6 or more
+        touches (4 given: 2 more)"``; with touches left out it counts the touches given, left
+        out and used, and how many more to take.
+    """
+    more = needed - used
+    take = f"{more} more touch{'es' if more > 1 else ''}"
+    if not left_out:
+        what = (f"no redundancy: {used} touches determine the result exactly, so nothing checks "
+                "it and a wrong touch goes unseen" if dof <= 0 else
+                f"redundancy {dof} is too little to single out a wrong touch")
+        return f"{what}; take {needed} or more touches ({used} given: {take})"
+    counts = (f"of the {used + left_out} touches given, {left_out} left out as "
+              f"{'an outlier' if left_out == 1 else 'outliers'} and {used} used")
+    what = (f"no redundancy: {counts}, which determine the result exactly, so nothing checks it"
+            if dof <= 0 else
+            f"redundancy {dof} is too little to single out a wrong touch: {counts}")
+    return (f"{what}; take {take} (re-touching one left out counts), so that {needed} or more "
+            "are used")
+
+
 def verdict(result: Mapping[str, Any]) -> Verdict:
     """Grade a calibration result by the rule of this module.
 
@@ -230,8 +267,10 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         r = _floats(res)
     except (TypeError, ValueError):
         r = np.full(1, np.nan)  # unreadable residuals: no bound can hold
+    left_out = 0
     if excluded and len(labels) == len(r):
         r = r[[lab not in excluded for lab in labels]]
+        left_out = len(labels) - len(r)
     n = len(r) if r.ndim else 0
     ssr = float(np.sum(r**2)) if np.all(np.isfinite(r)) else float("inf")
     if result.get("accuracy_source") in ("stated", "default"):
@@ -313,12 +352,7 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
                      "touch checks them, so an error there goes unseen): repeat them")
     needed = touches_for_outlier_check(n, dof) if n else None
     if needed is not None:
-        if dof <= 0:
-            check.append(f"no redundancy: {n} touches determine the result exactly, so nothing "
-                         f"checks it and a wrong touch goes unseen; take {needed} or more touches")
-        else:
-            check.append(f"redundancy {dof} is too little to single out a wrong touch; take "
-                         f"{needed} or more touches")
+        check.append(_too_few(n, left_out, dof, needed))
     if poor:
         level, reasons = "poor", poor + check
     elif check:

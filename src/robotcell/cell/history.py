@@ -5,12 +5,14 @@ Before :func:`~robotcell.cell.schema.save_cell` replaces a cell file, the file i
 ``cell.yaml.2.bak``, ...). No backup is ever overwritten, so the file as the user first wrote it
 stays beside every later version. :func:`cell_history` lists the versions, oldest first, with the
 provenance of every item (the procedure, time, residual RMS and note that each calibration
-records) and which items changed from one version to the next.
+records) and which items changed from one version to the next; :meth:`Version.summary` says
+it in one line, :meth:`Version.to_json` in full.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import math
 import os
 import re
 from collections.abc import Mapping
@@ -117,6 +119,59 @@ class Version:
     provenance: dict[str, dict[str, Any]] = field(default_factory=dict)
     changed: list[str] = field(default_factory=list)
     error: str | None = None
+
+    def summary(self, first: bool = False) -> str:
+        """What this version changed, in one line: each item with its procedure and RMS.
+
+        Parameters
+        ----------
+        first : bool
+            The oldest version kept: its items are listed as what it holds.
+
+        Returns
+        -------
+        str
+            E.g. ``"tool pointer (tcp, RMS 0.087 mm); frame part (workpiece, RMS 0.120
+            mm)"``, ``"not readable: ..."`` or ``"no item changed its provenance"``.
+        """
+        if self.error is not None:
+            return f"not readable: {self.error}"
+        if not self.changed:
+            return "no item changed its provenance"
+        items = "; ".join(f"{item} ({_brief(self.provenance[item])})" for item in self.changed)
+        return f"first kept version, {len(self.changed)} item(s): {items}" if first else items
+
+    def to_json(self) -> dict[str, Any]:
+        """The version as plain JSON values: ``file``, ``number`` (null for the current file),
+        ``current``, ``written``, ``changed``, ``error`` and ``provenance`` (every item's
+        provenance as written; a value JSON cannot hold is given as text, NaN as null)."""
+        return {"file": str(self.path), "number": self.number, "current": self.number is None,
+                "written": self.modified, "changed": list(self.changed), "error": self.error,
+                "provenance": _plain(self.provenance)}
+
+
+def _brief(prov: Mapping[str, Any]) -> str:
+    """An item's provenance in a few words: its source and residual RMS."""
+    text = str(prov.get("source", "no provenance recorded" if not prov else "?"))
+    rms = prov.get("rms_mm")
+    if isinstance(rms, (int, float)) and not isinstance(rms, bool) and math.isfinite(rms):
+        text += f", RMS {rms:.3f} mm"
+    return text
+
+
+def _plain(value: Any) -> Any:
+    """``value`` (parsed YAML) as JSON values: mappings, lists, finite numbers, text, null."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if value is None or isinstance(value, bool):
+        return value
+    if isinstance(value, int):
+        return int(value)
+    if isinstance(value, float):
+        return float(value) if math.isfinite(value) else None
+    return str(value)
 
 
 def _items(data: Any) -> dict[str, dict[str, Any]]:

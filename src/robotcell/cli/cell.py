@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import click
@@ -85,42 +86,31 @@ def show(path: str) -> None:
     click.echo(format_table(head, rows))
 
 
-def _provenance_text(prov: dict) -> str:
-    """One line of a provenance mapping as written: source, time, RMS, note, other keys."""
-    if not prov:
-        return "no provenance recorded"
-    parts = [str(prov.get("source", "?"))]
-    if prov.get("time") is not None:
-        parts.append(str(prov["time"]))
-    if isinstance(prov.get("rms_mm"), (int, float)):
-        parts.append(f"rms {prov['rms_mm']:.3f} mm")
-    parts += [str(prov[k]) if k == "note" else f"{k} {prov[k]}"
-              for k in prov if k not in ("source", "time", "rms_mm")]
-    return ", ".join(parts)
-
-
 @cell.command()
 @click.argument("path", type=click.Path(dir_okay=False))
-def history(path: str) -> None:
+@click.option("--json", "as_json", is_flag=True,
+              help="Print every version in full as JSON: file, number, when written, the items "
+                   "changed, and every item's provenance as written.")
+def history(path: str, as_json: bool) -> None:
     """List the versions of a cell file that its updates kept, oldest first.
 
     Every update (calibrate ... --cell, Cell.save) first copies the file to the next numbered
-    backup PATH.N.bak. For each version this prints the file, when it was written and the
-    provenance (procedure, time, residual RMS, note) of the items that changed from the version
-    before; the first version lists every item.
+    backup PATH.N.bak. Each version gets one line: the file, when it was written, and the items
+    whose provenance changed from the version before, each with its procedure and residual RMS
+    (the first version lists every item). --json gives every provenance field.
 
     \b
     Example:
       robotcell cell history cell.yaml
     """
     versions = cell_history(path)
-    click.echo(f"{len(versions)} version(s) of {path}, oldest first:")
-    for v in versions:
-        name = f"{v.path} (current)" if v.number is None else str(v.path)
-        click.echo(f"{name}  written {v.modified}")
-        if v.error is not None:
-            click.echo(f"  not readable: {v.error}")
-        elif not v.changed:
-            click.echo("  no item changed its provenance")
-        for item in v.changed:
-            click.echo(f"  {item}: {_provenance_text(v.provenance[item])}")
+    if as_json:
+        click.echo(json.dumps({"cell": path, "versions": [v.to_json() for v in versions]},
+                              indent=2))
+        return
+    names = [f"{v.path} (current)" if v.number is None else str(v.path) for v in versions]
+    width = max(len(n) for n in names)
+    click.echo(f"{len(versions)} version(s) of {path}, oldest first (--json for every "
+               "provenance field):")
+    for k, (name, v) in enumerate(zip(names, versions)):
+        click.echo(f"{name.ljust(width)}  {v.modified}  {v.summary(first=k == 0)}")

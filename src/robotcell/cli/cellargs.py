@@ -23,7 +23,7 @@ from robotcell.cell.validation import axis_limit_violation, axis_range, check_ax
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.io.tables import CELL_EXTENT_MM
+from robotcell.io.tables import CELL_EXTENT_MM, refuse_empty
 
 __all__ = [
     "NORMAL_UP",
@@ -212,8 +212,12 @@ def check_axis_columns(cell: Cell, cols: dict, source: str, track: bool = True,
     """Refuse the ``track`` (unless ``track`` is False: a column the command does not use) and
     table columns (``table``, or a positioner's ``e1..en``) of a batch file whose values are
     outside the limits of the cell's axes, naming line and column. With ``warn`` they are named
-    in a warning line instead; a track position beyond 100 m is refused still."""
+    in a warning line instead; a track position beyond 100 m is refused still. An empty cell in
+    these columns is refused, naming its line: a line has no track position or table angle of
+    its own to default to."""
     label = f"cell {cell.name!r}"
+    refuse_empty(cols, [*(["track"] if track else []), *table_columns(cell)[1]], source,
+                 optional=True)
     checks = []
     if track and cell.track is not None and isinstance(cols.get("track"), np.ndarray):
         checks.append((cell.track, cols["track"] * 1e-3, ["track"]))

@@ -113,12 +113,15 @@ def counted(n: int, noun: str) -> str:
 
 
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:
-    """Parse ``"1,2,3"`` into floats, with an error naming ``what`` on bad input."""
+    """Parse ``"1,2,3"`` into floats, with an error naming ``what`` on bad input.
+
+    Each value is a number as :func:`robotcell.io.tables.spreadsheet_number` reads it (no
+    ``1_000``)."""
     parts = [p.strip() for p in text.split(",") if p.strip() != ""]
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        raise InputError(f"{what} must be comma-separated numbers, got {text!r}") from None
+    numbers = [tables.spreadsheet_number(p) for p in parts]
+    if any(v is None for v in numbers):
+        raise InputError(f"{what} must be comma-separated numbers, got {text!r}")
+    values = [float(v) for v in numbers if v is not None]
     if count is not None and len(values) != count:
         raise InputError(f"{what} needs {count} comma-separated values, got {len(values)}")
     if not all(math.isfinite(v) for v in values):

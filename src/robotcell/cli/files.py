@@ -31,11 +31,21 @@ _OUTPUTS = "robotcell.files.outputs"
 class OutputPath(click.Path):
     """Type of a parameter naming a file (or folder) the command writes.
 
-    The value is kept for :func:`refuse_overwriting_inputs` also when the parameter is not
+    A folder parameter (``file_okay=False``) given an existing file is refused saying that it
+    names a folder; any output inside a file (``notes.txt/out.csv``) is refused naming that
+    file. The value is kept for :func:`refuse_overwriting_inputs` also when the parameter is not
     passed to the command's function (``expose_value=False``).
     """
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if not self.file_okay and os.path.isfile(value):
+            self.fail(f"{str(value)!r} exists and is a file, but this option names a folder: "
+                      "the one the files are written into (created when missing); give a folder",
+                      param, ctx)
+        above = next((p for p in Path(value).parents if p.exists()), None)
+        if above is not None and not above.is_dir():
+            self.fail(f"cannot write {str(value)!r}: {str(above)!r} is a file, not a folder",
+                      param, ctx)
         value = super().convert(value, param, ctx)
         if ctx is not None and param is not None:
             ctx.meta.setdefault(_OUTPUTS, {})[param.name] = value

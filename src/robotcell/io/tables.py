@@ -10,12 +10,14 @@ from __future__ import annotations
 import csv
 import difflib
 import io
+import math
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, read_text
@@ -25,10 +27,14 @@ __all__ = [
     "LIMIT_TOLERANCE",
     "MAX_ABS_VALUE",
     "NOTE_COLUMNS",
+    "empty_rows",
     "format_table",
+    "optional_column",
     "outside_limits",
     "read_csv",
+    "refuse_empty",
     "require_columns",
+    "spreadsheet_number",
     "unknown_columns",
     "unknown_columns_warning",
     "write_columns",
@@ -55,16 +61,24 @@ NOTE_COLUMNS = ("note", "notes", "comment", "comments", "remark", "remarks", "de
 def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray | list[str]]:
     """Read a CSV file with a header into columns.
 
-    Numeric columns become float arrays; a column with any non-numeric entry stays a list of
-    strings. Column names are lower-cased and stripped. Files as spreadsheets save them are
-    read:
+    Numeric columns become float arrays; a column with any non-numeric entry, or with no value
+    at all, stays a list of strings; a note column (:data:`NOTE_COLUMNS`) is always text.
+    Column names are lower-cased and stripped. Files as spreadsheets save them are read:
 
     - the encoding follows :func:`robotcell.io.fileio.read_text` (UTF-8 with or without a
       byte-order mark; otherwise Windows-1252 / Latin-1);
     - the separator is ``,``, or ``;`` when the header line holds semicolons and no comma (the
       "CSV" of a spreadsheet in a European locale). In a semicolon-separated file a number may
       use a decimal comma (``1234,5``); a number with both ``.`` and ``,`` (a thousands
-      separator) is refused with a message that names the dialect.
+      separator) is refused with a message that names the dialect;
+    - blank lines, and lines of separators only, are skipped; a column without a name whose
+      cells are all empty (the trailing separator a spreadsheet writes) is left out, and so are
+      empty cells after the last column;
+    - an empty cell is kept as "not given": NaN in a numeric column, ``""`` in a text column.
+      Whether it may be empty is for the reader of the column to say (:func:`require_columns`,
+      :func:`refuse_empty`, :func:`optional_column`);
+    - numbers are read as a spreadsheet writes them (:func:`spreadsheet_number`): ``1_673.4``
+      or digits other than ``0-9``, which Python's ``float`` would take, are refused.
 
     Parameters
     ----------
@@ -77,14 +91,17 @@ def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray 
     Returns
     -------
     dict of str to ndarray or list of str
-        Column name -> values, one per data line (blank lines skipped).
+        Column name -> values, one per data line.
 
     Raises
     ------
     InputError
-        Missing or binary file, empty file, a header of one column whose names are separated by
-        a tab or ``|``, ragged rows, an empty cell, NaN or infinity, a number beyond
-        :data:`MAX_ABS_VALUE` in size, or a number written with a thousands separator.
+        Missing or binary file, empty file, a comment or title line above the header, a header
+        of one column whose names are separated by a tab or ``|``, ragged rows, a value in a
+        column without a name, a comment line among the data, NaN or infinity, a number
+        beyond :data:`MAX_ABS_VALUE` in size, a number written with a thousands separator or
+        with ``_``; each naming its line (as the file counts them, the header being line 1
+        when nothing is above it).
     """
     p = Path(path)
     if not p.is_file():
@@ -94,62 +111,169 @@ def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray 
     semicolon = ";" in first and "," not in first
     reader = csv.reader(io.StringIO(text, newline=""), delimiter=";" if semicolon else ",")
     try:
-        rows = [r for r in reader if any(c.strip() for c in r)]
+        rows = [(reader.line_num, r) for r in reader if any(c.strip() for c in r)]
     except csv.Error as exc:
         raise InputError(f"{path}: not a valid CSV file ({exc})") from None
     if len(rows) < 2:
         raise InputError(f"{path}: needs a header line and at least one data line")
-    header = [h.strip().lower() for h in rows[0]]
-    other = next((name for s, name in (("\t", "tabs"), ("|", "'|'"))
-                  if len(header) == 1 and s in header[0]), None)
-    if other is not None:
-        raise InputError(f"{path}: the header is one column {rows[0][0].strip()!r}, its names "
-                         f"separated by {other}: robotcell reads values separated by ',' (or "
-                         "';' with decimal commas); save the file as CSV")
-    if len(set(header)) != len(header):
-        raise InputError(f"{path}: repeated column name in header {header}")
-    cols: dict[str, list[str]] = {h: [] for h in header}
-    for lineno, row in enumerate(rows[1:], start=2):
-        if len(row) != len(header):
-            hint = ""
-            if not semicolon and len(row) > len(header):
-                hint = (" (decimal commas in a comma-separated file? Save it with ';' as the "
-                        "separator, or write numbers with a decimal point)")
-            raise InputError(f"{path}: line {lineno} has {len(row)} values, header has "
-                             f"{len(header)}{hint}")
-        for h, cell in zip(header, row):
-            cell = cell.strip()
-            if cell == "":
-                raise InputError(f"{path}: line {lineno}: empty value in column '{h}'")
-            cols[h].append(cell)
-    out: dict[str, np.ndarray | list[str]] = {}
-    for h, cells in cols.items():
-        values = [_number(c, semicolon) for c in cells]
-        if any(v is None for v in values):
-            if semicolon and h not in NOTE_COLUMNS:
-                _refuse_thousands(cells, h, path)
-            out[h] = cells
-            continue
-        arr = np.array(values, dtype=float)
-        if np.any(np.isinf(arr) if allow_nan else ~np.isfinite(arr)):
-            raise InputError(f"{path}: column '{h}' contains NaN or infinite values")
-        huge = np.flatnonzero(np.abs(arr) > MAX_ABS_VALUE)
-        if huge.size:
-            raise InputError(f"{path}: line {huge[0] + 2}: column '{h}' has {cells[huge[0]]}, "
-                             f"beyond {MAX_ABS_VALUE:.0e} in size: no "
-                             "measurement in mm or deg is that large; correct the typing error")
-        out[h] = arr
-    return out
+    header = _header(rows, path, semicolon)
+    cells = _cells(rows, header, path, semicolon)
+    lines = [line for line, _ in rows[1:]]
+    return {h: _column(v, h, lines, path, semicolon, allow_nan) for h, v in cells.items()}
+
+
+#: A number as a spreadsheet writes it: a sign, digits 0-9 with a decimal point, an exponent;
+#: or NaN and infinity, read so that they are refused by name.
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:e[+-]?[0-9]+)?"
+                     r"|[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
+
+
+def spreadsheet_number(text: str) -> float | None:
+    """``text`` as a number, if a spreadsheet writes it so, else None.
+
+    A sign, the digits ``0-9`` with an optional decimal point, an optional exponent
+    (``-1.5E+03``); ``nan`` and ``inf``/``infinity`` are numbers too (for the caller to refuse
+    or allow). Python's ``float`` reads more: ``1_673.4`` (digit grouping) and digits of other
+    scripts (``١٢``), which are typing errors in a table; they give None here.
+
+    Parameters
+    ----------
+    text : str
+        A cell or an option's value; surrounding white space is ignored.
+
+    Returns
+    -------
+    float or None
+    """
+    t = text.strip()
+    return float(t) if _NUMBER.fullmatch(t) else None
 
 
 def _number(cell: str, decimal_comma: bool) -> float | None:
     """``cell`` as a float (a decimal comma allowed when ``decimal_comma``), or None."""
     if decimal_comma and "," in cell and "." not in cell and cell.count(",") == 1:
         cell = cell.replace(",", ".")
+    return spreadsheet_number(cell)
+
+
+def _python_only(cell: str, decimal_comma: bool) -> bool:
+    """Whether Python's ``float`` reads ``cell`` although a spreadsheet writes no such number."""
+    if _number(cell, decimal_comma) is not None:
+        return False
     try:
-        return float(cell)
+        float(cell.replace(",", ".") if decimal_comma and cell.count(",") == 1 else cell)
     except ValueError:
-        return None
+        return False
+    return True
+
+
+def _shown(cells: list[str], sep: str) -> str:
+    """A line of the file as it was written, cut to 60 characters, for a message."""
+    line = sep.join(cells).strip()
+    return repr(line if len(line) <= 60 else line[:57] + "...")
+
+
+def _header(rows: list[tuple[int, list[str]]], path: str | Path, semicolon: bool) -> list[str]:
+    """The column names of the first line, ``""`` for a column without a name; refused when
+    the first line is a comment or a title above the header, or its names are separated by
+    tabs or ``|``, or a name repeats."""
+    (line, cells), (_, data) = rows[0], rows[1]
+    header = [h.strip().lower() for h in cells]
+    sep = ";" if semicolon else ","
+    if not any(_number(c.strip(), semicolon) is not None for c in data):  # a second header?
+        if header[0].startswith("#"):
+            raise InputError(f"{path}: line {line} {_shown(cells, sep)} is a comment above the "
+                             "header: robotcell reads the first line as the header (the column "
+                             "names) and skips no comment lines; delete the comment line(s), or "
+                             "keep remarks in a column 'note'")
+        if len(_trimmed(data)) > len(_trimmed(cells)):
+            raise InputError(f"{path}: line {line} {_shown(cells, sep)} has "
+                             f"{len(_trimmed(cells))} value(s), and the line after it "
+                             f"{len(_trimmed(data))} names and no number: a title above the "
+                             "header? robotcell reads the first line as the header (the column "
+                             "names); delete the line(s) above it")
+    other = next((name for s, name in (("\t", "tabs"), ("|", "'|'"))
+                  if len(_trimmed(header)) == 1 and s in header[0]), None)
+    if other is not None:
+        raise InputError(f"{path}: the header is one column {cells[0].strip()!r}, its names "
+                         f"separated by {other}: robotcell reads values separated by ',' (or "
+                         "';' with decimal commas); save the file as CSV")
+    named = [h for h in header if h]
+    if len(set(named)) != len(named):
+        raise InputError(f"{path}: repeated column name in header {named}")
+    return header
+
+
+def _trimmed(cells: list[str]) -> list[str]:
+    """The cells of a line without the empty ones at its end (trailing separators)."""
+    n = len(cells)
+    while n and not cells[n - 1].strip():
+        n -= 1
+    return cells[:n]
+
+
+def _cells(rows: list[tuple[int, list[str]]], header: list[str], path: str | Path,
+           semicolon: bool) -> dict[str, list[str]]:
+    """The stripped cells of every named column; refused: a line with more values than the
+    header or fewer than its named columns, a value in a column without a name, a comment
+    line."""
+    width = len(_trimmed(header))
+    notes = header[0] in NOTE_COLUMNS
+    cols: dict[str, list[str]] = {h: [] for h in header if h}
+    for line, row in rows[1:]:
+        cells = [c.strip() for c in row]
+        if cells[0].startswith("#") and not notes:
+            raise InputError(f"{path}: line {line} starts with '#': robotcell skips no comment "
+                             "lines; delete it, or keep the remark in a column 'note'")
+        given = len(_trimmed(cells))
+        if given > len(header) or len(cells) < width:
+            hint = ""
+            if not semicolon and given > width:
+                hint = (" (decimal commas in a comma-separated file? Save it with ';' as the "
+                        "separator, or write numbers with a decimal point)")
+            raise InputError(f"{path}: line {line} has {min(given, len(cells))} values, header "
+                             f"has {width}{hint}")
+        for j, c in enumerate(cells[:len(header)]):
+            if c and not header[j]:
+                raise InputError(f"{path}: line {line}: value {c!r} in column {j + 1}, which has "
+                                 "no name in the header; name the column, or delete the value")
+        for h, c in zip(header, cells):
+            if h:
+                cols[h].append(c)
+    return cols
+
+
+def _column(cells: list[str], name: str, lines: list[int], path: str | Path, semicolon: bool,
+            allow_nan: bool) -> np.ndarray | list[str]:
+    """One column: text (a note column, a column with text or without any value), or numbers
+    with NaN where a cell is empty; refused: Python-only numbers, NaN (unless ``allow_nan``),
+    infinity, a size beyond :data:`MAX_ABS_VALUE`, a thousands separator."""
+    if name in NOTE_COLUMNS:
+        return cells
+    odd = next((i for i, c in enumerate(cells) if _python_only(c, semicolon)), None)
+    if odd is not None:
+        c = cells[odd]
+        fix = (f"write {c.replace('_', '')}" if "_" in c else "write it with the digits 0-9")
+        raise InputError(f"{path}: line {lines[odd]}: column '{name}' has {c!r}, which is not a "
+                         f"number as a spreadsheet writes it; {fix}")
+    values = [_number(c, semicolon) if c else math.nan for c in cells]
+    if any(v is None for v in values) or not any(cells):
+        if semicolon:
+            _refuse_thousands(cells, name, path)
+        return cells
+    arr = np.array(values, dtype=float)
+    given = np.array([c != "" for c in cells])
+    bad = np.flatnonzero(given & (np.isinf(arr) if allow_nan else ~np.isfinite(arr)))
+    if bad.size:
+        raise InputError(f"{path}: line {lines[bad[0]]}: column '{name}' has "
+                         f"{cells[bad[0]]!r}: NaN or infinite values are not measurements; "
+                         "correct the value, or delete the line")
+    huge = np.flatnonzero(np.abs(arr) > MAX_ABS_VALUE)
+    if huge.size:
+        raise InputError(f"{path}: line {lines[huge[0]]}: column '{name}' has {cells[huge[0]]}, "
+                         f"beyond {MAX_ABS_VALUE:.0e} in size: no "
+                         "measurement in mm or deg is that large; correct the typing error")
+    return arr
 
 
 def _refuse_thousands(cells: list[str], column: str, path: str | Path) -> None:
@@ -259,15 +383,133 @@ def outside_limits(values: np.ndarray, columns: Sequence[str], lower: Sequence[f
     return "; ".join(named) + more
 
 
-def require_columns(cols: dict, names: Sequence[str], path: str | Path) -> np.ndarray:
-    """Stack numeric columns ``names`` into an ``(N, len(names))`` array, or raise naming the gap."""
+def empty_rows(values: np.ndarray | Sequence[str]) -> NDArray[np.intp]:
+    """The rows of a column of :func:`read_csv` whose cell is empty ("not given").
+
+    Parameters
+    ----------
+    values : ndarray or sequence of str, shape (N,)
+        A numeric column (an empty cell is NaN) or a text column (an empty cell is ``""``).
+
+    Returns
+    -------
+    ndarray of int
+        Row indices (row ``i`` is line ``i + 2`` of the file), increasing.
+    """
+    if isinstance(values, np.ndarray):
+        return np.flatnonzero(np.isnan(values))
+    return np.array([i for i, v in enumerate(values) if not str(v).strip()], dtype=np.intp)
+
+
+def refuse_empty(cols: Mapping[str, Any], names: Iterable[str], path: str | Path,
+                 optional: bool = False) -> None:
+    """Refuse an empty cell in the columns ``names`` that ``cols`` has, naming line and column.
+
+    A reader calls it for the columns it needs a value of on every line: a required column, or
+    an optional one with no default per line (a track position, a table angle).
+
+    Parameters
+    ----------
+    cols : mapping
+        Columns from :func:`read_csv`.
+    names : iterable of str
+        The columns to check; those ``cols`` lacks are skipped.
+    path : str or Path
+        The file, for the message.
+    optional : bool
+        The column may be left out as a whole (the message says so).
+
+    Raises
+    ------
+    InputError
+        E.g. ``"t.csv: line 4: empty value in column 'z' (and 2 more lines), which needs a
+        value on every line; fill it in, or delete the line"``.
+    """
+    for name in names:
+        if name not in cols:
+            continue
+        rows = empty_rows(cols[name])
+        if rows.size:
+            more = f" (and {rows.size - 1} more line(s))" if rows.size > 1 else ""
+            fix = ("fill it in on every line, or leave the column out" if optional
+                   else "fill it in, or delete the line")
+            raise InputError(f"{path}: line {rows[0] + 2}: empty value in column '{name}'{more}, "
+                             f"which needs a value on every line; {fix}")
+
+
+def require_columns(cols: Mapping[str, Any], names: Sequence[str], path: str | Path,
+                    empty_as_nan: bool = False) -> np.ndarray:
+    """Stack numeric columns ``names`` into an ``(N, len(names))`` array, or raise naming the gap.
+
+    Parameters
+    ----------
+    cols : mapping
+        Columns from :func:`read_csv`.
+    names : sequence of str
+        Columns the reader needs, each with a number on every line.
+    path : str or Path
+        The file, for the message.
+    empty_as_nan : bool
+        Take an empty cell as NaN (a file whose writer writes ``nan`` for a value it did not
+        have) instead of refusing it.
+
+    Returns
+    -------
+    ndarray, shape (N, len(names))
+
+    Raises
+    ------
+    InputError
+        A missing column, an empty cell (naming line and column), or a value that is not a
+        number (naming line, column and value).
+    """
     missing = [n for n in names if n not in cols]
     if missing:
         raise InputError(f"{path}: missing column(s) {', '.join(missing)} (have: {', '.join(cols)})")
+    if not empty_as_nan:
+        refuse_empty(cols, names, path)
+    out = []
     for n in names:
-        if not isinstance(cols[n], np.ndarray):
-            raise InputError(f"{path}: column '{n}' must be numeric")
-    return np.stack([cols[n] for n in names], axis=1)
+        v = cols[n]
+        if not isinstance(v, np.ndarray):
+            bad = next((i for i, c in enumerate(v) if str(c).strip()), None)
+            if bad is not None:
+                raise InputError(f"{path}: line {bad + 2}: column '{n}' must be numeric, found "
+                                 f"{v[bad]!r}")
+            v = np.full(len(v), np.nan)
+        out.append(v)
+    return np.stack(out, axis=1)
+
+
+def optional_column(cols: Mapping[str, Any], name: str, default: float, path: str | Path
+                    ) -> NDArray[np.float64] | None:
+    """A numeric column with a default per line: ``default`` where a cell is empty.
+
+    Parameters
+    ----------
+    cols : mapping
+        Columns from :func:`read_csv`.
+    name : str
+        The column.
+    default : float
+        The value of a line that leaves the cell empty, in the column's unit.
+    path : str or Path
+        The file, for the message.
+
+    Returns
+    -------
+    ndarray, shape (N,), or None
+        The values; None when the file has no such column.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, naming line and column.
+    """
+    if name not in cols:
+        return None
+    v = require_columns(cols, [name], path, empty_as_nan=True)[:, 0]
+    return np.where(np.isnan(v), default, v)
 
 
 def write_csv(path: str | Path | TextIO, header: Sequence[str], rows: np.ndarray,

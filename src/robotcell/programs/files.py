@@ -33,6 +33,9 @@ def check_folder(folder: str | Path) -> Path:
     p = Path(folder)
     if p.exists() and not p.is_dir():
         raise InputError(f"cannot write into {str(folder)!r}: it is a file; give a folder")
+    if not p.exists() and p.parent.is_file():
+        raise InputError(f"cannot write into {str(folder)!r}: {str(p.parent)!r} is a file, not "
+                         "a folder")
     if not p.exists() and not p.parent.is_dir():
         raise InputError(f"cannot write into {str(folder)!r}: the folder {str(p.parent)!r} does "
                          "not exist; create it first")

@@ -16,6 +16,10 @@ Without ``table`` (or ``e1..en``) the writer chooses the table's values along a 
 the table carries (:func:`robotcell.cell.tablechoice.choose_table`); a path in another frame
 keeps the table at 0.
 
+A line may leave ``motion``, ``speed`` or ``zone`` empty: it takes the default above. The pose
+columns, and ``track`` and the table's columns when the file has them, need a value on every
+line (a track or table value has no default for one line alone).
+
 :func:`read_path` reads it into SI units and checks every value against the cell.
 """
 
@@ -31,7 +35,13 @@ from robotcell.cell import Cell, Positioner
 from robotcell.controllers.model import MOTIONS
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.io.tables import read_csv, require_columns, unknown_columns
+from robotcell.io.tables import (
+    optional_column,
+    read_csv,
+    refuse_empty,
+    require_columns,
+    unknown_columns,
+)
 
 __all__ = ["DEFAULT_SPEED", "PathTargets", "read_path", "table_columns"]
 
@@ -126,9 +136,10 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
     Raises
     ------
     InputError
-        A missing pose column, a non-numeric value, an unknown motion, a speed that is not
-        positive, a negative zone, a track or table column for a cell without one, or a value
-        outside the track's or table's limits; the message names the file, line and column.
+        A missing pose column, an empty pose, track or table value, a non-numeric value, an
+        unknown motion, a speed that is not positive, a negative zone, a track or table column
+        for a cell without one, or a value outside the track's or table's limits; the message
+        names the file, line and column.
     """
     p = str(path)
     cols = read_csv(path)
@@ -138,37 +149,43 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
                 for unknown in [unknown_columns(cols, known)] if unknown]
     T = pose_from_vendor(require_columns(cols, _POSE, p), "kuka")
     n = T.shape[0]
-    if "motion" in cols:
-        motion = []
-        for i, word in enumerate(cols["motion"]):
-            key = str(word).strip().lower()
-            if key not in _MOTION_WORDS:
-                raise InputError(f"{p}: line {i + 2}: column 'motion' has {word!r}; use one of "
-                                 f"{', '.join(MOTIONS)}")
-            motion.append(_MOTION_WORDS[key])
-    else:
-        motion = ["ptp"] + ["lin"] * (n - 1)
-    speed = np.full(n, DEFAULT_SPEED)
-    if "speed" in cols:
-        speed = _numeric(cols, "speed", p) * 1e-3
-        bad = np.flatnonzero(~(speed > 0))
-        if bad.size:
-            raise InputError(f"{p}: line {bad[0] + 2}: column 'speed' must be positive (mm/s)")
-    zone = np.zeros(n)
-    if "zone" in cols:
-        zone = _numeric(cols, "zone", p) * 1e-3
-        bad = np.flatnonzero(zone < 0)
-        if bad.size:
-            raise InputError(f"{p}: line {bad[0] + 2}: column 'zone' must not be negative (mm)")
+    motion = _motion(cols, n, p)
+    speed = optional_column(cols, "speed", DEFAULT_SPEED * 1e3, p)
+    speed = np.full(n, DEFAULT_SPEED) if speed is None else speed * 1e-3
+    bad = np.flatnonzero(~(speed > 0))
+    if bad.size:
+        raise InputError(f"{p}: line {bad[0] + 2}: column 'speed' must be positive (mm/s)")
+    zone = optional_column(cols, "zone", 0.0, p)
+    zone = np.zeros(n) if zone is None else zone * 1e-3
+    bad = np.flatnonzero(zone < 0)
+    if bad.size:
+        raise InputError(f"{p}: line {bad[0] + 2}: column 'zone' must not be negative (mm)")
     track = None
     if "track" in cols:
         if cell.track is None:
             raise InputError(f"{p}: column 'track', but the cell has no track; leave it out")
+        refuse_empty(cols, ["track"], p, optional=True)
         track = _numeric(cols, "track", p) * 1e-3
         _limits(track, cell.track.lower, cell.track.upper, "track", 1e3, p, "track")
     table = _table(cols, cell, n, p)
     given = cell.turntable is None or any(c in cols for c in tcols)
     return PathTargets(T, motion, speed, zone, track, table, given, p, warnings)
+
+
+def _motion(cols: dict, n: int, path: str) -> list[str]:
+    """Column ``motion`` as ``ptp``/``lin`` per target; a line that leaves it empty, or a file
+    without it, moves ``ptp`` to the first target and ``lin`` after it."""
+    default = ["ptp"] + ["lin"] * (n - 1)
+    if "motion" not in cols:
+        return default
+    motion = []
+    for i, word in enumerate(cols["motion"]):
+        key = "" if isinstance(word, float) and np.isnan(word) else str(word).strip().lower()
+        if key and key not in _MOTION_WORDS:
+            raise InputError(f"{path}: line {i + 2}: column 'motion' has {word!r}; use one of "
+                             f"{', '.join(MOTIONS)}")
+        motion.append(_MOTION_WORDS[key] if key else default[i])
+    return motion
 
 
 def _table(cols: dict, cell: Cell, n: int, path: str) -> NDArray[np.float64]:
@@ -188,6 +205,7 @@ def _table(cols: dict, cell: Cell, n: int, path: str) -> NDArray[np.float64]:
         missing = ", ".join(c for c in names if c not in cols)
         raise InputError(f"{path}: positioner {tt.name!r} has {len(names)} axes: missing "
                          f"column(s) {missing} (deg)")
+    refuse_empty(cols, names, path, optional=True)
     values = np.column_stack([np.radians(_numeric(cols, c, path)) for c in names])
     lo, hi = np.atleast_1d(tt.lower), np.atleast_1d(tt.upper)
     for j, c in enumerate(names):

@@ -43,7 +43,7 @@ from robotcell.ik.limits import TWO_PI
 from robotcell.ik.trackchoice import arm_manipulability
 from robotcell.io.fileio import atomic_write
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
-from robotcell.io.tables import read_csv, require_columns, write_columns
+from robotcell.io.tables import read_csv, refuse_empty, require_columns, write_columns
 from robotcell.robot.robot import Robot
 
 if TYPE_CHECKING:
@@ -384,5 +384,6 @@ def read_targets(path: str | Path, fmt: str = "kuka"
     T = pose_from_vendor(require_columns(cols, names, path), fmt)
     table = None
     if "table" in cols:
+        refuse_empty(cols, ["table"], path, optional=True)
         table = np.radians(require_columns(cols, ["table"], path)[:, 0])
     return T, table

@@ -118,7 +118,7 @@ def read_reach(path: str | Path, cell: Cell) -> ReachTable:
               else ["table"])
     arms = [f"a{i + 1}" for i in range(cell.robot.n_joints)]
     reachable = _flags(cols, path)
-    data = require_columns(cols, ["score", "track", *tables, *arms], path)
+    data = require_columns(cols, ["score", "track", *tables, *arms], path, empty_as_nan=True)
     score = data[:, 0]
     line = 2 + np.arange(len(data))  # file line of each row, after the header
     bad = ~((score >= 0) & (score <= 1))  # NaN too
