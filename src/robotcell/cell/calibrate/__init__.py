@@ -16,19 +16,14 @@ See ``docs/python-api.md``.
 """
 
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
-from robotcell.cell.calibrate.procedures import (
-    SAME_POSE,
-    CellCalibration,
-    TurntablePose,
-    external_tcp,
-    frame,
-    positioner,
-    positioner_touches,
-    tcp,
-    track,
-    turntable,
-    workpiece,
-)
+from robotcell.cell.calibrate.common import CellCalibration
+from robotcell.cell.calibrate.procedures.external_tcp import external_tcp
+from robotcell.cell.calibrate.procedures.frame import frame
+from robotcell.cell.calibrate.procedures.positioner import positioner, positioner_touches
+from robotcell.cell.calibrate.procedures.tcp import tcp
+from robotcell.cell.calibrate.procedures.track import track
+from robotcell.cell.calibrate.procedures.turntable import TurntablePose, turntable
+from robotcell.cell.calibrate.procedures.workpiece import SAME_POSE, workpiece
 from robotcell.cell.calibrate.touches import (
     load_table,
     read_touches,
