@@ -15,22 +15,15 @@ from typing import Any
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cell.calibrate.procedures import frame, positioner, tcp, track, turntable, workpiece
+from robotcell.cell.calibrate.registry import having
 from robotcell.cell.calibrate.simulation import MAX_TOUCHES, Touches
 from robotcell.errors import InputError
 
 __all__ = ["MAX_TOUCHES", "PROCEDURES", "Touches", "check_counts", "simulate"]
 
-#: Procedures that can be simulated, with what they calibrate.
-PROCEDURES = {
-    "tcp": "a tool's TCP (XYZ 4-point) and orientation (ABC 2-point)",
-    "frame": "a base / user frame fixed in the cell (3-point)",
-    "track": "the robot's linear track (touches of known reference points)",
-    "turntable": "the turntable's root frame (one point on the table at several angles)",
-    "workpiece": "a workpiece frame on the turntable (3-point at any table angles)",
-    "positioner": "a 2-axis positioner's axis chain (one point on the table at several "
-                  "(tilt, rotate) values)",
-}
+#: Procedures that can be simulated (those of the registry with a ``simulate``), with what they
+#: calibrate.
+PROCEDURES = having(lambda p: p.summary if p.simulate is not None else None)
 
 
 def _rng(seed: int | np.random.Generator | None) -> np.random.Generator:
@@ -61,9 +54,7 @@ def _check_noise(noise: float) -> float:
     return float(noise)
 
 
-_SIMULATORS = {"tcp": tcp.simulate, "frame": frame.simulate, "track": track.simulate,
-               "turntable": turntable.simulate, "workpiece": workpiece.simulate,
-               "positioner": positioner.simulate}
+_SIMULATORS = having(lambda p: p.simulate)
 
 
 def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
@@ -75,7 +66,10 @@ def simulate(cell: Cell, procedure: str, *, noise: float = 1e-4,
     ----------
     cell : Cell
         The virtual cell: its values are the truth the touches are made in.
-    procedure : {"tcp", "frame", "track", "turntable", "workpiece", "positioner"}
+    procedure : str
+        A procedure of :data:`PROCEDURES`: ``"tcp"``, ``"frame"``, ``"track"``,
+        ``"turntable"``, ``"workpiece"``, ``"positioner"``, or one registered
+        (:func:`robotcell.cell.calibrate.register`).
     noise : float
         Touch-up error, 1-sigma per coordinate (m); 0 for exact touches.
     seed : int or numpy.random.Generator, optional

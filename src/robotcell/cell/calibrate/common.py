@@ -31,7 +31,6 @@ from robotcell.cell.calibrate.chain import (
 from robotcell.cell.calibrate.touches import MeasurementInput
 from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.robot.robot import Robot
 
 
 @dataclass(frozen=True)
@@ -118,8 +117,8 @@ def sha256_of(path: str | Path) -> str:
 
 
 def provenance_of(procedure: str, result: CalibrationResult, n: int, source: str,
-                time: str | None, cell: Cell, item: str, value: str, record: Record,
-                inputs: tuple[str, ...] | None = None) -> Provenance:
+                  time: str | None, cell: Cell, item: str, value: str, record: Record,
+                  inputs: tuple[str, ...] | None = None) -> Provenance:
     """Provenance of a calibration read from ``source`` with ``n`` touches, for ``item``.
 
     It names the calibration as an error source (by the item and the file's checksum), records
@@ -164,7 +163,7 @@ def _tool_option(tool: str | ArrayLike | None) -> dict[str, Any]:
 
 
 def recorded_options(sigma: float | None, tool: str | ArrayLike | None = None, **more: Any
-             ) -> dict[str, Any]:
+                     ) -> dict[str, Any]:
     """Options of a calibration in the units of the command line (mm, deg)."""
     out = _tool_option(tool)
     if sigma is not None:
@@ -174,8 +173,8 @@ def recorded_options(sigma: float | None, tool: str | ArrayLike | None = None, *
 
 
 def chained_inputs(cell: Cell | None, m: Measurements, p_R: NDArray[np.float64],
-             tool: str | ArrayLike | None, track: NDArray[np.float64] | None,
-             nominal: NominalAccuracy, notes: Notes) -> Chained:
+                   tool: str | ArrayLike | None, track: NDArray[np.float64] | None,
+                   nominal: NominalAccuracy, notes: Notes) -> Chained:
     """The tool and track the touches rest on (nothing without a cell); notes go to ``notes``."""
     if cell is None:
         return Chained()
@@ -191,11 +190,8 @@ def copied(cell: Cell) -> Cell:
     return replace(cell, tools=dict(cell.tools), frames=dict(cell.frames))
 
 
-def label_of(cell: Cell | None, cell_label: str | None) -> str:
-    return cell_label or (f"cell {cell.name!r}" if cell is not None else "the cell")
-
-
 def refuse_track_column(m: Measurements, why: str) -> None:
+    """Refuse column ``track`` of touches that cannot use it, saying ``why``."""
     if m.track is not None:
         raise InputError(f"{m.source}: column 'track' (track position of each touch) {why}")
 
@@ -204,12 +200,6 @@ def no_cell_track() -> str:
     """Why column ``track`` is refused without a cell."""
     return (f"needs {term('cell=FILE (Cell)', 'a cell (parameter cell)')}, which says where the "
             f"track is; remove the column or pass {term('cell', 'the cell')}")
-
-
-def arm_of(cell: Cell | None, robot: Robot | None) -> Robot | None:
-    if cell is not None and robot is not None:
-        raise InputError("the robot is the cell's: give a cell or a robot, not both")
-    return cell.robot if cell is not None else robot
 
 
 #: The frames of a result's value ``T_a_b`` by ``a``, as :func:`assumption` names them.
@@ -235,7 +225,7 @@ def _tool_text(m: Measurements, tool: str | ArrayLike | None) -> str:
 
 
 def assumption(cell: Cell | None, m: Measurements, tool: str | ArrayLike | None, value: str,
-             mapped: bool = False) -> str:
+               mapped: bool = False) -> str:
     """What a calibration took the touches with: tool, frame of the result, track, table.
 
     ``value`` is the result's pose ``T_a_b``; ``mapped`` says that the touches were mapped to

@@ -14,13 +14,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.measurements import Measurements
 from robotcell.cell import Cell, Turntable
-from robotcell.cell.calibrate.chain import Chained, NominalAccuracy
+from robotcell.cell.calibrate.chain import Chained
 from robotcell.cell.calibrate.common import (
     Notes,
     chained_inputs,
     no_cell_track,
     refuse_track_column,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
 from robotcell.cell.calibrate.touches import robot_in_world, tool_transform, track_positions
 from robotcell.cell.validation import check_axis_limits
 from robotcell.errors import InputError
@@ -53,12 +54,13 @@ def _table_touches(cell: Cell | None, m: Measurements, f: NDArray[np.float64],
     return f
 
 
-def on_table(cell: Cell | None, m: Measurements, tool: str | ArrayLike | None, label: str,
-              nominal: NominalAccuracy, notes: Notes, check: Callable[[], None]
-              ) -> tuple[NDArray[np.float64], NDArray[np.float64], Chained]:
+def on_table(cell: Cell | None, m: Measurements, context: CalibrationContext, notes: Notes,
+             check: Callable[[], None]
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], Chained]:
     """Touches of a point on a turntable: its angles (rad), the touches in its parent frame
     (m) and the inputs they rest on; ``check`` refuses what the procedure cannot use once the
     angles are within the table's limits."""
+    tool, label, nominal = context.tool, context.label(cell), context.nominal
     f_R = m.tcp(tool_transform(cell, tool, m))
     theta = m.axes[:, 0]
     if cell is not None:
@@ -84,9 +86,10 @@ def _in_world(cell: Cell | None) -> bool:
 
 
 def positioner_points(cell: Cell, m: Measurements, tool: str | ArrayLike | None, label: str
-                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The axis values (rad) of touches of a point on a positioner and the point in its parent
-    frame (m), checked against the axes' limits (:func:`positioner_touches`)."""
+    frame (m), checked against the axes' limits (as
+    :func:`robotcell.cell.calibrate.positioner_touches` gives them)."""
     f = m.tcp(tool_transform(cell, tool, m))
     names = [f"e{i + 1}" for i in range(m.axes.shape[1])]
     check_axis_limits(cell.turntable, m.axes, names, m.source, label)

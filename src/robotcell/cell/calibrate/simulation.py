@@ -38,12 +38,11 @@ from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, arm_sides
 from robotcell.io.fileio import atomic_write
-from robotcell.kinematics.transforms import invert
+from robotcell.kinematics.transforms import invert, transform_points
 from robotcell.robot.robot import Robot
 
 #: Candidate track positions when the track position of a procedure is chosen.
 TRACK_SAMPLES = 25
-
 
 #: Most touches one simulation places (memory of the configuration search grows with them).
 MAX_TOUCHES = 200
@@ -72,7 +71,7 @@ class Touches:
     Attributes
     ----------
     procedure : str
-        One of :data:`PROCEDURES`.
+        A procedure that simulates (:mod:`robotcell.cell.calibrate.registry`).
     q : ndarray, shape (N, n)
         Recorded arm joint values (rad).
     track : ndarray, shape (N,), or None
@@ -91,6 +90,12 @@ class Touches:
         Tool of the cell that touched (None for ``tcp``, which records flange poses).
     noise : float
         Touch-up error used (m, 1-sigma per coordinate).
+    track_column : bool
+        Whether the table has column ``track`` (not for touches taken in the robot base, as a
+        tool's flange poses are, nor for the track's own procedure).
+    moves_track : bool
+        Whether the track positions are the procedure's axis values (column ``e1``), as in the
+        track procedure, which moves the track itself.
     """
 
     procedure: str
@@ -102,15 +107,18 @@ class Touches:
     options: list[str] = field(default_factory=list)
     tool: str | None = None
     noise: float = 0.0
+    track_column: bool = True
+    moves_track: bool = False
 
     def measurements(self, robot: Robot | None = None) -> Measurements:
         """The touches as the procedure's measurements (SI), which write the measurement CSV.
 
         Each column of the procedure's specification (:data:`~robotcell.calibration.spec.SPECS`)
         that the simulation has values for is written: the joint values, the external axis
-        (``e1``: the track position of the track procedure, else the table's axis values), the
-        robot's track position (``track``; not for ``tcp``, whose flange poses are taken in the
-        robot base, nor for ``track``, whose positions are ``e1``) and column ``point``.
+        (``e1``: the track position when the procedure :attr:`moves_track`, else the table's
+        axis values), the robot's track position (``track``, unless not :attr:`track_column`:
+        a tool's flange poses are taken in the robot base, the track's positions are ``e1``)
+        and column ``point``.
 
         Parameters
         ----------
@@ -123,7 +131,7 @@ class Touches:
         Measurements
         """
         spec = SPECS[self.procedure]
-        axes = self.track if self.procedure == "track" else self.table
+        axes = self.track if self.moves_track else self.table
         reference = point = None
         if self.roles is not None and spec.role("reference"):
             reference = np.array([float(r) for r in self.roles])
@@ -132,7 +140,7 @@ class Touches:
         return Measurements(
             spec, "simulated touches", joints=self.q, robot=robot,
             axes=None if axes is None else np.reshape(axes, (len(self.q), -1)),
-            track=None if self.procedure in ("tcp", "track") else self.track,
+            track=self.track if self.track_column else None,
             point=point, reference=reference)
 
     def columns(self) -> tuple[list[str], list[list[str]]]:
@@ -359,3 +367,18 @@ def table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.flo
         raise InputError(f"table angle(s) {', '.join(f'{math.degrees(v):g}' for v in th[out])} deg "
                          "are outside the turntable limits")
     return th
+
+
+def touched_in_parent(cell: Cell, touches: Touches, m: Measurements) -> NDArray[np.float64]:
+    """The TCP positions of simulated touches (m) in the parent frame of what they calibrate.
+
+    The frame's parent (``touches.truth["parent"]``; a workpiece's is the turntable's): the
+    robot base for an item carried by the robot, else the world, through the track position of
+    each touch. ``m`` are the touches as measurements (:meth:`Touches.measurements`).
+    """
+    p_R = m.tcp(tool_pose(cell, touches.tool))
+    parent = touches.truth["parent"]
+    if parent == "turntable":
+        parent = cell.turntable.parent if cell.turntable is not None else "world"
+    e = np.zeros(m.n) if m.track is None else m.track
+    return p_R if parent == "robot" else transform_points(robot_pose(cell, e), p_R)

@@ -47,12 +47,8 @@ from robotcell.cell.calibrate.chain import (
     perturbed,
 )
 from robotcell.cell.calibrate.common import CellCalibration, copied, sha256_of
-from robotcell.cell.calibrate.procedures.frame import frame
-from robotcell.cell.calibrate.procedures.positioner import positioner
-from robotcell.cell.calibrate.procedures.tcp import tcp
-from robotcell.cell.calibrate.procedures.track import track
-from robotcell.cell.calibrate.procedures.turntable import turntable
-from robotcell.cell.calibrate.procedures.workpiece import workpiece
+from robotcell.cell.calibrate.context import CalibrationContext
+from robotcell.cell.calibrate.registry import having, procedure
 from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import format_table
@@ -64,7 +60,8 @@ __all__ = ["CellRecalibration", "ItemChange", "calibrate_cell"]
 MAX_ITERATIONS = 20
 CONVERGED = 1e-4
 
-_PROCEDURES = ("tcp", "frame", "track", "turntable", "workpiece", "positioner")
+#: The procedures that ``calibrate cell`` repeats, by name (those a cell records).
+_PROCEDURES = having(lambda p: p.repeat)
 _LEVELS = ("good", "check", "poor")
 
 
@@ -227,24 +224,12 @@ def _run(cell: Cell, key: str, prov: Provenance, nominal: NominalAccuracy, time:
     """Repeat one recorded calibration on ``cell``."""
     o = prov.options
     name = key.partition(".")[2] or None
-    kw: dict[str, Any] = {"sigma": o["sigma_mm"] * 1e-3 if "sigma_mm" in o else None,
-                          "file": prov.measurements, "nominal": nominal, "time": time}
-    path = prov.measurements
-    if prov.source == "tcp":
-        return tcp(cell, path, name, world_mode=o.get("world", "6d"), **kw)
-    kw["tool"] = _tool(o.get("tool"))
-    if prov.source == "frame":
-        return frame(cell, path, name, parent=o.get("parent"), **kw)
-    if prov.source == "track":
-        refs = o.get("references_mm")
-        return track(cell, path, references=None if refs is None
-                                else np.asarray(refs, dtype=float) * 1e-3,
-                                axis=o.get("axis"), roll=o.get("roll"), **kw)
-    if prov.source == "turntable":
-        return turntable(cell, path, height=o.get("height_mm", 0.0) * 1e-3, **kw)
-    if prov.source == "workpiece":
-        return workpiece(cell, path, name, **kw)
-    return positioner(cell, path, **kw)
+    context = CalibrationContext(tool=_tool(o.get("tool")),
+                                 sigma=o["sigma_mm"] * 1e-3 if "sigma_mm" in o else None,
+                                 time=time, file=prov.measurements, nominal=nominal)
+    repeat = procedure(prov.source).repeat
+    assert repeat is not None  # _recorded keeps the calibrations that are repeated
+    return repeat(cell, prov.measurements, name, o, context)
 
 
 def _size(key: str) -> int:

@@ -2,30 +2,30 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from pathlib import Path
-from typing import Literal
+from collections.abc import Mapping
+from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
+from robotcell.calibration.result import CalibrationResult
+from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell
-from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
 from robotcell.cell.calibrate.common import (
     CellCalibration,
     Notes,
     Record,
-    arm_of,
     assumption,
     chained_inputs,
     copied,
-    label_of,
     measurement_file,
     no_cell_track,
     provenance_of,
     recorded_options,
     refuse_track_column,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
+from robotcell.cell.calibrate.registry import Planner, Procedure
 from robotcell.cell.calibrate.simulation import (
     DOWN,
     Touches,
@@ -34,6 +34,7 @@ from robotcell.cell.calibrate.simulation import (
     reach,
     three_point,
     tool_name,
+    touched_in_parent,
 )
 from robotcell.cell.calibrate.touches import (
     MeasurementInput,
@@ -45,7 +46,6 @@ from robotcell.cell.calibrate.touches import (
 from robotcell.cell.kinematics import frame_pose, tool_pose
 from robotcell.errors import InputError, term
 from robotcell.kinematics.transforms import make_pose, transform_points
-from robotcell.robot.robot import Robot
 
 
 def _frame_parent(cell: Cell, name: str | None, parent: str | None, label: str) -> str:
@@ -69,12 +69,8 @@ def _frame_parent(cell: Cell, name: str | None, parent: str | None, label: str) 
 
 
 def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = None, *,
-          parent: Literal["world", "robot"] | None = None, robot: Robot | None = None,
-          tool: str | ArrayLike | None = None, sigma: float | None = None,
-          source: str | None = None, cell_label: str | None = None,
-          time: str | None = None, on_note: Callable[[str], None] | None = None,
-          file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
-          ) -> CellCalibration:
+          parent: Literal["world", "robot"] | None = None,
+          context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
     """A base / user frame (3-point, or N-point to known coordinates) into a cell.
 
     Parameters
@@ -90,14 +86,12 @@ def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = 
     parent : {"world", "robot"}, optional
         What carries the frame; default the existing frame's parent, else world. A frame in
         the world is computed from touches mapped to the world.
-    robot : Robot, optional
-        Robot model for joint values when no cell is given.
-    tool : str or array_like of shape (4, 4), optional
-        Tool that touched: a tool of the cell by name, or ``T_F_TCP`` (m); default the robot
-        model's tool. Its uncertainty (recorded in the cell, else the nominal accuracy) and the
-        track's, for touches mapped to the world, are part of the result's.
-    sigma, source, cell_label, time, on_note, file, nominal
-        As for :func:`tcp`.
+    context : CalibrationContext, optional
+        Who touched and how well, names in messages, where notes go, the touch file to record
+        and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
+    **keywords
+        Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
+        ``context``, e.g. ``sigma=1e-4, tool="torch"``.
 
     Returns
     -------
@@ -106,11 +100,13 @@ def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = 
     """
     from robotcell.calibration.frame import frame_3point, frame_npoint
 
+    ctx = CalibrationContext.of(context, **keywords)
+    tool, sigma = ctx.tool, ctx.sigma
     if cell is None and parent is not None:
         raise InputError("the parent of a frame is a cell's notion; give the cell too")
-    label = label_of(cell, cell_label)
-    notes = Notes(on_note)
-    m = read_touches("frame", measurements, source, arm_of(cell, robot), notes.one)
+    label = ctx.label(cell)
+    notes = Notes(ctx.on_note)
+    m = read_touches("frame", measurements, ctx.source, ctx.arm(cell), notes.one)
     p = m.tcp(tool_transform(cell, tool, m))
     in_world = False
     p_R, e = p, None
@@ -124,7 +120,7 @@ def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = 
             in_world = True
         else:
             track_positions(cell, m, label)
-    chained = chained_inputs(cell, m, p_R, tool, e, nominal, notes)
+    chained = chained_inputs(cell, m, p_R, tool, e, ctx.nominal, notes)
     if m.nominal is not None:
         m.check_count()
         result = frame_npoint(p, m.nominal, sigma, m.labels(), inputs=chained.inputs)
@@ -134,15 +130,15 @@ def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = 
     item = f"frames.{name}" if cell is not None and name is not None else ""
     key = f"T_world_{name}" if in_world else "T_R_W"
     assumed = assumption(cell, m, tool, f"T_world_{name or 'W'}" if in_world else key,
-                       mapped=in_world)
+                         mapped=in_world)
     if cell is None or name is None:
         return CellCalibration(result, notes=tuple(notes), key=item, value="T_R_W",
                                inputs=chained.keys, assumed=assumed)
     if in_world:
         result = result.renamed("T_R_W", key)
-    record = Record(measurement_file(measurements, file), recorded_options(sigma, tool, parent=parent), chained,
-                     nominal)
-    prov = provenance_of("frame", result, m.n, m.source, time, cell, item, key, record)
+    record = Record(measurement_file(measurements, ctx.file),
+                    recorded_options(sigma, tool, parent=parent), chained, ctx.nominal)
+    prov = provenance_of("frame", result, m.n, m.source, ctx.time, cell, item, key, record)
     new = copied(cell)
     new.update_frame(name, result.values[key], prov, parent=parent)
     return CellCalibration(result, new, f"frame {name!r} (parent {parent})", prov, tuple(notes),
@@ -151,8 +147,11 @@ def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = 
 
 # -- simulation ------------------------------------------------------------------------------------
 def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
-           track: float | None, frame: str | None = None, size: float = 0.2,
-           repeats: int = 2) -> Touches:
+             track: float | None, frame: str | None = None, size: float = 0.2,
+             repeats: int = 2) -> Touches:
+    """The touches of the frame procedure (:attr:`Procedure.simulate
+    <robotcell.cell.calibrate.registry.Procedure>`): the origin of a fixed ``frame``, a point
+    ``size`` along its +X and one ``size`` along its +Y, each ``repeats`` times."""
     name = frame_name(cell, frame, ("world", "robot"), "fixed")
     tname = tool_name(cell, tool)
     p_X, roles = three_point(size, repeats)
@@ -170,3 +169,27 @@ def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | Non
     return Touches("frame", q, e if cell.track is not None else None, None, roles,
                    truth={"pose": fr.pose.copy(), "parent": fr.parent, "name": name},
                    tool=tname, noise=noise)
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
+            context: CalibrationContext) -> CellCalibration:
+    """The recorded calibration again (:attr:`Procedure.repeat
+    <robotcell.cell.calibrate.registry.Procedure>`)."""
+    return frame(cell, file, name, parent=options.get("parent"), context=context)
+
+
+def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+    """The estimator on simulated touches (:attr:`Planner.calibrate
+    <robotcell.cell.calibrate.registry.Planner>`): 3-point, in the frame's parent."""
+    from robotcell.calibration.frame import frame_3point
+
+    m = touches.measurements(cell.robot)
+    return frame_3point(touched_in_parent(cell, touches, m), m.point, prior_sigma)
+
+
+PROCEDURE = Procedure(
+    "frame", "a base / user frame fixed in the cell (3-point)", SPECS["frame"], frame,
+    item="frames.NAME", repeat=_repeat, simulate=simulate,
+    planner=Planner(tuple({"size": s} for s in (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)),
+                    pose="T_R_W", truth="pose", calibrate=_estimate))

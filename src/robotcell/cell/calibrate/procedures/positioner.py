@@ -3,38 +3,36 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from pathlib import Path
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell
-from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
 from robotcell.cell.calibrate.common import (
     CellCalibration,
     Notes,
     Record,
-    arm_of,
     assumption,
     chained_inputs,
     copied,
-    label_of,
     measurement_file,
     no_cell_track,
     provenance_of,
     recorded_options,
     refuse_track_column,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
 from robotcell.cell.calibrate.ontable import positioner_points, world_track
+from robotcell.cell.calibrate.registry import Procedure
 from robotcell.cell.calibrate.simulation import DOWN, Touches, candidate_tracks, reach, tool_name
 from robotcell.cell.calibrate.touches import MeasurementInput, read_touches, tool_transform
 from robotcell.cell.kinematics import frame_pose, tool_pose
 from robotcell.errors import IllPosedError, InputError, term
 from robotcell.kinematics.bounds import within
 from robotcell.kinematics.transforms import make_pose, transform_points
-from robotcell.robot.robot import Robot
 
 
 def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
@@ -57,7 +55,7 @@ def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
         column per positioner axis) and, for a positioner in the world of a cell with a track,
         ``track`` (mm).
     tool, source, cell_label
-        As for :func:`frame`.
+        As the fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext`.
 
     Returns
     -------
@@ -66,13 +64,13 @@ def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
     points : ndarray, shape (N, 3)
         The touched point in the positioner's parent frame (world or robot base; m).
     """
-    label = label_of(cell, cell_label)
+    label = CalibrationContext(cell_label=cell_label).label(cell)
     if cell.turntable is None:
         raise InputError(f"{label} has no positioner; add a 'positioner' section to the cell "
                          "file first")
     spec = SPECS["positioner"].with_axes(cell.turntable.n_axes)
     return positioner_points(cell, read_touches(spec, measurements, source, cell.robot), tool,
-                              label)
+                             label)
 
 
 def _check_alone(values: NDArray[np.float64], source: str) -> None:
@@ -95,11 +93,7 @@ def _check_alone(values: NDArray[np.float64], source: str) -> None:
 
 
 def positioner(cell: Cell | None, measurements: MeasurementInput, *,
-               robot: Robot | None = None, tool: str | ArrayLike | None = None,
-               sigma: float | None = None, source: str | None = None,
-               cell_label: str | None = None, time: str | None = None,
-               on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
-               nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
+               context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
     """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
 
     The touches (:func:`positioner_touches`) go to
@@ -119,10 +113,12 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     measurements : Measurements, mapping, str or Path
         As for :func:`positioner_touches`: one point on the table touched at several (tilt,
         rotate) values ``e1``, ``e2`` (deg).
-    robot : Robot, optional
-        Robot model for joint values when no cell is given.
-    tool, sigma, source, cell_label, time, on_note, file, nominal
-        As for :func:`frame`.
+    context : CalibrationContext, optional
+        Who touched and how well, names in messages, where notes go, the touch file to record
+        and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
+    **keywords
+        Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
+        ``context``, e.g. ``sigma=1e-4, tool="torch"``.
 
     Returns
     -------
@@ -133,10 +129,12 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     """
     from robotcell.identification import calibrate_positioner
 
-    label = label_of(cell, cell_label)
-    notes = Notes(on_note)
+    ctx = CalibrationContext.of(context, **keywords)
+    tool, sigma, nominal = ctx.tool, ctx.sigma, ctx.nominal
+    label = ctx.label(cell)
+    notes = Notes(ctx.on_note)
     if cell is None:
-        m = read_touches("positioner", measurements, source, robot, notes.one)
+        m = read_touches("positioner", measurements, ctx.source, ctx.arm(None), notes.one)
         refuse_track_column(m, no_cell_track())
         points = m.tcp(tool_transform(None, tool))
         _check_alone(m.axes, m.source)
@@ -146,17 +144,18 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     pos = cell.turntable
     if pos is None or pos.n_axes != 2:
         raise InputError(f"{label} has no positioner of 2 axes (tilt, rotate) to calibrate")
-    m = read_touches("positioner", measurements, source, arm_of(cell, robot), notes.one)
+    m = read_touches("positioner", measurements, ctx.source, ctx.arm(cell), notes.one)
     values, points = positioner_points(cell, m, tool, label)
     chained = chained_inputs(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
-                       world_track(cell, m), nominal, notes)
+                             world_track(cell, m), nominal, notes)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
                                 labels=m.labels(), inputs=chained.inputs)
     key = "T_world_B" if pos.parent == "world" else "T_R_B"
     result = done.result.renamed("T_R_B", key)
-    record = Record(measurement_file(measurements, file), recorded_options(sigma, tool), chained, nominal)
-    prov = provenance_of("positioner", result, m.n, m.source, time, cell, "turntable", "chain",
-                       record)
+    record = Record(measurement_file(measurements, ctx.file), recorded_options(sigma, tool),
+                    chained, nominal)
+    prov = provenance_of("positioner", result, m.n, m.source, ctx.time, cell, "turntable", "chain",
+                         record)
     new = copied(cell)
     new.update_positioner(prov, done.robot.with_tool(np.eye(4)))
     return CellCalibration(result, new, f"positioner {pos.name!r} (axes, root)", prov,
@@ -182,9 +181,13 @@ def _positioner_values(lower: float, upper: float, values: ArrayLike | None,
 
 
 def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
-                track: float | None, tilts: ArrayLike | None = None,
-                rotates: ArrayLike | None = None, radius: float = 0.2,
-                height: float = 0.0) -> Touches:
+             track: float | None, tilts: ArrayLike | None = None,
+             rotates: ArrayLike | None = None, radius: float = 0.2,
+             height: float = 0.0) -> Touches:
+    """The touches of the positioner procedure (:attr:`Procedure.simulate
+    <robotcell.cell.calibrate.registry.Procedure>`): the point ``(radius, 0, height)`` of the
+    plate P at every combination of ``tilts`` (default -30, 0, 30 deg) and ``rotates``
+    (default 0, 90, 180, 270 deg), clipped to the limits."""
     pos = cell.turntable
     if pos is None or pos.n_axes != 2:
         raise InputError("the positioner procedure needs a cell with a positioner of 2 axes "
@@ -215,3 +218,17 @@ def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | Non
     return Touches("positioner", q, e if cell.track is not None else None, v, None,
                    truth={"chain": pos.chain, "parent": pos.parent, "point": p_P},
                    tool=tname, noise=noise)
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
+            context: CalibrationContext) -> CellCalibration:
+    """The recorded calibration again (:attr:`Procedure.repeat
+    <robotcell.cell.calibrate.registry.Procedure>`), started from the cell's chain."""
+    return positioner(cell, file, context=context)
+
+
+PROCEDURE = Procedure(
+    "positioner", "a 2-axis positioner's axis chain (one point on the table at several "
+    "(tilt, rotate) values)", SPECS["positioner"], positioner, item="positioner",
+    repeat=_repeat, simulate=simulate)

@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from pathlib import Path
-from typing import Literal
+from collections.abc import Mapping
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -14,28 +13,27 @@ from scipy.spatial.transform import Rotation
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell, Provenance
-from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, Chained, NominalAccuracy, touch_inputs
+from robotcell.cell.calibrate.chain import Chained, touch_inputs
 from robotcell.cell.calibrate.common import (
     CellCalibration,
     Notes,
     Record,
-    arm_of,
     assumption,
     copied,
-    label_of,
     measurement_file,
     no_cell_track,
     provenance_of,
     recorded_options,
     refuse_track_column,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
+from robotcell.cell.calibrate.registry import Planner, Procedure
 from robotcell.cell.calibrate.simulation import Touches, candidate_tracks, reach, tool_name
 from robotcell.cell.calibrate.touches import MeasurementInput, read_touches, track_positions
 from robotcell.cell.kinematics import robot_pose
-from robotcell.errors import InputError
+from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
-from robotcell.robot.robot import Robot
 
 #: Note of a tool calibrated from touches at several track positions.
 MAPPED_NOTE = ("note: the flange poses were mapped to the world through column 'track': the "
@@ -67,11 +65,8 @@ def _write_tool(cell: Cell, name: str, result: CalibrationResult, prov: Provenan
 
 
 def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = None, *,
-        robot: Robot | None = None, world_mode: Literal["6d", "5d"] = "6d",
-        sigma: float | None = None, source: str | None = None, cell_label: str | None = None,
-        time: str | None = None, on_note: Callable[[str], None] | None = None,
-        file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
-        ) -> CellCalibration:
+        world_mode: Literal["6d", "5d"] = "6d", context: CalibrationContext | None = None,
+        **keywords: Any) -> CellCalibration:
     """Tool TCP (XYZ 4-point / N-point) and orientation (ABC 2-point, ABC World) into a cell.
 
     Parameters
@@ -85,38 +80,36 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
         a track, ``track`` (mm): the touches are then mapped to the world.
     name : str, optional
         Tool of the cell to write (added when new). Without it nothing is written.
-    robot : Robot, optional
-        Robot model for joint values when no cell is given.
     world_mode : {"6d", "5d"}
         ABC World alignment of rows with ``point=world``.
-    sigma : float, optional
-        Touch-up accuracy, 1-sigma per coordinate (m), which the uncertainties rest on; default
-        :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
-    source : str, optional
-        Name of the measurements in messages and the provenance note.
-    cell_label : str, optional
-        Name of the cell in messages (e.g. its file); default ``cell 'NAME'``.
-    time : str, optional
-        ISO 8601 time of the provenance; default now.
-    on_note : callable, optional
-        Receives each note on the measurements as it arises (e.g. to print it on stderr).
-    file : str or Path, optional
-        The touch file a table was read from; it is recorded in the provenance with its
-        checksum (``measurements`` given as a path is recorded without it).
-    nominal : NominalAccuracy
-        Accuracy of the cell items the touches rest on that have no recorded uncertainty.
+    context : CalibrationContext, optional
+        Who touched and how well, names in messages, where notes go, the touch file to record
+        and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`);
+        no ``tool``: the flange poses are taken without one.
+    **keywords
+        Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
+        ``context``, e.g. ``sigma=1e-4, tool="torch"``.
 
     Returns
     -------
     CellCalibration
         A tool with an orientation not measured by the touches keeps its orientation (or the
         flange's, for a new tool), as a note says.
+
+    Raises
+    ------
+    InputError
+        Measurements the procedure cannot use, a cell without what they need, or a ``tool``.
     """
     from robotcell.calibration.tcp import calibrate_tool
 
-    label = label_of(cell, cell_label)
-    notes = Notes(on_note)
-    m = read_touches("tcp", measurements, source, arm_of(cell, robot), notes.one)
+    ctx = CalibrationContext.of(context, **keywords)
+    if ctx.tool is not None:
+        raise InputError(f"{term('tool', 'tool')} is not used by the tcp procedure: its "
+                         "flange poses are computed without a tool")
+    label = ctx.label(cell)
+    notes = Notes(ctx.on_note)
+    m = read_touches("tcp", measurements, ctx.source, ctx.arm(cell), notes.one)
     T = m.flange()
     m.check_points()
     m.check_count()
@@ -132,26 +125,26 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
     labels = m.labels(points=True)
     order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
-                            world_mode=world_mode, prior_sigma=sigma,
+                            world_mode=world_mode, prior_sigma=ctx.sigma,
                             labels=[labels[i] for i in order])
     chained = Chained()
     if cell is not None and e is not None and cell.track is not None:
         # The reference point, as each flange pose placed it, moves with the track.
         T_wR = cell.frame_pose("robot", track=e[order])
         c_R = np.einsum("nji,nj->ni", T_wR[:, :3, :3], result.values["pivot"] - T_wR[:, :3, 3])
-        chained = touch_inputs(cell, c_R, track=e[order], nominal=nominal)
+        chained = touch_inputs(cell, c_R, track=e[order], nominal=ctx.nominal)
         notes.add(list(chained.notes))
         result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
-                                world_mode=world_mode, prior_sigma=sigma,
+                                world_mode=world_mode, prior_sigma=ctx.sigma,
                                 labels=[labels[i] for i in order], inputs=chained.inputs)
     key = f"tools.{name}" if cell is not None and name is not None else ""
     assumed = assumption(cell, m, None, "T_F_TCP")
     if cell is None or name is None:
         return CellCalibration(result, notes=tuple(notes), key=key, value="T_F_TCP",
                                inputs=chained.keys, assumed=assumed)
-    record = Record(measurement_file(measurements, file), recorded_options(sigma, world=world_mode), chained,
-                     nominal)
-    prov = provenance_of("tcp", result, m.n, m.source, time, cell, key, "T_F_TCP", record)
+    record = Record(measurement_file(measurements, ctx.file),
+                    recorded_options(ctx.sigma, world=world_mode), chained, ctx.nominal)
+    prov = provenance_of("tcp", result, m.n, m.source, ctx.time, cell, key, "T_F_TCP", record)
     new = copied(cell)
     kept = _write_tool(new, name, result, prov, label)
     return CellCalibration(result, new, f"tool {name!r}", prov, tuple(notes), tuple(kept),
@@ -160,9 +153,13 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
 
 # -- simulation ------------------------------------------------------------------------------------
 def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
-         track: float | None, touches: int = 4, tilt: float = math.radians(30.0),
-         point: ArrayLike = (1.1, 0.0, 0.25), distance: float = 0.1,
-         orientation: bool = True) -> Touches:
+             track: float | None, touches: int = 4, tilt: float = math.radians(30.0),
+             point: ArrayLike = (1.1, 0.0, 0.25), distance: float = 0.1,
+             orientation: bool = True) -> Touches:
+    """The touches of the tool procedure (:attr:`Procedure.simulate
+    <robotcell.cell.calibrate.registry.Procedure>`): the tool's TCP on a reference tip from
+    ``touches`` directions tilted by ``tilt``, and with ``orientation`` the ABC 2-point touches
+    (the tip on the tool's -X axis and in its XY plane, ``distance`` from the TCP)."""
     name = tool_name(cell, tool)
     T_F_TCP = cell.tools[name].T_F_TCP
     least = SPECS["tcp"].minimum
@@ -199,4 +196,30 @@ def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | Non
     q, e = reach(cell, targets, E, T_F_TCP, labels, rng, noise)
     return Touches("tcp", q, e if cell.track is not None else None, None, roles,
                    truth={"T_F_TCP": T_F_TCP.copy(), "tcp": T_F_TCP[:3, 3].copy()},
-                   options=[], tool=None, noise=noise)
+                   options=[], tool=None, noise=noise, track_column=False)
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
+            context: CalibrationContext) -> CellCalibration:
+    """The recorded calibration again (:attr:`Procedure.repeat
+    <robotcell.cell.calibrate.registry.Procedure>`)."""
+    return tcp(cell, file, name, world_mode=options.get("world", "6d"), context=context)
+
+
+def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+    """The estimator on simulated touches (:attr:`Planner.calibrate
+    <robotcell.cell.calibrate.registry.Planner>`): the flange poses in the robot base."""
+    from robotcell.calibration.tcp import calibrate_tool
+
+    m = touches.measurements(cell.robot)
+    F = m.flange()
+    r = np.array(m.point)
+    return calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=prior_sigma)
+
+
+PROCEDURE = Procedure(
+    "tcp", "a tool's TCP (XYZ 4-point) and orientation (ABC 2-point)", SPECS["tcp"], tcp,
+    item="tools.NAME", repeat=_repeat, simulate=simulate,
+    planner=Planner(tuple({"tilt": math.radians(t)} for t in (10, 20, 30, 40, 50, 60)),
+                    pose="T_F_TCP", truth="T_F_TCP", calibrate=_estimate))

@@ -3,37 +3,35 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from pathlib import Path
-from typing import Literal
+from collections.abc import Mapping
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.measurements import Measurements
+from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell
-from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
 from robotcell.cell.calibrate.common import (
     CellCalibration,
     Notes,
     Record,
-    arm_of,
     assumption,
     chained_inputs,
     copied,
-    label_of,
     measurement_file,
     provenance_of,
     recorded_options,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
+from robotcell.cell.calibrate.registry import Planner, Procedure
 from robotcell.cell.calibrate.simulation import DOWN, Touches, reach, tool_name
 from robotcell.cell.calibrate.touches import MeasurementInput, read_touches, tool_transform
 from robotcell.cell.kinematics import tool_pose
 from robotcell.cell.validation import check_axis_limits
 from robotcell.errors import InputError, term
 from robotcell.kinematics.transforms import make_pose, transform_points
-from robotcell.robot.robot import Robot
 
 
 def _cell_track_axis(cell: Cell, axis: str | None, references: NDArray[np.float64],
@@ -81,12 +79,8 @@ def _reference_indices(m: Measurements, n_refs: int) -> NDArray[np.int_] | None:
 
 def track(cell: Cell | None, measurements: MeasurementInput, *,
           references: ArrayLike | None = None, axis: Literal["x", "z"] | None = None,
-          roll: Literal["zero"] | None = None, robot: Robot | None = None,
-          tool: str | ArrayLike | None = None, sigma: float | None = None,
-          source: str | None = None, cell_label: str | None = None,
-          time: str | None = None, on_note: Callable[[str], None] | None = None,
-          file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
-          ) -> CellCalibration:
+          roll: Literal["zero"] | None = None, context: CalibrationContext | None = None,
+          **keywords: Any) -> CellCalibration:
     """Linear track (direction, scale, straightness, rotation when determined) into a cell.
 
     Parameters
@@ -103,8 +97,12 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
         Axis of L along which the carriage moves; default the cell's, else x.
     roll : {"zero"}, optional
         Without references: fix the rotation about the track axis to zero (a convention).
-    robot, tool, sigma, source, cell_label, time, on_note, file, nominal
-        As for :func:`frame`.
+    context : CalibrationContext, optional
+        Who touched and how well, names in messages, where notes go, the touch file to record
+        and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
+    **keywords
+        Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
+        ``context``, e.g. ``sigma=1e-4, tool="torch"``.
 
     Returns
     -------
@@ -115,21 +113,24 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
     """
     from robotcell.calibration.track import calibrate_track
 
+    ctx = CalibrationContext.of(context, **keywords)
+    tool, sigma, nominal = ctx.tool, ctx.sigma, ctx.nominal
     refs = (np.zeros((0, 3)) if references is None
             else np.asarray(references, dtype=float).reshape(-1, 3))
-    label = label_of(cell, cell_label)
+    label = ctx.label(cell)
     if cell is not None:
         axis = _cell_track_axis(cell, axis, refs, roll, label)  # type: ignore[assignment]
-    notes = Notes(on_note)
-    m = read_touches("track", measurements, source, arm_of(cell, robot), notes.one)
+    notes = Notes(ctx.on_note)
+    m = read_touches("track", measurements, ctx.source, ctx.arm(cell), notes.one)
     f = m.tcp(tool_transform(cell, tool, m))
     e = m.axes[:, 0]
     if cell is not None:
         check_axis_limits(cell.track, e, ["e1"], m.source, label)
     m.check_count()
     idx = _reference_indices(m, len(refs))
-    options = recorded_options(sigma, tool, references_mm=(refs * 1e3).tolist() if len(refs) else None,
-                       axis=axis, roll=roll)
+    options = recorded_options(sigma, tool,
+                               references_mm=(refs * 1e3).tolist() if len(refs) else None,
+                               axis=axis, roll=roll)
     keep_offset = cell is not None and len(refs) < 2
     if keep_offset:
         # The fit takes the unmeasured carriage offset as zero; the cell knows it.
@@ -150,8 +151,8 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
         kept.append(f"note: the carriage offset is not measured (two or more "
                     f"{term('reference', 'reference')} points measure it): kept the offset of "
                     f"{label} ({offset} mm)")
-    record = Record(measurement_file(measurements, file), options, chained, nominal)
-    prov = provenance_of("track", result, m.n, m.source, time, cell, "track", "T_L_R", record)
+    record = Record(measurement_file(measurements, ctx.file), options, chained, nominal)
+    prov = provenance_of("track", result, m.n, m.source, ctx.time, cell, "track", "T_L_R", record)
     new = copied(cell)
     new.update_track(prov, T_L_R0=T_L_R0, scale=float(result.values["scale"]))
     return CellCalibration(result, new, f"track {tr.name!r} (robot_at_zero, scale)", prov,
@@ -160,8 +161,12 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
 
 # -- simulation ------------------------------------------------------------------------------------
 def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
-           track: float | None, references: ArrayLike | None = None, positions: int = 4,
-           travel: float = 1.0) -> Touches:
+             track: float | None, references: ArrayLike | None = None, positions: int = 4,
+             travel: float = 1.0) -> Touches:
+    """The touches of the track procedure (:attr:`Procedure.simulate
+    <robotcell.cell.calibrate.registry.Procedure>`): each reference point (in L; default two,
+    one on each side, a quarter of the travel from each end) at ``positions`` track positions
+    spread over ``travel``."""
     if cell.track is None:
         raise InputError("the cell has no track")
     if track is not None:
@@ -216,4 +221,38 @@ def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | Non
     options = [f"--reference={','.join(f'{v * 1e3:.3f}' for v in r)}" for r in refs]
     return Touches("track", q, e, None, [str(p + 1) for p in point],
                    truth={"T_L_R": t.T_L_R0.copy(), "scale": t.scale, "references": refs},
-                   options=options, tool=tname, noise=noise)
+                   options=options, tool=tname, noise=noise, track_column=False,
+                   moves_track=True)
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
+            context: CalibrationContext) -> CellCalibration:
+    """The recorded calibration again (:attr:`Procedure.repeat
+    <robotcell.cell.calibrate.registry.Procedure>`)."""
+    refs = options.get("references_mm")
+    return track(cell, file, references=None if refs is None
+                 else np.asarray(refs, dtype=float) * 1e-3,
+                 axis=options.get("axis"), roll=options.get("roll"), context=context)
+
+
+def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+    """The estimator on simulated touches (:attr:`Planner.calibrate
+    <robotcell.cell.calibrate.registry.Planner>`): the TCP positions in the robot base with the
+    true reference points."""
+    from robotcell.calibration.track import calibrate_track
+
+    m = touches.measurements(cell.robot)
+    p_R = m.tcp(tool_pose(cell, touches.tool))
+    t = cell.track
+    assert t is not None
+    return calibrate_track(m.axes[:, 0], p_R, references=touches.truth["references"],
+                           point=m.reference.astype(int) - 1, axis=t.axis,
+                           prior_sigma=prior_sigma)
+
+
+PROCEDURE = Procedure(
+    "track", "the robot's linear track (touches of known reference points)", SPECS["track"],
+    track, item="track", repeat=_repeat, simulate=simulate,
+    planner=Planner(tuple({"travel": t} for t in (0.1, 0.25, 0.5, 1.0, 1.5, 2.0)),
+                    pose="T_L_R", truth="T_L_R", calibrate=_estimate))

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -15,20 +15,19 @@ from robotcell.calibration.result import CalibrationResult, result_json
 from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import OWN, Sources
 from robotcell.cell import Cell
-from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
 from robotcell.cell.calibrate.common import (
     CellCalibration,
     Notes,
     Record,
-    arm_of,
     assumption,
     copied,
-    label_of,
     measurement_file,
     provenance_of,
     recorded_options,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
 from robotcell.cell.calibrate.ontable import cell_turntable, on_table
+from robotcell.cell.calibrate.registry import Planner, Procedure
 from robotcell.cell.calibrate.simulation import (
     DOWN,
     Touches,
@@ -37,18 +36,19 @@ from robotcell.cell.calibrate.simulation import (
     reach,
     table_angles,
     tool_name,
+    touched_in_parent,
 )
 from robotcell.cell.calibrate.touches import MeasurementInput, read_touches
 from robotcell.cell.kinematics import frame_pose, tool_pose
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_json
 from robotcell.kinematics.transforms import make_pose, rot_z, transform_points, validate_pose
-from robotcell.robot.robot import Robot
 
 
 @dataclass(frozen=True)
 class TurntablePose:
-    """A calibrated turntable root frame with its uncertainty, for :func:`workpiece`.
+    """A calibrated turntable root frame with its uncertainty, for the workpiece procedure
+    (:func:`robotcell.cell.calibrate.workpiece`).
 
     Attributes
     ----------
@@ -102,11 +102,7 @@ class TurntablePose:
 
 
 def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: float = 0.0,
-              robot: Robot | None = None, tool: str | ArrayLike | None = None,
-              sigma: float | None = None, source: str | None = None,
-              cell_label: str | None = None, time: str | None = None,
-              on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
-              nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
+              context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
     """Turntable root frame B and radius, from touches of one point on the table, into a cell.
 
     Parameters
@@ -118,8 +114,12 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
         turntable in the world of a cell with a track, ``track`` (mm).
     height : float
         Shift of the frame origin along the table axis from the plane of the touched point (m).
-    robot, tool, sigma, source, cell_label, time, on_note, file, nominal
-        As for :func:`frame`.
+    context : CalibrationContext, optional
+        Who touched and how well, names in messages, where notes go, the touch file to record
+        and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
+    **keywords
+        Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
+        ``context``, e.g. ``sigma=1e-4, tool="torch"``.
 
     Returns
     -------
@@ -128,11 +128,12 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     """
     from robotcell.calibration.turntable import calibrate_turntable
 
-    label = label_of(cell, cell_label)
-    parent = cell_turntable(cell, label).parent if cell is not None else None
-    notes = Notes(on_note)
-    m = read_touches("turntable", measurements, source, arm_of(cell, robot), notes.one)
-    theta, f, chained = on_table(cell, m, tool, label, nominal, notes, m.check_count)
+    ctx = CalibrationContext.of(context, **keywords)
+    tool, sigma = ctx.tool, ctx.sigma
+    parent = cell_turntable(cell, ctx.label(cell)).parent if cell is not None else None
+    notes = Notes(ctx.on_note)
+    m = read_touches("turntable", measurements, ctx.source, ctx.arm(cell), notes.one)
+    theta, f, chained = on_table(cell, m, ctx, notes, m.check_count)
     result = calibrate_turntable(theta, f, height=height, labels=m.labels(),
                                  prior_sigma=sigma, inputs=chained.inputs)
     key = "T_world_B" if parent == "world" else "T_R_B"
@@ -140,9 +141,10 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     if cell is None:
         return CellCalibration(result, notes=tuple(notes), assumed=assumed)
     result = result.renamed("T_R_B", key)
-    record = Record(measurement_file(measurements, file), recorded_options(sigma, tool, height_mm=height * 1e3),
-                     chained, nominal)
-    prov = provenance_of("turntable", result, m.n, m.source, time, cell, "turntable", key, record)
+    record = Record(measurement_file(measurements, ctx.file),
+                    recorded_options(sigma, tool, height_mm=height * 1e3), chained, ctx.nominal)
+    prov = provenance_of("turntable", result, m.n, m.source, ctx.time, cell, "turntable", key,
+                         record)
     new = copied(cell)
     tt = new.update_turntable(prov, T_parent_B=result.values[key])
     return CellCalibration(result, new, f"turntable {tt.name!r} ({key})", prov, tuple(notes),
@@ -151,8 +153,12 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
 
 # -- simulation ------------------------------------------------------------------------------------
 def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
-               track: float | None, touches: int = 6, angles: ArrayLike | None = None,
-               radius: float = 0.3, height: float = 0.05) -> Touches:
+             track: float | None, touches: int = 6, angles: ArrayLike | None = None,
+             radius: float = 0.3, height: float = 0.05) -> Touches:
+    """The touches of the turntable procedure (:attr:`Procedure.simulate
+    <robotcell.cell.calibrate.registry.Procedure>`): a point ``radius`` from the axis and
+    ``height`` above B at ``touches`` table angles (default evenly around the turn) or at
+    ``angles``."""
     one_axis_table(cell)
     tname = tool_name(cell, tool)
     if not (math.isfinite(radius) and radius > 0):
@@ -183,3 +189,41 @@ def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | Non
                    truth={"pose": tt.T_parent_B.copy(), "parent": tt.parent, "radius": radius,
                           "height": height},
                    options=[f"--height={-height * 1e3:g}"], tool=tname, noise=noise)
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
+            context: CalibrationContext) -> CellCalibration:
+    """The recorded calibration again (:attr:`Procedure.repeat
+    <robotcell.cell.calibrate.registry.Procedure>`)."""
+    return turntable(cell, file, height=options.get("height_mm", 0.0) * 1e-3, context=context)
+
+
+def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+    """The estimator on simulated touches (:attr:`Planner.calibrate
+    <robotcell.cell.calibrate.registry.Planner>`), in the turntable's parent frame."""
+    from robotcell.calibration.turntable import calibrate_turntable
+
+    m = touches.measurements(cell.robot)
+    return calibrate_turntable(m.axes[:, 0], touched_in_parent(cell, touches, m),
+                               height=-touches.truth["height"], prior_sigma=prior_sigma)
+
+
+def _simulation(design: dict[str, Any]) -> dict[str, Any]:
+    """A planning design as keywords of :func:`simulate` (:attr:`Planner.simulation
+    <robotcell.cell.calibrate.registry.Planner>`): a span of table angles as the angles."""
+    out = dict(design)
+    if "span" in out:
+        span = out.pop("span")
+        n = out.pop("touches", 6)
+        full = span >= 2 * math.pi - 1e-9
+        out["angles"] = np.linspace(-span / 2, span / 2, n, endpoint=not full)
+    return out
+
+
+PROCEDURE = Procedure(
+    "turntable", "the turntable's root frame (one point on the table at several angles)",
+    SPECS["turntable"], turntable, item="turntable", repeat=_repeat, simulate=simulate,
+    planner=Planner(tuple({"span": math.radians(s), "radius": r} for s in (60, 120, 180, 270, 360)
+                          for r in (0.1, 0.2, 0.3, 0.4)),
+                    pose="T_R_B", truth="pose", calibrate=_estimate, simulation=_simulation))

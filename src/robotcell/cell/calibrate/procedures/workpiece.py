@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Mapping
 from dataclasses import replace
-from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -15,7 +15,6 @@ from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell, Positioner
 from robotcell.cell.calibrate.chain import (
-    NOMINAL_ACCURACY,
     NominalAccuracy,
     item_sources,
     plate_inputs,
@@ -24,15 +23,14 @@ from robotcell.cell.calibrate.common import (
     CellCalibration,
     Notes,
     Record,
-    arm_of,
     assumption,
     chained_inputs,
     copied,
-    label_of,
     measurement_file,
     provenance_of,
     recorded_options,
 )
+from robotcell.cell.calibrate.context import CalibrationContext
 from robotcell.cell.calibrate.ontable import (
     cell_turntable,
     on_table,
@@ -40,6 +38,7 @@ from robotcell.cell.calibrate.ontable import (
     world_track,
 )
 from robotcell.cell.calibrate.procedures.turntable import TurntablePose
+from robotcell.cell.calibrate.registry import Planner, Procedure
 from robotcell.cell.calibrate.simulation import (
     DOWN,
     Touches,
@@ -50,12 +49,12 @@ from robotcell.cell.calibrate.simulation import (
     table_angles,
     three_point,
     tool_name,
+    touched_in_parent,
 )
 from robotcell.cell.calibrate.touches import MeasurementInput, read_touches, tool_transform
 from robotcell.cell.kinematics import frame_pose, tool_pose
 from robotcell.errors import InputError, term
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
-from robotcell.robot.robot import Robot
 
 #: Largest difference between a given turntable pose and the cell's that counts as the same
 #: calibration (m, rad): far above the cell file's rounding, far below any recalibration.
@@ -103,19 +102,20 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
                                     "robotcell.cell.calibrate.turntable") + ") so that the two agree"]
 
 
-def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None, *,
-                          tool: str | ArrayLike | None, sigma: float | None, label: str,
-                          time: str | None, notes: Notes, file: str | None,
-                          nominal: NominalAccuracy) -> CellCalibration:
+def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None,
+                          context: CalibrationContext, notes: Notes, file: str | None
+                          ) -> CellCalibration:
     """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P, with
     the chain's recorded error sources (:func:`robotcell.cell.calibrate.chain.plate_inputs`)."""
     from robotcell.calibration.frame import frame_3point
+
+    tool, sigma, label, nominal = context.tool, context.sigma, context.label(cell), context.nominal
 
     values, points = positioner_points(cell, m, tool, label)
     m.check_points()
     pos = cell.turntable
     touched = chained_inputs(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
-                       world_track(cell, m), nominal, notes)
+                             world_track(cell, m), nominal, notes)
     p_P, chained = plate_inputs(cell, values, points, touched, nominal)
     notes.add([n for n in chained.notes if n not in touched.notes])
     result = frame_3point(p_P, m.point, sigma, m.labels(points=True),
@@ -126,7 +126,8 @@ def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None, *,
         return CellCalibration(result, notes=tuple(notes), value="T_P_W", inputs=chained.keys,
                                assumed=assumed)
     record = Record(file, recorded_options(sigma, tool), chained, nominal)
-    prov = provenance_of("workpiece", result, m.n, m.source, time, cell, item, "T_P_W", record)
+    prov = provenance_of("workpiece", result, m.n, m.source, context.time, cell, item, "T_P_W",
+                         record)
     new = copied(cell)
     new.update_frame(name, result.values["T_P_W"], prov, parent="turntable")
     return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
@@ -135,11 +136,7 @@ def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None, *,
 
 def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | None = None, *,
               turntable: TurntablePose | CalibrationResult | None = None,
-              robot: Robot | None = None, tool: str | ArrayLike | None = None,
-              sigma: float | None = None, source: str | None = None,
-              cell_label: str | None = None, time: str | None = None,
-              on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
-              nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
+              context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
     """Workpiece frame ``T_B_W`` on a calibrated turntable into a cell (parent turntable).
 
     Parameters
@@ -159,8 +156,12 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
         The turntable calibration, whose uncertainty is then propagated; default the cell's
         turntable with its recorded uncertainty (or the nominal accuracy), whose error sources
         it may share with the tool.
-    robot, tool, sigma, source, cell_label, time, on_note, file, nominal
-        As for :func:`frame`.
+    context : CalibrationContext, optional
+        Who touched and how well, names in messages, where notes go, the touch file to record
+        and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
+    **keywords
+        Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
+        ``context``, e.g. ``sigma=1e-4, tool="torch"``.
 
     Returns
     -------
@@ -168,24 +169,25 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
     """
     from robotcell.calibration.workpiece import calibrate_workpiece
 
-    label = label_of(cell, cell_label)
-    notes = Notes(on_note)
+    ctx = CalibrationContext.of(context, **keywords)
+    tool, sigma, nominal = ctx.tool, ctx.sigma, ctx.nominal
+    label = ctx.label(cell)
+    notes = Notes(ctx.on_note)
     if cell is not None and isinstance(cell.turntable, Positioner):
         if turntable is not None:
             raise InputError(f"{label} has a positioner chain, which carries its own "
                              "calibration: give no turntable result")
         spec = SPECS["workpiece"].with_axes(cell.turntable.n_axes)
-        m = read_touches(spec, measurements, source, arm_of(cell, robot), notes.one)
-        return _positioner_workpiece(cell, m, name, tool=tool, sigma=sigma, label=label,
-                                     time=time, notes=notes, file=measurement_file(measurements, file),
-                                     nominal=nominal)
+        m = read_touches(spec, measurements, ctx.source, ctx.arm(cell), notes.one)
+        return _positioner_workpiece(cell, m, name, ctx, notes,
+                                     measurement_file(measurements, ctx.file))
     if isinstance(turntable, CalibrationResult):
         turntable = TurntablePose.from_result(turntable)
-    model = arm_of(cell, robot)
+    model = ctx.arm(cell)
     tt, where = _workpiece_turntable(cell, turntable, label, nominal)
     notes.add(where)
-    m = read_touches("workpiece", measurements, source, model, notes.one)
-    theta, f, chained = on_table(cell, m, tool, label, nominal, notes, m.check_points)
+    m = read_touches("workpiece", measurements, ctx.source, model, notes.one)
+    theta, f, chained = on_table(cell, m, ctx, notes, m.check_points)
     result = calibrate_workpiece(theta, f, m.point, tt.T, T_R_B_covariance=tt.covariance,
                                  inputs=chained.inputs, prior_sigma=sigma,
                                  labels=m.labels(points=True))
@@ -195,9 +197,10 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
     if cell is None or name is None:
         return CellCalibration(result, notes=tuple(notes), key=item, value="T_B_W",
                                inputs=inputs, assumed=assumed)
-    record = Record(measurement_file(measurements, file), recorded_options(sigma, tool), chained, nominal)
-    prov = provenance_of("workpiece", result, m.n, m.source, time, cell, item, "T_B_W", record,
-                       inputs)
+    record = Record(measurement_file(measurements, ctx.file), recorded_options(sigma, tool),
+                    chained, nominal)
+    prov = provenance_of("workpiece", result, m.n, m.source, ctx.time, cell, item, "T_B_W",
+                         record, inputs)
     new = copied(cell)
     new.update_frame(name, result.values["T_B_W"], prov, parent="turntable")
     return CellCalibration(result, new, f"frame {name!r} (parent turntable)", prov, tuple(notes),
@@ -206,8 +209,12 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
 
 # -- simulation ------------------------------------------------------------------------------------
 def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | None,
-               track: float | None, frame: str | None = None, size: float = 0.15,
-               repeats: int = 2, angles: ArrayLike | None = None) -> Touches:
+             track: float | None, frame: str | None = None, size: float = 0.15,
+             repeats: int = 2, angles: ArrayLike | None = None) -> Touches:
+    """The touches of the workpiece procedure (:attr:`Procedure.simulate
+    <robotcell.cell.calibrate.registry.Procedure>`): 3-point on ``frame`` (on a one-axis
+    turntable) as for the frame procedure, at table angles spread over +-20 deg or ``angles``
+    (one per touch)."""
     one_axis_table(cell)
     name = frame_name(cell, frame, ("turntable",), "workpiece")
     tname = tool_name(cell, tool)
@@ -230,8 +237,35 @@ def simulate(cell: Cell, rng: np.random.Generator, noise: float, tool: str | Non
         return make_pose(DOWN[None, None], p_w[:, :, None])
 
     E = candidate_tracks(cell, track, n)
-    labels = [f"touch {i + 1} ({r}, {math.degrees(v):.0f} deg)" for i, (r, v) in enumerate(zip(roles, th))]
+    labels = [f"touch {i + 1} ({r}, {math.degrees(v):.0f} deg)"
+              for i, (r, v) in enumerate(zip(roles, th))]
     q, e = reach(cell, targets, E, tool_pose(cell, tname), labels, rng, noise)
     return Touches("workpiece", q, e if cell.track is not None else None, th, roles,
                    truth={"pose": T_B_W.copy(), "parent": "turntable", "name": name},
                    tool=tname, noise=noise)
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
+            context: CalibrationContext) -> CellCalibration:
+    """The recorded calibration again (:attr:`Procedure.repeat
+    <robotcell.cell.calibrate.registry.Procedure>`), on the cell's turntable."""
+    return workpiece(cell, file, name, context=context)
+
+
+def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+    """The estimator on simulated touches (:attr:`Planner.calibrate
+    <robotcell.cell.calibrate.registry.Planner>`), on the cell's turntable."""
+    from robotcell.calibration.workpiece import calibrate_workpiece
+
+    m = touches.measurements(cell.robot)
+    assert cell.turntable is not None
+    return calibrate_workpiece(m.axes[:, 0], touched_in_parent(cell, touches, m), m.point,
+                               cell.turntable.T_parent_B, prior_sigma=prior_sigma)
+
+
+PROCEDURE = Procedure(
+    "workpiece", "a workpiece frame on the turntable (3-point at any table angles)",
+    SPECS["workpiece"], workpiece, item="frames.NAME", repeat=_repeat, simulate=simulate,
+    planner=Planner(tuple({"size": s} for s in (0.05, 0.1, 0.15, 0.2, 0.3, 0.4)),
+                    pose="T_B_W", truth="pose", calibrate=_estimate))
