@@ -30,6 +30,7 @@ from robotcell.cell.calibrate.procedures.track import track
 from robotcell.cell.calibrate.procedures.turntable import TurntablePose, turntable
 from robotcell.cell.calibrate.procedures.workpiece import SAME_POSE, workpiece
 from robotcell.cell.calibrate.registry import (
+    PROCEDURES,
     Planner,
     Procedure,
     for_result,
@@ -46,7 +47,7 @@ from robotcell.cell.calibrate.touches import (
 )
 from robotcell.cell.calibrate.whole import CellRecalibration, ItemChange, calibrate_cell
 
-__all__ = ["NOMINAL_ACCURACY", "SAME_POSE", "CalibrationContext", "CellCalibration",
+__all__ = ["NOMINAL_ACCURACY", "PROCEDURES", "SAME_POSE", "CalibrationContext", "CellCalibration",
            "CellRecalibration", "ItemChange", "NominalAccuracy", "Planner", "Procedure",
            "TurntablePose", "calibrate_cell", "external_tcp", "for_result", "frame", "having",
            "load_table", "positioner", "positioner_touches", "procedure", "read_touches",

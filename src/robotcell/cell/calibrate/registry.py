@@ -33,8 +33,8 @@ if TYPE_CHECKING:
     from robotcell.cell.calibrate.context import CalibrationContext
     from robotcell.cell.calibrate.simulation import Touches
 
-__all__ = ["Planner", "Procedure", "attach", "for_result", "having", "procedure", "register",
-           "unregister"]
+__all__ = ["PROCEDURES", "Planner", "Procedure", "attach", "for_result", "having", "procedure",
+           "register", "unregister"]
 
 T = TypeVar("T")
 
@@ -229,3 +229,7 @@ def having(part: Callable[[Procedure], T | None]) -> Mapping[str, T]:
     The mapping is live: a procedure registered later is in it.
     """
     return _Having(part)
+
+
+#: Every registered procedure, by name, in the order registered (live).
+PROCEDURES: Mapping[str, Procedure] = having(lambda p: p)

@@ -36,7 +36,6 @@ from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell, Turntable
 from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.errors import InputError
-from robotcell.ik import analytic_solver, arm_sides
 from robotcell.io.fileio import atomic_write
 from robotcell.kinematics.transforms import invert, transform_points
 from robotcell.robot.robot import Robot
@@ -295,6 +294,9 @@ def _usual_configuration(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.flo
     """Weight 1 for configurations with the wrist centre on the same sides of axis 1 and of the
     lower arm as at the robot's home position (how a technician teaches), 1e-3 for the others;
     all 1 for arms without those configuration flags or without a home position."""
+    # imported when touches are placed: the calibrations, which load this module too, solve no IK
+    from robotcell.ik import analytic_solver, arm_sides
+
     if robot.home is None or analytic_solver(robot).method != "opw":
         return np.ones(q.shape[:-1])
     front, elbow = arm_sides(robot, q)
