@@ -26,8 +26,8 @@ from typing import Literal
 
 from robotcell.errors import InputError
 
-__all__ = ["JOINT_COLUMNS", "POSE_COLUMNS", "ROLES", "SPECS", "Column", "TableSpec", "add", "remove",
-           "result_procedures"]
+__all__ = ["JOINT_COLUMNS", "POSE_COLUMNS", "ROLES", "SPECS", "Column", "TableSpec", "add",
+           "remove", "result_procedures"]
 
 #: The roles of the columns of a measurement table.
 ROLES = ("pose", "axis", "track", "point", "reference", "nominal")
