@@ -508,7 +508,7 @@ def procedure_command(proc: Procedure) -> click.Command:
     command = click.argument("measurements", type=click.Path(dir_okay=False))(command)
     columns = ", ".join(c.name for c in proc.spec.columns)
     return click.command(proc.name, cls=Command, help=(
-        f"{proc.summary[:1].upper()}{proc.summary[1:]}.\n\n\b\nRows: TCP positions x,y,z (mm) or "
+        f"{proc.summary[:1].upper()}{proc.summary[1:]}.\n\nRows: TCP positions x,y,z (mm) or "
         f"joint values a1..a6 with --robot or --cell" + (f"; columns {columns}" if columns
                                                         else "") + "."))(command)
 
