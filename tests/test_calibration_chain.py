@@ -138,8 +138,8 @@ def plate_touches(cell, rng):
     """Joint values touching frame 'part' on the positioner's plate (origin, x, xy twice, 300 mm
     apart, at tilts up to 70 deg and random tool orientations), without error, and the axis
     values (rad). Tilts beyond those of the positioner's touches (30 deg) make its error show."""
+    from robotcell.cell.calibrate.simulation import DOWN, Touches
     from robotcell.kinematics.transforms import invert
-    from robotcell.studies.simulate import DOWN, Touches
 
     v = np.radians([[60.0, 30.0], [60.0, 30.0], [-60.0, 100.0],
                     [0.0, 0.0], [70.0, -60.0], [-45.0, 200.0]])

@@ -17,8 +17,8 @@ from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.cell import Cell, Provenance
 from robotcell.cell.history import cell_history
 from robotcell.io.tables import read_csv
-from robotcell.programs import write_program
 from robotcell.kinematics.transforms import rot_z
+from robotcell.programs import write_program
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "cell_kr16_track_turntable.yaml"

@@ -3,7 +3,7 @@
 A table is a mapping of lower-case column name to one value per touch: numbers (a float array)
 or text (a list of str), as :func:`robotcell.io.tables.read_csv` returns a CSV file with a header
 (see ``docs/calibration.md``). What a procedure reads from it, the roles and units of its columns
-and its fewest touches, is its :class:`~robotcell.calibration.spec.Procedure`
+and its fewest touches, is its :class:`~robotcell.calibration.spec.TableSpec`
 (:data:`~robotcell.calibration.spec.SPECS`); :func:`read_measurements` reads a table by it, once,
 into :class:`Measurements` (SI): the touches (TCP positions, flange poses or joint values), the
 external axis values, the robot's track positions, the touched points and their known
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.calibration.spec import JOINT_COLUMNS, SPECS, Column, Procedure
+from robotcell.calibration.spec import JOINT_COLUMNS, SPECS, Column, TableSpec
 from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import (
@@ -79,7 +79,7 @@ class Measurements:
 
     Attributes
     ----------
-    procedure : Procedure
+    procedure : TableSpec
         What the table was read by (:data:`~robotcell.calibration.spec.SPECS`).
     source : str
         Name of the table in messages (its file), and of each touch by its line.
@@ -105,7 +105,7 @@ class Measurements:
         Remarks made while reading (columns not used, identical rows).
     """
 
-    procedure: Procedure
+    procedure: TableSpec
     source: str
     points: NDArray[np.float64] | None = None
     poses: NDArray[np.float64] | None = None
@@ -252,14 +252,14 @@ def columns_of(table: Any, source: str) -> dict[str, Any]:
     return cols
 
 
-def read_measurements(procedure: Procedure | str, cols: Columns, source: str,
+def read_measurements(procedure: TableSpec | str, cols: Columns, source: str,
                       robot: Robot | None = None,
                       on_note: Callable[[str], None] | None = None) -> Measurements:
     """Read a measurement table by a procedure's specification, into SI units.
 
     Parameters
     ----------
-    procedure : Procedure or str
+    procedure : TableSpec or str
         The procedure (or its name in :data:`~robotcell.calibration.spec.SPECS`).
     cols : mapping
         The table: lower-case column names to float arrays or lists of str, of one length (as
@@ -280,7 +280,7 @@ def read_measurements(procedure: Procedure | str, cols: Columns, source: str,
     Raises
     ------
     InputError
-        A column the procedure refuses (:attr:`Procedure.unused`), missing or non-numeric pose
+        A column the procedure refuses (:attr:`TableSpec.unused`), missing or non-numeric pose
         or axis columns, values in metres or radians by mistake, joint values without a robot
         or outside its limits, point names the procedure does not know or points not touched.
     """
@@ -359,7 +359,7 @@ def _axis(cols: Columns, source: str, column: Column) -> NDArray[np.float64]:
     return np.radians(_numeric(cols, (column.name,), source)[:, 0])
 
 
-def _points(spec: Procedure, cols: Columns, n: int, source: str) -> tuple[str, ...] | None:
+def _points(spec: TableSpec, cols: Columns, n: int, source: str) -> tuple[str, ...] | None:
     """Column ``point`` in lower case, the procedure's default point (also for a line that
     leaves the cell empty), or None; checked by :func:`_check_points`. A procedure without a
     default point refuses an empty cell."""
@@ -372,7 +372,7 @@ def _points(spec: Procedure, cols: Columns, n: int, source: str) -> tuple[str, .
     return tuple(name or str(spec.default_point) for name in names)
 
 
-def _check_points(spec: Procedure, roles: Sequence[str] | None, source: str) -> None:
+def _check_points(spec: TableSpec, roles: Sequence[str] | None, source: str) -> None:
     """Refuse a column ``point`` that is missing, holds names the procedure does not know, or
     leaves out a point the procedure needs (the origin, x and xy of a 3-point frame)."""
     if roles is None:

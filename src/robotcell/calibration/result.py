@@ -434,28 +434,8 @@ class CalibrationResult:
         def touches(key: str) -> list[int]:
             return [labels.index(str(v)) for v in data.get(key) or [] if str(v) in labels]
 
-        sigma_json = data.get("sigma") or {}
-        sigma: dict[str, Any] = {}
-        for key, v in sigma_json.items():
-            for unit, scale in (("_mm", 1e-3), ("_deg", math.pi / 180)):
-                if key.endswith(unit):
-                    sigma[key[:-len(unit)]] = np.asarray(v, dtype=float) * scale
-                    break
-            else:
-                sigma[key] = np.asarray(v, dtype=float)
-        values: dict[str, Any] = {}
-        covariance = None
-        poses = {m.group(1) for m in map(_POSE_KEY.fullmatch, [*data, *sigma_json]) if m}
-        if data.get("matrix") is not None and len(poses) == 1:
-            key = poses.pop()
-            T = np.array(data["matrix"], dtype=float)
-            T[:3, 3] *= 1e-3
-            values[key] = T
-            cov = data.get(f"{key}_covariance_mm_rad")
-            if cov is not None:
-                to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
-                covariance = (pose_covariance(cov, f"{source}: '{key}_covariance_mm_rad'")
-                              * np.outer(to_si, to_si))
+        sigma = _sigma_si(data.get("sigma") or {})
+        values, covariance = _pose_si(data, source)
         points = data.get("points_mm")
         return cls(
             str(data["procedure"]), values, sigma, mm * 1e-3,
@@ -617,3 +597,38 @@ def pose_covariance(value: object, where: str) -> NDArray[np.float64]:
         raise InputError(f"{where} is not a covariance (symmetric, no negative variance)"
                          f"{advice}")
     return cov
+
+
+def _sigma_si(sigma_json: dict[str, Any]) -> dict[str, Any]:
+    """The 1-sigma of a result as JSON in SI, keyed without their unit (``_mm``, ``_deg``)."""
+    sigma: dict[str, Any] = {}
+    for key, v in sigma_json.items():
+        for unit, scale in (("_mm", 1e-3), ("_deg", math.pi / 180)):
+            if key.endswith(unit):
+                sigma[key[:-len(unit)]] = np.asarray(v, dtype=float) * scale
+                break
+        else:
+            sigma[key] = np.asarray(v, dtype=float)
+    return sigma
+
+
+def _pose_si(data: dict[str, Any], source: str
+             ) -> tuple[dict[str, Any], NDArray[np.float64] | None]:
+    """The pose ``T_a_b`` of a result as JSON (``matrix``, the one pose its fields or sigma
+    name) in SI, and its covariance ``T_a_b_covariance_mm_rad`` (origin in m, rotation vector in
+    rad; None when not given)."""
+    sigma_json = data.get("sigma") or {}
+    values: dict[str, Any] = {}
+    covariance = None
+    poses = {m.group(1) for m in map(_POSE_KEY.fullmatch, [*data, *sigma_json]) if m}
+    if data.get("matrix") is not None and len(poses) == 1:
+        key = poses.pop()
+        T = np.array(data["matrix"], dtype=float)
+        T[:3, 3] *= 1e-3
+        values[key] = T
+        cov = data.get(f"{key}_covariance_mm_rad")
+        if cov is not None:
+            to_si = np.array([1e-3, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+            covariance = (pose_covariance(cov, f"{source}: '{key}_covariance_mm_rad'")
+                          * np.outer(to_si, to_si))
+    return values, covariance

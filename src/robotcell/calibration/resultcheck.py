@@ -1,7 +1,8 @@
 """Checks of a calibration result given as JSON (mm, deg), before it is read back.
 
 What :meth:`robotcell.calibration.result.CalibrationResult.from_json` refuses: a field missing
-(:data:`REQUIRED`) or of the wrong type, an unknown ``procedure``, a number that is not finite
+(:data:`REQUIRED`) or of the wrong type, an unknown ``procedure`` (one no procedure of
+:data:`~robotcell.calibration.spec.SPECS` writes), a number that is not finite
 (anywhere), a length (a key ending in ``_mm``, the translation of a pose) beyond
 :data:`~robotcell.io.tables.MAX_ABS_VALUE` mm, a pose (:data:`POSES`; a track's ``rotation``)
 that is not a rigid transform (a proper rotation), or a quantity the report draws
@@ -14,15 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from robotcell.calibration.spec import result_procedures
 from robotcell.io.tables import MAX_ABS_VALUE
 from robotcell.kinematics.transforms import check_pose
 
-__all__ = ["GEOMETRY", "POSES", "PROCEDURES", "REQUIRED", "TOUCH_LISTS", "UNIT_VECTORS", "is_points",
-           "malformed"]
-
-#: The ``procedure`` of every result robotcell's calibrations write (``--json``).
-PROCEDURES = ("tcp", "frame-3point", "frame-npoint", "external-tcp", "track", "turntable",
-              "workpiece", "positioner-2axis")
+__all__ = ["GEOMETRY", "POSES", "REQUIRED", "TOUCH_LISTS", "UNIT_VECTORS", "is_points", "malformed"]
 
 #: Fields of a result that name touches (by their labels).
 TOUCH_LISTS = ("excluded", "unchecked", "outliers", "disagreeing", "gross_outliers")
@@ -88,9 +85,10 @@ def malformed(data: dict[str, Any]) -> str | None:
     is not there is not checked (:data:`REQUIRED` says which must be)."""
     if not isinstance(data["procedure"], str):
         return "'procedure' must be a text"
-    if data["procedure"] not in PROCEDURES:
+    known = result_procedures()
+    if data["procedure"] not in known:
         return (f"'procedure' {data['procedure']!r} is none robotcell calibrates "
-                f"({', '.join(PROCEDURES)})")
+                f"({', '.join(known)})")
     where = _not_finite(data, "")
     if where is not None:
         return f"{where.lstrip('.')!r} is not a finite number"

@@ -1,6 +1,6 @@
 """What each calibration procedure reads from a measurement table: columns, roles, units, counts.
 
-One :class:`Procedure` per procedure (:data:`SPECS`) says which columns its measurement table
+One :class:`TableSpec` per procedure (:data:`SPECS`) says which columns its measurement table
 has, the role of each (what it is), its unit in the table (the vendor boundary: mm, deg), which
 values column ``point`` takes, and the fewest touches the procedure can use. Everything that
 reads, writes or counts touches takes them from here: the reader of measurement tables
@@ -24,7 +24,10 @@ from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Literal
 
-__all__ = ["JOINT_COLUMNS", "POSE_COLUMNS", "ROLES", "SPECS", "Column", "Procedure"]
+from robotcell.errors import InputError
+
+__all__ = ["JOINT_COLUMNS", "POSE_COLUMNS", "ROLES", "SPECS", "Column", "TableSpec", "add",
+           "remove", "result_procedures"]
 
 #: The roles of the columns of a measurement table.
 ROLES = ("pose", "axis", "track", "point", "reference", "nominal")
@@ -45,7 +48,7 @@ class Column:
     name : str
         Lower-case name in the table's header.
     role : {"axis", "track", "point", "reference", "nominal"}
-        What it holds (:data:`ROLES`; the pose columns are :attr:`Procedure.pose`).
+        What it holds (:data:`ROLES`; the pose columns are :attr:`TableSpec.pose`).
     unit : {"mm", "deg", ""}
         Its unit in the table; ``""`` for text.
     meaning : str
@@ -67,7 +70,7 @@ class Column:
 
 
 @dataclass(frozen=True)
-class Procedure:
+class TableSpec:
     """The measurement table of one calibration procedure.
 
     Attributes
@@ -98,6 +101,10 @@ class Procedure:
         Columns the procedure refuses rather than ignores, each with the rest of the message
         after ``column 'NAME'`` (what it is and why it is refused; ``{procedure}`` stands for
         the procedure as the caller names it).
+    results : tuple of str
+        The ``procedure`` its estimators write into a result
+        (:attr:`~robotcell.calibration.result.CalibrationResult.procedure`), e.g.
+        ``("frame-3point", "frame-npoint")``; default its :attr:`name`.
     """
 
     name: str
@@ -110,6 +117,11 @@ class Procedure:
     counted: str = "touches"
     counted_point: str | None = None
     unused: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    results: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.results:
+            object.__setattr__(self, "results", (self.name,))
 
     def role(self, role: str) -> tuple[Column, ...]:
         """The columns of ``role``, in table order."""
@@ -126,7 +138,7 @@ class Procedure:
         the refused :attr:`unused` ones (which get their own message)."""
         return self.names + tuple(self.unused)
 
-    def with_axes(self, n: int) -> Procedure:
+    def with_axes(self, n: int) -> TableSpec:
         """The same procedure with ``n`` axis columns ``e1..en`` (as its first axis column):
         a workpiece on a positioner chain of ``n`` axes."""
         axes = self.role("axis")
@@ -158,38 +170,71 @@ _NOMINAL = tuple(Column(f"nominal_{a}", "nominal", "mm", f"known {a} of the touc
                         "the frame being calibrated") for a in "xyz")
 
 _SPECS = {
-    "tcp": Procedure(
+    "tcp": TableSpec(
         "tcp", "flange", (_track_column(), _point("tcp, -x, xy or world")),
         points=("tcp", "-x", "xy", "world"), default_point="tcp", counted_point="tcp",
         counted="touches of the reference point (point=tcp)"),
-    "frame": Procedure(
+    "frame": TableSpec(
         "frame", "tcp", (_track_column(), _point("origin, x or xy"), *_NOMINAL),
-        points=("origin", "x", "xy"), required_points=("origin", "x", "xy"), counted="points"),
-    "external-tcp": Procedure(
+        points=("origin", "x", "xy"), required_points=("origin", "x", "xy"), counted="points",
+        results=("frame-3point", "frame-npoint")),
+    "external-tcp": TableSpec(
         "external-tcp", "tcp", (_point("tcp, x or xy"),), points=("tcp", "x", "xy"),
         default_point="tcp", counted_point="tcp", counted="touches of the fixed TCP",
         unused=MappingProxyType({"track": (
             "(track position of each touch) is not used by {procedure}: touch the "
             "fixed tool with the track at one position and remove the column")})),
-    "track": Procedure(
+    "track": TableSpec(
         "track", "tcp", (Column("e1", "axis", "mm", "track position at each touch"),
                          _point("number 1..K of the reference point touched", "reference")),
         unused=MappingProxyType({"track": (
             "(track position of each touch) is not used by {procedure}: its track "
             "positions are column e1")})),
-    "turntable": Procedure(
+    "turntable": TableSpec(
         "turntable", "tcp", (Column("e1", "axis", "deg", _E1_TABLE, 4, "table"),
                              _track_column())),
-    "workpiece": Procedure(
+    "workpiece": TableSpec(
         "workpiece", "tcp", (Column("e1", "axis", "deg", _E1_TABLE, 4, "workpiece"),
                              _track_column(), _point("origin, x or xy")),
         points=("origin", "x", "xy"), required_points=("origin", "x", "xy")),
-    "positioner": Procedure(
+    "positioner": TableSpec(
         "positioner", "tcp", (Column("e1", "axis", "deg", "tilt (axis 1) at each touch", 4),
                               Column("e2", "axis", "deg", "rotate (axis 2) at each touch", 4),
                               _track_column()),
-        counted="touches that turn one axis alone"),
+        counted="touches that turn one axis alone", results=("positioner-2axis",)),
 }
 
-#: The procedures, by name (read-only).
-SPECS: Mapping[str, Procedure] = MappingProxyType(_SPECS)
+#: The procedures, by name (read-only; :func:`add` and :func:`remove` change it).
+SPECS: Mapping[str, TableSpec] = MappingProxyType(_SPECS)
+
+
+def add(spec: TableSpec) -> None:
+    """Add the table of a procedure defined outside this module (a plug-in), so that its
+    results are known (:func:`result_procedures`).
+
+    The registry of procedures (:func:`robotcell.cell.calibrate.registry.register`) calls it;
+    the specifications above are the built-in procedures'.
+
+    Raises
+    ------
+    InputError
+        A procedure of that name, or a result name, is known already.
+    """
+    if spec.name in _SPECS:
+        raise InputError(f"a procedure named {spec.name!r} is known already")
+    taken = set(spec.results) & set(result_procedures())
+    if taken:
+        raise InputError(f"procedure {spec.name!r}: results named {', '.join(sorted(taken))} "
+                         "are written by another procedure already")
+    _SPECS[spec.name] = spec
+
+
+def remove(name: str) -> None:
+    """Remove the table of a procedure that :func:`add` added (nothing when unknown)."""
+    _SPECS.pop(name, None)
+
+
+def result_procedures() -> tuple[str, ...]:
+    """The ``procedure`` of every result robotcell's calibrations write, in the order of
+    :data:`SPECS` (e.g. ``"frame-3point"`` of the frame procedure)."""
+    return tuple(r for spec in _SPECS.values() for r in spec.results)

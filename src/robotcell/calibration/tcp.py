@@ -14,7 +14,8 @@ instead aligns the tool with the world axes (5D: tool +X along world -Z; 6D: add
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,6 +24,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.calibration.fitting import (
     SAME_POINT,
     SINGULAR_CONDITION,
+    Fit,
     fit,
     nearest_rotation,
     outlier_warnings,
@@ -166,6 +168,36 @@ def calibrate_tool(
         no plane (the XY touch on the X axis to rounding). Similar orientations and short
         distances are computed, with a warning and a larger condition number.
     """
+    T, Ta, Tp, Tw = _tool_touches(touches, axis_touches, plane_touches, world_touches, world_mode)
+    n, na, nq = len(T), len(Ta), len(Tp)
+    if labels is None:
+        labels = ([f"{i + 1}" for i in range(n)] + [f"{n + i + 1} (-x)" for i in range(na)]
+                  + [f"{n + na + i + 1} (xy)" for i in range(nq)])
+    elif len(labels) != n + na + nq:
+        raise InputError(f"labels has {len(labels)} entries for {n + na + nq} touches")
+    x0, R0 = _tool_start(T, Ta, Tp)
+    resid, measured = _tool_model(T, Ta, Tp, R0)
+    names = ["tcp x", "tcp y", "tcp z", "pivot x", "pivot y", "pivot z"]
+    if na:
+        names += ["tool rotation about flange x", "tool rotation about flange y",
+                  "tool rotation about flange z"]
+    flipped = None if inputs is None else Inputs(-inputs.sensitivity, inputs.sources, inputs.names)
+    res = fit(resid, x0, names, prior_sigma, advice=SIMILAR, measured=measured, inputs=flipped)
+    warnings = outlier_warnings(res, labels)
+    spread = orientation_spread(T[:, :3, :3])
+    if spread < GOOD_SPREAD:
+        warnings.append(f"the touch orientations differ by only {np.degrees(spread):.1f} deg in their "
+                        f"least-varied direction: the TCP is poorly determined; {ADVICE}")
+    orientation = _tool_orientation(res, Ta, Tp, Tw, R0, world_mode, warnings)
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: {ADVICE}")
+    return _tool_result(res, orientation, labels, names, warnings)
+
+
+def _tool_touches(touches: ArrayLike, axis_touches: ArrayLike | None,
+                  plane_touches: ArrayLike | None, world_touches: ArrayLike | None,
+                  world_mode: str) -> tuple[NDArray[np.float64], ...]:
+    """The flange poses of :func:`calibrate_tool`, checked: TCP, -X, XY and ABC World touches."""
     T = _poses(touches, "touch flange poses")
     Ta = _poses(axis_touches, "ABC 2-point -X flange poses")
     Tp = _poses(plane_touches, "ABC 2-point XY flange poses")
@@ -181,13 +213,14 @@ def calibrate_tool(
                             "axis and one with it in the tool's XY plane (positive Y)")
     if len(Ta) and len(Tw):
         raise InputError("give either ABC 2-point touches or ABC World alignments, not both")
-    spread = orientation_spread(T[:, :3, :3])
-    n, na, nq = len(T), len(Ta), len(Tp)
-    if labels is None:
-        labels = ([f"{i + 1}" for i in range(n)] + [f"{n + i + 1} (-x)" for i in range(na)]
-                  + [f"{n + na + i + 1} (xy)" for i in range(nq)])
-    elif len(labels) != n + na + nq:
-        raise InputError(f"labels has {len(labels)} entries for {n + na + nq} touches")
+    return T, Ta, Tp, Tw
+
+
+def _tool_start(T: NDArray[np.float64], Ta: NDArray[np.float64], Tp: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Start of the fit: TCP and reference point by least squares, and with ABC 2-point touches
+    the tool orientation ``R0`` from them (else the flange's); the parameters start at them."""
+    n, na = len(T), len(Ta)
     # Linear start: [R_i, -I] [t; c] = -p_i.
     A = np.concatenate([T[:, :3, :3], np.broadcast_to(-np.eye(3), (n, 3, 3))], axis=2).reshape(-1, 6)
     if scaled_condition(A) > SINGULAR_CONDITION:  # A is the Jacobian of the TCP touches, exactly
@@ -214,7 +247,18 @@ def calibrate_tool(
         Y = w / np.linalg.norm(w)
         R0 = np.column_stack([X, Y, np.cross(X, Y)])
         x0 += [np.zeros(3)]
-    x0 = np.concatenate(x0)
+    return np.concatenate(x0), R0
+
+
+def _tool_model(T: NDArray[np.float64], Ta: NDArray[np.float64], Tp: NDArray[np.float64],
+                R0: NDArray[np.float64]
+                ) -> tuple[Callable[[NDArray[np.float64]], NDArray[np.float64]],
+                           Callable[[NDArray[np.float64]], NDArray[np.float64]]]:
+    """The residuals of the touches at parameters ``x`` (TCP, reference point, and with ABC
+    2-point touches the rotation from ``R0``), and the projection of each touch's residual onto
+    the directions it measures (an ABC 2-point touch does not measure along the tool axis or
+    within its plane)."""
+    n, na, nq = len(T), len(Ta), len(Tp)
     across = (np.diag([0.0, 1.0, 1.0]), np.diag([0.0, 0.0, 1.0]))  # in the tool frame
 
     def measured(x: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -238,48 +282,39 @@ def calibrate_tool(
                 out.append(np.einsum("nij,nj->ni", RkR, v @ E))
         return np.concatenate(out)
 
-    names = ["tcp x", "tcp y", "tcp z", "pivot x", "pivot y", "pivot z"]
-    if na:
-        names += ["tool rotation about flange x", "tool rotation about flange y",
-                  "tool rotation about flange z"]
-    flipped = None if inputs is None else Inputs(-inputs.sensitivity, inputs.sources, inputs.names)
-    res = fit(resid, x0, names, prior_sigma, advice=SIMILAR, measured=measured, inputs=flipped)
+    return resid, measured
+
+
+@dataclass
+class _Orientation:
+    """The tool orientation of a TCP fit (:func:`_tool_orientation`)."""
+
+    R: NDArray[np.float64] | None
+    sigma: NDArray[np.float64] | None
+    A: NDArray[np.float64]
+    extra_own: NDArray[np.float64]
+    undetermined: list[str]
+
+
+def _tool_orientation(res: Fit, Ta: NDArray[np.float64], Tp: NDArray[np.float64],
+                      Tw: NDArray[np.float64], R0: NDArray[np.float64], world_mode: str,
+                      warnings: list[str]) -> _Orientation:
+    """The tool orientation from ABC 2-point touches (in the fit) or ABC World alignments, its
+    1-sigma and how ``T_F_TCP`` follows the fit's parameters; warnings go to ``warnings``."""
     t, c = res.x[:3], res.x[3:6]
-    values: dict = {"tcp": t, "pivot": c}
-    sigma: dict = {"tcp": res.sigma[:3], "pivot": res.sigma[3:6]}
-    warnings = outlier_warnings(res, labels)
     undetermined: list[str] = []
-    if spread < GOOD_SPREAD:
-        warnings.append(f"the touch orientations differ by only {np.degrees(spread):.1f} deg in their "
-                        f"least-varied direction: the TCP is poorly determined; {ADVICE}")
-    R_tool = None
+    R_tool = sigma_rot = None
     A = np.eye(6, len(res.x))  # T_F_TCP (origin, rotation vector) from the fit's parameters
     A[3:6] = 0.0
     extra_own = np.zeros((6, 0))
-    if na:
+    if len(Ta):
         R_tool = perturb_rotation(R0, res.x[6:9])
         A[3:6, 6:9] = np.eye(3)
         sigma_rot = res.sigma[6:9]
         # The reference point in the tool frame at each ABC 2-point touch.
         local = [np.einsum("nji,nj->ni", Tk[:, :3, :3] @ R_tool, c - Tk[:, :3, 3]) - t @ R_tool
                  for Tk in (Ta, Tp)]
-        dist = -local[0][:, 0]
-        if np.any(dist <= 0):
-            raise IllPosedError("in a -X touch the reference point lies on the tool's positive X side; "
-                                "the -X touch must move the tool back, against its tool direction")
-        xy = local[1][:, :2]
-        if np.any(xy[:, 1] <= 0):
-            raise IllPosedError("the XY-plane touches lie on both sides of the tool's X axis; keep them "
-                                "all on the tool's positive Y side")
-        if dist.min() < GOOD_AXIS_DISTANCE:
-            warnings.append(f"in a -X touch the reference point is only {dist.min() * 1e3:.1f}"
-                            " mm from the TCP: the tool direction is poorly determined; move the tool "
-                            f"back along its axis by at least {GOOD_AXIS_DISTANCE * 1e3:.0f} mm")
-        sin_xy = np.min(xy[:, 1] / np.linalg.norm(xy, axis=1))
-        if sin_xy < NEAR_COLLINEAR_SIN:
-            warnings.append(f"an XY-plane touch is only {np.degrees(np.arcsin(sin_xy)):.1f} deg off the "
-                            "tool's X axis (nearly collinear): the rotation about X is poorly "
-                            "determined; move the tool sideways, toward its +Y side")
+        warnings += _two_point_warnings(local)
     elif len(Tw):
         R_tool, sigma_rot = _world_orientation(Tw[:, :3, :3], world_mode)
         extra_own = np.vstack([np.zeros((3, 3)), np.diag(np.nan_to_num(sigma_rot))])
@@ -291,8 +326,41 @@ def calibrate_tool(
                                 "rotation from the flange X axis is used)")
     else:
         undetermined.append("tool orientation (add ABC 2-point touches or ABC World alignments)")
-    if res.condition > CONDITION_LIMIT:
-        warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: {ADVICE}")
+    return _Orientation(R_tool, sigma_rot, A, extra_own, undetermined)
+
+
+def _two_point_warnings(local: list[NDArray[np.float64]]) -> list[str]:
+    """Check the reference point in the tool frame at the -X and XY touches (``local``): refuse
+    one on the wrong side, warn of one too near the TCP or the X axis."""
+    warnings = []
+    dist = -local[0][:, 0]
+    if np.any(dist <= 0):
+        raise IllPosedError("in a -X touch the reference point lies on the tool's positive X side; "
+                            "the -X touch must move the tool back, against its tool direction")
+    xy = local[1][:, :2]
+    if np.any(xy[:, 1] <= 0):
+        raise IllPosedError("the XY-plane touches lie on both sides of the tool's X axis; keep them "
+                            "all on the tool's positive Y side")
+    if dist.min() < GOOD_AXIS_DISTANCE:
+        warnings.append(f"in a -X touch the reference point is only {dist.min() * 1e3:.1f}"
+                        " mm from the TCP: the tool direction is poorly determined; move the tool "
+                        f"back along its axis by at least {GOOD_AXIS_DISTANCE * 1e3:.0f} mm")
+    sin_xy = np.min(xy[:, 1] / np.linalg.norm(xy, axis=1))
+    if sin_xy < NEAR_COLLINEAR_SIN:
+        warnings.append(f"an XY-plane touch is only {np.degrees(np.arcsin(sin_xy)):.1f} deg off the "
+                        "tool's X axis (nearly collinear): the rotation about X is poorly "
+                        "determined; move the tool sideways, toward its +Y side")
+    return warnings
+
+
+def _tool_result(res: Fit, orientation: _Orientation, labels: Sequence[str], names: list[str],
+                 warnings: list[str]) -> CalibrationResult:
+    """The result of :func:`calibrate_tool` from its fit and the tool orientation."""
+    t, c = res.x[:3], res.x[3:6]
+    values: dict = {"tcp": t, "pivot": c}
+    sigma: dict = {"tcp": res.sigma[:3], "pivot": res.sigma[3:6]}
+    R_tool, sigma_rot, A, extra_own = (orientation.R, orientation.sigma, orientation.A,
+                                       orientation.extra_own)
     tool = res.sources.map(A)
     if extra_own.size:  # ABC World: the spread of the alignments, independent of the touches
         tool = Sources(6, {**tool.factors, OWN: np.hstack([tool.factors[OWN], extra_own])})
@@ -314,7 +382,7 @@ def calibrate_tool(
                      "ABC World) if the process needs the tool direction")
     return CalibrationResult(
         procedure="tcp", values=values, sigma=sigma, labels=list(labels),
-        undetermined=undetermined, warnings=warnings, next_step=next_step, json_fields=extra,
-        covariance=res.covariance, parameter_names=names,
+        undetermined=orientation.undetermined, warnings=warnings, next_step=next_step,
+        json_fields=extra, covariance=res.covariance, parameter_names=names,
         estimates={"T_F_TCP": Estimate(tool, A @ res.input_gain, determined)}, **fit_fields(res),
     )

@@ -23,6 +23,8 @@ points off one common line parallel to the axis also determine ``c``.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -30,6 +32,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.calibration.fitting import (
     SAME_POINT,
+    Fit,
     fit,
     kabsch,
     nearest_rotation,
@@ -268,6 +271,42 @@ def calibrate_track(
         determine the parameters (see :func:`robotcell.calibration.fit`). Repeated track
         positions are data: they are averaged by the fit.
     """
+    f, e, d, labels, refs, groups = _track_touches(e, f, references, point, axis, roll, labels)
+    travel = _check_positions(e)
+    warnings: list[str] = [] if refs is None else _check_references(refs, d)
+    if refs is None:
+        tf = _unknown_point_track(e, f, d, axis, roll, prior_sigma, inputs)
+    else:
+        tf = _known_points_track(e, f, refs, groups, d, prior_sigma, inputs)
+    warnings += _track_warnings(tf, travel)
+    return _track_result(tf, f, refs, axis, labels, warnings)
+
+
+@dataclass
+class _TrackFit:
+    """A track fit (:func:`_unknown_point_track`, :func:`_known_points_track`) and what the
+    result of :func:`calibrate_track` takes from it."""
+
+    res: Fit
+    values: dict
+    sigma: dict
+    estimates: dict
+    undetermined: list[str]
+    direction: NDArray[np.float64]
+    direction_cov: NDArray[np.float64]
+    scale: float
+    Q: NDArray[np.float64] | None
+    source: str | None
+    offset: NDArray[np.float64] | None
+    next_step: str
+
+
+def _track_touches(e: ArrayLike, f: ArrayLike, references: ArrayLike | None,
+                   point: ArrayLike | None, axis: str, roll: str | None,
+                   labels: Sequence[str] | None) -> tuple[Any, ...]:
+    """The input of :func:`calibrate_track`, checked: TCP positions, track positions, the track
+    axis as a vector, the labels, the reference points and the index of the one each touch
+    touched."""
     f = as_points(f, "TCP positions")
     e = np.asarray(e, dtype=float)
     if f.ndim != 2 or e.shape != (len(f),):
@@ -284,7 +323,6 @@ def calibrate_track(
     if roll not in (None, "zero"):
         raise InputError(f"roll must be None or 'zero', got {roll!r}")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
-
     refs = None if references is None else as_points(np.atleast_2d(references), "reference points")
     if refs is not None and roll is not None:
         raise InputError("roll='zero' is a convention for an unmeasured rotation; with known "
@@ -305,93 +343,116 @@ def calibrate_track(
         if unused:
             raise InputError(f"reference point(s) {', '.join(str(u + 1) for u in unused)} were "
                              "never touched; drop them or add their touches")
-    travel = _check_positions(e)
-    warnings: list[str] = [] if refs is None else _check_references(refs, d)
+    return f, e, d, labels, refs, groups
 
+
+def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDArray[np.float64],
+                         axis: str, roll: str | None, prior_sigma: float | None,
+                         inputs: Inputs | None) -> _TrackFit:
+    """The track from touches of one unknown point: direction, scale and the point; the rotation
+    only by the zero-roll convention (``roll="zero"``)."""
     values: dict = {}
     sigma: dict = {}
     estimates: dict = {}
     undetermined: list[str] = []
-    if refs is None:
-        res, e_mean = _fit_unknown_point(e, f, prior_sigma, inputs)
+    res, e_mean = _fit_unknown_point(e, f, prior_sigma, inputs)
 
-        def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
-            s = np.linalg.norm(x[3:])
-            return np.concatenate([x[3:] / s, [s], x[:3] + e_mean * x[3:]])
+    def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        s = np.linalg.norm(x[3:])
+        return np.concatenate([x[3:] / s, [s], x[:3] + e_mean * x[3:]])
 
-        y = derived(res.x)
-        cov = propagate(derived, res.x, res.covariance)
-        sd = np.sqrt(np.abs(np.diag(cov)))
-        direction, scale = y[:3], float(y[3])
-        values.update(direction=direction, scale=scale, point=y[4:7])
-        sigma.update(direction=sd[:3], scale=float(sd[3]), point=sd[4:7])
-        direction_cov = cov[:3, :3]
-        undetermined.append(
-            "rotation of L_Q_R about the track axis: touches of one unknown point cannot see it"
-            + (" (set by the zero-roll convention)" if roll == "zero" else ""))
-        undetermined.append("carriage offset (position of R in L at track position 0)"
-                            + (": taken as zero, the lecture's assumption (ii)" if roll == "zero" else ""))
-        if roll == "zero":
-            Q = zero_roll_rotation(direction, axis)
+    y = derived(res.x)
+    cov = propagate(derived, res.x, res.covariance)
+    sd = np.sqrt(np.abs(np.diag(cov)))
+    direction, scale = y[:3], float(y[3])
+    values.update(direction=direction, scale=scale, point=y[4:7])
+    sigma.update(direction=sd[:3], scale=float(sd[3]), point=sd[4:7])
+    direction_cov = cov[:3, :3]
+    undetermined.append(
+        "rotation of L_Q_R about the track axis: touches of one unknown point cannot see it"
+        + (" (set by the zero-roll convention)" if roll == "zero" else ""))
+    undetermined.append("carriage offset (position of R in L at track position 0)"
+                        + (": taken as zero, the lecture's assumption (ii)" if roll == "zero" else ""))
+    if roll == "zero":
+        Q = zero_roll_rotation(direction, axis)
 
-            def roll_rotvec(x: NDArray[np.float64]) -> NDArray[np.float64]:
-                return Rotation.from_matrix(zero_roll_rotation(derived(x)[:3], axis) @ Q.T).as_rotvec()
+        def roll_rotvec(x: NDArray[np.float64]) -> NDArray[np.float64]:
+            return Rotation.from_matrix(zero_roll_rotation(derived(x)[:3], axis) @ Q.T).as_rotvec()
 
-            values["T_L_R"] = make_pose(Q, np.zeros(3))
-            A = np.zeros((7, 6))
-            A[3:6] = jacobian(roll_rotvec, res.x)
-            A[6] = jacobian(lambda x: [np.linalg.norm(x[3:])], res.x)
-            sigma["T_L_R_rotation"] = np.sqrt(np.abs(np.diag(A[3:6] @ res.covariance @ A[3:6].T)))
-            across = np.eye(3) - np.outer(d, d)
-            U = np.linalg.svd(across)[0][:, :2]
-            determined = np.zeros((7, 3))
-            determined[3:6, :2], determined[6, 2] = U, 1.0
-            estimates["T_L_R"] = estimate(res.sources, res.input_gain, A, determined)
-            source, offset = "convention: zero roll", None
-            next_step = ("the rotation about the track axis is a convention, not a measurement; to "
-                         "measure it, touch reference points with known coordinates in L "
-                         f"({term('reference', 'references')})")
-        else:
-            Q, source, offset = None, None, None
-            next_step = ("enter the direction and scale in the track's machine data; for the full "
-                         "rotation L_Q_R touch one reference point with known coordinates in L off "
-                         "the track axis (two or more also give the carriage offset) and pass them "
-                         f"with {term('reference', 'references')}, or accept the zero-roll "
-                         f"convention ({term('roll=zero', 'roll=' + repr('zero'))})")
-    else:
-        res, unpack = _fit_known_points(e, f, refs, groups, d, prior_sigma, inputs)
-        Q, scale, c = unpack(res.x)
-        scale = float(scale)
-        A = np.zeros((7, len(res.x)))
-        A[:3] = jacobian(lambda x: unpack(x)[2], res.x)
-        A[3:6, :3] = np.eye(3)
-        A[6, 3] = 1.0
-        determined = np.eye(7)[:, 3:] if len(refs) < 2 else None
+        values["T_L_R"] = make_pose(Q, np.zeros(3))
+        A = np.zeros((7, 6))
+        A[3:6] = jacobian(roll_rotvec, res.x)
+        A[6] = jacobian(lambda x: [np.linalg.norm(x[3:])], res.x)
+        sigma["T_L_R_rotation"] = np.sqrt(np.abs(np.diag(A[3:6] @ res.covariance @ A[3:6].T)))
+        across = np.eye(3) - np.outer(d, d)
+        U = np.linalg.svd(across)[0][:, :2]
+        determined = np.zeros((7, 3))
+        determined[3:6, :2], determined[6, 2] = U, 1.0
         estimates["T_L_R"] = estimate(res.sources, res.input_gain, A, determined)
+        source, offset = "convention: zero roll", None
+        next_step = ("the rotation about the track axis is a convention, not a measurement; to "
+                     "measure it, touch reference points with known coordinates in L "
+                     f"({term('reference', 'references')})")
+    else:
+        Q, source, offset = None, None, None
+        next_step = ("enter the direction and scale in the track's machine data; for the full "
+                     "rotation L_Q_R touch one reference point with known coordinates in L off "
+                     "the track axis (two or more also give the carriage offset) and pass them "
+                     f"with {term('reference', 'references')}, or accept the zero-roll "
+                     f"convention ({term('roll=zero', 'roll=' + repr('zero'))})")
+    return _TrackFit(res, values, sigma, estimates, undetermined, direction, direction_cov, scale,
+                     Q, source, offset, next_step)
 
-        def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
-            Qx, _, cx = unpack(x)
-            return np.concatenate([Qx.T @ d, cx])
 
-        cov = propagate(derived, res.x, res.covariance)
-        sd = np.sqrt(np.abs(np.diag(cov)))
-        direction = Q.T @ d
-        direction_cov = cov[:3, :3]
-        values.update(direction=direction, scale=scale, T_L_R=make_pose(Q, c))
-        sigma.update(direction=sd[:3], scale=float(res.sigma[3]), T_L_R_rotation=res.sigma[:3])
-        if len(refs) >= 2:
-            sigma["T_L_R_position"] = sd[3:6]
-            offset = c
-        else:
-            undetermined.append("carriage offset (position of R in L at track position 0): taken "
-                                "as zero, the lecture's assumption (ii); two or more known "
-                                "reference points measure it")
-            offset = None
-        source = "measured"
-        next_step = ("enter T_L_R (robot base on the carriage at track position 0) and the scale in "
-                     "the controller's track machine data, then verify by touching a reference "
-                     "point at both ends of the track")
+def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: NDArray[np.float64],
+                        groups: NDArray[np.int_], d: NDArray[np.float64],
+                        prior_sigma: float | None, inputs: Inputs | None) -> _TrackFit:
+    """The track from touches of reference points known in L: its pose ``T_L_R`` and scale (the
+    carriage offset with two or more points)."""
+    values: dict = {}
+    sigma: dict = {}
+    estimates: dict = {}
+    undetermined: list[str] = []
+    res, unpack = _fit_known_points(e, f, refs, groups, d, prior_sigma, inputs)
+    Q, scale, c = unpack(res.x)
+    scale = float(scale)
+    A = np.zeros((7, len(res.x)))
+    A[:3] = jacobian(lambda x: unpack(x)[2], res.x)
+    A[3:6, :3] = np.eye(3)
+    A[6, 3] = 1.0
+    determined = np.eye(7)[:, 3:] if len(refs) < 2 else None
+    estimates["T_L_R"] = estimate(res.sources, res.input_gain, A, determined)
 
+    def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        Qx, _, cx = unpack(x)
+        return np.concatenate([Qx.T @ d, cx])
+
+    cov = propagate(derived, res.x, res.covariance)
+    sd = np.sqrt(np.abs(np.diag(cov)))
+    direction = Q.T @ d
+    direction_cov = cov[:3, :3]
+    values.update(direction=direction, scale=scale, T_L_R=make_pose(Q, c))
+    sigma.update(direction=sd[:3], scale=float(res.sigma[3]), T_L_R_rotation=res.sigma[:3])
+    if len(refs) >= 2:
+        sigma["T_L_R_position"] = sd[3:6]
+        offset = c
+    else:
+        undetermined.append("carriage offset (position of R in L at track position 0): taken "
+                            "as zero, the lecture's assumption (ii); two or more known "
+                            "reference points measure it")
+        offset = None
+    source = "measured"
+    next_step = ("enter T_L_R (robot base on the carriage at track position 0) and the scale in "
+                 "the controller's track machine data, then verify by touching a reference "
+                 "point at both ends of the track")
+    return _TrackFit(res, values, sigma, estimates, undetermined, direction, direction_cov, scale,
+                     Q, source, offset, next_step)
+
+
+def _track_warnings(tf: _TrackFit, travel: float) -> list[str]:
+    """Refuse a scale no track has; warn of one far from 1, a poor condition, a short travel."""
+    res, scale, direction_cov = tf.res, tf.scale, tf.direction_cov
+    warnings: list[str] = []
     if not 1.0 / SCALE_REFUSE < scale < SCALE_REFUSE:
         raise InputError(
             f"the robot base moved {scale:.3g} times the commanded track travel; the touches are "
@@ -410,6 +471,17 @@ def calibrate_track(
                         f"direction is poorly determined (1-sigma {np.degrees(direction_sigma):.2f} "
                         f"deg); spread them over at least {TRAVEL_WARN * 1e3:.0f} mm, ideally "
                         "the whole track")
+    return warnings
+
+
+def _track_result(tf: _TrackFit, f: NDArray[np.float64], refs: NDArray[np.float64] | None,
+                  axis: str, labels: list[str], warnings: list[str]) -> CalibrationResult:
+    """The result of :func:`calibrate_track` from its fit."""
+    res, direction, scale, Q, source, offset = (tf.res, tf.direction, tf.scale, tf.Q, tf.source,
+                                                tf.offset)
+    values, sigma, estimates, undetermined, next_step = (tf.values, tf.sigma, tf.estimates,
+                                                         tf.undetermined, tf.next_step)
+    direction_sigma = float(np.sqrt(np.abs(np.trace(tf.direction_cov))))
     warnings += outlier_warnings(res, labels)
     across = res.residuals - np.outer(res.residuals @ direction, direction)
     json_fields = {

@@ -16,12 +16,12 @@ phase) and ``r``, which keeps ``X_B``, ``Y_B`` orthonormal and the radius common
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.fitting import SAME_POINT, fit, outlier_warnings, perturb_rotation
+from robotcell.calibration.fitting import SAME_POINT, Fit, fit, outlier_warnings, perturb_rotation
 from robotcell.calibration.propagate import propagate
 from robotcell.calibration.result import (
     CONDITION_LIMIT,
@@ -153,19 +153,7 @@ def calibrate_turntable(
         do not determine the parameters (see :func:`robotcell.calibration.fit`). A point near the
         axis is computed, with a warning below :data:`RADIUS_WARN` and a larger condition number.
     """
-    f = as_points(f, "TCP positions")
-    theta = np.asarray(theta, dtype=float)
-    if f.ndim != 2 or theta.shape != (len(f),):
-        raise InputError(f"table angles must have shape (N,) matching TCP positions (N, 3); "
-                         f"got {theta.shape} and {f.shape}")
-    if not np.all(np.isfinite(theta)) or not np.isfinite(height):
-        raise InputError("table angles or height contain NaN or infinite values")
-    n = len(f)
-    if n < SPECS["turntable"].minimum:
-        raise InputError(f"touches: {n} given, at least {SPECS['turntable'].minimum} needed at "
-                         "different table angles (6 or "
-                         "more let a wrong touch be singled out)")
-    labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
+    f, theta, labels = _turntable_touches(theta, f, height, labels)
     spread = _check_angles(theta)
     b_plane, R0, r0 = _linear_start(theta, f)
     rot_theta = rot_z(theta)
@@ -182,6 +170,35 @@ def calibrate_turntable(
              "rotation about R z", "radius"]
     x0 = np.concatenate([b_plane + height * R0[:, 2], np.zeros(3), [r0]])
     res = fit(residuals, x0, names, prior_sigma, inputs=inputs)
+    return _turntable_result(res, unpack, f, height, spread, labels)
+
+
+def _turntable_touches(theta: ArrayLike, f: ArrayLike, height: float,
+                       labels: Sequence[str] | None
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
+    """The input of :func:`calibrate_turntable`, checked: TCP positions, angles, labels."""
+    f = as_points(f, "TCP positions")
+    theta = np.asarray(theta, dtype=float)
+    if f.ndim != 2 or theta.shape != (len(f),):
+        raise InputError(f"table angles must have shape (N,) matching TCP positions (N, 3); "
+                         f"got {theta.shape} and {f.shape}")
+    if not np.all(np.isfinite(theta)) or not np.isfinite(height):
+        raise InputError("table angles or height contain NaN or infinite values")
+    n = len(f)
+    if n < SPECS["turntable"].minimum:
+        raise InputError(f"touches: {n} given, at least {SPECS['turntable'].minimum} needed at "
+                         "different table angles (6 or "
+                         "more let a wrong touch be singled out)")
+    labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
+    return f, theta, labels
+
+
+def _turntable_result(res: Fit, unpack: Callable[[NDArray[np.float64]],
+                                                 tuple[NDArray[np.float64], float]],
+                      f: NDArray[np.float64], height: float, spread: float, labels: list[str]
+                      ) -> CalibrationResult:
+    """The result of :func:`calibrate_turntable` from its fit (``unpack`` gives ``T_R_B`` and
+    the radius of the parameters)."""
     T, radius = unpack(res.x)
     axis = T[:3, 2]
     tilt = float(np.arccos(np.clip(axis[2], -1.0, 1.0)))
@@ -197,22 +214,7 @@ def calibrate_turntable(
     else:
         tilt_sigma = axis_sigma
 
-    warnings = []
-    if spread < SPREAD_WARN:
-        warnings.append(f"the touches span only {np.degrees(spread):.0f} deg of table rotation; "
-                        "spread them over at least 90 deg (ideally around the full turn) for a "
-                        "well-determined axis")
-    if radius < RADIUS_WARN:
-        warnings.append(f"the reference point is only {radius * 1e3:.1f} mm from the table axis: the "
-                        "axis direction and the angle zero are poorly determined; touch a point at "
-                        f"least {RADIUS_WARN * 1e3:.0f} mm from the axis, ideally near the rim")
-    if tilt > np.pi / 2:
-        warnings.append("Z_B points downward in the robot base: positive table angles turn the "
-                        "table clockwise seen from above; check the axis sign in the controller's "
-                        "machine data if that is unexpected")
-    if res.condition > CONDITION_LIMIT:
-        warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: "
-                        "spread the touches around the full turn and use a point near the rim")
+    warnings = _turntable_warnings(res, spread, radius, tilt)
     warnings += outlier_warnings(res, labels)
     to_mm_rad = np.array([1e3, 1e3, 1e3, 1.0, 1.0, 1.0])
     cov6_mm = res.covariance[:6, :6] * np.outer(to_mm_rad, to_mm_rad)
@@ -243,3 +245,25 @@ def calibrate_turntable(
         estimates={"T_R_B": estimate(res.sources, res.input_gain, np.eye(6, 7))},
         **fit_fields(res),
     )
+
+
+def _turntable_warnings(res: Fit, spread: float, radius: float, tilt: float) -> list[str]:
+    """Warnings of a turntable fit: a short spread of angles, a point near the axis, an axis
+    pointing down, a poor condition."""
+    warnings = []
+    if spread < SPREAD_WARN:
+        warnings.append(f"the touches span only {np.degrees(spread):.0f} deg of table rotation; "
+                        "spread them over at least 90 deg (ideally around the full turn) for a "
+                        "well-determined axis")
+    if radius < RADIUS_WARN:
+        warnings.append(f"the reference point is only {radius * 1e3:.1f} mm from the table axis: the "
+                        "axis direction and the angle zero are poorly determined; touch a point at "
+                        f"least {RADIUS_WARN * 1e3:.0f} mm from the axis, ideally near the rim")
+    if tilt > np.pi / 2:
+        warnings.append("Z_B points downward in the robot base: positive table angles turn the "
+                        "table clockwise seen from above; check the axis sign in the controller's "
+                        "machine data if that is unexpected")
+    if res.condition > CONDITION_LIMIT:
+        warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: "
+                        "spread the touches around the full turn and use a point near the rim")
+    return warnings

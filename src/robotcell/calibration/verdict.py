@@ -288,6 +288,30 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         if not size <= CELL_EXTENT_MM:
             poor.append(f"{name} of {size:.3g} mm is beyond any real cell "
                         f"({CELL_EXTENT_MM / 1e3:.0f} m): a unit or typing error in the measurements")
+    x2, bound = _chi2_checks(result, ssr, n, dof, s, what, poor, check)
+    _geometry_checks(result, cond, poor, check)
+    _touch_checks(result, excluded, dof, poor, check)
+    needed = touches_for_outlier_check(n, dof) if n else None
+    if needed is not None:
+        check.append(_too_few(n, left_out, dof, needed))
+    if poor:
+        level, reasons = "poor", poor + check
+    elif check:
+        level, reasons = "check", check
+    else:
+        level = "good"
+        rms = math.sqrt(ssr / n) if n else 0.0
+        reasons = [f"RMS {rms:.3f} mm within {what}, condition number "
+                   + f"{format_condition(cond)}, no warnings"]
+    return Verdict(level=level, reasons=reasons, condition=cond, touch_sigma_mm=s,
+                   accuracy_source=source, chi2=x2, chi2_bound=bound, touches_needed=needed)
+
+
+def _chi2_checks(result: Mapping[str, Any], ssr: float, n: int, dof: int, s: float, what: str,
+                 poor: list[str], check: list[str]) -> tuple[float | None, float | None]:
+    """The residuals against the touch accuracy ``s`` (mm; ``what`` names it): a chi-square
+    beyond its bound is ``check``, beyond the bound for :data:`POOR_FACTOR` times the accuracy
+    ``poor``. Returns the chi-square and its bound (None without redundancy)."""
     x2 = bound = None
     if dof > 0:
         x2 = _number(result.get("chi2"), ssr / s**2)
@@ -304,6 +328,12 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
             check.append(f"RMS {rms:.3f} mm is larger than {what} explains (chi-square "
                          f"{x2:.3g} > {bound:.3g}, the {CHI2_P:.1%} bound for {dof} redundant "
                          "coordinates)")
+    return x2, bound
+
+
+def _geometry_checks(result: Mapping[str, Any], cond: float, poor: list[str],
+                     check: list[str]) -> None:
+    """A track scale far from 1 and the condition number, into ``poor`` and ``check``."""
     scale = result.get("scale")
     if isinstance(scale, (int, float)):
         if not abs(scale - 1.0) <= SCALE_POOR:
@@ -318,6 +348,12 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
     elif cond > CONDITION_GOOD:
         check.append(f"condition number {format_condition(cond)} > {CONDITION_GOOD:.0f}: "
                      "spread the touches")
+
+
+def _touch_checks(result: Mapping[str, Any], excluded: list[str], dof: int, poor: list[str],
+                  check: list[str]) -> None:
+    """The touches the result flags (outliers, disagreeing, gross, left out, unchecked) and its
+    warnings, into ``poor`` and ``check``."""
     warnings = result.get("warnings") or []
     warnings = list(warnings) if isinstance(warnings, list) else [str(warnings)]
     about_outliers = sum("outlier" in str(w) for w in warnings)
@@ -350,17 +386,3 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
     if unchecked and dof > 0:
         check.append(f"touch(es) {', '.join(unchecked)} decide part of the result alone (no other "
                      "touch checks them, so an error there goes unseen): repeat them")
-    needed = touches_for_outlier_check(n, dof) if n else None
-    if needed is not None:
-        check.append(_too_few(n, left_out, dof, needed))
-    if poor:
-        level, reasons = "poor", poor + check
-    elif check:
-        level, reasons = "check", check
-    else:
-        level = "good"
-        rms = math.sqrt(ssr / n) if n else 0.0
-        reasons = [f"RMS {rms:.3f} mm within {what}, condition number "
-                   + f"{format_condition(cond)}, no warnings"]
-    return Verdict(level=level, reasons=reasons, condition=cond, touch_sigma_mm=s,
-                   accuracy_source=source, chi2=x2, chi2_bound=bound, touches_needed=needed)

@@ -16,6 +16,7 @@ input. The moving pose is ``T_R_W(theta) = T_R_B Rz(theta) T_B_W`` (:func:`workp
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -138,6 +139,38 @@ def calibrate_workpiece(
         determine the frame (see :func:`robotcell.calibration.frame.frame_3point`). Points close
         together are computed, with a warning and a larger condition number.
     """
+    f, theta, roles, T_R_B, turntable, labels = _workpiece_touches(theta, f, roles, T_R_B,
+                                                                   T_R_B_covariance, labels)
+    n = len(f)
+    back = rot_z(theta) @ T_R_B[:3, :3]  # carries a vector in B at angle 0 back to R
+    p = table_points(T_R_B, theta, f)
+    to_b = None if inputs is None else inputs.rotated(np.swapaxes(back, 1, 2))
+    if turntable is not None:
+        t0 = np.concatenate([T_R_B[:3, 3], np.zeros(3)])
+        moved = jacobian(lambda t: table_points(perturb_pose(T_R_B, t), theta, f), t0)
+        to_b = joined(to_b, moved.reshape(n, 3, 6), turntable,
+                      [f"turntable {k}" for k in ("x", "y", "z", "rx", "ry", "rz")])
+    out = frame_3point(p, list(roles), prior_sigma, labels, inputs=to_b).renamed("T_R_W", "T_B_W")
+    out.residuals = np.einsum("nij,nj->ni", back, out.residuals)
+    if out.points is not None:
+        out.points = f
+    out.procedure = "workpiece"
+    if turntable is None:
+        out.undetermined.append("the turntable calibration's own uncertainty (no covariance "
+                                "given), which is not included in the 1-sigma figures")
+    out.next_step = ("enter T_B_W as the workpiece (base) frame on the turntable's kinematics in "
+                     "the controller, then check it by touching the origin at two other table "
+                     "angles")
+    out.json_fields.update({"turntable_matrix": pose_fields(T_R_B)["matrix"],
+                            "turntable_included": turntable is not None})
+    return out
+
+
+def _workpiece_touches(theta: ArrayLike, f: ArrayLike, roles: Sequence[str], T_R_B: ArrayLike,
+                       T_R_B_covariance: ArrayLike | Sources | None,
+                       labels: Sequence[str] | None) -> tuple[Any, ...]:
+    """The input of :func:`calibrate_workpiece`, checked: TCP positions, angles, roles, the
+    turntable's pose and its error sources (None when not given), labels."""
     f = as_points(f, "TCP positions")
     theta = np.asarray(theta, dtype=float)
     n = len(f)
@@ -164,26 +197,4 @@ def calibrate_workpiece(
             raise InputError(f"T_R_B covariance must be a finite 6x6 matrix, got shape {cov_t.shape}")
         turntable = Sources.of("turntable", cov_t)
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(n)]
-
-    back = rot_z(theta) @ T_R_B[:3, :3]  # carries a vector in B at angle 0 back to R
-    p = table_points(T_R_B, theta, f)
-    to_b = None if inputs is None else inputs.rotated(np.swapaxes(back, 1, 2))
-    if turntable is not None:
-        t0 = np.concatenate([T_R_B[:3, 3], np.zeros(3)])
-        moved = jacobian(lambda t: table_points(perturb_pose(T_R_B, t), theta, f), t0)
-        to_b = joined(to_b, moved.reshape(n, 3, 6), turntable,
-                      [f"turntable {k}" for k in ("x", "y", "z", "rx", "ry", "rz")])
-    out = frame_3point(p, list(roles), prior_sigma, labels, inputs=to_b).renamed("T_R_W", "T_B_W")
-    out.residuals = np.einsum("nij,nj->ni", back, out.residuals)
-    if out.points is not None:
-        out.points = f
-    out.procedure = "workpiece"
-    if turntable is None:
-        out.undetermined.append("the turntable calibration's own uncertainty (no covariance "
-                                "given), which is not included in the 1-sigma figures")
-    out.next_step = ("enter T_B_W as the workpiece (base) frame on the turntable's kinematics in "
-                     "the controller, then check it by touching the origin at two other table "
-                     "angles")
-    out.json_fields.update({"turntable_matrix": pose_fields(T_R_B)["matrix"],
-                            "turntable_included": turntable is not None})
-    return out
+    return f, theta, roles, T_R_B, turntable, labels

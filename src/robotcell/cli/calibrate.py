@@ -6,14 +6,14 @@ is refused. With ``--cell CELL.yaml`` (tcp, frame, track, turntable, workpiece) 
 written into the cell file: the command parses its options, makes one call of
 :mod:`robotcell.cell.calibrate` (which returns the result and the updated cell), prints its notes on
 stderr and saves the cell through :class:`CellTarget`.
-Subcommands of other modules are listed in ``REGISTERED`` at the bottom of this file and imported
-only when used.
+There is one subcommand per procedure of the registry
+(:data:`robotcell.cell.calibrate.PROCEDURES`): its own command where it has options of its own,
+in this module or in another one listed in ``REGISTERED`` at the bottom of this file (imported
+only when used), else one made from the procedure (:func:`procedure_command`).
 """
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 import json
 import math
 from collections.abc import Callable
@@ -26,9 +26,11 @@ from numpy.typing import NDArray
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
+from robotcell.cell.calibrate import PROCEDURES, CalibrationContext, Procedure
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
+from robotcell.cli import load_command
 from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
-from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, Group
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.robot.models import load_robot
@@ -36,19 +38,19 @@ from robotcell.robot.robot import Robot
 
 
 class CalibrateGroup(Group):
-    """The ``calibrate`` group: its own subcommands plus the lazily imported ``REGISTERED`` ones."""
+    """The ``calibrate`` group: ``cell`` and one subcommand per registered procedure, its own
+    (here or in ``REGISTERED``, imported when used) or one made from the procedure."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
-        extra = [name for name, target in REGISTERED.items()
-                 if importlib.util.find_spec(target.split(":")[0]) is not None]
-        return sorted(set(super().list_commands(ctx)) | set(extra))
+        return sorted(set(super().list_commands(ctx)) | set(REGISTERED) | set(PROCEDURES))
 
     def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
         cmd = super().get_command(ctx, name)
-        if cmd is not None or name not in self.list_commands(ctx):
+        if cmd is not None:
             return cmd
-        module, attr = REGISTERED[name].split(":")
-        return getattr(importlib.import_module(module), attr)
+        if name in REGISTERED:
+            return load_command(REGISTERED[name])
+        return procedure_command(PROCEDURES[name]) if name in PROCEDURES else None
 
 
 @click.group(cls=CalibrateGroup)
@@ -474,12 +476,49 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
     emit(out, as_json)
 
 
+def procedure_command(proc: Procedure) -> click.Command:
+    """The ``calibrate`` subcommand of a registered procedure that has no command of its own.
+
+    It takes the measurement CSV, ``--cell`` (with ``--name`` for a procedure that writes a
+    tool or a frame) and the options every calibration takes (:func:`measurement_options`), and
+    calls the procedure's ``calibrate`` with them as its
+    :class:`~robotcell.cell.calibrate.CalibrationContext`.
+    """
+    what = proc.item.partition(".")[0].removesuffix("s")  # "tool" or "frame" when named
+
+    def run(measurements: str, cell_path: str | None, robot: str | None, tool: str | None,
+            sigma: float | None, as_json: bool, accept_poor: bool, name: str | None = None
+            ) -> None:
+        target = CellTarget.open(cell_path, robot)
+        if proc.named:
+            require_name(name, target, what)
+        model, T_tool = robot_and_tool(robot, tool, target)
+        cell, label = cell_of(target)
+        context = CalibrationContext(robot=None if cell else model, tool=T_tool,
+                                     sigma=sigma_m(sigma), source=measurements, cell_label=label,
+                                     on_note=echo_note, **chain_options(measurements))
+        out = proc.calibrate(cell, measurements, *([name] if proc.named else []), context=context)
+        finish(out, target, as_json, accept_poor)
+
+    command = cell_option(measurement_options(run))
+    if proc.named:
+        command = click.option("--name", default=None, metavar=what.upper(),
+                               help=f"With --cell: the {what} of the cell to write (added when "
+                                    "new).")(command)
+    command = click.argument("measurements", type=click.Path(dir_okay=False))(command)
+    columns = ", ".join(c.name for c in proc.spec.columns)
+    return click.command(proc.name, cls=Command, help=(
+        f"{proc.summary[:1].upper()}{proc.summary[1:]}.\n\nRows: TCP positions x,y,z (mm) or "
+        f"joint values a1..a6 with --robot or --cell" + (f"; columns {columns}" if columns
+                                                        else "") + "."))(command)
+
+
 # ------------------------------------------------------------------------------------------------
 # Registration list: calibrate subcommands that live in other modules, "name": "module:attribute".
-# A module listed here is imported only when its subcommand is used; an entry whose module does
-# not exist yet is simply not offered. Subcommands may use measurement_options, robot_and_tool,
-# sigma_m, gate, emit, finish, and for --cell cell_option, CellTarget, cell_of and echo_note, from
-# this module.
+# A module listed here is imported only when its subcommand is used (robotcell.cli.load_command);
+# one that cannot be imported is an error, never left out in silence. Subcommands may use
+# measurement_options, robot_and_tool, sigma_m, gate, emit, finish, and for --cell cell_option,
+# CellTarget, cell_of and echo_note, from this module.
 REGISTERED: dict[str, str] = {
     "track": "robotcell.cli.calibrate_axes:track",
     "turntable": "robotcell.cli.calibrate_axes:turntable",

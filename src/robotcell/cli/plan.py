@@ -12,7 +12,13 @@ import click
 from robotcell.cell import Cell
 from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
-from robotcell.cli.simulate import calibrate_hint, cell_options, common_keywords, design_keywords
+from robotcell.cli.simulate import (
+    ProcedureChoice,
+    calibrate_hint,
+    cell_options,
+    common_keywords,
+    design_keywords,
+)
 from robotcell.errors import InputError
 from robotcell.studies.plan import DESIGNS, LEVER, Candidate
 from robotcell.studies.plan import plan as make_plan
@@ -42,8 +48,26 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
         yield from bar
 
 
+def _designs(procedure: str, max_size: float | None, max_radius: float | None
+             ) -> list[dict[str, Any]]:
+    """The candidate designs of ``procedure`` within ``--max-size`` and ``--max-radius`` (mm)."""
+    designs = DESIGNS[procedure]
+    for name, limit, key, applies in (("--max-size", max_size, "size", ("frame", "workpiece")),
+                                      ("--max-radius", max_radius, "radius", ("turntable",))):
+        if limit is None:
+            continue
+        if procedure not in applies:
+            raise InputError(f"{name} does not apply to {procedure}")
+        designs = [d for d in designs if d[key] <= limit * 1e-3 + 1e-12]
+        if not designs:
+            smallest = min(d[key] for d in DESIGNS[procedure]) * 1e3
+            raise InputError(f"{name} {limit:g} mm leaves no design; the smallest is "
+                             f"{smallest:g} mm")
+    return designs
+
+
 @click.command(cls=Command)
-@click.argument("procedure", type=click.Choice(list(DESIGNS)))
+@click.argument("procedure", type=ProcedureChoice(DESIGNS))
 @cell_options
 @click.option("--runs", type=click.IntRange(min=0), default=100, show_default=True,
               help="Monte Carlo runs at the best design (0: none).")
@@ -54,10 +78,8 @@ def _progress(items: Sized, label: str) -> Iterable[Any]:
 @click.option("-o", "--output", type=OUTPUT, default=None,
               callback=output_of("CSV", "the proposed touches"),
               help="Write the proposed touches (exact joint values to teach) as CSV, atomically.")
-def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: str | None,
-         frame: str | None, track_mm: float | None, touches: int | None, repeats: int | None,
-         runs: int, max_size: float | None, max_radius: float | None,
-         output: str | None) -> None:
+def plan(procedure: str, cell_path: str, noise: float, runs: int, output: str | None,
+         **given: Any) -> None:
     """Propose touches for PROCEDURE that minimise the predicted uncertainty.
 
     Every candidate design (tcp: tilt; frame/workpiece: size of the 3-point triangle; track:
@@ -78,22 +100,12 @@ def plan(procedure: str, cell_path: str, noise: float, seed: int | None, tool: s
         raise InputError(f"--noise must be a positive number of millimetres, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
     cell = Cell.load(cell_path)
-    common = common_keywords(procedure, tool, frame, track_mm)
-    common.update(design_keywords(procedure, {"touches": touches, "repeats": repeats}))
-    designs = DESIGNS[procedure]
-    for name, limit, key, applies in (("--max-size", max_size, "size", ("frame", "workpiece")),
-                                      ("--max-radius", max_radius, "radius", ("turntable",))):
-        if limit is None:
-            continue
-        if procedure not in applies:
-            raise InputError(f"{name} does not apply to {procedure}")
-        designs = [d for d in designs if d[key] <= limit * 1e-3 + 1e-12]
-        if not designs:
-            smallest = min(d[key] for d in DESIGNS[procedure]) * 1e3
-            raise InputError(f"{name} {limit:g} mm leaves no design; the smallest is "
-                             f"{smallest:g} mm")
-    p = make_plan(cell, procedure, noise * 1e-3, runs=runs, seed=seed, progress=_progress,
-                  designs=designs, **common)
+    common = common_keywords(procedure, given["tool"], given["frame"], given["track_mm"])
+    common.update(design_keywords(procedure, {"touches": given["touches"],
+                                              "repeats": given["repeats"]}))
+    designs = _designs(procedure, given["max_size"], given["max_radius"])
+    p = make_plan(cell, procedure, noise * 1e-3, runs=runs, seed=given["seed"],
+                  progress=_progress, designs=designs, **common)
     click.echo(f"plan for '{procedure}' with a touch-up error of {noise:g} mm (1-sigma per "
                "coordinate); predicted 1-sigma of the calibrated pose:")
     click.echo(format_table(["design", "position mm", "rotation deg",

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 import shlex
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +57,24 @@ DESIGN_OPTIONS: dict[str, tuple[str, tuple[str, ...], Callable[[Any], Any]]] = {
     "tilts": ("tilts", ("positioner",), lambda v: np.radians(parse_numbers(v, "--tilts"))),
     "rotates": ("rotates", ("positioner",), lambda v: np.radians(parse_numbers(v, "--rotates"))),
 }
+
+
+class ProcedureChoice(click.Choice):
+    """A choice of procedure among those of a live mapping of the registry (e.g.
+    :data:`robotcell.studies.simulate.PROCEDURES`), as it stands when the command runs: a
+    procedure registered after this module was imported is offered too."""
+
+    def __init__(self, procedures: Mapping[str, Any]):
+        self.procedures = procedures
+        super().__init__(list(procedures))
+
+    @property
+    def choices(self) -> tuple[str, ...]:  # type: ignore[override]
+        return tuple(self.procedures)
+
+    @choices.setter
+    def choices(self, value: Any) -> None:
+        """The choices are the mapping's; click's own assignment is ignored."""
 
 
 def cell_options(func: Callable) -> Callable:
@@ -175,7 +193,7 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
 
 
 @click.command(cls=Command)
-@click.argument("procedure", type=click.Choice(list(PROCEDURES)))
+@click.argument("procedure", type=ProcedureChoice(PROCEDURES))
 @cell_options
 @design_options
 @click.option("-o", "--output", type=OUTPUT, default=None, callback=output_of("CSV", "the touches"),

@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -358,6 +359,22 @@ def calibrate_positioner(
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
     meas = Measurements(q, f, None, tuple(labels))
     start = nominal if nominal is not None else start_model(meas, np.zeros(2, dtype=bool), "positioner")
+    ident, res = _identified(start, meas, f, prior_sigma, inputs)
+    side = 1.0 if nominal is None else _normal_side(nominal)
+    geometry = _geometry_sigmas(ident, res, side)
+    robot = replace(ident.robot, base=ident.base @ ident.robot.base, tool=ident.target_tool)
+    if nominal is not None:
+        robot = nearest_writing(robot, nominal)
+    result = _positioner_result(ident, res, geometry, robot, q, f, labels)
+    return PositionerCalibration(result=result, robot=robot, identification=ident)
+
+
+def _identified(start: Robot, meas: Measurements, f: NDArray[np.float64],
+                prior_sigma: float | None, inputs: Inputs | None) -> tuple[IdentificationResult, Fit]:
+    """The chain identified from ``start`` on the touches ``meas`` (of points ``f``, (N, 3)),
+    and its fit; one touch that the others single out is left out and the chain identified
+    again."""
+    q, labels = meas.q, meas.labels
     sigma = prior_sigma if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
     name = f"{start.name}_calibrated"
     ident = identify(start, meas, point_sigma=sigma, name=name)
@@ -376,6 +393,24 @@ def calibrate_positioner(
             res_other = _fit_of(other, q, f, keep, prior_sigma, inputs)
             if keeps_out(res_other, worst):
                 ident, res = other, res_other
+    return ident, res
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """The geometry of an identified positioner (:func:`_geometry`) with its 1-sigma."""
+
+    values: dict[str, Any]
+    keys: list[str]
+    A: NDArray[np.float64]
+    C: NDArray[np.float64]
+    sigma: dict[str, object]
+
+
+def _geometry_sigmas(ident: IdentificationResult, res: Fit, side: float) -> _Geometry:
+    """The axes, their common normal, zeros and root frame of the identified chain, and their
+    first-order 1-sigma from the fit's covariance (``A``: their derivative by the free
+    parameters, ``C`` their covariance)."""
     x = ident._x
     kept = _free_index(ident)
 
@@ -384,7 +419,6 @@ def calibrate_positioner(
         xx[kept] = v
         return xx
 
-    side = 1.0 if nominal is None else _normal_side(nominal)
     geo = _geometry(ident, x, side)
     keys = ["tilt_point", "tilt_axis", "rotate_point", "rotate_axis", "normal_length", "axis_angle",
             "tilt_zero", "rotate_zero", "radius"]
@@ -404,12 +438,18 @@ def calibrate_positioner(
         sigma_out[k] = sig[k0:k0 + size] if size > 1 else float(sig[k0])
         k0 += size
     sigma_out["T_R_B_position"], sigma_out["T_R_B_rotation"] = sig[k0:k0 + 3], sig[k0 + 3:k0 + 6]
+    return _Geometry(geo, keys, A, C, sigma_out)
+
+
+def _positioner_result(ident: IdentificationResult, res: Fit, geometry: _Geometry, robot: Robot,
+                       q: NDArray[np.float64], f: NDArray[np.float64], labels: list[str]
+                       ) -> CalibrationResult:
+    """The result of :func:`calibrate_positioner` (procedure ``positioner-2axis``)."""
+    geo, keys, A, C, sigma_out = (geometry.values, geometry.keys, geometry.A, geometry.C,
+                                  geometry.sigma)
     T_R_B = np.eye(4)
     T_R_B[:3, :3], T_R_B[:3, 3] = geo["R"], geo["origin"]
     values = {"T_R_B": T_R_B, **{k: geo[k] if np.size(geo[k]) > 1 else float(geo[k]) for k in keys}}
-    robot = replace(ident.robot, base=ident.base @ ident.robot.base, tool=ident.target_tool)
-    if nominal is not None:
-        robot = nearest_writing(robot, nominal)
     warnings = []
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
@@ -438,4 +478,4 @@ def calibrate_positioner(
                              "chain": _chain_estimate(ident, res, robot, q)},
         **fit_fields(res),
     )
-    return PositionerCalibration(result=result, robot=robot, identification=ident)
+    return result

@@ -23,6 +23,7 @@ from robotcell.calibration.result import CalibrationResult, result_json
 from robotcell.calibration.resultcheck import is_points
 from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
+from robotcell.cell.calibrate.registry import attach, for_result
 from robotcell.io.fileio import atomic_write, read_json
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, fmt, png, pyplot, scene_figure
@@ -89,20 +90,35 @@ def _frames(result: dict[str, Any]) -> tuple[str, list[tuple[str, np.ndarray]]]:
     frames : list of (str, ndarray of shape (4, 4))
         Label and pose (translation in mm) of each frame to draw.
     """
-    if result.get("procedure") == "workpiece" and isinstance(result.get("turntable_matrix"), list):
-        # The touches are where the table had turned each of them, in the turntable's parent
-        # (the world in a cell, else the robot base): drawn there, with B and W at table 0.
-        T_P_B = np.array(result["turntable_matrix"], dtype=float)
-        T_B_W = np.array(result["matrix"], dtype=float)
-        parent = "the turntable's parent frame"
-        return parent, [(parent, np.eye(4)), (_FRAME_NAMES["B"], T_P_B),
-                        ("workpiece W at table 0", T_P_B @ T_B_W)]
+    proc = for_result(result.get("procedure"))
+    own = None if proc is None or proc.figure_frames is None else proc.figure_frames(result)
+    if own is not None:
+        return own
     keys = [*result, *(result.get("sigma") or {})]
     match = next((m for m in map(_POSE_KEY.fullmatch, keys) if m), None)
     if match is None or match[1] == "F" or not isinstance(result.get("matrix"), list):
         return _FRAME_NAMES["R"], [(_FRAME_NAMES["R"], np.eye(4))]
     a, b = _FRAME_NAMES[match[1]], _FRAME_NAMES.get(match[2], match[2])
     return a, [(a, np.eye(4)), (b, np.array(result["matrix"], dtype=float))]
+
+
+def _workpiece_frames(result: dict[str, Any]
+                      ) -> tuple[str, list[tuple[str, np.ndarray]]] | None:
+    """:func:`_frames` of a workpiece on a turntable: the turntable's parent frame, B and W."""
+    if not isinstance(result.get("turntable_matrix"), list):
+        return None
+    # The touches are where the table had turned each of them, in the turntable's parent
+    # (the world in a cell, else the robot base): drawn there, with B and W at table 0.
+    T_P_B = np.array(result["turntable_matrix"], dtype=float)
+    T_B_W = np.array(result["matrix"], dtype=float)
+    parent = "the turntable's parent frame"
+    return parent, [(parent, np.eye(4)), (_FRAME_NAMES["B"], T_P_B),
+                    ("workpiece W at table 0", T_P_B @ T_B_W)]
+
+
+# The frames of the figure of a workpiece's results, registered with the procedure (the
+# registry stands below the reports and cannot name them).
+attach("workpiece", figure_frames=_workpiece_frames)
 
 
 def _scene(result: dict[str, Any], room: int) -> str:

@@ -216,9 +216,9 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
         echo("  $ robotcell " + shlex.join(args))
         if procedure == "workpiece":
             kw["turntable"] = turntable
-        done = getattr(cellcal, procedure)(cell, read_csv(csv_path), source=str(csv_path),
-                                            cell_label=str(cell_file), file=csv_path, **kw,
-                                            **touches.keywords())
+        calibrate = cellcal.procedure(procedure).calibrate
+        done = calibrate(cell, read_csv(csv_path), source=str(csv_path), cell_label=str(cell_file),
+                         file=csv_path, **kw, **touches.keywords())
         verdict = done.result.verdict
         if verdict.level == "poor":  # the command refuses to write it (exit 3); so does the demo
             raise InputError(f"{procedure}: poor calibration, nothing written: "

@@ -16,7 +16,7 @@ the 1-sigma error of a point ``LEVER`` from the frame's origin, in metres.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Sized
+from collections.abc import Callable, Iterable, Mapping, Sized
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,20 +24,14 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.calibration.frame import frame_3point
 from robotcell.calibration.result import CalibrationResult
-from robotcell.calibration.tcp import calibrate_tool
-from robotcell.calibration.track import calibrate_track
-from robotcell.calibration.turntable import calibrate_turntable
-from robotcell.calibration.workpiece import calibrate_workpiece
 from robotcell.cell import Cell
-from robotcell.cell.kinematics import robot_pose, tool_pose
+from robotcell.cell.calibrate.registry import Planner, having
 from robotcell.errors import InputError, RobotcellError
-from robotcell.kinematics.transforms import transform_points
 from robotcell.studies.simulate import Touches, check_counts, simulate
 
-__all__ = ["DESIGNS", "LEVER", "Candidate", "MonteCarlo", "Plan", "calibrate_touches",
-           "plan", "pose_error", "predicted_sigma"]
+__all__ = ["DESIGNS", "LEVER", "PLANNERS", "POSE_KEY", "Candidate", "MonteCarlo", "Plan",
+           "calibrate_touches", "plan", "pose_error", "predicted_sigma"]
 
 #: ``progress(items, label)``: wraps a sized iterable (e.g. in a progress bar) and yields its items.
 Progress = Callable[[Sized, str], Iterable[Any]]
@@ -45,31 +39,22 @@ Progress = Callable[[Sized, str], Iterable[Any]]
 #: Distance from the frame origin at which rotation uncertainty is weighed against position (m).
 LEVER = 0.5
 
+#: The procedures that can be planned (those of the registry with a
+#: :class:`~robotcell.cell.calibrate.registry.Planner`), by name.
+PLANNERS: Mapping[str, Planner] = having(lambda p: p.planner)
+
 #: Candidate designs per procedure: keyword arguments of :func:`robotcell.studies.simulate.simulate`
 #: (SI units); the number of touches stays as the user asks.
-DESIGNS: dict[str, list[dict[str, Any]]] = {
-    "tcp": [{"tilt": math.radians(t)} for t in (10, 20, 30, 40, 50, 60)],
-    "frame": [{"size": s} for s in (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)],
-    "track": [{"travel": t} for t in (0.1, 0.25, 0.5, 1.0, 1.5, 2.0)],
-    "turntable": [{"span": math.radians(s), "radius": r} for s in (60, 120, 180, 270, 360)
-                  for r in (0.1, 0.2, 0.3, 0.4)],
-    "workpiece": [{"size": s} for s in (0.05, 0.1, 0.15, 0.2, 0.3, 0.4)],
-}
+DESIGNS: Mapping[str, list[dict[str, Any]]] = having(
+    lambda p: None if p.planner is None else [dict(d) for d in p.planner.designs])
 
 #: The key of the calibrated pose in each procedure's result values.
-POSE_KEY = {"tcp": "T_F_TCP", "frame": "T_R_W", "track": "T_L_R", "turntable": "T_R_B",
-            "workpiece": "T_B_W"}
+POSE_KEY: Mapping[str, str] = having(lambda p: None if p.planner is None else p.planner.pose)
 
 
 def _design_to_simulation(procedure: str, design: dict[str, Any]) -> dict[str, Any]:
     """Turn a planning design into :func:`simulate` keywords (table spans into angle lists)."""
-    out = dict(design)
-    if procedure == "turntable" and "span" in out:
-        span = out.pop("span")
-        n = out.pop("touches", 6)
-        full = span >= 2 * math.pi - 1e-9
-        out["angles"] = np.linspace(-span / 2, span / 2, n, endpoint=not full)
-    return out
+    return PLANNERS[procedure].simulation(dict(design))
 
 
 def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = None
@@ -79,7 +64,8 @@ def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = 
     TCP positions come from the recorded joint values through the cell's robot and the tool
     that touched. Frame and turntable touches are mapped into the parent frame of what they
     calibrate (world, or the robot base for items carried by it), so the pose in the result is
-    expressed in that parent (under the procedure's usual key, e.g. ``T_R_B``).
+    expressed in that parent (under the procedure's usual key, e.g. ``T_R_B``). Each procedure
+    says how (:attr:`Planner.calibrate <robotcell.cell.calibrate.registry.Planner>`).
 
     Parameters
     ----------
@@ -93,31 +79,7 @@ def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = 
     -------
     CalibrationResult
     """
-    m = touches.measurements(cell.robot)
-    if touches.procedure == "tcp":
-        F = m.flange()
-        r = np.array(m.point)
-        return calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=prior_sigma)
-    p_R = m.tcp(tool_pose(cell, touches.tool))
-    if touches.procedure == "track":
-        t = cell.track
-        assert t is not None
-        return calibrate_track(m.axes[:, 0], p_R, references=touches.truth["references"],
-                               point=m.reference.astype(int) - 1, axis=t.axis,
-                               prior_sigma=prior_sigma)
-    parent = touches.truth["parent"]
-    if parent == "turntable":
-        parent = cell.turntable.parent if cell.turntable is not None else "world"
-    e = np.zeros(m.n) if m.track is None else m.track
-    f = p_R if parent == "robot" else transform_points(robot_pose(cell, e), p_R)
-    if touches.procedure == "frame":
-        return frame_3point(f, m.point, prior_sigma)
-    if touches.procedure == "turntable":
-        return calibrate_turntable(m.axes[:, 0], f, height=-touches.truth["height"],
-                                   prior_sigma=prior_sigma)
-    assert cell.turntable is not None
-    return calibrate_workpiece(m.axes[:, 0], f, m.point, cell.turntable.T_parent_B,
-                               prior_sigma=prior_sigma)
+    return PLANNERS[touches.procedure].calibrate(cell, touches, prior_sigma)
 
 
 def _pose_sigma(result: CalibrationResult, key: str) -> tuple[float, float]:
@@ -149,7 +111,7 @@ def pose_error(T_est: NDArray[np.float64], T_true: NDArray[np.float64]) -> tuple
 
 def _true_pose(touches: Touches) -> NDArray[np.float64]:
     """The truth, in the frame :func:`calibrate_touches` expresses the result in."""
-    return touches.truth[{"tcp": "T_F_TCP", "track": "T_L_R"}.get(touches.procedure, "pose")]
+    return touches.truth[PLANNERS[touches.procedure].truth]
 
 
 @dataclass
@@ -238,7 +200,9 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
     ----------
     cell : Cell
         Virtual cell whose values are taken as the truth.
-    procedure : {"tcp", "frame", "track", "turntable", "workpiece"}
+    procedure : str
+        A procedure of :data:`PLANNERS`: ``"tcp"``, ``"frame"``, ``"track"``, ``"turntable"``,
+        ``"workpiece"``, or one registered with a planner.
     noise : float
         Touch-up accuracy, 1-sigma per coordinate (m); > 0.
     runs : int
@@ -294,7 +258,7 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
     touches = simulate(cell, procedure, noise=0.0, **kw)
     mc = None
     if runs:
-        if cell.track is not None and procedure != "track":
+        if cell.track is not None and not touches.moves_track:
             kw["track"] = float(touches.track[0])  # where the robot stands, as planned
         mc = _monte_carlo(cell, procedure, noise, runs, seed, progress, kw, best)
     return Plan(procedure, noise, best, candidates, touches, mc)

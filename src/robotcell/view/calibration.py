@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from robotcell.cell.calibrate.registry import attach, for_result
 from robotcell.kinematics.transforms import make_pose
 from robotcell.view.scene import Arrows, Item, Lines, Points, Scene, Triads
 from robotcell.view.shapes import (
@@ -94,37 +95,69 @@ def _track_lines(fitted: NDArray[np.float64], direction: NDArray[np.float64]) ->
 
 def _geometry(result: Mapping[str, Any], fitted: NDArray[np.float64] | None,
               frames: list[tuple[str, NDArray[np.float64]]]) -> list[Item]:
-    """The fitted geometry a procedure draws beyond its frames."""
-    proc = result["procedure"]
-    if proc == "turntable" and "matrix" in result and "radius_mm" in result:
-        T = _pose_m(result["matrix"])
-        r, h = float(result["radius_mm"]) * 1e-3, float(result.get("height_mm") or 0.0) * 1e-3
-        centre = T @ make_pose(np.eye(3), [0.0, 0.0, -h])
-        z = T[:3, 2]
-        lo, hi = min(0.0, -h) - 0.3 * r, max(0.0, -h) + 0.3 * r
-        return [circle("fitted circle", centre, r, color="teal",
-                       hover=f"the touched point about the axis: radius {r * 1e3:.3f} mm"),
-                Arrows("axis Z_B", T[:3, 3] + lo * z, (hi - lo) * z, color="blue", width=4.0,
-                       head=0.15, hover=[("the table's axis Z_B, the way a positive angle turns "
-                                          "it (right hand)")])]
-    if proc == "track" and fitted is not None and result.get("direction") is not None:
-        return _track_lines(fitted, np.asarray(result["direction"], dtype=float))
+    """The fitted geometry a procedure draws beyond its frames: its registered ``scene``
+    (:attr:`Procedure.scene <robotcell.cell.calibrate.registry.Procedure>`), or nothing."""
+    proc = for_result(result["procedure"])
+    return [] if proc is None or proc.scene is None else proc.scene(result, fitted, frames)
+
+
+def _turntable_geometry(result: Mapping[str, Any], fitted: NDArray[np.float64] | None,
+                        frames: list[tuple[str, NDArray[np.float64]]]) -> list[Item]:
+    """A turntable's fitted circle and its axis Z_B."""
+    if not ("matrix" in result and "radius_mm" in result):
+        return []
+    T = _pose_m(result["matrix"])
+    r, h = float(result["radius_mm"]) * 1e-3, float(result.get("height_mm") or 0.0) * 1e-3
+    centre = T @ make_pose(np.eye(3), [0.0, 0.0, -h])
+    z = T[:3, 2]
+    lo, hi = min(0.0, -h) - 0.3 * r, max(0.0, -h) + 0.3 * r
+    return [circle("fitted circle", centre, r, color="teal",
+                   hover=f"the touched point about the axis: radius {r * 1e3:.3f} mm"),
+            Arrows("axis Z_B", T[:3, 3] + lo * z, (hi - lo) * z, color="blue", width=4.0,
+                   head=0.15, hover=[("the table's axis Z_B, the way a positive angle turns "
+                                      "it (right hand)")])]
+
+
+def _track_geometry(result: Mapping[str, Any], fitted: NDArray[np.float64] | None,
+                    frames: list[tuple[str, NDArray[np.float64]]]) -> list[Item]:
+    """The lines a track's fixed point(s) move along."""
+    if fitted is None or result.get("direction") is None:
+        return []
+    return _track_lines(fitted, np.asarray(result["direction"], dtype=float))
+
+
+def _positioner_geometry(result: Mapping[str, Any], fitted: NDArray[np.float64] | None,
+                         frames: list[tuple[str, NDArray[np.float64]]]) -> list[Item]:
+    """A positioner's tilt and rotate axes and their common normal."""
     keys = ("tilt_point_mm", "tilt_axis", "rotate_point_mm", "rotate_axis")
-    if proc == "positioner-2axis" and all(result.get(k) is not None for k in keys):
-        p0, u0, p1, u1 = (np.asarray(result[k], dtype=float) for k in keys)
-        p0, p1 = p0 * 1e-3, p1 * 1e-3
-        span = fitted if fitted is not None else np.array([p0, p1])
-        return [line_through("tilt axis", p0, u0, span, color="darkviolet",
-                             hover="the tilt axis"),
-                line_through("rotate axis (tilt at 0)", p1, u1, span, color="blue",
-                             hover="the rotate axis, with the tilt axis at 0"),
-                Lines("common normal", np.array([p0, p1]), color="gray", width=3.0, dash="dash",
-                      hover=f"common normal of the axes: {np.linalg.norm(p1 - p0) * 1e3:.3f} mm")]
-    if proc == "tcp" and result.get("pivot_mm") is not None:
-        return [Points("reference tip (fitted)", _m(result["pivot_mm"]).reshape(1, 3),
-                       color="teal", symbol="diamond", size=6.0,
-                       hover=["the reference tip, fitted"], hover_xyz=True)]
-    return []
+    if not all(result.get(k) is not None for k in keys):
+        return []
+    p0, u0, p1, u1 = (np.asarray(result[k], dtype=float) for k in keys)
+    p0, p1 = p0 * 1e-3, p1 * 1e-3
+    span = fitted if fitted is not None else np.array([p0, p1])
+    return [line_through("tilt axis", p0, u0, span, color="darkviolet",
+                         hover="the tilt axis"),
+            line_through("rotate axis (tilt at 0)", p1, u1, span, color="blue",
+                         hover="the rotate axis, with the tilt axis at 0"),
+            Lines("common normal", np.array([p0, p1]), color="gray", width=3.0, dash="dash",
+                  hover=f"common normal of the axes: {np.linalg.norm(p1 - p0) * 1e3:.3f} mm")]
+
+
+def _tcp_geometry(result: Mapping[str, Any], fitted: NDArray[np.float64] | None,
+                  frames: list[tuple[str, NDArray[np.float64]]]) -> list[Item]:
+    """A tool's fitted reference tip."""
+    if result.get("pivot_mm") is None:
+        return []
+    return [Points("reference tip (fitted)", _m(result["pivot_mm"]).reshape(1, 3),
+                   color="teal", symbol="diamond", size=6.0,
+                   hover=["the reference tip, fitted"], hover_xyz=True)]
+
+
+# The scene of each procedure's results, registered with the procedure (the registry stands
+# below the views and cannot name them).
+for _name, _scene in (("tcp", _tcp_geometry), ("track", _track_geometry),
+                      ("turntable", _turntable_geometry), ("positioner", _positioner_geometry)):
+    attach(_name, scene=_scene)
 
 
 def calibration_scene(result: Mapping[str, Any], frame: str = "robot base R",

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.measurements import Measurements, columns_of, read_measurements
-from robotcell.calibration.spec import SPECS, Procedure
+from robotcell.calibration.spec import SPECS, TableSpec
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import tool_pose
 from robotcell.cell.validation import check_axis_limits
@@ -61,14 +61,14 @@ def load_table(measurements: Table | str | Path, source: str | None = None
     return columns_of(measurements, source), source
 
 
-def read_touches(procedure: Procedure | str, measurements: MeasurementInput,
+def read_touches(procedure: TableSpec | str, measurements: MeasurementInput,
                  source: str | None = None, robot: Robot | None = None,
                  on_note: Callable[[str], None] | None = None) -> Measurements:
     """The measurements of a calibration, read once by the procedure's specification.
 
     Parameters
     ----------
-    procedure : Procedure or str
+    procedure : TableSpec or str
         The procedure (:data:`~robotcell.calibration.spec.SPECS`).
     measurements : Measurements, mapping, str or Path
         Touches read before (returned as they are; their notes go to ``on_note`` again), a

@@ -39,7 +39,6 @@ from robotcell.calibration.result import to_jsonable
 from robotcell.calibration.uncertainty import OWN, Sources, factor_of
 from robotcell.calibration.verdict import Verdict
 from robotcell.cell import Cell, Positioner, Provenance
-from robotcell.cell.calibrate import procedures
 from robotcell.cell.calibrate.chain import (
     NOMINAL_ACCURACY,
     NominalAccuracy,
@@ -47,6 +46,9 @@ from robotcell.cell.calibrate.chain import (
     item_sources,
     perturbed,
 )
+from robotcell.cell.calibrate.common import CellCalibration, copied, sha256_of
+from robotcell.cell.calibrate.context import CalibrationContext
+from robotcell.cell.calibrate.registry import having, procedure
 from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import format_table
@@ -58,7 +60,8 @@ __all__ = ["CellRecalibration", "ItemChange", "calibrate_cell"]
 MAX_ITERATIONS = 20
 CONVERGED = 1e-4
 
-_PROCEDURES = ("tcp", "frame", "track", "turntable", "workpiece", "positioner")
+#: The procedures that ``calibrate cell`` repeats, by name (those a cell records).
+_PROCEDURES = having(lambda p: p.repeat)
 _LEVELS = ("good", "check", "poor")
 
 
@@ -119,7 +122,7 @@ class CellRecalibration:
 
     cell: Cell
     changes: tuple[ItemChange, ...]
-    steps: tuple[procedures.CellCalibration, ...]
+    steps: tuple[CellCalibration, ...]
     items: tuple[str, ...]
     covariance: NDArray[np.float64]
     iterations: int
@@ -195,7 +198,7 @@ def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
         path = Path(prov.measurements)
         if not path.is_file():
             problems.append(f"{key}: touch file {path} is missing")
-        elif prov.sha256 is not None and procedures.sha256_of(path) != prov.sha256:
+        elif prov.sha256 is not None and sha256_of(path) != prov.sha256:
             problems.append(f"{key}: touch file {path} has changed since the calibration "
                             "(checksum differs)")
         else:
@@ -217,28 +220,16 @@ def _tool(option: Any) -> str | NDArray[np.float64] | None:
 
 
 def _run(cell: Cell, key: str, prov: Provenance, nominal: NominalAccuracy, time: str | None
-         ) -> procedures.CellCalibration:
+         ) -> CellCalibration:
     """Repeat one recorded calibration on ``cell``."""
     o = prov.options
     name = key.partition(".")[2] or None
-    kw: dict[str, Any] = {"sigma": o["sigma_mm"] * 1e-3 if "sigma_mm" in o else None,
-                          "file": prov.measurements, "nominal": nominal, "time": time}
-    path = prov.measurements
-    if prov.source == "tcp":
-        return procedures.tcp(cell, path, name, world_mode=o.get("world", "6d"), **kw)
-    kw["tool"] = _tool(o.get("tool"))
-    if prov.source == "frame":
-        return procedures.frame(cell, path, name, parent=o.get("parent"), **kw)
-    if prov.source == "track":
-        refs = o.get("references_mm")
-        return procedures.track(cell, path, references=None if refs is None
-                                else np.asarray(refs, dtype=float) * 1e-3,
-                                axis=o.get("axis"), roll=o.get("roll"), **kw)
-    if prov.source == "turntable":
-        return procedures.turntable(cell, path, height=o.get("height_mm", 0.0) * 1e-3, **kw)
-    if prov.source == "workpiece":
-        return procedures.workpiece(cell, path, name, **kw)
-    return procedures.positioner(cell, path, **kw)
+    context = CalibrationContext(tool=_tool(o.get("tool")),
+                                 sigma=o["sigma_mm"] * 1e-3 if "sigma_mm" in o else None,
+                                 time=time, file=prov.measurements, nominal=nominal)
+    repeat = procedure(prov.source).repeat
+    assert repeat is not None  # _recorded keeps the calibrations that are repeated
+    return repeat(cell, prov.measurements, name, o, context)
 
 
 def _size(key: str) -> int:
@@ -258,7 +249,7 @@ def _difference(T: NDArray[np.float64], scale: float, T0: NDArray[np.float64],
     return np.r_[d, scale - scale0] if size == 7 else d
 
 
-def _estimate_value(run: procedures.CellCalibration, cell: Cell
+def _estimate_value(run: CellCalibration, cell: Cell
                     ) -> tuple[NDArray[np.float64], float]:
     """The pose (and scale) a calibration estimates for its item; unmeasured parts as they are."""
     r = run.result
@@ -377,7 +368,7 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
     original = {k: _values(cell, k) for k, _ in recorded if k != "turntable"
                 or not isinstance(cell.turntable, Positioner)}
     estimated = [k for k, p in recorded if p.source != "positioner"]
-    current = procedures.copied(cell)
+    current = copied(cell)
     prior = {k: item_sources(cell, k, nominal)[0] for k in estimated}
     for it in range(1, MAX_ITERATIONS + 1):
         runs = [_run(current, k, p, nominal, time) for k, p in recorded]
@@ -399,7 +390,7 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
             break
     runs = [_run(current, k, p, nominal, time) for k, p in recorded]
     stamp = time or Provenance.now("cell").time
-    new = procedures.copied(cell)
+    new = copied(cell)
     changes = []
     for key, prov in recorded:
         if key not in estimated:  # the positioner chain: its calibration at the fitted values
@@ -434,7 +425,7 @@ def _input_sources(cell: Cell, key: str, nominal: NominalAccuracy) -> tuple[Sour
         return Sources(6, {f"{key} nominal": np.diag(nominal.sigma(6))}), None
 
 
-def _equations(system: _System, run: procedures.CellCalibration, cell: Cell, name: str,
+def _equations(system: _System, run: CellCalibration, cell: Cell, name: str,
                original: tuple[NDArray[np.float64], float] | None, prior: Sources | None) -> None:
     """The equations of one calibration (its touch noise is the error source ``name``).
 
