@@ -61,8 +61,9 @@ class PoseResult:
     AP_abc, RP_abc : ndarray, shape (3,), or None
         Orientation accuracy and repeatability about x, y, z (rad), when measured.
     drift : tuple of float, or None
-        ``(dAP_p, dRP_l)``: the change of ``AP_p`` and ``RP_l`` from the first to the last
-        :data:`DRIFT_CYCLES` cycles (m), when the log has time stamps and enough cycles.
+        ``(dAP_p, dRP_l)`` from the first to the last :data:`DRIFT_CYCLES` cycles in time (m):
+        the length of the change of the vector ``AP`` (how far the barycentre moved) and the
+        change of ``RP_l``, when the log has time stamps and enough cycles.
     """
 
     pose: str
@@ -248,7 +249,7 @@ def _pose_results(log: Log, plan: TestPlan) -> list[PoseResult]:
         if log.time is not None and len(idx) >= 2 * DRIFT_CYCLES:
             first = pose_figures(log.p[idx[:DRIFT_CYCLES]], T[:3, 3])
             last = pose_figures(log.p[idx[-DRIFT_CYCLES:]], T[:3, 3])
-            r.drift = (abs(last.AP_p - first.AP_p), abs(last.RP_l - first.RP_l))
+            r.drift = (float(np.linalg.norm(last.AP - first.AP)), abs(last.RP_l - first.RP_l))
         out.append(r)
     return out
 
