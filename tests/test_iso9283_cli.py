@@ -61,8 +61,8 @@ def test_analyse_prints_the_documented_json(made, capsys, tmp_path):
 
 
 def test_a_fail_exits_3_with_the_report_written(made, capsys, tmp_path):
-    code, out, err = run(capsys, "iso9283", "analyse", made / "meas.csv", "--plan",
-                         made / "plan.csv", "--limit-rp", "0.001", "-o", tmp_path / "r.html")
+    code, out, _ = run(capsys, "iso9283", "analyse", made / "meas.csv", "--plan",
+                       made / "plan.csv", "--limit-rp", "0.001", "-o", tmp_path / "r.html")
     assert code == 3 and "verdict: FAIL: RP_l" in out
     assert "verdict: FAIL" in (tmp_path / "r.html").read_text()
 

@@ -99,8 +99,7 @@ def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs
     """
     from robotcell.iso9283 import plan, write_plan, write_programs
     from robotcell.iso9283.planfile import table_names
-    from robotcell.kinematics.transforms import rot_y, rot_z
-    from robotcell.kinematics.transforms import rot_x as rx
+    from robotcell.kinematics.transforms import rot_x, rot_y, rot_z
 
     a, b, c = np.radians(parse_numbers(opts["orientation"], "--orientation", 3))
     size = None if opts["size"] is None else opts["size"] * 1e-3
@@ -109,7 +108,7 @@ def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs
         p = plan(cell, tool, frame, size, _mm3(opts["centre"], "--centre"),
                  None if opts["track_mm"] is None else opts["track_mm"] * 1e-3,
                  np.radians(parse_numbers(opts["table"], "--table")).squeeze(),
-                 rot_z(a) @ rot_y(b) @ rx(c))
+                 rot_z(a) @ rot_y(b) @ rot_x(c))
         files = [] if programs is None else write_programs(
             p, cell, programs, opts["vendors"] or VENDORS, opts["cycles"], opts["path_cycles"],
             opts["speed"] * 1e-3,

@@ -16,9 +16,20 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["CIRCLE_FRACTION", "CIRCLE_SEGMENTS", "CORNER_FRACTION", "LINE_POINTS", "POSE_NAMES",
-           "PATH_NAMES", "circle_points", "cube_corners", "grid_points", "line_points",
-           "pose_points", "with_orientation"]
+__all__ = [
+    "CIRCLE_FRACTION",
+    "CIRCLE_SEGMENTS",
+    "CORNER_FRACTION",
+    "LINE_POINTS",
+    "PATH_NAMES",
+    "POSE_NAMES",
+    "circle_points",
+    "cube_corners",
+    "grid_points",
+    "line_points",
+    "pose_points",
+    "with_orientation",
+]
 
 #: Names of the five test poses, P1 the centre of the test plane.
 POSE_NAMES = ("P1", "P2", "P3", "P4", "P5")

@@ -29,8 +29,17 @@ from robotcell.iso9283.planfile import table_names, write_table
 from robotcell.iso9283.testplan import TestPlan
 from robotcell.programs import VENDORS, write_program
 
-__all__ = ["CYCLE_ORDER", "LINE_ZONE", "MIN_CYCLES", "PATH_CYCLES", "POSE_CYCLES",
-           "PROGRAM_NAMES", "pose_sequence", "path_sequence", "write_programs"]
+__all__ = [
+    "CYCLE_ORDER",
+    "LINE_ZONE",
+    "MIN_CYCLES",
+    "PATH_CYCLES",
+    "POSE_CYCLES",
+    "PROGRAM_NAMES",
+    "path_sequence",
+    "pose_sequence",
+    "write_programs",
+]
 
 #: Cycles of the pose test and of the path test that ISO 9283 prescribes.
 POSE_CYCLES, PATH_CYCLES = 30, 10

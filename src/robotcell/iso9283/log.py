@@ -30,8 +30,8 @@ from numpy.typing import NDArray
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import read_csv, unknown_columns_warning
-from robotcell.iso9283.cycles import MIN_CYCLES
 from robotcell.iso9283.cube import POSE_NAMES
+from robotcell.iso9283.cycles import MIN_CYCLES
 from robotcell.iso9283.planfile import write_table
 from robotcell.iso9283.testplan import TestPlan
 

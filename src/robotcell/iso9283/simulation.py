@@ -16,6 +16,7 @@ speed :data:`PATH_SPEED` along the paths.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -24,6 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from robotcell.cell import Cell
 from robotcell.errors import InputError
+from robotcell.iso9283.cube import POSE_NAMES
 from robotcell.iso9283.cycles import CYCLE_ORDER, MIN_CYCLES, PATH_CYCLES, POSE_CYCLES
 from robotcell.iso9283.log import Log
 from robotcell.iso9283.testplan import TestPlan
@@ -40,7 +42,7 @@ def _dense(T: NDArray[np.float64], spacing: float) -> NDArray[np.float64]:
     """The path through poses ``T`` (M, 4, 4) sampled at most ``spacing`` apart (m), every
     pose included; each sample has the orientation of its segment's start."""
     out = [T[:1]]
-    for a, b in zip(T[:-1], T[1:]):
+    for a, b in itertools.pairwise(T):
         n = max(1, math.ceil(np.linalg.norm(b[:3, 3] - a[:3, 3]) / spacing))
         s = np.linspace(0.0, 1.0, n + 1)[1:]
         seg = np.repeat(a[None], n, axis=0)
@@ -116,7 +118,7 @@ def simulate(truth: Cell, plan: TestPlan, controller: Cell | None = None, noise:
                         tool=plan.tool, frame=plan.frame)
         return real, path.q
 
-    order = [list(("P1", "P2", "P3", "P4", "P5")).index(p) for p in CYCLE_ORDER]
+    order = [POSE_NAMES.index(p) for p in CYCLE_ORDER]
     T_poses, _ = reached(plan.poses)
     names = list(CYCLE_ORDER) * cycles
     real = np.tile(T_poses[order], (cycles, 1, 1))

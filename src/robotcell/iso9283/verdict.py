@@ -78,20 +78,20 @@ def judge(figures: Mapping[str, Sequence[tuple[float, str]]], limits: Limits) ->
     """
     label = {"AP": "AP_p", "RP": "RP_l", "AT": "AT_p", "RT": "RT_p"}
     reasons, failed = [], False
-    for key in label:
+    for key, name in label.items():
         values = figures.get(key, [])
         limit = getattr(limits, key)
         if limit is None:
             continue
         if not values:
-            reasons.append(f"{label[key]} not measured (limit {limit * 1e3:g} mm)")
+            reasons.append(f"{name} not measured (limit {limit * 1e3:g} mm)")
             failed = True
             continue
         value, where = max(values)
         ok = value <= limit
         failed |= not ok
-        reasons.append(f"{label[key]} {value * 1e3:.3f} mm ({where}) "
+        reasons.append(f"{name} {value * 1e3:.3f} mm ({where}) "
                        f"{'<=' if ok else '>'} {limit * 1e3:g} mm")
     if not reasons:
-        return Verdict("none", ["no limit given (limit_ap, limit_rp, limit_at, limit_rt)"])
+        return Verdict("none", ["no limit given for AP_p, RP_l, AT_p or RT_p"])
     return Verdict("fail" if failed else "pass", reasons)

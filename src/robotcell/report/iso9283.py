@@ -164,8 +164,9 @@ def write_iso9283_report(path: str | Path, result: Iso9283Result, cell: Cell | N
     if plan.table is not None:
         where.append(f"table {np.degrees(np.atleast_1d(plan.table)).round(3).tolist()} deg")
     head, rows = _pose_rows(result)
-    parts = [f"<p>Log {html.escape(result.source)}; {html.escape(', '.join(where))}. Figures as "
-             "ISO 9283 defines them (the formulas and their sources: docs/iso9283.md).</p>",
+    intro = (f"<p>Log {html.escape(result.source)}; {html.escape(', '.join(where))}. Figures as "
+             "ISO 9283 defines them (the formulas and their sources: docs/iso9283.md).</p>")
+    parts = [intro,
              "<h2>Poses</h2>", table(head, rows),
              f'<figure><img src="{_pose_figure(result)}" alt="measured points per pose"></figure>']
     if result.distances:
