@@ -194,3 +194,26 @@ def test_a_cell_calibrated_by_robotcell_passes_where_the_nominal_one_fails(capsy
     code, data = verdicts["calibrated"]
     assert code == 0 and data["verdict"]["level"] == "pass"
     assert max(p["AP_p_mm"] for p in data["poses"]) < 0.5
+
+
+def test_an_identified_arm_compensates_the_real_arm_that_the_nominal_misses():
+    from accuracy_helpers import kr16_truth
+
+    from robotcell.cell.parts import Provenance
+    from robotcell.iso9283 import Limits, analyse
+
+    nominal = Cell.load(TRACK_CELL)
+    truth = Cell.load(TRACK_CELL)
+    truth.set_identified(kr16_truth(np.random.default_rng(2)), "truth.yaml",
+                         Provenance("manual"))
+    p = plan(nominal, "torch", size=0.5)
+    limits = Limits(AP=0.1e-3)
+    missed = analyse(simulate(truth, p, nominal, path_cycles=0, cycles=10, seed=1), p,
+                     limits=limits)
+    # the controller's cell knows the real arm (a perfect identification): it compensates
+    kept = analyse(simulate(truth, p, truth, path_cycles=0, cycles=10, seed=1), p,
+                   limits=limits)
+    assert missed.verdict.level == "fail"
+    assert max(r.figures.AP_p for r in missed.poses) > 0.3e-3
+    assert kept.verdict.level == "pass"
+    assert max(r.figures.AP_p for r in kept.poses) < 0.03e-3
