@@ -49,7 +49,8 @@ SHRINK, MAX_SHRINKS = 0.98, 25
 #: Random configurations that set the manipulability scale and the reach of an arm.
 SAMPLES = 4096
 
-_SCALES: weakref.WeakKeyDictionary[Robot, tuple[float, float, float, float]] = \
+#: Per arm, per tool (its bytes): what :func:`manipulability_scale` found.
+_SCALES: weakref.WeakKeyDictionary[Robot, dict[bytes, tuple[float, float, float, float]]] = \
     weakref.WeakKeyDictionary()
 
 
@@ -73,9 +74,10 @@ def manipulability_scale(robot: Robot, tool: NDArray[np.float64] | None = None
     z_low, z_high : float
         Lowest and highest TCP height in R (m).
     """
-    key = robot if tool is None else None
-    if key is not None and key in _SCALES:
-        return _SCALES[key]
+    known = _SCALES.setdefault(robot, {})
+    key = b"" if tool is None else np.asarray(tool, dtype=float).tobytes()
+    if key in known:
+        return known[key]
     rng = np.random.default_rng(0)
     lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
     q = rng.uniform(lo, hi, (SAMPLES, robot.n_joints))
@@ -83,8 +85,7 @@ def manipulability_scale(robot: Robot, tool: NDArray[np.float64] | None = None
     p = robot.fk(q, tool=tool)[:, :3, 3]
     out = (scale, float(np.max(np.hypot(p[:, 0], p[:, 1]))), float(p[:, 2].min()),
            float(p[:, 2].max()))
-    if key is not None:
-        _SCALES[key] = out
+    known[key] = out
     return out
 
 
