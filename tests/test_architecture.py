@@ -136,7 +136,8 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
 #: package's ``__init__`` and ``errors``.
 CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell", "io",
-            "controllers", "export", "programs", "accuracy", "studies", "view", "report", "cli",
+            "controllers", "export", "programs", "iso9283", "accuracy", "studies", "view", "report",
+            "cli",
             "robots"}
 TOP_MODULES = {"__init__.py", "errors.py"}
 
@@ -160,7 +161,8 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: ``robotcell.kinematics`` and the robot (an arm with its IK, model files, the library) stands on
 #: both; the estimators stand on the robot, the cell on them (it holds an identified arm, and
 #: calibrates into itself); the controllers (one package per vendor: its export, its programs,
-#: its limits) and the exports beside them over the cell, the programs over both; the 3D views
+#: its limits) and the exports beside them over the cell, the programs over both, the ISO 9283
+#: acceptance test beside the programs (it writes its cycles through them); the 3D views
 #: of cells, paths, programs and results over the programs, and the HTML reports, which embed
 #: them, over the views; the accuracy (filtered poses and programs, with their report) over the
 #: reports.
@@ -172,7 +174,7 @@ LAYERS = [
     {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification"},
     {"robotcell.cell"},
     {"robotcell.controllers", "robotcell.export"},
-    {"robotcell.programs"},
+    {"robotcell.programs", "robotcell.iso9283"},
     {"robotcell.view"},
     {"robotcell.report"},
     {"robotcell.accuracy"},
@@ -199,6 +201,7 @@ def test_every_module_is_in_a_layer():
     assert layer("robotcell.robot.robot") == 2 and layer("robotcell.cli.fk") == 11
     assert layer("robotcell.view.plot") == 7 and layer("robotcell.report.identification") == 8
     assert layer("robotcell.programs.write") == 6 and layer("robotcell.accuracy.filter") == 9
+    assert layer("robotcell.iso9283.analysis") == 6 and layer("robotcell.report.iso9283") == 8
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES

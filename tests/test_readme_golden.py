@@ -71,6 +71,8 @@ def test_the_readme_commands_print_what_they_printed(tmp_path, capsys, monkeypat
     folder = tmp_path / "readme"
     folder.mkdir()
     monkeypatch.chdir(folder)
+    # A progress bar appears after a job has run a while: when, depends on the machine's load.
+    monkeypatch.setattr("robotcell.cli.progress.PROGRESS_AFTER", float("inf"))
     seen = _outputs(folder, capsys)
     if os.environ.get("ROBOTCELL_GOLDEN") == "write":
         GOLDEN.write_text(json.dumps(seen, indent=1, sort_keys=False) + "\n", encoding="utf-8")

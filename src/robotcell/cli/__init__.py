@@ -40,6 +40,7 @@ COMMANDS = {
     "program": "robotcell.cli.program:program",
     "view": "robotcell.cli.view:view",
     "compensate": "robotcell.cli.compensate:compensate",
+    "iso9283": "robotcell.cli.iso9283:iso9283",
 }
 
 

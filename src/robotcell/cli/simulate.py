@@ -192,7 +192,21 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
     return " ".join(parts + t.options)
 
 
-@click.command(cls=Command)
+class _Simulate(Command):
+    """``simulate``, which hands ``simulate iso9283 ...`` to the acceptance test's simulation
+    (:func:`robotcell.cli.iso9283.simulate_iso9283`)."""
+
+    def make_context(self, info_name: str | None, args: list[str],
+                     parent: click.Context | None = None, **extra: Any) -> click.Context:
+        if args[:1] == ["iso9283"]:
+            from robotcell.cli.iso9283 import simulate_iso9283
+
+            return simulate_iso9283.make_context(f"{info_name} iso9283", args[1:], parent,
+                                                 **extra)
+        return super().make_context(info_name, args, parent, **extra)
+
+
+@click.command(cls=_Simulate)
 @click.argument("procedure", type=ProcedureChoice(PROCEDURES))
 @cell_options
 @design_options
@@ -209,6 +223,7 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
     (mm, robot's track position), point. The command line that calibrates the file is printed
     on stderr. Procedures: tcp, frame, track, turntable, workpiece, positioner (a 2-axis
     positioner: one point on the plate at every combination of --tilts and --rotates).
+    'robotcell simulate iso9283 --help': the log of an ISO 9283 acceptance test.
 
     \b
     Examples:

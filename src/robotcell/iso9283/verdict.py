@@ -1,0 +1,97 @@
+"""The verdict of an ISO 9283 test: each figure that has a limit against it (:func:`judge`).
+
+A figure passes when its largest value over the poses (AP_p, RP_l) or paths (AT_p, RT_p) is at
+most its limit. The verdict is ``pass`` when every limit given is met, ``fail`` when one is not
+(or its figure was not measured), ``none`` when no limit is given. No robot model of the
+library carries a datasheet repeatability, so no limit has a default.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from robotcell.errors import InputError
+
+__all__ = ["Limits", "Verdict", "judge"]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Largest acceptable figures (m); None: no limit.
+
+    Attributes
+    ----------
+    AP, RP : float or None
+        Pose accuracy ``AP_p`` and repeatability ``RP_l`` of every pose.
+    AT, RT : float or None
+        Path accuracy ``AT_p`` and repeatability ``RT_p`` of every path.
+    """
+
+    AP: float | None = None
+    RP: float | None = None
+    AT: float | None = None
+    RT: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("AP", "RP", "AT", "RT"):
+            v = getattr(self, name)
+            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise InputError(f"limit_{name.lower()} must be a positive length (m), got {v!r}")
+
+    def to_json(self) -> dict[str, float | None]:
+        """The limits in mm (None where not given)."""
+        return {f"{k}_mm": None if (v := getattr(self, k)) is None else v * 1e3
+                for k in ("AP", "RP", "AT", "RT")}
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """``level`` (``pass``, ``fail`` or ``none``) and one reason per limit."""
+
+    level: str
+    reasons: list[str]
+
+    def line(self) -> str:
+        """The verdict as one line: ``verdict: PASS: AP_p 0.214 mm (P3) <= 0.5 mm; ...``."""
+        return f"verdict: {self.level.upper()}: {'; '.join(self.reasons)}"
+
+    def to_json(self) -> dict[str, Any]:
+        return {"level": self.level, "reasons": list(self.reasons)}
+
+
+def judge(figures: Mapping[str, Sequence[tuple[float, str]]], limits: Limits) -> Verdict:
+    """The verdict on the figures.
+
+    Parameters
+    ----------
+    figures : mapping of str to sequence of (float, str)
+        ``"AP"``, ``"RP"``, ``"AT"``, ``"RT"`` -> (value in m, pose or path) of every pose or
+        path measured.
+    limits : Limits
+
+    Returns
+    -------
+    Verdict
+    """
+    label = {"AP": "AP_p", "RP": "RP_l", "AT": "AT_p", "RT": "RT_p"}
+    reasons, failed = [], False
+    for key, name in label.items():
+        values = figures.get(key, [])
+        limit = getattr(limits, key)
+        if limit is None:
+            continue
+        if not values:
+            reasons.append(f"{name} not measured (limit {limit * 1e3:g} mm)")
+            failed = True
+            continue
+        value, where = max(values)
+        ok = value <= limit
+        failed |= not ok
+        reasons.append(f"{name} {value * 1e3:.3f} mm ({where}) "
+                       f"{'<=' if ok else '>'} {limit * 1e3:g} mm")
+    if not reasons:
+        return Verdict("none", ["no limit given for AP_p, RP_l, AT_p or RT_p"])
+    return Verdict("fail" if failed else "pass", reasons)
