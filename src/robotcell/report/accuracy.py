@@ -19,14 +19,15 @@ from numpy.typing import ArrayLike
 
 from robotcell.io.fileio import atomic_write
 from robotcell.report.calibration import _CSS, _SCRIPT, _png
-from robotcell.report.identification import _pyplot, _table
+from robotcell.report.identification import _table
+from robotcell.view.pyplot import pyplot
 
 __all__ = ["write_accuracy_report"]
 
 
 def _figure(error_mm: np.ndarray, dpos_mm: np.ndarray, sigma_mm: np.ndarray) -> str:
     """Per point: predicted error without filtering, correction, 1-sigma after (mm, log)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(9, 3.4))
     k = np.arange(1, len(error_mm) + 1)
     ax.semilogy(k, np.maximum(error_mm, 1e-6), "o", color="tab:red", ms=4,

@@ -30,6 +30,7 @@ from robotcell.io.fileio import atomic_write, read_json
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.view.calibration import calibration_scene, outliers
 from robotcell.view.plot import MAX_PAGE_BYTES, embed_within
+from robotcell.view.pyplot import pyplot
 from robotcell.view.scene import Scene
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
@@ -110,8 +111,7 @@ def _frames(result: dict[str, Any]) -> tuple[str, list[tuple[str, np.ndarray]]]:
 
 def _png(fig: Any) -> str:
     """A matplotlib figure as a ``data:image/png;base64,...`` URI; the figure is closed."""
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90)
     plt.close(fig)
@@ -146,11 +146,7 @@ def _scene(result: dict[str, Any], room: int) -> str:
 
 
 def _figure_residuals(result: dict[str, Any]) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     r = np.array(result["residuals_mm"], dtype=float)
     labels = result.get("labels") or [str(i + 1) for i in range(len(r))]
     fig, ax = plt.subplots(figsize=(7, 3.2))

@@ -28,6 +28,7 @@ from robotcell.io.fileio import atomic_write
 from robotcell.report.calibration import _CSS, _SCRIPT, SCENE_SLOT, _fmt, _png, scene_figure
 from robotcell.view.identification import identification_scene
 from robotcell.view.plot import MAX_PAGE_BYTES
+from robotcell.view.pyplot import pyplot
 
 __all__ = ["write_identification_report"]
 
@@ -35,18 +36,9 @@ __all__ = ["write_identification_report"]
 N_CORRELATIONS = 10
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _figure_errors(before: NDArray[np.float64], after: NDArray[np.float64], title: str) -> str:
     """Histogram of the per-row errors of both models, and the errors per row (mm)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.4))
     both = np.maximum(np.concatenate([before, after]), 1e-6)
     bins = np.geomspace(both.min(), both.max() * 1.001 + 1e-9, 30)  # log: both models visible
@@ -67,7 +59,7 @@ def _figure_errors(before: NDArray[np.float64], after: NDArray[np.float64], titl
 
 
 def _figure_observability(o1: float, o1_random: NDArray[np.float64]) -> str:
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 2.8))
     ax.hist(o1_random, bins=12, color="tab:gray", label=f"{len(o1_random)} random sets")
     ax.axvline(o1, color="tab:blue", linewidth=2, label="measured configurations")
