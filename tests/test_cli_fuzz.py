@@ -19,6 +19,11 @@ calibrates into) and leaves no temporary file.
 ``pytest -q`` runs the first cases of each command (:data:`CASES`, first number, about 170);
 ``ROBOTCELL_FUZZ=full`` runs the full set (second number, about 1,700), as ``.ci/run`` does.
 ``ROBOTCELL_FUZZ_SEED`` changes the seed (default 2026); the cases of a failing seed are printed.
+
+The first cases of every command (:data:`READ_ONLY`) also run as another user, from a read-only
+copy of the package and without a writable home (tests/readonly_helpers.py: numba cannot cache
+its machine code, matplotlib cannot keep its settings), all in one process: the same checks, and
+the same exit status and output as the same cases run here.
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
+from readonly_helpers import PROGRESS, read_only_install
 
 from robotcell import pose_from_vendor, pose_to_vendor
 from robotcell.kinematics.transforms import rot_z
@@ -763,28 +769,7 @@ def test_cli_fuzz(command, tmp_path, capsys, monkeypatch, good):
         before = _files(d)
         code, out, err = run(capsys, *case.args)
         codes[code] = codes.get(code, 0) + 1
-        after = _files(d)
-        problems = []
-        if code not in DOCUMENTED:
-            problems.append(f"exit status {code}")
-        if "Traceback" in out or "Traceback" in err:
-            problems.append("traceback")
-        if PYTHON_WARNING.search(err) or PYTHON_WARNING.search(out):
-            problems.append("a Python warning")
-        if code == 2 and "error:" not in err:
-            problems.append("exit 2 without 'error:'")
-        if code != 0 and after != before:
-            problems.append(f"a refused run changed files {_diff(before, after)}")
-        owned = {str(p.relative_to(d)) for w in case.writes
-                 for p in ([w, *w.rglob("*")] if w.is_dir() else [w])}
-        if code == 0 and _diff(before, after) - owned:
-            problems.append(f"changed inputs {sorted(_diff(before, after) - owned)}")
-        if "-o onto the input" in case.what and code != 2:
-            problems.append("an output onto an input was not refused")
-        if any(name.endswith(".tmp") for name in after):
-            problems.append("temporary files left")
-        if sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("case")):
-            problems.append("files written outside the case's folder")
+        problems = _problems(case, d, code, out, err, before)
         if problems:
             failures.append(f"case {k} ({case.what}): {', '.join(problems)}; robotcell "
                             f"{' '.join(case.args)}\n  stderr: {err.strip()[-300:]}")
@@ -795,6 +780,88 @@ def test_cli_fuzz(command, tmp_path, capsys, monkeypatch, good):
     # full set: a few fast cases may all end one way).
     if FULL:
         assert codes.get(2, 0) > 0 and (command in REFUSALS_ONLY or codes.get(0, 0) > 0), codes
+
+
+def _problems(case: Case, d: Path, code: int, out: str, err: str, before: dict[str, bytes]
+              ) -> list[str]:
+    """What is wrong with the run of ``case`` in folder ``d`` (its files were ``before``), which
+    ended with ``code``, ``out`` and ``err``; the runs' folder is ``d``'s parent."""
+    after = _files(d)
+    problems = []
+    if code not in DOCUMENTED:
+        problems.append(f"exit status {code}")
+    if "Traceback" in out or "Traceback" in err:
+        problems.append("traceback")
+    if PYTHON_WARNING.search(err) or PYTHON_WARNING.search(out):
+        problems.append("a Python warning")
+    if code == 2 and "error:" not in err:
+        problems.append("exit 2 without 'error:'")
+    if code != 0 and after != before:
+        problems.append(f"a refused run changed files {_diff(before, after)}")
+    owned = {str(p.relative_to(d)) for w in case.writes
+             for p in ([w, *w.rglob("*")] if w.is_dir() else [w])}
+    if code == 0 and _diff(before, after) - owned:
+        problems.append(f"changed inputs {sorted(_diff(before, after) - owned)}")
+    if "-o onto the input" in case.what and code != 2:
+        problems.append("an output onto an input was not refused")
+    if any(name.endswith(".tmp") for name in after):
+        problems.append("temporary files left")
+    if sorted(p.name for p in d.parent.iterdir() if not p.name.startswith("case")):
+        problems.append("files written outside the case's folder")
+    return problems
+
+
+#: Cases per command run as another user from a read-only install, without a writable home
+#: (tests/readonly_helpers.py): the first ones of each command's sequence (in ``pytest -q``, in
+#: the full set).
+READ_ONLY = (2, 10)
+
+
+def test_cli_fuzz_read_only_install(good, tmp_path, capsys, monkeypatch):
+    # The first cases of every command, as a user who can write neither robotcell's folder nor
+    # a home (numba cannot cache there, nor matplotlib keep its settings), all in one process
+    # (the kernels compiled in memory once): the checks above, no exit 1, and the same exit
+    # status and output as the same cases run here, from the normal install.
+    n = READ_ONLY[1 if FULL else 0]
+    with read_only_install() as install:
+        runs = _read_only_cases(install.work, n, good)
+        normal = _read_only_cases(tmp_path, n, good)
+        for (*_, d, before), (*_, here, _) in zip(runs, normal, strict=True):
+            for name in before:  # the same times of writing (cell history lists them)
+                os.utime(here / name, ns=((d / name).stat().st_atime_ns,
+                                          (d / name).stat().st_mtime_ns))
+        install.give(install.work)
+        results = install.robotcell_runs([(case.args, d.parent) for _, _, case, d, _ in runs])
+        failures = []
+        for (command, k, case, d, before), (code, out, err), (*_, twin, here, _) in zip(
+                runs, results, normal, strict=True):
+            problems = _problems(case, d, code, out, err, before)
+            monkeypatch.chdir(here.parent)
+            expected = [x.replace(str(tmp_path), str(install.work)) if isinstance(x, str) else x
+                        for x in run(capsys, *twin.args)]
+            if [code, out, PROGRESS.sub("", err)] != [*expected[:2], PROGRESS.sub("", expected[2])]:
+                problems.append(f"not the result of a normal run {expected}")
+            if problems:
+                failures.append(f"{command} case {k} ({case.what}): {', '.join(problems)}; "
+                                f"robotcell {' '.join(case.args)}\n  stderr: {err.strip()[-300:]}")
+    assert not failures, (f"seed {SEED}, {len(failures)} of {len(runs)} cases failed:\n"
+                          + "\n".join(failures[:8]))
+
+
+def _read_only_cases(folder: Path, n: int, good: dict[str, Path]
+                     ) -> list[tuple[str, int, Case, Path, dict[str, bytes]]]:
+    """The first ``n`` cases of every command in ``folder/COMMAND/caseK``: the command, ``K``,
+    the case, its folder and its files."""
+    cases = []
+    for command in CASES:
+        rng = np.random.default_rng([SEED, list(CASES).index(command)])
+        (folder / command).mkdir()
+        for k in range(n):
+            d = folder / command / f"case{k}"
+            d.mkdir()
+            case = _case(command, rng, d, good)
+            cases.append((command, k, case, d, _files(d)))
+    return cases
 
 
 def _diff(before: dict[str, bytes], after: dict[str, bytes]) -> set[str]:

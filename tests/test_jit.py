@@ -1,11 +1,13 @@
 """Kernels written once: Python first, compiled by numba once single-pose calls add up."""
 
+import importlib.util
 import json
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import robotcell
 from robotcell.kinematics import jit
@@ -54,3 +56,45 @@ def test_a_few_poses_never_load_numba_and_a_loop_does():
                           env={"PYTHONPATH": SRC, "PATH": "/usr/bin:/bin"}, timeout=300,
                           check=True)
     assert json.loads(proc.stdout.strip().splitlines()[-1]) == [False, True, True, True]
+
+
+def _triple_in(folder: Path):
+    """A function defined in a module file of its own in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "kern.py").write_text("def triple(x):\n    return 3.0 * x\n")
+    spec = importlib.util.spec_from_file_location(f"kern_{folder.name}", folder / "kern.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.triple
+
+
+@pytest.mark.parametrize("writable", [None, "NUMBA_CACHE_DIR", "__pycache__", "user-wide"])
+def test_machine_code_is_cached_where_numba_can_write_else_compiled_in_memory(writable, tmp_path,
+                                                                              monkeypatch):
+    # numba's places, in its order: NUMBA_CACHE_DIR, __pycache__ beside the source, the user-wide
+    # cache ($XDG_CACHE_HOME/numba). A file where a folder must be makes a place unwritable,
+    # for root too.
+    import numba
+
+    src = tmp_path / writable if writable else tmp_path / "none"
+    places = {"NUMBA_CACHE_DIR": tmp_path / "cache", "__pycache__": src / "__pycache__",
+              "user-wide": tmp_path / "xdg" / "numba"}
+    for name, place in places.items():
+        if name != writable:
+            place.parent.mkdir(parents=True, exist_ok=True)
+            place.write_text("not a folder")
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(places["NUMBA_CACHE_DIR"])
+                        if writable == "NUMBA_CACHE_DIR" else "")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    monkeypatch.setattr(jit, "_CACHE_WRITABLE", {})
+    fn = _triple_in(src)
+    f = jit.compiled(fn)  # no error where numba's cache=True raises
+    assert f(2.0) == 6.0
+    cached = list(tmp_path.rglob("kern.triple-*.nbi"))  # numba's index of the machine code
+    if writable is None:
+        with pytest.raises(RuntimeError, match="cannot cache function 'triple'"):
+            numba.njit(cache=True)(fn)
+        assert cached == [] and jit._CACHE_WRITABLE == {str(src): False}
+    else:
+        assert len(cached) == 1 and cached[0].is_relative_to(places[writable])
+        assert jit._CACHE_WRITABLE == {str(src): True}

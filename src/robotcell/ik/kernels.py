@@ -14,7 +14,8 @@ ortho-parallel arm on a linear track after choosing the track value in closed fo
 :func:`best_valid_rows` for its parts.
 
 This module is imported when a solver is built (loading numba takes about 0.3 s, the cached
-machine code about 0.3 s more; the first process after an install compiles it). It holds every
+machine code about 0.3 s more; the first process after an install compiles it, and every process
+where numba can write no cache: :func:`robotcell.kinematics.jit.compiled`). It holds every
 function its kernels call and takes every tolerance as an argument (:func:`pack`): numba's cache
 notices changes of this file only.
 """
@@ -24,10 +25,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
-from robotcell.kinematics.jit import NUMBA_OPTIONS
+from robotcell.kinematics.jit import compiled
 
 __all__ = ["FOLD_CHECK", "FOLD_DOWN", "FOLD_NONE", "FOLD_UP", "METHODS", "best_valid_rows",
            "cfg_params", "choose_poses", "exact_rows", "fold_modes", "fold_rows", "interval_rows",
@@ -98,13 +98,13 @@ def pack(method: str, params: NDArray[np.float64], T_O_R: NDArray[np.float64],
 
 
 # -- angles ---------------------------------------------------------------------------------------
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _wrap(a: float) -> float:
     """The equivalent of ``a`` in ``(-pi, pi]`` (rad), as :func:`robotcell.ik.limits.wrap_to_pi`."""
     return a - TWO_PI * np.ceil((a - math.pi) * (1.0 / TWO_PI))
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _angle(sign: float, offset: float, c: float, s: float, y: float, x: float) -> float:
     """Controller value ``sign * (atan2(y, x) - offset)`` in ``(-pi, pi]`` by one atan2: the pair
     ``(y, x)`` (any positive scale) is turned by ``-offset`` (``c``, ``s`` its cosine and sine),
@@ -114,7 +114,7 @@ def _angle(sign: float, offset: float, c: float, s: float, y: float, x: float) -
     return math.atan2(-y if sign < 0 else y, x)
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _clamp_circular(q: float, lo: float, hi: float, tol: float) -> float:
     """The 2*pi-equivalent of ``q`` inside ``[lo, hi]`` up to ``tol``, else the nearer limit
     (circularly)."""
@@ -124,7 +124,7 @@ def _clamp_circular(q: float, lo: float, hi: float, tol: float) -> float:
     return lo if abs(_wrap(q - lo)) <= abs(_wrap(q - hi)) else hi
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _excess(d: float, rnd: float) -> float:
     """The square of an excess distance ``d`` (m), 0 up to the rounding ``rnd``."""
     return d * d if d > rnd else 0.0
@@ -141,7 +141,7 @@ def _angles(signs, offsets) -> NDArray[np.float64]:
     return np.concatenate([signs, offsets, np.cos(offsets), np.sin(offsets)])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
     """All 8 branches of an ortho-parallel arm for the target ``R``, ``P`` in O (see
     :mod:`robotcell.ik.opw`): controller values into ``q`` (8, 6), NaN where the branch does not
@@ -255,7 +255,7 @@ def ur_params(d1, a2, a3, d4, d5, d6, signs, offsets) -> NDArray[np.float64]:
     return np.concatenate([[d1, a2, a3, d4, d5, d6], _angles(signs, offsets)])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _free_t6(c0, c1, u0, u1, w0, w1, target, d5, rmin, rmax) -> float:
     """Canonical t6 (rad) at the wrist singularity: nearest to ``target`` with axes 2/3 in reach.
 
@@ -282,7 +282,7 @@ def _free_t6(c0, c1, u0, u1, w0, w1, target, d5, rmin, rmax) -> float:
     return math.atan2(vx * u0 + vy * u1, vx * w0 + vy * w1)
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _ur(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
     """All 8 branches of a UR-type arm for the target ``R_O_6``, ``p_O_6`` (see
     :mod:`robotcell.ik.ur`), as :func:`_opw`. Branch ``k = 4 * shoulder + 2 * elbow + wrist``:
@@ -375,7 +375,7 @@ def palletizer_params(A_r, A_h, b, L2, L3, s1, s4, g22, o2, g32, g33, o3, v_n, R
                            np.ravel(v_n), np.ravel(R_n0)])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _palletizer(cfg, p, R, P, q, err, reach) -> None:
     """All 4 branches of a palletizer for the target ``R_O_n``, ``p_O_n`` (see
     :mod:`robotcell.ik.palletizer`), branch ``k = 2 * shoulder + elbow``: shoulder 1 = ``W``
@@ -427,7 +427,7 @@ def _palletizer(cfg, p, R, P, q, err, reach) -> None:
 
 
 # -- limits and the exact branches ----------------------------------------------------------------
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _fold(q, modes, lower, upper, tol) -> bool:
     """Fold the values ``q`` (n,) of one branch in place by the 2*pi rule of
     :class:`robotcell.ik.limits.JointFolder`; whether every checked value is within its limits
@@ -450,7 +450,7 @@ def _fold(q, modes, lower, upper, tol) -> bool:
     return inside if checked else not np.isnan(q[0])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _exact(valid, err, exact_tol) -> None:
     """Keep in ``valid`` (branches,) only the exact branches when one is: a branch solved at the
     boundary of its reach stands for the pose only when no valid branch reaches it exactly (see
@@ -464,14 +464,14 @@ def _exact(valid, err, exact_tol) -> None:
             valid[k] = valid[k] and err[k] <= exact_tol
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def fold_rows(q, modes, lower, upper, tol, inside) -> None:
     """:func:`_fold` on every row of ``q`` (N, n) in place; ``inside`` (N,) receives the result."""
     for i in range(q.shape[0]):
         inside[i] = _fold(q[i], modes, lower, upper, tol)
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def exact_rows(valid, err, exact_tol) -> None:
     """:func:`_exact` on every row of ``valid`` and ``err`` (N, branches), in place."""
     for i in range(valid.shape[0]):
@@ -479,7 +479,7 @@ def exact_rows(valid, err, exact_tol) -> None:
 
 
 # -- the loop over poses --------------------------------------------------------------------------
-@njit(**NUMBA_OPTIONS)
+@compiled
 def solve_poses(cfg, T, T_tcp_end, ref, q, err, reach, valid) -> None:
     """Every branch of every target: the analytic IK of one solver (a batch or one pose).
 
@@ -606,20 +606,20 @@ def track_config(lower: float, upper: float, w: NDArray[np.float64], T_O_L: NDAr
                            np.ravel(np.array(coupled, dtype=float))])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _cone(cone, c: float, s: float) -> bool:
     """An axis within its limits, given (cos, sin) of its paper angle (no arctangent): ``cone``
     is ``(limited, cos mid, sin mid, cos half)`` of :func:`track_config`."""
     return cone[0] == 0.0 or c * cone[1] + s * cone[2] >= cone[3]
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _either_wrist(cone, c: float, h: float) -> bool:
     """Axis 5 within its limits for ``t5`` or ``-t5`` (the two wrist flips), ``h = |sin t5|``."""
     return cone[0] == 0.0 or c * cone[1] + h * abs(cone[2]) >= cone[3]
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _coupled_ok(cfg, p, tc, c1, s1, c2, s2, c3, s3) -> bool:
     """Coupled axes among 1..3 within limits, given (cos, sin) of the paper's angles t1, t2, t3."""
     nrows = int(tc[_ROWS])
@@ -638,7 +638,7 @@ def _coupled_ok(cfg, p, tc, c1, s1, c2, s2, c3, s3) -> bool:
     return True
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _arm_constants(p):
     """``(kappa, cos psi, sin psi, 1 / (2 c2 kappa), c2^2 + kappa^2)`` of an ortho-parallel arm."""
     kappa = math.hypot(p[1], p[5])
@@ -646,7 +646,7 @@ def _arm_constants(p):
             p[4] * p[4] + kappa * kappa)
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _manipulability_at(cfg, p, tc, k, R02, R12, R22, cx, cy, cz) -> float:
     """Best ``|det J|`` (m^3) over the arm's branches that reach the wrist centre ``c`` (in O) with
     axes 1, 2, 3 and 5 within their limits, for the target orientation's third column ``R_2``;
@@ -691,7 +691,7 @@ def _manipulability_at(cfg, p, tc, k, R02, R12, R22, cx, cy, cz) -> float:
     return best * (c2 * kappa)
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _row_times(a0, a1, a2, a3, M):
     """The row ``(a0, a1, a2, a3)`` times the 4x4 matrix ``M``."""
     return (a0 * M[0, 0] + a1 * M[1, 0] + a2 * M[2, 0] + a3 * M[3, 0],
@@ -700,7 +700,7 @@ def _row_times(a0, a1, a2, a3, M):
             a0 * M[0, 3] + a1 * M[1, 3] + a2 * M[2, 3] + a3 * M[3, 3])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _wrist_line(cfg, tc, Ti, B):
     """``R_O_e`` (3x3 tuple) and ``p_O_e`` at track value 0 of the target ``T_L_TCP`` ``Ti``
     (``T_O_e = T_O_L Ti B``, ``B`` the end frame in the TCP frame), and the wrist centre there."""
@@ -718,13 +718,13 @@ def _wrist_line(cfg, tc, Ti, B):
     return R, P, C
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def cfg_params(cfg):
     """The structure's parameters in a solver configuration (:func:`pack`)."""
     return cfg[_LIMITS + 3 * int(cfg[_N]):]
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _interval(p, C, w0, w1, w2):
     """Roots of ``|C + x w - S|^2 = (c2 + kappa + |a1|)^2 + b^2`` (m), NaN where the wrist
     centre ``C`` (at track value 0, in O) never comes that close to the shoulder."""
@@ -738,7 +738,7 @@ def _interval(p, C, w0, w1, w2):
     return (-half_b - root) / a, (-half_b + root) / a
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _scan_interval(cfg, p, tc, C):
     """The interval of :func:`_interval` clipped to the track limits; NaN where empty."""
     lo, hi = _interval(p, C, tc[_W], tc[_W + 1], tc[_W + 2])
@@ -748,7 +748,7 @@ def _scan_interval(cfg, p, tc, C):
     return lo, hi
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _score(cfg, p, tc, k, R, C, x) -> float:
     """:func:`_manipulability_at` at track value ``x`` (0 for NaN)."""
     if np.isnan(x):
@@ -757,7 +757,7 @@ def _score(cfg, p, tc, k, R, C, x) -> float:
                               C[1] + tc[_W + 1] * x, C[2] + tc[_W + 2] * x)
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _argmax(a, n: int) -> int:
     """``np.argmax(a[:n])``: the first maximum, or the first NaN."""
     k = 0
@@ -769,7 +769,7 @@ def _argmax(a, n: int) -> int:
     return k
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _refine(cfg, p, tc, k, R, C, centre, half, lo, hi, lin_f, xs, ms, at) -> None:
     """Grids of ``len(lin_f)`` values around ``centre``, +-``half``, shrinking around the best for
     each stage; every value tried and its score into ``xs``, ``ms`` from index ``at``."""
@@ -786,7 +786,7 @@ def _refine(cfg, p, tc, k, R, C, centre, half, lo, hi, lin_f, xs, ms, at) -> Non
         half = half * tc[_SHRINK]
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer, prefer, xs, ms):
     """The track value of one target and whether the scan found one where the arm reaches it
     (see :func:`robotcell.ik.trackchoice.choose_track`); ``xs``, ``ms`` are scratch."""
@@ -850,7 +850,7 @@ def _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer, prefer, xs, ms):
     return x, found
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q, err, reach,
                  valid, manipulability) -> int:
     """The track value of every target, and (for an arm without coupling) its branches there.
@@ -920,7 +920,7 @@ def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q
     return again
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def scan_rows(cfg, tc, T, T_tcp_end, lin, x, m, lower, upper) -> None:
     """Manipulability of every target ``T_L_TCP`` (N, 4, 4) on the track values ``lin`` (K,)
     of its interval into ``x``, ``m`` (N, K) (m, m^3), the interval into ``lower``, ``upper``."""
@@ -935,7 +935,7 @@ def scan_rows(cfg, tc, T, T_tcp_end, lin, x, m, lower, upper) -> None:
             m[i, k] = _score(cfg, p, tc, ac, R, C, x[i, k])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def wrist_rows(cfg, tc, T, T_tcp_end, R, C) -> None:
     """``R_O_e`` (N, 3, 3) and the wrist centre (N, 3) in O at track value 0 of targets ``T``."""
     for i in range(T.shape[0]):
@@ -946,14 +946,14 @@ def wrist_rows(cfg, tc, T, T_tcp_end, R, C) -> None:
                 R[i, r, c] = Ri[r][c]
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def interval_rows(p, C, w, lower, upper) -> None:
     """:func:`_interval` of wrist centres ``C`` (N, 3) moving along ``w`` (3,)."""
     for i in range(C.shape[0]):
         lower[i], upper[i] = _interval(p, (C[i, 0], C[i, 1], C[i, 2]), w[0], w[1], w[2])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _det_j(p, q) -> float:
     """``|det J|`` of an ortho-parallel arm at controller values ``q`` (6,) in closed form (m^3):
     ``n * c2 * kappa * |sin(gamma)| * |sin(t5)|`` (see :mod:`robotcell.ik.trackchoice`)."""
@@ -968,14 +968,14 @@ def _det_j(p, q) -> float:
     return n * c2 * cross * abs(math.sin(t5))
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def manipulability_rows(p, q, out) -> None:
     """:func:`_det_j` of every row of ``q`` (N, 6) into ``out`` (N,); NaN gives NaN."""
     for i in range(q.shape[0]):
         out[i] = _det_j(p, q[i])
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def _best_valid(p, q, valid) -> float:
     """``|det J|`` of the best valid branch of one target's arm values ``q`` (8, 6) (0 if none):
     the two wrists of an arm configuration (branches 2k, 2k + 1) have the same value."""
@@ -988,7 +988,7 @@ def _best_valid(p, q, valid) -> float:
     return best
 
 
-@njit(**NUMBA_OPTIONS)
+@compiled
 def best_valid_rows(p, q, valid, out) -> None:
     """:func:`_best_valid` of every target: ``q`` (N, 8, 6), ``valid`` (N, 8), ``out`` (N,)."""
     for i in range(q.shape[0]):

@@ -11,9 +11,12 @@ calls of the Python kernel. So a :class:`Kernel` runs as Python until it has spe
 :data:`PYTHON_BUDGET` seconds or numba is loaded anyway (the inverse kinematics is compiled code);
 a command that computes a few poses never loads numba, a loop over many poses pays the load once
 (at most about twice its Python time overall), and :func:`compile_all` compiles every kernel at
-once for a script that knows it will loop. The machine code is cached on disk (numba's cache, in
-``__pycache__`` beside the source or in numba's user-wide cache directory), so only the first
-process after an install or an edit compiles.
+once for a script that knows it will loop. Every compiled function of robotcell is made by
+:func:`compiled`: its machine code is cached on disk where numba can write (the folder
+``NUMBA_CACHE_DIR`` names, ``__pycache__`` beside the source, or numba's user-wide cache
+directory), so only the first process after an install or an edit compiles. Where none of them
+is writable (a read-only install run by a user without a writable home), it is compiled in
+memory, in each process, without a message.
 
 A kernel must not call another function of robotcell: numba's cache notices changes of the
 kernel's own source file only.
@@ -21,22 +24,73 @@ kernel's own source file only.
 
 from __future__ import annotations
 
+import inspect
+import os
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-__all__ = ["NUMBA_OPTIONS", "PYTHON_BUDGET", "Kernel", "compile_all"]
+__all__ = ["PYTHON_BUDGET", "Kernel", "compile_all", "compiled"]
 
 #: Seconds a kernel may spend running as Python, one pose at a time, before it is compiled.
 PYTHON_BUDGET = 0.5
-#: Options of every compiled function of robotcell: cached machine code; division by zero and
-#: the square root of a negative number give inf and NaN as in numpy, without an exception.
-NUMBA_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy"}
 
 _KERNELS: list[Kernel] = []
+#: Per source folder: whether numba can cache the machine code of the functions it holds.
+_CACHE_WRITABLE: dict[str, bool] = {}
+
+
+def compiled(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn`` compiled by numba: the one place that sets the options of robotcell's machine code.
+
+    Parameters
+    ----------
+    fn : callable
+        Plain Python that numba can compile in nopython mode.
+
+    Returns
+    -------
+    callable
+        numba's dispatcher of ``fn`` (nopython mode, no fast-math), compiled on its first call
+        for the argument types of that call. Division by zero and the square root of a negative
+        number give inf and NaN as in numpy, without an exception. The machine code is cached
+        on disk where numba can write a cache for ``fn``'s source file, else compiled in memory
+        for this process (:func:`_cache_writable`).
+    """
+    import numba
+
+    return numba.njit(cache=_cache_writable(fn), error_model="numpy")(fn)
+
+
+def _cache_writable(fn: Callable[..., Any]) -> bool:
+    """Whether numba's cache can write the machine code of ``fn``: decided once per folder.
+
+    numba looks for a cache folder when a function is compiled with ``cache=True`` and raises
+    ``RuntimeError`` if it finds none. It tries, in order, the folder ``NUMBA_CACHE_DIR`` names,
+    ``__pycache__`` beside the source file and numba's user-wide cache directory
+    (``$XDG_CACHE_HOME/numba`` or ``~/.cache/numba`` on Linux; each under a name made from the
+    source file's folder), and keeps the first it can create and write a file in. numba's own
+    :class:`numba.core.caching.FunctionCache` makes that choice here, so that every rule of
+    numba (its locators, ``NUMBA_CACHE_LOCATOR_CLASSES``) is followed; then a file is written in
+    the folder it chose (a zip archive's locator does not check that). Every locator depends on
+    the source file's folder only, so the answer holds for every function of that folder.
+    """
+    folder = os.path.dirname(os.path.abspath(inspect.getfile(fn)))
+    if folder not in _CACHE_WRITABLE:
+        from numba.core.caching import FunctionCache
+
+        try:
+            path = FunctionCache(fn).cache_path
+            os.makedirs(path, exist_ok=True)
+            tempfile.TemporaryFile(dir=path).close()
+            _CACHE_WRITABLE[folder] = True
+        except (RuntimeError, OSError):
+            _CACHE_WRITABLE[folder] = False
+    return _CACHE_WRITABLE[folder]
 
 
 class Kernel:
@@ -75,9 +129,7 @@ class Kernel:
     def compile(self) -> Callable[..., Any]:
         """Compile ``fn`` (or load it from the cache) and call the compiled version from now on."""
         if self.call == self._python:
-            import numba
-
-            self.call = numba.njit(**NUMBA_OPTIONS)(self.fn)
+            self.call = compiled(self.fn)
         return self.call
 
 

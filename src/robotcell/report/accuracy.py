@@ -18,7 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from robotcell.io.fileio import atomic_write
-from robotcell.report.page import CSS, SCRIPT, png, pyplot, table
+from robotcell.report.page import CSS, SCRIPT, png, table
+from robotcell.view.pyplot import pyplot
 
 __all__ = ["write_accuracy_report"]
 

@@ -26,9 +26,10 @@ from robotcell.calibration.verdict import verdict as judge
 from robotcell.cell.calibrate.registry import attach, for_result
 from robotcell.io.fileio import atomic_write, read_json
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, fmt, png, pyplot, scene_figure
+from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, fmt, png, scene_figure
 from robotcell.view.calibration import calibration_scene, outliers
 from robotcell.view.plot import MAX_PAGE_BYTES
+from robotcell.view.pyplot import pyplot
 
 __all__ = ["CONDITION_GOOD", "CONDITION_POOR", "load_result", "verdict", "write_report"]
 

@@ -25,9 +25,10 @@ from robotcell.identification.measurements import Measurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
-from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, pyplot, scene_figure, table
+from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, scene_figure, table
 from robotcell.view.identification import identification_scene
 from robotcell.view.plot import MAX_PAGE_BYTES
+from robotcell.view.pyplot import pyplot
 
 __all__ = ["write_identification_report"]
 

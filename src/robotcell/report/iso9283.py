@@ -18,9 +18,10 @@ from robotcell.cell import Cell
 from robotcell.io.fileio import atomic_write
 from robotcell.iso9283 import Iso9283Result
 from robotcell.iso9283.cube import cube_corners
-from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, pyplot, scene_figure, table
+from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, scene_figure, table
 from robotcell.view.cellscene import cell_scene
 from robotcell.view.plot import MAX_PAGE_BYTES
+from robotcell.view.pyplot import pyplot
 from robotcell.view.scene import Lines, Points, Scene
 from robotcell.view.shapes import magnification
 

@@ -16,25 +16,15 @@ import math
 from typing import Any
 
 from robotcell.view.plot import MAX_PAGE_BYTES, embed_within
+from robotcell.view.pyplot import pyplot
 from robotcell.view.scene import Scene
 
-__all__ = ["CSS", "SCENE_SLOT", "SCRIPT", "fmt", "png", "pyplot", "scene_figure", "table"]
-
-
-def pyplot():
-    """matplotlib's ``pyplot`` on the Agg backend (no screen needed), imported on first use."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+__all__ = ["CSS", "SCENE_SLOT", "SCRIPT", "fmt", "png", "scene_figure", "table"]
 
 
 def png(fig: Any) -> str:
     """A matplotlib figure as a ``data:image/png;base64,...`` URI; the figure is closed."""
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90)
     plt.close(fig)

@@ -45,6 +45,7 @@ from robotcell.io.fileio import atomic_write
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
 from robotcell.io.tables import read_csv, refuse_empty, require_columns, write_columns
 from robotcell.robot.robot import Robot
+from robotcell.view.pyplot import pyplot
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
@@ -257,11 +258,7 @@ def reach_html(rm: ReachMap, points: ArrayLike, title: str = "Reachability map",
         the side, coloured by score (unreachable ones as red crosses), and the track position
         (mm) and table angle (deg) along the targets.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     p = np.asarray(points, dtype=float).reshape(-1, 3) * 1e3
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
     ok = rm.reachable

@@ -13,6 +13,8 @@
   :mod:`robotcell.view.path`: a path with the arm at each point, on a slider;
   :mod:`robotcell.view.program`: a robot program in it, its bad points marked;
   :mod:`robotcell.view.reach`: a reachability map in the cell.
+- :mod:`robotcell.view.pyplot`: matplotlib's pyplot, off screen, for the PNG figures of the
+  reports and of the reachability map.
 
 The views stand over the cell and the programs and under the reports (:mod:`robotcell.report`),
 which draw the scenes of results. The names below are imported on first use (PEP 562), so that
