@@ -7,7 +7,7 @@ import click
 from robotcell.cli.common import NOISE_MAX_MM, as_flags
 from robotcell.cli.files import Command, OutputPath
 from robotcell.errors import InputError
-from robotcell.studies.demo import DEMO_NOISE, run_demo
+from robotcell.demo.walkthrough import DEMO_NOISE, run_demo
 
 
 @click.command(cls=Command)
