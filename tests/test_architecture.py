@@ -342,3 +342,28 @@ def test_no_module_outside_the_controllers_branches_on_a_vendor_name(name):
     later."""
     tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
     assert not vendor_branches(name, tree), f"{name} branches on {vendor_branches(name, tree)}"
+
+
+def private_imports(name: str, tree: ast.AST) -> list[str]:
+    """Names starting with ``_`` that a module imports from another (``from m import _x``,
+    dunder names and ``__future__`` excepted), as ``line: module._x``."""
+    return [f"{node.lineno}: {node.module}.{alias.name}" for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__"
+            for alias in node.names
+            if alias.name.startswith("_") and not (alias.name.startswith("__")
+                                                   and alias.name.endswith("__"))]
+
+
+def test_private_imports_are_found():
+    # a guard that the check below sees what it is meant to forbid, and lets the rest through
+    code = ("from __future__ import annotations\nfrom robotcell.a import _b, c\n"
+            "from robotcell import __version__\ndef f():\n    from .d import _E\n")
+    assert private_imports("robotcell.x", ast.parse(code)) == ["2: robotcell.a._b", "5: d._E"]
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_module_imports_another_modules_private_name(name):
+    """A name starting with ``_`` is private to its module: another module that needs it needs
+    it public (documented, in ``__all__``) or moved to where both can import it."""
+    tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
+    assert not private_imports(name, tree), f"{name} imports {private_imports(name, tree)}"
