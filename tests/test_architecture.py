@@ -137,7 +137,7 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 #: package's ``__init__`` and ``errors``.
 CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell", "io",
             "controllers", "export", "programs", "iso9283", "accuracy", "studies", "view", "report",
-            "cli",
+            "demo", "cli",
             "robots"}
 TOP_MODULES = {"__init__.py", "errors.py"}
 
@@ -154,18 +154,20 @@ def test_the_top_level_holds_only_the_concept_packages():
 
 
 #: The layers, bottom first: a module imports only modules of its own layer or of lower layers
-#: (a module belongs to the longest prefix listed). The vendor-boundary helpers of ``io`` (files,
-#: tables, pose formats, YAML) and the pose algebra sit under everything (the pose formats convert
-#: the poses of ``robotcell.kinematics.transforms``, which compiles its one-pose check with
+#: (a module belongs to the longest prefix listed). They make four tiers (docs/conventions.md,
+#: "Layout"). The core: the vendor-boundary helpers of ``io`` (files, tables, pose formats, YAML)
+#: and the pose algebra sit under everything (the pose formats convert the poses of
+#: ``robotcell.kinematics.transforms``, which compiles its one-pose check with
 #: ``robotcell.kinematics.jit``); the solvers of ``robotcell.ik`` work on the arm of
 #: ``robotcell.kinematics`` and the robot (an arm with its IK, model files, the library) stands on
 #: both; the estimators stand on the robot, the cell on them (it holds an identified arm, and
-#: calibrates into itself); the controllers (one package per vendor: its export, its programs,
-#: its limits) and the exports beside them over the cell, the programs over both, the ISO 9283
-#: acceptance test beside the programs (it writes its cycles through them); the 3D views
-#: of cells, paths, programs and results over the programs, and the HTML reports, which embed
-#: them, over the views; the accuracy (filtered poses and programs, with their report) over the
-#: reports.
+#: calibrates into itself). The features (:data:`FEATURES`): the controllers (one package per
+#: vendor: its export, its programs, its limits) and the exports beside them over the cell, the
+#: programs over both, the ISO 9283 acceptance test beside the programs (it writes its cycles
+#: through them); the accuracy (filtered poses and programs) over the programs, the studies
+#: beside it. The presentation: the 3D views of cells, paths, programs and results, the HTML
+#: reports, which embed them, over the views, and the demo walk-through, which writes both, over
+#: the reports. The command line on top.
 LAYERS = [
     {"robotcell.errors", "robotcell.kinematics.jit", "robotcell.kinematics.transforms",
      "robotcell.io"},
@@ -175,10 +177,10 @@ LAYERS = [
     {"robotcell.cell"},
     {"robotcell.controllers", "robotcell.export"},
     {"robotcell.programs", "robotcell.iso9283"},
+    {"robotcell.accuracy", "robotcell.studies"},
     {"robotcell.view"},
     {"robotcell.report"},
-    {"robotcell.accuracy"},
-    {"robotcell.studies"},
+    {"robotcell.demo"},
     {"robotcell.cli"},
 ]
 
@@ -199,9 +201,10 @@ def test_every_module_is_in_a_layer():
     assert layer("robotcell.controllers.kuka.program") == 5
     assert layer("robotcell.kinematics.transforms") == 0 and layer("robotcell.kinematics.arm") == 1
     assert layer("robotcell.robot.robot") == 2 and layer("robotcell.cli.fk") == 11
-    assert layer("robotcell.view.plot") == 7 and layer("robotcell.report.identification") == 8
-    assert layer("robotcell.programs.write") == 6 and layer("robotcell.accuracy.filter") == 9
-    assert layer("robotcell.iso9283.analysis") == 6 and layer("robotcell.report.iso9283") == 8
+    assert layer("robotcell.view.plot") == 8 and layer("robotcell.report.identification") == 9
+    assert layer("robotcell.programs.write") == 6 and layer("robotcell.accuracy.filter") == 7
+    assert layer("robotcell.iso9283.analysis") == 6 and layer("robotcell.report.iso9283") == 9
+    assert layer("robotcell.studies.reach") == 7 and layer("robotcell.demo.walkthrough") == 10
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES
@@ -209,6 +212,59 @@ def test_every_module_is_in_a_layer():
 def test_imports_go_down_the_layers(name):
     up = sorted(t for t in internal(GRAPH[name]) if layer(t) > layer(name))
     assert not up, f"{name} (layer {layer(name)}) imports {up} from a layer above"
+
+
+#: The features: each stands on the core and is presented by the reports, views and command
+#: line above it.
+FEATURES = {"controllers", "export", "programs", "iso9283", "accuracy", "studies"}
+#: The presentation tier and what stands on it, which no feature imports.
+PRESENTATION = {"view", "report", "demo", "cli"}
+#: The imports allowed between features (docs/conventions.md, "Layout"): the controllers are the
+#: vendor plug-ins every feature that speaks a controller's language goes through; the ISO 9283
+#: test writes its cycles with the programs' public ``write_program``; filtering a program reads,
+#: checks and rewrites it with the programs' readers and checks.
+FEATURE_USES = {"export": {"controllers"}, "programs": {"controllers"},
+                "iso9283": {"controllers", "programs"}, "accuracy": {"controllers", "programs"},
+                "studies": {"controllers"}, "controllers": set()}
+
+
+def package_of(module: str) -> str:
+    """The concept package of a robotcell module (``robotcell.accuracy.poses`` -> ``accuracy``)."""
+    return module.split(".")[1] if module.count(".") else module
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if package_of(n) in FEATURES))
+def test_features_import_neither_report_nor_view(name):
+    """A feature returns its results; the command line (or the demo) hands them to the report
+    or view that presents them (an import inside a function counts)."""
+    bad = sorted(t for t in internal(GRAPH[name]) if package_of(t) in PRESENTATION)
+    assert not bad, f"{name} imports {bad}: return the result and let the caller present it"
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if package_of(n) in FEATURES))
+def test_features_import_no_other_feature_but_the_allowed_ones(name):
+    own = package_of(name)
+    bad = sorted(t for t in internal(GRAPH[name])
+                 if package_of(t) in FEATURES - {own} - FEATURE_USES[own])
+    assert not bad, f"{name} imports {bad}, another feature (allowed: {FEATURE_USES[own]})"
+
+
+def test_the_iso9283_test_uses_only_the_public_program_writer():
+    uses = {t for n in MODULES if package_of(n) == "iso9283"
+            for t in internal(GRAPH[n]) if package_of(t) == "programs"}
+    assert uses <= {"robotcell.programs"}, uses
+
+
+def test_the_feature_check_sees_a_report_import_inside_a_function(tmp_path):
+    # a guard that the checks above see the imports they are meant to forbid
+    path = tmp_path / "poses.py"
+    path.write_text("def f():\n    from robotcell.report.accuracy import write_accuracy_report\n"
+                    "    from ..programs import write_program\n", encoding="utf-8")
+    found = internal(imports_of("robotcell.accuracy.poses", path))
+    assert found == {"robotcell.report.accuracy", "robotcell.programs"}
+    assert {package_of(t) for t in found} & PRESENTATION == {"report"}
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES
@@ -286,3 +342,28 @@ def test_no_module_outside_the_controllers_branches_on_a_vendor_name(name):
     later."""
     tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
     assert not vendor_branches(name, tree), f"{name} branches on {vendor_branches(name, tree)}"
+
+
+def private_imports(name: str, tree: ast.AST) -> list[str]:
+    """Names starting with ``_`` that a module imports from another (``from m import _x``,
+    dunder names and ``__future__`` excepted), as ``line: module._x``."""
+    return [f"{node.lineno}: {node.module}.{alias.name}" for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__"
+            for alias in node.names
+            if alias.name.startswith("_") and not (alias.name.startswith("__")
+                                                   and alias.name.endswith("__"))]
+
+
+def test_private_imports_are_found():
+    # a guard that the check below sees what it is meant to forbid, and lets the rest through
+    code = ("from __future__ import annotations\nfrom robotcell.a import _b, c\n"
+            "from robotcell import __version__\ndef f():\n    from .d import _E\n")
+    assert private_imports("robotcell.x", ast.parse(code)) == ["2: robotcell.a._b", "5: d._E"]
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_module_imports_another_modules_private_name(name):
+    """A name starting with ``_`` is private to its module: another module that needs it needs
+    it public (documented, in ``__all__``) or moved to where both can import it."""
+    tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
+    assert not private_imports(name, tree), f"{name} imports {private_imports(name, tree)}"

@@ -19,10 +19,11 @@ from view_helpers import figure_from_page, triads
 from robotcell import load_robot, make_pose
 from robotcell.cell import Cell, Frame, Tool, Turntable
 from robotcell.controllers.data import collect, flatten_table
+from robotcell.demo.walkthrough import EXPORT_FILES, VIEW_TABLE
 from robotcell.export import EXPORT_FORMATS, parse_export
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.programs.check import check_program_file
-from robotcell.studies.demo import EXPORT_FILES, VIEW_TABLE, demo_cells
+from robotcell.studies.demo import demo_cells
 from robotcell.studies.plan import pose_error
 
 #: Controller reference frame of each export (see docs/export.md).
@@ -214,7 +215,7 @@ def test_turntable_cell_command_by_command(tmp_path, capsys):
 def test_a_poor_demo_names_the_noise_parameter_in_python_and_the_option_in_the_cli(tmp_path,
                                                                                    capsys):
     from robotcell.errors import InputError
-    from robotcell.studies.demo import run_demo
+    from robotcell.demo.walkthrough import run_demo
 
     with pytest.raises(InputError, match="tcp: poor calibration, nothing written: .*; try a "
                                          "smaller noise$"):

@@ -149,7 +149,7 @@ def test_progress_in_blocks_gives_the_same_map(capsys, tmp_path, monkeypatch):
 
 def test_write_reach_map_is_the_reach_command_as_one_call(tmp_path, capsys):
     from robotcell.io.tables import read_csv
-    from robotcell.studies.reach import write_reach_map
+    from robotcell.report.reach import write_reach_map
 
     cell = Cell.load(CELL)
     T, table = read_targets(SEAM)

@@ -174,7 +174,7 @@ def test_reach_and_sweep_with_a_two_axis_positioner(capsys, tmp_path):
     ranked = sweep(cell, T, layouts, frame="part", tool="torch", table=v)
     assert ranked[0].index == 0 and ranked[0].fraction == 1.0    # as built: every target
     assert all(r.fraction < 1.0 for r in ranked if r.layout.values["turntable.x"] == 2000)
-    from robotcell.studies.reach import reach_html
+    from robotcell.report.reach import reach_html
     page = reach_html(rm, T[:, :3, 3], frame="part")
     assert "30 of 30 targets reachable" in page
 

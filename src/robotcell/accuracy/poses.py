@@ -27,7 +27,6 @@ from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import read_csv, refuse_empty, write_csv
 from robotcell.programs.path import read_path, table_columns
-from robotcell.report.accuracy import write_accuracy_report
 
 __all__ = ["CompensatedPoses", "compensate_poses"]
 #: Decimals of the output (mm, deg): 1e-9 mm and deg, as the program formats.
@@ -96,8 +95,8 @@ def _with_columns() -> list:
 
 
 def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "world",
-                     output: str | Path | None = None, max_correction: float = MAX_CORRECTION,
-                     report: str | Path | None = None) -> CompensatedPoses:
+                     output: str | Path | None = None, max_correction: float = MAX_CORRECTION
+                     ) -> CompensatedPoses:
     """Filter the poses of a file and write the poses to command (all or nothing).
 
     Parameters
@@ -114,13 +113,12 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
         The CSV to write (atomically; not written when a pose is refused).
     max_correction : float
         Largest correction taken (m).
-    report : str or Path, optional
-        Also write the HTML page of the predicted errors and 1-sigma per pose
-        (:func:`robotcell.report.accuracy.write_accuracy_report`).
 
     Returns
     -------
     CompensatedPoses
+        With what the HTML page of the predicted errors needs
+        (:func:`robotcell.report.accuracy.write_poses_report`).
 
     Raises
     ------
@@ -155,7 +153,4 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
     rows = np.hstack(parts)
     if output is not None:
         write_csv(output, header, rows, DECIMALS)
-    if report is not None:
-        write_accuracy_report(report, Path(path).name, [f"pose {i + 1}" for i in range(len(rows))],
-                              r.error, r.dpos, r.sigma)
     return CompensatedPoses(r, header, rows, list(targets.warnings))

@@ -48,7 +48,6 @@ from robotcell.programs.files import check_folder, write_all
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import placement, tool_pose_of
 from robotcell.programs.write import written_poses
-from robotcell.report.accuracy import write_accuracy_report
 
 __all__ = ["JOINTS", "CompensatedPoint", "CompensatedProgram", "compensate_program"]
 
@@ -145,8 +144,7 @@ def _angle(A: NDArray[np.float64], B: NDArray[np.float64]) -> float:
 def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints: str = "taught",
                        pulses_per_degree: ArrayLike | None = None,
                        max_correction: float = MAX_CORRECTION, max_rotation: float = MAX_ROTATION,
-                       inputs: tuple[str | Path, ...] = (), report: str | Path | None = None
-                       ) -> CompensatedProgram:
+                       inputs: tuple[str | Path, ...] = ()) -> CompensatedProgram:
     """Filter every Cartesian point of a program and write it to a folder, all files or none.
 
     Parameters
@@ -166,13 +164,12 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
         Largest correction taken (m, rad).
     inputs : tuple of str or Path
         Further files the run read (the cell file), which no output may replace.
-    report : str or Path, optional
-        Also write the HTML page of the predicted errors and 1-sigma per point
-        (:func:`robotcell.report.accuracy.write_accuracy_report`).
 
     Returns
     -------
     CompensatedProgram
+        With what the HTML page of the predicted errors needs
+        (:func:`robotcell.report.accuracy.write_program_report`).
 
     Raises
     ------
@@ -267,8 +264,4 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     refuse(refused, "point", names)
     out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}
     result.files = write_all(folder, out, (*program.files, *inputs))
-    if report is not None:
-        pp = result.points
-        write_accuracy_report(report, Path(path).name, [p.name for p in pp],
-                              [p.error for p in pp], [p.dpos for p in pp], [p.sigma for p in pp])
     return result

@@ -61,15 +61,17 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
     from robotcell.accuracy.filter import FilterRefused
     from robotcell.accuracy.poses import DECIMALS, compensate_poses
     from robotcell.io.tables import write_csv
+    from robotcell.report.accuracy import write_poses_report
 
     cell = Cell.load(cell_path)
     try:
         with as_flags({"max_correction": "--max-correction"}):
-            result = compensate_poses(poses, cell, tool, frame, output, max_correction * 1e-3,
-                                      report)
+            result = compensate_poses(poses, cell, tool, frame, output, max_correction * 1e-3)
     except FilterRefused as exc:
         click.echo(format_table(["pose", "why"], [list(p) for p in exc.points]), err=True)
         raise BadPoints(f"{poses}: {exc}") from None
+    if report is not None:
+        write_poses_report(report, poses, result)
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     if as_json:

@@ -6,8 +6,8 @@ import click
 
 from robotcell.cli.common import NOISE_MAX_MM, as_flags
 from robotcell.cli.files import Command, OutputPath
+from robotcell.demo.walkthrough import DEMO_NOISE, run_demo
 from robotcell.errors import InputError
-from robotcell.studies.demo import DEMO_NOISE, run_demo
 
 
 @click.command(cls=Command)

@@ -23,6 +23,7 @@ from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.identification.validation import select_configurations
 from robotcell.io.tables import format_table, write_csv
+from robotcell.report.identification import write_identification_report
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
 from robotcell.studies.identify import identify_file, zero_offset_controllers
@@ -192,8 +193,11 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     _check_columns(measurements)
     with as_flags({"the nominal model as robot": "the nominal model with --robot"}):
         run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
-                            math.radians(angle_accuracy), scale, compliance, folds, report,
-                            offsets_for, output, force)
+                            math.radians(angle_accuracy), scale, compliance, folds,
+                            report is not None, offsets_for, output, force)
+    if report is not None:
+        write_identification_report(run.result, report, run.cross, run.observability,
+                                    run.measurements)
     result, cv, offsets = run.result, run.cross_stats, run.offsets
     verdict, why = result.verdict
     if as_json:

@@ -256,17 +256,19 @@ def compensate_cmd(program_file: str, cell_path: str, folder: str, joints: str,
     from robotcell.accuracy.filter import FilterRefused
     from robotcell.accuracy.program import compensate_program
     from robotcell.cli.common import check_kind
+    from robotcell.report.accuracy import write_program_report
 
     check_kind(report, "HTML", "the accuracy report", "--report")
     cell = Cell.load(cell_path)
     with as_flags(FLAGS):
         try:
             result = compensate_program(program_file, cell, folder, joints, _ppd(ppd),
-                                        max_correction * 1e-3, inputs=(cell_path,),
-                                        report=report)
+                                        max_correction * 1e-3, inputs=(cell_path,))
         except FilterRefused as exc:
             click.echo(format_table(["point", "why"], [list(p) for p in exc.points]), err=True)
             raise BadPoints(f"{program_file}: {exc}") from None
+    if report is not None:
+        write_program_report(report, program_file, result)
     if as_json:
         click.echo(json.dumps(result.to_json(), indent=2))
         return

@@ -35,7 +35,7 @@ from robotcell.cli.progress import DeferredProgress
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS
 from robotcell.io.tables import require_columns
-from robotcell.studies.reach import write_reach_map
+from robotcell.report.reach import write_reach_map
 
 
 def target_options(f: Callable[..., None]) -> Callable[..., None]:

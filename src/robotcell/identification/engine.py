@@ -47,7 +47,7 @@ from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.covariance import ParameterCovariance
 from robotcell.robot.robot import Robot
 
-__all__ = ["identify", "identify_with_coupling"]
+__all__ = ["Problem", "identifiable", "identify", "identify_with_coupling"]
 
 #: Default measurement accuracies: a laser tracker (m per coordinate) and a 6D probe (rad).
 POINT_SIGMA = 0.05e-3
@@ -62,7 +62,7 @@ MAX_SIGMA_ANGLE = math.radians(2.0)
 _LENGTHS = ("a", "d", "x", "y", "z")
 
 
-class _Problem:
+class Problem:
     """Weighted residuals and analytic Jacobian of one measurement set over a free subset."""
 
     def __init__(self, chain: Chain, meas: Measurements, point_sigma: float, angle_sigma: float):
@@ -158,7 +158,7 @@ def _start_base(chain: Chain, meas: Measurements, x: NDArray[np.float64]):
     return B, np.zeros((0, 3)), X
 
 
-def _solve(prob: _Problem, x0: NDArray[np.float64], free: NDArray[np.int_]) -> NDArray[np.float64]:
+def _solve(prob: Problem, x0: NDArray[np.float64], free: NDArray[np.int_]) -> NDArray[np.float64]:
     """Levenberg-Marquardt over the parameters ``free``; returns the full vector."""
     x = x0.copy()
 
@@ -215,9 +215,30 @@ def _pivoted_qr(A: NDArray[np.float64], Q: NDArray[np.float64], tol: float,
     return chosen, Q
 
 
-def _identifiable(J: NDArray[np.float64], cand: Sequence[int], prio: Sequence[int],
-                  names: Sequence[str], tol: float):
-    """Split ``cand`` into kept and fixed columns; a reason for every fixed one."""
+def identifiable(J: NDArray[np.float64], cand: Sequence[int], prio: Sequence[int],
+                 names: Sequence[str], tol: float):
+    """Split ``cand`` into kept and fixed columns; a reason for every fixed one.
+
+    Parameters
+    ----------
+    J : ndarray, shape (M, P)
+        Weighted Jacobian of the residuals over every parameter (unitless).
+    cand : sequence of int
+        Columns that may be identified.
+    prio : sequence of int
+        Columns kept first when two cannot be told apart.
+    names : sequence of str, length P
+        Parameter names, for the reasons.
+    tol : float
+        Relative tolerance of the rank decision.
+
+    Returns
+    -------
+    kept : ndarray of int
+        The columns identified, sorted.
+    fixed : dict of int to str
+        Each fixed column with why it is fixed.
+    """
     norms = np.linalg.norm(J, axis=0)
     fixed: dict[int, str] = {}
     live = [c for c in cand if norms[c] > 0]
@@ -375,7 +396,7 @@ def identify(
     chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, B, X)
     if not pose:
         x[np.array(chain.target_params).ravel()] = r.ravel()
-    prob = _Problem(chain, measurements, point_sigma, angle_sigma)
+    prob = Problem(chain, measurements, point_sigma, angle_sigma)
     groups = np.array(chain.groups)
     prio = np.flatnonzero(np.isin(groups, ("base", "target")))
     x1 = _solve(prob, x, prio)
@@ -389,7 +410,7 @@ def identify(
     if fit_coupling and chain.coupling_param >= 0:
         cand.append(chain.coupling_param)
     J1 = prob.jacobian(x1)
-    kept, fixed = _identifiable(J1, cand, set(prio), chain.names, rank_tol)
+    kept, fixed = identifiable(J1, cand, set(prio), chain.names, rank_tol)
     # Rows that repeat a configuration measure it again; they say nothing more about the chain.
     distinct = len(np.unique(measurements.q, axis=0))
     m = distinct * prob.ncomp

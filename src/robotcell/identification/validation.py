@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from robotcell.errors import InputError
 from robotcell.identification.chain import Chain
-from robotcell.identification.engine import _identifiable, _Problem, identify
+from robotcell.identification.engine import Problem, identifiable, identify
 from robotcell.identification.measurements import Measurements
 from robotcell.robot.robot import Robot
 
@@ -107,12 +107,12 @@ def _jacobian_blocks(nominal: Robot, q: NDArray[np.float64], n_targets: int, pos
     for k in range(ch.n_targets):
         x[ch.target_params[k]] = spots[k % 3] * (1 + k // 3)
     pts, R = ch.predict(x, q)
-    prob = _Problem(ch, Measurements(q, pts, R if pose else None), point_sigma, angle_sigma)
+    prob = Problem(ch, Measurements(q, pts, R if pose else None), point_sigma, angle_sigma)
     groups = np.array(ch.groups)
     prio = np.flatnonzero(np.isin(groups, ("base", "target")))
     cand = list(prio) + list(np.flatnonzero(groups == "link"))
     J = prob.jacobian(x)
-    kept, _ = _identifiable(J, cand, set(prio), ch.names, 1e-6)
+    kept, _ = identifiable(J, cand, set(prio), ch.names, 1e-6)
     return J[:, kept].reshape(len(q), prob.ncomp, kept.size)
 
 

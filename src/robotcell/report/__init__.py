@@ -1,9 +1,12 @@
 """HTML reports of results: one self-contained page each, its figures and 3D scene embedded.
 
 - :mod:`robotcell.report.calibration`: the report of a calibration result, made from the JSON a
-  calibration writes (``robotcell report``), and the page's common parts;
+  calibration writes (``robotcell report``);
 - :mod:`robotcell.report.identification`: the report of a kinematic identification;
-- :mod:`robotcell.report.accuracy`: the report of a filtering through an identified arm.
+- :mod:`robotcell.report.accuracy`: the report of a filtering through an identified arm;
+- :mod:`robotcell.report.reach`: the page of a reachability map;
+- :mod:`robotcell.report.iso9283`: the report of an ISO 9283 acceptance test;
+- :mod:`robotcell.report.page`: the parts every page shares.
 
 The reports stand on the 3D views (:mod:`robotcell.view`) whose scenes they embed.
 """

@@ -13,6 +13,7 @@ from __future__ import annotations
 import html
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -21,7 +22,11 @@ from robotcell.io.fileio import atomic_write
 from robotcell.report.page import CSS, SCRIPT, png, table
 from robotcell.view.pyplot import pyplot
 
-__all__ = ["write_accuracy_report"]
+if TYPE_CHECKING:
+    from robotcell.accuracy.poses import CompensatedPoses
+    from robotcell.accuracy.program import CompensatedProgram
+
+__all__ = ["write_accuracy_report", "write_poses_report", "write_program_report"]
 
 
 def _figure(error_mm: np.ndarray, dpos_mm: np.ndarray, sigma_mm: np.ndarray) -> str:
@@ -86,3 +91,47 @@ def write_accuracy_report(path: str | Path, title: str, names: list[str], error:
     out = Path(path)
     atomic_write(out, page)
     return out
+
+
+def write_poses_report(path: str | Path, poses: str | Path, result: CompensatedPoses) -> Path:
+    """Write the page of a filtered poses file (``robotcell compensate --report``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The HTML file.
+    poses : str or Path
+        The poses file that was filtered (its name titles the page).
+    result : CompensatedPoses
+        What :func:`robotcell.accuracy.poses.compensate_poses` returned.
+
+    Returns
+    -------
+    Path
+    """
+    r = result.result
+    names = [f"pose {i + 1}" for i in range(len(result.rows))]
+    return write_accuracy_report(path, Path(poses).name, names, r.error, r.dpos, r.sigma)
+
+
+def write_program_report(path: str | Path, program: str | Path,
+                         result: CompensatedProgram) -> Path:
+    """Write the page of a filtered program (``robotcell program compensate --report``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The HTML file.
+    program : str or Path
+        The program file that was filtered (its name titles the page).
+    result : CompensatedProgram
+        What :func:`robotcell.accuracy.program.compensate_program` returned.
+
+    Returns
+    -------
+    Path
+    """
+    pp = result.points
+    return write_accuracy_report(path, Path(program).name, [p.name for p in pp],
+                                 [p.error for p in pp], [p.dpos for p in pp],
+                                 [p.sigma for p in pp])

@@ -14,12 +14,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from numpy.typing import NDArray
+
 from robotcell.cell import Cell
 from robotcell.cell.identified import adopt_identified, identification_provenance
 from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
 from robotcell.identification import identify, identify_with_coupling, read_measurements
 from robotcell.identification.circles import first_estimate
+from robotcell.identification.measurements import Measurements
 from robotcell.identification.offsets import JointOffset, joint_offsets
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import (
@@ -27,7 +31,6 @@ from robotcell.identification.validation import (
     compare_observability,
     cross_validate,
 )
-from robotcell.report.identification import write_identification_report
 from robotcell.robot.models import load_robot, save_robot
 
 __all__ = ["IdentificationRun", "controller_offsets", "identify_file", "zero_offset_controllers"]
@@ -89,6 +92,10 @@ class IdentificationRun:
         :func:`controller_offsets` of the result, when ``offsets_for`` was given.
     written : bool
         Whether the model file (and the cell) was written.
+    observability : (float, ndarray) or None
+        O1 of the measured configurations and of random sets, when asked for (``report``).
+    measurements : Measurements or None
+        The measurements identified, when asked for (``report``).
     """
 
     result: IdentificationResult
@@ -96,6 +103,8 @@ class IdentificationRun:
     folds: int | None
     offsets: dict[str, Any] | None
     written: bool
+    observability: tuple[float, NDArray[np.float64]] | None = None
+    measurements: Measurements | None = None
 
     @property
     def cross_stats(self) -> dict[str, float] | None:
@@ -116,7 +125,7 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
                   cell: str | Path | None = None, j23_factor: float | None = None,
                   point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
                   scale: bool = False, compliance: bool = False, folds: int | None = None,
-                  report: str | Path | None = None, offsets_for: str | None = None,
+                  report: bool = False, offsets_for: str | None = None,
                   output: str | Path | None = None, force: bool = False) -> IdentificationRun:
     """Identify the kinematic model of an arm or positioner from a measurement CSV.
 
@@ -141,8 +150,10 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
     folds : int, optional
         Folds of a cross-validation; with a report or a cell and none given,
         ``min(5, rows)``.
-    report : str or Path, optional
-        HTML report to write.
+    report : bool
+        Also compute what the HTML report needs (the observability of the measured
+        configurations; the run keeps the measurements), which
+        :func:`robotcell.report.identification.write_identification_report` writes.
     offsets_for : str, optional
         A controller of :func:`zero_offset_controllers` (``kuka``, ``abb``).
         Also compute the joint zero offsets in that controller's units.
@@ -177,17 +188,17 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
     else:
         result = identify(nominal, meas, **options)
     cross = None
-    if (report is not None or cell is not None) and folds is None:
+    if (report or cell is not None) and folds is None:
         folds = min(DEFAULT_FOLDS, meas.n_rows)
     if folds is not None:
         if j23_factor is not None:
             options["coupling"] = j23_factor
         cross = cross_validate(nominal, meas, folds=folds, **options)
-    if report is not None:
+    obs = None
+    if report:
         obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
                                     pose=meas.rotations is not None, point_sigma=point_sigma,
                                     angle_sigma=angle_sigma)
-        write_identification_report(result, report, cross, obs, meas)
     offsets = (None if offsets_for is None
                else controller_offsets(joint_offsets(result), offsets_for))
     written = output is not None and (result.verdict[0] != "poor" or force)
@@ -196,4 +207,5 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
             save_robot(result.robot, output)
         else:
             adopt_identified(cell, result, output, identification_provenance(result, cross))
-    return IdentificationRun(result, cross, folds, offsets, written)
+    return IdentificationRun(result, cross, folds, offsets, written, obs,
+                             meas if report else None)
