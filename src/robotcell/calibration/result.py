@@ -504,8 +504,8 @@ class CalibrationResult:
         parts = self._sigma_parts().get(key)
         if parts is None:
             return []
-        lines = [f"    the 1-sigma above is relative to frame {parts['relative_to']!r}; its parts "
-                 "(position mm / rotation deg, adding in quadrature):"]
+        lines = [(f"    the 1-sigma above is relative to frame {parts['relative_to']!r}; its "
+                  "parts (position mm / rotation deg, adding in quadrature):")]
         for part, what in PARTS.items():
             if part in parts:
                 p = parts[part]
