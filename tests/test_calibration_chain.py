@@ -17,12 +17,13 @@ from dataclasses import replace
 
 import numpy as np
 from ruamel.yaml import YAML
+from scipy.spatial.transform import Rotation
 from touch_helpers import pose_error, retouched
 
 from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import Cell
 from robotcell.cell import calibrate as cellcal
-from robotcell.kinematics.transforms import make_pose
+from robotcell.kinematics.transforms import make_pose, transform_points
 from robotcell.studies.simulate import simulate
 
 NOISE = 1e-4
@@ -197,3 +198,55 @@ def test_a_calibrated_positioner_keeps_its_error_sources_in_the_cell_file(tmp_pa
     mm_rad = np.array(written["covariance_mm_rad"])
     units = np.r_[1e3, 1e3, 1e3, 1, 1, 1, 1e3, 1, 1e3, 1, 1e3, 1, 1e3, 1]  # a and d in mm
     np.testing.assert_allclose(np.diag(mm_rad)[:10], (np.diag(cov) * units**2)[:10], rtol=1e-5)
+
+
+#: Trials of the chain "tool, then external TCP": the spread of a correct 1-sigma is 1 +- 0.05
+#: (chi-square with 200 degrees of freedom), so 0.8 and 1.25 are 4 and 5 standard deviations away.
+#: Leaving out the reference tool's error (its touch noise only) fails the bound on the origin.
+EXTERNAL_TRIALS = 200
+
+
+def external_touches(cell, rng):
+    """Joint values touching a fixed tool with the robot's 'pointer' (its TCP four times from
+    directions 30 deg apart, two points on its +X axis and two in its XY plane, 150 mm away),
+    without error, and the fixed tool's pose in the robot base."""
+    from robotcell.cell.calibrate.simulation import DOWN, Touches
+
+    T_R_X = make_pose(Rotation.from_euler("xyz", [10, -5, 30], degrees=True).as_matrix(),
+                      [0.9, 0.2, 0.3])
+    p_X = np.array([[0, 0, 0]] * 4 + [[0.15, 0, 0]] * 2 + [[0.05, 0.15, 0]] * 2, dtype=float)
+    roles = ["tcp"] * 4 + ["x"] * 2 + ["xy"] * 2
+    R = DOWN[[62, 74, 86, 98, 3, 4, 5, 6]]  # tilted 30 deg four ways, then upright
+    T = make_pose(R, transform_points(T_R_X, p_X))
+    sol = cell.robot.ik(T[:, None], tool=cell.tools["pointer"].T_F_TCP)
+    q = np.array([sol.q[i][tuple(np.argwhere(ok)[rng.integers(ok.sum())])]
+                  for i, ok in enumerate(sol.valid)])
+    return Touches("external-tcp", q, None, None, roles, truth={}, tool="pointer",
+                   noise=0.0), T_R_X
+
+
+def test_an_external_tcp_carries_the_error_of_the_reference_tool():
+    """Tool, then a fixed tool touched with it: every touch moves with the reference tool's
+    error, so the external TCP's 1-sigma includes it (error / 1-sigma spread 0.8-1.25, fewer
+    than 1 % of GOOD results more than 4 sigma off)."""
+    _, fixed = cells()
+    tool = fixed.tools["pointer"].T_F_TCP
+    rng = np.random.default_rng(7)
+    design = simulate(fixed, "tcp", noise=0.0, tool="pointer")
+    touches, T_R_X = external_touches(fixed, rng)
+    z, good, off = [], 0, 0
+    for _ in range(EXTERNAL_TRIALS):
+        t = cellcal.tcp(fixed, retouched(design, fixed, tool, rng, NOISE), "pointer",
+                        sigma=NOISE)
+        out = cellcal.external_tcp(t.cell, retouched(touches, fixed, tool, rng, NOISE),
+                                   tool="pointer", sigma=NOISE)
+        r = out.result
+        z.append(z_scores(r.values["T_R_TCP"], T_R_X, r.sigma["T_R_TCP_position"],
+                          r.sigma["T_R_TCP_rotation"]))
+        if r.verdict.level == "good":
+            good += 1
+            off += bool(np.max(np.abs(z[-1])) > 4.0)
+    assert out.inputs == ("tools.pointer",)
+    spread = np.sqrt(np.mean(np.square(z), axis=0))
+    assert np.all((spread > 0.8) & (spread < 1.25)), np.round(spread, 3)
+    assert good >= 0.9 * EXTERNAL_TRIALS and off < 0.01 * good, (good, off)

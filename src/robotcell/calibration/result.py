@@ -17,7 +17,8 @@ from numpy.typing import NDArray
 
 from robotcell.calibration.fitting import Fit
 from robotcell.calibration.resultcheck import REQUIRED, TOUCH_LISTS, malformed
-from robotcell.calibration.uncertainty import Estimate
+from robotcell.calibration.sigmaparts import PARTS, pose_parts
+from robotcell.calibration.uncertainty import OWN, Estimate
 from robotcell.calibration.verdict import (
     CONDITION_GOOD,
     CONDITION_POOR,
@@ -321,6 +322,17 @@ class CalibrationResult:
                     out[key] = s
         return out
 
+    def _sigma_parts(self) -> dict[str, Any]:
+        """The 1-sigma of each pose with inherited error sources, split into its parts
+        (:mod:`robotcell.calibration.sigmaparts`), with the frame the total is relative to."""
+        out: dict[str, Any] = {}
+        for key, est in self.estimates.items():
+            if (key not in self.values or self._kind(key) != "pose" or est.sources.size != 6
+                    or set(est.sources.factors) <= {OWN}):
+                continue
+            out[key] = {"relative_to": key.split("_")[1], **pose_parts(est.sources)}
+        return out
+
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict in vendor units (mm, deg).
 
@@ -333,7 +345,10 @@ class CalibrationResult:
             ``touch_sigma_mm`` and ``accuracy_source`` (the accuracy the residuals are tested
             against), ``residual_sigma_mm`` (the residuals' estimate) and ``chi2``, the touches
             ``excluded``, ``unchecked``, ``outliers`` and ``gross_outliers`` (labels), ``sigma`` (1-sigma of each estimated
-            quantity, keys with units), ``undetermined``, ``warnings``, ``next_step``,
+            quantity, keys with units), ``sigma_parts`` (for a pose with inherited error
+            sources: what its 1-sigma is relative to, and its parts ``own``, ``recorded`` and
+            ``assumed``, see :mod:`robotcell.calibration.sigmaparts`), ``undetermined``,
+            ``warnings``, ``next_step``,
             ``points_mm`` (N x 3, when the procedure records its measured points), then the
             procedure's own fields (``json_fields``), and ``verdict`` (level, reasons, the
             condition number and the chi-square figures it used; see :attr:`verdict`).
@@ -359,6 +374,7 @@ class CalibrationResult:
             "disagreeing": [self.labels[i] for i in self.disagreeing],
             "gross_outliers": [self.labels[i] for i in self.gross],
             "sigma": self._sigma_json(),
+            **({"sigma_parts": parts} if (parts := self._sigma_parts()) else {}),
             "undetermined": list(self.undetermined),
             "warnings": list(self.warnings),
             "next_step": self.next_step,
@@ -472,6 +488,7 @@ class CalibrationResult:
                     lines.append(f"    1-sigma position (mm):      {_fmt(np.asarray(sp) * 1e3, 3)}")
                 if sr is not None:
                     lines.append(f"    1-sigma rotation (deg):     {_fmt(np.degrees(sr), 4)}")
+                lines += self._part_lines(key)
                 continue
             scale, unit, dec = {"length": (1e3, " mm", 3), "angle": (180 / math.pi, " deg", 4),
                                 "number": (1.0, "", 6)}[kind]
@@ -480,6 +497,21 @@ class CalibrationResult:
             if s is not None:
                 text += f"  (1-sigma {_fmt(np.asarray(s, dtype=float) * scale, dec)})"
             lines.append(f"  {key}{unit and ' (' + unit.strip() + ')'}: {text}")
+        return lines
+
+    def _part_lines(self, key: str) -> list[str]:
+        """The parts of the 1-sigma of pose ``key`` when it inherits error sources."""
+        parts = self._sigma_parts().get(key)
+        if parts is None:
+            return []
+        lines = [(f"    the 1-sigma above is relative to frame {parts['relative_to']!r}; its "
+                  "parts (position mm / rotation deg, adding in quadrature):")]
+        for part, what in PARTS.items():
+            if part in parts:
+                p = parts[part]
+                names = f" [{', '.join(p['sources'])}]" if p["sources"] else ""
+                lines.append(f"      {what}{names}: {_fmt(p['position_mm'], 3)} / "
+                             f"{_fmt(p['rotation_deg'], 4)}")
         return lines
 
     def _noise_line(self) -> str:

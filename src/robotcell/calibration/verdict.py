@@ -248,7 +248,8 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         A calibration result as JSON (mm, deg): the output of ``CalibrationResult.to_json()`` or
         of ``robotcell calibrate ... --json``. Used: ``residuals_xyz_mm`` (or ``residuals_mm``),
         ``dof``, ``noise_source``, ``noise_sigma_mm``, ``condition``, ``warnings``, ``scale``,
-        ``matrix`` and the lengths ending in ``_mm``.
+        ``matrix``, the lengths ending in ``_mm`` and ``sigma_parts`` (a pose whose 1-sigma
+        holds an assumed part gets a reason saying so, whatever the level).
 
     Returns
     -------
@@ -303,8 +304,27 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
         rms = math.sqrt(ssr / n) if n else 0.0
         reasons = [f"RMS {rms:.3f} mm within {what}, condition number "
                    + f"{format_condition(cond)}, no warnings"]
+    reasons += _assumed_parts(result)
     return Verdict(level=level, reasons=reasons, condition=cond, touch_sigma_mm=s,
                    accuracy_source=source, chi2=x2, chi2_bound=bound, touches_needed=needed)
+
+
+def _assumed_parts(result: Mapping[str, Any]) -> list[str]:
+    """A reason per pose whose 1-sigma holds an assumed part (``sigma_parts``), with the part
+    its own touches determine: an assumed figure must not read as a measured one."""
+    out = []
+    parts = result.get("sigma_parts")
+    for key, p in (parts.items() if isinstance(parts, Mapping) else ()):
+        try:
+            assumed = float(np.max(_floats(p["assumed"]["position_mm"])))
+            own = float(np.max(_floats(p["own"]["position_mm"])))
+            names = ", ".join(str(n) for n in p["assumed"]["sources"])
+        except (KeyError, TypeError, ValueError):
+            continue
+        out.append(f"{key}: up to {assumed:.3g} mm of its 1-sigma is ASSUMED ({names}: no "
+                   f"recorded uncertainty); its own touches determine it to {own:.3g} mm "
+                   "relative to what touched")
+    return out
 
 
 def _chi2_checks(result: Mapping[str, Any], ssr: float, n: int, dof: int, s: float, what: str,

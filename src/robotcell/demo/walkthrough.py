@@ -138,7 +138,8 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     echo(f"virtual cell: KUKA KR 16 on a 6 m track (KL1500) beside a turntable (DKP_400), "
          f"tool 'torch', workpiece 'part'\n  nominal cell (the drawings): {cell_file}\n"
          f"  true cell (the virtual hardware): {truth_file}\n"
-         f"  touch-up error {noise * 1e3:g} mm (1-sigma per coordinate), seed {seed}\n")
+         f"  touch-up error {noise * 1e3:g} mm (1-sigma per coordinate), simulated and stated "
+         f"to every calibration (--sigma {noise * 1e3:g}), seed {seed}\n")
     rng = np.random.default_rng(seed)
     # procedure, options of the command, keywords of the library call, of the simulation
     steps: list[tuple[str, list[str], dict[str, Any], dict[str, Any]]] = [
@@ -156,7 +157,8 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
         touches = simulate(truth, procedure, noise=noise, seed=rng, **design)
         csv_path = out / f"{procedure}.csv"
         touches.write_csv(csv_path)
-        args = (["calibrate", procedure, str(csv_path), "--cell", str(cell_file), "--json"]
+        args = (["calibrate", procedure, str(csv_path), "--cell", str(cell_file), "--json",
+                 "--sigma", f"{noise * 1e3:g}"]
                 + [str(out / a) if a.endswith(".json") else a for a in extra] + touches.options)
         echo(f"{procedure}: simulated {len(touches.q)} touches -> {csv_path.name}")
         echo("  $ robotcell " + shlex.join(args))
@@ -164,7 +166,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
             kw["turntable"] = turntable
         calibrate = cellcal.procedure(procedure).calibrate
         done = calibrate(cell, read_csv(csv_path), source=str(csv_path), cell_label=str(cell_file),
-                         file=csv_path, **kw, **touches.keywords())
+                         file=csv_path, sigma=noise, **kw, **touches.keywords())
         verdict = done.result.verdict
         if verdict.level == "poor":  # the command refuses to write it (exit 3); so does the demo
             raise InputError(f"{procedure}: poor calibration, nothing written: "

@@ -6,7 +6,7 @@ from typing import Any
 
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell
-from robotcell.cell.calibrate.common import CellCalibration, Notes, assumption
+from robotcell.cell.calibrate.common import CellCalibration, Notes, assumption, chained_inputs
 from robotcell.cell.calibrate.context import CalibrationContext
 from robotcell.cell.calibrate.registry import Procedure
 from robotcell.cell.calibrate.touches import MeasurementInput, read_touches, tool_transform
@@ -27,8 +27,10 @@ def external_tcp(cell: Cell | None, measurements: MeasurementInput, *,
         (a point in its XY plane with +Y).
     context : CalibrationContext, optional
         Its ``tool`` is the reference tool: a tool of the cell by name, or ``T_F_TCP`` (m);
-        default the robot model's tool. Nothing is written, so ``time``, ``file`` and
-        ``nominal`` are not used (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
+        default the robot model's tool. In a cell the reference tool's error sources (its
+        recorded uncertainty, else the accuracy ``nominal``) are part of the result's 1-sigma,
+        as in every calibration that touches with a tool. Nothing is written, so ``time`` and
+        ``file`` are not used (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
     **keywords
         Fields of :class:`~robotcell.cell.calibrate.context.CalibrationContext` over
         ``context``, e.g. ``sigma=1e-4, tool="torch"``.
@@ -45,8 +47,10 @@ def external_tcp(cell: Cell | None, measurements: MeasurementInput, *,
     notes = Notes(ctx.on_note)
     m = read_touches("external-tcp", measurements, ctx.source, ctx.arm(cell), notes.one)
     p = m.tcp(tool_transform(cell, ctx.tool, m))
-    result = calibrate_external_tcp(p, m.point, ctx.sigma, m.labels(points=True))
-    return CellCalibration(result, notes=tuple(notes), value="T_R_TCP",
+    chained = chained_inputs(cell, m, p, ctx.tool, None, ctx.nominal, notes)
+    result = calibrate_external_tcp(p, m.point, ctx.sigma, m.labels(points=True),
+                                    inputs=chained.inputs)
+    return CellCalibration(result, notes=tuple(notes), value="T_R_TCP", inputs=chained.keys,
                            assumed=assumption(cell, m, ctx.tool, "T_R_TCP"))
 
 
