@@ -12,7 +12,7 @@ import pytest
 from cli_helpers import run
 
 from robotcell.cell import Cell
-from robotcell.ik.config import kuka_status_turn
+from robotcell.ik.config import abb_confdata, kuka_status_turn
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.programs import read_program
 from robotcell.programs.check import check_program, check_program_file
@@ -225,3 +225,104 @@ def test_status_and_turn_of_linear_points_are_not_taken_as_their_configuration(t
     src.write_text(src.read_text().replace("LIN XP2\nSLIN", "PTP XP2\nSLIN"))
     q = check_program_file(src, cell).points[1].q
     assert math.isclose(math.degrees(q[5]), 102 - 360, abs_tol=1e-6)
+
+
+# -- 6. RAPID optional arguments right after the target (MultiMove \ID, \NoEOffs) ---------------
+IRB_CELL = """\
+name: irb2400_minimal
+robot:
+  model: abb_irb2400
+tools:
+  tool1:
+    number: 1
+    frame: {x: 0, y: 0, z: 150, a: 0, b: 0, c: 0}
+    provenance: {source: nominal}
+"""
+
+
+def _robtarget(cell: Cell, q_deg) -> str:
+    tool = cell.tools["tool1"].T_F_TCP
+    v = pose_to_vendor(cell.fk(np.radians(q_deg), tool=tool), "abb")
+    cf = abb_confdata(cell.robot, np.radians(q_deg))
+    return (f"[[{v[0]:.4f},{v[1]:.4f},{v[2]:.4f}],[{v[3]:.8f},{v[4]:.8f},{v[5]:.8f},"
+            f"{v[6]:.8f}],[{cf[0]},{cf[1]},{cf[2]},{cf[3]}],[9E9,9E9,9E9,9E9,9E9,9E9]]")
+
+
+def test_rapid_optional_arguments_after_the_target_are_read(tmp_path, capsys):
+    (tmp_path / "cell.yaml").write_text(IRB_CELL)
+    cell = Cell.load(tmp_path / "cell.yaml")
+    q = [10, 20, 10, 30, 40, 50]
+    mod = tmp_path / "mm_rob1.mod"
+    mod.write_text(
+        "MODULE mm_rob1\n"
+        '    PERS tasks all_tasks{2}:=[["T_ROB1"],["T_ROB2"]];\n'
+        "    VAR syncident sync1;\n"
+        f"    CONST robtarget p10:={_robtarget(cell, q)};\n"
+        "    CONST jointtarget j0:=[[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+        "    PROC main()\n"
+        "        SyncMoveOn sync1, all_tasks;\n"
+        "        MoveAbsJ j0\\NoEOffs, v1000, fine, tool1;\n"
+        "        MoveAbsJ [[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]]\\ID:=5\\NoEOffs, v1000,"
+        " z50, tool1;\n"
+        "        MoveJ p10\\ID:=10, v1000, z50, tool1\\WObj:=wobj0;\n"
+        "        MoveL p10 \\ID:=20, v500 \\V:=550, z10 \\Z:=5, tool1;\n"
+        "        SyncMoveOff sync1;\n"
+        "    ENDPROC\n"
+        "ENDMODULE\n")
+    program, skipped = read_program(mod)
+    assert not skipped
+    assert [(p.name, p.motion) for p in program.points] == [
+        ("j0", "ptp"), ("line 9", "ptp"), ("p10", "ptp"), ("p10", "lin")]
+    assert [p.zone for p in program.points] == pytest.approx([0, 0.05, 0.05, 0.005])
+    assert program.points[3].speed == pytest.approx(0.55)  # \V:= overrides v500
+    report = check_program(program, cell)
+    assert np.allclose(np.degrees(report.points[2].q), q, atol=1e-6)
+    code, _, err = run(capsys, "program", "check", mod, "--cell", tmp_path / "cell.yaml")
+    assert code in (0, 3) and "error:" not in err
+
+
+def test_rapid_confdata_is_taken_only_where_configuration_monitoring_is_on(tmp_path):
+    (tmp_path / "cell.yaml").write_text(IRB_CELL)
+    cell = Cell.load(tmp_path / "cell.yaml")
+    mod = tmp_path / "conf.mod"
+    p = _robtarget(cell, [10, 20, 10, 30, 40, 50])
+    mod.write_text(f"MODULE conf\n    CONST robtarget p1:={p};\n    PROC main()\n"
+                   "        MoveJ p1, v100, fine, tool1;\n        MoveL p1, v100, fine, tool1;\n"
+                   "        ConfL \\Off;\n        ConfJ\\Off;\n        MoveL p1, v100, fine, tool1;\n"
+                   "        MoveJ p1, v100, fine, tool1;\n        ConfJ \\On;\n"
+                   "        MoveJ p1, v100, fine, tool1;\n    ENDPROC\nENDMODULE\n")
+    program, _ = read_program(mod)
+    assert [pt.config is not None for pt in program.points] == [True, True, False, False, True]
+
+
+def test_rapid_arrays_trigg_and_arc_motions_and_targets_of_other_modules(tmp_path):
+    (tmp_path / "cell.yaml").write_text(IRB_CELL)
+    cell = Cell.load(tmp_path / "cell.yaml")
+    a, b = _robtarget(cell, [10, 20, 10, 30, 40, 50]), _robtarget(cell, [12, 20, 10, 30, 40, 50])
+    mod = tmp_path / "weld.mod"
+    mod.write_text(
+        "MODULE weld(SYSMODULE)\n"
+        f"    CONST robtarget seam{{2}}:=[{a},\n        {b}];\n"
+        "    VAR robtarget pCur;\n"
+        "    PROC main()\n"
+        "        IF TRUE THEN\n        MoveJ seam{1}, v100, z10, tool1;\n"
+        "        ELSEIF FALSE THEN\n        TriggL seam{2}, v100, trig1, z10, tool1;\n        ENDIF\n"
+        "        ArcLStart seam{1}, v100, sm1, wd1, fine, tool1;\n"
+        "        ArcLEnd seam{2}, v100, sm1, wd1, fine, tool1;\n"
+        "        MoveL Offs(seam{1}, 0, 0, 50), v100, fine, tool1;\n"
+        "        MoveL pCur, v100, fine, tool1;\n"
+        "        MoveL pOther, v100, fine, tool1;\n"
+        "        MoveC seam{1}, seam{2}, v100, fine, tool1;\n"
+        "    ENDPROC\nENDMODULE\n")
+    program, skipped = read_program(mod)
+    assert program.name == "weld"
+    assert [(p.name, p.motion, p.line) for p in program.points] == [
+        ("seam{1}", "ptp", 7), ("seam{2}", "lin", 9), ("seam{1}", "lin", 11),
+        ("seam{2}", "lin", 12)]
+    assert skipped == [
+        "line 13: MoveL Offs(seam{1}, 0, 0, 50) (a target computed at run time)",
+        "line 14: MoveL pCur (pCur is a variable set at run time)",
+        ("line 15: MoveL pOther (pOther is declared in no data of this module (a target of "
+        "another module of the task is not read))"),
+        "line 16: MoveC (circular motions are not checked)"]
+    assert check_program(program, cell).good

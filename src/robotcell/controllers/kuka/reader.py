@@ -264,7 +264,8 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     ------
     InputError
         A missing file, a missing ``DEF``/``END``/``ENDDAT``, an unreadable aggregate or number,
-        a motion to a point declared nowhere in the program; the message names the file and line.
+        a motion to a named point with no ``.dat`` beside the ``.src``; the message names the
+        file and line.
     """
     src = _src_of(Path(path))
     lines = Lines(src, "KUKA .src file")
@@ -503,9 +504,8 @@ class _SrcReader:
                                            f"program's .dat, and there is no "
                                            f"{Path(self.lines.path).stem}.dat beside the .src; "
                                            "copy it there with the .src")
-        raise self.lines.error(lineno, f"{target} is not declared in the program's .dat nor in "
-                                       "the .src (a global point of another module is not "
-                                       "read: copy its declaration into the program's .dat)")
+        return None, (f"{target} is declared in neither the program's .dat nor its .src (a "
+                      "global point of another module is not read)")
 
     def program_point(self, kind: str, target: str, value: _Point, tool: Ref, base: Ref,
                       approx: bool, lineno: int) -> ProgramPoint:
