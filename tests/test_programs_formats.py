@@ -60,6 +60,10 @@ def test_robodks_yaskawa_job_is_read():
     assert [p.name for p in pts] == ["C00002", "C00003", "C00004", "C00005"]
     assert all(p.frame.kind == "base" and p.frame.number is None for p in pts)  # POSTYPE BASE
     assert pts[0].tool.number == 9 and pts[0].config.values == (0, 0, 0, 0, 0, 0)
+    # tool 9 is set in the job (SETE P00095 (1..6), SETTOOL TL#(9) P00095): the tool RoboDK
+    # wrote for the same station in Program.src ($TOOL = {X -30, Y 0, Z 40, A 0, B -60, C 0})
+    kuka_tool = read_program(ROBODK / "Program.src")[0].points[0].tool.pose
+    assert np.allclose(pts[0].tool.pose, kuka_tool, atol=1e-12)
     assert np.allclose(pts[0].pose[:3, 3], [0.41857, 0.147321, 0.251179])
     assert pts[0].speed == pytest.approx(0.2)
 

@@ -326,3 +326,119 @@ def test_rapid_arrays_trigg_and_arc_motions_and_targets_of_other_modules(tmp_pat
         "another module of the task is not read))"),
         "line 16: MoveC (circular motions are not checked)"]
     assert check_program(program, cell).good
+
+
+# -- 7. YASKAWA: //ARGINFO, SETTOOL and SETE -------------------------------------------------
+JOB = """\
+/JOB
+//NAME ARGJOB
+//POS
+///NPOS 2,0,0,0,0,0
+///TOOL 1
+///POSTYPE BASE
+///RECTAN
+///RCONF 0,0,0,0,0,0,0,0
+C00000=1000.000,0.000,1000.000,180.0000,0.0000,0.0000
+C00001=1000.000,100.000,1000.000,180.0000,0.0000,0.0000
+//ARGINFO
+///ARGTYPE B,D
+///COMMENT
+Arg1
+Arg2
+//INST
+///DATE 2024/01/01 00:00
+///ATTR SC,RW,RJ
+///GROUP1 RB1
+NOP
+MOVJ C00000 VJ=20.00
+SETE P00095 (1) 0
+SETE P00095 (2) 0
+SETE P00095 (3) 200000
+SETE P00095 (4) 0
+SETE P00095 (5) 0
+SETE P00095 (6) 0
+SETTOOL TL#(1) P00095
+MOVL C00001 V=100.0
+SETE P00096 (3) D000
+SETTOOL TL#(1) P00096
+MOVL C00000 V=100.0
+MOVL P001 V=100.0
+END
+"""
+
+
+def test_a_job_with_arginfo_settool_and_sete_is_read_in_program_order(tmp_path):
+    job = tmp_path / "ARGJOB.JBI"
+    job.write_text(JOB)
+    program, skipped = read_program(job)
+    assert [(p.name, p.line) for p in program.points] == [("C00000", 21), ("C00001", 29)]
+    # the first motion takes the cell's tool 1; the second the 200 mm tool the job sets
+    assert program.points[0].tool.pose is None
+    assert np.allclose(program.points[1].tool.pose[:3, 3], [0, 0, 0.2])
+    assert skipped == [
+        ("line 32: MOVL C00000 (tool 1 is set by SETTOOL at line 31 from P00096, whose values the "
+        "job sets at run time)"),
+        "line 33: MOVL P001 (a position variable, set at run time)"]
+
+
+def test_a_coordinated_station_motion_adds_its_axes_to_the_robots_point(tmp_path):
+    text = JOB.replace("///NPOS 2,0,0,0,0,0", "///NPOS 2,0,1,0,0,0").replace(
+        "//ARGINFO", "///POSTYPE PULSE\n///PULSE\nEC00000=1000,-500\n//ARGINFO").replace(
+        "MOVJ C00000 VJ=20.00", "MOVJ C00000 VJ=20.00\n+MOVJ EC00000 VJ=10.00")
+    job = tmp_path / "COORD.JBI"
+    job.write_text(text)
+    program, _ = read_program(job)
+    assert program.points[0].external == {"EC1": 1000.0, "EC2": -500.0}
+
+
+# -- 8. FANUC: /END with trailing characters, offsets by registers, DEFAULT_GROUP --------------
+LS = """\
+/PROG  OFFS
+/ATTR
+OWNER\t\t= MNEDITOR;
+DEFAULT_GROUP\t= 1,*,*,*,*;
+/MN
+   1:  UFRAME_NUM=0 ;
+   2:  UTOOL_NUM=1 ;
+   3:J P[1] 100% FINE    ;
+   4:L P[2] 200mm/sec CNT60 Tool_Offset,PR[15]    ;
+   5:L P[2] 200mm/sec CNT60 Offset,PR[3]    ;
+   6:L P[1] 200mm/sec FINE INC    ;
+   7:L P[2] 200mm/sec FINE    ;
+/POS
+P[1]{
+   GP1:
+\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',
+\tX =  1000.000  mm,\tY =     0.000  mm,\tZ =   800.000  mm,
+\tW =   180.000 deg,\tP =     0.000 deg,\tR =     0.000 deg
+   GP2:
+\tUF : 0, UT : 1,
+\tJ1=    30.000 deg
+};
+P[2]{
+   GP1:
+\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',
+\tX =  1000.000  mm,\tY =   100.000  mm,\tZ =   800.000  mm,
+\tW =   180.000 deg,\tP =     0.000 deg,\tR =     0.000 deg
+};
+/END\x1a"""
+
+
+def test_a_listing_with_offsets_and_a_disabled_group_reads_the_rest(tmp_path, capsys):
+    ls = tmp_path / "OFFS.LS"
+    ls.write_bytes(LS.encode())  # the last line: /END and an end-of-file mark, no newline
+    program, skipped = read_program(ls)
+    assert [(p.name, p.line) for p in program.points] == [("P[1]", 8), ("P[2]", 12)]
+    assert program.points[0].external == {}  # group 2 is not moved by this program
+    assert skipped == [
+        "P[1]: its GP2 data are not used: the program's DEFAULT_GROUP does not move group 2",
+        ("line 9: L P[2] (Tool_Offset, PR[15]: the position is offset at run time by data not "
+        "in the program)"),
+        ("line 10: L P[2] (Offset, PR[3]: the position is offset at run time by data not in the "
+        "program)"),
+        "line 11: L P[1] (INC: a motion relative to where the robot is)"]
+    (tmp_path / "cell.yaml").write_text(
+        "name: m20ia\nrobot:\n  model: fanuc_m20ia\ntools:\n  pin:\n    number: 1\n"
+        "    frame: {x: 0, y: 0, z: 100, a: 0, b: 0, c: 0}\n    provenance: {source: nominal}\n")
+    code, _, err = run(capsys, "program", "check", ls, "--cell", tmp_path / "cell.yaml")
+    assert code in (0, 3) and "error:" not in err and err.count("note: not checked:") == 4

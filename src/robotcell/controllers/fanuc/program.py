@@ -129,6 +129,12 @@ _CONFIG_RE = re.compile(r"CONFIG\s*:\s*'([^']*)'")
 _PR_SET_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*([-+0-9.eE]+)\s*;")
 _FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*PR\[\s*(\d+)\s*\]\s*;",
                            re.IGNORECASE)
+_SECTION_RE = re.compile(r"^\s*(/[A-Za-z]+)")
+_GROUP_RE = re.compile(r"^\s*DEFAULT_GR\w*\s*=\s*([^;]*);")
+#: Motion options that move the position by data outside the program (FANUC R-30iB
+#: Operator's Manual, "Motion instruction options": Offset, Tool_Offset, VOFFSET, INC).
+_OFFSET_RE = re.compile(r"\b(Tool_Offset|Offset|VOFFSET|VTOOL_OFFSET|INC)\b"
+                        r"\s*(?:,\s*(PR\[[^\]]*\]))?", re.IGNORECASE)
 _SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|cm/min|inch/min|deg/sec|sec|msec|%)", re.IGNORECASE)
 
 
@@ -243,6 +249,30 @@ def _zone(text: str, lines: Lines, lineno: int) -> float | None:
     return None
 
 
+def _default_group(lines: Lines, start: int, end: int) -> set[str]:
+    """The motion groups the program moves (``GP1``, ...) from ``DEFAULT_GROUP = 1,1,*,*,*;``
+    in ``/ATTR`` (every group when the line is missing)."""
+    for lineno in range(start, end):
+        if m := _GROUP_RE.match(lines.lines[lineno - 1]):
+            flags = [f.strip() for f in m.group(1).split(",")]
+            return {f"GP{i + 1}" for i, f in enumerate(flags) if f == "1"}
+    return {f"GP{i}" for i in range(1, 9)}
+
+
+def _run_time_option(rest: str) -> str | None:
+    """Why a motion's position is not the one in ``/POS``: an option that offsets it by data
+    the program does not hold, or a coordinated motion."""
+    if m := _OFFSET_RE.search(rest):
+        opt = m.group(1)
+        reg = f", {m.group(2)}" if m.group(2) else ""
+        return (f"{opt}{reg}: the position is offset at run time by data not in the program"
+                if opt.upper() != "INC" else "INC: a motion relative to where the robot is")
+    if re.search(r"\bCOORD\b", rest, re.IGNORECASE):
+        return ("COORD: a coordinated motion, its position relative to the leader group, which "
+                "the program does not hold")
+    return None
+
+
 def read(path: str | Path) -> tuple[Program, list[str]]:
     """Read a FANUC ``.ls`` listing.
 
@@ -267,7 +297,8 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     lines = Lines(path, "FANUC .ls file")
     marks: dict[str, int] = {}
     for lineno, text in enumerate(lines.lines, start=1):
-        key = text.strip().split()[0] if text.strip() else ""
+        m = _SECTION_RE.match(text)  # '/END' and whatever follows it on the line (an EOF mark)
+        key = m.group(1).upper() if m else ""
         if key in ("/PROG", "/ATTR", "/MN", "/POS", "/END", "/APPL") and key not in marks:
             marks[key] = lineno
     for key in ("/PROG", "/MN"):
@@ -281,6 +312,13 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     positions = _positions(lines, pos_start + 1, marks["/END"]) if "/POS" in marks else {}
     points: list[ProgramPoint] = []
     skipped: list[str] = []
+    groups = _default_group(lines, marks["/PROG"], marks["/MN"])
+    for n, p in positions.items():
+        off = sorted({k.split(":")[0] for k in p.external if k.startswith("GP")} - groups)
+        for g in off:
+            p.external = {k: v for k, v in p.external.items() if not k.startswith(g + ":")}
+            skipped.append(f"P[{n}]: its {g} data are not used: the program's DEFAULT_GROUP "
+                           f"does not move group {g[2:]}")
     registers: dict[int, dict[int, float]] = {}
     defined: dict[tuple[str, int], np.ndarray] = {}  # UTOOL/UFRAME set from a PR in the program
     for lineno in range(marks["/MN"] + 1, pos_start):
@@ -308,6 +346,9 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         if reg == "PR":
             skipped.append(f"line {lineno}: {kind} {label} (a position register, not held by "
                            "the program)")
+            continue
+        if why := _run_time_option(rest):
+            skipped.append(f"line {lineno}: {kind} {label} ({why})")
             continue
         if n not in positions:
             raise lines.error(lineno, f"{label} is not in the /POS section")
