@@ -442,3 +442,16 @@ def test_a_listing_with_offsets_and_a_disabled_group_reads_the_rest(tmp_path, ca
         "    frame: {x: 0, y: 0, z: 100, a: 0, b: 0, c: 0}\n    provenance: {source: nominal}\n")
     code, _, err = run(capsys, "program", "check", ls, "--cell", tmp_path / "cell.yaml")
     assert code in (0, 3) and "error:" not in err and err.count("note: not checked:") == 4
+
+
+def test_a_cartesian_point_before_any_tool_is_set_is_not_checked(tmp_path):
+    # KRL keeps the $TOOL and $BASE of what ran before until the program sets them: a Cartesian
+    # point is named, a joint point (whose axes do not depend on the tool) is read
+    src = _files(tmp_path / "p", pre_src=(
+        "DEF pre( )\nPTP {A1 0,A2 -90,A3 90,A4 0,A5 30,A6 0}\nLIN XP1\n$TOOL=TOOL_DATA[1]\n"
+        "LIN XP1\nEND\n"), pre_dat="DEFDAT pre\nDECL E6POS XP1={X 900,Y 0,Z 900,A 0,B 90,C 0}\n"
+                                   "ENDDAT\n")
+    program, skipped = read_program(src)
+    assert [p.line for p in program.points] == [2]
+    assert skipped == ["line 3: LIN XP1 (the program sets no tool before this motion)",
+                       "line 5: LIN XP1 (the program sets no base before this motion)"]

@@ -286,8 +286,9 @@ class _SrcReader:
 
     def __init__(self, lines: Lines, dat_path: Path | None, dat: _Dat) -> None:
         self.lines, self.dat_path, self.dat = lines, dat_path, dat
-        self.tool: Ref | Unknown = Ref(number=0)
-        self.base: Ref | Unknown = Ref(number=0, on_table=None)
+        # until the program sets them, the controller keeps the tool and base of what ran before
+        self.tool: Ref | Unknown = "the program sets no tool before this motion"
+        self.base: Ref | Unknown = "the program sets no base before this motion"
         self.slots: dict[tuple[str, int], np.ndarray | Unknown] = {}
         self.speed: float | None = None
         self.zone = 0.0
@@ -473,11 +474,13 @@ class _SrcReader:
             self.skipped.append(f"{label} ({why})")
             return
         tool, base = self.with_refs(parts[1] if len(parts) > 1 else "", lineno)
-        unknown = [r for r in ((tool, base) if value.pose is not None else (tool,))
-                   if isinstance(r, str)]
-        if unknown:
-            self.skipped.append(f"{label} ({unknown[0]})")
+        if value.pose is not None and (isinstance(tool, str) or isinstance(base, str)):
+            self.skipped.append(f"{label} ({tool if isinstance(tool, str) else base})")
             return
+        if isinstance(tool, str):  # joints: checked whatever the tool; the TCP is the flange's
+            tool = Ref(number=0)
+        if isinstance(base, str):
+            base = Ref(number=0, on_table=None)
         self.out.append(self.program_point(kind, target, value, tool, base,
                                            bool(_APPROX_RE.search(after)), lineno))
 
