@@ -9,8 +9,7 @@ The reader follows KRL as KUKA's manuals describe it (sources in ``docs/programs
 - motions ``PTP``/``LIN``/``CIRC`` and the spline ones ``SPTP``/``SLIN``/``SCIRC``/``SPL``, to a
   point named in the ``.dat``, an aggregate written in the line, or an expression; ``C_DIS``,
   ``C_PTP``, ``C_ORI``, ``C_VEL``, ``C_SPL`` approximate; ``WITH`` gives values for that motion
-  (the spline inline forms write ``$TOOL = STOOL2(FPn)`` and ``$BASE = SBASE(FPn.BASE_NO)``
-  there); ``PTP_REL``/``LIN_REL``/``CIRC_REL`` (and the spline ones) move relative to where the
+  (``$TOOL``/``$BASE`` given there hold for it); ``PTP_REL``/``LIN_REL``/``CIRC_REL`` (and the spline ones) move relative to where the
   robot is; ``frame1 : frame2`` is the geometric operator;
 - the tool and the base: ``$TOOL=``/``$BASE=`` a frame, ``TOOL_DATA[n]``, ``BASE_DATA[n]``,
   ``EK(...)`` or ``$NULLFRAME``; ``BAS(#TOOL,n)``/``BAS(#BASE,n)``; the inline forms'
@@ -287,14 +286,16 @@ class _SrcReader:
     def __init__(self, lines: Lines, dat_path: Path | None, dat: _Dat) -> None:
         self.lines, self.dat_path, self.dat = lines, dat_path, dat
         # until the program sets them, the controller keeps the tool and base of what ran before
-        self.tool: Ref | Unknown = "the program sets no tool before this motion"
-        self.base: Ref | Unknown = "the program sets no base before this motion"
+        self.tool: Ref | Unknown = ("the program sets no tool before this motion (calls to "
+                                     "other routines are not followed)")
+        self.base: Ref | Unknown = ("the program sets no base before this motion (calls to "
+                                     "other routines are not followed)")
         self.slots: dict[tuple[str, int], np.ndarray | Unknown] = {}
         self.speed: float | None = None
         self.zone = 0.0
         self.motion_data: dict[str, str] = {}
         self.local: set[str] = set()
-        self.changed: dict[str, int] = {}
+        self.assigned: dict[str, _Point | str] = {}  # points given a value in the .src
         self.out: list[ProgramPoint] = []
         self.skipped: list[str] = []
 
@@ -353,9 +354,21 @@ class _SrcReader:
             for part in re.split(r",(?![^\[]*\])", m.group(1)):
                 self.local.add(re.split(r"[\[=\s]", part.strip(), maxsplit=1)[0].upper())
         elif m := _ASSIGN_RE.match(line):
-            key = re.sub(r"\s+", "", m.group(1)).upper()
-            if key in self.dat.points:
-                self.changed.setdefault(key, lineno)
+            self.assign(m, line, lineno)
+
+    def assign(self, m: re.Match, line: str, lineno: int) -> None:
+        """``NAME = {aggregate}`` gives a point of the program (or of its .dat) a value from
+        here on; any other assignment to one makes it a value of run time."""
+        key = re.sub(r"\s+", "", m.group(1)).upper()
+        if key not in self.dat.points and key.split("[")[0] not in self.local | self.dat.unset:
+            return
+        value = line[line.index("=") + 1:].strip()
+        if "." not in line[:line.index("=")] and value.startswith("{") and ":" not in (
+                _target(value)[1]):
+            typ, fields = aggregate_fields(value, self.lines, lineno)
+            self.assigned[key] = _Point(_kind_of(typ, fields), fields, self.lines, lineno, key)
+        else:
+            self.assigned[key] = f"{m.group(1).strip()} is set at run time (line {lineno})"
 
     # -- tool and base -------------------------------------------------------------------------
     def slot(self, kind: str, n: int) -> tuple[np.ndarray | None, Unknown | None]:
@@ -375,8 +388,6 @@ class _SrcReader:
             n = int(m.group(2))
             pose, why = self.slot("TOOL_DATA", n)
             return why or Ref(number=n, pose=pose)
-        if m := re.match(r"^STOOL2\s*\(\s*(\w+)\s*\)$", value, re.IGNORECASE):
-            return self.fdat(m.group(1), lineno)[0]
         return f"the tool is $TOOL={value}, computed at run time (line {lineno})"
 
     def base_ref(self, value: str, lineno: int) -> Ref | Unknown:
@@ -389,8 +400,6 @@ class _SrcReader:
             n = int(m.group(m.lastindex))
             pose, why = self.slot("BASE_DATA", n)
             return why or Ref(number=n, pose=pose, on_table=m.re is _EK_RE)
-        if m := re.match(r"^SBASE\s*\(\s*(\w+)\s*\.\s*BASE_NO\s*\)$", value, re.IGNORECASE):
-            return self.fdat(m.group(1), lineno)[1]
         return f"the base is $BASE={value}, computed at run time (line {lineno})"
 
     def set_slot(self, m: re.Match, lineno: int) -> None:
@@ -442,8 +451,8 @@ class _SrcReader:
                 base_why or Ref(number=base_no, pose=base_pose, on_table=None))
 
     def with_refs(self, clause: str, lineno: int) -> tuple[Ref | Unknown, Ref | Unknown]:
-        """The tool and base of one motion: set in its ``WITH`` clause (the spline inline forms
-        write ``$TOOL = STOOL2(FP1), $BASE = SBASE(FP1.BASE_NO)``), else the current ones."""
+        """The tool and base of one motion: set in its ``WITH`` clause, else the current ones
+        (a function of the clause, such as a spline inline form's, is a value of run time)."""
         tool, base = self.tool, self.base
         for item in _top_level(clause):
             if m := _TOOL_RE.match(item):
@@ -492,9 +501,9 @@ class _SrcReader:
         key = re.sub(r"\s+", "", target).upper()
         if key.startswith("$"):
             return None, "not held by the program"
-        if key in self.changed:
-            return None, (f"{target} is changed by the program at line {self.changed[key]}, "
-                          "at run time")
+        if key in self.assigned:
+            value = self.assigned[key]
+            return (None, value) if isinstance(value, str) else (value, "")
         if key in self.dat.points:
             return self.dat.points[key], ""
         base = key.split("[")[0].split(".")[0]

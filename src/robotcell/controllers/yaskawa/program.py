@@ -292,8 +292,10 @@ class _Job:
         cname = next((k + n for k, n in refs if k == "C"), None)
         if cname is None:
             var = re.search(r"\b(L?P\d+|P\[[^\]]*\])", rest)
+            axes = " ".join(k + n for k, n in refs)
             self.skipped.append(f"line {lineno}: {instr} " + (
                 f"{var.group(1)} (a position variable, set at run time)" if var else
+                f"{axes} (a motion of the base axis or the station alone)" if axes else
                 "without a C position"))
             return
         c = self.positions[cname]
