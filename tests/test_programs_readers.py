@@ -225,6 +225,10 @@ def test_status_and_turn_of_linear_points_are_not_taken_as_their_configuration(t
     src.write_text(src.read_text().replace("LIN XP2\nSLIN", "PTP XP2\nSLIN"))
     q = check_program_file(src, cell).points[1].q
     assert math.isclose(math.degrees(q[5]), 102 - 360, abs_tol=1e-6)
+    # a program that starts with a LIN starts where the robot is: its S and T say where
+    src.write_text(src.read_text().replace("PTP XP1\nPTP XP2", "LIN XP2"))
+    program, _ = read_program(src)
+    assert program.points[0].config is not None and program.points[1].config is None
 
 
 # -- 6. RAPID optional arguments right after the target (MultiMove \ID, \NoEOffs) ---------------

@@ -19,7 +19,8 @@ The reader follows KRL as KUKA's manuals describe it (sources in ``docs/programs
 - Status and Turn are used by the controller for PTP motions only ("The robot controller only
   takes the programmed Status and Turn values into consideration for PTP motions. They are
   ignored for CP motions", KSS 8 System Integrators manual): a ``LIN``/``SLIN`` point's S and T
-  are not taken as its configuration.
+  are not taken as its configuration, except for the program's first point, where they are the
+  only statement of the configuration the robot starts in.
 
 What the file does not hold is read and named, never refused: points of ``$config.dat``
 (``XHOME``, the tool and base of ``FDAT FHOME``), points declared in another module, variables
@@ -530,7 +531,9 @@ class _SrcReader:
         if approx and "APO_DIST" in self.motion_data:
             z = lines.number(self.motion_data["APO_DIST"], lineno) * 1e-3
         name = f"line {lineno}" if target.startswith("{") else target
-        config = value.config if motion == "ptp" else None  # S and T: PTP only
+        # S and T: PTP only. A linear first motion keeps the configuration the robot is in,
+        # which the files do not hold: the point's S and T are the best statement of it.
+        config = value.config if motion == "ptp" or not self.out else None
         return ProgramPoint(name, lineno, motion, tool, base, value.pose, value.joints, config,
                             dict(value.external), v if motion == "lin" else None, z, value.where)
 
