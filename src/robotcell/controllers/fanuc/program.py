@@ -14,9 +14,12 @@ axis 0, with the table at the point's angle in group 2 (no coordinated motion is
 
 Read: the same, and what pendants and offline tools write: joint positions (``J1 = .. deg``),
 comments on positions (``P[3:"approach"]``), other numbers of decimals, ``cm/min``, ``sec``
-and ``%`` speeds, a tool or user frame set in the program from a position register
-(``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win over the cell's), motions to
-position registers and circular motions (skipped and named).
+and ``%`` speeds, ``/END`` followed by an end-of-file mark, a tool or user frame set in the
+program from a position register (``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win
+over the cell's), in program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked,
+with the reason: motions to position registers, ``Offset``/``Tool_Offset``/``VOFFSET``/``INC``
+and ``COORD`` motions, positions in frames set from registers set at run time, circular
+motions, and the data of groups the program does not move (``docs/programs.md``).
 """
 
 from __future__ import annotations

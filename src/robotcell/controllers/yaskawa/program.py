@@ -16,9 +16,12 @@ Written (sources in ``docs/programs.md``, chiefly the DX100 and NX100 manuals' j
 Angles are written with 4 decimals (9e-7 rad), millimetres with 3, pulses as integers.
 
 Read: the same, and what pendants and offline tools write: several ``USER``/``TOOL``/``RCONF``
-blocks, ``RCONF`` with 6, 8 or 24 values, pulse positions of the robot (skipped: their pulses
-per degree are not in the job), ``///FRAME`` with three or four slashes, ``MOVC``/``MOVS``
-(skipped).
+blocks, ``RCONF`` with 6, 8 or 24 values, ``///FRAME`` with three or four slashes, sections
+such as ``//ARGINFO`` between ``//POS`` and ``//INST``, ``+MOVJ`` station motions, tools set by
+``SETTOOL`` from ``SETE`` values, in program order. Named as not checked, with the reason: pulse
+positions of the robot (their pulses per degree are not in the job), position variables, tools
+and user frames set at run time, station-only motions, ``MOVC``/``MOVS``
+(``docs/programs.md``).
 """
 
 from __future__ import annotations
