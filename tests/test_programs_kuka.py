@@ -109,8 +109,6 @@ def test_a_real_robodk_program_for_a_kr16_is_read_and_checked():
      "line 13: the aggregate is not closed"),
     (lambda s, d: d.write_text(d.read_text().replace("ENDDAT", "")), "no ENDDAT"),
     (lambda s, d: s.write_text(s.read_text().replace("\nEND\n", "\n")), "no END"),
-    (lambda s, d: s.write_text(s.read_text().replace("PTP XP1", "PTP XP99")),
-     "XP99 is not declared"),
     (lambda s, d: d.write_text(d.read_text().replace(",Y 0.000000,", ",Y 0.0.0,", 1)),
      "line 5: '0.0.0' is not a number"),
     (lambda s, d: d.write_text(d.read_text().replace("X 200.000000,", "", 1)),
@@ -133,3 +131,15 @@ def test_a_base_on_the_turntable_set_without_ek_is_a_bad_point(cell, written):
     report = check_program_file(src, cell)
     assert len(report.bad) == 36
     assert "carried by the turntable: set it with $BASE=EK(...)" in report.bad[0].problems[0]
+
+
+def test_a_point_declared_in_no_file_of_the_program_is_named_not_checked(written, capsys):
+    # a global point of another module's .dat (DECL GLOBAL) is valid KRL: named, not refused
+    src = written[0]
+    src.write_text(src.read_text().replace("PTP XP1", "PTP XP99"))
+    program, skipped = read_program(src)
+    assert len(program.points) == 35
+    assert skipped[0].endswith("PTP XP99 (XP99 is declared in neither the program's .dat nor "
+                               "its .src (a global point of another module is not read))")
+    code, _, err = run(capsys, "program", "check", src, "--cell", CELL)
+    assert code in (0, 3) and "note: not checked:" in err and "error:" not in err

@@ -163,7 +163,8 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
     n = len(report.points)
     if report.good:
         if not as_json:
-            click.echo(f"{program_file}: {counted(n, 'point')}, all good")
+            click.echo(f"{program_file}: {counted(n, 'point')}, all good" if n else
+                       f"{program_file}: no point checked")
         return
     click.echo(format_table(["point", "line", "problem"], report.rows()), err=True)
     bad = len(report.bad)

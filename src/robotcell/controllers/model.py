@@ -113,7 +113,9 @@ class ProgramPoint:
     joints : ndarray, shape (n,), or None
         Arm joint values (radians; controller values), for a joint point.
     config : Config or None
-        Configuration flags written with a Cartesian point (None when the file writes none).
+        Configuration flags written with a Cartesian point, where the controller uses them (None
+        when the file writes none, or when the controller ignores them for this motion: KUKA's
+        Status and Turn on a linear motion, ABB's confdata under ``ConfJ``/``ConfL \\Off``).
     external : dict of str to float
         External axis values by the name the file gives them (``E1``, ``eax_b``, ``GP2:J1``,
         ``BC1``, ``EC1``), in the file's units (mm, deg, pulses).

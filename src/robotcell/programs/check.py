@@ -429,6 +429,9 @@ def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLik
     Returns
     -------
     CheckReport
+        A program none of whose motions can be checked (each depends on data the files do not
+        hold, or it has no motion) gives a report with no point and the reasons in
+        ``skipped``.
 
     Raises
     ------
@@ -436,7 +439,7 @@ def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLik
         A file that cannot be read (the message names the file and line).
     """
     program, skipped = read_program(path)
-    if not program.points:
-        raise InputError(f"{path}: the program moves to no point robotcell can check")
+    if not program.points:  # a valid program whose motions all depend on data it lacks
+        return CheckReport(program, [], list(skipped) or ["the program moves to no point"])
     return check_program(program, cell, pulses_per_degree, max_step, singular_margin,
                          shoulder_margin, skipped)

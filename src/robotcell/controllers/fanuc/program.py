@@ -14,9 +14,12 @@ axis 0, with the table at the point's angle in group 2 (no coordinated motion is
 
 Read: the same, and what pendants and offline tools write: joint positions (``J1 = .. deg``),
 comments on positions (``P[3:"approach"]``), other numbers of decimals, ``cm/min``, ``sec``
-and ``%`` speeds, a tool or user frame set in the program from a position register
-(``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win over the cell's), motions to
-position registers and circular motions (skipped and named).
+and ``%`` speeds, ``/END`` followed by an end-of-file mark, a tool or user frame set in the
+program from a position register (``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win
+over the cell's), in program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked,
+with the reason: motions to position registers, ``Offset``/``Tool_Offset``/``VOFFSET``/``INC``
+and ``COORD`` motions, positions in frames set from registers set at run time, circular
+motions, and the data of groups the program does not move (``docs/programs.md``).
 """
 
 from __future__ import annotations
@@ -127,8 +130,15 @@ _VALUE_RE = re.compile(r"\b([A-Z]+\d*)\s*=\s*([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s*(
 _UF_RE = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
 _CONFIG_RE = re.compile(r"CONFIG\s*:\s*'([^']*)'")
 _PR_SET_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*([-+0-9.eE]+)\s*;")
-_FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*PR\[\s*(\d+)\s*\]\s*;",
-                           re.IGNORECASE)
+_PR_ANY_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*(?:,\s*\d+\s*)?(?::[^\]]*)?\]\s*=")
+_FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*"
+                           r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*;", re.IGNORECASE)
+_SECTION_RE = re.compile(r"^\s*(/[A-Za-z]+)")
+_GROUP_RE = re.compile(r"^\s*DEFAULT_GR\w*\s*=\s*([^;]*);")
+#: Motion options that move the position by data outside the program (FANUC R-30iB
+#: Operator's Manual, "Motion instruction options": Offset, Tool_Offset, VOFFSET, INC).
+_OFFSET_RE = re.compile(r"\b(Tool_Offset|Offset|VOFFSET|VTOOL_OFFSET|INC)\b"
+                        r"\s*(?:,\s*(PR\[[^\]]*\]))?", re.IGNORECASE)
 _SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|cm/min|inch/min|deg/sec|sec|msec|%)", re.IGNORECASE)
 
 
@@ -243,6 +253,30 @@ def _zone(text: str, lines: Lines, lineno: int) -> float | None:
     return None
 
 
+def _default_group(lines: Lines, start: int, end: int) -> set[str]:
+    """The motion groups the program moves (``GP1``, ...) from ``DEFAULT_GROUP = 1,1,*,*,*;``
+    in ``/ATTR`` (every group when the line is missing)."""
+    for lineno in range(start, end):
+        if m := _GROUP_RE.match(lines.lines[lineno - 1]):
+            flags = [f.strip() for f in m.group(1).split(",")]
+            return {f"GP{i + 1}" for i, f in enumerate(flags) if f == "1"}
+    return {f"GP{i}" for i in range(1, 9)}
+
+
+def _run_time_option(rest: str) -> str | None:
+    """Why a motion's position is not the one in ``/POS``: an option that offsets it by data
+    the program does not hold, or a coordinated motion."""
+    if m := _OFFSET_RE.search(rest):
+        opt = m.group(1)
+        reg = f", {m.group(2)}" if m.group(2) else ""
+        return (f"{opt}{reg}: the position is offset at run time by data not in the program"
+                if opt.upper() != "INC" else "INC: a motion relative to where the robot is")
+    if re.search(r"\bCOORD\b", rest, re.IGNORECASE):
+        return ("COORD: a coordinated motion, run relative to the leader group's moving frame, "
+                "which the program does not hold")
+    return None
+
+
 def read(path: str | Path) -> tuple[Program, list[str]]:
     """Read a FANUC ``.ls`` listing.
 
@@ -267,7 +301,8 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     lines = Lines(path, "FANUC .ls file")
     marks: dict[str, int] = {}
     for lineno, text in enumerate(lines.lines, start=1):
-        key = text.strip().split()[0] if text.strip() else ""
+        m = _SECTION_RE.match(text)  # '/END' and whatever follows it on the line (an EOF mark)
+        key = m.group(1).upper() if m else ""
         if key in ("/PROG", "/ATTR", "/MN", "/POS", "/END", "/APPL") and key not in marks:
             marks[key] = lineno
     for key in ("/PROG", "/MN"):
@@ -279,47 +314,81 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         lines.lines[marks["/PROG"] - 1].split()) > 1 else Path(path).stem
     pos_start = marks.get("/POS", marks["/END"])
     positions = _positions(lines, pos_start + 1, marks["/END"]) if "/POS" in marks else {}
-    points: list[ProgramPoint] = []
     skipped: list[str] = []
-    registers: dict[int, dict[int, float]] = {}
-    defined: dict[tuple[str, int], np.ndarray] = {}  # UTOOL/UFRAME set from a PR in the program
+    groups = _default_group(lines, marks["/PROG"], marks["/MN"])
+    for n, p in positions.items():
+        off = sorted({k.split(":")[0] for k in p.external if k.startswith("GP")} - groups)
+        for g in off:
+            p.external = {k: v for k, v in p.external.items() if not k.startswith(g + ":")}
+            skipped.append(f"P[{n}]: its {g} data are not used: the program's DEFAULT_GROUP "
+                           f"does not move group {g[2:]}")
+    main = _Main(lines, positions, skipped)
     for lineno in range(marks["/MN"] + 1, pos_start):
-        text = lines.lines[lineno - 1]
+        main.line(lines.lines[lineno - 1], lineno)
+    return Program(name, "fanuc", main.points, (str(path),)), skipped
+
+
+class _Main:
+    """The ``/MN`` lines in order: position registers and the tool and user frames set from
+    them, and the motions."""
+
+    def __init__(self, lines: Lines, positions: dict[int, _Position], skipped: list[str]) -> None:
+        self.lines, self.positions, self.skipped = lines, positions, skipped
+        # PR elements set to numbers since the register was last set otherwise
+        self.registers: dict[int, dict[int, float]] = {}
+        # UTOOL/UFRAME set from a PR in the program: the pose, or why it is not known
+        self.defined: dict[tuple[str, int], np.ndarray | str] = {}
+        self.points: list[ProgramPoint] = []
+
+    def line(self, text: str, lineno: int) -> None:
         if m := _PR_SET_RE.match(text):
-            registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = lines.number(
-                m.group(3), lineno)
-            continue
-        if m := _FRAME_SET_RE.match(text):
-            pr = registers.get(int(m.group(3)), {})
-            if sorted(pr) != [1, 2, 3, 4, 5, 6]:
-                raise lines.error(lineno, f"PR[{m.group(3)}] is not set in full (X..R) before "
-                                          f"{m.group(1)}[{m.group(2)}] takes it")
-            defined[(m.group(1).upper(), int(m.group(2)))] = pose_from_vendor(
-                [pr[i] for i in range(1, 7)], "fanuc")
-            continue
-        m = _MOVE_RE.match(text)
-        if not m:
-            continue
+            self.registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = (
+                self.lines.number(m.group(3), lineno))
+        elif m := _FRAME_SET_RE.match(text):
+            self.frame_set(m.group(1).upper(), int(m.group(2)), int(m.group(3)), lineno)
+        elif m := _PR_ANY_RE.match(text):  # a register set at run time (LPOS, another PR)
+            self.registers.pop(int(m.group(1)), None)
+        elif m := _MOVE_RE.match(text):
+            self.motion(m, lineno)
+
+    def frame_set(self, kind: str, number: int, reg: int, lineno: int) -> None:
+        """``UTOOL[n]=PR[m]``: the register's values if the program sets all six as numbers."""
+        pr = self.registers.get(reg, {})
+        if sorted(pr) == [1, 2, 3, 4, 5, 6]:
+            self.defined[(kind, number)] = pose_from_vendor([pr[i] for i in range(1, 7)],
+                                                            "fanuc")
+        else:
+            self.defined[(kind, number)] = (f"{kind}[{number}] is set at line {lineno} from "
+                                            f"PR[{reg}], whose values are set at run time")
+
+    def motion(self, m: re.Match, lineno: int) -> None:
+        lines, skipped = self.lines, self.skipped
         kind, reg, n, rest = m.group(1), m.group(2), int(m.group(3)), m.group(4)
         label = f"{reg}[{n}]"
         if kind in ("C", "A"):
             skipped.append(f"line {lineno}: {kind} {label} (circular motions are not checked)")
-            continue
+            return
         if reg == "PR":
             skipped.append(f"line {lineno}: {kind} {label} (a position register, not held by "
                            "the program)")
-            continue
-        if n not in positions:
+            return
+        if why := _run_time_option(rest):
+            skipped.append(f"line {lineno}: {kind} {label} ({why})")
+            return
+        if n not in self.positions:
             raise lines.error(lineno, f"{label} is not in the /POS section")
-        p = positions[n]
+        p = self.positions[n]
+        tool, frame = self.defined.get(("UTOOL", p.ut)), self.defined.get(("UFRAME", p.uf))
+        why = next((w for w in (tool, frame) if isinstance(w, str)), None)
+        if why and (p.pose is not None or isinstance(tool, str)):
+            skipped.append(f"line {lineno}: {kind} {label} ({why})")
+            return
         motion = "ptp" if kind == "J" else "lin"
-        tool = Ref(number=p.ut, pose=defined.get(("UTOOL", p.ut)))
-        frame = Ref(number=p.uf, kind="base", pose=defined.get(("UFRAME", p.uf)))
-        points.append(ProgramPoint(
-            label, lineno, motion, tool, frame, p.pose,
-            p.joints, p.config, dict(p.external), _speed(rest, motion, lines, lineno),
+        self.points.append(ProgramPoint(
+            label, lineno, motion, Ref(number=p.ut, pose=tool),
+            Ref(number=p.uf, kind="base", pose=None if isinstance(frame, str) else frame),
+            p.pose, p.joints, p.config, dict(p.external), _speed(rest, motion, lines, lineno),
             _zone(rest, lines, lineno), p.where))
-    return Program(name, "fanuc", points, (str(path),)), skipped
 
 
 # -- editing in place ----------------------------------------------------------------------------

@@ -16,9 +16,12 @@ Written (sources in ``docs/programs.md``, chiefly the DX100 and NX100 manuals' j
 Angles are written with 4 decimals (9e-7 rad), millimetres with 3, pulses as integers.
 
 Read: the same, and what pendants and offline tools write: several ``USER``/``TOOL``/``RCONF``
-blocks, ``RCONF`` with 6, 8 or 24 values, pulse positions of the robot (skipped: their pulses
-per degree are not in the job), ``///FRAME`` with three or four slashes, ``MOVC``/``MOVS``
-(skipped).
+blocks, ``RCONF`` with 6, 8 or 24 values, ``///FRAME`` with three or four slashes, sections
+such as ``//ARGINFO`` between ``//POS`` and ``//INST``, ``+MOVJ`` station motions, tools set by
+``SETTOOL`` from ``SETE`` values, in program order. Named as not checked, with the reason: pulse
+positions of the robot (their pulses per degree are not in the job), position variables, tools
+and user frames set at run time, station-only motions, ``MOVC``/``MOVS``
+(``docs/programs.md``).
 """
 
 from __future__ import annotations
@@ -113,6 +116,16 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
 # -- reading -------------------------------------------------------------------------------------
 _DATA_RE = re.compile(r"^(C|BC|EC|P|BP|EX)(\d+)\s*=\s*(.*)$")
 _MOVE_RE = re.compile(r"^\s*(MOVJ|MOVL|MOVC|MOVS|SMOVJ|SMOVL)\s+(.*)$", re.IGNORECASE)
+#: A coordinated job's second group moving with the line before (``+MOVJ EC00000 VJ=10.00``).
+_COORD_MOVE_RE = re.compile(r"^\s*\+(MOVJ|MOVL|MOVC|MOVS)\s+(.*)$", re.IGNORECASE)
+#: ``SETTOOL TL#(n) P001``: tool n set from a position variable (INFORM, "SETTOOL").
+_SETTOOL_RE = re.compile(r"^\s*SETTOOL\s+TL#\(\s*(\d+)\s*\)\s*(\S+)?", re.IGNORECASE)
+#: ``SETE P00095 (1) -30000``: element k (1..6: X, Y, Z, Rx, Ry, Rz) of a position variable.
+_SETE_RE = re.compile(r"^\s*SETE\s+(L?P\d+)\s*\(\s*(\d+)\s*\)\s*(\S+)", re.IGNORECASE)
+#: ``MFRAME UF#(n) PX000 PX001 PX002``: user frame n made from position variables.
+_MFRAME_RE = re.compile(r"^\s*MFRAME\s+UF#\(\s*(\d+)\s*\)", re.IGNORECASE)
+#: Characters that end a line without being part of it (whitespace, the Ctrl-Z end of file).
+_BLANK = " \t\r\n\x1a\x00"
 
 
 class _Position:
@@ -181,51 +194,123 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     """
     lines = Lines(path, "YASKAWA job")
     marks: dict[str, int] = {}
+    sections: list[int] = []  # the lines of every '//' section header: //POS, //ARGINFO, //INST
     for lineno, text in enumerate(lines.lines, start=1):
         key = text.strip().split(" ")[0].upper() if text.strip() else ""
+        if re.match(r"^//?[A-Z]", key):
+            sections.append(lineno)
         if key in ("/JOB", "//POS", "//INST") and key not in marks:
             marks[key] = lineno
     for key in ("/JOB", "//POS", "//INST"):
         if key not in marks:
             raise InputError(f"{path}: no {key} line: not a YASKAWA job")
-    last = next((i for i in range(len(lines.lines), 0, -1) if lines.lines[i - 1].strip()), 0)
-    if lines.lines[last - 1].strip().upper() != "END":
+    last = next((i for i in range(len(lines.lines), 0, -1)
+                 if lines.lines[i - 1].strip(_BLANK)), 0)
+    if lines.lines[last - 1].strip(_BLANK).upper() != "END":
         raise InputError(f"{path}: line {last}: the job does not end with END (truncated file?)")
     name = next((t.split(None, 1)[1].strip() for t in lines.lines
                  if t.strip().upper().startswith("//NAME") and len(t.split()) > 1),
                 Path(path).stem)
-    positions = _pos_section(lines, marks["//POS"] + 1, marks["//INST"])
-    points: list[ProgramPoint] = []
-    skipped: list[str] = []
+    pos_end = min((n for n in sections if n > marks["//POS"]), default=marks["//INST"])
+    job = _Job(lines, _pos_section(lines, marks["//POS"] + 1, pos_end))
     for lineno in range(marks["//INST"] + 1, last):
-        text = lines.lines[lineno - 1].strip()
-        m = _MOVE_RE.match(text)
-        if not m:
-            continue
-        instr, rest = m.group(1).upper(), m.group(2)
-        if instr in ("MOVC", "MOVS"):
-            skipped.append(f"line {lineno}: {instr} (circular and spline motions are not "
-                           "checked)")
-            continue
-        refs = re.findall(r"\b(C|BC|EC)(\d+)\b", rest)
-        cname = next((k + n for k, n in refs if k == "C"), None)
-        if cname is None:
-            skipped.append(f"line {lineno}: {instr} without a C position")
-            continue
-        missing = [k + n for k, n in refs if k + n not in positions]
-        if missing:
-            raise lines.error(lineno, f"{', '.join(missing)} not in the //POS section")
-        c = positions[cname]
-        if c.kind == "C-pulse":
-            skipped.append(f"line {lineno}: {instr} {cname} (robot pulses: their pulses per "
-                           "degree are not in the job)")
-            continue
-        external: dict[str, float] = {}
+        job.instruction(lines.lines[lineno - 1].strip(), lineno)
+    return Program(name, "yaskawa", job.points, (str(path),)), job.skipped
+
+
+class _Job:
+    """The instructions of a job in order: the motions and what changes tools and frames."""
+
+    def __init__(self, lines: Lines, positions: dict[str, _Position]) -> None:
+        self.lines, self.positions = lines, positions
+        self.changed: dict[tuple[str, int], str] = {}  # (TOOL|USER, n) -> why, set by the job
+        self.tools: dict[int, NDArray[np.float64]] = {}  # tools set by SETTOOL from SETE values
+        self.elements: dict[str, dict[int, float] | None] = {}  # SETE constants per variable
+        self.points: list[ProgramPoint] = []
+        self.skipped: list[str] = []
+
+    def instruction(self, text: str, lineno: int) -> None:
+        if m := _SETE_RE.match(text):
+            var, k, value = m.group(1).upper(), int(m.group(2)), m.group(3)
+            known = self.elements.setdefault(var, {})
+            if known is not None and re.fullmatch(r"[-+]?\d+", value):
+                known[k] = float(value)
+            else:
+                self.elements[var] = None  # an element set from a variable at run time
+        elif m := _SETTOOL_RE.match(text):
+            self.settool(int(m.group(1)), (m.group(2) or "").upper(), lineno)
+        elif m := _MFRAME_RE.match(text):
+            self.changed[("USER", int(m.group(1)))] = (
+                f"user frame {m.group(1)} is set by MFRAME at line {lineno} from position "
+                "variables")
+        elif m := _COORD_MOVE_RE.match(text):
+            self.coordinated(m.group(2), lineno)
+        elif m := _MOVE_RE.match(text):
+            self.motion(m.group(1).upper(), m.group(2), lineno)
+
+    def settool(self, n: int, var: str, lineno: int) -> None:
+        """``SETTOOL TL#(n) Pxxx``: tool n from the position variable, when the job sets its six
+        elements X, Y, Z (um) and Rx, Ry, Rz (0.01 deg) by ``SETE`` with numbers (the units
+        RoboDK's Motoman post writes); else the tool is not known."""
+        known = self.elements.get(var)
+        if known is not None and all(k in known for k in range(1, 7)):
+            values = [known[k] / (1000 if k <= 3 else 100) for k in range(1, 7)]
+            self.tools[n] = pose_from_vendor(values, "yaskawa")
+            self.changed.pop(("TOOL", n), None)
+            return
+        self.tools.pop(n, None)
+        self.changed[("TOOL", n)] = (f"tool {n} is set by SETTOOL at line {lineno} from "
+                                     f"{var or 'a variable'}, whose values the job sets at run "
+                                     "time")
+
+    def external(self, refs: list[tuple[str, str]]) -> dict[str, float]:
+        out: dict[str, float] = {}
         for k, n in refs:
             if k == "BC":
-                external["BC1"] = positions[k + n].values[0]
+                out["BC1"] = self.positions[k + n].values[0]
             elif k == "EC":
-                external.update({f"EC{i + 1}": v for i, v in enumerate(positions[k + n].values)})
+                out.update({f"EC{i + 1}": v for i, v in enumerate(self.positions[k + n].values)})
+        return out
+
+    def refs(self, rest: str, lineno: int) -> list[tuple[str, str]]:
+        refs = re.findall(r"\b(C|BC|EC)(\d+)\b", rest)
+        missing = [k + n for k, n in refs if k + n not in self.positions]
+        if missing:
+            raise self.lines.error(lineno, f"{', '.join(missing)} not in the //POS section")
+        return refs
+
+    def coordinated(self, rest: str, lineno: int) -> None:
+        """``+MOVJ EC00001 ...``: a station's motion with the robot's on the line before."""
+        refs = self.refs(rest, lineno)
+        if self.points and self.points[-1].line == lineno - 1:
+            self.points[-1].external.update(self.external(refs))
+
+    def motion(self, instr: str, rest: str, lineno: int) -> None:
+        lines = self.lines
+        if instr in ("MOVC", "MOVS"):
+            self.skipped.append(f"line {lineno}: {instr} (circular and spline motions are not "
+                                "checked)")
+            return
+        refs = self.refs(rest, lineno)
+        cname = next((k + n for k, n in refs if k == "C"), None)
+        if cname is None:
+            var = re.search(r"\b(L?P\d+|P\[[^\]]*\])", rest)
+            axes = " ".join(k + n for k, n in refs)
+            self.skipped.append(f"line {lineno}: {instr} " + (
+                f"{var.group(1)} (a position variable, set at run time)" if var else
+                f"{axes} (a motion of the base axis or the station alone)" if axes else
+                "without a C position"))
+            return
+        c = self.positions[cname]
+        if c.kind == "C-pulse":
+            self.skipped.append(f"line {lineno}: {instr} {cname} (robot pulses: their pulses "
+                                "per degree are not in the job)")
+            return
+        why = self.changed.get(("TOOL", c.tool)) or (
+            self.changed.get(("USER", c.user)) if c.postype == "USER" else None)
+        if why:
+            self.skipped.append(f"line {lineno}: {instr} {cname} ({why})")
+            return
         frame = (Ref(number=c.user, kind="base") if c.postype == "USER" else
                  Ref(kind="robot" if c.postype == "ROBOT" else "base", number=None))
         if c.postype not in ("USER", "BASE", "ROBOT"):
@@ -236,11 +321,12 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         speed = re.search(r"\bV\s*=\s*([0-9.]+)", rest)
         zone = re.search(r"\bPL\s*=\s*(\d+)", rest)
         motion = "ptp" if instr.endswith("J") else "lin"
-        points.append(ProgramPoint(
-            cname, lineno, motion, Ref(number=c.tool), frame, pose, None, config, external,
+        self.points.append(ProgramPoint(
+            cname, lineno, motion, Ref(number=c.tool, pose=self.tools.get(c.tool)), frame,
+            pose, None, config,
+            self.external(refs),
             lines.number(speed.group(1), lineno) * 1e-3 if speed and motion == "lin" else None,
             lines.number(zone.group(1), lineno) * 1e-3 if zone else 0.0, c.where))
-    return Program(name, "yaskawa", points, (str(path),)), skipped
 
 
 # -- editing in place ----------------------------------------------------------------------------
