@@ -3,9 +3,11 @@
 Before :func:`~robotcell.cell.schema.save_cell` replaces a cell file, the file is copied to
 ``<name>.<N>.bak`` with ``N`` one more than the highest number already there (``cell.yaml.1.bak``,
 ``cell.yaml.2.bak``, ...). No backup is ever overwritten, so the file as the user first wrote it
-stays beside every later version. :func:`cell_history` lists the versions, oldest first, with the
-provenance of every item (the procedure, time, residual RMS and note that each calibration
-records) and which items changed from one version to the next.
+stays beside every later version. Updates are serialised (:mod:`robotcell.cell.update`), so the
+backups are every version in the order they were written. Backups go beside the file itself:
+beside the file a symbolic link points to, not beside the link. :func:`cell_history` lists the
+versions, oldest first, with the provenance of every item (the procedure, time, residual RMS and
+note that each calibration records) and which items changed from one version to the next.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from robotcell.errors import InputError
-from robotcell.io.fileio import atomic_copy, read_text
+from robotcell.io.fileio import atomic_copy, read_text, real_destination
 from robotcell.io.yamlfile import parse_yaml
 
 __all__ = ["Version", "backups", "cell_history", "keep_version"]
@@ -40,9 +42,10 @@ def backups(path: str | Path) -> list[tuple[int, Path]]:
     Returns
     -------
     list of (int, Path)
-        Number and path of every ``<name>.<N>.bak`` beside the file, by increasing number.
+        Number and path of every ``<name>.<N>.bak`` beside the file (beside the file it links
+        to, for a symbolic link), by increasing number.
     """
-    p = Path(path)
+    p = real_destination(path)
     pattern = _pattern(p)
     found = []
     for child in (p.parent if str(p.parent) else Path(".")).iterdir():
@@ -68,7 +71,7 @@ def keep_version(path: str | Path) -> Path:
     Path
         The backup written, ``<name>.<N>.bak``.
     """
-    p = Path(path)
+    p = real_destination(path)
     number = max((n for n, _ in backups(p)), default=0) + 1
     while True:
         dst = p.with_name(f"{p.name}.{number}.bak")
@@ -155,7 +158,7 @@ def cell_history(path: str | Path) -> list[Version]:
     InputError
         Neither the file nor a backup of it exists.
     """
-    p = Path(path)
+    p = real_destination(path)
     paths: list[tuple[int | None, Path]] = [*backups(p)]
     if p.is_file():
         paths.append((None, p))
