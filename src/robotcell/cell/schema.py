@@ -52,7 +52,7 @@ from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, check_destination, read_text
 from robotcell.io.locking import file_lock
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.io.yamlfile import dump_yaml, parse_yaml, update_document
+from robotcell.io.yamlfile import parse_yaml, update_document, written_yaml
 from robotcell.robot.models import load_robot, robot_from_dict, robot_to_dict
 
 __all__ = ["CellRecord", "cell_fields", "cell_to_dict", "read_cell_file", "save_cell"]
@@ -119,7 +119,8 @@ def read_cell_file(path: str | Path) -> tuple[Any, str, Path]:
 
 
 def save_cell(cell: CellRecord, path: str | Path,
-              read: Callable[[Any, str, Path], CellRecord]) -> Path | None:
+              read: Callable[[Any, str, Path], CellRecord],
+              written: tuple[Any, dict[str, Any]] | None = None) -> Path | None:
     """Write ``cell`` to a cell file atomically, keeping the file as the user wrote it.
 
     An existing file that reads as a cell is updated in place: only the values that differ from
@@ -142,6 +143,10 @@ def save_cell(cell: CellRecord, path: str | Path,
         ``read(data, origin, base_dir)``: the cell that the content of a cell file is
         (:func:`robotcell.cell.model.cell_from_dict`); an existing file that it reads is
         updated in place, and the new text must read with it.
+    written : (document, dict), optional
+        The file as it is, read under its lock by the caller: its round-trip document
+        (:func:`robotcell.io.yamlfile.parse_yaml`, changed in place here) and what it says
+        (:func:`cell_to_dict` of its cell). Default: the file is read here.
 
     Returns
     -------
@@ -159,15 +164,17 @@ def save_cell(cell: CellRecord, path: str | Path,
     base = real.resolve().parent
     new = cell_to_dict(cell, base)
     with file_lock(real):
-        written = _as_written(real, base, read) if real.is_file() else None
+        if written is None and real.is_file():
+            written = _as_written(real, base, read)
         if written is None:
-            text = _HEADER + dump_yaml(new, str(path))
+            text, back = written_yaml(new, str(path))
+            text = _HEADER + text
         else:
             doc, old = written
             update_document(doc, old, new)
-            text = dump_yaml(doc, str(path))
+            text, back = written_yaml(doc, str(path))
         try:
-            read(parse_yaml(text, str(path)), str(path), base)
+            read(back, str(path), base)
         except InputError as exc:
             raise InputError(f"the cell as it would be written does not load ({exc}); "
                              f"{path} is unchanged") from None

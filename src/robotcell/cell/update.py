@@ -28,10 +28,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 from robotcell.cell.model import Cell, cell_from_dict
-from robotcell.cell.schema import save_cell
+from robotcell.cell.schema import cell_to_dict, save_cell
 from robotcell.io.fileio import check_destination, read_text
 from robotcell.io.locking import LOCK_WAIT, file_lock
 from robotcell.io.yamlfile import parse_yaml
@@ -64,10 +64,22 @@ class CellFileUpdate(Generic[T]):
     repeated: bool = False
 
 
-def _read(path: Path, origin: str) -> tuple[str, Cell]:
-    """The text of the cell file and the cell it holds."""
-    text = read_text(path, "cell file")
-    return text, cell_from_dict(parse_yaml(text, origin), origin, path.resolve().parent)
+@dataclass(frozen=True)
+class _Version:
+    """A cell file as read: its text, its round-trip document, what it says, and its cell."""
+
+    text: str
+    document: Any
+    said: dict[str, Any]
+    cell: Cell
+
+    @classmethod
+    def read(cls, path: Path, origin: str) -> _Version:
+        text = read_text(path, "cell file")
+        document = parse_yaml(text, origin)
+        base = path.resolve().parent
+        cell = cell_from_dict(document, origin, base)
+        return cls(text, document, cell_to_dict(cell, base), cell)
 
 
 def update_cell_file(path: str | Path, change: Callable[[Cell], tuple[Cell | None, T]], *,
@@ -103,19 +115,19 @@ def update_cell_file(path: str | Path, change: Callable[[Cell], tuple[Cell | Non
     """
     real = check_destination(path)
     origin = str(path)
-    text, cell = _read(real, origin)
-    new, value = change(cell)
+    version = _Version.read(real, origin)
+    new, value = change(version.cell)
     if new is None:
         return CellFileUpdate(None, value)
     with file_lock(real, wait, on_note):
-        now, cell = _read(real, origin)
-        repeated = now != text
+        repeated = read_text(real, "cell file") != version.text
         if repeated:
             if on_note is not None:
                 on_note(f"note: {path} was updated by another process while this ran; this "
                         "update is made again on the version it wrote")
-            new, value = change(cell)
+            version = _Version.read(real, origin)
+            new, value = change(version.cell)
             if new is None:
                 return CellFileUpdate(None, value, repeated=True)
-        backup = save_cell(new, real, cell_from_dict)
+        backup = save_cell(new, real, cell_from_dict, (version.document, version.said))
     return CellFileUpdate(new, value, backup, repeated)

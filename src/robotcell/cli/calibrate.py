@@ -17,8 +17,10 @@ import importlib
 import importlib.util
 import json
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TypeVar
 
 import click
@@ -491,6 +493,12 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
            None, as_json, accept_poor)
 
 
+def _shown(path: Path) -> str:
+    """``path`` relative to the working folder when it is inside it, else as it is."""
+    relative = os.path.relpath(path)
+    return str(path) if relative.startswith("..") else relative
+
+
 @calibrate.command("cell")
 @cell_option
 @result_options
@@ -517,7 +525,7 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
                          "are fitted together")
     target = CellTarget.open(cell_path, None)
     refuse_overwriting_inputs(click.get_current_context(),
-                              read=[(f"the touch file of {key}", str(path))
+                              read=[(f"the touch file of {key}", _shown(path))
                                     for key, path in cellcal.touch_files(target.cell)])
     nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
 
@@ -527,8 +535,8 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
         gate(out, as_json, accept_poor)
         return out.cell, out
 
-    out = target.update(change, lambda out: (f"{len(out.items)} item(s) fitted with the whole "
-                                             f"cell ({', '.join(out.items)})", ()))
+    out = target.update(change, lambda out: ((f"{len(out.items)} item(s) fitted with the whole "
+                                              f"cell ({', '.join(out.items)})"), ()))
     emit(out, as_json)
 
 

@@ -107,8 +107,8 @@ def file_lock(path: str | Path, wait: float = LOCK_WAIT,
                          f"{lock_file} for more than {wait:g} s; nothing was written. Run again "
                          "when that update has finished") from None
     except OSError as exc:
-        raise InputError(f"cannot lock {path} for the update: {lock_file}: "
-                         f"{exc.strerror or exc}") from None
+        raise InputError(f"cannot lock {path} for the update: its lock file {lock_file}: "
+                         f"{exc.strerror or exc}; remove it, or make its folder writable") from None
     try:
         yield lock_file
     finally:

@@ -28,6 +28,7 @@ is a key of an item's error sources).
 from __future__ import annotations
 
 import io
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -39,7 +40,7 @@ from ruamel.yaml.events import CollectionEndEvent, CollectionStartEvent
 
 from robotcell.errors import InputError, RobotcellError
 
-__all__ = ["FLOW_MAX", "MAX_DEPTH", "dump_yaml", "parse_yaml", "update_document"]
+__all__ = ["FLOW_MAX", "MAX_DEPTH", "dump_yaml", "parse_yaml", "update_document", "written_yaml"]
 
 #: Deepest nesting of mappings and lists accepted. A cell file needs 4 (``tools`` > name >
 #: ``frame`` > ``x``), a robot model file 5 (a coupling matrix in a nested ``ik_seed``).
@@ -117,7 +118,8 @@ def dump_yaml(data: Any, what: str = "the file") -> str:
     """YAML text of ``data``: a document from :func:`parse_yaml` as it was written.
 
     Plain mappings and lists are written in block style, with the innermost ones (poses, short
-    lists of numbers) in flow style. The text is read back before it is returned.
+    lists of numbers) in flow style. The text is read back before it is returned
+    (:func:`written_yaml`).
 
     Parameters
     ----------
@@ -138,22 +140,47 @@ def dump_yaml(data: Any, what: str = "the file") -> str:
     RobotcellError
         The text would not read back as ``data`` (a defect of the writer: nothing is written).
     """
+    return written_yaml(data, what)[0]
+
+
+def written_yaml(data: Any, what: str = "the file") -> tuple[str, Any]:
+    """:func:`dump_yaml` of ``data`` and the document its text reads back as.
+
+    Parameters
+    ----------
+    data : Any
+        As for :func:`dump_yaml`.
+    what : str
+        What is written, for the message of a text that does not read back.
+
+    Returns
+    -------
+    text : str
+    document : Any
+        :func:`parse_yaml` of ``text``, equal to ``data``.
+
+    Raises
+    ------
+    RobotcellError
+        The text would not read back as ``data`` (a defect of the writer: nothing is written).
+    """
     styled = _styled(data)
     _restyle(styled)
     buf = io.StringIO()
     _yaml().dump(styled, buf)
     text = buf.getvalue()
+    back = None
     try:
         back = parse_yaml(text, what)
     except InputError as exc:
-        why = str(exc)
+        why: str | None = str(exc)
     else:
         why = _difference(_plain(back), _plain(data))
     if why:
         raise RobotcellError(f"the YAML text written for {what} does not read back as what was "
                              f"meant ({why}); nothing was written. This is a defect of "
                              "robotcell: please report it with the file")
-    return text
+    return text, back
 
 
 def _plain(value: Any) -> Any:
@@ -185,7 +212,7 @@ def _difference(got: Any, meant: Any, where: str = "") -> str | None:
                 return why
         return None
     same = got == meant or (isinstance(got, float) and isinstance(meant, float)
-                            and got != got and meant != meant)
+                            and math.isnan(got) and math.isnan(meant))
     return None if same else f"the value at {at}"
 
 
