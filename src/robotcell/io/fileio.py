@@ -160,12 +160,11 @@ def real_destination(path: str | Path) -> Path:
     Returns
     -------
     Path
-        ``path`` itself when no part of it is a symbolic link, else the file it leads to
-        (absolute), which may not exist yet.
+        ``path`` itself when it is not a symbolic link, else the file the link leads to (through
+        every link, absolute), which may not exist yet.
     """
     p = Path(path)
-    real = Path(os.path.realpath(p))
-    return p if real == p.absolute() else real
+    return Path(os.path.realpath(p)) if p.is_symlink() else p
 
 
 def check_links(path: str | Path) -> None:

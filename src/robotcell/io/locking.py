@@ -21,6 +21,7 @@ lock).
 
 from __future__ import annotations
 
+import os
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -59,7 +60,7 @@ def lock_path(path: str | Path) -> Path:
 
 
 def _lock_of(path: Path) -> FileLock:
-    key = str(path.absolute())
+    key = os.path.realpath(path)  # one object per file, however it is spelt
     with _GUARD:
         if key not in _LOCKS:
             _LOCKS[key] = FileLock(key)
