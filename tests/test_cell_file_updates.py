@@ -383,7 +383,7 @@ def test_a_process_killed_while_holding_the_lock_does_not_block_the_next_update(
         assert lock_path("cell.yaml").exists()  # left behind; the OS released the lock itself
         start = time.monotonic()
         done = update_cell_file("cell.yaml", _calibrate_tool)
-    assert time.monotonic() - start < LOCK_WAIT / 4
+    assert time.monotonic() - start < LOCK_WAIT / 2  # (the calibration: no wait)
     assert done.backup is not None and Cell.load("cell.yaml").tools["torch"].provenance.source \
         == "tcp"
 
@@ -397,19 +397,19 @@ def test_an_update_waits_for_the_lock_says_so_and_gives_up_with_nothing_written(
                            r"which has held its lock .*cell.yaml.lock for more than 1 s; nothing "
                            "was written"):
             update_cell_file("cell.yaml", _calibrate_tool, wait=1.0, on_note=notes.append)
-        assert 1.0 <= time.monotonic() - start < 10
+        assert 1.0 <= time.monotonic() - start < LOCK_WAIT  # (the calibration, and 1 s)
         assert notes == [(f"waiting for cell.yaml: another process is updating it (lock "
                           f"{lock_path('cell.yaml')}); waiting at most 1 s")]
         assert _snapshot(calibrated) == before
 
 
 def test_the_command_line_waits_for_an_update_and_then_writes(calibrated, capsys):
-    with holder(1.5) as proc:
+    with holder(6.0) as proc:  # (longer than the calibration before the lock)
         code, _, err = run(capsys, "calibrate", "tcp", "tcp.csv", "--cell", "cell.yaml",
                            "--name", "torch")
         assert proc.wait(timeout=30) == 0  # it let go, was not killed
     assert code == 0, err
-    assert err.startswith("waiting for cell.yaml: another process is updating it")
+    assert "waiting for cell.yaml: another process is updating it" in err
     assert "updated cell.yaml: tool 'torch'" in err
 
 
