@@ -48,7 +48,10 @@ def backups(path: str | Path) -> list[tuple[int, Path]]:
     p = real_destination(path)
     pattern = _pattern(p)
     found = []
-    for child in (p.parent if str(p.parent) else Path(".")).iterdir():
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        return []
+    for child in folder.iterdir():
         m = pattern.fullmatch(child.name)
         if m:
             found.append((int(m[1]), p.with_name(child.name)))
