@@ -17,6 +17,8 @@ lock).
   deleted when no update runs.
 - **Re-entrant.** A process that holds the lock of a file may take it again (a save inside an
   update); it is released when the outermost holder lets go.
+- **Shared.** The lock file gets the read and write permissions of the file it guards, so that
+  whoever may write a cell file shared by a team (``664``) may also lock it.
 """
 
 from __future__ import annotations
@@ -38,8 +40,9 @@ __all__ = ["LOCK_WAIT", "file_lock", "lock_path"]
 #: takes (a whole-cell fit takes seconds), short enough that a script is not stuck for long.
 LOCK_WAIT = 60.0
 
-#: One lock object per lock file in this process, so that taking a held lock again nests.
-_LOCKS: dict[str, FileLock] = {}
+#: One lock object per lock file (and permissions) in this process, so that taking a held lock
+#: again nests.
+_LOCKS: dict[tuple[str, int | None], FileLock] = {}
 _GUARD = threading.Lock()
 
 
@@ -59,11 +62,12 @@ def lock_path(path: str | Path) -> Path:
     return real.with_name(real.name + ".lock")
 
 
-def _lock_of(path: Path) -> FileLock:
-    key = os.path.realpath(path)  # one object per file, however it is spelt
+def _lock_of(path: Path, mode: int | None) -> FileLock:
+    """The lock object of lock file ``path``, created with permissions ``mode`` when new."""
+    key = (os.path.realpath(path), mode)  # one object per file, however it is spelt
     with _GUARD:
         if key not in _LOCKS:
-            _LOCKS[key] = FileLock(key)
+            _LOCKS[key] = FileLock(key[0]) if mode is None else FileLock(key[0], mode=mode)
         return _LOCKS[key]
 
 
@@ -94,7 +98,11 @@ def file_lock(path: str | Path, wait: float = LOCK_WAIT,
         folder without write permission); nothing was done.
     """
     lock_file = lock_path(path)
-    lock = _lock_of(lock_file)
+    try:  # whoever may write the file may lock it (a team's 664 cell file)
+        mode: int | None = real_destination(path).stat().st_mode & 0o666
+    except OSError:
+        mode = None
+    lock = _lock_of(lock_file, mode)
     try:
         try:
             lock.acquire(timeout=0)
