@@ -3,11 +3,9 @@
 Before :func:`~robotcell.cell.schema.save_cell` replaces a cell file, the file is copied to
 ``<name>.<N>.bak`` with ``N`` one more than the highest number already there (``cell.yaml.1.bak``,
 ``cell.yaml.2.bak``, ...). No backup is ever overwritten, so the file as the user first wrote it
-stays beside every later version. Updates are serialised (:mod:`robotcell.cell.update`), so the
-backups are every version in the order they were written. Backups go beside the file itself:
-beside the file a symbolic link points to, not beside the link. :func:`cell_history` lists the
-versions, oldest first, with the provenance of every item (the procedure, time, residual RMS and
-note that each calibration records) and which items changed from one version to the next.
+stays beside every later version. :func:`cell_history` lists the versions, oldest first, with the
+provenance of every item (the procedure, time, residual RMS and note that each calibration
+records) and which items changed from one version to the next.
 """
 
 from __future__ import annotations
@@ -62,7 +60,10 @@ def keep_version(path: str | Path) -> Path:
     """Copy the cell file to its next numbered backup, never overwriting one.
 
     The number is claimed by creating the file exclusively, so two updates at once get two
-    backups. The copy is atomic and keeps the file's permissions and modification time.
+    backups. The copy is atomic and keeps the file's permissions and modification time. Updates
+    are serialised (:mod:`robotcell.cell.update`), so the backups are every version in the order
+    they were written. A backup goes beside the file itself: beside the file a symbolic link
+    points to, not beside the link.
 
     Parameters
     ----------

@@ -3,10 +3,9 @@
 Every subcommand reads a CSV (mm, deg; see docs/calibration.md), prints a report in mm/deg or,
 with ``--json``, one JSON object, and exits with status 2 and the reason on stderr when the input
 is refused. With ``--cell CELL.yaml`` (tcp, frame, track, turntable, workpiece) the result is
-written into the cell file: the command parses its options and hands the one call of
-:mod:`robotcell.cell.calibrate` it makes (which returns the result and the updated cell) to
-:class:`CellTarget`, which runs it as one locked update of the file
-(:func:`robotcell.cell.update.update_cell_file`) and prints its notes on stderr.
+written into the cell file: the command parses its options, makes one call of
+:mod:`robotcell.cell.calibrate` (which returns the result and the updated cell), prints its notes on
+stderr and saves the cell through :class:`CellTarget`.
 Subcommands of other modules are listed in ``REGISTERED`` at the bottom of this file and imported
 only when used.
 """
@@ -31,6 +30,7 @@ from robotcell.calibration.result import CalibrationResult
 from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
+from robotcell.cell.calibrate.whole import touch_files
 from robotcell.cell.update import update_cell_file
 from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Group, refuse_overwriting_inputs
@@ -185,6 +185,10 @@ T = TypeVar("T")
 @dataclass
 class CellTarget:
     """A cell file that a calibration updates (``--cell``).
+
+    The command hands its one call of :mod:`robotcell.cell.calibrate` to :meth:`update`, which
+    runs it as one locked update of the file (:func:`robotcell.cell.update.update_cell_file`):
+    again on the version another update wrote meanwhile, if one did.
 
     Attributes
     ----------
@@ -526,7 +530,7 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
     target = CellTarget.open(cell_path, None)
     refuse_overwriting_inputs(click.get_current_context(),
                               read=[(f"the touch file of {key}", _shown(path))
-                                    for key, path in cellcal.touch_files(target.cell)])
+                                    for key, path in touch_files(target.cell)])
     nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
 
     def change(cell: Cell) -> tuple[Cell, cellcal.CellRecalibration]:

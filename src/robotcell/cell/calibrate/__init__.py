@@ -35,14 +35,9 @@ from robotcell.cell.calibrate.touches import (
     robot_in_world,
     track_positions,
 )
-from robotcell.cell.calibrate.whole import (
-    CellRecalibration,
-    ItemChange,
-    calibrate_cell,
-    touch_files,
-)
+from robotcell.cell.calibrate.whole import CellRecalibration, ItemChange, calibrate_cell
 
 __all__ = ["NOMINAL_ACCURACY", "SAME_POSE", "CellCalibration", "CellRecalibration", "ItemChange",
            "NominalAccuracy", "TurntablePose", "calibrate_cell", "external_tcp", "frame",
            "load_table", "positioner", "positioner_touches", "read_touches", "robot_in_world",
-           "tcp", "touch_files", "track", "track_positions", "turntable", "workpiece"]
+           "tcp", "track", "track_positions", "turntable", "workpiece"]
