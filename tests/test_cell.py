@@ -71,14 +71,17 @@ def test_save_keeps_previous_version_as_numbered_backup(tmp_path):
     c = Cell.load(EXAMPLE)
     out = tmp_path / "cell.yaml"
     assert c.save(out) is None
-    assert [p.name for p in tmp_path.iterdir()] == ["cell.yaml"]
+    # no backup; the empty lock file the save was locked on stays beside it (docs/cell.md)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "cell.yaml.lock"]
+    assert (tmp_path / "cell.yaml.lock").read_bytes() == b""
     first = out.read_text()
     c.set_tool("torch", np.eye(4), Provenance.now("tcp", rms_mm=0.2))
     assert c.save(out) == tmp_path / "cell.yaml.1.bak"
     assert (tmp_path / "cell.yaml.1.bak").read_text() == first
     assert out.read_text() != first
     np.testing.assert_allclose(Cell.load(out).tools["torch"].T_F_TCP, np.eye(4))
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "cell.yaml.1.bak"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "cell.yaml.1.bak",
+                                                          "cell.yaml.lock"]
 
 
 @pytest.mark.parametrize("mode", [0o664, 0o640, 0o600])
@@ -91,6 +94,9 @@ def test_save_keeps_permissions_of_file_and_backups(tmp_path, mode):
     c.save(out)
     assert stat.S_IMODE(out.stat().st_mode) == mode
     assert stat.S_IMODE((tmp_path / "cell.yaml.1.bak").stat().st_mode) == mode
+    (tmp_path / "cell.yaml.lock").unlink()  # made at the first save; made again, as the file is
+    c.save(out)
+    assert stat.S_IMODE((tmp_path / "cell.yaml.lock").stat().st_mode) == mode  # lockable by all
     c.save(out)  # the next backup keeps it too
     assert stat.S_IMODE((tmp_path / "cell.yaml.2.bak").stat().st_mode) == mode
 
@@ -126,7 +132,7 @@ def test_failed_save_leaves_old_file_intact(tmp_path, monkeypatch, where):
         raise OSError("simulated crash")
 
     if where == "dump":
-        monkeypatch.setattr(cellmod, "dump_yaml", boom)
+        monkeypatch.setattr(cellmod, "written_yaml", boom)
     elif where == "fsync":
         real_fsync = os.fsync
         calls = []

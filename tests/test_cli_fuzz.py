@@ -417,7 +417,7 @@ def _case(command: str, rng: np.random.Generator, d: Path, good: dict[str, Path]
     writes = list(writes)
     if "--cell" in args and args[0] == "calibrate":
         cell = Path(args[args.index("--cell") + 1])
-        writes += [cell, cell.with_name(cell.name + ".1.bak")]
+        writes += [cell, cell.with_name(cell.name + ".1.bak"), cell.with_name(cell.name + ".lock")]
     args = [str(a) for a in args]
     if inputs and "-o" in args and rng.random() < 0.05:
         onto = inputs[int(rng.integers(0, len(inputs)))]
@@ -543,7 +543,8 @@ def _positioner(rng, d, good, out):
     if rng.random() < 0.5:
         cell, w = _cell_for("positioner", rng, d)
         return (["calibrate", "positioner", path, "--cell", cell, "--tool", "pointer"],
-                f"{what}; {w}", [path, cell], [cell, cell.with_name(cell.name + ".1.bak")])
+                f"{what}; {w}", [path, cell], [cell, cell.with_name(cell.name + ".1.bak"),
+                                               cell.with_name(cell.name + ".lock")])
     return (["calibrate", "positioner", path, "--robot", "kuka_kr16", "--tool",
              "250,0,0,0,0,0", "--json", "-o", out], what, [path], [out])
 
@@ -699,6 +700,119 @@ BUILDERS = {"fk": _fk, "ik": _ik, "export": _export, "cell-show": _cell_show, "r
             "cell-history": _cell_history}
 
 
+# -- the cell file's safety: the whole-cell refit, a lock left behind, links ----------------------
+def _calibrated(good: dict[str, Path]) -> Path:
+    """A folder with a copy of the example cell whose tool pointer and frame fixture are
+    calibrated from the touch files tcp.csv and frame.csv beside it (made once)."""
+    from robotcell.cell import Cell
+    from robotcell.cell import calibrate as cellcal
+
+    folder = good["tcp.csv"].parent / "calibrated"
+    if not folder.is_dir():
+        folder.mkdir()
+        shutil.copy(EXAMPLE, folder / "cell.yaml")
+        for name in ("tcp.csv", "frame.csv"):
+            shutil.copy(good[name], folder / name)
+        cell = cellcal.tcp(Cell.load(folder / "cell.yaml"), folder / "tcp.csv", "pointer").cell
+        cell = cellcal.frame(cell, folder / "frame.csv", "fixture", tool="pointer").cell
+        cell.save(folder / "cell.yaml")
+        for kept in folder.glob("cell.yaml.*"):  # its backup and lock file
+            kept.unlink()
+    return folder
+
+
+def _cell_writes(cell: Path, backup: int = 1) -> list[Path]:
+    """What an update of ``cell`` writes: the file, its next backup, its lock file."""
+    return [cell, cell.with_name(f"{cell.name}.{backup}.bak"), cell.with_name(cell.name + ".lock")]
+
+
+def _cell_refit(rng, d, good, out):
+    """calibrate cell on a calibrated cell: a touch file or the cell mutated; -o as text, as
+    JSON, named for another kind, onto a touch file or onto the cell through a link."""
+    for f in _calibrated(good).iterdir():
+        shutil.copy(f, d / f.name)
+    cell, touches = d / "cell.yaml", [d / "tcp.csv", d / "frame.csv"]
+    what = "valid"
+    if rng.random() < 0.3:
+        target = touches[int(rng.integers(0, 2))]
+        content, w = mutate_csv(target.read_text(), rng)
+        _write(target, content)
+        what = f"{target.name}: {w}"
+    elif rng.random() < 0.2:
+        cell, what = _mutated(cell.read_text(), rng, d, "cell.yaml")
+    kind = str(rng.choice(["none", "json", "text", "json-name", "touch", "link"]))
+    outputs, options = [], []
+    if kind == "json":
+        outputs, options = [d / "res.json"], ["--json", "-o", d / "res.json"]
+    elif kind == "text":
+        outputs, options = [out], ["-o", out]
+    elif kind == "json-name":
+        options = ["-o", d / "res.json"]
+        what += "; -o res.json without --json (never written)"
+    elif kind == "touch":
+        onto = touches[int(rng.integers(0, 2))]
+        options, what = ["--json", "-o", onto], what + f"; -o onto the input {onto.name}"
+    elif kind == "link":
+        os.symlink("cell.yaml", d / "view.txt")
+        options, what = ["-o", d / "view.txt"], what + "; -o onto the input cell.yaml, linked"
+    return (["calibrate", "cell", "--cell", cell, *options], what, [cell, *touches],
+            _cell_writes(cell) + outputs)
+
+
+def _cell_lock(rng, d, good, out):
+    """calibrate tcp into a cell whose lock file a killed process left (empty, or with bytes in
+    it), whose lock file is a folder (refused), or whose backups have gaps."""
+    cell = _write(d / "cell.yaml", EXAMPLE.read_text(encoding="utf-8"))
+    content, what = mutate_csv(good["tcp.csv"].read_text(), rng) if rng.random() < 0.5 else \
+        (good["tcp.csv"].read_text(), "valid")
+    touches = _write(d / "tcp.csv", content)
+    lock = cell.with_name("cell.yaml.lock")
+    kind = str(rng.choice(["left", "junk", "folder", "gaps"]))
+    backup = 1
+    if kind == "left":
+        lock.touch()
+    elif kind == "junk":
+        _write(lock, bytes(rng.integers(0, 256, 50, dtype=np.uint8)))
+    elif kind == "folder":
+        lock.mkdir()
+        what += " (never written)"
+    else:
+        for k in (1, 3):
+            _write(cell.with_name(f"cell.yaml.{k}.bak"), EXAMPLE.read_text(encoding="utf-8"))
+        backup = 4
+    return (["calibrate", "tcp", touches, "--cell", cell, "--name", "pointer"],
+            f"{what}; lock {kind}", [cell, touches], _cell_writes(cell, backup))
+
+
+def _cell_link(rng, d, good, out):
+    """calibrate tcp into a cell given through a symbolic link (written where it points) or a
+    hard link (refused), sometimes with -o through a symbolic link."""
+    (d / "shared").mkdir()
+    real = _write(d / "shared" / "cell.yaml", EXAMPLE.read_text(encoding="utf-8"))
+    content, what = mutate_csv(good["tcp.csv"].read_text(), rng) if rng.random() < 0.4 else \
+        (good["tcp.csv"].read_text(), "valid")
+    touches = _write(d / "tcp.csv", content)
+    cell, writes = d / "cell.yaml", _cell_writes(real) + [d / "cell.yaml"]
+    if rng.random() < 0.3:
+        os.link(real, cell)
+        what, writes = what + "; --cell with 2 hard links (never written)", []
+    else:
+        os.symlink(os.path.join("shared", "cell.yaml"), cell)
+        what += "; --cell through a link"
+    options = []
+    if rng.random() < 0.4:
+        os.symlink(os.path.join("shared", "res.json"), d / "res.json")
+        options = ["--json", "-o", d / "res.json"]
+        writes += [d / "res.json", d / "shared" / "res.json"]  # (the link reads as its target)
+        what += "; -o through a link"
+    return (["calibrate", "tcp", touches, "--cell", cell, "--name", "pointer", *options], what,
+            [cell, touches], writes)
+
+
+CASES.update({"cell-refit": (3, 30), "cell-lock": (3, 30), "cell-link": (3, 30)})
+BUILDERS.update({"cell-refit": _cell_refit, "cell-lock": _cell_lock, "cell-link": _cell_link})
+
+
 def _write(path: Path, content: bytes | str) -> Path:
     if isinstance(content, str):
         path.write_bytes(content.encode("utf-8", errors="surrogatepass"))
@@ -804,6 +918,8 @@ def _problems(case: Case, d: Path, code: int, out: str, err: str, before: dict[s
         problems.append(f"changed inputs {sorted(_diff(before, after) - owned)}")
     if "-o onto the input" in case.what and code != 2:
         problems.append("an output onto an input was not refused")
+    if "(never written)" in case.what and code == 0:
+        problems.append("a run that can write nothing succeeded")
     if any(name.endswith(".tmp") for name in after):
         problems.append("temporary files left")
     if sorted(p.name for p in d.parent.iterdir() if not p.name.startswith("case")):

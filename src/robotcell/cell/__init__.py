@@ -7,6 +7,8 @@
 - :mod:`robotcell.cell.validation`: values given for a cell checked against its limits and size;
 - :mod:`robotcell.cell.model`: :class:`Cell`, which holds the parts, reads and writes its file;
 - :mod:`robotcell.cell.history`: the numbered backups of a cell file and its history;
+- :mod:`robotcell.cell.update`: a change of a cell file as one locked read-change-write step
+  (:func:`~robotcell.cell.update.update_cell_file`);
 - :mod:`robotcell.cell.kinematics`: coupled forward kinematics (arm, track, positioner, frames);
 - :mod:`robotcell.cell.ik`: inverse kinematics and paths in the cell;
 - :mod:`robotcell.cell.axischain`: the kinematic chain of a positioner's axes;

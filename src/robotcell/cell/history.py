@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from robotcell.errors import InputError
-from robotcell.io.fileio import atomic_copy, read_text
+from robotcell.io.fileio import atomic_copy, read_text, real_destination
 from robotcell.io.yamlfile import parse_yaml
 
 __all__ = ["Version", "backups", "cell_history", "keep_version"]
@@ -42,12 +42,16 @@ def backups(path: str | Path) -> list[tuple[int, Path]]:
     Returns
     -------
     list of (int, Path)
-        Number and path of every ``<name>.<N>.bak`` beside the file, by increasing number.
+        Number and path of every ``<name>.<N>.bak`` beside the file (beside the file it links
+        to, for a symbolic link), by increasing number.
     """
-    p = Path(path)
+    p = real_destination(path)
     pattern = _pattern(p)
     found = []
-    for child in (p.parent if str(p.parent) else Path(".")).iterdir():
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        return []
+    for child in folder.iterdir():
         m = pattern.fullmatch(child.name)
         if m:
             found.append((int(m[1]), p.with_name(child.name)))
@@ -58,7 +62,10 @@ def keep_version(path: str | Path) -> Path:
     """Copy the cell file to its next numbered backup, never overwriting one.
 
     The number is claimed by creating the file exclusively, so two updates at once get two
-    backups. The copy is atomic and keeps the file's permissions and modification time.
+    backups. The copy is atomic and keeps the file's permissions and modification time. Updates
+    are serialised (:mod:`robotcell.cell.update`), so the backups are every version in the order
+    they were written. A backup goes beside the file itself: beside the file a symbolic link
+    points to, not beside the link.
 
     Parameters
     ----------
@@ -70,7 +77,7 @@ def keep_version(path: str | Path) -> Path:
     Path
         The backup written, ``<name>.<N>.bak``.
     """
-    p = Path(path)
+    p = real_destination(path)
     number = max((n for n, _ in backups(p)), default=0) + 1
     while True:
         dst = p.with_name(f"{p.name}.{number}.bak")
@@ -210,7 +217,7 @@ def cell_history(path: str | Path) -> list[Version]:
     InputError
         Neither the file nor a backup of it exists.
     """
-    p = Path(path)
+    p = real_destination(path)
     paths: list[tuple[int | None, Path]] = [*backups(p)]
     if p.is_file():
         paths.append((None, p))

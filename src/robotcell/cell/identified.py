@@ -4,17 +4,19 @@
 the cell's ``robot.identified`` to it, with the identification's provenance (time, RMS of the
 residuals, held-out error of the cross-validation). Both files change or neither: everything is
 checked first (the model is an identification of the cell's arm, both destinations can be
-written), then the model file is written atomically, then the cell file is saved (atomically,
-with a numbered backup); if that fails the model file is put back as it was.
+written), then the model file is written atomically, then the cell file is updated (under its
+lock, atomically, with a numbered backup); if that fails the model file is put back as it was.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from robotcell.cell.model import Cell
 from robotcell.cell.parts import Provenance
 from robotcell.cell.schema import cell_to_dict
+from robotcell.cell.update import update_cell_file
 from robotcell.errors import InputError
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
@@ -49,8 +51,11 @@ def identification_provenance(result: IdentificationResult,
 
 
 def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_path: str | Path,
-                     provenance: Provenance) -> Cell:
+                     provenance: Provenance, on_note: Callable[[str], None] | None = None) -> Cell:
     """Write the identified model file and make it the arm of a cell file, both or neither.
+
+    The cell file is changed as one locked step (:func:`robotcell.cell.update.update_cell_file`):
+    an update of it by another process at the same time is kept.
 
     Parameters
     ----------
@@ -62,6 +67,8 @@ def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_
         The identified model file (YAML).
     provenance : Provenance
         See :func:`identification_provenance`.
+    on_note : callable, optional
+        Receives the notes of the cell file's update (a wait for another update).
 
     Returns
     -------
@@ -75,23 +82,29 @@ def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_
         nominal the identification started from must be the cell's ``robot.model``), or a file
         cannot be written: nothing is changed then.
     """
-    cell = Cell.load(cell_path)
-    try:
-        cell.set_identified(result.robot, str(Path(model_path).resolve()), provenance)
-    except InputError as exc:
-        raise InputError(f"{cell_path}: {exc} (the cell's robot.model is {cell.robot_model})") \
-            from None
     check_destination(model_path)
     check_destination(cell_path)
-    cell_to_dict(cell, Path(cell_path).resolve().parent)  # every value writable before any write
     old = read_text(model_path, "model file") if Path(model_path).is_file() else None
-    save_robot(result.robot, model_path)
+    written: list[bool] = []
+
+    def adopt(cell: Cell) -> tuple[Cell, None]:
+        try:
+            cell.set_identified(result.robot, str(Path(model_path).resolve()), provenance)
+        except InputError as exc:
+            raise InputError(f"{cell_path}: {exc} (the cell's robot.model is "
+                             f"{cell.robot_model})") from None
+        cell_to_dict(cell, Path(cell_path).resolve().parent)  # every value writable first
+        if not written:  # the same model for every version of the cell
+            save_robot(result.robot, model_path)
+            written.append(True)
+        return cell, None
+
     try:
-        cell.save(cell_path)
+        done = update_cell_file(cell_path, adopt, on_note=on_note)
     except BaseException:
-        if old is None:
+        if written and old is None:
             Path(model_path).unlink(missing_ok=True)
-        else:
+        elif written:
             atomic_write(model_path, old)
         raise
-    return cell
+    return done.cell

@@ -450,17 +450,31 @@ class Cell:
         same directory, flushed and fsynced, then moved over ``path`` with ``os.replace``: if
         the process dies at any point, ``path`` holds either the old or the new content in
         full. The file and its backups keep the permissions of the file replaced (a new file
-        gets ``0o666`` less the umask). See :func:`robotcell.cell.schema.save_cell`.
+        gets ``0o666`` less the umask). The new text is read back as a cell before it replaces
+        the file. See :func:`robotcell.cell.schema.save_cell`.
+
+        ``save`` writes this cell over whatever the file says now. To change a cell file that
+        another process may update at the same time, use
+        :func:`robotcell.cell.update.update_cell_file`, which reads, changes and writes under
+        the file's lock.
 
         Parameters
         ----------
         path : str or Path
-            Destination. A robot model file is written relative to its directory.
+            Destination. A robot model file is written relative to its directory. Through a
+            symbolic link the file it points to is written (the link stays); a file with
+            several hard links is refused.
 
         Returns
         -------
         Path or None
             The backup of the previous file, or None when there was no file.
+
+        Raises
+        ------
+        InputError
+            The file cannot be written, or the cell as written would not load; the file is
+            unchanged.
         """
         return save_cell(self, path, cell_from_dict)
 

@@ -18,7 +18,9 @@ writes atomically: a temporary file in the same directory, flushed and fsynced, 
 ``os.replace``; the previous file is kept as a numbered backup ``<name>.<N>.bak`` that no later
 update overwrites (:mod:`robotcell.cell.history`). The file and its backups keep the permissions
 the file had (see :mod:`robotcell.io.fileio`, which also gives the encoding rule of
-:func:`read_cell_file`).
+:func:`read_cell_file`). The text is read back as a cell before it replaces the file, and the
+file is locked while it is read and replaced; :mod:`robotcell.cell.update` makes a whole
+read-change-write one locked step.
 """
 
 from __future__ import annotations
@@ -48,8 +50,9 @@ from robotcell.cell.parts import (
 )
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write, check_destination, read_text
+from robotcell.io.locking import file_lock
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
-from robotcell.io.yamlfile import dump_yaml, parse_yaml, update_document
+from robotcell.io.yamlfile import parse_yaml, update_document, written_yaml
 from robotcell.robot.models import load_robot, robot_from_dict, robot_to_dict
 
 __all__ = ["CellRecord", "cell_fields", "cell_to_dict", "read_cell_file", "save_cell"]
@@ -116,14 +119,19 @@ def read_cell_file(path: str | Path) -> tuple[Any, str, Path]:
 
 
 def save_cell(cell: CellRecord, path: str | Path,
-              read: Callable[[Any, str, Path], CellRecord]) -> Path | None:
+              read: Callable[[Any, str, Path], CellRecord],
+              written: tuple[Any, dict[str, Any]] | None = None) -> Path | None:
     """Write ``cell`` to a cell file atomically, keeping the file as the user wrote it.
 
     An existing file that reads as a cell is updated in place: only the values that differ from
     what the file says change, in their places; comments, key order, layout and keys this
     writer does not use are kept. Another file is replaced whole. Either way the previous file is
     first copied to the next numbered backup ``<name>.<N>.bak``, which no later save overwrites.
-    This is what :meth:`Cell.save <robotcell.cell.model.Cell.save>` does.
+    The new text is read back as a cell before it replaces the file: a text that would not load
+    is never installed. The file is locked (:func:`robotcell.io.locking.file_lock`) from before
+    it is read until it is replaced. A symbolic link is followed: the file it points to is
+    updated, its backup goes beside that file, and the link stays. This is what
+    :meth:`Cell.save <robotcell.cell.model.Cell.save>` does.
 
     Parameters
     ----------
@@ -134,26 +142,44 @@ def save_cell(cell: CellRecord, path: str | Path,
     read : callable
         ``read(data, origin, base_dir)``: the cell that the content of a cell file is
         (:func:`robotcell.cell.model.cell_from_dict`); an existing file that it reads is
-        updated in place.
+        updated in place, and the new text must read with it.
+    written : (document, dict), optional
+        The file as it is, read under its lock by the caller: its round-trip document
+        (:func:`robotcell.io.yamlfile.parse_yaml`, changed in place here) and what it says
+        (:func:`cell_to_dict` of its cell). Default: the file is read here.
 
     Returns
     -------
     Path or None
         The backup of the previous file, or None when there was none.
+
+    Raises
+    ------
+    InputError
+        The file cannot be written (read-only, several hard links, no folder), its lock is held
+        by another process for longer than :data:`robotcell.io.locking.LOCK_WAIT`, or the new
+        text would not load as a cell (the reason is named); the file is unchanged.
     """
-    p = Path(path)
-    base = p.resolve().parent
+    real = check_destination(path)  # a read-only file is refused before the backup is made
+    base = real.resolve().parent
     new = cell_to_dict(cell, base)
-    check_destination(p)  # a read-only file is refused before the backup is made
-    written = _as_written(p, base, read) if p.is_file() else None
-    if written is None:
-        text = _HEADER + dump_yaml(new)
-    else:
-        doc, old = written
-        update_document(doc, old, new)
-        text = dump_yaml(doc)
-    backup = keep_version(p) if p.exists() else None
-    atomic_write(p, text)
+    with file_lock(real):
+        if written is None and real.is_file():
+            written = _as_written(real, base, read)
+        if written is None:
+            text, back = written_yaml(new, str(path))
+            text = _HEADER + text
+        else:
+            doc, old = written
+            update_document(doc, old, new)
+            text, back = written_yaml(doc, str(path))
+        try:
+            read(back, str(path), base)
+        except InputError as exc:
+            raise InputError(f"the cell as it would be written does not load ({exc}); "
+                             f"{path} is unchanged") from None
+        backup = keep_version(real) if real.exists() else None
+        atomic_write(real, text)
     return backup
 
 

@@ -16,8 +16,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TypeVar
 
 import click
 import numpy as np
@@ -28,9 +31,11 @@ from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate import PROCEDURES, CalibrationContext, Procedure
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
+from robotcell.cell.calibrate.whole import touch_files
+from robotcell.cell.update import update_cell_file
 from robotcell.cli import load_command
 from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
-from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, Group
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, Group, refuse_overwriting_inputs
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.robot.models import load_robot
@@ -99,20 +104,26 @@ def _check_output_kind(ctx: click.Context) -> None:
                    "the result" if as_json else "the report (add --json for the JSON result)")
 
 
-def measurement_options(func: Callable) -> Callable:
-    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o,
-    --accept-poor."""
-    func = click.option("--accept-poor", is_flag=True,
-                        help="Write and exit 0 even when the verdict is poor (default: a poor "
-                             "result exits with status 3 and changes no file).")(func)
+def result_options(func: Callable) -> Callable:
+    """Options --json and -o of every calibrate subcommand (``calibrate cell`` too): -o FILE is
+    checked as every command's output, and its name against what --json says is written."""
     func = click.option("-o", "--output", default=None, metavar="FILE", type=OUTPUT,
                         expose_value=False, callback=_keep_output,
                         help="Also write the result to FILE, atomically and only when the run "
                              "succeeds: the JSON object with --json, else the report. Use it "
                              "instead of '--json > FILE', which empties FILE when a run is "
                              "refused.")(func)
-    func = click.option("--json", "as_json", is_flag=True, callback=_keep_json,
+    return click.option("--json", "as_json", is_flag=True, callback=_keep_json,
                         help="Print one JSON object (and write it to -o FILE).")(func)
+
+
+def measurement_options(func: Callable) -> Callable:
+    """Options shared by every calibrate subcommand: --robot, --tool, --sigma, --json, -o,
+    --accept-poor."""
+    func = click.option("--accept-poor", is_flag=True,
+                        help="Write and exit 0 even when the verdict is poor (default: a poor "
+                             "result exits with status 3 and changes no file).")(func)
+    func = result_options(func)
     func = click.option("--sigma", type=float, default=None, metavar="MM",
                         help="Touch-up accuracy, 1-sigma per coordinate (mm), which the "
                              "uncertainties rest on and the residuals are checked against "
@@ -169,16 +180,25 @@ def chain_options(measurements: str) -> dict:
     return {"file": measurements, "nominal": nominal}
 
 
+#: What a change of the cell file returns beside the cell (a calibration's result).
+T = TypeVar("T")
+
+
 @dataclass
 class CellTarget:
     """A cell file that a calibration updates (``--cell``).
+
+    The command hands its one call of :mod:`robotcell.cell.calibrate` to :meth:`update`, which
+    runs it as one locked update of the file (:func:`robotcell.cell.update.update_cell_file`):
+    again on the version another update wrote meanwhile, if one did.
 
     Attributes
     ----------
     path : str
         The cell file as the user named it (used in messages).
     cell : Cell
-        Its content; a calibration returns an updated copy, written back by :meth:`save`.
+        Its content as read when the command started (for its options: the tools a --tool may
+        name); :meth:`update` changes the file as it is when the result is written.
     """
 
     path: str
@@ -206,17 +226,32 @@ class CellTarget:
                              "give one of them or X,Y,Z,A,B,C in mm/deg")
         return name
 
-    def save(self, cell: Cell, what: str, notes: tuple[str, ...] = ()) -> None:
-        """Write ``cell`` into the cell file; say on stderr ``notes`` and what was updated."""
-        for note in notes:
-            echo_note(note)
-        self.cell = cell
-        try:
-            backup = self.cell.save(self.path)
-        except OSError as exc:
-            raise InputError(f"cannot write {self.path}: {exc}") from None
-        kept = f" (previous version: {backup})" if backup is not None else ""
-        click.echo(f"updated {self.path}: {what}{kept}", err=True)
+    def update(self, change: Callable[[Cell], tuple[Cell | None, T]],
+               said: Callable[[T], tuple[str, tuple[str, ...]]]) -> T:
+        """Change the cell file as one locked update
+        (:func:`robotcell.cell.update.update_cell_file`), saying on stderr what was updated.
+
+        Parameters
+        ----------
+        change : callable
+            ``change(cell) -> (new cell or None, value)``; it may run twice (the second time
+            on the version another update wrote meanwhile) and refuses by raising.
+        said : callable
+            ``said(value) -> (what was updated, notes)`` for the message.
+
+        Returns
+        -------
+        The value of the change that was written.
+        """
+        done = update_cell_file(self.path, change, on_note=echo_note)
+        if done.cell is not None:
+            what, notes = said(done.value)
+            for note in notes:
+                echo_note(note)
+            self.cell = done.cell
+            kept = f" (previous version: {done.backup})" if done.backup is not None else ""
+            click.echo(f"updated {self.path}: {what}{kept}", err=True)
+        return done.value
 
 
 def require_name(name: str | None, target: CellTarget | None, what: str) -> None:
@@ -270,9 +305,18 @@ def cell_of(target: CellTarget | None) -> tuple[Cell | None, str | None]:
     return (None, None) if target is None else (target.cell, target.path)
 
 
+#: Key of ``click.Context.meta`` under which the notes said are kept.
+NOTES_KEY = "robotcell.calibrate.notes"
+
+
 def echo_note(note: str) -> None:
-    """Print a note of a calibration on stderr."""
-    click.echo(note, err=True)
+    """Print a note of a calibration on stderr, once in a run (a calibration repeated on the
+    version another update wrote says its notes again)."""
+    ctx = click.get_current_context(silent=True)
+    said = ctx.meta.setdefault(NOTES_KEY, set()) if ctx is not None else set()
+    if note not in said:
+        said.add(note)
+        click.echo(note, err=True)
 
 
 def emit(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool) -> None:
@@ -311,7 +355,7 @@ def gate(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool,
     if v.level != "poor":
         return
     if accept_poor:
-        click.echo("warning: the verdict is poor; written anyway (--accept-poor)", err=True)
+        echo_note("warning: the verdict is poor; written anyway (--accept-poor)")
         return
     # The report goes to stdout only, never to an output file: a poor result writes nothing.
     click.echo(json.dumps(result.to_json(), indent=2) if as_json else result.summary())
@@ -319,14 +363,26 @@ def gate(result: CalibrationResult | cellcal.CellRecalibration, as_json: bool,
                           "measurements, or pass --accept-poor to use the result anyway")
 
 
-def finish(out: cellcal.CellCalibration, target: CellTarget | None, as_json: bool,
-           accept_poor: bool) -> None:
-    """The end of a calibration command: :func:`gate`, the cell file saved (with ``--cell``),
-    what the calibration assumed on stderr (``assumed: tool ..., result ... in frame ...,
-    track ..., table ...``), and the result (:func:`emit`)."""
-    gate(out.result, as_json, accept_poor)
-    if out.cell is not None and target is not None:
-        target.save(out.cell, out.item, out.update_notes)
+def finish(calibration: Callable[[Cell | None], cellcal.CellCalibration],
+           target: CellTarget | None, as_json: bool, accept_poor: bool) -> None:
+    """The calibration of a command and its end.
+
+    ``calibration(cell)`` is the command's one call of :mod:`robotcell.cell.calibrate`, on the
+    cell given (None without ``--cell``). With ``--cell`` it runs as one locked update of the
+    file (:meth:`CellTarget.update`), :func:`gate` before anything is written; then what the
+    calibration assumed on stderr (``assumed: tool ..., result ... in frame ..., track ...,
+    table ...``), and the result (:func:`emit`).
+    """
+    if target is None:
+        out = calibration(None)
+        gate(out.result, as_json, accept_poor)
+    else:
+        def change(cell: Cell) -> tuple[Cell | None, cellcal.CellCalibration]:
+            done = calibration(cell)
+            gate(done.result, as_json, accept_poor)
+            return done.cell, done
+
+        out = target.update(change, lambda done: (done.item, done.update_notes))
     if out.assumed:
         click.echo(f"assumed: {out.assumed}", err=True)
     emit(out.result, as_json)
@@ -367,11 +423,12 @@ def tcp(measurements: str, world_mode: str, name: str | None, cell_path: str | N
     require_name(name, target, "tool")
     prior = sigma_m(sigma)
     model, _ = robot_and_tool(robot, None, target)
-    cell, label = cell_of(target)
-    out = cellcal.tcp(cell, measurements, name, robot=None if cell else model, world_mode=world_mode,
-                      sigma=prior, source=measurements, cell_label=label, on_note=echo_note,
-                      **chain_options(measurements))
-    finish(out, target, as_json, accept_poor)
+    label = cell_of(target)[1]
+    options = chain_options(measurements)
+    finish(lambda cell: cellcal.tcp(cell, measurements, name, robot=None if cell else model,
+                                    world_mode=world_mode, sigma=prior, source=measurements,
+                                    cell_label=label, on_note=echo_note, **options),
+           target, as_json, accept_poor)
 
 
 @calibrate.command("frame")
@@ -409,11 +466,13 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
                          "CELL.yaml")
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cell, label = cell_of(target)
-    out = cellcal.frame(cell, measurements, name, parent=parent, robot=None if cell else model,
-                        tool=T_tool, sigma=prior, source=measurements, cell_label=label,
-                        on_note=echo_note, **chain_options(measurements))
-    finish(out, target, as_json, accept_poor)
+    label = cell_of(target)[1]
+    options = chain_options(measurements)
+    finish(lambda cell: cellcal.frame(cell, measurements, name, parent=parent,
+                                      robot=None if cell else model, tool=T_tool, sigma=prior,
+                                      source=measurements, cell_label=label, on_note=echo_note,
+                                      **options),
+           target, as_json, accept_poor)
 
 
 @calibrate.command("external-tcp")
@@ -435,17 +494,20 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
     """
     prior = sigma_m(sigma)
     model, T_tool = robot_and_tool(robot, tool)
-    out = cellcal.external_tcp(None, measurements, robot=model, tool=T_tool, sigma=prior,
-                               source=measurements, on_note=echo_note)
-    finish(out, None, as_json, accept_poor)
+    finish(lambda cell: cellcal.external_tcp(cell, measurements, robot=model, tool=T_tool,
+                                             sigma=prior, source=measurements, on_note=echo_note),
+           None, as_json, accept_poor)
+
+
+def _shown(path: Path) -> str:
+    """``path`` relative to the working folder when it is inside it, else as it is."""
+    relative = os.path.relpath(path)
+    return str(path) if relative.startswith("..") else relative
 
 
 @calibrate.command("cell")
 @cell_option
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
-@click.option("-o", "--output", default=None, metavar="FILE", type=click.Path(),
-              expose_value=False, callback=_keep_output,
-              help="Also write the result to FILE (the JSON object with --json, else the report).")
+@result_options
 @click.option("--accept-poor", is_flag=True,
               help="Write the cell and exit 0 even when the verdict is poor.")
 def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
@@ -458,6 +520,7 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
     from those taken with it, and the track, turntable and frames measured with it follow it.
     The report says what changed, by how much and in units of its 1-sigma. A missing or changed
     touch file is refused (exit 2), naming it; a poor verdict writes nothing (exit 3).
+    -o may name none of the touch files.
 
     \b
     Example:
@@ -467,12 +530,19 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
         raise InputError("calibrate cell needs --cell CELL.yaml: the cell whose calibrations "
                          "are fitted together")
     target = CellTarget.open(cell_path, None)
+    refuse_overwriting_inputs(click.get_current_context(),
+                              read=[(f"the touch file of {key}", _shown(path))
+                                    for key, path in touch_files(target.cell)])
     nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
-    out = cellcal.calibrate_cell(target.cell, cell_label=cell_path, nominal=nominal,
-                                 on_note=echo_note)
-    gate(out, as_json, accept_poor)
-    target.save(out.cell, f"{len(out.items)} item(s) fitted with the whole cell "
-                f"({', '.join(out.items)})")
+
+    def change(cell: Cell) -> tuple[Cell, cellcal.CellRecalibration]:
+        out = cellcal.calibrate_cell(cell, cell_label=cell_path, nominal=nominal,
+                                     on_note=echo_note)
+        gate(out, as_json, accept_poor)
+        return out.cell, out
+
+    out = target.update(change, lambda out: ((f"{len(out.items)} item(s) fitted with the whole "
+                                              f"cell ({', '.join(out.items)})"), ()))
     emit(out, as_json)
 
 

@@ -67,12 +67,12 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     refs = np.array([parse_numbers(r, "--reference", 3) for r in references]).reshape(-1, 3) * 1e-3
-    cell, label = cell_of(target)
-    out = cellcal.track(cell, measurements, references=refs, axis=axis, roll=roll,
-                        robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
-                        source=measurements, cell_label=label, on_note=echo_note,
-                        **chain_options(measurements))
-    finish(out, target, as_json, accept_poor)
+    label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    finish(lambda cell: cellcal.track(cell, measurements, references=refs, axis=axis, roll=roll,
+                                      robot=None if cell else model, tool=T_tool, sigma=prior,
+                                      source=measurements, cell_label=label, on_note=echo_note,
+                                      **options),
+           target, as_json, accept_poor)
 
 
 @click.command("turntable", cls=Command)
@@ -104,11 +104,12 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
                          f"(100 m, the size of any real cell), got {height:g}")
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cell, label = cell_of(target)
-    out = cellcal.turntable(cell, measurements, height=height * 1e-3, robot=None if cell else model,
-                            tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label, on_note=echo_note, **chain_options(measurements))
-    finish(out, target, as_json, accept_poor)
+    label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    finish(lambda cell: cellcal.turntable(cell, measurements, height=height * 1e-3,
+                                          robot=None if cell else model, tool=T_tool, sigma=prior,
+                                          source=measurements, cell_label=label,
+                                          on_note=echo_note, **options),
+           target, as_json, accept_poor)
 
 
 @click.command("positioner", cls=Command)
@@ -135,11 +136,11 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     """
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    cell, label = cell_of(target)
-    out = cellcal.positioner(cell, measurements, robot=None if cell else model, tool=T_tool,
-                             sigma=sigma_m(sigma), source=measurements, cell_label=label,
-                             on_note=echo_note, **chain_options(measurements))
-    finish(out, target, as_json, accept_poor)
+    label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    finish(lambda cell: cellcal.positioner(cell, measurements, robot=None if cell else model,
+                                           tool=T_tool, sigma=prior, source=measurements,
+                                           cell_label=label, on_note=echo_note, **options),
+           target, as_json, accept_poor)
 
 
 @click.command("workpiece", cls=Command)
@@ -174,8 +175,9 @@ def workpiece(measurements: str, turntable_json: str | None, name: str | None,
     require_name(name, target, "frame")
     model, T_tool = robot_and_tool(robot, tool, target)
     given = None if turntable_json is None else cellcal.TurntablePose.load(turntable_json)
-    cell, label = cell_of(target)
-    out = cellcal.workpiece(cell, measurements, name, turntable=given, robot=None if cell else model,
-                            tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label, on_note=echo_note, **chain_options(measurements))
-    finish(out, target, as_json, accept_poor)
+    label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    finish(lambda cell: cellcal.workpiece(cell, measurements, name, turntable=given,
+                                          robot=None if cell else model, tool=T_tool, sigma=prior,
+                                          source=measurements, cell_label=label,
+                                          on_note=echo_note, **options),
+           target, as_json, accept_poor)

@@ -169,9 +169,11 @@ def warn_unknown_columns(path: str, cols: dict, known: Iterable[str]) -> None:
 
 
 def check_output(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
-    """Callback of an output option: refuse a missing folder or a folder before any work."""
+    """Callback of an output option: refuse a missing folder or a folder before any work (a file
+    of several hard links is refused by :func:`robotcell.cli.files.refuse_overwriting_inputs`,
+    once an output onto an input has been named as such)."""
     if value is not None:
-        check_destination(value)
+        check_destination(value, links=False)
     return value
 
 

@@ -7,7 +7,8 @@ and so before anything is written, it compares the files it would write (its par
 name, :data:`NAME_OR_FILE`), and refuses with exit status 2 when one names the same file as
 another: ``robotcell export --cell cell.yaml -o cell.yaml`` would replace the cell by the
 export. Paths are compared resolved (symbolic links, ``./``, ``..``), and existing files also by
-identity (hard links).
+identity (hard links). An output that has several hard links is refused too
+(:func:`robotcell.io.fileio.check_links`): replacing it would cut it from its other names.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Any
 import click
 
 from robotcell.errors import InputError
+from robotcell.io.fileio import check_links
 
 __all__ = ["NAME_OR_FILE", "OUTPUT", "Command", "Group", "LiveChoice", "NameOrFile",
            "OutputPath", "refuse_overwriting_inputs"]
@@ -132,7 +134,8 @@ def _inputs(ctx: click.Context) -> Iterator[tuple[click.Parameter, str]]:
             yield param, f
 
 
-def refuse_overwriting_inputs(ctx: click.Context, derived: Iterable[tuple[str, str]] = ()) -> None:
+def refuse_overwriting_inputs(ctx: click.Context, derived: Iterable[tuple[str, str]] = (),
+                              read: Iterable[tuple[str, str]] = ()) -> None:
     """Refuse an output of the command that is one of its inputs, or another of its outputs.
 
     Parameters
@@ -142,6 +145,9 @@ def refuse_overwriting_inputs(ctx: click.Context, derived: Iterable[tuple[str, s
     derived : iterable of (str, str)
         Further files the command writes, with what names them (``("reach.html", "-o")`` for
         the page written next to ``-o reach.csv``).
+    read : iterable of (str, str)
+        Further files the command reads that no parameter names, with what names them
+        (``("the touch file of tools.torch", "tcp.csv")``, which a cell file records).
 
     Raises
     ------
@@ -152,17 +158,22 @@ def refuse_overwriting_inputs(ctx: click.Context, derived: Iterable[tuple[str, s
     outputs = [(_label(p), f) for p in ctx.command.params if isinstance(p.type, OutputPath)
                for f in _values(given.get(p.name))]
     outputs += list(derived)
-    inputs = list(_inputs(ctx))
+    inputs = [(_label(p), f) for p, f in _inputs(ctx)] + list(read)
     for k, (out_label, out) in enumerate(outputs):
-        for param, f in inputs:
+        for in_label, f in inputs:
             if _same_file(out, f):
-                raise InputError(f"{out_label} {out} names the same file as {_label(param)} {f}, "
+                raise InputError(f"{out_label} {out} names the same file as {in_label} {f}, "
                                  "which this command reads: writing it would replace that input; "
                                  "write to another file")
         for other_label, other in outputs[:k]:
             if _same_file(out, other):
                 raise InputError(f"{out_label} {out} names the same file as {other_label} "
                                  f"{other}: give each output its own file")
+    for out_label, out in outputs:
+        try:
+            check_links(out)
+        except InputError as exc:
+            raise InputError(f"{out_label} {exc}") from None
 
 
 class Command(click.Command):

@@ -5,5 +5,7 @@ stands on it; controller exports are the package :mod:`robotcell.export`, over t
 - :mod:`robotcell.io.tables`: CSV measurement tables with named columns;
 - :mod:`robotcell.io.poseformats`: vendor pose conventions (KUKA, ABB, FANUC, YASKAWA);
 - :mod:`robotcell.io.fileio`: reading text and writing files atomically;
-- :mod:`robotcell.io.yamlfile`: YAML read strictly and updated keeping comments.
+- :mod:`robotcell.io.yamlfile`: YAML read strictly, updated keeping comments, read back when
+  written;
+- :mod:`robotcell.io.locking`: the lock of a file that several processes update.
 """

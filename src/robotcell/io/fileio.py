@@ -21,6 +21,12 @@ write permission for its owner is refused, not replaced. A run that
 fails before the write leaves nothing behind, and one that dies during it leaves the old file or
 the new one in full, never a partial or empty file. A missing folder, or a destination that is a
 folder, is refused with :class:`~robotcell.errors.InputError` naming it.
+
+**Links.** A destination given through a symbolic link is written where the link points
+(:func:`real_destination`): the file the link names is replaced, in its own folder, and the link
+stays a link. A destination with more than one hard link is refused, naming why: replacing it
+would give this name a new file and leave the other names with the old content, and writing it
+in place could leave it half-written.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ import codecs
 import json
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -36,8 +43,8 @@ from typing import Any, BinaryIO
 
 from robotcell.errors import InputError
 
-__all__ = ["atomic_copy", "atomic_write", "check_destination", "decode_text", "read_json",
-           "read_text"]
+__all__ = ["atomic_copy", "atomic_write", "check_destination", "check_links", "decode_text",
+           "read_json", "read_text", "real_destination"]
 
 
 def _as_latin1(exc: UnicodeError) -> tuple[str, int]:
@@ -142,28 +149,87 @@ def read_json(path: str | Path, advice: str) -> Any:
         raise InputError(f"{path}: not valid JSON ({exc}); {advice}") from None
 
 
-def check_destination(path: str | Path) -> Path:
-    """``path`` as a Path whose folder exists and which is neither a folder nor read-only.
+def real_destination(path: str | Path) -> Path:
+    """The file that writing ``path`` replaces: ``path`` with its symbolic links followed.
 
-    A file without write permission for its owner is refused: ``os.replace`` would go over it,
-    so the owner's protection is respected instead.
+    Parameters
+    ----------
+    path : str or Path
+        A destination as the user gave it; it need not exist.
+
+    Returns
+    -------
+    Path
+        ``path`` itself when it is not a symbolic link, else the file the link leads to (through
+        every link, absolute), which may not exist yet.
+    """
+    p = Path(path)
+    return Path(os.path.realpath(p)) if p.is_symlink() else p
+
+
+def check_links(path: str | Path) -> None:
+    """Refuse a destination that has more than one hard link.
+
+    ``os.replace`` would give this name a new file and leave every other name of the file with
+    the old content, silently; writing into the file instead would not be atomic.
 
     Raises
     ------
     InputError
-        ``path`` is a folder or a read-only file, or its folder does not exist.
+        Naming the number of links and what to do.
     """
-    p = Path(path)
+    try:
+        st = Path(path).stat()
+    except OSError:  # no such file (yet)
+        return
+    links = st.st_nlink
+    if stat.S_ISREG(st.st_mode) and links > 1:  # (a folder's links are its subfolders)
+        raise InputError(f"cannot write {path}: the file has {links} hard links (other names for "
+                         "the same file); replacing it would leave the other names with the old "
+                         "content, and writing it in place is not atomic. Replace the hard links "
+                         "by symbolic links (ln -s), or write to another file")
+
+
+def check_destination(path: str | Path, links: bool = True) -> Path:
+    """The file a write to ``path`` replaces, its folder existing and it neither a folder nor
+    read-only (nor, with ``links``, a file of several hard links).
+
+    A file without write permission for its owner is refused: ``os.replace`` would go over it,
+    so the owner's protection is respected instead. A symbolic link is followed
+    (:func:`real_destination`): the checks hold for the file it points to.
+
+    Parameters
+    ----------
+    path : str or Path
+        The destination as given.
+    links : bool
+        Also refuse a file with more than one hard link (:func:`check_links`).
+
+    Returns
+    -------
+    Path
+        :func:`real_destination` of ``path``.
+
+    Raises
+    ------
+    InputError
+        ``path`` is a folder or a read-only file, its folder does not exist, or (``links``) it
+        has several hard links.
+    """
+    p = real_destination(path)
     if str(path) == "" or p.is_dir():
         raise InputError(f"cannot write {str(path)!r}: it is a folder; give a file name")
     folder = p.parent
     if not folder.is_dir():
-        raise InputError(f"cannot write {path}: the folder {str(folder)!r} does not exist; "
+        shown = f" (the file {path} links to)" if p != Path(path) else ""
+        raise InputError(f"cannot write {path}{shown}: the folder {str(folder)!r} does not exist; "
                          "create it first")
     if p.exists() and not p.stat().st_mode & 0o200:
         raise InputError(f"cannot write {path}: the file is read-only (mode "
                          f"{p.stat().st_mode & 0o777:o}); make it writable or write to another "
                          "file")
+    if links:
+        check_links(p)
     return p
 
 
@@ -215,15 +281,17 @@ def atomic_write(path: str | Path, content: str | bytes) -> None:
     Parameters
     ----------
     path : str or Path
-        Destination file; its folder must exist.
+        Destination file; its folder must exist. Through a symbolic link, the file it points to
+        is replaced and the link stays.
     content : str or bytes
         Text (written as UTF-8, newlines as given) or bytes.
 
     Raises
     ------
     InputError
-        The folder does not exist, ``path`` is a folder or a read-only file, or the file cannot
-        be written (the message names the file and the system's reason).
+        The folder does not exist, ``path`` is a folder, a read-only file or a file with several
+        hard links, or the file cannot be written (the message names the file and the system's
+        reason).
     """
     p = check_destination(path)
     data = content.encode("utf-8") if isinstance(content, str) else content

@@ -13,11 +13,22 @@ Every YAML file robotcell reads (cell files, robot model files, layouts files) g
 - **What the user wrote is kept.** The parsed document remembers comments, key order, flow or
   block style and the spelling of every value; :func:`update_document` changes in place only
   the values that a program changed, and :func:`dump_yaml` writes the rest exactly as it was.
+
+Every YAML file robotcell writes (cell files, robot model files) is made by :func:`dump_yaml`,
+which reads its text back before returning it: a text that does not parse, or parses to other
+data than was given, is never returned (:class:`~robotcell.errors.RobotcellError`), so it never
+replaces a file. A collection is written on one line (flow style: poses, rows of numbers) only
+when it holds no other collection and fits in :data:`FLOW_MAX` characters; a longer one, or one
+that holds collections (the provenance of a calibrated item with its error sources), is written
+one entry a line (block style), also where the file had it in flow style. No line of a mapping
+is then ever broken by the writer, which YAML does not allow inside a key (``track 45f77e8b0e19``
+is a key of an item's error sources).
 """
 
 from __future__ import annotations
 
 import io
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -27,13 +38,17 @@ from ruamel.yaml.constructor import DuplicateKeyError
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 from ruamel.yaml.events import CollectionEndEvent, CollectionStartEvent
 
-from robotcell.errors import InputError
+from robotcell.errors import InputError, RobotcellError
 
-__all__ = ["MAX_DEPTH", "dump_yaml", "parse_yaml", "update_document"]
+__all__ = ["FLOW_MAX", "MAX_DEPTH", "dump_yaml", "parse_yaml", "update_document", "written_yaml"]
 
 #: Deepest nesting of mappings and lists accepted. A cell file needs 4 (``tools`` > name >
 #: ``frame`` > ``x``), a robot model file 5 (a coupling matrix in a nested ``ik_seed``).
 MAX_DEPTH = 32
+
+#: Longest collection written on one line (characters, estimated): far below the writer's line
+#: width (4096), so that a flow collection is never broken over lines.
+FLOW_MAX = 1000
 
 
 def _yaml() -> YAML:
@@ -99,29 +114,122 @@ def parse_yaml(text: str, origin: str) -> Any:
         raise InputError(f"{origin}: not valid YAML: {_where(exc)}{problem}") from None
 
 
-def dump_yaml(data: Any) -> str:
+def dump_yaml(data: Any, what: str = "the file") -> str:
     """YAML text of ``data``: a document from :func:`parse_yaml` as it was written.
 
     Plain mappings and lists are written in block style, with the innermost ones (poses, short
-    lists of numbers) in flow style.
+    lists of numbers) in flow style. The text is read back before it is returned
+    (:func:`written_yaml`).
 
     Parameters
     ----------
     data : Any
-        Mappings, lists and scalars, plain or as returned by :func:`parse_yaml`.
+        Mappings, lists and scalars, plain or as returned by :func:`parse_yaml`; a collection in
+        flow style that holds collections or is longer than :data:`FLOW_MAX` is set to block
+        style.
+    what : str
+        What is written, for the message of a text that does not read back.
 
     Returns
     -------
     str
+        Text that :func:`parse_yaml` reads to data equal to ``data``.
+
+    Raises
+    ------
+    RobotcellError
+        The text would not read back as ``data`` (a defect of the writer: nothing is written).
     """
+    return written_yaml(data, what)[0]
+
+
+def written_yaml(data: Any, what: str = "the file") -> tuple[str, Any]:
+    """:func:`dump_yaml` of ``data`` and the document its text reads back as.
+
+    Parameters
+    ----------
+    data : Any
+        As for :func:`dump_yaml`.
+    what : str
+        What is written, for the message of a text that does not read back.
+
+    Returns
+    -------
+    text : str
+    document : Any
+        :func:`parse_yaml` of ``text``, equal to ``data``.
+
+    Raises
+    ------
+    RobotcellError
+        The text would not read back as ``data`` (a defect of the writer: nothing is written).
+    """
+    styled = _styled(data)
+    _restyle(styled)
     buf = io.StringIO()
-    _yaml().dump(_styled(data), buf)
-    return buf.getvalue()
+    _yaml().dump(styled, buf)
+    text = buf.getvalue()
+    back = None
+    try:
+        back = parse_yaml(text, what)
+    except InputError as exc:
+        why: str | None = str(exc)
+    else:
+        why = _difference(_plain(back), _plain(data))
+    if why:
+        raise RobotcellError(f"the YAML text written for {what} does not read back as what was "
+                             f"meant ({why}); nothing was written. This is a defect of "
+                             "robotcell: please report it with the file")
+    return text, back
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as plain dicts, lists and scalars (tuples as lists)."""
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _difference(got: Any, meant: Any, where: str = "") -> str | None:
+    """Where plain data ``got`` differs from ``meant`` (NaN equal to NaN), or None."""
+    at = where or "the top level"
+    if isinstance(meant, dict) or isinstance(got, dict):
+        if not (isinstance(meant, dict) and isinstance(got, dict)) or list(got) != list(meant):
+            return f"the keys at {at}"
+        for key in meant:
+            why = _difference(got[key], meant[key], f"{where}.{key}" if where else str(key))
+            if why:
+                return why
+        return None
+    if isinstance(meant, list) or isinstance(got, list):
+        if not (isinstance(meant, list) and isinstance(got, list)) or len(got) != len(meant):
+            return f"the list at {at}"
+        for i, (g, m) in enumerate(zip(got, meant)):
+            why = _difference(g, m, f"{where}[{i}]")
+            if why:
+                return why
+        return None
+    same = got == meant or (isinstance(got, float) and isinstance(meant, float)
+                            and math.isnan(got) and math.isnan(meant))
+    return None if same else f"the value at {at}"
 
 
 def _is_leaf(value: Any) -> bool:
     items = value.values() if isinstance(value, Mapping) else value
     return not any(isinstance(v, (Mapping, list)) for v in items)
+
+
+def _flow_length(value: Any) -> int:
+    """Length of ``value`` (a leaf collection) written on one line, over-estimated."""
+    parts = [*value.keys(), *value.values()] if isinstance(value, Mapping) else list(value)
+    return 2 + sum(len(repr(v)) + 4 for v in parts)
+
+
+def _one_line(value: Any) -> bool:
+    """Whether a collection is written in flow style: a leaf of at most :data:`FLOW_MAX`."""
+    return bool(value) and _is_leaf(value) and _flow_length(value) <= FLOW_MAX
 
 
 def _styled(value: Any) -> Any:
@@ -134,9 +242,19 @@ def _styled(value: Any) -> Any:
         out = CommentedSeq(_styled(v) for v in value)
     else:
         return value
-    if out and _is_leaf(out):
+    if _one_line(out):
         out.fa.set_flow_style()
     return out
+
+
+def _restyle(value: Any) -> None:
+    """Set to block style every flow collection in ``value`` that :func:`_one_line` refuses."""
+    if not isinstance(value, (CommentedMap, CommentedSeq)):
+        return
+    if value.fa.flow_style() and not _one_line(value):
+        value.fa.set_block_style()
+    for item in value.values() if isinstance(value, CommentedMap) else value:
+        _restyle(item)
 
 
 def update_document(doc: CommentedMap, old: Mapping[str, Any], new: Mapping[str, Any]) -> None:

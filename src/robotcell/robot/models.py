@@ -458,9 +458,20 @@ def _clean(v: Any, decimals: int = 9) -> Any:
 def save_robot(robot: Robot, path: str | Path) -> None:
     """Write ``robot`` as a YAML model file (millimetres and degrees), atomically.
 
+    The text is read back as a robot model before it replaces the file: a file that would not
+    load is never written. Through a symbolic link the file it points to is written.
+
     Raises
     ------
     InputError
-        The file cannot be written (missing folder, a folder, no permission).
+        The file cannot be written (missing folder, a folder, no permission, several hard
+        links), or the model as written would not load (the reason is named); the file is
+        unchanged.
     """
-    atomic_write(path, dump_yaml(robot_to_dict(robot)))
+    text = dump_yaml(robot_to_dict(robot), str(path))
+    try:
+        robot_from_dict(parse_yaml(text, str(path)), str(path))
+    except InputError as exc:
+        raise InputError(f"the model as it would be written does not load ({exc}); {path} is "
+                         "unchanged") from None
+    atomic_write(path, text)

@@ -53,7 +53,7 @@ from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import format_table
 
-__all__ = ["CellRecalibration", "ItemChange", "calibrate_cell"]
+__all__ = ["CellRecalibration", "ItemChange", "calibrate_cell", "touch_files"]
 
 #: Gauss-Newton steps at most, and the step (in units of each parameter's 1-sigma) below which
 #: the fit has converged.
@@ -185,16 +185,36 @@ class CellRecalibration:
         return "\n".join(lines)
 
 
-def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
-    """Items with a recorded touch file, refusing missing or changed files (all named)."""
+def _calibrated(cell: Cell) -> list[tuple[str, Provenance]]:
+    """Items whose provenance records a touch file of a procedure :func:`calibrate_cell`
+    repeats, with that provenance."""
     items: list[tuple[str, Any]] = [(f"tools.{n}", t) for n, t in cell.tools.items()]
     items += [(f"frames.{n}", f) for n, f in cell.frames.items()]
     items += [("track", cell.track), ("turntable", cell.turntable)]
+    return [(key, owner.provenance) for key, owner in items
+            if owner is not None and owner.provenance.measurements is not None
+            and owner.provenance.source in _PROCEDURES]
+
+
+def touch_files(cell: Cell) -> list[tuple[str, Path]]:
+    """The touch files :func:`calibrate_cell` reads: those the cell's calibrations recorded.
+
+    Parameters
+    ----------
+    cell : Cell
+
+    Returns
+    -------
+    list of (str, Path)
+        Item (``tools.torch``, ``track``, ...) and its touch file, in the order of the cell.
+    """
+    return [(key, Path(prov.measurements)) for key, prov in _calibrated(cell)]
+
+
+def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
+    """Items with a recorded touch file, refusing missing or changed files (all named)."""
     out, problems = [], []
-    for key, owner in items:
-        prov = None if owner is None else owner.provenance
-        if prov is None or prov.measurements is None or prov.source not in _PROCEDURES:
-            continue
+    for key, prov in _calibrated(cell):
         path = Path(prov.measurements)
         if not path.is_file():
             problems.append(f"{key}: touch file {path} is missing")
@@ -392,9 +412,8 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
     stamp = time or Provenance.now("cell").time
     new = copied(cell)
     changes = []
-    for key, prov in recorded:
+    for (key, prov), run in zip(recorded, runs):
         if key not in estimated:  # the positioner chain: its calibration at the fitted values
-            run = runs[[k for k, _ in recorded].index(key)]
             new.update_positioner(run.provenance, run.cell.turntable.chain)
             continue
         rows = system.slices[key]
@@ -403,18 +422,42 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
         T0, scale0 = original[key]
         delta = _difference(T, scale, T0, scale0, _size(key))
         _moved(new, key, delta, replace(prov, time=stamp, sources=item.factors,
-                                        note=f"{prov.note}; fitted with the whole cell"))
+                                        rms_mm=run.result.rms * 1e3, note=_fitted(prov.note)))
         changes.append(ItemChange(key, T0, T, delta, item.sigma, prior[key].sigma))
     return CellRecalibration(new, tuple(changes), tuple(runs), tuple(estimated),
                              sources.covariance, it, tuple(notes))
 
 
+#: Directions of an error source's factor kept when it is written (relative to the largest,
+#: every parameter's row scaled to length 1).
+RANK_TOL = 1e-5
+
+#: What the note of an item fitted with the whole cell ends with.
+FITTED = "; fitted with the whole cell"
+
+
+def _fitted(note: str) -> str:
+    """The note of an item after a whole-cell fit: said once, however often the cell is fitted."""
+    return note if note.endswith(FITTED) else note + FITTED
+
+
 def _compact(F: NDArray[np.float64]) -> NDArray[np.float64]:
     """A factor with the same ``F F^T`` and as few columns as its rank (every item's rows at
-    once, so the correlations between items stay)."""
-    U, S, _ = np.linalg.svd(F, full_matrices=False)
-    keep = S > S[0] * 1e-9 if S.size and S[0] > 0 else np.zeros(S.shape, dtype=bool)
-    return U[:, keep] * S[keep]
+    once, so the correlations between items stay).
+
+    The rank is taken with every row scaled to length 1 (parameters in m, rad and the track's
+    scale differ by orders of magnitude), dropping the directions below :data:`RANK_TOL` of the
+    largest: they change no parameter's variance by more than 1e-10 of it, far below the 6
+    digits a cell file keeps, and would otherwise come and go from one fit of the same cell to
+    the next. Each column's largest entry is positive, so that fitting the same cell again
+    writes the same factor (the SVD's signs are arbitrary)."""
+    lengths = np.linalg.norm(F, axis=1)
+    lengths = np.where(lengths > 0, lengths, 1.0)
+    U, S, _ = np.linalg.svd(F / lengths[:, None], full_matrices=False)
+    keep = S > S[0] * RANK_TOL if S.size and S[0] > 0 else np.zeros(S.shape, dtype=bool)
+    C = lengths[:, None] * U[:, keep] * S[keep]
+    peak = C[np.argmax(np.abs(C), axis=0), np.arange(C.shape[1])]
+    return C * np.where(peak < 0, -1.0, 1.0)
 
 
 def _input_sources(cell: Cell, key: str, nominal: NominalAccuracy) -> tuple[Sources, str | None]:
