@@ -601,10 +601,3 @@ def test_an_identified_scale_is_the_same_robot_a_j23_factor_is_not():
     with pytest.raises(Exception, match=r"its joint coupling differs \(q_model = C q: C\[3, 2\]"):
         cell.set_identified(replace(NOMINAL, coupling=Coupling(C)), "j23.yaml",
                             Provenance("identify"))
-
-
-def test_identify_propose_with_a_cell_is_refused(tmp_path, capsys):
-    (tmp_path / "cell.yaml").write_text(CELL)
-    code, _out, err = run(capsys, "identify", "--propose", "5", "--robot", "kuka_kr16",
-                          "--cell", tmp_path / "cell.yaml")
-    assert code == 2 and "--cell takes an identified model" in err
