@@ -164,8 +164,8 @@ def _configuration(path: str, cols: dict, cell: Cell
         raise InputError(f"{path}: columns {', '.join(ARM_FLAGS)} and a controller's flags "
                          f"({', '.join(get(vendor[0].vendor).csv_config)}): give one kind of "
                          "configuration")
-    method = analytic_solver(cell.nominal_robot).method
-    if vendor is not None and method != "opw":
+    method = "opw" if vendor is None else analytic_solver(cell.nominal_robot).method
+    if method != "opw":
         raise InputError(f"{path}: columns {', '.join(get(vendor[0].vendor).csv_config)} are "
                          f"{vendor[0].vendor}'s flags of an arm with a spherical wrist; "
                          f"{cell.nominal_robot.name} is a {method.upper()}-type arm: give its "
