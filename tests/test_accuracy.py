@@ -154,7 +154,8 @@ def test_end_to_end_a_kr16_identified_then_a_path_filtered(kr16, tmp_path, capsy
                          "-o", tmp_path / "cmd.csv")
     assert code == 0, err
     c = read_csv(tmp_path / "cmd.csv")
-    assert list(c) == [*"xyzabc", *(f"a{i}" for i in range(1, 7)), "dpos", "drot"]
+    assert list(c) == [*"xyzabc", *(f"a{i}" for i in range(1, 7)), "shoulder", "elbow", "wrist",
+                       "dpos", "drot"]
     commanded = pose_from_vendor(np.column_stack([c[k] for k in "xyzabc"]), "kuka")
     q_file = np.radians(np.column_stack([c[f"a{i}"] for i in range(1, 7)]))
     ctrl = Cell.load(tmp_path / "cell.yaml").controller()
@@ -237,6 +238,24 @@ def test_a_filtered_program_is_checked_where_the_unfiltered_one_meant(
         assert len(before) == len(after)
         changed += sum(a != b for a, b in zip(before, after))
     assert 36 <= changed <= 36 * (3 if vendor == "fanuc" else 1)
+
+
+def test_program_compensate_says_which_configuration_each_point_keeps(kr16, nominal_programs,
+                                                                     tmp_path, capsys):
+    from robotcell.ik.config import kuka_status_turn
+
+    truth, _, _ = kr16
+    _, programs = nominal_programs
+    cell = _identified_example(tmp_path, truth)
+    code, out, err = run(capsys, "program", "compensate", programs["kuka"], "--cell", cell,
+                         "-o", tmp_path / "filtered", "--json")
+    assert code == 0, err
+    points = json.loads(out)["points"]
+    q = np.radians([[p[f"a{i}"] for i in range(1, 7)] for p in points])
+    status, _ = kuka_status_turn(NOMINAL, q)
+    flags = np.array([[p["shoulder"], p["elbow"], p["wrist"]] for p in points])
+    # KUKA Status: bit 0 overhead = shoulder 1, bit 1 elbow front = elbow 0
+    assert (flags[:, 0] == (status & 1)).all() and (flags[:, 1] == 1 - ((status >> 1) & 1)).all()
 
 
 def test_program_write_in_a_cell_with_an_identified_arm_writes_filtered_points(
@@ -582,10 +601,3 @@ def test_an_identified_scale_is_the_same_robot_a_j23_factor_is_not():
     with pytest.raises(Exception, match=r"its joint coupling differs \(q_model = C q: C\[3, 2\]"):
         cell.set_identified(replace(NOMINAL, coupling=Coupling(C)), "j23.yaml",
                             Provenance("identify"))
-
-
-def test_identify_propose_with_a_cell_is_refused(tmp_path, capsys):
-    (tmp_path / "cell.yaml").write_text(CELL)
-    code, _out, err = run(capsys, "identify", "--propose", "5", "--robot", "kuka_kr16",
-                          "--cell", tmp_path / "cell.yaml")
-    assert code == 2 and "--cell takes an identified model" in err

@@ -6,8 +6,11 @@ industrial arm). Filtering turns this around, as calibration products do (RoboDK
 ``FilterTarget``; KUKA's absolutely accurate robot, ABB's Absolute Accuracy inside the
 controller): for each desired pose,
 
-1. the configuration is the one the nominal arm would use for it: its solution nearest to the
-   robot's home, or the one with the given flags (KUKA S/T, ABB confdata, FANUC CONFIG);
+1. the configuration is the one the nominal arm would use for it: the one with the given flags
+   (KUKA S/T, ABB confdata, FANUC CONFIG, or the solver's own shoulder, elbow, wrist of
+   :mod:`robotcell.ik.config`, which every arm type has: a Universal Robots controller has no
+   flags), else its solution nearest to given reference joints (URScript's ``qnear``), else to
+   the robot's home;
 2. the identified arm's IK in that configuration gives the joint values that put the real TCP on
    the desired pose (the identified arm's branches are refined from the nominal's, so the branch
    is the same);
@@ -37,6 +40,7 @@ from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.controllers.model import Config
 from robotcell.errors import InputError, RobotcellError
 from robotcell.identification.uncertainty import position_sigma
+from robotcell.ik.config import ARM_FLAGS, branch_of_flags, flags_of_branch
 from robotcell.ik.select import nearest
 from robotcell.kinematics.transforms import invert, validate_pose
 from robotcell.programs.config import config_text, select
@@ -90,6 +94,8 @@ class FilteredPoses:
         length of its error, m); NaN when the identified model carries no covariance.
     branch : ndarray of int, shape (N,)
         The IK branch (configuration) used.
+    flags : ndarray of int, shape (N, 3)
+        Its shoulder, elbow, wrist flags (:func:`robotcell.ik.config.flags_of_branch`).
     """
 
     T: NDArray[np.float64]
@@ -102,6 +108,7 @@ class FilteredPoses:
     error_rot: NDArray[np.float64]
     sigma: NDArray[np.float64]
     branch: NDArray[np.int_]
+    flags: NDArray[np.int_]
 
 
 def _angles(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -130,22 +137,34 @@ def refuse(refused: list[tuple[int, str]], what: str, names: list[str] | None = 
     raise FilterRefused(f"{len(labelled)} {what}(s) cannot be filtered: {text}{more}", labelled)
 
 
-def _nominal_branch(ctrl: Cell, sol: CellIKSolutions, config: list[Config] | None
+def _flags_text(flags: NDArray[np.int_]) -> str:
+    """``shoulder 1, elbow 0, wrist 1``."""
+    return ", ".join(f"{name} {int(v)}" for name, v in zip(ARM_FLAGS, flags))
+
+
+def _nominal_branch(ctrl: Cell, sol: CellIKSolutions, config: list[Config] | ArrayLike | None,
+                    near: NDArray[np.float64] | None
                     ) -> tuple[NDArray[np.float64], NDArray[np.int_]]:
-    """The nominal arm's solution per pose and its branch: the given flags, else nearest home."""
+    """The nominal arm's solution per pose and its branch: the given flags (a vendor's, or the
+    solver's shoulder, elbow, wrist), on the equivalent nearest ``near`` (else home)."""
     robot = ctrl.robot
     home = robot.home if robot.home is not None else np.zeros(robot.n_joints)
+    ref = np.broadcast_to(home, sol.q.shape[:-2] + home.shape) if near is None else near
     if config is None:
-        q, _, branch = nearest(robot, sol, np.broadcast_to(home, sol.q.shape[:-2] + home.shape))
+        q, _, branch = nearest(robot, sol, ref)
         return q, branch
-    vendors = {c.vendor for c in config}
-    if len(vendors) != 1:
-        raise InputError(f"config: the flags of one vendor, got {sorted(vendors)}")
-    wanted = np.array([c.values for c in config])
-    q, found, _ = select(robot, sol.q, sol.reachable, wanted, vendors.pop())
-    ref = np.where(found[:, None], q, 0.0)
-    _, _, branch = nearest(robot, sol, ref)
-    return q, np.where(found, branch, -1)
+    if isinstance(config, list) and all(isinstance(c, Config) for c in config):
+        vendors = {c.vendor for c in config}
+        if len(vendors) != 1:
+            raise InputError(f"config: the flags of one vendor, got {sorted(vendors)}")
+        wanted = np.array([c.values for c in config])
+        q, found, _ = select(robot, sol.q, sol.reachable, wanted, vendors.pop(), near)
+        _, _, branch = nearest(robot, sol, np.where(found[:, None], q, 0.0))
+        return q, np.where(found, branch, -1)
+    k = branch_of_flags(sol.method, config)
+    mine = np.arange(sol.valid.shape[-1]) == k[:, None]
+    q, _, branch = nearest(robot, replace(sol, valid=sol.valid & mine), ref)
+    return q, branch
 
 
 def _polish(robot: Robot, q: NDArray[np.float64], T: NDArray[np.float64], steps: int = 2
@@ -169,7 +188,7 @@ def _polish(robot: Robot, q: NDArray[np.float64], T: NDArray[np.float64], steps:
 
 
 def identified_joints(cell: Cell, T_R_F: ArrayLike, q_nominal: ArrayLike
-                      ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+                      ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.int_]]:
     """The identified arm's joints for flange poses, in the nominal joints' configuration.
 
     Parameters
@@ -188,6 +207,8 @@ def identified_joints(cell: Cell, T_R_F: ArrayLike, q_nominal: ArrayLike
         rounding (rad, m; 0 where none).
     found : ndarray of bool, shape (N,)
         The identified arm reaches the pose on that branch within the limits.
+    branch : ndarray of int, shape (N,)
+        That branch (-1 where the nominal joints are on none).
     """
     T = np.asarray(T_R_F, dtype=float)
     q_nom = np.nan_to_num(np.asarray(q_nominal, dtype=float))
@@ -198,12 +219,33 @@ def identified_joints(cell: Cell, T_R_F: ArrayLike, q_nominal: ArrayLike
     same = ident.valid & (np.arange(ident.valid.shape[-1]) == branch[:, None])
     q, found, _ = nearest(cell.robot, replace(ident, valid=same), q_nom)
     found &= known
-    return _polish(cell.robot, np.where(found[:, None], q, 0.0), T), found
+    return _polish(cell.robot, np.where(found[:, None], q, 0.0), T), found, branch
+
+
+def _reference(near: ArrayLike | None, n: int, n_joints: int) -> NDArray[np.float64] | None:
+    """Reference joints per pose as an ``(n, n_joints)`` array, or None."""
+    if near is None:
+        return None
+    ref = np.asarray(near, dtype=float)
+    if ref.shape != (n, n_joints) or not np.isfinite(ref).all():
+        raise InputError(f"near must give {n_joints} finite joint values per pose, shape "
+                         f"({n}, {n_joints}), got {ref.shape}")
+    return ref
+
+
+def _unreached(config: list[Config] | NDArray[np.int_] | None, i: int) -> str:
+    """Why pose ``i`` has no nominal solution: the flags asked for, or the limits."""
+    if config is None:
+        return "the nominal arm does not reach it within the axis limits"
+    text = (config_text(config[i]) if isinstance(config[i], Config)
+            else _flags_text(np.asarray(config[i])))
+    return f"the nominal arm does not reach it with the flags given ({text})"
 
 
 def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayLike | None = None,
                  track: ArrayLike | None = None, table: ArrayLike = 0.0,
-                 config: list[Config] | None = None, max_correction: float = MAX_CORRECTION,
+                 config: list[Config] | ArrayLike | None = None, near: ArrayLike | None = None,
+                 max_correction: float = MAX_CORRECTION,
                  max_rotation: float = MAX_ROTATION) -> FilteredPoses:
     """The poses to command so that the real (identified) arm reaches the desired ones.
 
@@ -222,9 +264,15 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
         Track positions (m); default chosen per pose by the nominal arm (a cell with a track).
     table : array_like, shape (N,) or (N, k)
         Table angles or positioner axis values (rad).
-    config : list of Config, optional
-        Configuration flags per pose (:class:`robotcell.controllers.model.Config`, one vendor);
-        default the nominal arm's solution nearest to the robot's home.
+    config : list of Config, or array_like of int with shape (N, 3), optional
+        The configuration per pose: a controller's flags
+        (:class:`robotcell.controllers.model.Config`, one vendor), or the solver's shoulder,
+        elbow, wrist flags, 0 or 1 (:mod:`robotcell.ik.config`; every arm type, a UR arm too).
+        Default: the nominal arm's solution nearest to ``near``.
+    near : array_like, shape (N, n), optional
+        Reference joints per pose (rad, m; URScript's ``qnear``): the solution nearest to them
+        (among those with the flags ``config`` gives), each axis on its 2*pi-equivalent nearest
+        them. Default the robot's home.
     max_correction, max_rotation : float
         Largest correction taken (m, rad; default 5 mm and 1 deg).
 
@@ -235,7 +283,8 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
     Raises
     ------
     InputError
-        A cell without an identified arm, bad poses, an unknown tool or frame.
+        A cell without an identified arm, bad poses, flags or reference joints, an unknown tool
+        or frame.
     FilterRefused
         A pose the nominal arm does not reach in its configuration, one the identified arm
         cannot reach in that configuration, or a correction above the limits; each is named.
@@ -248,24 +297,21 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
         raise InputError(f"desired poses must have shape (N, 4, 4), got {Tq.shape}")
     n = Tq.shape[0]
     if config is not None and len(config) != n:
-        raise InputError(f"config must give one Config per pose ({n}), got {len(config)}")
+        raise InputError(f"config must give the flags of each pose ({n}), got {len(config)}")
     ctrl = cell.controller()
+    ref = _reference(near, n, ctrl.robot.n_joints)
     T_tool = tool_pose(cell, tool)
     T_F_TCP = cell.robot.tool if T_tool is None else T_tool
     nom = ctrl.ik(Tq, frame, track, table, T_tool)
-    q_nom, branch = _nominal_branch(ctrl, nom, config)
+    q_nom, branch = _nominal_branch(ctrl, nom, config, ref)
     track_, table_ = nom.track, nom.table
     T_R_F = (invert(robot_pose(cell, track_)) @ cell.frame_pose(frame, track_, table_) @ Tq
              @ invert(T_F_TCP))
-    q, found = identified_joints(cell, T_R_F, q_nom)
-    refused: list[tuple[int, str]] = []
-    for i in np.flatnonzero(branch < 0):
-        what = "with the flags given" if config is not None else "within the axis limits"
-        extra = f" ({config_text(config[i])})" if config is not None else ""
-        refused.append((int(i), f"the nominal arm does not reach it {what}{extra}"))
-    for i in np.flatnonzero((branch >= 0) & ~found):
-        refused.append((int(i), ("the identified arm cannot reach it in the configuration the "
-                                 "nominal arm uses (within the axis limits)")))
+    q, found, _ = identified_joints(cell, T_R_F, q_nom)
+    refused = [(int(i), _unreached(config, i)) for i in np.flatnonzero(branch < 0)]
+    refused += [(int(i), ("the identified arm cannot reach it in the configuration the nominal "
+                          "arm uses (within the axis limits)"))
+                for i in np.flatnonzero((branch >= 0) & ~found)]
     T_cmd = ctrl.fk(q, track_, table_, tool=T_tool, frame=frame)
     dpos = np.linalg.norm(T_cmd[:, :3, 3] - Tq[:, :3, 3], axis=-1)
     drot = _angles(Tq, T_cmd)
@@ -277,4 +323,5 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
     sigma = (np.full(n, np.nan) if cell.robot.covariance is None
              else position_sigma(cell.robot, q, T_F_TCP))
     return FilteredPoses(T_cmd, q, np.asarray(track_, dtype=float), np.asarray(table_, dtype=float),
-                         dpos, drot, error, error_rot, sigma, branch)
+                         dpos, drot, error, error_rot, sigma, branch,
+                         flags_of_branch(nom.method, branch))

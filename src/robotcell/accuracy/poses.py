@@ -2,11 +2,18 @@
 
 The poses file is the path file of ``program write`` (:mod:`robotcell.programs.path`: ``x, y, z``
 in mm, ``a, b, c`` in deg as ``R = Rz(a) Ry(b) Rx(c)``, optional ``track`` in mm and ``table`` or
-``e1..en`` in deg), with optional configuration columns: ``s, t`` (KUKA Status and Turn),
-``cf1, cf4, cf6, cfx`` (ABB confdata) or ``config`` (FANUC, ``N U T, 0, 0, 0``). The output has
-one row per pose: ``x, y, z, a, b, c``, the pose to command in the same frame; ``a1..an``, the
-controller's joint values (deg; mm for a prismatic axis); the external axes (``track`` mm,
-``table`` or ``e1..en`` deg); ``dpos`` (mm) and ``drot`` (deg), the size of the correction.
+``e1..en`` in deg), with optional configuration columns, per pose: a controller's flags, ``s, t``
+(KUKA Status and Turn), ``cf1, cf4, cf6, cfx`` (ABB confdata) or ``config`` (FANUC, ``N U T, 0,
+0, 0``); or the solver's own flags ``shoulder, elbow, wrist`` (0 or 1,
+:mod:`robotcell.ik.config`), which every arm type has (a Universal Robots arm has no controller
+flags); and reference joints ``near_a1..near_an`` (deg; mm for a prismatic axis): the solution
+nearest them, as URScript's ``get_inverse_kin(x, qnear)`` chooses (among those with the flags, when
+flags are given too). Without any, the nominal arm's solution nearest to the robot's home.
+
+The output has one row per pose: ``x, y, z, a, b, c``, the pose to command in the same frame;
+``a1..an``, the controller's joint values (deg; mm for a prismatic axis); ``shoulder, elbow,
+wrist``, the configuration they are in; the external axes (``track`` mm, ``table`` or ``e1..en``
+deg); ``dpos`` (mm) and ``drot`` (deg), the size of the correction.
 """
 
 from __future__ import annotations
@@ -14,7 +21,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,10 +29,12 @@ from numpy.typing import NDArray
 from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_poses
 from robotcell.cell import Cell
 from robotcell.controllers.model import Config
-from robotcell.controllers.registry import CONTROLLERS
+from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
+from robotcell.ik.analytic import analytic_solver
+from robotcell.ik.config import ARM_FLAGS
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.io.tables import read_csv, refuse_empty, write_csv
+from robotcell.io.tables import read_csv, refuse_empty, require_columns, write_columns
 from robotcell.programs.path import read_path, table_columns
 
 __all__ = ["CompensatedPoses", "compensate_poses"]
@@ -44,6 +53,10 @@ class CompensatedPoses:
         The output's columns.
     rows : ndarray, shape (N, len(header))
         The output's values (mm, deg).
+    chosen_by : str
+        How the configurations were chosen: ``by the columns s, t``, ``by the columns
+        shoulder, elbow, wrist``, ``nearest near_a1..near_a6``, ``nearest the robot's home``
+        (flags and reference joints joined by ``, ``).
     warnings : list of str
         Columns of the poses file that were not used.
     """
@@ -51,28 +64,37 @@ class CompensatedPoses:
     result: FilteredPoses
     header: list[str]
     rows: NDArray[np.float64]
+    chosen_by: str = "nearest the robot's home"
     warnings: list[str] = field(default_factory=list)
 
+    def write(self, destination: str | Path | TextIO) -> None:
+        """Write the output CSV (a path atomically, or an open stream); the flags as integers."""
+        columns = {h: (v.astype(int) if h in ARM_FLAGS else v)
+                   for h, v in zip(self.header, self.rows.T)}
+        write_columns(destination, columns, DECIMALS)
+
     def to_json(self) -> dict[str, Any]:
-        """``{"points": [{"x": .., "a1": .., "dpos": .., "drot": .., "error_mm": ..,
-        "error_deg": .., "sigma_mm": ..}, ...], ...}`` (mm, deg; sigma null without a
-        covariance)."""
+        """``{"points": [{"x": .., "a1": .., "shoulder": .., "elbow": .., "wrist": ..,
+        "branch": .., "dpos": .., "drot": .., "error_mm": .., "error_deg": .., "sigma_mm": ..},
+        ...], "configuration": .., ...}`` (mm, deg; sigma null without a covariance)."""
         r = self.result
         points = []
         for i, row in enumerate(self.rows):
             d: dict[str, Any] = {"point": i + 1, **{k: float(v) for k, v in zip(self.header, row)}}
+            d.update({k: int(v) for k, v in zip(ARM_FLAGS, r.flags[i])}, branch=int(r.branch[i]))
             d["error_mm"] = float(r.error[i] * 1e3)
             d["error_deg"] = math.degrees(float(r.error_rot[i]))
             d["sigma_mm"] = None if not math.isfinite(r.sigma[i]) else float(r.sigma[i] * 1e3)
             points.append(d)
-        return {"points": points, "max_dpos_mm": float(r.dpos.max(initial=0.0) * 1e3),
+        return {"points": points, "configuration": self.chosen_by,
+                "max_dpos_mm": float(r.dpos.max(initial=0.0) * 1e3),
                 "max_error_mm": float(r.error.max(initial=0.0) * 1e3),
                 "max_sigma_mm": (None if not np.isfinite(r.sigma).all() or r.sigma.size == 0
                                  else float(r.sigma.max() * 1e3))}
 
 
 def _configs(path: str, cols: dict) -> list[Config] | None:
-    """The configuration columns of the poses file, as flags of one vendor, or None."""
+    """The controller's configuration columns of the poses file, as flags of one vendor, or None."""
     given = [c for c in CONTROLLERS.values() if any(k in cols for k in c.csv_config)]
     if not given:
         return None
@@ -92,6 +114,67 @@ def _configs(path: str, cols: dict) -> list[Config] | None:
 def _with_columns() -> list:
     """The controllers whose flags a poses file may give in columns."""
     return [c for c in CONTROLLERS.values() if c.csv_config]
+
+
+def _arm_flags(path: str, cols: dict) -> NDArray[np.int_] | None:
+    """The solver's flags ``shoulder, elbow, wrist`` of the poses file (N, 3), or None."""
+    if not any(k in cols for k in ARM_FLAGS):
+        return None
+    values = require_columns(cols, ARM_FLAGS, path)  # all three, a value on every line
+    bad = np.argwhere(~np.isin(values, (0.0, 1.0)))
+    if bad.size:
+        i, j = bad[0]
+        raise InputError(f"{path}: line {i + 2}: column '{ARM_FLAGS[j]}' must be 0 or 1, got "
+                         f"{values[i, j]:g} (docs/accuracy.md: the configuration flags)")
+    return values.astype(int)
+
+
+def _near(path: str, cols: dict, cell: Cell) -> NDArray[np.float64] | None:
+    """The reference joints ``near_a1..near_an`` of the poses file (rad, m), or None."""
+    names = _near_columns(cell)
+    if not any(k in cols for k in names):
+        return None
+    q = require_columns(cols, names, path)  # every axis, a value on every line
+    return q * np.where(cell.robot.prismatic, 1e-3, math.pi / 180)
+
+
+def _near_columns(cell: Cell) -> list[str]:
+    """``near_a1..near_an`` for the cell's arm."""
+    return [f"near_a{i + 1}" for i in range(cell.robot.n_joints)]
+
+
+def _chosen_by(flag_columns: tuple[str, ...], near: bool, n_joints: int) -> str:
+    """How the configurations are chosen, for the output."""
+    parts = [f"by the columns {', '.join(flag_columns)}"] if flag_columns else []
+    if near:
+        parts.append(f"nearest near_a1..near_a{n_joints}")
+    elif not flag_columns:
+        parts.append("nearest the robot's home")
+    return ", ".join(parts)
+
+
+def _configuration(path: str, cols: dict, cell: Cell
+                   ) -> tuple[list[Config] | NDArray[np.int_] | None, NDArray[np.float64] | None,
+                              str]:
+    """The configuration columns of the poses file: the flags (a controller's or the solver's),
+    the reference joints, and how they choose (:func:`_chosen_by`)."""
+    vendor, arm = _configs(path, cols), _arm_flags(path, cols)
+    if vendor is not None and arm is not None:
+        raise InputError(f"{path}: columns {', '.join(ARM_FLAGS)} and a controller's flags "
+                         f"({', '.join(get(vendor[0].vendor).csv_config)}): give one kind of "
+                         "configuration")
+    method = "opw" if vendor is None else analytic_solver(cell.nominal_robot).method
+    if method != "opw":
+        raise InputError(f"{path}: columns {', '.join(get(vendor[0].vendor).csv_config)} are "
+                         f"{vendor[0].vendor}'s flags of an arm with a spherical wrist; "
+                         f"{cell.nominal_robot.name} is a {method.upper()}-type arm: give its "
+                         f"configuration as columns {', '.join(ARM_FLAGS)} (0 or 1) or its "
+                         f"joints near_a1..near_a{cell.robot.n_joints} (deg)")
+    near = _near(path, cols, cell)
+    used = get(vendor[0].vendor).csv_config if vendor is not None else (
+        ARM_FLAGS if arm is not None else ())
+    return (vendor if vendor is not None else arm), near, _chosen_by(
+        tuple(used), near is not None, cell.robot.n_joints)
 
 
 def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "world",
@@ -129,18 +212,18 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
     """
     p = str(path)
     cols = read_csv(path)
-    config = _configs(p, cols)
-    extra = tuple(k for c in _with_columns() for k in c.csv_config)
+    config, near, chosen_by = _configuration(p, cols, cell)
+    extra = (*(k for c in _with_columns() for k in c.csv_config), *ARM_FLAGS, *_near_columns(cell))
     targets = read_path(path, cell, extra)
     if tool not in cell.tools:
         raise InputError(f"tool {tool!r} is not a tool of the cell (tools: "
                          f"{', '.join(cell.tools) or 'none'})")
-    r = filter_poses(cell, targets.T, frame, tool, targets.track, targets.table, config,
+    r = filter_poses(cell, targets.T, frame, tool, targets.track, targets.table, config, near,
                      max_correction)
     robot = cell.robot
     qs = np.where(robot.prismatic, 1e3, 180 / math.pi)
-    header = [*"xyz", *"abc", *(f"a{i + 1}" for i in range(robot.n_joints))]
-    parts = [pose_to_vendor(r.T, "kuka"), r.q * qs]
+    header = [*"xyz", *"abc", *(f"a{i + 1}" for i in range(robot.n_joints)), *ARM_FLAGS]
+    parts = [pose_to_vendor(r.T, "kuka"), r.q * qs, r.flags]
     if cell.track is not None:
         header.append("track")
         parts.append(r.track[:, None] * 1e3)
@@ -150,7 +233,7 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
         parts.append(np.degrees(r.table).reshape(len(r.q), -1))
     header += ["dpos", "drot"]
     parts.append(np.column_stack([r.dpos * 1e3, np.degrees(r.drot)]))
-    rows = np.hstack(parts)
+    result = CompensatedPoses(r, header, np.hstack(parts), chosen_by, list(targets.warnings))
     if output is not None:
-        write_csv(output, header, rows, DECIMALS)
-    return CompensatedPoses(r, header, rows, list(targets.warnings))
+        result.write(output)
+    return result

@@ -40,6 +40,8 @@ from robotcell.controllers.model import Program
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.identification.uncertainty import position_sigma
+from robotcell.ik.analytic import analytic_solver
+from robotcell.ik.config import ARM_FLAGS, flags_of_branch
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.check import check_program
@@ -75,6 +77,9 @@ class CompensatedPoint:
         1-sigma of the filtered TCP position (m; NaN without a covariance).
     q_old, q_new : ndarray, shape (n,)
         The controller's joints before and after (rad).
+    flags : tuple of int
+        The configuration kept: the IK branch's shoulder, elbow, wrist flags
+        (:func:`robotcell.ik.config.flags_of_branch`).
     """
 
     name: str
@@ -87,6 +92,7 @@ class CompensatedPoint:
     sigma: float
     q_old: NDArray[np.float64]
     q_new: NDArray[np.float64]
+    flags: tuple[int, int, int] = (-1, -1, -1)
 
 
 @dataclass
@@ -132,7 +138,8 @@ class CompensatedProgram:
             "points": [{"name": p.name, "line": p.line, "kind": p.kind, "dpos": p.dpos * 1e3,
                         "drot": math.degrees(p.drot), "error_mm": p.error * 1e3,
                         "error_deg": math.degrees(p.error_rot), "sigma_mm": num(p.sigma * 1e3),
-                        **{f"a{i + 1}": math.degrees(v) for i, v in enumerate(p.q_new)}}
+                        **{f"a{i + 1}": math.degrees(v) for i, v in enumerate(p.q_new)},
+                        **dict(zip(ARM_FLAGS, p.flags))}
                        for p in self.points],
         }
 
@@ -215,7 +222,8 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     q_nom = np.stack([checked.points[i].q for i in todo])
     T_tool = np.stack([tools[i] for i in todo])
     T_R_F = invert(robot_pose(cell, track)) @ T_world @ invert(T_tool)
-    q, found = identified_joints(cell, T_R_F, q_nom)
+    q, found, branch = identified_joints(cell, T_R_F, q_nom)
+    arm_flags = flags_of_branch(analytic_solver(cell.nominal_robot).method, branch)
     refused += [(todo[k], ("the identified arm cannot reach it in the configuration the nominal "
                            "arm uses (within the axis limits)")) for k in np.flatnonzero(~found)]
     new = [np.eye(4)] * len(todo)
@@ -260,7 +268,8 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
         result.points.append(CompensatedPoint(
             p.name, p.line, "cartesian" if p.pose is not None else "joints", dpos[k], drot[k],
             float(np.linalg.norm(T_real[k, :3, 3] - T_world[k, :3, 3])),
-            _angle(T_world[k], T_real[k]), float(sigma[k]), q_nom[k], q[k]))
+            _angle(T_world[k], T_real[k]), float(sigma[k]), q_nom[k], q[k],
+            tuple(int(v) for v in arm_flags[k])))
     refuse(refused, "point", names)
     out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}
     result.files = write_all(folder, out, (*program.files, *inputs))

@@ -81,7 +81,8 @@ class Cell:
         Set when ``robot`` is an identified arm: then ``robot`` says where the TCP goes (FK, IK,
         reach, checks, touches given as joint values) and ``identified.nominal``, the controller's
         model, turns joint values into what the controller is told (:meth:`controller`).
-        ``robot`` carries the nominal's tool.
+        ``robot`` carries the nominal's tool, and the nominal as its ``ik_seed`` when its model
+        file names none (a model written by another tool): its IK branches are the nominal's.
     """
 
     robot: Robot
@@ -100,6 +101,8 @@ class Cell:
             check_identified(self.identified.nominal, self.robot)
             if not np.array_equal(self.robot.tool, self.identified.nominal.tool):
                 self.robot = self.robot.with_tool(self.identified.nominal.tool)
+            if self.robot.ik_seed is None:  # a model from another tool: the nominal seeds its IK
+                self.robot = replace(self.robot, ik_seed=self.identified.nominal)
         if self.track is not None and not np.allclose(self.T_world_R, np.eye(4), atol=0):
             raise InputError("a robot on a track is placed by the track (track frame and "
                              "robot_at_zero); do not give the robot a frame as well")

@@ -563,12 +563,17 @@ def procedure_command(proc: Procedure) -> click.Command:
         if proc.named:
             require_name(name, target, what)
         model, T_tool = robot_and_tool(robot, tool, target)
-        cell, label = cell_of(target)
-        context = CalibrationContext(robot=None if cell else model, tool=T_tool,
-                                     sigma=sigma_m(sigma), source=measurements, cell_label=label,
-                                     on_note=echo_note, **chain_options(measurements))
-        out = proc.calibrate(cell, measurements, *([name] if proc.named else []), context=context)
-        finish(out, target, as_json, accept_poor)
+        label = cell_of(target)[1]
+        options = chain_options(measurements)
+
+        def calibration(cell: Cell | None) -> cellcal.CellCalibration:
+            context = CalibrationContext(robot=None if cell else model, tool=T_tool,
+                                         sigma=sigma_m(sigma), source=measurements,
+                                         cell_label=label, on_note=echo_note, **options)
+            return proc.calibrate(cell, measurements, *([name] if proc.named else []),
+                                  context=context)
+
+        finish(calibration, target, as_json, accept_poor)
 
     command = cell_option(measurement_options(run))
     if proc.named:

@@ -6,12 +6,14 @@ import json
 import sys
 
 import click
+import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.common import (
     MAX_CORRECTION_MM,
     BadPoints,
     as_flags,
+    counted,
     format_table,
     in_range,
     output_of,
@@ -36,19 +38,22 @@ from robotcell.cli.files import OUTPUT, Command
               help="Also write an HTML page: predicted error without filtering and 1-sigma "
                    "after, per pose.")
 @click.option("--json", "as_json", is_flag=True,
-              help='Print {"points": [{"x": .., "a1": .., "dpos": .., "drot": .., "error_mm": '
-                   '.., "sigma_mm": ..}, ...]}.')
+              help='Print {"points": [{"x": .., "a1": .., "shoulder": .., "branch": .., "dpos": .., '
+                   '"error_mm": .., "sigma_mm": ..}, ...], "configuration": ..}.')
 def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | None,
                max_correction: float, report: str | None, as_json: bool) -> None:
     """Filter POSES (CSV: x, y, z mm and a, b, c deg in --frame; optional track mm, table or
-    e1..en deg; optional flags s, t or cf1, cf4, cf6, cfx or config) through the cell's
-    identified arm: for each desired pose, the pose to tell the controller, whose nominal model
-    then moves the real arm onto it (docs/accuracy.md).
+    e1..en deg; optional configuration columns) through the cell's identified arm: for each
+    desired pose, the pose to tell the controller, whose nominal model then moves the real arm
+    onto it (docs/accuracy.md).
 
-    The configuration is the one the nominal arm uses for the desired pose (nearest to the
-    robot's home) unless flag columns give one. The output has x, y, z, a, b, c (the pose to
-    command), a1..a6 (the controller's joints, deg), the external axes, dpos (mm) and drot (deg),
-    the size of the correction.
+    The configuration is the nominal arm's solution nearest to the robot's home, unless columns
+    say which: a controller's flags (s, t; cf1, cf4, cf6, cfx; config), or the solver's own
+    flags shoulder, elbow, wrist (0 or 1; every arm type, a Universal Robots arm too), and/or
+    reference joints near_a1..near_a6 (deg; the solution nearest them, as a UR controller's
+    qnear). The output has x, y, z, a, b, c (the pose to command), a1..a6 (the controller's
+    joints, deg), shoulder, elbow, wrist (their configuration), the external axes, dpos (mm) and
+    drot (deg), the size of the correction.
 
     Exit status 0 when done; 2 for refused input; 3 when a pose cannot be filtered (out of the
     identified arm's reach in its configuration, or a correction above --max-correction: a wrong
@@ -59,8 +64,7 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
       robotcell compensate examples/seam_part.csv --cell cell.yaml --tool torch --frame part -o commanded.csv
     """
     from robotcell.accuracy.filter import FilterRefused
-    from robotcell.accuracy.poses import DECIMALS, compensate_poses
-    from robotcell.io.tables import write_csv
+    from robotcell.accuracy.poses import compensate_poses
     from robotcell.report.accuracy import write_poses_report
 
     cell = Cell.load(cell_path)
@@ -77,7 +81,7 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
     if as_json:
         click.echo(json.dumps(result.to_json(), indent=2))
     elif output is None:
-        write_csv(sys.stdout, result.header, result.rows, DECIMALS)
+        result.write(sys.stdout)
     data = result.to_json()
     if not as_json:
         sigma = data["max_sigma_mm"]
@@ -85,4 +89,13 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
                    f"{data['max_dpos_mm']:.4f} mm; predicted error without filtering up to "
                    f"{data['max_error_mm']:.4f} mm"
                    + (f", 1-sigma after filtering up to {sigma:.4f} mm" if sigma is not None
-                      else "") + (f"; wrote {output}" if output else ""), err=output is None)
+                      else "") + f"; configurations: {_configurations(result)}"
+                   + (f"; wrote {output}" if output else ""), err=output is None)
+
+
+def _configurations(result) -> str:
+    """``shoulder 1, elbow 0, wrist 0 (17 poses), ... (chosen by ...)``."""
+    flags, counts = np.unique(result.result.flags, axis=0, return_counts=True)
+    parts = [f"shoulder {f[0]}, elbow {f[1]}, wrist {f[2]} ({counted(int(c), 'pose')})"
+             for f, c in zip(flags, counts)]
+    return "; ".join(parts) + f" (chosen {result.chosen_by})"

@@ -37,7 +37,8 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     urdf     the calibrated cell as a URDF tree for ROS tools (m, rad): robot, track and
              turntable joints, tools and frames as fixed links; the identified arm where the
              cell has one, and for a Universal Robots arm also OUT_kinematics.yaml, the UR
-             description's calibration file (with -o)
+             description's calibration file (with -o; axis scales it cannot hold are left
+             out with a warning)
 
     \b
     Examples:
@@ -54,5 +55,8 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
         refuse_overwriting_inputs(click.get_current_context(),
                                   [("the UR calibration file written next to -o",
                                     str(ur_kinematics_path(output)))])
-    for f in export_files(cell, fmt, output):
+    done = export_files(cell, fmt, output)
+    for f in done.files:
         click.echo(f"wrote {f}", err=True)
+    for w in done.warnings:
+        click.echo(f"warning: {w}", err=True)

@@ -15,18 +15,17 @@ from robotcell.cli.common import (
     check_kind,
     check_not_folder,
     check_output,
+    parse_numbers,
     read_csv,
     warn_unknown_columns,
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, LiveChoice
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
-from robotcell.identification.validation import select_configurations
 from robotcell.io.tables import format_table, write_csv
 from robotcell.report.identification import write_identification_report
-from robotcell.robot.models import load_robot
-from robotcell.robot.robot import Robot
 from robotcell.studies.identify import identify_file, zero_offset_controllers
+from robotcell.studies.propose import propose_configurations
 
 #: Columns of a measurement CSV (docs/identification.md): joints ``a1..aN``, one target ``x,y,z``
 #: or several ``x1,y1,z1,...``, an orientation ``qw,qx,qy,qz``.
@@ -56,30 +55,23 @@ ACCURACY_MIN, ACCURACY_MAX = 1e-4, 1e3
 #: Largest ``|--j23-factor|``: a J2/J3 linkage moves axis 3 by about as much as axis 2 (FANUC: -1).
 J23_MAX = 10.0
 
-#: Random configurations within the joint limits that --propose picks from.
-_CANDIDATES = 1000
-
-
-def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int, accuracy: float,
-             angle_accuracy: float, output: str | None, as_json: bool) -> None:
+def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientation: bool,
+             seed: int, accuracy: float, angle_accuracy: float, box: str | None,
+             output: str | None, as_json: bool) -> None:
     """``--propose N``: write the selected configurations (deg, mm) and print O1 against random."""
-    if n < 1 or targets < 1:
-        raise InputError(f"--propose and --targets must be positive, got {n} and {targets}")
-    if n >= _CANDIDATES:
-        raise InputError(f"--propose {n}: at most {_CANDIDATES - 1} configurations (they are "
-                         f"picked from {_CANDIDATES} random candidates)")
-    if orientation and targets != 1:
-        raise InputError("--orientation goes with one target per configuration (--targets 1)")
-    sel = select_configurations(nominal, n, n_targets=targets, pose=orientation, seed=seed,
-                                n_candidates=_CANDIDATES,
-                                point_sigma=accuracy * 1e-3, angle_sigma=math.radians(angle_accuracy))
+    box_m = None if box is None else np.array(parse_numbers(box, "--box", 6)) * 1e-3
+    with as_flags({"n": "--propose", "n_targets": "--targets", "pose": "--orientation"}):
+        prop = propose_configurations(n, robot, cell, targets, orientation, seed,
+                                      accuracy * 1e-3, math.radians(angle_accuracy), box_m)
+    nominal, sel = prop.robot, prop.selection
     q = np.where(nominal.prismatic, sel.q * 1e3, np.degrees(sel.q))
     header = [f"a{i}" for i in range(1, nominal.n_joints + 1)]
     if output is not None:
         write_csv(output, header, q)
     rand = sel.o1_random
     if as_json:
-        data = {"robot": nominal.name, "o1": sel.o1, "o1_random": rand.tolist()}
+        data = {"robot": nominal.name, "o1": sel.o1, "o1_random": rand.tolist(),
+                "work_volume": prop.volume.description}
         if output is None:
             data["configurations"] = q.tolist()
         click.echo(json.dumps(data))
@@ -87,7 +79,8 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
     if output is None:
         write_csv(sys.stdout, header, q)
     click.echo(f"observability O1 of the {n} proposed configurations: {sel.o1:.4g}; {len(rand)} "
-               f"random sets within the joint limits: median {np.median(rand):.4g}, best "
+               f"random sets within the joint limits with the flange and the reflectors "
+               f"{prop.volume.description}: median {np.median(rand):.4g}, best "
                f"{rand.max():.4g} ({(sel.o1 / rand.max() - 1) * 100:+.0f} % over the best)",
                err=output is None)
     if output is not None:
@@ -123,23 +116,29 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "
               "ABB arm-side offsets (rad). Needs --robot.")
 @click.option("--propose", "propose", type=int, metavar="N", help="Instead of identifying: propose "
-              "N configurations within the joint limits of --robot that maximise the observability "
-              "O1; CSV a1..aN (deg, mm) to -o or standard output.")
+              "N configurations within the joint limits of --robot and the work volume (--box) "
+              "that maximise the observability O1; CSV a1..aN (deg, mm) to -o or standard "
+              "output.")
 @click.option("--targets", "targets", type=int, default=1, show_default=True,
               help="With --propose: reflectors measured per configuration.")
 @click.option("--orientation", "orientation", is_flag=True,
               help="With --propose: the orientation is measured too (6D probe, camera).")
 @click.option("--seed", "seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="With --propose: seed of the random candidates and comparison sets.")
+@click.option("--box", "box", metavar="XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
+              help="With --propose: keep the flange and the reflectors inside this box (mm, "
+                   "robot base frame); default above the floor: z >= 0 of the cell's world "
+                   "with --cell, else of the robot base.")
 @click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
               help="Also make the identified model (-o) the arm of this cell file "
                    "(robot.identified), with the identification's time, RMS and held-out error "
-                   "(--folds or 5); its robot.model is the nominal when --robot is not given.")
+                   "(--folds or 5); its robot.model is the nominal when --robot is not given. "
+                   "With --propose: its robot.model and its floor.")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
              compliance: bool, force: bool, folds: int | None, report: str | None,
              offsets_for: str | None, propose: int | None, targets: int, orientation: bool,
-             seed: int, cell_path: str | None) -> None:
+             seed: int, box: str | None, cell_path: str | None) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -155,7 +154,9 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     file is not written unless --force).
 
     --propose N (no MEASUREMENTS) proposes N configurations to measure instead: those that
-    maximise Borm and Menq's observability index O1 for --robot, compared with random sets.
+    maximise Borm and Menq's observability index O1 for --robot (or the cell's robot), compared
+    with random sets, all within the joint limits with the flange and the reflectors inside
+    --box, or above the floor.
 
     \b
     Examples:
@@ -174,14 +175,15 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
-        if cell_path is not None:
-            raise InputError("--propose N writes configurations to measure; --cell takes an "
-                             "identified model, give it with MEASUREMENTS.csv and -o")
-        if robot is None:
-            raise InputError("--propose needs --robot NOMINAL (library name or model file)")
+        if robot is None and cell_path is None:
+            raise InputError("--propose needs --robot NOMINAL (library name or model file) or "
+                             "--cell CELL.yaml (its robot.model)")
         check_kind(output, "CSV", "the proposed configurations")
-        return _propose(load_robot(robot), propose, targets, orientation, seed, accuracy,
-                        angle_accuracy, output, as_json)
+        return _propose(propose, robot, cell_path, targets, orientation, seed, accuracy,
+                        angle_accuracy, box, output, as_json)
+    if box is not None:
+        raise InputError("--box goes with --propose: where the proposed configurations may put "
+                         "the flange and the reflectors")
     if measurements is None:
         raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
     check_kind(output, "YAML", "the identified model file")

@@ -11,6 +11,7 @@ frames and sources: ``docs/export.md``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from robotcell.cell import Cell
@@ -21,8 +22,9 @@ from robotcell.export import urdf
 from robotcell.export.ur import cell_ur_kinematics
 from robotcell.io.fileio import atomic_write, check_destination
 
-__all__ = ["EXPORT_FORMATS", "URDF", "ControllerData", "Slot", "export_cell", "export_files",
-           "other_kinds", "output_ending", "parse_export", "ur_kinematics_path", "write_formats"]
+__all__ = ["EXPORT_FORMATS", "URDF", "ControllerData", "ExportedFiles", "Slot", "export_cell",
+           "export_files", "other_kinds", "output_ending", "parse_export", "ur_kinematics_path",
+           "write_formats"]
 
 #: format name -> controller (``export``, ``parse_export``): the registered controllers, live
 EXPORT_FORMATS = CONTROLLERS
@@ -76,18 +78,36 @@ def ur_kinematics_path(output: str | Path) -> Path:
     return p.with_name(f"{p.stem}_kinematics.yaml")
 
 
-def export_files(cell: Cell, fmt: str, output: str | Path) -> list[Path]:
+@dataclass(frozen=True)
+class ExportedFiles:
+    """What :func:`export_files` wrote.
+
+    Attributes
+    ----------
+    files : list of Path
+        The files written.
+    warnings : list of str
+        What a file could not hold of the cell (a UR calibration file and an identified arm's
+        axis scales, :func:`robotcell.export.ur.scale_left_out`); the files hold the rest.
+    """
+
+    files: list[Path]
+    warnings: list[str] = field(default_factory=list)
+
+
+def export_files(cell: Cell, fmt: str, output: str | Path) -> ExportedFiles:
     """Write the export of ``cell`` to ``output`` (atomically), and what goes with it.
 
     The URDF of a cell whose identified arm is a Universal Robots arm comes with the UR
     description's calibration file (:func:`robotcell.export.ur.ur_kinematics`), written to
     :func:`ur_kinematics_path` of ``output``, so that the UR description (and MoveIt) build the
-    arm as it is.
+    arm as it is. An arm identified with axis scales, which that file cannot hold, gets the file
+    of its geometry without them and a warning that says so.
 
     Returns
     -------
-    list of Path
-        The files written.
+    ExportedFiles
+        The files written and the warnings.
     """
     text = export_cell(cell, fmt)
     extra = cell_ur_kinematics(cell) if fmt.lower() == URDF else None
@@ -97,8 +117,8 @@ def export_files(cell: Cell, fmt: str, output: str | Path) -> list[Path]:
         check_destination(files[1])
     atomic_write(files[0], text)
     if extra is not None:
-        atomic_write(files[1], extra)
-    return files
+        atomic_write(files[1], extra.text)
+    return ExportedFiles(files, [] if extra is None else list(extra.warnings))
 
 
 def parse_export(text: str, fmt: str) -> ControllerData:

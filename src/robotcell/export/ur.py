@@ -31,11 +31,20 @@ which commutes with its motion), so a nominal arm gives the layout of ``default_
 ...). The ``hash`` names the file's numbers (``robotcell_`` and 16 hex digits of their SHA-256):
 it is not the controller's calibration hash, and the UR driver, which compares the two, says so
 when it connects (the controller keeps its own calibration; this file is the arm as measured).
+
+The file holds joint origins only: each joint turns by the controller's value. An arm identified
+with a scale per axis (``robotcell identify --scale``: ``q_model = (1 + s) q``, a coupling of
+the model file) cannot be written whole. :func:`cell_ur_kinematics` then writes what the file
+can hold, the identified geometry without the scales, and says so in a warning that names the
+scales and how far the file's arm is from the identified one within the joint limits
+(:func:`scale_left_out`).
 """
 
 from __future__ import annotations
 
 import hashlib
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -46,21 +55,66 @@ from robotcell.errors import InputError
 from robotcell.kinematics.dh import link_transform
 from robotcell.robot.robot import Robot
 
-__all__ = ["SEGMENTS", "cell_ur_kinematics", "is_ur_arm", "ur_kinematics", "ur_origins"]
+__all__ = ["SEGMENTS", "URKinematics", "axis_scale", "cell_ur_kinematics", "is_ur_arm",
+           "scale_left_out", "ur_kinematics", "ur_origins"]
 
 #: The keys of the joints' origins in the calibration file, base to tip.
 SEGMENTS = ("shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3")
 #: Largest offset (m, rad) of the last link's x part and the flange from the identity.
 _SCREW_TOL = 1e-9
+#: Configurations within the joint limits at which a left-out scale is measured.
+_SCALE_SAMPLES = 2000
+
+
+@dataclass(frozen=True)
+class URKinematics:
+    """The UR calibration file of a cell's arm and what it could not hold.
+
+    Attributes
+    ----------
+    text : str
+        The file (YAML, m and rad).
+    warnings : list of str
+        What the file leaves out of the identified model, and how far that puts its arm from the
+        identified one (:func:`scale_left_out`); empty when it holds the whole model.
+    """
+
+    text: str
+    warnings: list[str]
+
+
+def axis_scale(robot: Robot) -> NDArray[np.float64] | None:
+    """The scale factors ``1 + s`` per axis of a coupling that only scales axes, else None.
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    ndarray, shape (n,), or None
+        The diagonal of ``C`` when the robot's coupling is ``q_model = diag(1 + s) q`` (no
+        offset, no interaction limits, no passive joint); None without a coupling or for any
+        other one (a J2/J3 linkage).
+    """
+    c = robot.coupling
+    if c is None or c.matrix.shape != (robot.n_joints, robot.n_joints):
+        return None
+    C = c.matrix
+    if np.any(C - np.diag(np.diag(C))) or np.any(c.offset) or c.interaction.shape[0]:
+        return None
+    return np.diag(C).copy()
 
 
 def is_ur_arm(robot: Robot) -> bool:
-    """Whether ``robot`` (or the nominal model it is identified from) is a UR-type arm."""
+    """Whether ``robot`` (or the nominal model it is identified from) is a UR-type arm, with no
+    coupling but a scale per axis (:func:`axis_scale`)."""
     from robotcell.ik.ur import ur_problems  # the IK package only when a URDF is exported
 
     nominal = robot.ik_seed or robot
-    return (nominal.n_joints == 6 and robot.convention == "standard" and robot.coupling is None
-            and not ur_problems(nominal))
+    return (nominal.n_joints == 6 and robot.convention == "standard"
+            and (robot.coupling is None or axis_scale(robot) is not None)
+            and not ur_problems(nominal.uncoupled()))
 
 
 def _split(j) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -124,8 +178,48 @@ def ur_kinematics(robot: Robot) -> str:
     return "\n".join(lines) + "\n"
 
 
-def cell_ur_kinematics(cell: Cell) -> str | None:
-    """The calibration file of a cell whose identified arm is a UR-type arm, else None."""
+def scale_left_out(robot: Robot) -> str | None:
+    """What leaving the axis scales out of the calibration file does, or None without scales.
+
+    Parameters
+    ----------
+    robot : Robot
+        A UR-type arm whose coupling scales axes (:func:`axis_scale`).
+
+    Returns
+    -------
+    str or None
+        A warning naming each scale (``axis 2 x1.000210``) and the largest and RMS distance of
+        the flange of the arm without them from the identified arm's, over 2000 configurations
+        within the joint limits (seeded; unlimited axes over +-180 deg).
+    """
+    scale = axis_scale(robot)
+    if scale is None or np.all(scale == 1.0):
+        return None
+    rng = np.random.default_rng(0)
+    lo = np.where(np.isfinite(robot.lower), robot.lower, -math.pi)
+    hi = np.where(np.isfinite(robot.upper), robot.upper, math.pi)
+    q = lo + (hi - lo) * rng.random((_SCALE_SAMPLES, robot.n_joints))
+    eye = np.eye(4)
+    d = np.linalg.norm(robot.fk(q, tool=eye)[:, :3, 3]
+                       - replace(robot, coupling=None).fk(q, tool=eye)[:, :3, 3], axis=-1)
+    named = ", ".join(f"axis {i + 1} x{v:.6f}" for i, v in enumerate(scale) if v != 1.0)
+    return (f"the UR calibration file cannot hold the identified arm's axis scales ({named}; "
+            "identify --scale): it holds the identified geometry without them, whose flange is "
+            f"up to {d.max() * 1e3:.3f} mm ({math.sqrt(np.mean(d**2)) * 1e3:.3f} mm RMS) from "
+            "the identified arm's within the joint limits; the URDF holds the scales (its joints "
+            "take q_model = (1 + s) q); identify without --scale for a calibration file that "
+            "holds the whole model")
+
+
+def cell_ur_kinematics(cell: Cell) -> URKinematics | None:
+    """The calibration file of a cell whose identified arm is a UR-type arm, else None.
+
+    An arm identified with axis scales gets the file of its geometry without them, and the
+    warning of :func:`scale_left_out`.
+    """
     if cell.identified is None or not is_ur_arm(cell.robot):
         return None
-    return ur_kinematics(cell.robot)
+    left_out = scale_left_out(cell.robot)
+    text = ur_kinematics(replace(cell.robot, coupling=None))
+    return URKinematics(text, [] if left_out is None else [left_out])

@@ -14,7 +14,11 @@ from robotcell.calibration.result import CONDITION_LIMIT, to_jsonable
 from robotcell.io.tables import format_table
 from robotcell.robot.robot import Robot
 
-__all__ = ["IdentificationResult", "Parameter"]
+__all__ = ["OUTLIERS_NAMED", "IdentificationResult", "Parameter"]
+
+#: Outlier rows the verdict's reason names; it counts the others (``and 2 more``), the summary's
+#: and the JSON's outlier lists name every one.
+OUTLIERS_NAMED = 5
 
 
 @dataclass(frozen=True)
@@ -221,8 +225,10 @@ class IdentificationResult:
         if self.condition > CONDITION_LIMIT:
             reasons.append(f"condition number {self.condition:.0f} above {CONDITION_LIMIT:.0f}")
         if self.outliers:
-            reasons.append(f"{len(self.outliers)} outlier row(s): "
-                           + ", ".join(self.labels[i] for i in self.outliers[:5]))
+            shown = [self.labels[i] for i in self.outliers[:OUTLIERS_NAMED]]
+            more = len(self.outliers) - len(shown)
+            reasons.append(f"{len(self.outliers)} outlier row(s): " + ", ".join(shown)
+                           + (f" and {more} more" if more else ""))
         if reasons:
             return "check", "; ".join(reasons)
         return "good", "residuals consistent with the stated accuracy, well conditioned"

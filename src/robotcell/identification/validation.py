@@ -29,7 +29,7 @@ from robotcell.identification.measurements import Measurements
 from robotcell.robot.robot import Robot
 
 __all__ = ["CrossValidation", "PoseSelection", "compare_observability", "cross_validate", "observability",
-           "select_configurations"]
+           "random_configurations", "reflector_spots", "select_configurations"]
 
 
 @dataclass(frozen=True)
@@ -95,6 +95,15 @@ def cross_validate(nominal: Robot, measurements: Measurements, folds: int = 5, s
     return CrossValidation(folds, before, after, fold)
 
 
+def reflector_spots(n_targets: int) -> NDArray[np.float64]:
+    """Where the observability of proposed configurations assumes the reflectors: spread over a
+    100 mm circle 50 mm in front of the flange (the 4th to 6th on a 200 mm circle 100 mm in
+    front, ...), in the flange frame, shape (n_targets, 3) (m)."""
+    spots = np.array([[0.1, 0.0, 0.05], [-0.05, 0.087, 0.05], [-0.05, -0.087, 0.05]])
+    k = np.arange(n_targets)
+    return spots[k % 3] * (1 + k // 3)[:, None]
+
+
 def _jacobian_blocks(nominal: Robot, q: NDArray[np.float64], n_targets: int, pose: bool,
                      point_sigma: float, angle_sigma: float):
     """Weighted identification Jacobian at the nominal model, rows grouped per configuration."""
@@ -102,10 +111,8 @@ def _jacobian_blocks(nominal: Robot, q: NDArray[np.float64], n_targets: int, pos
     x = ch.values.copy()
     if ch.coupling_param >= 0 and nominal.coupling is not None:
         x[ch.coupling_param] = nominal.coupling.j23_factor or 0.0
-    # Targets spread over a 100 mm flange, in front of it.
-    spots = np.array([[0.1, 0.0, 0.05], [-0.05, 0.087, 0.05], [-0.05, -0.087, 0.05]])
-    for k in range(ch.n_targets):
-        x[ch.target_params[k]] = spots[k % 3] * (1 + k // 3)
+    for k, spot in enumerate(reflector_spots(ch.n_targets)):
+        x[ch.target_params[k]] = spot
     pts, R = ch.predict(x, q)
     prob = Problem(ch, Measurements(q, pts, R if pose else None), point_sigma, angle_sigma)
     groups = np.array(ch.groups)
@@ -143,7 +150,7 @@ class PoseSelection:
     o1_random: NDArray[np.float64]
 
 
-def _random_configurations(nominal: Robot, rng: np.random.Generator, m: int) -> NDArray[np.float64]:
+def random_configurations(nominal: Robot, rng: np.random.Generator, m: int) -> NDArray[np.float64]:
     """``m`` uniform configurations within the limits (unlimited: +-180 deg, +-1 m), (m, n)."""
     lo = np.where(np.isfinite(nominal.lower), nominal.lower, np.where(nominal.prismatic, -1.0, -math.pi))
     hi = np.where(np.isfinite(nominal.upper), nominal.upper, np.where(nominal.prismatic, 1.0, math.pi))
@@ -176,7 +183,7 @@ def compare_observability(nominal: Robot, q: NDArray[np.float64], *, n_targets: 
     """
     q = np.asarray(q, dtype=float)
     N = len(q)
-    rand = _random_configurations(nominal, np.random.default_rng(seed), N * n_random)
+    rand = random_configurations(nominal, np.random.default_rng(seed), N * n_random)
     B = _jacobian_blocks(nominal, np.concatenate([q, rand]), n_targets, pose, point_sigma, angle_sigma)
     p = B.shape[2]
     B = B / np.linalg.norm(B.reshape(-1, p), axis=0)
@@ -218,7 +225,7 @@ def select_configurations(
     """
     rng = np.random.default_rng(seed)
     if candidates is None:
-        candidates = _random_configurations(nominal, rng, n_candidates)
+        candidates = random_configurations(nominal, rng, n_candidates)
     cand = np.asarray(candidates, dtype=float)
     if cand.ndim != 2 or cand.shape[1] != nominal.n_joints or len(cand) < n:
         raise InputError(f"candidates must have shape (C, {nominal.n_joints}) with C >= {n}, got {cand.shape}")

@@ -1,4 +1,15 @@
-"""Arm configuration flags as robot controllers write them: KUKA Status/Turn, ABB confdata.
+"""Arm configuration flags: the solver's own (shoulder, elbow, wrist) and as robot controllers
+write them (KUKA Status/Turn, ABB confdata).
+
+**The solver's flags.** Every analytic solver (:mod:`robotcell.ik.analytic`) numbers its branches
+``k = 4 * shoulder + 2 * elbow + wrist`` (a 4-axis palletizer ``k = 2 * shoulder + elbow``), each
+flag 0 or 1 (docs/ik.md, "Branches"): :func:`branch_of_flags` and :func:`flags_of_branch` go
+between the two. These are the configuration of every arm type robotcell solves, also of a
+Universal-Robots-type arm, whose controller has no configuration flags (URScript's
+``get_inverse_kin(x, qnear)`` returns the solution nearest ``qnear``). On a UR arm (canonical angles
+``t_i``, the controller's values for Universal Robots' own models): shoulder 1 = the wrist-2 point
+(where axes 5 and 6 meet) at negative x of the canonical frame 1 (the base frame turned with axis
+1), elbow 1 = ``sin t3 < 0``, wrist 1 = ``sin t5 < 0``.
 
 Defined for ortho-parallel arms with a spherical wrist (:mod:`robotcell.ik.opw`), from the
 geometry of the configuration:
@@ -41,7 +52,11 @@ from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.opw import OPWParameters
 from robotcell.kinematics.arm import Arm
 
-__all__ = ["abb_confdata", "arm_sides", "kuka_status_turn"]
+__all__ = ["ARM_FLAGS", "abb_confdata", "arm_sides", "branch_of_flags", "flags_of_branch",
+           "kuka_status_turn"]
+
+#: The solver's configuration flags, the bits of its branch index (most significant first).
+ARM_FLAGS = ("shoulder", "elbow", "wrist")
 
 _QUARTER = math.pi / 2
 #: Joint values closer to 0 than this (rad) count as 0 for signs and quadrants: solvers return
@@ -138,3 +153,61 @@ def abb_confdata(robot: Arm, q: ArrayLike) -> NDArray[np.int_]:
     quad = np.floor(arr[..., [0, 3, 5]] / _QUARTER).astype(int)
     cfx = 4 * (~front).astype(int) + 2 * (~elbow).astype(int) + (arr[..., 4] < 0).astype(int)
     return np.concatenate([quad, cfx[..., None]], axis=-1)
+
+
+def branch_of_flags(method: str, flags: ArrayLike) -> NDArray[np.int_]:
+    """The branch index of the solver's configuration flags.
+
+    Parameters
+    ----------
+    method : str
+        The solver's method (:attr:`robotcell.ik.result.IKSolutions.method`): ``opw``, ``ur`` or
+        ``palletizer``.
+    flags : array_like of int, shape (..., 3)
+        ``shoulder, elbow, wrist`` (:data:`ARM_FLAGS`), each 0 or 1.
+
+    Returns
+    -------
+    ndarray of int, shape (...)
+        ``4 * shoulder + 2 * elbow + wrist``; a palletizer's ``2 * shoulder + elbow``.
+
+    Raises
+    ------
+    InputError
+        A flag that is not 0 or 1, or a wrist flag of 1 for a palletizer (it has no wrist flip).
+    """
+    f = np.asarray(flags)
+    if f.ndim == 0 or f.shape[-1] != 3:
+        raise InputError(f"flags must have shape (..., 3) (shoulder, elbow, wrist), got {f.shape}")
+    if not np.isin(f, (0, 1)).all():
+        raise InputError(f"the flags {', '.join(ARM_FLAGS)} are 0 or 1, got "
+                         f"{np.unique(f[~np.isin(f, (0, 1))]).tolist()}")
+    f = f.astype(int)
+    if method == "palletizer":
+        if f[..., 2].any():
+            raise InputError("a 4-axis palletizer has no wrist flip: its branches are "
+                             "2 * shoulder + elbow; give wrist 0")
+        return 2 * f[..., 0] + f[..., 1]
+    return 4 * f[..., 0] + 2 * f[..., 1] + f[..., 2]
+
+
+def flags_of_branch(method: str, branch: ArrayLike) -> NDArray[np.int_]:
+    """The solver's configuration flags of branch indices (the inverse of
+    :func:`branch_of_flags`).
+
+    Parameters
+    ----------
+    method : str
+        ``opw``, ``ur`` or ``palletizer``.
+    branch : array_like of int, shape (...)
+        Branch indices; -1 for none.
+
+    Returns
+    -------
+    ndarray of int, shape (..., 3)
+        ``shoulder, elbow, wrist``; -1 where ``branch`` is negative; a palletizer's wrist is 0.
+    """
+    b = np.asarray(branch, dtype=int)
+    bits = (np.stack([b >> 1, b & 1, np.zeros_like(b)], axis=-1) if method == "palletizer"
+            else np.stack([b >> 2, (b >> 1) & 1, b & 1], axis=-1))
+    return np.where(b[..., None] < 0, -1, bits)
