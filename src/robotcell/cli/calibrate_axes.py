@@ -9,6 +9,8 @@ turntable, positioner and workpiece.
 
 from __future__ import annotations
 
+import math
+
 import click
 import numpy as np
 
@@ -25,7 +27,7 @@ from robotcell.cli.calibrate import (
     robot_and_tool,
     sigma_m,
 )
-from robotcell.cli.common import parse_numbers
+from robotcell.cli.common import group_tolerance_option, parse_numbers
 from robotcell.cli.files import Command
 from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM
@@ -113,10 +115,12 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
 
 @click.command("positioner", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
+@group_tolerance_option("Axis values e1, e2")
 @cell_option
 @measurement_options
-def positioner(measurements: str, cell_path: str | None, robot: str | None, tool: str | None,
-               sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+def positioner(measurements: str, group_tolerance: float | None, cell_path: str | None,
+               robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+               accept_poor: bool) -> None:
     """2-axis (tilt-rotate) positioner: both axis lines, common normal, zeros, root frame.
 
     \b
@@ -125,7 +129,8 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     With --cell the cell's chain is the start and the calibrated chain is written into the cell
     file (its 'positioner' section); the values are in the positioner's parent frame (the world,
     mapped through column track (mm) in a cell with a track). Without --cell they are in the
-    robot base, and each axis needs at least 3 touches that move it alone.
+    robot base, and each axis needs at least 3 touches that move it alone (the other axis at
+    one commanded value, to the --group-tolerance).
 
     \b
     Examples:
@@ -138,7 +143,9 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     cell, label = cell_of(target)
     out = cellcal.positioner(cell, measurements, robot=None if cell else model, tool=T_tool,
                              sigma=sigma_m(sigma), source=measurements, cell_label=label,
-                             on_note=echo_note, **chain_options(measurements))
+                             on_note=echo_note, group_tol=(None if group_tolerance is None
+                                                           else math.radians(group_tolerance)),
+                             **chain_options(measurements))
     finish(out, target, as_json, accept_poor)
 
 

@@ -15,6 +15,7 @@ from robotcell.cli.common import (
     check_kind,
     check_not_folder,
     check_output,
+    group_tolerance_option,
     read_csv,
     warn_unknown_columns,
 )
@@ -138,11 +139,12 @@ def _propose(nominal: Robot, n: int, targets: int, orientation: bool, seed: int,
               help="Also make the identified model (-o) the arm of this cell file "
                    "(robot.identified), with the identification's time, RMS and held-out error "
                    "(--folds or 5); its robot.model is the nominal when --robot is not given.")
+@group_tolerance_option("Joint values")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
              compliance: bool, force: bool, folds: int | None, report: str | None,
              offsets_for: str | None, propose: int | None, targets: int, orientation: bool,
-             seed: int, cell_path: str | None) -> None:
+             seed: int, cell_path: str | None, group_tolerance: float | None) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -194,10 +196,12 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
     _check_columns(measurements)
-    with as_flags({"the nominal model as robot": "the nominal model with --robot"}):
+    with as_flags({"the nominal model as robot": "the nominal model with --robot",
+                   "state the grouping tolerance": "state it with --group-tolerance"}):
         run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
                             math.radians(angle_accuracy), scale, compliance, folds, report,
-                            offsets_for, output, force)
+                            offsets_for, output, force,
+                            None if group_tolerance is None else math.radians(group_tolerance))
     result, cv, offsets = run.result, run.cross_stats, run.offsets
     verdict, why = result.verdict
     if as_json:

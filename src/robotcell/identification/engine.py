@@ -30,12 +30,14 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from robotcell.calibration.fitting import kabsch, scaled_condition
+from robotcell.calibration.grouping import distinct as count_distinct
+from robotcell.calibration.grouping import joint_tolerances
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import COMPLIANT_JOINTS, Chain
 from robotcell.identification.gravity import require_masses
@@ -298,6 +300,7 @@ def identify(
     max_sigma_length: float = MAX_SIGMA_LENGTH,
     max_sigma_angle: float = MAX_SIGMA_ANGLE,
     name: str | None = None,
+    group_tol: ArrayLike | None = None,
 ) -> IdentificationResult:
     """Identify the kinematic parameters of a serial chain from measured points or poses.
 
@@ -332,6 +335,11 @@ def identify(
         ``fixed``: the measurements see it too weakly to move it (``math.inf``: never).
     name : str, optional
         Name of the identified model (default ``<nominal>_identified``).
+    group_tol : float or array_like, shape (n,), optional
+        Joint values within this of each other are the same commanded value, for the count of
+        distinct configurations that the redundancy check rests on: one number (rad, a
+        prismatic joint taking as many mm as that is deg) or one per joint (rad, m); default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -390,8 +398,10 @@ def identify(
         cand.append(chain.coupling_param)
     J1 = prob.jacobian(x1)
     kept, fixed = _identifiable(J1, cand, set(prio), chain.names, rank_tol)
-    # Rows that repeat a configuration measure it again; they say nothing more about the chain.
-    distinct = len(np.unique(measurements.q, axis=0))
+    # Rows that repeat a configuration measure it again (to what the joint values resolve, so
+    # read-back jitter does not make a repeat new); they say nothing more about the chain.
+    tol = None if group_tol is None else joint_tolerances(group_tol, nominal.prismatic)
+    distinct = count_distinct(measurements.q, tol, nominal.prismatic)
     m = distinct * prob.ncomp
     if m < 2 * kept.size:
         rows = (f"{prob.N} rows" if distinct == prob.N else

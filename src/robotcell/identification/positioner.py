@@ -301,6 +301,7 @@ def calibrate_positioner(
     prior_sigma: float | None = None,
     labels: Sequence[str] | None = None,
     inputs: Inputs | None = None,
+    group_tol: float | None = None,
 ) -> PositionerCalibration:
     """Calibrate a tilt-rotate positioner from touches of one point on its table.
 
@@ -327,6 +328,11 @@ def calibrate_positioner(
         Name of each touch (default ``"1".."N"``).
     inputs : Inputs, optional
         Earlier calibrations the touched points rest on (the tool, a track).
+    group_tol : float, optional
+        Axis values within this of each other (rad) are the same commanded value, for the touches
+        that move one axis alone; default derived from the data
+        (:func:`robotcell.calibration.grouping.resolution`), so that values read back from the
+        controller with jitter group as the grid commanded.
 
     Returns
     -------
@@ -357,10 +363,11 @@ def calibrate_positioner(
                          f"{nominal.n_joints}")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
     meas = Measurements(q, f, None, tuple(labels))
-    start = nominal if nominal is not None else start_model(meas, np.zeros(2, dtype=bool), "positioner")
+    start = (nominal if nominal is not None
+             else start_model(meas, np.zeros(2, dtype=bool), "positioner", group_tol))
     sigma = prior_sigma if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
     name = f"{start.name}_calibrated"
-    ident = identify(start, meas, point_sigma=sigma, name=name)
+    ident = identify(start, meas, point_sigma=sigma, name=name, group_tol=group_tol)
     used = np.ones(len(f), dtype=bool)
     res = _fit_of(ident, q, f, used, prior_sigma, inputs)
     if len(res.suspects) == 1:
@@ -369,7 +376,8 @@ def calibrate_positioner(
         keep[worst] = False
         try:
             other = identify(start, Measurements(q, _imputed(ident, q, f, keep), None,
-                                                 tuple(labels)), point_sigma=sigma, name=name)
+                                                 tuple(labels)), point_sigma=sigma, name=name,
+                             group_tol=group_tol)
         except IllPosedError:
             other = None
         if other is not None:

@@ -103,7 +103,8 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
                   point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
                   scale: bool = False, compliance: bool = False, folds: int | None = None,
                   report: str | Path | None = None, offsets_for: Literal["kuka", "abb"] | None = None,
-                  output: str | Path | None = None, force: bool = False) -> IdentificationRun:
+                  output: str | Path | None = None, force: bool = False,
+                  group_tol: float | None = None) -> IdentificationRun:
     """Identify the kinematic model of an arm or positioner from a measurement CSV.
 
     Parameters
@@ -135,6 +136,10 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         Identified model file (YAML) to write, unless the verdict is poor and not ``force``.
     force : bool
         Write ``output`` even when the verdict is poor.
+    group_tol : float, optional
+        Joint values within this of each other are the same commanded value (rad; a prismatic
+        joint takes as many mm as that is deg); default derived from the data
+        (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -151,12 +156,13 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         raise InputError("offsets_for needs robot (the nominal model): the offsets correct the "
                          "nominal model the controller uses")
     options: dict[str, Any] = {"point_sigma": point_sigma, "angle_sigma": angle_sigma,
-                               "scale": scale, "compliance": compliance}
+                               "scale": scale, "compliance": compliance, "group_tol": group_tol}
     if robot is not None or cell is not None:
         nominal = load_robot(robot) if robot is not None else Cell.load(cell).nominal_robot
         meas = read_measurements(measurements, nominal.prismatic)
     else:
-        nominal, meas = first_estimate(measurements, j23_factor=j23_factor or 0.0)
+        nominal, meas = first_estimate(measurements, j23_factor=j23_factor or 0.0,
+                                       group_tol=group_tol)
     if j23_factor is not None:
         result = identify_with_coupling(nominal, meas, j23_factor, **options)
     else:

@@ -33,6 +33,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from robotcell.calibration.grouping import alone_groups
 from robotcell.calibration.measurements import Measurements
 from robotcell.calibration.result import CalibrationResult, result_json
 from robotcell.calibration.spec import SPECS
@@ -839,22 +840,22 @@ def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
                               label)
 
 
-def _check_alone(values: NDArray[np.float64], source: str) -> None:
+def _check_alone(values: NDArray[np.float64], source: str, group_tol: float | None) -> None:
     """Refuse touches in which no 3 rows turn one axis alone over 10 deg (no start without a cell).
 
     ``values`` (N, 2) are tilt and rotate (rad); the circle point analysis that starts the fit
-    without a nominal chain needs such a group per axis.
+    without a nominal chain needs such a group per axis, the other axis held to what the values
+    resolve (:func:`robotcell.calibration.grouping.alone_groups`).
     """
     least = SPECS["positioner"].minimum
     for k, name in enumerate(("e1 (tilt)", "e2 (rotate)")):
-        other = np.round(values[:, 1 - k], 9)
-        if not any(len(np.unique(np.round(values[other == o, k], 9))) >= least
-                   and np.ptp(values[other == o, k]) >= math.radians(10.0) * 0.999
-                   for o in np.unique(other)):
+        if not alone_groups(values, k, least=least, span=math.radians(10.0), tol=group_tol):
+            held = ("" if group_tol is None else
+                    f" (the other axis within the stated {math.degrees(group_tol):g} deg)")
             raise IllPosedError(
-                f"{source}: no {least} touches turn {name} alone over 10 deg or more; without "
-                f"{term('cell (Cell)', 'a cell')} the positioner calibration starts from the "
-                "circles of such touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give "
+                f"{source}: no {least} touches turn {name} alone over 10 deg or more{held}; "
+                f"without {term('cell (Cell)', 'a cell')} the positioner calibration starts from "
+                "the circles of such touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give "
                 "the cell with the positioner's nominal chain")
 
 
@@ -863,7 +864,8 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
                sigma: float | None = None, source: str | None = None,
                cell_label: str | None = None, time: str | None = None,
                on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
-               nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
+               nominal: NominalAccuracy = NOMINAL_ACCURACY, group_tol: float | None = None
+               ) -> CellCalibration:
     """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
 
     The touches (:func:`positioner_touches`) go to
@@ -887,6 +889,9 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
         Robot model for joint values when no cell is given.
     tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
+    group_tol : float, optional
+        Axis values within this of each other (rad) are the same commanded value; default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -903,8 +908,9 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
         m = read_touches("positioner", measurements, source, robot, notes.one)
         _refuse_track_column(m, _no_cell_track())
         points = m.tcp(tool_transform(None, tool))
-        _check_alone(m.axes, m.source)
-        done = calibrate_positioner(m.axes, points, prior_sigma=sigma, labels=m.labels())
+        _check_alone(m.axes, m.source, group_tol)
+        done = calibrate_positioner(m.axes, points, prior_sigma=sigma, labels=m.labels(),
+                                    group_tol=group_tol)
         return CellCalibration(done.result, notes=tuple(notes),
                                assumed=_assumed(None, m, tool, "T_R_B"))
     pos = cell.turntable
@@ -915,7 +921,7 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     chained = _chained(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
                        _world_track(cell, m), nominal, notes)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
-                                labels=m.labels(), inputs=chained.inputs)
+                                labels=m.labels(), inputs=chained.inputs, group_tol=group_tol)
     key = "T_world_B" if pos.parent == "world" else "T_R_B"
     result = done.result.renamed("T_R_B", key)
     record = _Record(_file(measurements, file), _options(sigma, tool), chained, nominal)
