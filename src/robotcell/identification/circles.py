@@ -1,7 +1,9 @@
 """Geometric first estimate (circle point analysis): joint axes from rows moving one joint.
 
 Rows that differ only in joint ``j`` move every target on a circle about axis ``j`` (revolute)
-or along a line parallel to it (prismatic). A plane and circle fit per target gives the axis
+or along a line parallel to it (prismatic); "only" to what the joint values resolve
+(:func:`robotcell.calibration.grouping.alone_groups`: joints read back from a controller with
+jitter group as the values commanded), each row brought back with its own values. A plane and circle fit per target gives the axis
 line in the device frame D: normal of the plane (oriented so that a positive joint value turns
 right-handed about it) through the circle's centre. Lines measured with joints ``1..j-1`` away
 from zero are brought back to the zero position by the inverse screw motions of the axes found
@@ -24,6 +26,7 @@ from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError
 from robotcell.identification.chain import PARALLEL_TOL
 from robotcell.identification.measurements import Measurements, read_measurements
+from robotcell.identification.result import GEOMETRIC_SOURCE
 from robotcell.robot.robot import Robot
 
 __all__ = ["axis_lines", "first_estimate", "start_model"]
@@ -264,7 +267,7 @@ def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
     names = tuple(f"A{i}" for i in range(1, len(types) + 1))
     chain = AxisChain(points=pts_R, directions=dirs_R, types=tuple(types), flange=F, names=names)
     return dh_from_axes(chain, "standard", name=name, title=name,
-                        source="circle point analysis of the measurements").robot
+                        source=GEOMETRIC_SOURCE).robot
 
 
 def _any_perpendicular(z: NDArray[np.float64]) -> NDArray[np.float64]:
