@@ -427,7 +427,7 @@ def test_compensate_json_and_report_give_the_error_and_sigma_per_pose(kr16, tmp_
     assert {"x", "a1", "dpos", "drot", "error_mm", "sigma_mm"} <= set(p)
     assert 0.2 < p["error_mm"] < 5 and 0 < p["sigma_mm"] < 0.05
     page = (tmp_path / "acc.html").read_text()
-    assert "1-sigma filtered (mm)" in page and "data:image/png;base64," in page
+    assert "3D RMS error filtered (mm)" in page and "data:image/png;base64," in page
     assert not (tmp_path / "cmd.csv").exists()
 
 

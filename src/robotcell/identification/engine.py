@@ -21,6 +21,11 @@ Steps (``docs/identification.md``):
 5. **Uncertainty.** ``cov = s0^2 (J^T J)^-1`` with the weighted Jacobian and the a-posteriori
    variance factor ``s0^2 = chi^2 / dof``; correlations, the scaled condition number, and rows
    whose residual is an outlier at 3 sigma (leave-one-out noise level, hat-matrix leverage).
+   The leave-one-out residuals (closed form) give the scatter no parameter explains
+   (``unexplained``) and of it the model error beyond the stated accuracy.
+
+Constants named in ``hold`` (:func:`robotcell.identification.identify_validated` holds those
+that do not predict held-out rows better) stay at their nominal values with the reason given.
 """
 
 from __future__ import annotations
