@@ -83,17 +83,17 @@ class ValidatedIdentification:
     chosen: Candidate
 
     def sentence(self) -> str:
-        """What was written and why, in mm (for reports)."""
+        """Which set was chosen (the model a file receives) and why, in mm (for reports)."""
         c, k = self.chosen, self.cross.folds
         start = next(x for x in self.candidates if x.label == "start").rms * 1e3
         full = next(x for x in self.candidates if x.label == "identified")
         if c.label == "identified":
-            return (f"written: every identifiable constant free ({c.free}); held-out RMS "
+            return (f"chosen: every identifiable constant free ({c.free}); held-out RMS "
                     f"{c.rms * 1e3:.4f} mm against {start:.4f} mm for the start model "
                     f"({k}-fold cross-validation)")
         what = ("the start model (no link constant moved)" if c.label == "start"
                 else f"the {c.free} most significant of {full.free} constants free")
-        return (f"written: {what}, chosen by {k}-fold cross-validation: held-out RMS "
+        return (f"chosen: {what}, by {k}-fold cross-validation: held-out RMS "
                 f"{c.rms * 1e3:.4f} mm, against {full.rms * 1e3:.4f} mm with every constant "
                 f"free and {start:.4f} mm for the start model")
 
