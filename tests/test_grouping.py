@@ -203,3 +203,34 @@ def test_jittered_repeats_of_a_configuration_count_once_for_the_redundancy():
     pts = (nominal.fk(q) @ np.array([0.05, 0.02, 0.1, 1.0]))[:, :3]
     with pytest.raises(IllPosedError, match=r"40 rows in 8 distinct configuration\(s\)"):
         identify(nominal, Measurements(q, pts))
+
+
+def test_turntable_and_track_commands_take_a_stated_tolerance(tmp_path, capsys):
+    # table angles 0, 2, 4, 180, 182 deg: five angles as read, two at a stated 5 deg
+    rng = np.random.default_rng(10)
+    theta = np.radians([0.0, 2.0, 4.0, 180.0, 182.0])
+    touched = np.column_stack([1.2 + 0.3 * np.cos(theta), 0.3 * np.sin(theta),
+                               np.full(5, 0.4)]) + rng.normal(0.0, NOISE, (5, 3))
+    rows = np.column_stack([touched * 1e3, np.degrees(theta)])
+    np.savetxt(tmp_path / "table.csv", rows, delimiter=",", fmt="%.6f", header="x,y,z,e1",
+               comments="")
+    code, _, err = run(capsys, "calibrate", "turntable", tmp_path / "table.csv", "--sigma",
+                       "0.05")
+    assert "distinct table angle" not in err
+    code, _, err = run(capsys, "calibrate", "turntable", tmp_path / "table.csv",
+                       "--group-tolerance", "5")
+    assert code == 2 and "only 2 distinct table angle(s)" in err
+    # track positions 3 mm apart: three positions as read, one at a stated 5 mm
+    e = np.array([1000.0, 1003.0, 1006.0])
+    touched = np.array([1.5, 0.2, 0.3]) - np.outer(e * 1e-3, [1.0, 0.0, 0.0])
+    rows = np.column_stack([touched * 1e3, e])
+    np.savetxt(tmp_path / "track.csv", rows, delimiter=",", fmt="%.6f", header="x,y,z,e1",
+               comments="")
+    code, _, err = run(capsys, "calibrate", "track", tmp_path / "track.csv")
+    assert "same track position" not in err
+    code, _, err = run(capsys, "calibrate", "track", tmp_path / "track.csv",
+                       "--group-tolerance", "5")
+    assert code == 2 and "all 3 touches are at the same track position" in err
+    code, _, err = run(capsys, "calibrate", "track", tmp_path / "track.csv",
+                       "--group-tolerance", "50")
+    assert code == 2 and "--group-tolerance must be from 1e-06 to 5 mm" in err

@@ -23,8 +23,10 @@ the measurement can resolve:
   its own values, or values equal to rounding) it is :data:`EXACT`: values equal to 1e-9 rad
   or m.
 
-Both run on a k-d tree (``scipy.spatial.cKDTree``, Chebyshev distance): only rows nearer than a
-few grid steps are compared, so the cost grows about linearly with the rows.
+Both run on a k-d tree (``scipy.spatial.cKDTree``, Chebyshev distance): each row is linked to its
+16 nearest rows within a few grid steps, and the groups these links leave are linked through
+their centres (single linkage, exact on a line, where the values are sorted instead), so time and
+memory grow about linearly with the rows however many share a value.
 """
 
 from __future__ import annotations
@@ -48,11 +50,14 @@ EXACT = 1e-9
 #: angle, 0.5 mm for a length (controllers read back within 0.01-0.1 deg of the commanded value).
 MAX_JITTER_ANGLE = math.radians(0.5)
 MAX_JITTER_LENGTH = 0.5e-3
-#: Ratio between the nearest-neighbour distance of rows at different commanded values and that
-#: of rows at the same value, from which the two are told apart.
+#: Ratio between the merge distance of rows at different commanded values and that of rows at
+#: the same value from which the two are told apart (and the reach, in plausible jitters, of the
+#: merge distances computed).
 GAP_RATIO = 10.0
 #: Smallest merge distance counted, in units of the plausible jitter: rows equal to rounding.
 _FLOOR = 1e-9 / MAX_JITTER_ANGLE
+#: Nearest rows each row is linked to (:func:`_linkage`).
+_NEIGHBOURS = 16
 
 
 def _as_rows(values: ArrayLike) -> NDArray[np.float64]:
@@ -107,23 +112,47 @@ def _tolerances(tol: ArrayLike, k: int) -> NDArray[np.float64]:
     return np.maximum(t, EXACT)
 
 
-def _merge_distances(scaled: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Single-linkage merge distances of the rows up to :data:`GAP_RATIO` (scaled units).
+def _linkage(scaled: NDArray[np.float64], reach: float
+             ) -> tuple[NDArray[np.float64], NDArray[np.int_]]:
+    """Single linkage of the rows up to ``reach`` (largest column difference, scaled units).
 
-    The edges of the minimum spanning tree (largest column difference) no longer than
-    ``GAP_RATIO``, sorted, then ``inf`` when the rows do not all link within it.
+    Returns the merge distances no longer than ``reach`` (unsorted) and the group of each row
+    when every merge up to ``reach`` is made. On a line these are the gaps between the sorted
+    values. Else each row is linked to its :data:`_NEIGHBOURS` nearest rows within reach (a k-d
+    tree query, linear memory however many rows share a value), the minimum spanning forest of
+    those links merges the rows, and the groups it leaves are linked again through their
+    centres, the same way, until no two are within reach.
     """
-    n = len(scaled)
-    if scaled.shape[1] == 1:  # on a line the tree's edges are the gaps between sorted values
-        gaps = np.maximum(np.diff(np.sort(scaled[:, 0])), _FLOOR)
-        return np.sort(np.where(gaps <= GAP_RATIO, gaps, np.inf))
-    tree = cKDTree(scaled)
-    near = tree.sparse_distance_matrix(tree, GAP_RATIO, p=np.inf, output_type="ndarray")
-    near = near[near["i"] < near["j"]]
-    weight = np.maximum(near["v"], _FLOOR)  # rows equal to rounding are linked too
-    graph = coo_matrix((weight, (near["i"], near["j"])), shape=(n, n)).tocsr()
-    edges = np.sort(minimum_spanning_tree(graph).data)
-    return np.append(edges, np.inf) if len(edges) < n - 1 else edges
+    n, k = scaled.shape
+    if k == 1:
+        order = np.argsort(scaled[:, 0], kind="stable")
+        gaps = np.maximum(np.diff(scaled[order, 0]), _FLOOR)
+        labels = np.empty(n, dtype=int)
+        labels[order] = np.concatenate([[0], np.cumsum(gaps > reach)])
+        return gaps[gaps <= reach], labels
+    m = min(n, _NEIGHBOURS + 1)
+    d, j = cKDTree(scaled).query(scaled, k=m, p=np.inf, distance_upper_bound=reach)
+    d, j = d.reshape(n, m), j.reshape(n, m)
+    i = np.broadcast_to(np.arange(n)[:, None], (n, m))
+    ok = np.isfinite(d) & (j != i)  # itself, and no row within reach, left out
+    weight = np.maximum(d[ok], _FLOOR)  # rows equal to rounding are linked too
+    forest = minimum_spanning_tree(coo_matrix((weight, (i[ok], j[ok])), shape=(n, n)).tocsr())
+    count, labels = connected_components(forest, directed=False)
+    edges = forest.data
+    if 1 < count < n:
+        centres = np.zeros((count, k))
+        np.add.at(centres, labels, scaled)
+        centres /= np.bincount(labels, minlength=count)[:, None]
+        more, joined = _linkage(centres, reach)
+        edges, labels = np.concatenate([edges, more]), joined[labels]
+    return edges, labels
+
+
+def _merge_distances(scaled: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Single-linkage merge distances of the rows up to :data:`GAP_RATIO` (scaled units): sorted,
+    then ``inf`` when the rows do not all link within it."""
+    edges = np.sort(_linkage(scaled, GAP_RATIO)[0])
+    return np.append(edges, np.inf) if len(edges) < len(scaled) - 1 else edges
 
 
 def resolution(values: ArrayLike, prismatic: ArrayLike | None = None) -> NDArray[np.float64]:
@@ -186,10 +215,7 @@ def groups(values: ArrayLike, tol: ArrayLike | None = None,
     if n == 0:
         return np.zeros(0, dtype=int)
     t = resolution(rows, prismatic) if tol is None else _tolerances(tol, k)
-    scaled = rows / t
-    pairs = cKDTree(scaled).query_pairs(1.0 + 1e-12, p=np.inf, output_type="ndarray")
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, labels = connected_components(graph, directed=False)
+    labels = _linkage(rows / t, 1.0 + 1e-12)[1]
     _, first, inverse = np.unique(labels, return_index=True, return_inverse=True)
     order = np.argsort(np.argsort(first))
     return order[inverse]

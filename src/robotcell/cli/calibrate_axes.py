@@ -44,11 +44,12 @@ from robotcell.io.tables import CELL_EXTENT_MM
 @click.option("--roll", type=click.Choice(["zero"]), default=None,
               help="Without --reference: return the full rotation L_Q_R with zero roll about the "
                    "track axis (a convention, not a measurement).")
+@group_tolerance_option("Track positions e1", "mm")
 @cell_option
 @measurement_options
 def track(measurements: str, references: tuple[str, ...], axis: str | None, roll: str | None,
-          cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
-          as_json: bool, accept_poor: bool) -> None:
+          group_tolerance: float | None, cell_path: str | None, robot: str | None,
+          tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
     """Linear track: direction in the robot base, scale, straightness; rotation when determined.
 
     \b
@@ -73,6 +74,7 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     out = cellcal.track(cell, measurements, references=refs, axis=axis, roll=roll,
                         robot=None if cell else model, tool=T_tool, sigma=sigma_m(sigma),
                         source=measurements, cell_label=label, on_note=echo_note,
+                        group_tol=None if group_tolerance is None else group_tolerance * 1e-3,
                         **chain_options(measurements))
     finish(out, target, as_json, accept_poor)
 
@@ -82,10 +84,12 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
 @click.option("--height", type=float, default=0.0, show_default=True, metavar="MM",
               help="Shift of the frame origin along the table axis from the plane of the touched "
                    "point (mm), e.g. -20 when the point is 20 mm above the table top.")
+@group_tolerance_option("Table angles e1")
 @cell_option
 @measurement_options
-def turntable(measurements: str, height: float, cell_path: str | None, robot: str | None,
-              tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+def turntable(measurements: str, height: float, group_tolerance: float | None,
+              cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
+              as_json: bool, accept_poor: bool) -> None:
     """Turntable root frame B (R_T_B) and radius from touches of one point on the table.
 
     \b
@@ -109,7 +113,10 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     cell, label = cell_of(target)
     out = cellcal.turntable(cell, measurements, height=height * 1e-3, robot=None if cell else model,
                             tool=T_tool, sigma=sigma_m(sigma), source=measurements,
-                            cell_label=label, on_note=echo_note, **chain_options(measurements))
+                            cell_label=label, on_note=echo_note,
+                            group_tol=(None if group_tolerance is None
+                                       else math.radians(group_tolerance)),
+                            **chain_options(measurements))
     finish(out, target, as_json, accept_poor)
 
 

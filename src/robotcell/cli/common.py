@@ -98,25 +98,28 @@ def in_range(lo: float, hi: float, unit: str) -> Callable[[click.Context, click.
     return callback
 
 
-#: Range of ``--group-tolerance`` (deg; mm for prismatic joints): read-back jitter is 0.01-0.1
-#: deg, and a few degrees would merge values commanded apart.
+#: Range of ``--group-tolerance`` (deg; mm for prismatic joints and track positions): read-back
+#: jitter is 0.01-0.1 deg, and a few degrees would merge values commanded apart.
 GROUP_TOLERANCE_DEG = (1e-6, 5.0)
 
 
-def group_tolerance_option(values: str) -> Callable[[Callable], Callable]:
-    """Option ``--group-tolerance DEG`` (None when not given) of the commands that group rows.
+def group_tolerance_option(values: str, unit: str = "deg") -> Callable[[Callable], Callable]:
+    """Option ``--group-tolerance`` (None when not given) of the commands that group rows.
 
     Parameters
     ----------
     values : str
         What the tolerance applies to, for the help text (``Joint values``).
+    unit : {"deg", "mm"}
+        Unit of the values: ``deg`` (a prismatic joint taking mm), or ``mm`` (track positions).
     """
+    also = " (mm for a prismatic joint)" if unit == "deg" else ""
     return click.option(
-        "--group-tolerance", "group_tolerance", type=float, default=None, metavar="DEG",
-        callback=in_range(*GROUP_TOLERANCE_DEG, "deg"),
-        help=f"{values} within this many deg (mm for a prismatic joint) of each other are the "
-             "same commanded value, e.g. read back from the controller with jitter. Default: "
-             "derived from the data (docs/calibration.md, 'Rows taken at the same axis values').")
+        "--group-tolerance", "group_tolerance", type=float, default=None, metavar=unit.upper(),
+        callback=in_range(*GROUP_TOLERANCE_DEG, unit),
+        help=f"{values} within this many {unit}{also} of each other are the same commanded "
+             "value, e.g. read back from the controller with jitter. Default: derived from the "
+             "data (docs/calibration.md, 'Rows taken at the same axis values').")
 
 
 def counted(n: int, noun: str) -> str:

@@ -659,8 +659,8 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
           tool: str | ArrayLike | None = None, sigma: float | None = None,
           source: str | None = None, cell_label: str | None = None,
           time: str | None = None, on_note: Callable[[str], None] | None = None,
-          file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY
-          ) -> CellCalibration:
+          file: str | Path | None = None, nominal: NominalAccuracy = NOMINAL_ACCURACY,
+          group_tol: float | None = None) -> CellCalibration:
     """Linear track (direction, scale, straightness, rotation when determined) into a cell.
 
     Parameters
@@ -679,6 +679,9 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
         Without references: fix the rotation about the track axis to zero (a convention).
     robot, tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
+    group_tol : float, optional
+        Track positions within this of each other (m) are one commanded position; default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -711,7 +714,7 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
     chained = _chained(cell, m, f, tool, None, nominal, notes)
     result = calibrate_track(e, f, references=refs if len(refs) else None, point=idx,
                              axis=axis or "x", roll=roll, labels=m.labels(),
-                             prior_sigma=sigma, inputs=chained.inputs)
+                             prior_sigma=sigma, inputs=chained.inputs, group_tol=group_tol)
     assumed = _assumed(cell, m, tool, "T_L_R")
     if cell is None:
         return CellCalibration(result, notes=tuple(notes), assumed=assumed)
@@ -939,7 +942,8 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
               sigma: float | None = None, source: str | None = None,
               cell_label: str | None = None, time: str | None = None,
               on_note: Callable[[str], None] | None = None, file: str | Path | None = None,
-              nominal: NominalAccuracy = NOMINAL_ACCURACY) -> CellCalibration:
+              nominal: NominalAccuracy = NOMINAL_ACCURACY, group_tol: float | None = None
+              ) -> CellCalibration:
     """Turntable root frame B and radius, from touches of one point on the table, into a cell.
 
     Parameters
@@ -953,6 +957,9 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
         Shift of the frame origin along the table axis from the plane of the touched point (m).
     robot, tool, sigma, source, cell_label, time, on_note, file, nominal
         As for :func:`frame`.
+    group_tol : float, optional
+        Table angles within this of each other (rad) are one commanded angle; default derived
+        from the data (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -967,7 +974,7 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     m = read_touches("turntable", measurements, source, _arm(cell, robot), notes.one)
     theta, f, chained = _on_table(cell, m, tool, label, nominal, notes, m.check_count)
     result = calibrate_turntable(theta, f, height=height, labels=m.labels(),
-                                 prior_sigma=sigma, inputs=chained.inputs)
+                                 prior_sigma=sigma, inputs=chained.inputs, group_tol=group_tol)
     key = "T_world_B" if parent == "world" else "T_R_B"
     assumed = _assumed(cell, m, tool, key, mapped=parent == "world")
     if cell is None:
