@@ -122,7 +122,10 @@ def test_the_covariance_round_trips_through_the_model_file(kr16, tmp_path):
     back = load_robot(tmp_path / "arm.yaml").covariance
     assert back.names == res.robot.covariance.names
     assert np.allclose(back.matrix, res.robot.covariance.matrix, rtol=1e-9, atol=0)
-    assert "A1.theta" not in back.names and "base.x" not in back.names
+    # the robot base in the tracker frame is kept with its correlations, the targets are not
+    assert "A1.theta" not in back.names and "base.x" in back.names
+    assert not any(n.startswith("target") for n in back.names)
+    assert back.model_error == pytest.approx(res.model_error, rel=1e-5)
 
 
 # -- end to end -----------------------------------------------------------------------------------
@@ -384,9 +387,10 @@ def test_export_of_an_identified_ur5e_writes_the_calibration_file_the_descriptio
 # -- how good it will be --------------------------------------------------------------------------
 def test_the_predicted_sigma_agrees_with_a_monte_carlo_of_the_identification():
     """A 3-axis arm with two reflectors, 20 configurations, 0.05 mm noise, identified 50 times:
-    the RMS of the identified FK's error at 8 test configurations (against a noise-free
-    identification, the same gauge) over the trials, against the predicted 1-sigma
-    (sqrt of the trace of J C J^T, pooled over the points). Its standard deviation follows from
+    the RMS of the error of the identified TCP as located in the measuring frame (base and arm)
+    at 8 test configurations (against a noise-free identification, the same gauge) over the
+    trials, against the predicted 1-sigma (sqrt of the trace of J C J^T over the base and the
+    arm's constants, plus the model error, pooled over the points). Its standard deviation follows from
     the predicted covariance S of the stacked errors (Var of a Gaussian quadratic form,
     2 tr(S^2)): the bounds 0.8 and 1.25 are more than 3 of it away."""
     from robotcell.identification import Measurements
@@ -411,14 +415,16 @@ def test_the_predicted_sigma_agrees_with_a_monte_carlo_of_the_identification():
 
     exact = identify(nominal, measure(rng.uniform(-1.5, 1.5, (400, 3)), 0.0), point_sigma=noise)
     q_test, tool = rng.uniform(-1.5, 1.5, (8, 3)), make_pose(None, [0.1, 0.05, 0.15])
-    ref = exact.robot.fk(q_test, tool=tool)[:, :3, 3]
+    ref = (exact.base @ exact.robot.fk(q_test, tool=tool))[:, :3, 3]
     q = rng.uniform(-1.5, 1.5, (20, 3))
     trials, squares, S, sigmas = 50, [], 0.0, []
     for _ in range(trials):
         res = identify(nominal, measure(q, noise), point_sigma=noise)
-        squares.append(np.sum((res.robot.fk(q_test, tool=tool)[:, :3, 3] - ref) ** 2))
-        J = position_jacobian(res.robot, q_test, tool).reshape(-1, len(res.robot.covariance.names))
-        S = S + J @ res.robot.covariance.matrix @ J.T / trials
+        # the TCP as the identification locates it in the measuring frame (base and arm)
+        squares.append(np.sum(((res.base @ res.robot.fk(q_test, tool=tool))[:, :3, 3] - ref) ** 2))
+        cov = res.robot.covariance
+        J = position_jacobian(res.robot, q_test, tool).reshape(-1, len(cov.names))
+        S = S + (J @ cov.matrix @ J.T + cov.model_error**2 * np.eye(len(J))) / trials
         sigmas.append(position_sigma(res.robot, q_test, tool))
     assert np.allclose(np.sum(np.mean(np.square(sigmas), axis=0)), np.trace(S))
     ratio = math.sqrt(np.mean(squares) / np.trace(S))
@@ -440,7 +446,7 @@ def test_compensate_json_and_report_give_the_error_and_sigma_per_pose(kr16, tmp_
     assert {"x", "a1", "dpos", "drot", "error_mm", "sigma_mm"} <= set(p)
     assert 0.2 < p["error_mm"] < 5 and 0 < p["sigma_mm"] < 0.05
     page = (tmp_path / "acc.html").read_text()
-    assert "1-sigma filtered (mm)" in page and "data:image/png;base64," in page
+    assert "3D RMS error filtered (mm)" in page and "data:image/png;base64," in page
     assert not (tmp_path / "cmd.csv").exists()
 
 

@@ -179,7 +179,8 @@ def test_outlier_row_is_flagged():
 
 
 def test_coupling_and_scale_are_identified():
-    # A FANUC-style arm: the controller's J3 is the forearm angle, q3_model = J3 - J2.
+    # A parallel arm (as the IRB 2400): the controller's axis 3 is the forearm angle,
+    # q3_model = J3 - J2 (FANUC's linkage is +1: docs/robots.md).
     rng = np.random.default_rng(8)
     nominal = load_robot("kuka_kr16")
     scale = np.array([0.0, 2e-4, -3e-4, 0.0, 0.0, 0.0])

@@ -126,9 +126,9 @@ def test_identify_j23_factor_report(tmp_path, capsys):
     nominal = load_robot("kuka_kr16")
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng, coupling=-1.0)
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
-    csv = tmp_path / "fanuc.csv"
+    csv = tmp_path / "parallel_arm.csv"  # axis 3 = the forearm's angle, q3_model = J3 - J2
     write_csv(csv, meas)
-    out = tmp_path / "fanuc_identified.yaml"
+    out = tmp_path / "parallel_arm_identified.yaml"
     code, stdout, _ = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--j23-factor", "-1",
                           "--json", "--accuracy", "0.02", "-o", out)
     assert code == 0

@@ -21,8 +21,8 @@ A correction above ``max_correction`` (default 5 mm) is refused: no real arm is 
 drawing, the identified model is wrong (another robot, a unit error). Besides the commanded pose
 :func:`filter_poses` predicts, per pose, the TCP error without filtering (the identified arm at
 the joints the controller computes for the desired pose) and, for a model that carries the
-identification's covariance, the 1-sigma of the filtered position
-(:func:`robotcell.identification.uncertainty.position_sigma`).
+identification's covariance, the 3D RMS of the filtered position's error (base, constants and
+model error: :func:`robotcell.identification.uncertainty.position_sigma`).
 """
 
 from __future__ import annotations
@@ -90,8 +90,9 @@ class FilteredPoses:
         Predicted TCP error without filtering: where the identified arm takes the joints the
         controller computes for the desired pose, against it (m, rad).
     sigma : ndarray, shape (N,)
-        1-sigma of the filtered TCP position from the identification's covariance (the RMS
-        length of its error, m); NaN when the identified model carries no covariance.
+        3D RMS of the filtered TCP position's error (the RMS length of the error the
+        identification's covariance and model error predict, m); NaN when the identified
+        model carries no covariance.
     branch : ndarray of int, shape (N,)
         The IK branch (configuration) used.
     flags : ndarray of int, shape (N, 3)

@@ -74,7 +74,7 @@ class CompensatedPoint:
     error, error_rot : float
         Predicted TCP error without filtering (m, rad).
     sigma : float
-        1-sigma of the filtered TCP position (m; NaN without a covariance).
+        3D RMS of the filtered TCP position's error (m; NaN without a covariance).
     q_old, q_new : ndarray, shape (n,)
         The controller's joints before and after (rad).
     flags : tuple of int

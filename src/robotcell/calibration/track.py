@@ -39,6 +39,7 @@ from robotcell.calibration.fitting import (
     outlier_warnings,
     perturb_rotation,
 )
+from robotcell.calibration.grouping import distinct
 from robotcell.calibration.propagate import jacobian, propagate
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, fit_fields
 from robotcell.calibration.spec import SPECS
@@ -112,14 +113,20 @@ def _axis_vector(axis: str) -> NDArray[np.float64]:
     return TRACK_AXES[axis]
 
 
-def _check_positions(e: NDArray[np.float64]) -> float:
-    """Refuse touches that leave the track direction undetermined; return the travel (m)."""
+def _check_positions(e: NDArray[np.float64], group_tol: float | None) -> float:
+    """Refuse touches that leave the track direction undetermined; return the travel (m).
+
+    Positions read back with jitter around one commanded position are one position
+    (:func:`robotcell.calibration.grouping.distinct`).
+    """
     travel = float(e.max() - e.min())
-    if travel == 0.0:
+    if travel == 0.0 or distinct(e, group_tol, [True]) < 2:
+        within = "" if travel == 0.0 else f", read back within {travel * 1e3:.3f} mm"
         raise IllPosedError(
-            f"all {len(e)} touches are at the same track position ({e[0] * 1e3:.3f} mm), so the "
-            "track direction and scale are not determined; touch at two or more track positions, "
-            f"spread over at least {TRAVEL_WARN * 1e3:.0f} mm of travel, ideally the whole track")
+            f"all {len(e)} touches are at the same track position ({e.mean() * 1e3:.3f} mm"
+            f"{within}), so the track direction and scale are not determined; touch at two or "
+            f"more track positions, spread over at least {TRAVEL_WARN * 1e3:.0f} mm of travel, "
+            "ideally the whole track")
     return travel
 
 
@@ -211,6 +218,7 @@ def calibrate_track(
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
     inputs: Inputs | None = None,
+    group_tol: float | None = None,
 ) -> CalibrationResult:
     """Calibrate a linear track from TCP touches of fixed reference points.
 
@@ -245,6 +253,11 @@ def calibrate_track(
     inputs : Inputs, optional
         Earlier calibrations the touched points rest on (the tool), whose errors are added to
         the uncertainty.
+    group_tol : float, optional
+        Track positions within this of each other (m) are the same commanded position, for the
+        check that the touches are at two or more; default derived from the data
+        (:func:`robotcell.calibration.grouping.resolution`), so that positions read back with
+        jitter count as the position commanded.
 
     Returns
     -------
@@ -272,7 +285,7 @@ def calibrate_track(
         positions are data: they are averaged by the fit.
     """
     f, e, d, labels, refs, groups = _track_touches(e, f, references, point, axis, roll, labels)
-    travel = _check_positions(e)
+    travel = _check_positions(e, group_tol)
     warnings: list[str] = [] if refs is None else _check_references(refs, d)
     if refs is None:
         tf = _unknown_point_track(e, f, d, axis, roll, prior_sigma, inputs)

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.fitting import SAME_POINT, Fit, fit, outlier_warnings, perturb_rotation
+from robotcell.calibration.grouping import distinct as count_distinct
 from robotcell.calibration.propagate import propagate
 from robotcell.calibration.result import (
     CONDITION_LIMIT,
@@ -61,13 +62,15 @@ def angular_spread(theta: ArrayLike) -> float:
     return float(2.0 * np.pi - gaps.max())
 
 
-def _check_angles(theta: NDArray[np.float64]) -> float:
+def _check_angles(theta: NDArray[np.float64], group_tol: float | None) -> float:
     """Refuse angles that leave the circle undetermined (fewer than 3 distinct); return the spread.
 
-    Repeated angles (90 twice, 0 and 360) are data, averaged by the fit.
+    Repeated angles (90 twice, 0 and 360, or read back with jitter around one commanded angle)
+    are data, averaged by the fit: angles are told apart to what they resolve
+    (:func:`robotcell.calibration.grouping.distinct`, on the unit circle, whose chord is the
+    angle to 1e-5 relative at the jitter's scale).
     """
-    on_circle = np.round(np.stack([np.cos(theta), np.sin(theta)], axis=1), 9) + 0.0
-    distinct = len(np.unique(on_circle, axis=0))
+    distinct = count_distinct(np.stack([np.cos(theta), np.sin(theta)], axis=1), group_tol)
     if distinct < 3:
         raise IllPosedError(
             f"the touches are at only {distinct} distinct table angle(s) (modulo 360 deg): a "
@@ -106,6 +109,7 @@ def calibrate_turntable(
     labels: Sequence[str] | None = None,
     prior_sigma: float | None = None,
     inputs: Inputs | None = None,
+    group_tol: float | None = None,
 ) -> CalibrationResult:
     """Calibrate the root frame B of a turntable from touches of one point on the table.
 
@@ -130,6 +134,10 @@ def calibrate_turntable(
     inputs : Inputs, optional
         Earlier calibrations the touched points rest on (the tool, a track), whose errors are
         added to the uncertainty.
+    group_tol : float, optional
+        Table angles within this of each other (rad) are the same commanded angle, for the count
+        of distinct angles; default derived from the data
+        (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -154,7 +162,7 @@ def calibrate_turntable(
         axis is computed, with a warning below :data:`RADIUS_WARN` and a larger condition number.
     """
     f, theta, labels = _turntable_touches(theta, f, height, labels)
-    spread = _check_angles(theta)
+    spread = _check_angles(theta, group_tol)
     b_plane, R0, r0 = _linear_start(theta, f)
     rot_theta = rot_z(theta)
 

@@ -9,6 +9,8 @@ turntable, positioner and workpiece.
 
 from __future__ import annotations
 
+import math
+
 import click
 import numpy as np
 
@@ -25,7 +27,7 @@ from robotcell.cli.calibrate import (
     robot_and_tool,
     sigma_m,
 )
-from robotcell.cli.common import parse_numbers
+from robotcell.cli.common import group_tolerance_option, parse_numbers
 from robotcell.cli.files import Command
 from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM
@@ -42,11 +44,12 @@ from robotcell.io.tables import CELL_EXTENT_MM
 @click.option("--roll", type=click.Choice(["zero"]), default=None,
               help="Without --reference: return the full rotation L_Q_R with zero roll about the "
                    "track axis (a convention, not a measurement).")
+@group_tolerance_option("Track positions e1", "mm")
 @cell_option
 @measurement_options
 def track(measurements: str, references: tuple[str, ...], axis: str | None, roll: str | None,
-          cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
-          as_json: bool, accept_poor: bool) -> None:
+          group_tolerance: float | None, cell_path: str | None, robot: str | None,
+          tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
     """Linear track: direction in the robot base, scale, straightness; rotation when determined.
 
     \b
@@ -68,10 +71,11 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
     model, T_tool = robot_and_tool(robot, tool, target)
     refs = np.array([parse_numbers(r, "--reference", 3) for r in references]).reshape(-1, 3) * 1e-3
     label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    tol = None if group_tolerance is None else group_tolerance * 1e-3
     finish(lambda cell: cellcal.track(cell, measurements, references=refs, axis=axis, roll=roll,
                                       robot=None if cell else model, tool=T_tool, sigma=prior,
                                       source=measurements, cell_label=label, on_note=echo_note,
-                                      **options),
+                                      group_tol=tol, **options),
            target, as_json, accept_poor)
 
 
@@ -80,10 +84,12 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
 @click.option("--height", type=float, default=0.0, show_default=True, metavar="MM",
               help="Shift of the frame origin along the table axis from the plane of the touched "
                    "point (mm), e.g. -20 when the point is 20 mm above the table top.")
+@group_tolerance_option("Table angles e1")
 @cell_option
 @measurement_options
-def turntable(measurements: str, height: float, cell_path: str | None, robot: str | None,
-              tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+def turntable(measurements: str, height: float, group_tolerance: float | None,
+              cell_path: str | None, robot: str | None, tool: str | None, sigma: float | None,
+              as_json: bool, accept_poor: bool) -> None:
     """Turntable root frame B (R_T_B) and radius from touches of one point on the table.
 
     \b
@@ -105,19 +111,22 @@ def turntable(measurements: str, height: float, cell_path: str | None, robot: st
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    tol = None if group_tolerance is None else math.radians(group_tolerance)
     finish(lambda cell: cellcal.turntable(cell, measurements, height=height * 1e-3,
                                           robot=None if cell else model, tool=T_tool, sigma=prior,
                                           source=measurements, cell_label=label,
-                                          on_note=echo_note, **options),
+                                          on_note=echo_note, group_tol=tol, **options),
            target, as_json, accept_poor)
 
 
 @click.command("positioner", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
+@group_tolerance_option("Axis values e1, e2")
 @cell_option
 @measurement_options
-def positioner(measurements: str, cell_path: str | None, robot: str | None, tool: str | None,
-               sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+def positioner(measurements: str, group_tolerance: float | None, cell_path: str | None,
+               robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+               accept_poor: bool) -> None:
     """2-axis (tilt-rotate) positioner: both axis lines, common normal, zeros, root frame.
 
     \b
@@ -126,7 +135,8 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     With --cell the cell's chain is the start and the calibrated chain is written into the cell
     file (its 'positioner' section); the values are in the positioner's parent frame (the world,
     mapped through column track (mm) in a cell with a track). Without --cell they are in the
-    robot base, and each axis needs at least 3 touches that move it alone.
+    robot base, and each axis needs at least 3 touches that move it alone (the other axis at
+    one commanded value, to the --group-tolerance).
 
     \b
     Examples:
@@ -137,9 +147,11 @@ def positioner(measurements: str, cell_path: str | None, robot: str | None, tool
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
     label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
+    tol = None if group_tolerance is None else math.radians(group_tolerance)
     finish(lambda cell: cellcal.positioner(cell, measurements, robot=None if cell else model,
                                            tool=T_tool, sigma=prior, source=measurements,
-                                           cell_label=label, on_note=echo_note, **options),
+                                           cell_label=label, on_note=echo_note, group_tol=tol,
+                                           **options),
            target, as_json, accept_poor)
 
 

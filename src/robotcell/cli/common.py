@@ -29,6 +29,7 @@ from robotcell.io.tables import (
 )
 
 __all__ = [
+    "GROUP_TOLERANCE_DEG",
     "MAX_CORRECTION_MM",
     "NOISE_MAX_MM",
     "BadPoints",
@@ -37,6 +38,7 @@ __all__ = [
     "check_not_folder",
     "check_output",
     "format_table",
+    "group_tolerance_option",
     "in_range",
     "output_of",
     "parse_numbers",
@@ -94,6 +96,30 @@ def in_range(lo: float, hi: float, unit: str) -> Callable[[click.Context, click.
                              f"{value:g}")
         return value
     return callback
+
+
+#: Range of ``--group-tolerance`` (deg; mm for prismatic joints and track positions): read-back
+#: jitter is 0.01-0.1 deg, and a few degrees would merge values commanded apart.
+GROUP_TOLERANCE_DEG = (1e-6, 5.0)
+
+
+def group_tolerance_option(values: str, unit: str = "deg") -> Callable[[Callable], Callable]:
+    """Option ``--group-tolerance`` (None when not given) of the commands that group rows.
+
+    Parameters
+    ----------
+    values : str
+        What the tolerance applies to, for the help text (``Joint values``).
+    unit : {"deg", "mm"}
+        Unit of the values: ``deg`` (a prismatic joint taking mm), or ``mm`` (track positions).
+    """
+    also = " (mm for a prismatic joint)" if unit == "deg" else ""
+    return click.option(
+        "--group-tolerance", "group_tolerance", type=float, default=None, metavar=unit.upper(),
+        callback=in_range(*GROUP_TOLERANCE_DEG, unit),
+        help=f"{values} within this many {unit}{also} of each other are the same commanded "
+             "value, e.g. read back from the controller with jitter. Default: derived from the "
+             "data (docs/calibration.md, 'Rows taken at the same axis values').")
 
 
 def counted(n: int, noun: str) -> str:

@@ -15,6 +15,7 @@ from robotcell.cli.common import (
     check_kind,
     check_not_folder,
     check_output,
+    group_tolerance_option,
     parse_numbers,
     read_csv,
     warn_unknown_columns,
@@ -24,7 +25,7 @@ from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.io.tables import format_table, write_csv
 from robotcell.report.identification import write_identification_report
-from robotcell.studies.identify import identify_file, zero_offset_controllers
+from robotcell.studies.identify import DEFAULT_FOLDS, identify_file, zero_offset_controllers
 from robotcell.studies.propose import propose_configurations
 
 #: Columns of a measurement CSV (docs/identification.md): joints ``a1..aN``, one target ``x,y,z``
@@ -52,7 +53,7 @@ def _print_offsets(offsets: dict, vendor: str) -> None:
 #: Range of ``--accuracy`` (mm) and ``--angle-accuracy`` (deg): 0.1 um (0.1 mdeg) is finer than
 #: any measuring device, 1 m (1000 deg) coarser than any measurement worth a fit.
 ACCURACY_MIN, ACCURACY_MAX = 1e-4, 1e3
-#: Largest ``|--j23-factor|``: a J2/J3 linkage moves axis 3 by about as much as axis 2 (FANUC: -1).
+#: Largest ``|--j23-factor|``: a J2/J3 linkage moves axis 3 by about as much as axis 2 (FANUC: 1).
 J23_MAX = 10.0
 
 def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientation: bool,
@@ -99,7 +100,8 @@ def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientat
               "proposed configurations (CSV).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of the report.")
 @click.option("--j23-factor", "j23", type=float, help="J2/J3 coupling k: q3_model = J3 + k * J2 "
-              "(FANUC: -1). The report says whether the data support it.")
+              "(FANUC: 1, as the ROS-Industrial driver's J23_factor; docs/robots.md). The report "
+              "compares the fits with it, without it and with k fitted, in mm.")
 @click.option("--accuracy", "accuracy", type=float, default=0.05, show_default=True,
               help="Accuracy of a measured coordinate (mm).")
 @click.option("--angle-accuracy", "angle_accuracy", type=float, default=0.02, show_default=True,
@@ -108,10 +110,13 @@ def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientat
 @click.option("--compliance", "compliance", is_flag=True, help="Also identify the gravity compliance "
               "of axes 2 and 3 (needs the link masses: joint keys mass, com in the model file).")
 @click.option("--force", "force", is_flag=True, help="Write -o even when the verdict is poor.")
-@click.option("--folds", "folds", type=int, help="Also K-fold cross-validate: every row predicted "
-              "by the models identified without it (mean, RMS, max before and after).")
+@click.option("--folds", "folds", type=click.IntRange(min=0), default=DEFAULT_FOLDS,
+              show_default=True, help="K-fold cross-validation: every row predicted by the models "
+              "identified without it (mean, RMS, max of the start model and the identified one); "
+              "constants are freed only as far as they predict held-out rows better than the "
+              "start model. 0: none (every identifiable constant freed, unchecked).")
 @click.option("--report", "report", type=OUTPUT, callback=check_not_folder, help="Also write a "
-              "self-contained HTML report (figures embedded); cross-validates with --folds or 5.")
+              "self-contained HTML report (figures embedded).")
 @click.option("--offsets-for", "offsets_for", type=LiveChoice(zero_offset_controllers), help="Also print "
               "the identified joint zero offsets for the controller: KUKA $MAMES corrections (deg), "
               "ABB arm-side offsets (rad). Needs --robot.")
@@ -132,26 +137,32 @@ def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientat
 @click.option("--cell", "cell_path", type=click.Path(dir_okay=False),
               help="Also make the identified model (-o) the arm of this cell file "
                    "(robot.identified), with the identification's time, RMS and held-out error "
-                   "(--folds or 5); its robot.model is the nominal when --robot is not given. "
+                   "(--folds); its robot.model is the nominal when --robot is not given. "
                    "With --propose: its robot.model and its floor.")
+@group_tolerance_option("Joint values")
 def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
              j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
-             compliance: bool, force: bool, folds: int | None, report: str | None,
+             compliance: bool, force: bool, folds: int, report: str | None,
              offsets_for: str | None, propose: int | None, targets: int, orientation: bool,
-             seed: int, box: str | None, cell_path: str | None) -> None:
+             seed: int, box: str | None, cell_path: str | None,
+             group_tolerance: float | None) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
     x,y,z (mm, in the measuring device's frame) or several x1,y1,z1,x2,y2,z2,..., and with one
     target optionally its orientation qw,qx,qy,qz. See docs/identification.md.
 
-    --folds K adds a K-fold cross-validation: every row predicted by the nominal and the
-    identified model fitted without it. --report FILE.html writes the report as one HTML page
-    with figures (errors before and after, cross-validation, parameters, correlations,
-    observability of the measured configurations against random ones).
+    A K-fold cross-validation (--folds, default 5) predicts every row by the start and the
+    identified model fitted without it; when freeing every constant predicts held-out rows worse
+    than the start, fewer constants (chosen by the same cross-validation) or none are freed.
+    The report states the predicted error of a position (1-sigma per axis, 3D RMS, 95 % radius)
+    and the model error the fit cannot explain. --report FILE.html writes the report as one
+    HTML page with figures (errors before and after, cross-validation, parameters,
+    correlations, observability of the measured configurations against random ones).
 
     Exit status: 0 identified; 2 refused input (reason on stderr); 3 poor result (the model
-    file is not written unless --force).
+    file is not written unless --force), e.g. a nominal model the data contradict (a constant
+    moved more than 20 mm or 2 deg).
 
     --propose N (no MEASUREMENTS) proposes N configurations to measure instead: those that
     maximise Borm and Menq's observability index O1 for --robot (or the cell's robot), compared
@@ -161,7 +172,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     \b
     Examples:
       robotcell identify tracker.csv --robot kuka_kr16 -o kr16_identified.yaml
-      robotcell identify tracker.csv --robot fanuc_m20ia --j23-factor -1 --json
+      robotcell identify tracker.csv --robot fanuc_m20ia --j23-factor 1 --json
       robotcell identify --propose 30 --robot kuka_kr16 --targets 3 -o to_measure.csv
     """
     for name, value, unit in (("--accuracy", accuracy, "mm"),
@@ -171,7 +182,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
                              f"to {ACCURACY_MAX:g}, got {value:g}")
     if j23 is not None and not abs(j23) <= J23_MAX:
         raise InputError(f"--j23-factor must be a finite number from -{J23_MAX:g} to {J23_MAX:g} "
-                         f"(a linkage's ratio; FANUC: -1), got {j23:g}")
+                         f"(a linkage's ratio; FANUC: 1), got {j23:g}")
     if propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
@@ -193,10 +204,13 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
     _check_columns(measurements)
-    with as_flags({"the nominal model as robot": "the nominal model with --robot"}):
+    with as_flags({"the nominal model as robot": "the nominal model with --robot",
+                   "folds=0": "--folds 0", "folds": "--folds",
+                   "state the grouping tolerance": "state it with --group-tolerance"}):
         run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
                             math.radians(angle_accuracy), scale, compliance, folds,
-                            report is not None, offsets_for, output, force)
+                            report is not None, offsets_for, output, force,
+                            None if group_tolerance is None else math.radians(group_tolerance))
     if report is not None:
         write_identification_report(run.result, report, run.cross, run.observability,
                                     run.measurements)
@@ -209,10 +223,11 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
         if offsets is not None:
             _print_offsets(offsets, offsets_for)
         if cv is not None:
-            click.echo(f"cross-validation, {run.folds} folds (held-out rows, mm): nominal mean "
+            click.echo(f"cross-validation, {run.folds} folds (held-out rows, mm): start model mean "
                        f"{cv['before_mean_mm']:.4f} RMS {cv['before_rms_mm']:.4f} max "
                        f"{cv['before_max_mm']:.4f}; identified mean {cv['after_mean_mm']:.4f} RMS "
                        f"{cv['after_rms_mm']:.4f} max {cv['after_max_mm']:.4f}")
+            click.echo(run.choice.sentence())
     if run.written and not as_json:
         click.echo(f"identified model written to {output}"
                    + (f"; {cell_path} computes with it (robot.identified)" if cell_path else ""))

@@ -3,7 +3,9 @@
 See ``docs/identification.md``.
 """
 
-from robotcell.identification.engine import identify, identify_with_coupling
+from robotcell.identification.choice import ValidatedIdentification, identify_validated
+from robotcell.identification.coupling import identify_with_coupling
+from robotcell.identification.engine import identify
 from robotcell.identification.ik import solve_identified
 from robotcell.identification.measurements import Measurements, read_measurements
 from robotcell.identification.positioner import PositionerCalibration, calibrate_positioner
@@ -18,6 +20,7 @@ from robotcell.identification.validation import (
 )
 
 __all__ = ["CrossValidation", "IdentificationResult", "Measurements", "Parameter", "PoseSelection",
-           "PositionerCalibration", "calibrate_positioner", "compare_observability", "cross_validate", "identify",
+           "PositionerCalibration", "ValidatedIdentification", "calibrate_positioner",
+           "compare_observability", "cross_validate", "identify", "identify_validated",
            "identify_with_coupling", "observability", "read_measurements", "select_configurations",
            "solve_identified"]

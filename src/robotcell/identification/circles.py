@@ -1,7 +1,9 @@
 """Geometric first estimate (circle point analysis): joint axes from rows moving one joint.
 
 Rows that differ only in joint ``j`` move every target on a circle about axis ``j`` (revolute)
-or along a line parallel to it (prismatic). A plane and circle fit per target gives the axis
+or along a line parallel to it (prismatic); "only" to what the joint values resolve
+(:func:`robotcell.calibration.grouping.alone_groups`: joints read back from a controller with
+jitter group as the values commanded), each row brought back with its own values. A plane and circle fit per target gives the axis
 line in the device frame D: normal of the plane (oriented so that a positive joint value turns
 right-handed about it) through the circle's centre. Lines measured with joints ``1..j-1`` away
 from zero are brought back to the zero position by the inverse screw motions of the axes found
@@ -17,12 +19,14 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from robotcell.calibration.grouping import alone_groups, joint_tolerances, resolution
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError
 from robotcell.identification.chain import PARALLEL_TOL
 from robotcell.identification.measurements import Measurements, read_measurements
+from robotcell.identification.result import GEOMETRIC_SOURCE
 from robotcell.robot.robot import Robot
 
 __all__ = ["axis_lines", "first_estimate", "start_model"]
@@ -34,19 +38,6 @@ MIN_STROKE = 0.01
 #: A group whose targets deviate from a straight line by less than this fraction of their
 #: travel is a prismatic joint.
 LINE_TOL = 1e-3
-
-
-def _groups(q: NDArray[np.float64], j: int, span: float) -> list[NDArray[np.int_]]:
-    """Row sets (>= 3 rows) in which only joint ``j`` changes, by at least ``span``."""
-    others = np.delete(q, j, axis=1)
-    keys = np.round(others, 9)
-    _, inv = np.unique(keys, axis=0, return_inverse=True)
-    out = []
-    for g in np.unique(inv):
-        rows = np.flatnonzero(inv == g)
-        if len(np.unique(np.round(q[rows, j], 9))) >= 3 and np.ptp(q[rows, j]) >= span * 0.999:
-            out.append(rows)
-    return out
 
 
 def _fit_group(qj: NDArray[np.float64], p: NDArray[np.float64]):
@@ -83,16 +74,23 @@ def _mean_line(points: list, dirs: list, weights: list):
 
 
 def _back(pts, dirs, types, q, j) -> NDArray[np.float64]:
-    """``M_{j-1}(-q_{j-1}) ... M_1(-q_1)``: brings a row's geometry back to joints 1..j-1 at zero."""
+    """``M_{j-1}(-q_{j-1}) ... M_1(-q_1)`` per row of ``q`` (N, n): shape (N, 4, 4).
+
+    Brings each row's geometry back to joints 1..j-1 at zero, with that row's own values (read
+    back values differ a little from row to row of a group).
+    """
+    B = np.broadcast_to(np.eye(4), (len(q), 4, 4))
+    if not j:
+        return B
     axes = AxisChain(points=pts[:j], directions=dirs[:j], types=tuple(types[:j]))
-    M = axes.motions(-q[:j])
-    B = np.eye(4)
+    M = axes.motions(-q[:, :j])
     for i in range(j):
-        B = M[i] @ B
+        B = M[:, i] @ B
     return B
 
 
 def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
+               group_tol: ArrayLike | None = None,
                ) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
     """Joint axes at ``q = 0`` in the device frame from rows moving one joint at a time.
 
@@ -104,6 +102,11 @@ def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
         Known prismatic joints. When not given, every joint value is taken as an angle and the
         joint type comes from the fit (a straight line: prismatic); the axis lines after a
         prismatic joint are then only right when its values are 0 in the rows that move them.
+    group_tol : float or array_like, shape (n,), optional
+        Joint values within this of each other are the same commanded value: one number (rad,
+        a prismatic joint taking as many mm as that is deg) or one per joint (rad, m); default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`), so that
+        joints read back from a controller with jitter group as the values commanded.
 
     Returns
     -------
@@ -120,26 +123,29 @@ def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
     """
     q, p = meas.q, meas.points
     n = q.shape[1]
+    pris = np.zeros(n, dtype=bool) if prismatic is None else np.asarray(prismatic, dtype=bool)
+    tol = None if group_tol is None else joint_tolerances(group_tol, pris)
     pts, dirs, types = np.zeros((n, 3)), np.zeros((n, 3)), []
     for j in range(n):
-        pj = prismatic is not None and prismatic[j]
-        groups = _groups(q, j, MIN_STROKE if pj else MIN_SPAN)
+        groups = alone_groups(q, j, least=3, span=MIN_STROKE if pris[j] else MIN_SPAN,
+                              tol=tol, prismatic=pris)
         if not groups:
             raise IllPosedError(
                 f"joint {j + 1}: no rows move it alone; the circle point analysis needs at least 3 "
                 f"rows that differ only in a{j + 1}, spread over at least "
-                f"{math.degrees(MIN_SPAN):.0f} deg or {MIN_STROKE * 1e3:.0f} mm (or give the nominal "
-                "model as robot)")
+                f"{math.degrees(MIN_SPAN):.0f} deg or {MIN_STROKE * 1e3:.0f} mm, the other joints "
+                f"held to within {_tolerance_text(q, j, tol, pris)} (or state the grouping "
+                "tolerance, or give the nominal model as robot)")
         fits = []
         for rows in groups:
             # Undo the motion of the axes before j (their lines are known at q = 0).
-            back = _back(pts, dirs, types, q[rows[0]], j) if j else np.eye(4)
+            back = _back(pts, dirs, types, q[rows], j)
             for k in range(p.shape[1]):
-                loc = p[rows, k] @ back[:3, :3].T + back[:3, 3]
+                loc = np.einsum("nij,nj->ni", back[:, :3, :3], p[rows, k]) + back[:, :3, 3]
                 fits.append(_fit_group(q[rows, j], loc))
         kinds = {f[0] for f in fits}
         if prismatic is not None:
-            kind = "prismatic" if pj else "revolute"
+            kind = "prismatic" if pris[j] else "revolute"
         else:
             kind = "prismatic" if kinds == {"prismatic"} else "revolute"
         use = [f for f in fits if f[0] == kind]
@@ -148,8 +154,19 @@ def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
     return pts, dirs, types
 
 
-def first_estimate(path: str | Path, name: str = "identified", j23_factor: float = 0.0
-                   ) -> tuple[Robot, Measurements]:
+def _tolerance_text(q: NDArray[np.float64], j: int, tol: NDArray[np.float64] | None,
+                    pris: NDArray[np.bool_]) -> str:
+    """The grouping tolerance of the joints other than ``j``, in deg and mm, for a message."""
+    others = np.delete(pris, j)
+    used = resolution(np.delete(q, j, axis=1), others) if tol is None else np.delete(tol, j)
+    scale = np.where(others, 1e3, 180.0 / math.pi)
+    parts = sorted({f"{t:.3g} {'mm' if p else 'deg'}" for t, p in zip(used * scale, others)})
+    how = "derived from the data" if tol is None else "stated"
+    return f"{' / '.join(parts)} ({how})"
+
+
+def first_estimate(path: str | Path, name: str = "identified", j23_factor: float = 0.0,
+                   group_tol: float | None = None) -> tuple[Robot, Measurements]:
     """Start model and measurements from a CSV without a nominal model.
 
     Parameters
@@ -165,6 +182,10 @@ def first_estimate(path: str | Path, name: str = "identified", j23_factor: float
         ``a3 + k * a2`` (FANUC: 1, the ROS-Industrial driver's ``J23_factor``). The rows must
         move one joint of the chain at a time, i.e. in these model values (moving J2 alone on a
         FANUC means a3 = -a2, so that the forearm keeps still relative to the upper arm).
+    group_tol : float, optional
+        Joint values within this of each other are the same commanded value (rad; a prismatic
+        joint takes as many mm as that is deg); default derived from the data (see
+        :func:`axis_lines`).
 
     Returns
     -------
@@ -181,10 +202,10 @@ def first_estimate(path: str | Path, name: str = "identified", j23_factor: float
         A joint that no rows move alone (in model values).
     """
     raw = read_measurements(path)
-    types = axis_lines(_model_values(raw, j23_factor))[2]
+    types = axis_lines(_model_values(raw, j23_factor), group_tol=group_tol)[2]
     pris = np.array([t == "prismatic" for t in types])
     meas = read_measurements(path, pris) if pris.any() else raw
-    return start_model(_model_values(meas, j23_factor), pris, name), meas
+    return start_model(_model_values(meas, j23_factor), pris, name, group_tol), meas
 
 
 def _model_values(meas: Measurements, k: float) -> Measurements:
@@ -197,7 +218,7 @@ def _model_values(meas: Measurements, k: float) -> Measurements:
 
 
 def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
-                name: str = "identified") -> Robot:
+                name: str = "identified", group_tol: ArrayLike | None = None) -> Robot:
     """Standard-DH start model from rows moving one joint at a time (circle point analysis).
 
     Parameters
@@ -207,6 +228,8 @@ def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
     prismatic : ndarray of bool, shape (n,), optional
         Known prismatic joints (default: from the fits, see :func:`axis_lines`).
     name : str
+    group_tol : float or array_like, shape (n,), optional
+        Grouping tolerance of the joint values, see :func:`axis_lines`.
 
     Returns
     -------
@@ -216,7 +239,7 @@ def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
         target, ``X`` toward the target. Nearly parallel consecutive axes (within 1 deg) are made
         exactly parallel. Joint names ``A1..An``, no limits.
     """
-    pts, dirs, types = axis_lines(meas, prismatic)
+    pts, dirs, types = axis_lines(meas, prismatic, group_tol)
     T_D_R = _base_frame(pts, dirs)
     R, t = T_D_R[:3, :3], T_D_R[:3, 3]
     pts_R, dirs_R = (pts - t) @ R, dirs @ R
@@ -244,7 +267,7 @@ def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
     names = tuple(f"A{i}" for i in range(1, len(types) + 1))
     chain = AxisChain(points=pts_R, directions=dirs_R, types=tuple(types), flange=F, names=names)
     return dh_from_axes(chain, "standard", name=name, title=name,
-                        source="circle point analysis of the measurements").robot
+                        source=GEOMETRIC_SOURCE).robot
 
 
 def _any_perpendicular(z: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -21,33 +21,40 @@ Steps (``docs/identification.md``):
 5. **Uncertainty.** ``cov = s0^2 (J^T J)^-1`` with the weighted Jacobian and the a-posteriori
    variance factor ``s0^2 = chi^2 / dof``; correlations, the scaled condition number, and rows
    whose residual is an outlier at 3 sigma (leave-one-out noise level, hat-matrix leverage).
+   The leave-one-out residuals (closed form) give the scatter no parameter explains
+   (``unexplained``) and of it the model error beyond the stated accuracy.
+
+Constants named in ``hold`` (:func:`robotcell.identification.identify_validated` holds those
+that do not predict held-out rows better) stay at their nominal values with the reason given.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from robotcell.calibration.fitting import kabsch, scaled_condition
+from robotcell.calibration.grouping import distinct as count_distinct
+from robotcell.calibration.grouping import joint_tolerances
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import COMPLIANT_JOINTS, Chain
 from robotcell.identification.gravity import require_masses
 from robotcell.identification.measurements import Measurements
-from robotcell.identification.result import IdentificationResult, Parameter
+from robotcell.identification.result import IdentificationResult, Parameter, beyond_accuracy
 from robotcell.ik import analytic_solver
 from robotcell.ik.seeded import SeededSolver
 from robotcell.kinematics.coupling import Coupling
 from robotcell.kinematics.covariance import ParameterCovariance
 from robotcell.robot.robot import Robot
 
-__all__ = ["Problem", "identifiable", "identify", "identify_with_coupling"]
+__all__ = ["Problem", "identifiable", "identify"]
 
 #: Default measurement accuracies: a laser tracker (m per coordinate) and a 6D probe (rad).
 POINT_SIGMA = 0.05e-3
@@ -319,6 +326,8 @@ def identify(
     max_sigma_length: float = MAX_SIGMA_LENGTH,
     max_sigma_angle: float = MAX_SIGMA_ANGLE,
     name: str | None = None,
+    hold: Mapping[str, str] | None = None,
+    group_tol: ArrayLike | None = None,
 ) -> IdentificationResult:
     """Identify the kinematic parameters of a serial chain from measured points or poses.
 
@@ -353,6 +362,14 @@ def identify(
         ``fixed``: the measurements see it too weakly to move it (``math.inf``: never).
     name : str, optional
         Name of the identified model (default ``<nominal>_identified``).
+    hold : mapping of str to str, optional
+        Constants to hold at their nominal values (link constants, scales, compliances or the
+        J2/J3 factor, by name: ``A2.a``), each with the reason reported in ``fixed``.
+    group_tol : float or array_like, shape (n,), optional
+        Joint values within this of each other are the same commanded value, for the count of
+        distinct configurations that the redundancy check rests on: one number (rad, a
+        prismatic joint taking as many mm as that is deg) or one per joint (rad, m); default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -362,7 +379,7 @@ def identify(
     ------
     InputError
         Measurements that do not fit the robot (number of joints), bad accuracies, a nominal
-        model whose coupling is not a J2/J3 factor.
+        model whose coupling is not a J2/J3 factor, a held constant the chain does not have.
     IllPosedError
         Too few rows for the unknowns, or orientations that do not change.
     """
@@ -409,10 +426,14 @@ def identify(
         cand += list(np.flatnonzero(groups == "compliance"))
     if fit_coupling and chain.coupling_param >= 0:
         cand.append(chain.coupling_param)
+    cand, chosen = _unheld(cand, hold or {}, chain)
     J1 = prob.jacobian(x1)
     kept, fixed = identifiable(J1, cand, set(prio), chain.names, rank_tol)
-    # Rows that repeat a configuration measure it again; they say nothing more about the chain.
-    distinct = len(np.unique(measurements.q, axis=0))
+    fixed.update(chosen)
+    # Rows that repeat a configuration measure it again (to what the joint values resolve, so
+    # read-back jitter does not make a repeat new); they say nothing more about the chain.
+    tol = None if group_tol is None else joint_tolerances(group_tol, nominal.prismatic)
+    distinct = count_distinct(measurements.q, tol, nominal.prismatic)
     m = distinct * prob.ncomp
     if m < 2 * kept.size:
         rows = (f"{prob.N} rows" if distinct == prob.N else
@@ -436,6 +457,21 @@ def identify(
             break
     return _result(nominal, chain, prob, x2, np.array(sorted(free), dtype=int), fixed, rp0, rr0,
                    name, x1)
+
+
+def _unheld(cand: list[int], hold: Mapping[str, str], chain: Chain
+            ) -> tuple[list[int], dict[int, str]]:
+    """The candidates without those held by name, and the reason of each held one."""
+    unknown = sorted(set(hold) - set(chain.names))
+    if unknown:
+        raise InputError(f"cannot hold {', '.join(unknown)}: {chain.robot.name}'s chain has no "
+                         "such constant (names as A2.a, A3.theta, A2.scale, j23_factor)")
+    frame = sorted(n for n in hold if chain.groups[chain.index(n)] in ("base", "target"))
+    if frame:
+        raise InputError(f"cannot hold {', '.join(frame)}: the robot base in the device frame and "
+                         "the targets are always identified")
+    held = {chain.index(n): why for n, why in hold.items()}
+    return [c for c in cand if c not in held], held
 
 
 def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> IdentificationResult:
@@ -474,9 +510,12 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
                                 "length" if (nm.split(".")[-1] in ("a", "d", "x", "y", "z")) else
                                 ("number" if g in ("scale", "coupling") else
                                  "compliance" if g == "compliance" else "angle")))
-    arm = [i for i, k in enumerate(kept) if chain.groups[k] in ("link", "scale", "coupling")]
+    unexplained = _unexplained(U, w, prob, s0)
+    model_error = beyond_accuracy(unexplained, 1.0 / prob.wp, dof)
+    arm = [i for i, k in enumerate(kept)
+           if chain.groups[k] in ("base", "link", "scale", "coupling")]
     covariance = ParameterCovariance(tuple(chain.names[kept[i]] for i in arm),
-                                     cov[np.ix_(arm, arm)])
+                                     cov[np.ix_(arm, arm)], model_error)
     robot = _to_robot(nominal, chain, x, name, covariance)
     return IdentificationResult(
         robot=robot, nominal=nominal, base=chain.base_pose(x), targets=chain.targets(x),
@@ -489,9 +528,34 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
         labels=list(prob.meas.labels),
         scale=x[chain.scale_params].copy(),
         coupling=float(x[chain.coupling_param]) if chain.coupling_param >= 0 else 0.0,
-        point_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, _chain=chain, _x=x,
-        _x_nominal=x_nominal,
+        point_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, unexplained=unexplained,
+        _q=prob.meas.q, _chain=chain, _x=x, _x_nominal=x_nominal,
     )
+
+
+def _unexplained(U: NDArray[np.float64], w: NDArray[np.float64], prob: Problem,
+                 s0: float) -> float:
+    """Scatter per coordinate (m) of a held-out measured point that no parameter explains.
+
+    The leave-one-out residual of each row, in closed form from the hat matrix of the weighted
+    Jacobian (``U`` of its SVD): ``e_i = (I - H_ii)^-1 r_i``, the residual of the row predicted
+    by the fit without it (exact for the linearised fit). A scatter ``u`` per coordinate that no
+    parameter explains gives it the covariance ``u^2 (I - H_ii)^-1`` (the scatter itself and the
+    error it leaves in the parameters fitted without the row), so ``u^2`` is the sum of the
+    squared point residuals over the sum of the matching diagonal of ``(I - H_ii)^-1``. Rows that
+    alone determine a direction (leverage 1) have no such residual and are left out.
+    """
+    N, c = prob.N, prob.ncomp
+    Ui = U.reshape(N, c, -1)
+    H = Ui @ np.swapaxes(Ui, 1, 2)
+    ok = np.linalg.eigvalsh(H).max(axis=1) < 1.0 - 1e-6
+    if not ok.any():
+        return s0 / prob.wp if math.isfinite(s0) else float("nan")
+    inflate = np.linalg.inv(np.eye(c) - H[ok])
+    e = np.einsum("nij,nj->ni", inflate, w[ok])
+    pts = slice(0, 3 * prob.K)
+    var = np.sum(e[:, pts] ** 2) / np.sum(np.diagonal(inflate, axis1=1, axis2=2)[:, pts])
+    return math.sqrt(float(var)) / prob.wp
 
 
 def _to_robot(nominal: Robot, chain: Chain, x: NDArray[np.float64], name: str | None,
@@ -544,43 +608,3 @@ def _ik_seed(nominal: Robot) -> Robot | None:
     except InputError:
         return None
     return nominal.ik_seed if isinstance(solver, SeededSolver) else nominal
-
-
-def identify_with_coupling(nominal: Robot, measurements: Measurements, k: float,
-                           **options) -> IdentificationResult:
-    """Identify with a stated J2/J3 coupling ``k`` and say whether the data support it.
-
-    Fits three times: with ``k`` held, without coupling (``k = 0`` held) and with ``k`` free.
-    ``coupling_check`` of the returned result (the fit with ``k`` held) holds ``k``,
-    ``rms_with_mm``, ``rms_without_mm``, ``k_fitted``, ``k_sigma`` and a ``verdict`` sentence.
-
-    Parameters
-    ----------
-    nominal : Robot
-    measurements : Measurements
-    k : float
-        Stated factor: ``q3_model = J3 + k * J2`` (FANUC: -1 when J3 is the forearm's angle to the
-        horizontal, as the ROS-Industrial FANUC driver's ``J23_factor``).
-    **options
-        Passed to :func:`identify` (accuracies, ``scale``, ``rank_tol``, ``max_sigma_length``,
-        ``max_sigma_angle``, ``name``).
-
-    Returns
-    -------
-    IdentificationResult
-    """
-    with_k = identify(nominal, measurements, coupling=k, **options)
-    without = identify(nominal, measurements, coupling=0.0, **options)
-    free = identify(nominal, measurements, coupling=k, fit_coupling=True, **options)
-    p = free.parameter("j23_factor")
-    consistent = abs(p.value - k) <= 3 * p.sigma if p.free else False
-    if consistent:
-        verdict = f"the data support k = {k:g} (fitted {p.value:.5f} +- {p.sigma:.5f})"
-    else:
-        verdict = (f"the data do not support k = {k:g}: fitted k = {p.value:.5f} +- {p.sigma:.5f}; "
-                   "check the controller's J2/J3 convention")
-    with_k.coupling_check = {
-        "k": k, "rms_with_mm": with_k.rms_after * 1e3, "rms_without_mm": without.rms_after * 1e3,
-        "k_fitted": p.value, "k_sigma": p.sigma, "supported": consistent, "verdict": verdict,
-    }
-    return with_k

@@ -302,6 +302,7 @@ def calibrate_positioner(
     prior_sigma: float | None = None,
     labels: Sequence[str] | None = None,
     inputs: Inputs | None = None,
+    group_tol: float | None = None,
 ) -> PositionerCalibration:
     """Calibrate a tilt-rotate positioner from touches of one point on its table.
 
@@ -328,6 +329,11 @@ def calibrate_positioner(
         Name of each touch (default ``"1".."N"``).
     inputs : Inputs, optional
         Earlier calibrations the touched points rest on (the tool, a track).
+    group_tol : float, optional
+        Axis values within this of each other (rad) are the same commanded value, for the touches
+        that move one axis alone; default derived from the data
+        (:func:`robotcell.calibration.grouping.resolution`), so that values read back from the
+        controller with jitter group as the grid commanded.
 
     Returns
     -------
@@ -358,8 +364,9 @@ def calibrate_positioner(
                          f"{nominal.n_joints}")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
     meas = Measurements(q, f, None, tuple(labels))
-    start = nominal if nominal is not None else start_model(meas, np.zeros(2, dtype=bool), "positioner")
-    ident, res = _identified(start, meas, f, prior_sigma, inputs)
+    start = (nominal if nominal is not None
+             else start_model(meas, np.zeros(2, dtype=bool), "positioner", group_tol))
+    ident, res = _identified(start, meas, f, prior_sigma, inputs, group_tol)
     side = 1.0 if nominal is None else _normal_side(nominal)
     geometry = _geometry_sigmas(ident, res, side)
     robot = replace(ident.robot, base=ident.base @ ident.robot.base, tool=ident.target_tool)
@@ -370,14 +377,15 @@ def calibrate_positioner(
 
 
 def _identified(start: Robot, meas: Measurements, f: NDArray[np.float64],
-                prior_sigma: float | None, inputs: Inputs | None) -> tuple[IdentificationResult, Fit]:
+                prior_sigma: float | None, inputs: Inputs | None, group_tol: float | None
+                ) -> tuple[IdentificationResult, Fit]:
     """The chain identified from ``start`` on the touches ``meas`` (of points ``f``, (N, 3)),
     and its fit; one touch that the others single out is left out and the chain identified
-    again."""
+    again. ``group_tol`` as for :func:`calibrate_positioner`."""
     q, labels = meas.q, meas.labels
     sigma = prior_sigma if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
     name = f"{start.name}_calibrated"
-    ident = identify(start, meas, point_sigma=sigma, name=name)
+    ident = identify(start, meas, point_sigma=sigma, name=name, group_tol=group_tol)
     used = np.ones(len(f), dtype=bool)
     res = _fit_of(ident, q, f, used, prior_sigma, inputs)
     if len(res.suspects) == 1:
@@ -386,7 +394,8 @@ def _identified(start: Robot, meas: Measurements, f: NDArray[np.float64],
         keep[worst] = False
         try:
             other = identify(start, Measurements(q, _imputed(ident, q, f, keep), None,
-                                                 tuple(labels)), point_sigma=sigma, name=name)
+                                                 tuple(labels)), point_sigma=sigma, name=name,
+                             group_tol=group_tol)
         except IllPosedError:
             other = None
         if other is not None:

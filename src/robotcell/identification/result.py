@@ -11,10 +11,22 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
 from robotcell.calibration.result import CONDITION_LIMIT, to_jsonable
+from robotcell.identification.uncertainty import PredictedError
 from robotcell.io.tables import format_table
 from robotcell.robot.robot import Robot
 
-__all__ = ["OUTLIERS_NAMED", "IdentificationResult", "Parameter"]
+__all__ = ["CV_HELD", "GEOMETRIC_SOURCE", "MAX_CHANGE_ANGLE", "MAX_CHANGE_LENGTH", "OUTLIERS_NAMED",
+           "IdentificationResult", "Parameter", "beyond_accuracy"]
+
+#: How far a link constant of a real arm can be from its drawing (m, rad): manufacturing and
+#: mastering errors are well under a millimetre and a few tenths of a degree; a constant that
+#: moves further says that the nominal model is not this arm's.
+MAX_CHANGE_LENGTH = 20e-3
+MAX_CHANGE_ANGLE = math.radians(2.0)
+#: The reason of a constant held because freeing it predicts held-out rows worse begins so.
+CV_HELD = "held by cross-validation"
+#: The ``source`` of a start model built by the circle point analysis.
+GEOMETRIC_SOURCE = "circle point analysis of the measurements"
 
 #: Outlier rows the verdict's reason names; it counts the others (``and 2 more``), the summary's
 #: and the JSON's outlier lists name every one.
@@ -103,8 +115,13 @@ class IdentificationResult:
         J2/J3 factor ``k`` (``q3_model = J3 + k J2``).
     point_sigma, angle_sigma : float
         Accuracies used as weights (m, rad).
+    unexplained : float
+        Scatter per coordinate (m) of a measured point held out of the fit that no parameter
+        explains: from the leave-one-out cross-validated residuals, less the part the
+        parameters' uncertainty explains. It holds the measuring error and the model error.
     coupling_check : dict
-        Filled by the CLI / :func:`compare_coupling`: RMS with and without the coupling.
+        Filled by :func:`~robotcell.identification.coupling.coupling_check`: RMS with, without
+        and with the fitted J2/J3 coupling, and whether the data support the stated one.
     """
 
     robot: Robot
@@ -130,6 +147,8 @@ class IdentificationResult:
     coupling: float
     point_sigma: float
     angle_sigma: float
+    unexplained: float = float("nan")
+    _q: Any = None
     _chain: Any = None
     _x: Any = None
     _x_nominal: Any = None
@@ -173,6 +192,68 @@ class IdentificationResult:
             T[:3, 3] = self.targets[0]
         return T
 
+    @property
+    def model_error(self) -> float:
+        """Scatter per coordinate (m) that the model cannot explain beyond the stated accuracy.
+
+        What the arm does that its geometric model does not (elasticity, temperature, gear
+        errors), as the leave-one-out cross-validated residuals show it
+        (:func:`beyond_accuracy`); 0 when they are within the stated accuracy.
+        """
+        return beyond_accuracy(self.unexplained, self.point_sigma, self.dof)
+
+    def predicted_error(self, q: ArrayLike, measured: bool = False) -> PredictedError:
+        """The predicted error of the identified model's position of each target at ``q``.
+
+        Parameters
+        ----------
+        q : array_like, shape (N, n)
+            Controller joint values (rad, m).
+        measured : bool
+            False: the error of the predicted position against where the target really is
+            (the parameters' covariance and the model error). True: against a measurement of
+            it (plus the measuring error): what a row held out of the fit shows.
+
+        Returns
+        -------
+        PredictedError
+            Covariance shape (N, K, 3, 3), in the device frame D (m^2): ``J C J^T`` over every
+            identified parameter (base, links, targets; ``covariance``, correlations kept) plus
+            ``model_error^2`` per coordinate, or ``unexplained^2`` with ``measured``.
+        """
+        ch, x = self._chain, self._x
+        qq = np.atleast_2d(np.asarray(q, dtype=float))
+        kept = [ch.index(n) for n in self.free]
+        ev = ch.evaluate(x, qq)
+        pts, _ = ch.predict(x, qq)
+        J = ch.point_jacobian(x, qq, ev, pts)[..., kept]
+        u = self.unexplained if math.isfinite(self.unexplained) else self.point_sigma
+        floor = u if measured else self.model_error
+        S = J @ self.covariance @ np.swapaxes(J, -1, -2) + floor**2 * np.eye(3)
+        return PredictedError(S)
+
+    def error_figures(self) -> dict[str, Any]:
+        """The predicted error at the measured rows, in mm (the report's and JSON's figures).
+
+        Returns
+        -------
+        dict
+            ``model_error_mm`` and ``unexplained_mm`` (1-sigma per coordinate); of the
+            identified position of a target at the measured configurations (not a measurement
+            of it, :meth:`predicted_error`), the medians over rows and targets of ``per_axis_mm``
+            (1-sigma along x, y, z of the device frame), ``rms_mm`` (3D RMS) and
+            ``radius95_mm`` (95 % radius), and the largest ``rms_max_mm``.
+        """
+        out: dict[str, Any] = {"model_error_mm": self.model_error * 1e3,
+                               "unexplained_mm": self.unexplained * 1e3}
+        if self._q is not None:
+            e = self.predicted_error(self._q)
+            out.update(per_axis_mm=np.median(e.per_axis.reshape(-1, 3), axis=0) * 1e3,
+                       rms_mm=float(np.median(e.rms)) * 1e3,
+                       radius95_mm=float(np.median(e.radius())) * 1e3,
+                       rms_max_mm=float(e.rms.max()) * 1e3)
+        return out
+
     def parameter(self, name: str) -> Parameter:
         """The parameter called ``name``."""
         for p in self.parameters:
@@ -202,21 +283,58 @@ class IdentificationResult:
         x = self._x_nominal if nominal else self._x
         return self._chain.predict(x, np.atleast_2d(np.asarray(q, dtype=float)))
 
+    def moved_too_far(self) -> list[tuple[Parameter, float]]:
+        """Link constants that moved further from the start than a real arm differs from its
+        drawing (:data:`MAX_CHANGE_LENGTH`, :data:`MAX_CHANGE_ANGLE`), with their change (m,
+        rad; angles on the circle)."""
+        out = []
+        for p in self.parameters:
+            if not (p.free and math.isfinite(p.nominal) and p.kind in ("length", "angle")):
+                continue
+            change = p.value - p.nominal
+            if p.kind == "angle":
+                change = math.remainder(change, 2.0 * math.pi)
+            if abs(change) > (MAX_CHANGE_LENGTH if p.kind == "length" else MAX_CHANGE_ANGLE):
+                out.append((p, change))
+        return out
+
+    def _moved_text(self) -> str:
+        """The verdict's reason for constants that moved too far."""
+        moved = self.moved_too_far()
+        names = ", ".join(f"{p.name} {c * (1e3 if p.kind == 'length' else 180 / math.pi):+.1f} "
+                          f"{'mm' if p.kind == 'length' else 'deg'}" for p, c in moved[:6])
+        more = f" and {len(moved) - 6} more" if len(moved) > 6 else ""
+        bound = (f"more than {MAX_CHANGE_LENGTH * 1e3:g} mm or {math.degrees(MAX_CHANGE_ANGLE):g} "
+                 "deg, which no real arm is off its drawing")
+        if self.nominal.source == GEOMETRIC_SOURCE:
+            return (f"constants moved from the geometric start by {names}{more} ({bound}): check "
+                    "the rows that move one joint at a time")
+        return (f"the data contradict the nominal model {self.nominal.name}: its constants "
+                f"moved by {names}{more} ({bound}); it is not this arm's model (another robot?): "
+                "give this arm's nominal, or identify without one, from the geometric start of "
+                "rows moving one joint at a time (docs/identification.md)")
+
     @property
     def verdict(self) -> tuple[str, str]:
         """``("good" | "check" | "poor", why)``.
 
-        Poor: the residuals are more than 3 times the stated accuracy (``s0 > 3``), or nothing
-        but the base could be identified. Check: ``s0`` above the 99 % chi-square bound, a
-        condition number above 100, or outlier rows.
+        Poor: a link constant moved further than a real arm differs from its drawing (a nominal
+        model of another arm, :meth:`moved_too_far`), the residuals are more than 3 times the
+        stated accuracy (``s0 > 3``), or nothing but the base could be identified (unless
+        cross-validation held the constants, :data:`CV_HELD`). Check: ``s0`` above the 99 %
+        chi-square bound, a condition number above 100, or outlier rows.
         """
+        if self.moved_too_far():
+            return "poor", self._moved_text()
         s0 = self.variance_factor
         if math.isfinite(s0) and s0 > 3.0:
             return "poor", (f"the residuals are {s0:.1f} times the stated accuracy (RMS "
                             f"{self.rms_after * 1e3:.3f} mm); the model or the joint values do "
                             "not explain the measurements")
-        if not any(p.free and p.kind in ("length", "angle") and not p.name.startswith(("base.", "target"))
-                   for p in self.parameters):
+        chosen = any(why.startswith(CV_HELD) for _, why in self.fixed)
+        if not chosen and not any(p.free and p.kind in ("length", "angle")
+                                  and not p.name.startswith(("base.", "target"))
+                                  for p in self.parameters):
             return "poor", "no link parameter is identifiable from these measurements"
         reasons = []
         bound = math.sqrt(_chi2_bound(self.dof)) if self.dof > 0 else float("inf")
@@ -260,6 +378,7 @@ class IdentificationResult:
             "residuals_before_mm": np.linalg.norm(self.residuals_before, axis=-1) * 1e3,
             "labels": self.labels,
             "j23_factor": self.coupling,
+            "predicted_error": self.error_figures(),
             "verdict": self.verdict[0],
             "verdict_why": self.verdict[1],
         }
@@ -309,15 +428,59 @@ class IdentificationResult:
         lines.append(f"condition number {self.condition:.1f}, redundancy {self.dof}, variance factor "
                      f"{self.variance_factor:.3f} (1 when the stated accuracy "
                      f"{self.point_sigma * 1e3:.3f} mm is right)")
+        lines += self.error_lines()
         if self.outliers:
             lines.append("outlier rows (3 sigma): " + ", ".join(self.labels[i] for i in self.outliers))
         if self.coupling_check:
             c = self.coupling_check
-            lines.append(f"J2/J3 coupling k = {c['k']:g}: RMS {c['rms_with_mm']:.4f} mm with it, "
-                         f"{c['rms_without_mm']:.4f} mm without; {c['verdict']}")
+            lines.append(f"J2/J3 coupling: {c['verdict']}")
         v, why = self.verdict
         lines += ["", f"verdict: {v} ({why})"]
         return "\n".join(lines)
+
+    def error_lines(self) -> list[str]:
+        """The summary's lines on the model error and the predicted error of a position."""
+        f = self.error_figures()
+        lines = [(f"model error (what the geometric model does not explain): "
+                  f"{f['model_error_mm']:.4f} mm per coordinate (the leave-one-out residuals "
+                  f"scatter by {f['unexplained_mm']:.4f} mm, the stated accuracy is "
+                  f"{self.point_sigma * 1e3:.4f} mm)")]
+        if "rms_mm" in f:
+            x, y, z = f["per_axis_mm"]
+            lines.append(f"predicted error of a target position (median over the rows; whole "
+                         f"covariance and model error): 1-sigma per axis x {x:.4f} y {y:.4f} "
+                         f"z {z:.4f} mm, 3D RMS {f['rms_mm']:.4f} mm, 95 % radius "
+                         f"{f['radius95_mm']:.4f} mm")
+        return lines
+
+
+def beyond_accuracy(unexplained: float, accuracy: float, dof: int) -> float:
+    """The model error: the unexplained scatter beyond the stated accuracy (m per coordinate).
+
+    ``sqrt(max(unexplained^2 - (1 + sqrt(2 / dof)) accuracy^2, 0))``. A variance estimated from
+    ``dof`` degrees of freedom scatters by ``sqrt(2 / dof)`` of itself, so measurements exactly
+    as accurate as stated show an unexplained scatter above the accuracy half the time; only the
+    part beyond one such standard deviation counts (else a model error of a quarter of the
+    accuracy would appear on average where there is none, at 100 degrees of freedom).
+
+    Parameters
+    ----------
+    unexplained : float
+        :attr:`IdentificationResult.unexplained` (m).
+    accuracy : float
+        Stated accuracy of a measured coordinate (m).
+    dof : int
+        Redundancy of the fit.
+
+    Returns
+    -------
+    float
+        m; 0 when ``unexplained`` is not finite.
+    """
+    if not math.isfinite(unexplained):
+        return 0.0
+    floor = 1.0 + math.sqrt(2.0 / max(dof, 1))
+    return math.sqrt(max(unexplained**2 - floor * accuracy**2, 0.0))
 
 
 def _histogram(values: NDArray[np.float64], bins: int = 6, width: int = 40) -> list[str]:

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.bounds import LIMIT_TOL, within
 from robotcell.kinematics.coupling import Coupling
-from robotcell.kinematics.covariance import ParameterCovariance
+from robotcell.kinematics.covariance import ParameterCovariance, is_base_parameter
 from robotcell.kinematics.dh import CHAIN, JACOBIAN, NO_SHIFT, Chain, Convention
 from robotcell.kinematics.transforms import validate_pose, validate_single_pose
 
@@ -157,7 +157,8 @@ class Arm:
         if self.covariance is not None:
             known = {j.name or f"A{i}" for i, j in enumerate(self.joints, start=1)}
             bad = [n for n in self.covariance.names
-                   if n != "j23_factor" and n.rpartition(".")[0] not in known]
+                   if n != "j23_factor" and not is_base_parameter(n)
+                   and n.rpartition(".")[0] not in known]
             if bad:
                 raise InputError(f"covariance: parameter(s) {', '.join(bad)} of no joint of this "
                                  f"robot (joints {', '.join(sorted(known))})")

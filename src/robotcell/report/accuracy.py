@@ -3,9 +3,9 @@
 One self-contained page (``robotcell compensate ... --report FILE.html``, ``robotcell program
 compensate ... --report FILE.html``): per point the predicted TCP error without filtering (the
 identified arm at the joints the controller computes for the point as written, against it), the
-correction, and the 1-sigma of the filtered position from the identification's covariance, as a
-figure and a table. Figures are PNG ``data:`` URIs (:mod:`robotcell.report.page`; matplotlib imported
-only when a report is written).
+correction, and the 3D RMS of the filtered position's error from the identification's covariance
+and model error, as a figure and a table. Figures are PNG ``data:`` URIs
+(:mod:`robotcell.report.page`; matplotlib imported only when a report is written).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ __all__ = ["write_accuracy_report", "write_poses_report", "write_program_report"
 
 
 def _figure(error_mm: np.ndarray, dpos_mm: np.ndarray, sigma_mm: np.ndarray) -> str:
-    """Per point: predicted error without filtering, correction, 1-sigma after (mm, log)."""
+    """Per point: predicted error without filtering, correction, 3D RMS error after (mm, log)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(9, 3.4))
     k = np.arange(1, len(error_mm) + 1)
@@ -39,7 +39,7 @@ def _figure(error_mm: np.ndarray, dpos_mm: np.ndarray, sigma_mm: np.ndarray) -> 
     ax.semilogy(k, np.maximum(dpos_mm, 1e-6), "x", color="tab:gray", ms=4, label="correction")
     if np.isfinite(sigma_mm).any():
         ax.semilogy(k, np.maximum(sigma_mm, 1e-6), "s", color="tab:blue", ms=4,
-                    label="1-sigma of the filtered position")
+                    label="3D RMS error of the filtered position")
     ax.set_xlabel("point")
     ax.set_ylabel("TCP position [mm]")
     ax.legend(fontsize=8)
@@ -60,8 +60,8 @@ def write_accuracy_report(path: str | Path, title: str, names: list[str], error:
     names : list of str
         Point names.
     error, dpos, sigma : array_like, shape (N,)
-        Predicted error without filtering, correction, and 1-sigma after filtering (m; sigma
-        NaN without a covariance).
+        Predicted error without filtering, correction, and the 3D RMS of the error after
+        filtering (m; sigma NaN without a covariance).
 
     Returns
     -------
@@ -73,11 +73,12 @@ def write_accuracy_report(path: str | Path, title: str, names: list[str], error:
     head = (f"<p>{len(names)} points. Without filtering the TCP misses by {rms:.3f} mm RMS, "
             f"{e.max(initial=0.0):.3f} mm at most (predicted: the identified arm against the "
             "controller's nominal model). Filtered, it lands within the identification's "
-            + (f"uncertainty: 1-sigma {s.max():.4f} mm at most.</p>" if known else
+            + (f"uncertainty: 3D RMS error {s.max():.4f} mm at most (the RMS length of the "
+               "error the identification's covariance and model error predict).</p>" if known else
                "uncertainty (the identified model carries no covariance to state it).</p>"))
     rows = [[n, float(a), float(b), float(c) if known else "-"] for n, a, b, c in zip(names, e, d, s)]
     rows_html = table(["point", "error without filtering (mm)", "correction (mm)",
-                    "1-sigma filtered (mm)"], rows)
+                    "3D RMS error filtered (mm)"], rows)
     name = html.escape(title)
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>robotcell accuracy: {name}</title>

@@ -119,8 +119,7 @@ def write_identification_report(
     extra = ""
     if result.coupling_check:
         c = result.coupling_check
-        extra = (f"<h2>J2/J3 coupling</h2><p>k = {c['k']:g}: RMS {c['rms_with_mm']:.4f} mm with it, "
-                 f"{c['rms_without_mm']:.4f} mm without; {html.escape(c['verdict'])}.</p>")
+        extra = f"<h2>J2/J3 coupling</h2><p>{html.escape(c['verdict'])}.</p>"
     fig_fit = _figure_errors(e0, e1, "Position error on the measured rows (largest target per row)")
     per_row = table(["row", "nominal (mm)", "identified (mm)", "outlier"],
                      [[lab, float(a), float(b), "yes" if i in result.outliers else ""]
@@ -132,8 +131,8 @@ def write_identification_report(
         fig_cv = _figure_errors(b, a, f"Held-out position error, {cv.folds}-fold cross-validation")
         cv_html = (f"<p>Every row predicted by the models fitted without its fold ({cv.folds} folds).</p>"
                    + table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
-                            [["nominal (base and targets fitted)", *_stats(cv.before.ravel() * 1e3)],
-                             ["identified", *_stats(cv.after.ravel() * 1e3)]])
+                            [["start model (base and targets fitted)", *_stats(cv.before.ravel() * 1e3)],
+                             ["identified (written)", *_stats(cv.after.ravel() * 1e3)]])
                    + f'<figure><img src="{fig_cv}" alt="cross-validated errors"></figure>')
     fixed = ("<ul>" + "".join(f"<li><b>{html.escape(n)}</b>: {html.escape(w)}</li>" for n, w in result.fixed)
              + "</ul>") if result.fixed else "<p>none: every candidate parameter is identifiable</p>"
@@ -173,7 +172,9 @@ def write_identification_report(
 <h2>Position error before and after identification</h2>{errors}
 <p>Condition number {result.condition:.1f}, redundancy {result.dof}, variance factor
 {result.variance_factor:.3f} (1 when the stated accuracy is right).</p>
-<figure><img src="{fig_fit}" alt="errors before and after"></figure>{extra}{scene_html}
+<figure><img src="{fig_fit}" alt="errors before and after"></figure>
+<h2>Predicted error</h2><ul>{"".join(f"<li>{html.escape(t)}</li>" for t in result.error_lines())}</ul>
+{extra}{scene_html}
 <h2>Cross-validation</h2>{cv_html}
 <h2>Parameters held at their nominal value, and why</h2>{fixed}
 <h2>Parameters (mm, deg) with 1-sigma</h2>{params}

@@ -280,8 +280,9 @@ def _unit_scales(names: tuple[str, ...], ls: float, as_: float) -> np.ndarray:
 def _covariance(value: Any, origin: str, ls: float, as_: float) -> ParameterCovariance:
     """Parse key ``covariance`` (file units) into a :class:`ParameterCovariance` in SI units."""
     where = f"{origin}: key 'covariance'"
-    _mapping(value, where, {"parameters", "matrix"},
-             f"{where} must be a mapping with keys parameters, matrix", ("parameters", "matrix"))
+    _mapping(value, where, {"parameters", "matrix", "model_error"},
+             f"{where} must be a mapping with keys parameters, matrix (and model_error)",
+             ("parameters", "matrix"))
     names, rows = value["parameters"], value["matrix"]
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
         raise InputError(f"{where}.parameters must be a list of names (A2.a, A3.beta, ...)")
@@ -289,9 +290,10 @@ def _covariance(value: Any, origin: str, ls: float, as_: float) -> ParameterCova
         raise InputError(f"{where}.matrix must be a list of rows")
     M = np.array([[_number(v, f"{where}.matrix row {i}") for v in r]
                   for i, r in enumerate(rows, start=1)] if rows else np.zeros((0, 0)))
+    model_error = _number(value.get("model_error", 0.0), f"{where}.model_error") * ls
     try:
         s = _unit_scales(tuple(names), ls, as_)
-        return ParameterCovariance(tuple(names), M * s[:, None] * s[None, :])
+        return ParameterCovariance(tuple(names), M * s[:, None] * s[None, :], model_error)
     except (InputError, ValueError) as exc:
         raise InputError(f"{where}: {exc}") from None
 
@@ -428,6 +430,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         M = cov.matrix * s[:, None] * s[None, :]
         data["covariance"] = {"parameters": list(cov.names),
                               "matrix": [[float(f"{v:.12g}") for v in row] for row in M]}
+        if cov.model_error:
+            data["covariance"]["model_error"] = float(f"{cov.model_error * 1e3:.6g}")
     if robot.home is not None:
         data["home"] = [
             _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.axes)

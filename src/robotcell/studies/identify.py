@@ -21,22 +21,22 @@ from robotcell.cell import Cell
 from robotcell.cell.identified import adopt_identified, identification_provenance
 from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
-from robotcell.identification import identify, identify_with_coupling, read_measurements
+from robotcell.identification import identify, read_measurements
+from robotcell.identification.choice import (
+    DEFAULT_FOLDS,
+    ValidatedIdentification,
+    identify_validated,
+)
 from robotcell.identification.circles import first_estimate
+from robotcell.identification.coupling import coupling_check
 from robotcell.identification.measurements import Measurements
 from robotcell.identification.offsets import JointOffset, joint_offsets
 from robotcell.identification.result import IdentificationResult
-from robotcell.identification.validation import (
-    CrossValidation,
-    compare_observability,
-    cross_validate,
-)
+from robotcell.identification.validation import CrossValidation, compare_observability
 from robotcell.robot.models import load_robot, save_robot
 
-__all__ = ["IdentificationRun", "controller_offsets", "identify_file", "zero_offset_controllers"]
-
-#: Folds of the cross-validation a report or a cell's provenance asks for when none is given.
-DEFAULT_FOLDS = 5
+__all__ = ["DEFAULT_FOLDS", "IdentificationRun", "controller_offsets", "identify_file",
+           "zero_offset_controllers"]
 
 
 def controller_offsets(offsets: list[JointOffset], vendor: str) -> dict[str, Any]:
@@ -84,10 +84,14 @@ class IdentificationRun:
     Attributes
     ----------
     result : IdentificationResult
+        The identification written (the chosen set of free constants).
     cross : CrossValidation or None
-        The cross-validation, when asked for (``folds``, a report or a cell).
+        Its cross-validation (None with ``folds=0``): held-out errors of the start model
+        (``before``) and of ``result`` (``after``).
     folds : int or None
         Its number of folds.
+    choice : ValidatedIdentification or None
+        The sets of free constants compared and the one chosen (None with ``folds=0``).
     offsets : dict or None
         :func:`controller_offsets` of the result, when ``offsets_for`` was given.
     written : bool
@@ -105,6 +109,7 @@ class IdentificationRun:
     written: bool
     observability: tuple[float, NDArray[np.float64]] | None = None
     measurements: Measurements | None = None
+    choice: ValidatedIdentification | None = None
 
     @property
     def cross_stats(self) -> dict[str, float] | None:
@@ -116,6 +121,12 @@ class IdentificationRun:
         data = self.result.to_json()
         if self.cross is not None:
             data["cross_validation"] = {"folds": self.folds, **self.cross_stats}
+        if self.choice is not None:
+            c = self.choice
+            data["cross_validation"].update(
+                chosen=c.chosen.label, chosen_free=c.chosen.free, why=c.sentence(),
+                candidates=[{"label": x.label, "free": x.free, "rms_mm": x.rms * 1e3}
+                            for x in c.candidates])
         if self.offsets is not None:
             data["joint_offsets"] = self.offsets
         return data
@@ -124,9 +135,10 @@ class IdentificationRun:
 def identify_file(measurements: str | Path, robot: str | Path | None = None,
                   cell: str | Path | None = None, j23_factor: float | None = None,
                   point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
-                  scale: bool = False, compliance: bool = False, folds: int | None = None,
+                  scale: bool = False, compliance: bool = False, folds: int = DEFAULT_FOLDS,
                   report: bool = False, offsets_for: str | None = None,
-                  output: str | Path | None = None, force: bool = False) -> IdentificationRun:
+                  output: str | Path | None = None, force: bool = False,
+                  group_tol: float | None = None) -> IdentificationRun:
     """Identify the kinematic model of an arm or positioner from a measurement CSV.
 
     Parameters
@@ -140,16 +152,18 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         A cell file: its ``robot.model`` is the nominal when ``robot`` is not given, and the
         identified model written to ``output`` becomes its ``robot.identified``.
     j23_factor : float, optional
-        A stated J2/J3 coupling ``q3_model = J3 + k J2``.
+        A stated J2/J3 coupling ``q3_model = J3 + k J2`` (FANUC: 1), checked against the fits
+        without it and with it free (:func:`~robotcell.identification.coupling.coupling_check`).
     point_sigma : float
         Accuracy of a measured coordinate (m).
     angle_sigma : float
         Accuracy of a measured orientation (rad).
     scale, compliance : bool
         Also identify a scale per axis; the gravity compliance of axes 2 and 3.
-    folds : int, optional
-        Folds of a cross-validation; with a report or a cell and none given,
-        ``min(5, rows)``.
+    folds : int
+        Folds of the cross-validation that chooses the constants to free (at most the rows;
+        :func:`~robotcell.identification.identify_validated`); 0: none, every identifiable
+        constant is freed unchecked.
     report : bool
         Also compute what the HTML report needs (the observability of the measured
         configurations; the run keeps the measurements), which
@@ -161,6 +175,10 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         Identified model file (YAML) to write, unless the verdict is poor and not ``force``.
     force : bool
         Write ``output`` even when the verdict is poor.
+    group_tol : float, optional
+        Joint values within this of each other are the same commanded value (rad; a prismatic
+        joint takes as many mm as that is deg); default derived from the data
+        (:func:`robotcell.calibration.grouping.resolution`).
 
     Returns
     -------
@@ -169,31 +187,35 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
     Raises
     ------
     InputError
-        ``cell`` without ``output``; ``offsets_for`` without a nominal ``robot``; bad measurements.
+        ``cell`` without ``output``; ``offsets_for`` without a nominal ``robot``; bad measurements;
+        ``folds`` below 0 or 1.
     """
     if cell is not None and output is None:
         raise InputError("cell needs output: the identified model file the cell will name")
     if offsets_for is not None and robot is None:
         raise InputError("offsets_for needs robot (the nominal model): the offsets correct the "
                          "nominal model the controller uses")
+    if folds < 0 or folds == 1:
+        raise InputError(f"folds must be 0 (no cross-validation) or at least 2, got {folds}")
     options: dict[str, Any] = {"point_sigma": point_sigma, "angle_sigma": angle_sigma,
-                               "scale": scale, "compliance": compliance}
+                               "scale": scale, "compliance": compliance, "group_tol": group_tol}
     if robot is not None or cell is not None:
         nominal = load_robot(robot) if robot is not None else Cell.load(cell).nominal_robot
         meas = read_measurements(measurements, nominal.prismatic)
     else:
-        nominal, meas = first_estimate(measurements, j23_factor=j23_factor or 0.0)
+        nominal, meas = first_estimate(measurements, j23_factor=j23_factor or 0.0,
+                                       group_tol=group_tol)
     if j23_factor is not None:
-        result = identify_with_coupling(nominal, meas, j23_factor, **options)
+        options["coupling"] = j23_factor
+    choice, cross = None, None
+    if folds:
+        folds = min(folds, meas.n_rows)
+        choice = identify_validated(nominal, meas, folds=folds, **options)
+        result, cross = choice.result, choice.cross
     else:
         result = identify(nominal, meas, **options)
-    cross = None
-    if (report or cell is not None) and folds is None:
-        folds = min(DEFAULT_FOLDS, meas.n_rows)
-    if folds is not None:
-        if j23_factor is not None:
-            options["coupling"] = j23_factor
-        cross = cross_validate(nominal, meas, folds=folds, **options)
+    if j23_factor is not None:
+        result.coupling_check = coupling_check(nominal, meas, j23_factor, result, **options)
     obs = None
     if report:
         obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
@@ -207,5 +229,5 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
             save_robot(result.robot, output)
         else:
             adopt_identified(cell, result, output, identification_provenance(result, cross))
-    return IdentificationRun(result, cross, folds, offsets, written, obs,
-                             meas if report else None)
+    return IdentificationRun(result, cross, folds or None, offsets, written, obs,
+                             meas if report else None, choice)

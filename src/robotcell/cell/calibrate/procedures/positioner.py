@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from robotcell.calibration.grouping import alone_groups
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell
 from robotcell.cell.calibrate.common import (
@@ -73,27 +74,28 @@ def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
                              label)
 
 
-def _check_alone(values: NDArray[np.float64], source: str) -> None:
+def _check_alone(values: NDArray[np.float64], source: str, group_tol: float | None) -> None:
     """Refuse touches in which no 3 rows turn one axis alone over 10 deg (no start without a cell).
 
     ``values`` (N, 2) are tilt and rotate (rad); the circle point analysis that starts the fit
-    without a nominal chain needs such a group per axis.
+    without a nominal chain needs such a group per axis, the other axis held to what the values
+    resolve (:func:`robotcell.calibration.grouping.alone_groups`).
     """
     least = SPECS["positioner"].minimum
     for k, name in enumerate(("e1 (tilt)", "e2 (rotate)")):
-        other = np.round(values[:, 1 - k], 9)
-        if not any(len(np.unique(np.round(values[other == o, k], 9))) >= least
-                   and np.ptp(values[other == o, k]) >= math.radians(10.0) * 0.999
-                   for o in np.unique(other)):
+        if not alone_groups(values, k, least=least, span=math.radians(10.0), tol=group_tol):
+            held = ("" if group_tol is None else
+                    f" (the other axis within the stated {math.degrees(group_tol):g} deg)")
             raise IllPosedError(
-                f"{source}: no {least} touches turn {name} alone over 10 deg or more; without "
-                f"{term('cell (Cell)', 'a cell')} the positioner calibration starts from the "
-                "circles of such touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give "
+                f"{source}: no {least} touches turn {name} alone over 10 deg or more{held}; "
+                f"without {term('cell (Cell)', 'a cell')} the positioner calibration starts from "
+                "the circles of such touches: touch a grid, e.g. 3 tilt by 4 rotate values, or give "
                 "the cell with the positioner's nominal chain")
 
 
 def positioner(cell: Cell | None, measurements: MeasurementInput, *,
-               context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
+               group_tol: float | None = None, context: CalibrationContext | None = None,
+               **keywords: Any) -> CellCalibration:
     """A 2-axis (tilt-rotate) positioner's axis chain into a cell, from touches of one point.
 
     The touches (:func:`positioner_touches`) go to
@@ -113,6 +115,9 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     measurements : Measurements, mapping, str or Path
         As for :func:`positioner_touches`: one point on the table touched at several (tilt,
         rotate) values ``e1``, ``e2`` (deg).
+    group_tol : float, optional
+        Axis values within this of each other (rad) are the same commanded value; default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
     context : CalibrationContext, optional
         Who touched and how well, names in messages, where notes go, the touch file to record
         and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
@@ -137,8 +142,9 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
         m = read_touches("positioner", measurements, ctx.source, ctx.arm(None), notes.one)
         refuse_track_column(m, no_cell_track())
         points = m.tcp(tool_transform(None, tool))
-        _check_alone(m.axes, m.source)
-        done = calibrate_positioner(m.axes, points, prior_sigma=sigma, labels=m.labels())
+        _check_alone(m.axes, m.source, group_tol)
+        done = calibrate_positioner(m.axes, points, prior_sigma=sigma, labels=m.labels(),
+                                    group_tol=group_tol)
         return CellCalibration(done.result, notes=tuple(notes),
                                assumed=assumption(None, m, tool, "T_R_B"))
     pos = cell.turntable
@@ -149,7 +155,7 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     chained = chained_inputs(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
                              world_track(cell, m), nominal, notes)
     done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
-                                labels=m.labels(), inputs=chained.inputs)
+                                labels=m.labels(), inputs=chained.inputs, group_tol=group_tol)
     key = "T_world_B" if pos.parent == "world" else "T_R_B"
     result = done.result.renamed("T_R_B", key)
     record = Record(measurement_file(measurements, ctx.file), recorded_options(sigma, tool),

@@ -79,8 +79,8 @@ def _reference_indices(m: Measurements, n_refs: int) -> NDArray[np.int_] | None:
 
 def track(cell: Cell | None, measurements: MeasurementInput, *,
           references: ArrayLike | None = None, axis: Literal["x", "z"] | None = None,
-          roll: Literal["zero"] | None = None, context: CalibrationContext | None = None,
-          **keywords: Any) -> CellCalibration:
+          roll: Literal["zero"] | None = None, group_tol: float | None = None,
+          context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
     """Linear track (direction, scale, straightness, rotation when determined) into a cell.
 
     Parameters
@@ -97,6 +97,9 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
         Axis of L along which the carriage moves; default the cell's, else x.
     roll : {"zero"}, optional
         Without references: fix the rotation about the track axis to zero (a convention).
+    group_tol : float, optional
+        Track positions within this of each other (m) are one commanded position; default
+        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
     context : CalibrationContext, optional
         Who touched and how well, names in messages, where notes go, the touch file to record
         and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
@@ -138,7 +141,8 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
     chained = chained_inputs(cell, m, f, tool, None, nominal, notes)
     result = calibrate_track(e, f, references=refs if len(refs) else None, point=idx,
                              axis=axis or "x", roll=roll, labels=m.labels(),
-                             prior_sigma=sigma, inputs=chained.inputs)
+                             prior_sigma=sigma, inputs=chained.inputs,
+                             group_tol=group_tol)
     assumed = assumption(cell, m, tool, "T_L_R")
     if cell is None:
         return CellCalibration(result, notes=tuple(notes), assumed=assumed)

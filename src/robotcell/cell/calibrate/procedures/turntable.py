@@ -102,7 +102,8 @@ class TurntablePose:
 
 
 def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: float = 0.0,
-              context: CalibrationContext | None = None, **keywords: Any) -> CellCalibration:
+              group_tol: float | None = None, context: CalibrationContext | None = None,
+              **keywords: Any) -> CellCalibration:
     """Turntable root frame B and radius, from touches of one point on the table, into a cell.
 
     Parameters
@@ -114,6 +115,9 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
         turntable in the world of a cell with a track, ``track`` (mm).
     height : float
         Shift of the frame origin along the table axis from the plane of the touched point (m).
+    group_tol : float, optional
+        Table angles within this of each other (rad) are one commanded angle; default derived
+        from the data (:func:`robotcell.calibration.grouping.resolution`).
     context : CalibrationContext, optional
         Who touched and how well, names in messages, where notes go, the touch file to record
         and the nominal accuracy (:class:`~robotcell.cell.calibrate.context.CalibrationContext`).
@@ -135,7 +139,7 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     m = read_touches("turntable", measurements, ctx.source, ctx.arm(cell), notes.one)
     theta, f, chained = on_table(cell, m, ctx, notes, m.check_count)
     result = calibrate_turntable(theta, f, height=height, labels=m.labels(),
-                                 prior_sigma=sigma, inputs=chained.inputs)
+                                 prior_sigma=sigma, inputs=chained.inputs, group_tol=group_tol)
     key = "T_world_B" if parent == "world" else "T_R_B"
     assumed = assumption(cell, m, tool, key, mapped=parent == "world")
     if cell is None:
