@@ -477,13 +477,19 @@ def frame(measurements: str, name: str | None, parent: str | None, cell_path: st
 
 @calibrate.command("external-tcp")
 @click.argument("measurements", type=click.Path(dir_okay=False))
+@click.option("--cell", "cell_path", default=None, metavar="CELL.yaml",
+              type=click.Path(dir_okay=False),
+              help="Take the robot, and with --tool NAME the reference tool with its recorded "
+                   "uncertainty (part of the result's 1-sigma), from this cell file; nothing is "
+                   "written into it.")
 @measurement_options
-def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sigma: float | None,
-                     as_json: bool, accept_poor: bool) -> None:
+def external_tcp_cmd(measurements: str, cell_path: str | None, robot: str | None,
+                     tool: str | None, sigma: float | None, as_json: bool,
+                     accept_poor: bool) -> None:
     """Fixed (external) tool touched with a robot-held reference tool of known TCP.
 
     \b
-    Rows: reference-tool TCP positions x,y,z (or a1..a6 with --robot and --tool = the
+    Rows: reference-tool TCP positions x,y,z (or a1..a6 with --robot or --cell and --tool = the
     reference tool). Column point: tcp (the fixed TCP, at least 3 touches from different
     directions), optionally x (a point on the fixed tool's +X axis) and xy (a point in its XY
     plane with +Y) for the orientation.
@@ -493,10 +499,14 @@ def external_tcp_cmd(measurements: str, robot: str | None, tool: str | None, sig
       robotcell calibrate external-tcp gun.csv --robot kuka_kr16 --tool 250,0,0,0,0,0
     """
     prior = sigma_m(sigma)
-    model, T_tool = robot_and_tool(robot, tool)
-    finish(lambda cell: cellcal.external_tcp(cell, measurements, robot=model, tool=T_tool,
-                                             sigma=prior, source=measurements, on_note=echo_note),
-           None, as_json, accept_poor)
+    target = CellTarget.open(cell_path, robot)
+    model, T_tool = robot_and_tool(robot, tool, target)
+    cell, label = cell_of(target)
+    options = {} if cell is None else {"robot": None, "cell_label": label,
+                                       "nominal": chain_options(measurements)["nominal"]}
+    finish(lambda _: cellcal.external_tcp(cell, measurements, **{
+        "robot": model, "tool": T_tool, "sigma": prior, "source": measurements,
+        "on_note": echo_note, **options}), None, as_json, accept_poor)
 
 
 def _shown(path: Path) -> str:
