@@ -445,6 +445,12 @@ def test_compensate_json_and_report_give_the_error_and_sigma_per_pose(kr16, tmp_
     p = data["points"][0]
     assert {"x", "a1", "dpos", "drot", "error_mm", "sigma_mm"} <= set(p)
     assert 0.2 < p["error_mm"] < 5 and 0 < p["sigma_mm"] < 0.05
+    # The three figures of one error: per axis (their squares add to the 3D RMS's square) and a
+    # 95 % radius between the isotropic (1.61 RMS) and the one-dimensional (1.96 RMS) case.
+    axes = np.array(p["sigma_axes_mm"])
+    assert np.isclose(np.sum(axes**2), p["sigma_mm"] ** 2, rtol=1e-9)
+    assert 1.55 * p["sigma_mm"] < p["radius95_mm"] < 1.97 * p["sigma_mm"]
+    assert data["max_radius95_mm"] == max(q["radius95_mm"] for q in data["points"])
     page = (tmp_path / "acc.html").read_text()
     assert "3D RMS error filtered (mm)" in page and "data:image/png;base64," in page
     assert not (tmp_path / "cmd.csv").exists()

@@ -39,7 +39,7 @@ from robotcell.cell.ik import CellIKSolutions
 from robotcell.cell.kinematics import robot_pose, tool_pose
 from robotcell.controllers.model import Config
 from robotcell.errors import InputError, RobotcellError
-from robotcell.identification.uncertainty import position_sigma
+from robotcell.identification.uncertainty import position_error
 from robotcell.ik.config import ARM_FLAGS, branch_of_flags, flags_of_branch
 from robotcell.ik.select import nearest
 from robotcell.kinematics.transforms import invert, validate_pose
@@ -97,6 +97,12 @@ class FilteredPoses:
         The IK branch (configuration) used.
     flags : ndarray of int, shape (N, 3)
         Its shoulder, elbow, wrist flags (:func:`robotcell.ik.config.flags_of_branch`).
+    sigma_axes : ndarray, shape (N, 3)
+        1-sigma of the filtered TCP position's error along the robot base's x, y, z (m); NaN
+        without a covariance.
+    radius95 : ndarray, shape (N,)
+        Radius that holds the filtered TCP position's error with 95 % probability (m); NaN
+        without a covariance.
     """
 
     T: NDArray[np.float64]
@@ -110,6 +116,8 @@ class FilteredPoses:
     sigma: NDArray[np.float64]
     branch: NDArray[np.int_]
     flags: NDArray[np.int_]
+    sigma_axes: NDArray[np.float64] | None = None
+    radius95: NDArray[np.float64] | None = None
 
 
 def _angles(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -321,8 +329,11 @@ def filter_poses(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | Arr
     T_real = cell.fk(np.nan_to_num(q_nom), track_, table_, tool=T_tool, frame=frame)
     error = np.linalg.norm(T_real[:, :3, 3] - Tq[:, :3, 3], axis=-1)
     error_rot = _angles(Tq, T_real)
-    sigma = (np.full(n, np.nan) if cell.robot.covariance is None
-             else position_sigma(cell.robot, q, T_F_TCP))
+    if cell.robot.covariance is None:
+        sigma, axes, r95 = np.full(n, np.nan), np.full((n, 3), np.nan), np.full(n, np.nan)
+    else:
+        predicted = position_error(cell.robot, q, T_F_TCP)
+        sigma, axes, r95 = predicted.rms, predicted.per_axis, predicted.radius(0.95)
     return FilteredPoses(T_cmd, q, np.asarray(track_, dtype=float), np.asarray(table_, dtype=float),
                          dpos, drot, error, error_rot, sigma, branch,
-                         flags_of_branch(nom.method, branch))
+                         flags_of_branch(nom.method, branch), axes, r95)

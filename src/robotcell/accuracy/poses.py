@@ -75,8 +75,11 @@ class CompensatedPoses:
 
     def to_json(self) -> dict[str, Any]:
         """``{"points": [{"x": .., "a1": .., "shoulder": .., "elbow": .., "wrist": ..,
-        "branch": .., "dpos": .., "drot": .., "error_mm": .., "error_deg": .., "sigma_mm": ..},
-        ...], "configuration": .., ...}`` (mm, deg; sigma null without a covariance)."""
+        "branch": .., "dpos": .., "drot": .., "error_mm": .., "error_deg": .., "sigma_mm": ..,
+        "sigma_axes_mm": [..], "radius95_mm": ..}, ...], "configuration": .., ...}`` (mm, deg;
+        ``sigma_mm`` the 3D RMS of the filtered position's error, ``sigma_axes_mm`` its 1-sigma
+        along the robot base's x, y, z, ``radius95_mm`` the radius holding it with 95 %
+        probability; null without a covariance)."""
         r = self.result
         points = []
         for i, row in enumerate(self.rows):
@@ -85,12 +88,18 @@ class CompensatedPoses:
             d["error_mm"] = float(r.error[i] * 1e3)
             d["error_deg"] = math.degrees(float(r.error_rot[i]))
             d["sigma_mm"] = None if not math.isfinite(r.sigma[i]) else float(r.sigma[i] * 1e3)
+            d["sigma_axes_mm"] = (None if not np.isfinite(r.sigma_axes[i]).all()
+                                  else [float(v * 1e3) for v in r.sigma_axes[i]])
+            d["radius95_mm"] = (None if not math.isfinite(r.radius95[i])
+                                else float(r.radius95[i] * 1e3))
             points.append(d)
         return {"points": points, "configuration": self.chosen_by,
                 "max_dpos_mm": float(r.dpos.max(initial=0.0) * 1e3),
                 "max_error_mm": float(r.error.max(initial=0.0) * 1e3),
                 "max_sigma_mm": (None if not np.isfinite(r.sigma).all() or r.sigma.size == 0
-                                 else float(r.sigma.max() * 1e3))}
+                                 else float(r.sigma.max() * 1e3)),
+                "max_radius95_mm": (None if not np.isfinite(r.radius95).all()
+                                    or r.radius95.size == 0 else float(r.radius95.max() * 1e3))}
 
 
 def _configs(path: str, cols: dict) -> list[Config] | None:

@@ -88,8 +88,8 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
         click.echo(f"{len(result.rows)} poses filtered: largest correction "
                    f"{data['max_dpos_mm']:.4f} mm; predicted error without filtering up to "
                    f"{data['max_error_mm']:.4f} mm"
-                   + (f", 1-sigma after filtering up to {sigma:.4f} mm" if sigma is not None
-                      else "") + f"; configurations: {_configurations(result)}"
+                   + (f", after filtering 3D RMS error up to {sigma:.4f} mm and 95 % radius up "
+                      f"to {data['max_radius95_mm']:.4f} mm" if sigma is not None else "") + f"; configurations: {_configurations(result)}"
                    + (f"; wrote {output}" if output else ""), err=output is None)
 
 
