@@ -49,6 +49,15 @@ class ExternalAxes:
     whole_units : bool
         The file holds the table's values in whole file units (YASKAWA station axes in encoder
         pulses), so a value is rounded to one before the point is solved.
+    decimals : int or None
+        The file holds the table's values to this many decimals of its unit (FANUC: 3), so a
+        value is rounded to them before the point is solved.
+    table_optional : bool
+        A program may leave the table's axes out (a YASKAWA job that moves the robot's group
+        alone): the table is then taken at 0, not named as missing.
+    unit_needed : str or None
+        Why the table's values cannot be converted (a unit the call must give, YASKAWA's
+        pulses per degree): raised as soon as a table value is converted.
     """
 
     vendor: str
@@ -59,6 +68,14 @@ class ExternalAxes:
     positioner: bool = False
     unused: tuple[str, ...] = ()
     whole_units: bool = False
+    decimals: int | None = None
+    table_optional: bool = False
+    unit_needed: str | None = None
+
+    def _convertible(self) -> None:
+        """Raise :attr:`unit_needed` when the table's values cannot be converted."""
+        if self.table and self.unit_needed:
+            raise InputError(self.unit_needed)
 
     def names(self) -> list[str]:
         """Track and table names, in that order."""
@@ -78,7 +95,13 @@ class ExternalAxes:
         -------
         dict of str to float
             Values in file units, track first.
+
+        Raises
+        ------
+        InputError
+            The table's values cannot be converted (:attr:`unit_needed`).
         """
+        self._convertible()
         out: dict[str, float] = {}
         if self.track:
             out[self.track] = float(track) * self.track_scale
@@ -89,8 +112,8 @@ class ExternalAxes:
 
     def held(self, table: ArrayLike) -> NDArray[np.float64]:
         """Table values as the file holds them: rounded to whole file units where
-        :attr:`whole_units` (YASKAWA encoder pulses), else unchanged (degrees, written with 9
-        decimals).
+        :attr:`whole_units` (YASKAWA encoder pulses), to :attr:`decimals` (FANUC degrees), else
+        unchanged (degrees, written with 9 decimals).
 
         Parameters
         ----------
@@ -101,12 +124,18 @@ class ExternalAxes:
         -------
         ndarray
             The same shape (rad).
+
+        Raises
+        ------
+        InputError
+            The table's values cannot be converted (:attr:`unit_needed`).
         """
         th = np.asarray(table, dtype=float)
-        if not self.whole_units or not self.table:
+        self._convertible()
+        if not self.table or (not self.whole_units and self.decimals is None):
             return th
         scale = np.asarray(self.table_scale) if self.positioner else self.table_scale[0]
-        return np.round(th * scale) / scale
+        return np.round(th * scale, 0 if self.whole_units else self.decimals) / scale
 
     def from_file(self, external: dict[str, float]
                   ) -> tuple[float, NDArray[np.float64] | float, list[str]]:
@@ -124,8 +153,14 @@ class ExternalAxes:
         table : float or ndarray, shape (n,)
             A turntable angle, or a positioner's axis values (0 where missing).
         problems : list of str
-            Axes of the cell the point does not write, and nonzero values of axes the cell
-            lacks.
+            Axes of the cell the point does not write (the table's axes not, where
+            :attr:`table_optional` and the point writes none of them), and nonzero values of
+            axes the cell lacks.
+
+        Raises
+        ------
+        InputError
+            A table value that cannot be converted (:attr:`unit_needed`).
         """
         problems = []
         track = 0.0
@@ -135,12 +170,16 @@ class ExternalAxes:
             else:
                 problems.append(f"{self.track} (the track) is not written")
         values = []
+        written = any(name in external for name in self.table)
+        if written:
+            self._convertible()
         for name, scale in zip(self.table, self.table_scale):
             if name in external:
                 values.append(external[name] / scale)
             else:
                 values.append(0.0)
-                problems.append(f"{name} (the table) is not written")
+                if written or not self.table_optional:
+                    problems.append(f"{name} (the table) is not written")
         for name, v in external.items():
             if name not in self.names() and v != 0 and abs(v) < 9e8:  # ABB: 9E9 = no axis
                 problems.append(f"{name} = {v:g}, but the cell has no such external axis")
