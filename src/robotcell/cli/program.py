@@ -138,11 +138,20 @@ def _write_json(cell: Cell, result) -> dict:
 @click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
 @_cell_option
 @_ppd_option
+@click.option("--singular-margin", "singular_margin", type=float, default=2.0,
+              show_default=True, callback=in_range(0.0, 45.0, "deg"),
+              help="Closest good approach to the wrist or elbow singularity, at a point or on a "
+                   "linear motion (deg).")
+@click.option("--shoulder-margin", "shoulder_margin", type=float, default=20.0,
+              show_default=True, callback=in_range(0.0, 1000.0, "mm"),
+              help="Closest good distance of the wrist centre from axis 1 (mm).")
 @click.option("--json", "as_json", is_flag=True, help="Print every point as JSON.")
-def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool) -> None:
+def check_cmd(program_file: str, cell_path: str, ppd: str | None, singular_margin: float,
+              shoulder_margin: float, as_json: bool) -> None:
     """Check every point of PROGRAM (KUKA .src with its .dat, ABB .mod, FANUC .ls, YASKAWA
-    .jbi) against the cell: reach, limits, configuration as written, distance to singularities,
-    configuration changes and jumps on linear motions.
+    .jbi) against the cell: reach, limits, configuration as written, distance to singularities;
+    and every linear motion as the controller follows it: a configuration change, a
+    singularity, reach or limits left on the way.
 
     Exit status 0 when every point is good, 3 with a table of the bad points, 2 for a file that
     cannot be read.
@@ -155,7 +164,8 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
 
     cell = Cell.load(cell_path)
     with as_flags(FLAGS):
-        report = check_program_file(program_file, cell, _ppd(ppd))
+        report = check_program_file(program_file, cell, _ppd(ppd),
+                                    math.radians(singular_margin), shoulder_margin * 1e-3)
     if as_json:
         click.echo(json.dumps(report.to_json(cell), indent=2))
     for s in report.skipped:

@@ -25,7 +25,7 @@ from robotcell.ik.config import ZERO_TOL
 from robotcell.ik.limits import TWO_PI
 from robotcell.robot.robot import Robot
 
-__all__ = ["candidates", "config_text", "config_values", "configs", "select"]
+__all__ = ["candidates", "config_text", "config_values", "configs", "select", "side_changes"]
 
 #: Axes (0-based) that may be moved by whole turns to meet flags that count turns or quadrants.
 _TURNING = (0, 3, 5)
@@ -134,3 +134,17 @@ def config_text(config: Config) -> str:
     (YASKAWA ``RCONF``, without the unused trailing values).
     """
     return get(config.vendor, "program format").config_text(config.values)
+
+
+#: What changes when a bit of ABB's cfx changes (RAPID reference, confdata; docs/ik.md).
+_SIDES = ((4, "the wrist centre passes axis 1: the shoulder"),
+          (2, "the elbow passes stretched"),
+          (1, "the wrist flips: axis 5 changes sign"))
+
+
+def side_changes(robot: Robot, q0: ArrayLike, q1: ArrayLike) -> str:
+    """Words for the sides of the arm (shoulder, elbow, wrist) that differ between two
+    configurations (shape ``(6,)``, rad); empty when none does."""
+    sides = config_values(robot, np.stack([np.asarray(q0, float), np.asarray(q1, float)]),
+                          "abb")[:, 3]
+    return "; ".join(w for bit, w in _SIDES if (sides[0] ^ sides[1]) & bit)
