@@ -197,8 +197,10 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     positions) so that the TCP stays where it was after a recalibration (a new tool, base,
     track, table or identified arm): solved in the --to cell where the --from cell had the TCP.
     Cartesian points are left as they are: they follow the exported tool and frame data.
-    Prints the largest axis change per point; a point the new cell cannot reach exits with
-    status 3 and nothing is written.
+    Each point keeps its configuration (shoulder, elbow and wrist sides, and its turns). Prints
+    the largest axis change per point; a point the new cell cannot reach in its configuration,
+    or only with an axis outside its limits, exits with status 3 naming it, and nothing is
+    written. Joint values outside the model's limits in the program are named.
 
     \b
     Example:
@@ -213,6 +215,8 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
                                       inputs=(old_path, new_path))
         except RetargetFailed as exc:
             raise BadPoints(f"{program_file}: {exc}") from None
+    for note in result.notes:
+        click.echo(f"note: {note}", err=True)
     rows = [[p.name, p.line, f"{math.degrees(p.change):.4f}", f"{p.tcp_error * 1e3:.6f}"]
             for p in result.points]
     if as_json:
