@@ -170,7 +170,7 @@ class ExternalAxes:
             else:
                 problems.append(f"{self.track} (the track) is not written")
         values = []
-        written = any(name in external for name in self.table)
+        written = not external.keys().isdisjoint(self.table)
         if written:
             self._convertible()
         for name, scale in zip(self.table, self.table_scale):
@@ -180,12 +180,63 @@ class ExternalAxes:
                 values.append(0.0)
                 if written or not self.table_optional:
                     problems.append(f"{name} (the table) is not written")
+        known = self.names()
         for name, v in external.items():
-            if name not in self.names() and v != 0 and abs(v) < 9e8:  # ABB: 9E9 = no axis
+            if name not in known and v != 0 and abs(v) < 9e8:  # ABB: 9E9 = no axis
                 problems.append(f"{name} = {v:g}, but the cell has no such external axis")
         table = np.array(values) if self.positioner else (values[0] if values else 0.0)
         return track, table, problems
 
+
+    def from_files(self, externals: list[dict[str, float]]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64], list[list[str]]]:
+        """:meth:`from_file` of many points: the points of a program write the same axes, and
+        are converted in one batch.
+
+        Parameters
+        ----------
+        externals : list of dict of str to float
+            Each point's external axes, as a reader returns them (file units).
+
+        Returns
+        -------
+        track : ndarray, shape (N,)
+        table : ndarray, shape (N,) or (N, n)
+        problems : list of list of str
+            Each point's, as :meth:`from_file` gives them.
+
+        Raises
+        ------
+        InputError
+            A table value that cannot be converted (:attr:`unit_needed`).
+        """
+        n = len(externals)
+        keys = externals[0].keys() if n else {}.keys()
+        if any(e.keys() != keys for e in externals):
+            rows = [self.from_file(e) for e in externals]
+            return (np.array([r[0] for r in rows], dtype=float),
+                    np.array([r[1] for r in rows], dtype=float), [r[2] for r in rows])
+        names = list(keys)
+        values = np.array([[e[k] for k in names] for e in externals], dtype=float).reshape(
+            n, len(names))
+        col = dict(zip(names, values.T))
+        common = {k: 0.0 for k in names}
+        _, _, missing = self.from_file(common)  # what no point writes
+        track = col[self.track] / self.track_scale if self.track in col else np.zeros(n)
+        table = np.column_stack([col[k] / sc if k in col else np.zeros(n)
+                                 for k, sc in zip(self.table, self.table_scale)]) \
+            if self.table else np.zeros((n, 0))
+        problems = [list(missing) for _ in range(n)]
+        known = self.names()
+        for k in names:
+            if k in known:
+                continue
+            v = col[k]
+            for i in np.flatnonzero((v != 0) & (np.abs(v) < 9e8)):
+                problems[i].append(f"{k} = {v[i]:g}, but the cell has no such external axis")
+        if not self.positioner:
+            table = table[:, 0] if self.table else np.zeros(n)
+        return track, table, problems
 
 def table_count(cell: Cell) -> tuple[int, bool]:
     """Number of table axes of ``cell`` and whether they are a positioner chain."""

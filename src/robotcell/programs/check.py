@@ -167,13 +167,26 @@ def _num(v: float) -> float | None:
 
 @dataclass
 class _Resolved:
-    """What the cell makes of a point before its joints are known."""
+    """What the cell makes of the points before their joints are known, one row per point.
 
-    T_F_TCP: NDArray[np.float64] | None
-    where: Placement | None
-    track: float
-    table: float | NDArray[np.float64]
-    problems: list[str]
+    Attributes
+    ----------
+    tools : ndarray, shape (N, 4, 4)
+        ``T_F_TCP`` (m; NaN where the cell has no such tool).
+    frames : list of Placement or None
+        The frame of each Cartesian point (None: a joint point, or a frame the cell lacks).
+    track : ndarray, shape (N,)
+        Track values (m).
+    table : ndarray, shape (N,) or (N, n)
+        Table values (rad).
+    problems : list of list of str
+    """
+
+    tools: NDArray[np.float64]
+    frames: list[Placement | None]
+    track: NDArray[np.float64]
+    table: NDArray[np.float64]
+    problems: list[list[str]]
 
 
 def _key(ref: Ref) -> tuple:
@@ -182,14 +195,15 @@ def _key(ref: Ref) -> tuple:
             None if ref.pose is None else id(ref.pose))
 
 
-def _resolve(cell: Cell, pts: list[ProgramPoint], axes: ExternalAxes) -> list[_Resolved]:
+def _resolve(cell: Cell, pts: list[ProgramPoint], axes: ExternalAxes) -> _Resolved:
     """Tool, frame and external axes of every point (each reference looked up once), and the
     track and table limits."""
+    track, table, problems = axes.from_files([p.external for p in pts])
     tools: dict[tuple, tuple[NDArray | None, str | None]] = {}
-    frames: dict[tuple, tuple[Placement | None, str | None]] = {}
-    out = []
-    for p in pts:
-        problems: list[str] = []
+    places: dict[tuple, tuple[Placement | None, str | None]] = {}
+    nan = np.full((4, 4), np.nan)
+    poses, frames = [], []
+    for p, said in zip(pts, problems):
         key = _key(p.tool)
         if key not in tools:
             try:
@@ -197,36 +211,38 @@ def _resolve(cell: Cell, pts: list[ProgramPoint], axes: ExternalAxes) -> list[_R
             except InputError as exc:
                 tools[key] = (None, str(exc))
         T_tool, why = tools[key]
-        problems += [why] if why else []
+        poses.append(nan if T_tool is None else T_tool)
+        if why:
+            said.insert(0, why)
         where = None
         if p.pose is not None:
             key = _key(p.frame)
-            if key not in frames:
+            if key not in places:
                 try:
-                    frames[key] = (placement(cell, axes.vendor, p.frame), None)
+                    places[key] = (placement(cell, axes.vendor, p.frame), None)
                 except InputError as exc:
-                    frames[key] = (None, str(exc))
-            where, why = frames[key]
-            problems += [why] if why else []
-        track, table, missing = axes.from_file(p.external)
-        out.append(_Resolved(T_tool, where, track, table, problems + missing))
-    _limits(cell, out)
-    return out
+                    places[key] = (None, str(exc))
+            where, why = places[key]
+            if why:
+                said.insert(1 if T_tool is None else 0, why)
+        frames.append(where)
+    res = _Resolved(np.array(poses).reshape(-1, 4, 4), frames, track, table, problems)
+    _limits(cell, res)
+    return res
 
 
-def _limits(cell: Cell, res: list[_Resolved]) -> None:
+def _limits(cell: Cell, res: _Resolved) -> None:
     """Name the track and table values outside their limits."""
     if cell.track is not None:
-        track = np.array([r.track for r in res])
-        for i in np.flatnonzero(~cell.track.within_limits(track)):
-            res[i].problems.append(f"track {track[i] * 1e3:g} mm is outside its limits "
+        for i in np.flatnonzero(~cell.track.within_limits(res.track)):
+            res.problems[i].append(f"track {res.track[i] * 1e3:g} mm is outside its limits "
                                    f"[{cell.track.lower * 1e3:g}, {cell.track.upper * 1e3:g}] mm")
     tt = cell.turntable
-    if tt is not None and res:
-        table = np.array([r.table for r in res], dtype=float)
-        for i in np.flatnonzero(~tt.within_limits(table)):
-            res[i].problems.append(f"table {np.round(np.degrees(table[i]), 4)} deg is outside its "
-                                   f"limits [{np.degrees(tt.lower)}, {np.degrees(tt.upper)}] deg")
+    if tt is not None and len(res.track):
+        for i in np.flatnonzero(~tt.within_limits(res.table)):
+            res.problems[i].append(f"table {np.round(np.degrees(res.table[i]), 4)} deg is outside "
+                                   f"its limits [{np.degrees(tt.lower)}, {np.degrees(tt.upper)}] "
+                                   "deg")
 
 
 def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | None = None,
@@ -268,14 +284,11 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     res = _resolve(cell, pts, axes)
     q = np.full((n, robot.n_joints), np.nan)
     T_world = np.full((n, 4, 4), np.nan)
-    problems = [r.problems for r in res]
-    track = np.array([r.track for r in res], dtype=float)
-    table = np.array([r.table for r in res], dtype=float)
-    tools = np.stack([np.full((4, 4), np.nan) if r.T_F_TCP is None else r.T_F_TCP for r in res]
-                     ) if n else np.zeros((0, 4, 4))
-    cart = np.array([i for i, (p, r) in enumerate(zip(pts, res)) if p.pose is not None
-                     and r.where is not None and r.T_F_TCP is not None], dtype=int)
-    solutions = _solve_cartesian(ctrl, pts, res, cart, q, T_world, problems, track, table, tools)
+    problems, track, table, tools = res.problems, res.track, res.table, res.tools
+    cart = np.array([i for i, (p, w) in enumerate(zip(pts, res.frames)) if p.pose is not None
+                     and w is not None], dtype=int)
+    cart = cart[np.isfinite(tools[cart]).all(axis=(1, 2))]
+    solutions = _solve_cartesian(ctrl, pts, res, cart, q, T_world)
     _joint_points(cell, robot, pts, q, T_world, problems, track, tools)
     _sequential(ctrl, pts, cart, solutions, q, problems)
     if cell.identified is not None and cart.size:  # where the real arm takes the joints
@@ -284,14 +297,13 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
                        @ tools[ok])
     wrist, elbow, shoulder = singular_distances(robot, np.nan_to_num(q))
     _singular(q, wrist, elbow, shoulder, singular_margin, shoulder_margin, problems)
-    _lines(ctrl, pts, res, q, track, table, tools, singular_margin, shoulder_margin, problems)
+    _lines(ctrl, pts, res, q, cart, solutions, singular_margin, shoulder_margin)
     known = np.isfinite(q).all(axis=-1)
-    checked = [CheckedPoint(p.name, p.line, p.motion, q[i], r.track, r.table, T_world[i],
-                            problems[i],
-                            float(wrist[i]) if known[i] else math.nan,
-                            float(elbow[i]) if known[i] else math.nan,
-                            float(shoulder[i]) if known[i] else math.nan)
-               for i, (p, r) in enumerate(zip(pts, res))]
+    wrist, elbow, shoulder = (np.where(known, x, math.nan).tolist()
+                              for x in (wrist, elbow, shoulder))
+    checked = [CheckedPoint(p.name, p.line, p.motion, q[i], float(track[i]), table[i],
+                            T_world[i], problems[i], wrist[i], elbow[i], shoulder[i])
+               for i, p in enumerate(pts)]
     return CheckReport(program, checked, list(skipped or []))
 
 
@@ -310,22 +322,21 @@ def _joint_points(cell: Cell, robot: Robot, pts: list[ProgramPoint], q: NDArray,
     T_world[ok] = robot_pose(cell, track[ok]) @ cell.robot.fk(q[ok], tool=np.eye(4)) @ tools[ok]
 
 
-def _solve_cartesian(cell: Cell, pts: list[ProgramPoint], res: list[_Resolved],
-                     idx: NDArray[np.int_], q: NDArray, T_world: NDArray,
-                     problems: list[list[str]], track: NDArray, table: NDArray, tools: NDArray
-                     ) -> IKSolutions | None:
+def _solve_cartesian(cell: Cell, pts: list[ProgramPoint], res: _Resolved,
+                     idx: NDArray[np.int_], q: NDArray, T_world: NDArray) -> IKSolutions | None:
     """IK of the Cartesian points ``idx`` in one batch; those with flags get their solution
     here. Returns the solutions (None without Cartesian points)."""
     if idx.size == 0:
         return None
     robot = cell.robot
+    track, tools, problems = res.track, res.tools, res.problems
     poses = np.stack([pts[i].pose for i in idx])
-    groups: dict[int, list[int]] = {}
-    for k, i in enumerate(idx):
-        groups.setdefault(id(res[i].where), []).append(k)
-    for ks in groups.values():
+    _, first, group = np.unique([id(res.frames[i]) for i in idx], return_index=True,
+                                return_inverse=True)
+    for g, k0 in enumerate(first):
+        ks = np.flatnonzero(group == g)
         rows = idx[ks]
-        T_world[rows] = res[rows[0]].where.world(cell, track[rows], table[rows]) @ poses[ks]
+        T_world[rows] = res.frames[idx[k0]].world(cell, track[rows], res.table[rows]) @ poses[ks]
     T_R_F = invert(robot_pose(cell, track[idx])) @ T_world[idx] @ invert(tools[idx])
     sol = robot.ik(T_R_F, tool=np.eye(4))
     unreached = ~sol.reachable.any(axis=-1)
@@ -433,20 +444,25 @@ def _singular(q: NDArray, wrist: NDArray, elbow: NDArray, shoulder: NDArray,
                                f"(shoulder singularity, margin {shoulder_margin * 1e3:g} mm)")
 
 
-def _lines(cell: Cell, pts: list[ProgramPoint], res: list[_Resolved], q: NDArray,
-           track: NDArray, table: NDArray, tools: NDArray, singular_margin: float,
-           shoulder_margin: float, problems: list[list[str]]) -> None:
-    """The linear motions between two points with joints (:func:`line_problems`)."""
-    known = np.isfinite(q).all(axis=-1) & np.isfinite(tools).all(axis=(1, 2))
+def _lines(cell: Cell, pts: list[ProgramPoint], res: _Resolved, q: NDArray,
+           cart: NDArray[np.int_], solutions: IKSolutions | None, singular_margin: float,
+           shoulder_margin: float) -> None:
+    """The linear motions between two points with joints (:func:`line_problems`); the IK
+    ``solutions`` of the Cartesian points ``cart`` are the ends of their lines."""
+    known = np.isfinite(q).all(axis=-1) & np.isfinite(res.tools).all(axis=(1, 2))
     ends = np.array([i for i in range(1, len(pts)) if pts[i].motion == "lin"
                      and known[i] and known[i - 1]], dtype=int)
     if ends.size == 0:
         return
-    frames = [r.where if r.where is not None else _WORLD for r in res]
-    data = LineData([p.name for p in pts], np.column_stack([ends - 1, ends]), q, track, table,
-                    tools, frames)
+    frames = [_WORLD if w is None else w for w in res.frames]
+    branches = None
+    if solutions is not None:
+        branches = np.full((len(pts),) + solutions.q.shape[1:], np.nan)
+        branches[cart] = solutions.q
+    data = LineData([p.name for p in pts], np.column_stack([ends - 1, ends]), q, res.track,
+                    res.table, res.tools, frames, branches)
     for i, words in line_problems(cell, data, singular_margin, shoulder_margin).items():
-        problems[i].extend(words)
+        res.problems[i].extend(words)
 
 
 def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLike | None = None,

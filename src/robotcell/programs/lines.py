@@ -52,7 +52,7 @@ __all__ = ["LineData", "line_problems"]
 SAMPLE_LENGTH = 0.01
 SAMPLE_ANGLE = math.radians(5.0)
 #: Fewest and most intervals a line is sampled in.
-MIN_INTERVALS, MAX_INTERVALS = 4, 256
+MIN_INTERVALS, MAX_INTERVALS = 2, 256
 #: A line whose samples come within REFINE_BELOW times a margin of a singularity is sampled
 #: REFINE_SAMPLES times more finely around its nearest approach, REFINE_ROUNDS times.
 REFINE_BELOW, REFINE_SAMPLES, REFINE_ROUNDS = 4.0, 8, 4
@@ -79,6 +79,9 @@ class LineData:
         ``T_F_TCP`` of each point (m).
     frames : list of Placement
         The frame each point's line is straight in (the frame of its target).
+    branches : ndarray, shape (N, 8, 6), optional
+        Every IK branch of each point's pose, with its own tool and in its own frame, where the
+        check solved them already (NaN rows elsewhere): the ends of the lines, not solved again.
     """
 
     names: list[str]
@@ -88,6 +91,7 @@ class LineData:
     table: NDArray[np.float64]
     tools: NDArray[np.float64]
     frames: list[Placement]
+    branches: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True)
@@ -161,20 +165,29 @@ class _Lines:
         sol = self.cell.robot.ik(T_R_F.reshape(-1, 4, 4), tool=np.eye(4))
         return sol.q.reshape(L, m, *sol.q.shape[-2:])
 
-    def path(self, s: NDArray[np.float64], anchor: NDArray[np.float64]) -> NDArray[np.float64]:
+    def path(self, s: NDArray[np.float64], anchor: NDArray[np.float64],
+             start: NDArray[np.float64] | None = None, end: NDArray[np.float64] | None = None
+             ) -> NDArray[np.float64]:
         """Joints on each line's branch at ``s`` (``(L, m)``), unwrapped from ``anchor`` (the
-        joints at ``s[:, 0]`` up to whole turns, ``(L, 6)``): shape ``(L, m, 6)``."""
-        q8 = self.solve(s)
-        q = np.take_along_axis(q8, self.branch[:, None, None, None], axis=2)[:, :, 0]
+        joints at ``s[:, 0]`` up to whole turns, ``(L, 6)``): shape ``(L, m, 6)``. ``start``
+        and ``end``: the branches at the first and the last of ``s`` (``(L, 8, 6)``), when
+        solved already (then only the samples between are solved)."""
+        pick = self.branch[:, None, None, None]
+        if start is None or end is None:
+            q = np.take_along_axis(self.solve(s), pick, axis=2)[:, :, 0]
+        else:
+            inner = np.take_along_axis(self.solve(s[:, 1:-1]), pick, axis=2)[:, :, 0]
+            ends = [np.take_along_axis(x, self.branch[:, None, None], axis=1) for x in (start, end)]
+            q = np.concatenate([ends[0], inner, ends[1]], axis=1)
         return _unwrap(self.cell.robot, q, anchor)
 
-    def start_branch(self, q0: NDArray[np.float64]) -> None:
-        """Set :attr:`branch`: the IK branch of the start pose the start joints ``q0`` are on."""
-        q8 = self.solve(np.zeros((len(q0), 1)))[:, 0]
+    def start_branch(self, q8: NDArray[np.float64], q0: NDArray[np.float64]) -> None:
+        """Set :attr:`branch`: the one of the branches ``q8`` (``(L, 8, 6)``) of the start pose
+        that the start joints ``q0`` are on."""
         rev = ~self.cell.robot.prismatic
         d = q8 - q0[:, None]
-        d[..., rev] = _wrap(d[..., rev])
-        dist = np.linalg.norm(d, axis=-1)
+        d[..., rev] = np.sin(0.5 * d[..., rev])  # 0 for whole turns, the distance near 0
+        dist = np.einsum("...j,...j->...", d, d)
         self.branch = np.argmin(np.where(np.isfinite(dist), dist, np.inf), axis=-1)
 
 
@@ -303,6 +316,31 @@ def _intervals(robot: Robot, T0: NDArray, T1: NDArray, q0: NDArray, q1: NDArray
     return (2 ** k).astype(int)
 
 
+def _ends(lines: _Lines, data: LineData, a: NDArray[np.int_], b: NDArray[np.int_]
+          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Every IK branch at the start and at the end of the lines from ``a`` to ``b``: from
+    ``data.branches`` where the check solved them (the start only where it has the end's tool
+    and frame), else solved here. Shapes ``(L, 8, 6)``."""
+    known = data.branches
+    have = [np.zeros(len(a), dtype=bool), np.zeros(len(a), dtype=bool)]
+    out = [None, None]
+    if known is not None:
+        have[1] = np.isfinite(known[b]).any(axis=(1, 2))
+        have[0] = (np.isfinite(known[a]).any(axis=(1, 2))
+                   & np.all(data.tools[a] == data.tools[b], axis=(1, 2))
+                   & np.array([data.frames[i] is data.frames[j] for i, j in zip(a, b)],
+                              dtype=bool))
+        out = [known[a], known[b]]  # copies: indexed by arrays
+    for k, s in ((0, 0.0), (1, 1.0)):
+        rest = np.flatnonzero(~have[k])
+        if rest.size:
+            solved = lines.subset(rest).solve(np.full((rest.size, 1), s))[:, 0]
+            if out[k] is None:
+                out[k] = np.full((len(a),) + solved.shape[1:], np.nan)
+            out[k][rest] = solved
+    return out[0], out[1]
+
+
 def _judge(cell: Cell, frame: Placement, data: LineData, rows: NDArray[np.int_], T0: NDArray,
            T1: NDArray, intervals: int, margins: _Margins, out: dict[int, list[str]]) -> None:
     """Follow the lines ``rows`` of ``data.lines`` in ``intervals`` steps and name their
@@ -311,9 +349,10 @@ def _judge(cell: Cell, frame: Placement, data: LineData, rows: NDArray[np.int_],
     a, b = data.lines[rows, 0], data.lines[rows, 1]
     lines = _Lines(cell, frame, T0, T1, np.stack([data.track[a], data.track[b]], axis=1),
                    np.stack([data.table[a], data.table[b]], axis=1), data.tools[b])
-    lines.start_branch(data.q[a])
     s = np.broadcast_to(np.linspace(0.0, 1.0, intervals + 1), (len(rows), intervals + 1)).copy()
-    path = lines.path(s, data.q[a])
+    start, end = _ends(lines, data, a, b)
+    lines.start_branch(start, data.q[a])
+    path = lines.path(s, data.q[a], start, end)
     reached = np.isfinite(path).all(axis=(1, 2))
     inside = robot._inside(path)
     at, q_near, ratio = _nearest_approach(lines, s, path, margins)

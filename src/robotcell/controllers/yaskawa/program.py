@@ -202,6 +202,7 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
                 Path(path).stem)
     positions = _pos_section(lines, marks["//POS"] + 1, marks["//INST"])
     points: list[ProgramPoint] = []
+    values: list[list[float]] = []
     skipped: list[str] = []
     for lineno in range(marks["//INST"] + 1, last):
         text = lines.lines[lineno - 1].strip()
@@ -237,15 +238,17 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         if c.postype not in ("USER", "BASE", "ROBOT"):
             raise lines.error(lineno, f"{cname}: POSTYPE {c.postype} is not read (USER, BASE, "
                                       "ROBOT or PULSE)")
-        pose = pose_from_vendor(c.values[:6], "yaskawa")
+        values.append(c.values[:6])
         config = Config("yaskawa", c.rconf) if c.rconf is not None else None
         speed = re.search(r"\bV\s*=\s*([0-9.]+)", rest)
         zone = re.search(r"\bPL\s*=\s*(\d+)", rest)
         motion = "ptp" if instr.endswith("J") else "lin"
         points.append(ProgramPoint(
-            cname, lineno, motion, Ref(number=c.tool), frame, pose, None, config, external,
+            cname, lineno, motion, Ref(number=c.tool), frame, None, None, config, external,
             lines.number(speed.group(1), lineno) * 1e-3 if speed and motion == "lin" else None,
             lines.number(zone.group(1), lineno) * 1e-3 if zone else 0.0, c.where))
+    for point, pose in zip(points, pose_from_vendor(np.reshape(values, (-1, 6)), "yaskawa")):
+        point.pose = pose  # the positions converted in one batch
     return Program(name, "yaskawa", points, (str(path),)), skipped
 
 
