@@ -113,6 +113,7 @@ def measure(vendor: str, n: int) -> dict:
 
 
 def main() -> None:
+    """Measure and print the times of a program of ``--points`` points of ``--vendor``."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--vendor", default="yaskawa", choices=["kuka", "abb", "fanuc",
                                                                  "yaskawa"])

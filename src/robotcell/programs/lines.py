@@ -142,6 +142,7 @@ class _Lines:
         self.branch = np.zeros(len(T0), dtype=int)
 
     def subset(self, rows: NDArray[np.int_]) -> _Lines:
+        """The lines ``rows`` alone, on their branches."""
         out = object.__new__(_Lines)
         out.cell, out.frame = self.cell, self.frame
         for k in ("T0", "dp", "rotvec", "track", "table", "tool_inv", "branch"):
