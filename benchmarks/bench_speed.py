@@ -1,11 +1,11 @@
 """The README's Speed table, from one run: every row measured in this process, now.
 
 Run: ``python benchmarks/bench_speed.py`` (EAIK from the ``benchmark`` extra:
-``pip install ".[benchmark]"``; about 5 minutes). It runs, in this order, the batched FK of
+``pip install ".[benchmark]"``; about 6 minutes). It runs, in this order, the batched FK of
 ``bench_fk.py``, the one-call rows of ``bench_percall.py``, the batched IK against EAIK, the
 coupled arms, the palletizer and the numeric IK of ``bench_ik.py``, the cell IK of
-``bench_cellik.py`` and the identification of ``bench_identify.py``, and prints the table as
-Markdown, ready for the README. Each row's own script says how it measures.
+``bench_cellik.py``, the identification of ``bench_identify.py`` and the program check of
+``bench_program_check.py``, and prints the table as Markdown, ready for the README. Each row's own script says how it measures.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import bench_fk
 import bench_identify
 import bench_ik
 import bench_percall
+import bench_program_check
 from machine import describe
 
 
@@ -35,6 +36,7 @@ def main() -> None:
     ok, false, _, _, _ = bench_ik.numeric_track()
     cell = bench_cellik.measure()
     times, ident = bench_identify.measure()
+    check = bench_program_check.measure("yaskawa", bench_program_check.N_POINTS)
     print(f"load average {os.getloadavg()[0]:.1f} at the end\n")
 
     rows = [("what", "robotcell", "reference in the same run", "target"),
@@ -83,6 +85,11 @@ def main() -> None:
                  (f"median {np.median(times):.2f} s, max {max(times):.2f} s wall over "
                  f"{len(times)} runs (RMS {ident.rms_before * 1e3:.2f} mm nominal -> "
                  f"{ident.rms_after * 1e3:.3f} mm)"), "", "< 2 s"))
+    rows.append(((f"`robotcell program check` of a {bench_program_check.N_POINTS:,}-point "
+                  "YASKAWA job, every point and linear motion checked"),
+                 f"{check['command']:.1f} s wall (a new process)",
+                 (f"the library call `check_program_file`: {check['wall']:.1f} s wall, "
+                  f"{check['cpu']:.1f} s CPU"), "< 10 s"))
     for r in rows:
         print("| " + " | ".join(r) + " |")
 

@@ -129,3 +129,57 @@ def test_a_point_the_new_cell_cannot_reach_writes_nothing(cells, tmp_path, capsy
     code, _, err = run(capsys, "program", "retarget", src, "--from", CELL, "--to", far_file,
                          "-o", tmp_path / "out")
     assert code == 3 and "nothing written" in err
+
+
+def _fanuc_point(folder: Path, q: list[float], e: float = 1200.0, t: float = 0.0) -> Path:
+    """A FANUC listing of one joint position (deg), rail ``e`` (mm), table ``t`` (deg)."""
+    L = ["/PROG  ONE", "/ATTR", "/MN", "   1:  UTOOL_NUM=1 ;", "   2:J P[1] 20% FINE ;", "/POS",
+         "P[1]{", "   GP1:", "\tUF : 0, UT : 1,",
+         f"\tJ1={q[0]:10.3f} deg,\tJ2={q[1]:10.3f} deg,"
+         f"\tJ3={q[2]:10.3f} deg,", f"\tJ4={q[3]:10.3f} deg,\tJ5={q[4]:10.3f} deg,"
+         f"\tJ6={q[5]:10.3f} deg,", f"\tE1={e:10.3f}  mm", "   GP2:", "\tUF : 0, UT : 1,",
+         f"\tJ1={t:10.3f} deg", "};", "/END"]
+    (folder / "one.ls").write_text("\n".join(L) + "\n")
+    return folder / "one.ls"
+
+
+def test_a_point_whose_configuration_leaves_the_limits_is_named_not_changed(cells, tmp_path,
+                                                                           capsys):
+    # Axis 1 just inside its limit (185 deg): after the tool change the point keeps its
+    # configuration only with axis 1 beyond it. Turning axis 1 a whole turn the other way (or
+    # another branch) would be silently another configuration: refused, naming the axis.
+    old, new = cells
+    probe = np.radians([170.0, -80, 95, 10, 40, -20])
+    T = old.fk(probe, 1.2, 0.0, tool="torch")
+    sol = new.ik(T, track=1.2, tool="torch")
+    d = np.abs(sol.q - probe).sum(-1)
+    step = np.degrees(sol.q[np.argmin(np.where(np.isfinite(d), d, np.inf))][0] - probe[0])
+    assert abs(step) > 1e-3
+    a1 = 185 - abs(step) / 2 if step > 0 else -185 + abs(step) / 2
+    (tmp_path / "in").mkdir()
+    path = _fanuc_point(tmp_path / "in", [a1, -80, 95, 10, 40, -20])
+    with pytest.raises(RetargetFailed, match=r"P\[1\] \(line 5\): the new cell keeps the point's "
+                                             r"configuration only with axis 1 at -?18[45]\.\d deg,"
+                                             r" outside its limits \[-185, 185\] deg"):
+        retarget_program(path, old, new, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_point_already_outside_the_limits_is_named(cells, tmp_path, capsys):
+    # The program's J6 is beyond the model's 350 deg: the retarget names it, and keeps the
+    # point's configuration (a 2 mm tool change moves the axes by a fraction of a degree, never
+    # to another branch).
+    old, new = cells
+    new_file = tmp_path / "new.yaml"
+    new.save(new_file)
+    (tmp_path / "in").mkdir()
+    path = _fanuc_point(tmp_path / "in", [-60, -80, 95, 10, 40, 355])
+    code, _, err = run(capsys, "program", "retarget", path, "--from", CELL, "--to", new_file,
+                       "-o", tmp_path / "out")
+    assert code == 3
+    assert "P[1] (line 5): in the program axis 6 is at 355.0 deg, outside its limits" in err
+    assert "outside them in the program already" in err
+    # within the limits, the same point keeps its configuration: every axis moves by little
+    path = _fanuc_point(tmp_path / "in", [-60, -80, 95, 10, 40, 345])
+    result = retarget_program(path, old, new, tmp_path / "out2")
+    assert result.notes == [] and result.points[0].change < np.radians(2)

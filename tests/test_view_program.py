@@ -43,22 +43,27 @@ def assert_arm_at_every_point(page, cell, report):
 
 
 def test_the_arm_at_each_point_is_the_fk_of_the_programs_joint_values(tmp_path, capsys):
-    # RoboDK's KUKA program (two joint points, four Cartesian ones; axis 6 turns 174 deg on a
-    # linear motion at line 54): the arm at each point, the bad point marked with its reason
+    # RoboDK's KUKA program (two joint points, four Cartesian ones), its first linear point
+    # (line 54) moved 2 m up, out of reach: the arm at each point, the bad point marked with its
+    # reason
     cell_path = ROBODK / "cell_kr16.yaml"
+    src = tmp_path / "Program.src"
+    src.write_text((ROBODK / "Program.src").read_text().replace(
+        "LIN {X 18.715,Y 147.321,Z 458.168", "LIN {X 18.715,Y 147.321,Z 2458.168", 1))
     out = tmp_path / "program.html"
-    code, _, err = run(capsys, "view", cell_path, "--program", ROBODK / "Program.src", "-o", out)
+    code, _, err = run(capsys, "view", cell_path, "--program", src, "-o", out)
     assert code == 0, err
     assert "6 points, 1 bad, the arm at every point" in err
     cell = Cell.load(cell_path)
-    report = check_program_file(ROBODK / "Program.src", cell)
+    report = check_program_file(src, cell)
     joints = [p.joints for p in report.program.points[:2]]
     np.testing.assert_array_equal([p.q for p in report.points[:2]], joints)  # as written
     data = assert_arm_at_every_point(out.read_text(), cell, report)
     mark = traces(data, "bad points")[0]
     assert mark["text"] == ["line 54"]
-    assert mark["hovertext"] == [("<b>point line 54</b>: on the linear motion from line 52 axis "
-                                  "6 turns by 173.6 deg (more than 30)")]
+    (why,) = report.points[2].problems
+    assert why.startswith("out of reach by ")
+    assert mark["hovertext"] == [f"<b>point line 54</b>: {why}"]
     np.testing.assert_allclose(xyz(mark)[0], report.points[2].T_world_TCP[:3, 3] * 1e3, atol=TOL)
     path = traces(data, "TCP path")[0]
     assert path["hovertext"][0] == "<b>line 51</b> (line 51, ptp)" and "%{x:.2f}" in path["hovertemplate"]

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import gc
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 import click
 import numpy as np
@@ -39,6 +41,20 @@ def _cell_option(f: Callable) -> Callable:
 def _ppd_option(f: Callable) -> Callable:
     return click.option("--pulses-per-degree", "ppd", default=None, metavar="N[,N...]",
                         help="YASKAWA: encoder pulses per degree of each station axis.")(f)
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector paused while a program is read and checked: the
+    objects of its points hold no cycles (reference counting frees them), and the collector's
+    passes over 100,000 points cost a quarter of the time (benchmarks/bench_program_check.py)."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
 
 
 @click.group(cls=Group)
@@ -138,11 +154,20 @@ def _write_json(cell: Cell, result) -> dict:
 @click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
 @_cell_option
 @_ppd_option
+@click.option("--singular-margin", "singular_margin", type=float, default=2.0,
+              show_default=True, callback=in_range(0.0, 45.0, "deg"),
+              help="Closest good approach to the wrist or elbow singularity, at a point or on a "
+                   "linear motion (deg).")
+@click.option("--shoulder-margin", "shoulder_margin", type=float, default=20.0,
+              show_default=True, callback=in_range(0.0, 1000.0, "mm"),
+              help="Closest good distance of the wrist centre from axis 1 (mm).")
 @click.option("--json", "as_json", is_flag=True, help="Print every point as JSON.")
-def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool) -> None:
+def check_cmd(program_file: str, cell_path: str, ppd: str | None, singular_margin: float,
+              shoulder_margin: float, as_json: bool) -> None:
     """Check every point of PROGRAM (KUKA .src with its .dat, ABB .mod, FANUC .ls, YASKAWA
-    .jbi) against the cell: reach, limits, configuration as written, distance to singularities,
-    configuration changes and jumps on linear motions.
+    .jbi) against the cell: reach, limits, configuration as written, distance to singularities;
+    and every linear motion as the controller follows it: a configuration change, a
+    singularity, reach or limits left on the way.
 
     Exit status 0 when every point is good, 3 with a table of the bad points, 2 for a file that
     cannot be read.
@@ -154,8 +179,9 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, as_json: bool)
     from robotcell.programs.check import check_program_file
 
     cell = Cell.load(cell_path)
-    with as_flags(FLAGS):
-        report = check_program_file(program_file, cell, _ppd(ppd))
+    with as_flags(FLAGS), _collector_paused():
+        report = check_program_file(program_file, cell, _ppd(ppd),
+                                    math.radians(singular_margin), shoulder_margin * 1e-3)
     if as_json:
         click.echo(json.dumps(report.to_json(cell), indent=2))
     for s in report.skipped:
@@ -188,8 +214,10 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     positions) so that the TCP stays where it was after a recalibration (a new tool, base,
     track, table or identified arm): solved in the --to cell where the --from cell had the TCP.
     Cartesian points are left as they are: they follow the exported tool and frame data.
-    Prints the largest axis change per point; a point the new cell cannot reach exits with
-    status 3 and nothing is written.
+    Each point keeps its configuration (shoulder, elbow and wrist sides, and its turns). Prints
+    the largest axis change per point; a point the new cell cannot reach in its configuration,
+    or only with an axis outside its limits, exits with status 3 naming it, and nothing is
+    written. Joint values outside the model's limits in the program are named.
 
     \b
     Example:
@@ -204,6 +232,8 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
                                       inputs=(old_path, new_path))
         except RetargetFailed as exc:
             raise BadPoints(f"{program_file}: {exc}") from None
+    for note in result.notes:
+        click.echo(f"note: {note}", err=True)
     rows = [[p.name, p.line, f"{math.degrees(p.change):.4f}", f"{p.tcp_error * 1e3:.6f}"]
             for p in result.points]
     if as_json:

@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.controllers.data import ControllerData
+
 __all__ = ["FLAG_LIMIT", "MOTIONS", "PTP_SPEED", "Config", "Program", "ProgramPoint", "Ref"]
 
 #: Largest size of a configuration value (a flag, a quadrant or turn count) a file may write: a
@@ -156,9 +158,14 @@ class Program:
     points : list of ProgramPoint
     files : tuple of str
         The files it was read from (empty for a program built in memory).
+    data : ControllerData or None
+        The cell's tools and frames as the controller holds them, for a writer that declares
+        the program's tool and frame in the program itself (ABB); None for a program read from
+        a file.
     """
 
     name: str
     vendor: str
     points: list[ProgramPoint] = field(default_factory=list)
     files: tuple[str, ...] = ()
+    data: ControllerData | None = None

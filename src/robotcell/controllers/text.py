@@ -7,6 +7,7 @@ corrupt program is refused with the place to look at.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from robotcell.controllers.data import fmt_num, parse_float
@@ -24,6 +25,11 @@ NUMBER = r"[-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?"
 
 def strip_comment(line: str, marker: str) -> str:
     """``line`` without its comment (from ``marker`` outside double quotes), right-stripped."""
+    at = line.find(marker)
+    if at < 0:
+        return line.rstrip()
+    if '"' not in line[:at]:
+        return line[:at].rstrip()
     quoted = False
     for i, ch in enumerate(line):
         if ch == '"':
@@ -59,7 +65,12 @@ class Lines:
     def number(self, text: str, lineno: int) -> float:
         """A finite number of at most :data:`~robotcell.io.tables.MAX_ABS_VALUE` in size, or an
         error naming the line."""
-        v = parse_float(text.strip(), f"{self.path}: line {lineno}")
+        try:
+            v = float(text)
+        except ValueError:
+            v = math.nan
+        if not math.isfinite(v):  # the message of parse_float, naming the line
+            v = parse_float(text.strip(), f"{self.path}: line {lineno}")
         if abs(v) > MAX_ABS_VALUE:
             raise self.error(lineno, f"{text.strip()} is beyond {MAX_ABS_VALUE:.0e} in size, "
                                      "which no value of a program is")

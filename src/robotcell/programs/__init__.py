@@ -4,7 +4,8 @@
 - :mod:`robotcell.programs.write`: :func:`write_program`, a path solved through the cell and
   written as a program;
 - :mod:`robotcell.programs.check`: :func:`check_program`, every point of a program through the
-  cell;
+  cell; :mod:`.lines`, every linear motion followed as the controller follows it; :mod:`.singular`,
+  the distances to the singularities;
 - :mod:`robotcell.programs.retarget`: :func:`retarget_program`, joint points recomputed after a
   recalibration;
 - :mod:`robotcell.programs.config`, :mod:`.frames`: configuration flags, tools and frames as a

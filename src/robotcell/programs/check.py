@@ -12,9 +12,10 @@ says what is wrong with it:
   controller keeps the configuration on a linear motion;
 - **singularity**: axis 5 within ``singular_margin`` of the wrist singularity, the arm within it
   of stretched or folded, or the wrist centre within ``shoulder_margin`` of axis 1;
-- **jumps**: on a linear motion from the previous point, a change of the arm's configuration or
-  an axis turning by more than ``max_step`` (a straight line cannot pass a flip). Joint motions
-  may move the axes as far as they like.
+- **linear motions**: the straight line from the previous point followed as the controller
+  follows it (:mod:`robotcell.programs.lines`): a change of the arm's configuration, a whole
+  turn of an axis against the configuration written, a singularity passed on the way, reach or
+  limits left on the way. Joint motions may move the axes as far as they like.
 
 A point is good when it has no problem; the program is good when every point is.
 
@@ -27,35 +28,43 @@ joints, so a filtered program is checked where it really goes (docs/accuracy.md)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell import Cell
-from robotcell.cell.ik import MAX_STEP
 from robotcell.cell.kinematics import robot_pose
 from robotcell.controllers.axes import ExternalAxes
-from robotcell.controllers.model import Config, Program, ProgramPoint
+from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
-from robotcell.ik.analytic import analytic_solver
+from robotcell.ik.result import IKSolutions
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.config import candidates, config_text, config_values, select
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import Placement, placement, tool_pose_of
+from robotcell.programs.lines import LineData, line_problems
 from robotcell.programs.path import table_columns
+from robotcell.programs.singular import (
+    SHOULDER_MARGIN,
+    SINGULAR_MARGIN,
+    outside_text,
+    singular_distances,
+)
 from robotcell.robot.robot import Robot
 
-__all__ = ["CheckReport", "CheckedPoint", "check_program", "check_program_file"]
+__all__ = ["SHOULDER_MARGIN", "SINGULAR_MARGIN", "CheckReport", "CheckedPoint", "check_program",
+           "check_program_file", "singular_distances"]
 
-#: Closest approach to the wrist or elbow singularity that still counts as good (rad).
-SINGULAR_MARGIN = math.radians(2.0)
-#: Closest approach of the wrist centre to axis 1 that still counts as good (m).
-SHOULDER_MARGIN = 0.02
+#: Rounds of choosing the solutions of points without flags all at once (:func:`_sequential`)
+#: before the rest are chosen one by one.
+SEQUENTIAL_ROUNDS = 20
+#: The frame of a linear motion to a joint point: the world.
+_WORLD = Placement("fixed", np.eye(4), "world")
 
 
 @dataclass
@@ -155,95 +164,92 @@ def _num(v: float) -> float | None:
     return None if not math.isfinite(v) else round(float(v), 9)
 
 
-def singular_distances(robot: Robot, q: ArrayLike
-                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Distances of configurations to the singularities of an ortho-parallel arm.
-
-    Parameters
-    ----------
-    robot : Robot
-    q : array_like, shape (..., 6)
-        Controller axis values (rad).
-
-    Returns
-    -------
-    wrist : ndarray, shape (...)
-        Angle of axis 5 from its singular values (rad): the wrist singularity.
-    elbow : ndarray, shape (...)
-        Angle of the forearm from the line through axes 2 and 3 (rad): the arm stretched or
-        folded.
-    shoulder : ndarray, shape (...)
-        Distance of the wrist centre from the line of axis 1 (m).
-        All NaN for an arm that is not ortho-parallel.
-    """
-    arr = np.asarray(q, dtype=float)
-    solver = analytic_solver(robot)
-    if solver.method != "opw":
-        nan = np.full(arr.shape[:-1], np.nan)
-        return nan, nan, nan
-    p = solver.params
-    model = robot.coupling.to_model(arr) if robot.coupling is not None else arr
-    th = model * p.signs + p.offsets
-    t2, t3 = th[..., 1], th[..., 2]
-    t23 = t2 + t3
-
-    def off_pi(t: NDArray) -> NDArray:
-        return np.abs(np.mod(t + math.pi / 2, math.pi) - math.pi / 2)
-
-    wx = p.a1 + p.c2 * np.sin(t2) + p.a2 * np.cos(t23) + p.c3 * np.sin(t23)
-    return off_pi(th[..., 4]), off_pi(t3 + math.atan2(p.a2, p.c3)), np.hypot(wx, p.b)
-
 
 @dataclass
 class _Resolved:
-    """What the cell makes of a point before its joints are known."""
+    """What the cell makes of the points before their joints are known, one row per point.
 
-    T_F_TCP: NDArray[np.float64] | None
-    where: Placement | None
-    track: float
-    table: float | NDArray[np.float64]
-    problems: list[str]
+    Attributes
+    ----------
+    tools : ndarray, shape (N, 4, 4)
+        ``T_F_TCP`` (m; NaN where the cell has no such tool).
+    frames : list of Placement or None
+        The frame of each Cartesian point (None: a joint point, or a frame the cell lacks).
+    track : ndarray, shape (N,)
+        Track values (m).
+    table : ndarray, shape (N,) or (N, n)
+        Table values (rad).
+    problems : list of list of str
+    """
+
+    tools: NDArray[np.float64]
+    frames: list[Placement | None]
+    track: NDArray[np.float64]
+    table: NDArray[np.float64]
+    problems: list[list[str]]
 
 
-def _resolve(cell: Cell, point: ProgramPoint, axes: ExternalAxes) -> _Resolved:
-    problems: list[str] = []
-    T_tool = where = None
-    try:
-        T_tool = tool_pose_of(cell, axes.vendor, point.tool)
-    except InputError as exc:
-        problems.append(str(exc))
-    if point.pose is not None:
-        try:
-            where = placement(cell, axes.vendor, point.frame)
-        except InputError as exc:
-            problems.append(str(exc))
-    track, table, missing = axes.from_file(point.external)
-    problems += missing
-    if cell.track is not None and not cell.track.within_limits(track):
-        problems.append(f"track {track * 1e3:g} mm is outside its limits "
-                        f"[{cell.track.lower * 1e3:g}, {cell.track.upper * 1e3:g}] mm")
+def _key(ref: Ref) -> tuple:
+    """A tool or frame reference as a dictionary key (its pose by identity)."""
+    return (ref.number, ref.name, ref.on_table, ref.kind,
+            None if ref.pose is None else id(ref.pose))
+
+
+def _resolve(cell: Cell, pts: list[ProgramPoint], axes: ExternalAxes) -> _Resolved:
+    """Tool, frame and external axes of every point (each reference looked up once), and the
+    track and table limits."""
+    track, table, problems = axes.from_files([p.external for p in pts])
+    tools: dict[tuple, tuple[NDArray | None, str | None]] = {}
+    places: dict[tuple, tuple[Placement | None, str | None]] = {}
+    nan = np.full((4, 4), np.nan)
+    poses, frames = [], []
+    for p, said in zip(pts, problems):
+        key = _key(p.tool)
+        if key not in tools:
+            try:
+                tools[key] = (tool_pose_of(cell, axes.vendor, p.tool), None)
+            except InputError as exc:
+                tools[key] = (None, str(exc))
+        T_tool, why = tools[key]
+        poses.append(nan if T_tool is None else T_tool)
+        if why:
+            said.insert(0, why)
+        where = None
+        if p.pose is not None:
+            key = _key(p.frame)
+            if key not in places:
+                try:
+                    places[key] = (placement(cell, axes.vendor, p.frame), None)
+                except InputError as exc:
+                    places[key] = (None, str(exc))
+            where, why = places[key]
+            if why:
+                said.insert(1 if T_tool is None else 0, why)
+        frames.append(where)
+    res = _Resolved(np.array(poses).reshape(-1, 4, 4), frames, track, table, problems)
+    _limits(cell, res)
+    return res
+
+
+def _limits(cell: Cell, res: _Resolved) -> None:
+    """Name the track and table values outside their limits."""
+    if cell.track is not None:
+        for i in np.flatnonzero(~cell.track.within_limits(res.track)):
+            res.problems[i].append(f"track {res.track[i] * 1e3:g} mm is outside its limits "
+                                   f"[{cell.track.lower * 1e3:g}, {cell.track.upper * 1e3:g}] mm")
     tt = cell.turntable
-    if tt is not None and not np.all(tt.within_limits(table)):
-        problems.append(f"table {np.round(np.degrees(table), 4)} deg is outside its limits "
-                        f"[{np.degrees(tt.lower)}, {np.degrees(tt.upper)}] deg")
-    return _Resolved(T_tool, where, track, table, problems)
-
-
-def _outside(robot: Robot, q: NDArray[np.float64]) -> str:
-    """Words for the first axis of ``q`` outside its limits."""
-    bad = (q < robot.lower) | (q > robot.upper)
-    if not np.any(bad):
-        return "the axes' interaction limits are exceeded"
-    j = int(np.argmax(bad))
-    return (f"axis {j + 1} is at {math.degrees(q[j]):.1f} deg, outside its limits "
-            f"[{math.degrees(robot.lower[j]):g}, {math.degrees(robot.upper[j]):g}] deg")
+    if tt is not None and len(res.track):
+        for i in np.flatnonzero(~tt.within_limits(res.table)):
+            res.problems[i].append(f"table {np.round(np.degrees(res.table[i]), 4)} deg is outside "
+                                   f"its limits [{np.degrees(tt.lower)}, {np.degrees(tt.upper)}] "
+                                   "deg")
 
 
 def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | None = None,
-                  max_step: float = MAX_STEP, singular_margin: float = SINGULAR_MARGIN,
+                  singular_margin: float = SINGULAR_MARGIN,
                   shoulder_margin: float = SHOULDER_MARGIN,
                   skipped: list[str] | None = None) -> CheckReport:
-    """Check every point of a program against a cell.
+    """Check every point of a program against a cell, and every linear motion between two.
 
     Parameters
     ----------
@@ -251,11 +257,10 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     cell : Cell
         The cell the program runs in (a six-axis ortho-parallel arm).
     pulses_per_degree : float or array_like, optional
-        YASKAWA: encoder pulses per degree of each station axis.
-    max_step : float
-        Largest axis change on a linear motion between two points (rad).
+        YASKAWA: encoder pulses per degree of each station axis (only for a job that moves one).
     singular_margin : float
-        Closest good approach to the wrist or elbow singularity (rad).
+        Closest good approach to the wrist or elbow singularity, at a point or on a linear motion
+        (rad).
     shoulder_margin : float
         Closest good distance of the wrist centre from axis 1 (m).
     skipped : list of str, optional
@@ -268,37 +273,165 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     Raises
     ------
     InputError
-        A YASKAWA program for a cell with station axes and no ``pulses_per_degree``.
+        A YASKAWA job that moves a station axis, for a cell with station axes, and no
+        ``pulses_per_degree``.
     """
     ctrl = cell.controller()
     robot = ctrl.robot
     axes = get(program.vendor, "program format").external_axes(cell, pulses_per_degree)
     pts = program.points
     n = len(pts)
-    res = [_resolve(cell, p, axes) for p in pts]
+    res = _resolve(cell, pts, axes)
     q = np.full((n, robot.n_joints), np.nan)
     T_world = np.full((n, 4, 4), np.nan)
-    problems = [list(r.problems) for r in res]
-    cart = [i for i, (p, r) in enumerate(zip(pts, res))
-            if p.pose is not None and r.where is not None and r.T_F_TCP is not None]
-    if cart:
-        _solve_cartesian(ctrl, pts, res, cart, q, T_world, problems)
-    for i, (p, r) in enumerate(zip(pts, res)):
-        if p.joints is not None:
-            q[i] = p.joints
-            if not robot.within_limits(p.joints):
-                problems[i].append(_outside(robot, p.joints))
-            if r.T_F_TCP is not None:
-                T_world[i] = cell.fk(p.joints, r.track, r.table, tool=r.T_F_TCP)
-    _sequential(ctrl, pts, res, q, T_world, problems)
-    if cell.identified is not None:  # where the real arm takes the controller's joints
-        for i in cart:
-            if np.isfinite(q[i]).all():
-                T_world[i] = cell.fk(q[i], res[i].track, res[i].table, tool=res[i].T_F_TCP)
+    problems, track, table, tools = res.problems, res.track, res.table, res.tools
+    cart = np.array([i for i, (p, w) in enumerate(zip(pts, res.frames)) if p.pose is not None
+                     and w is not None], dtype=int)
+    cart = cart[np.isfinite(tools[cart]).all(axis=(1, 2))]
+    solutions = _solve_cartesian(ctrl, pts, res, cart, q, T_world)
+    _joint_points(cell, robot, pts, q, T_world, problems, track, tools)
+    _sequential(ctrl, pts, cart, solutions, q, problems)
+    if cell.identified is not None and cart.size:  # where the real arm takes the joints
+        ok = cart[np.isfinite(q[cart]).all(axis=-1)]
+        T_world[ok] = (robot_pose(cell, track[ok]) @ cell.robot.fk(q[ok], tool=np.eye(4))
+                       @ tools[ok])
     wrist, elbow, shoulder = singular_distances(robot, np.nan_to_num(q))
-    for i in range(n):
-        if np.isnan(q[i]).any():
-            continue
+    _singular(q, wrist, elbow, shoulder, singular_margin, shoulder_margin, problems)
+    _lines(ctrl, pts, res, q, cart, solutions, singular_margin, shoulder_margin)
+    known = np.isfinite(q).all(axis=-1)
+    wrist, elbow, shoulder = (np.where(known, x, math.nan).tolist()
+                              for x in (wrist, elbow, shoulder))
+    checked = [CheckedPoint(p.name, p.line, p.motion, q[i], float(track[i]), table[i],
+                            T_world[i], problems[i], wrist[i], elbow[i], shoulder[i])
+               for i, p in enumerate(pts)]
+    return CheckReport(program, checked, list(skipped or []))
+
+
+def _joint_points(cell: Cell, robot: Robot, pts: list[ProgramPoint], q: NDArray,
+                  T_world: NDArray, problems: list[list[str]], track: NDArray,
+                  tools: NDArray) -> None:
+    """Joint points: their joints as written, within the limits of ``robot`` (the controller's
+    model), and their TCP in ``cell`` (in one batch)."""
+    idx = np.array([i for i, p in enumerate(pts) if p.joints is not None], dtype=int)
+    if idx.size == 0:
+        return
+    q[idx] = np.stack([pts[i].joints for i in idx])
+    for i in idx[~robot.within_limits(q[idx])]:
+        problems[i].append(outside_text(robot, q[i]))
+    ok = idx[np.isfinite(tools[idx]).all(axis=(1, 2))]
+    T_world[ok] = robot_pose(cell, track[ok]) @ cell.robot.fk(q[ok], tool=np.eye(4)) @ tools[ok]
+
+
+def _solve_cartesian(cell: Cell, pts: list[ProgramPoint], res: _Resolved,
+                     idx: NDArray[np.int_], q: NDArray, T_world: NDArray) -> IKSolutions | None:
+    """IK of the Cartesian points ``idx`` in one batch; those with flags get their solution
+    here. Returns the solutions (None without Cartesian points)."""
+    if idx.size == 0:
+        return None
+    robot = cell.robot
+    track, tools, problems = res.track, res.tools, res.problems
+    poses = np.stack([pts[i].pose for i in idx])
+    _, first, group = np.unique([id(res.frames[i]) for i in idx], return_index=True,
+                                return_inverse=True)
+    for g, k0 in enumerate(first):
+        ks = np.flatnonzero(group == g)
+        rows = idx[ks]
+        T_world[rows] = res.frames[idx[k0]].world(cell, track[rows], res.table[rows]) @ poses[ks]
+    T_R_F = invert(robot_pose(cell, track[idx])) @ T_world[idx] @ invert(tools[idx])
+    sol = robot.ik(T_R_F, tool=np.eye(4))
+    unreached = ~sol.reachable.any(axis=-1)
+    for k in np.flatnonzero(unreached):
+        err = (np.nanmin(sol.reach_error[k]) * 1e3 if sol.reach_error is not None
+               else math.nan)
+        problems[idx[k]].append("out of reach" + (f" by {err:.1f} mm" if math.isfinite(err)
+                                                  else ""))
+    flagged = np.array([k for k, i in enumerate(idx) if pts[i].config is not None
+                        and not unreached[k]], dtype=int)
+    if flagged.size == 0:
+        return sol
+    wanted = np.array([pts[idx[k]].config.values for k in flagged])
+    vendor = pts[idx[flagged[0]]].config.vendor
+    got, found, exists = select(robot, sol.q[flagged], sol.reachable[flagged], wanted, vendor)
+    q[idx[flagged[found]]] = got[found]
+    for j in np.flatnonzero(~found):
+        k, i = flagged[j], idx[flagged[j]]
+        text = config_text(pts[i].config)
+        if exists[j]:
+            problems[i].append(f"with the configuration as written ({text}) "
+                               + _outside_any(cell, sol.q[k], pts[i].config))
+        else:
+            reached = sorted({config_text(Config(vendor, tuple(int(x) for x in row)))
+                              for row in config_values(robot, sol.q[k][sol.reachable[k]],
+                                                       vendor)})
+            problems[i].append(f"no solution has the configuration as written ({text}); it is "
+                               f"reached as {', '.join(reached)}")
+    return sol
+
+
+def _outside_any(cell: Cell, branches: NDArray, config: Config) -> str:
+    """Why the solutions with ``config`` leave the limits, for the first of them."""
+    robot = cell.robot
+    cand = candidates(robot, branches[None])[0]
+    flags = config_values(robot, np.nan_to_num(cand), config.vendor)
+    match = np.all(flags == np.array(config.values), axis=-1) & np.isfinite(cand).all(axis=-1)
+    return outside_text(robot, cand[int(np.argmax(match))])
+
+
+def _sequential(cell: Cell, pts: list[ProgramPoint], cart: NDArray[np.int_],
+                sol: IKSolutions | None, q: NDArray, problems: list[list[str]]) -> None:
+    """Cartesian points without flags: the solution nearest to the previous point's, as a
+    controller keeps the configuration (the first: nearest to the robot's home).
+
+    Each point's choice depends on the one before; all are chosen at once against the previous
+    points' choices of the round before, until no choice changes (a few rounds: a choice
+    changes only where the one before it did), or one by one after SEQUENTIAL_ROUNDS."""
+    if sol is None:
+        return
+    robot = cell.robot
+    free = np.array([k for k, i in enumerate(cart) if pts[i].config is None
+                     and sol.reachable[k].any()], dtype=int)
+    if free.size == 0:
+        return
+    rows = cart[free]
+    part = replace(sol, q=sol.q[free], valid=sol.valid[free], reachable=sol.reachable[free],
+                   reach_error=None if sol.reach_error is None else sol.reach_error[free])
+    home = robot.home if robot.home is not None else np.zeros(robot.n_joints)
+    for _ in range(SEQUENTIAL_ROUNDS):
+        got, found, _ = nearest(robot, part, _previous(q, rows, home))
+        new = np.where(found[:, None], got, np.nan)
+        changed = ~np.all((new == q[rows]) | (np.isnan(new) & np.isnan(q[rows])), axis=-1)
+        q[rows] = new
+        if not changed.any():
+            break
+    else:  # the choices still change: the rest one by one, each against the one before
+        for k in range(int(np.argmax(changed)), len(rows)):
+            one = replace(part, q=part.q[k], valid=part.valid[k],
+                          reachable=part.reachable[k], reach_error=None)
+            got, found, _ = nearest(robot, one, _previous(q, rows[k:k + 1], home)[0])
+            q[rows[k]] = got if found else np.nan
+    for i in rows[~np.isfinite(q[rows]).all(axis=-1)]:
+        problems[i].append("no solution within the axis limits")
+
+
+def _previous(q: NDArray, rows: NDArray[np.int_], home: NDArray) -> NDArray:
+    """For each point of ``rows``, the joints of the last point before it that has any
+    (``home`` before the first)."""
+    known = np.isfinite(q).all(axis=-1)
+    last = np.where(known, np.arange(len(q)), -1)
+    last = np.maximum.accumulate(last)
+    before = np.concatenate([[-1], last[:-1]])[rows]
+    return np.where(before[:, None] >= 0, q[np.maximum(before, 0)], home)
+
+
+def _singular(q: NDArray, wrist: NDArray, elbow: NDArray, shoulder: NDArray,
+              singular_margin: float, shoulder_margin: float,
+              problems: list[list[str]]) -> None:
+    """Name the points within a margin of a singularity."""
+    known = np.isfinite(q).all(axis=-1)
+    with np.errstate(invalid="ignore"):
+        near = known & ((wrist < singular_margin) | (elbow < singular_margin)
+                        | (shoulder < shoulder_margin))
+    for i in np.flatnonzero(near):
         if wrist[i] < singular_margin:
             problems[i].append(f"axis 5 is {math.degrees(wrist[i]):.2f} deg from the wrist "
                                f"singularity (margin {math.degrees(singular_margin):g} deg)")
@@ -309,113 +442,31 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
         if shoulder[i] < shoulder_margin:
             problems[i].append(f"the wrist centre is {shoulder[i] * 1e3:.1f} mm from axis 1 "
                                f"(shoulder singularity, margin {shoulder_margin * 1e3:g} mm)")
-    _jumps(robot, pts, q, max_step, problems)
-    checked = [CheckedPoint(p.name, p.line, p.motion, q[i], r.track, r.table, T_world[i],
-                            problems[i],
-                            float(wrist[i]) if np.isfinite(q[i]).all() else math.nan,
-                            float(elbow[i]) if np.isfinite(q[i]).all() else math.nan,
-                            float(shoulder[i]) if np.isfinite(q[i]).all() else math.nan)
-               for i, (p, r) in enumerate(zip(pts, res))]
-    return CheckReport(program, checked, list(skipped or []))
 
 
-def _solve_cartesian(cell: Cell, pts: list[ProgramPoint], res: list[_Resolved], idx: list[int],
-                     q: NDArray, T_world: NDArray, problems: list[list[str]]) -> None:
-    """IK of the Cartesian points ``idx``; those with flags get their solution here."""
-    robot = cell.robot
-    for i in idx:
-        r = res[i]
-        T_world[i] = r.where.world(cell, r.track, r.table) @ pts[i].pose
-    e = np.array([res[i].track for i in idx])
-    T_R_F = (invert(robot_pose(cell, e)) @ T_world[idx]
-             @ invert(np.stack([res[i].T_F_TCP for i in idx])))
-    sol = robot.ik(T_R_F, tool=np.eye(4))
-    store = {i: k for k, i in enumerate(idx)}
-    flagged = [i for i in idx if pts[i].config is not None]
-    for i in idx:
-        k = store[i]
-        if not sol.reachable[k].any():
-            err = (np.nanmin(sol.reach_error[k]) * 1e3 if sol.reach_error is not None
-                   else math.nan)
-            problems[i].append("out of reach" + (f" by {err:.1f} mm" if math.isfinite(err)
-                                                 else ""))
-    if not flagged:
+def _lines(cell: Cell, pts: list[ProgramPoint], res: _Resolved, q: NDArray,
+           cart: NDArray[np.int_], solutions: IKSolutions | None, singular_margin: float,
+           shoulder_margin: float) -> None:
+    """The linear motions between two points with joints (:func:`line_problems`); the IK
+    ``solutions`` of the Cartesian points ``cart`` are the ends of their lines."""
+    known = np.isfinite(q).all(axis=-1) & np.isfinite(res.tools).all(axis=(1, 2))
+    ends = np.array([i for i in range(1, len(pts)) if pts[i].motion == "lin"
+                     and known[i] and known[i - 1]], dtype=int)
+    if ends.size == 0:
         return
-    ks = [store[i] for i in flagged]
-    wanted = np.array([pts[i].config.values for i in flagged])
-    vendor = pts[flagged[0]].config.vendor
-    got, found, exists = select(robot, sol.q[ks], sol.reachable[ks], wanted, vendor)
-    for j, i in enumerate(flagged):
-        if not sol.reachable[store[i]].any():
-            continue
-        if found[j]:
-            q[i] = got[j]
-            continue
-        text = config_text(pts[i].config)
-        if exists[j]:
-            problems[i].append(f"with the configuration as written ({text}) "
-                               + _outside_any(cell, sol.q[store[i]], pts[i].config))
-        else:
-            reached = sorted({config_text(Config(vendor, tuple(int(x) for x in row)))
-                              for row in config_values(robot, sol.q[store[i]][
-                                  sol.reachable[store[i]]], vendor)})
-            problems[i].append(f"no solution has the configuration as written ({text}); it is "
-                               f"reached as {', '.join(reached)}")
-
-
-def _outside_any(cell: Cell, branches: NDArray, config: Config) -> str:
-    """Why the solutions with ``config`` leave the limits, for the first of them."""
-    robot = cell.robot
-    cand = candidates(robot, branches[None])[0]
-    flags = config_values(robot, np.nan_to_num(cand), config.vendor)
-    match = np.all(flags == np.array(config.values), axis=-1) & np.isfinite(cand).all(axis=-1)
-    return _outside(robot, cand[int(np.argmax(match))])
-
-
-def _sequential(cell: Cell, pts: list[ProgramPoint], res: list[_Resolved], q: NDArray,
-                T_world: NDArray, problems: list[list[str]]) -> None:
-    """Cartesian points without flags: the solution nearest to the previous point's."""
-    robot = cell.robot
-    ref = robot.home if robot.home is not None else np.zeros(robot.n_joints)
-    for i, p in enumerate(pts):
-        if p.pose is not None and p.config is None and np.isfinite(T_world[i]).all() \
-                and not any(w.startswith("out of reach") for w in problems[i]):
-            r = res[i]
-            T_R_F = invert(robot_pose(cell, r.track)) @ T_world[i] @ invert(r.T_F_TCP)
-            sol = robot.ik(T_R_F, tool=np.eye(4))
-            got, found, _ = nearest(robot, sol, ref)
-            if found:
-                q[i] = got
-            else:
-                problems[i].append("no solution within the axis limits")
-        if np.isfinite(q[i]).all():
-            ref = q[i]
-
-
-def _jumps(robot: Robot, pts: list[ProgramPoint], q: NDArray, max_step: float,
-           problems: list[list[str]]) -> None:
-    """Linear motions that change the configuration or turn an axis by more than max_step."""
-    sides = np.full(len(pts), -1)
-    ok = np.isfinite(q).all(axis=-1)
-    if ok.any():
-        sides[ok] = config_values(robot, q[ok], "abb")[:, 3]  # cfx: shoulder, elbow, wrist
-    for i in range(1, len(pts)):
-        if pts[i].motion != "lin" or not (ok[i] and ok[i - 1]):
-            continue
-        prev = pts[i - 1].name
-        if sides[i] != sides[i - 1]:
-            problems[i].append(f"the linear motion from {prev} changes the arm's configuration "
-                               "(shoulder, elbow or wrist side): a straight line cannot")
-        step = np.abs(q[i] - q[i - 1])
-        j = int(np.argmax(step))
-        if step[j] > max_step:
-            problems[i].append(f"on the linear motion from {prev} axis {j + 1} turns by "
-                               f"{math.degrees(step[j]):.1f} deg (more than "
-                               f"{math.degrees(max_step):g})")
+    frames = [_WORLD if w is None else w for w in res.frames]
+    branches = None
+    if solutions is not None:
+        branches = np.full((len(pts),) + solutions.q.shape[1:], np.nan)
+        branches[cart] = solutions.q
+    data = LineData([p.name for p in pts], np.column_stack([ends - 1, ends]), q, res.track,
+                    res.table, res.tools, frames, branches)
+    for i, words in line_problems(cell, data, singular_margin, shoulder_margin).items():
+        res.problems[i].extend(words)
 
 
 def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLike | None = None,
-                       max_step: float = MAX_STEP, singular_margin: float = SINGULAR_MARGIN,
+                       singular_margin: float = SINGULAR_MARGIN,
                        shoulder_margin: float = SHOULDER_MARGIN) -> CheckReport:
     """Read a program file (any format, by extension) and check it against a cell.
 
@@ -423,7 +474,7 @@ def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLik
     ----------
     path : str or Path
         KUKA ``.src`` (with its ``.dat``), ABB ``.mod``, FANUC ``.ls``, YASKAWA ``.jbi``.
-    cell, pulses_per_degree, max_step, singular_margin, shoulder_margin
+    cell, pulses_per_degree, singular_margin, shoulder_margin
         As for :func:`check_program`.
 
     Returns
@@ -441,5 +492,5 @@ def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLik
     program, skipped = read_program(path)
     if not program.points:  # a valid program whose motions all depend on data it lacks
         return CheckReport(program, [], list(skipped) or ["the program moves to no point"])
-    return check_program(program, cell, pulses_per_degree, max_step, singular_margin,
-                         shoulder_margin, skipped)
+    return check_program(program, cell, pulses_per_degree, singular_margin, shoulder_margin,
+                         skipped)

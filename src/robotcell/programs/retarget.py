@@ -6,8 +6,12 @@ joints from the new tool and frame data (``robotcell export``). A point stored a
 or the base is recalibrated, or the arm identified, the same joints put the TCP elsewhere.
 :func:`retarget_program` recomputes them: the TCP of each joint point in the old cell (with the
 old cell's tool, track and table; for an arm identified since, where the old nominal model put
-it) is solved in the new cell at the same track and table values, in the configuration nearest
-to the old joints. Only the joint values in the files change; every other line is kept.
+it) is solved in the new cell at the same track and table values, in the point's configuration:
+the same shoulder, elbow and wrist sides, each revolute axis on the turn nearest to its old value.
+A point the new cell reaches only in another configuration, or whose configuration puts an axis
+outside its limits, is refused and named (a retarget never changes a configuration silently);
+joint values outside the model's limits in the program itself are named. All points are solved
+in one batch. Only the joint values in the files change; every other line is kept.
 """
 
 from __future__ import annotations
@@ -23,12 +27,16 @@ from robotcell.cell.kinematics import robot_pose
 from robotcell.controllers.model import Program, ProgramPoint
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError, RobotcellError
-from robotcell.ik.select import nearest
+from robotcell.ik.limits import TWO_PI
+from robotcell.ik.result import IKSolutions
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
+from robotcell.programs.config import config_values, side_changes
 from robotcell.programs.files import write_all
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import tool_pose_of
+from robotcell.programs.singular import outside_text
+from robotcell.robot.robot import Robot
 
 __all__ = ["RetargetFailed", "RetargetResult", "RetargetedPoint", "retarget_program"]
 
@@ -76,45 +84,121 @@ class RetargetResult:
         Cartesian points, left as they are (they follow the exported tool and frame data).
     files : list of str
         The files written.
+    notes : list of str
+        Joint values outside the model's limits in the program itself, by point.
     """
 
     program: Program
     points: list[RetargetedPoint] = field(default_factory=list)
     cartesian: int = 0
     files: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
 
-def _solve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
-           pulses_per_degree: ArrayLike | None) -> tuple[list[RetargetedPoint], list[str]]:
+def _resolve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
+             pulses_per_degree: ArrayLike | None) -> tuple[list[int], dict[str, NDArray],
+                                                           list[str]]:
+    """The points that can be solved (indices into ``points``), their track values and tool
+    poses in the old and the new cell (``track``, ``track_n``, ``tool``, ``tool_n``; the TCP in
+    the world does not depend on the table), and the problems of the others."""
     ctl = get(vendor, "program format")
     axes_old = ctl.external_axes(old, pulses_per_degree)
     axes_new = ctl.external_axes(new, pulses_per_degree)
-    out, problems = [], []
-    for p in points:
-        track, table, missing = axes_old.from_file(p.external)
-        track_n, table_n, _ = axes_new.from_file(p.external)
+    tools: dict[tuple, tuple] = {}
+    rows, problems = [], []
+    cols: dict[str, list] = {k: [] for k in ("track", "track_n", "tool", "tool_n")}
+    for k, p in enumerate(points):
+        track, _, missing = axes_old.from_file(p.external)
+        track_n, _, _ = axes_new.from_file(p.external)
         if missing:
             problems.append(f"{p.name} (line {p.line}): {'; '.join(missing)}")
             continue
-        try:
-            T_old = old.fk(p.joints, track, table, tool=tool_pose_of(old, vendor, p.tool))
-            T_tool = tool_pose_of(new, vendor, p.tool)
-        except InputError as exc:
-            problems.append(f"{p.name} (line {p.line}): {exc}")
+        key = (p.tool.number, p.tool.name, None if p.tool.pose is None else id(p.tool.pose))
+        if key not in tools:
+            try:
+                tools[key] = (tool_pose_of(old, vendor, p.tool), tool_pose_of(new, vendor, p.tool))
+            except InputError as exc:
+                tools[key] = (exc, exc)
+        if isinstance(tools[key][0], InputError):
+            problems.append(f"{p.name} (line {p.line}): {tools[key][0]}")
             continue
-        T_R_F = invert(robot_pose(new, track_n)) @ T_old @ invert(T_tool)
-        sol = new.robot.ik(T_R_F, tool=np.eye(4))
-        q, found, _ = nearest(new.robot, sol, p.joints)
-        if not found:
-            why = "out of reach" if not sol.reachable.any() else "outside the axis limits"
-            problems.append(f"{p.name} (line {p.line}): the new cell cannot put the TCP where "
-                            f"the old one had it ({why})")
-            continue
-        T_new = new.fk(q, track_n, table_n, tool=T_tool)
-        err = float(np.linalg.norm(T_new[:3, 3] - T_old[:3, 3]))
-        out.append(RetargetedPoint(p.name, p.line, p.joints.copy(), q,
-                                   float(np.max(np.abs(q - p.joints))), err))
-    return out, problems
+        rows.append(k)
+        for name, v in zip(cols, (track, track_n, *tools[key])):
+            cols[name].append(v)
+    return rows, {k: np.asarray(v, dtype=float) for k, v in cols.items()}, problems
+
+
+def _keep(robot: Robot, sol: IKSolutions, q_old: NDArray[np.float64]
+          ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """Of each point's branches, the one on the old joints' sides, each revolute axis on the
+    turn nearest to its old value.
+
+    Returns
+    -------
+    kept : ndarray, shape (N, 6)
+        NaN where no reachable branch is on the old sides.
+    has : ndarray of bool, shape (N,)
+    near : ndarray, shape (N, 6)
+        The reachable branch nearest to the old joints, whatever its sides (NaN where none).
+    """
+    rev = ~robot.prismatic
+    cand = sol.q.copy()
+    cand[..., rev] += TWO_PI * np.round((q_old[:, None, rev] - cand[..., rev]) / TWO_PI)
+    with np.errstate(invalid="ignore"):
+        sides = config_values(robot, np.nan_to_num(cand), "abb")[..., 3]
+    old_sides = config_values(robot, q_old, "abb")[:, 3]
+    dist = np.where(sol.reachable, np.sum((cand - q_old[:, None]) ** 2, axis=-1), np.inf)
+    same = np.where(sides == old_sides[:, None], dist, np.inf)
+    rows = np.arange(len(q_old))
+    kept = cand[rows, np.argmin(same, axis=-1)]
+    has = np.isfinite(same).any(axis=-1)
+    near = cand[rows, np.argmin(dist, axis=-1)]
+    return (np.where(has[:, None], kept, np.nan), has,
+            np.where(np.isfinite(dist).any(axis=-1)[:, None], near, np.nan))
+
+
+def _solve(old: Cell, new: Cell, points: list[ProgramPoint], vendor: str,
+           pulses_per_degree: ArrayLike | None
+           ) -> tuple[list[RetargetedPoint], list[str], list[str]]:
+    """The joint points solved in the new cell in their configurations, in one batch: the
+    points, the problems (nothing may be written) and the notes."""
+    rows, c, problems = _resolve(old, new, points, vendor, pulses_per_degree)
+    notes = []
+    q_old = np.array([points[k].joints for k in rows]).reshape(-1, new.robot.n_joints)
+    for k, q in zip(rows, q_old):
+        if not old.robot.within_limits(q):
+            notes.append(f"{points[k].name} (line {points[k].line}): in the program "
+                         f"{outside_text(old.robot, q)}")
+    if not rows:
+        return [], problems, notes
+    T_old = robot_pose(old, c["track"]) @ old.robot.fk(q_old, tool=np.eye(4)) @ c["tool"]
+    T_R_F = invert(robot_pose(new, c["track_n"])) @ T_old @ invert(c["tool_n"])
+    sol = new.robot.ik(T_R_F, tool=np.eye(4))
+    kept, has, near = _keep(new.robot, sol, q_old)
+    inside = new.robot._inside(kept)
+    T_new = (robot_pose(new, c["track_n"]) @ new.robot.fk(np.nan_to_num(kept), tool=np.eye(4))
+             @ c["tool_n"])
+    err = np.linalg.norm(T_new[:, :3, 3] - T_old[:, :3, 3], axis=-1)
+    out = []
+    for j, k in enumerate(rows):
+        p = points[k]
+        where = f"{p.name} (line {p.line}): "
+        if not sol.reachable[j].any():
+            problems.append(where + "the new cell cannot put the TCP where the old one had it "
+                                    "(out of reach)")
+        elif not has[j]:
+            problems.append(where + "the new cell reaches the TCP only in another configuration "
+                                    f"({side_changes(new.robot, q_old[j], near[j])}): "
+                                    "retargeting would change it")
+        elif not inside[j]:
+            was = " (outside them in the program already)" if not old.robot.within_limits(
+                q_old[j]) else ""
+            problems.append(where + "the new cell keeps the point's configuration only with "
+                            + outside_text(new.robot, kept[j]).replace(" is at ", " at ") + was)
+        else:
+            out.append(RetargetedPoint(p.name, p.line, q_old[j].copy(), kept[j],
+                                       float(np.max(np.abs(kept[j] - q_old[j]))), float(err[j])))
+    return out, problems, notes
 
 
 def _same_layout(old: Cell, new: Cell) -> None:
@@ -162,8 +246,10 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
         An unreadable program, a program with no point, a folder that cannot be written, or
         cells that differ in their axes (arm, track, turntable or positioner).
     RetargetFailed
-        A joint point the new cell cannot reach or that names a tool the cells lack; nothing is
-        written.
+        A joint point the new cell cannot reach in its configuration (out of reach, only on
+        other sides of the shoulder, elbow or wrist, or with an axis outside its limits), or
+        that names a tool the cells lack; nothing is written. The message names each, and the
+        joint values outside the model's limits in the program.
     """
     _same_layout(old, new)
     program, _ = read_program(path)
@@ -176,10 +262,10 @@ def retarget_program(path: str | Path, old: Cell, new: Cell, folder: str | Path,
     result = RetargetResult(program, cartesian=len(program.points) - len(joint))
     if joint and not ctl.edits_joints:
         raise InputError(f"{path}: {vendor} joint points are not retargeted")
-    moved, problems = _solve(old, new, joint, vendor, pulses_per_degree)
+    moved, problems, notes = _solve(old, new, joint, vendor, pulses_per_degree)
     if problems:
-        raise RetargetFailed("nothing written: " + "; ".join(problems))
-    result.points = moved
+        raise RetargetFailed("nothing written: " + "; ".join(problems + notes))
+    result.points, result.notes = moved, notes
     texts: dict[str, list[str]] = {f: read_text(f, "program file").splitlines()
                                    for f in program.files}
     for p, r in zip(joint, moved):

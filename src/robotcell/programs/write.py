@@ -275,7 +275,7 @@ def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, n
             external=axes.to_file(path.track[i], path.table[i]),
             speed=float(targets.speed[j]),
             zone=float(targets.zone[j])))
-    return Program(name, ctl.name, points)
+    return Program(name, ctl.name, points, data=ctl.data(cell))
 
 
 def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: str,

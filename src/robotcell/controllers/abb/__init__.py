@@ -5,7 +5,8 @@
   objects on the turntable's mechanical unit) and base frames as ``CONST pose``, in world.
 - Programs (:mod:`.program`): one module ``NAME.mod`` (``.prg`` read too).
 - Flags: ``confdata`` ``[cf1, cf4, cf6, cfx]`` (:func:`robotcell.ik.config.abb_confdata`).
-- Slots: none; tools and work objects are RAPID identifiers of at most 32 characters.
+- Slots: none; tools and work objects are RAPID identifiers of at most 32 characters; program
+  names of at most 28, so that the module ``MOD_NAME`` is one too.
 - External axes: ``eax_a..eax_f``, the track first (mm), the table's axes after it (deg),
   ``9E9`` for an axis the cell lacks.
 
@@ -47,7 +48,7 @@ class Abb(Controller):
     comment = "!"
     program_files = "ABB .mod"
     export_name = "cell.mod"
-    name_limit = 32
+    name_limit = 28  # MOD_ + 28 characters: a RAPID name of 32
     config_fields = ("cf1", "cf4", "cf6", "cfx")
     edits_joints = True
     csv_config = ("cf1", "cf4", "cf6", "cfx")
@@ -63,7 +64,11 @@ class Abb(Controller):
          "zonedata"),
         "ABB MultiMove application manual 3HAC021272-001, 6.3 'Coordinated work objects'",
         "KnoP-01/rapid-for-vim, syntax/rapid.vim: RAPID names of at most 32 characters",
-        "RoboDK ABB_RAPID_IRC5 post (confdata)",
+        ("RoboDK ABB_RAPID_IRC5 post (ros-industrial-attic/robodk_postprocessors): confdata; "
+         "MODULE MOD_<name> holding PROC <name>(); LOCAL PERS tooldata and wobjdata declared in "
+         "the program's module"),
+        ("ABB RobotStudio SDK, RapidDomain Scope enumeration: LOCAL data is available for its "
+         "module only"),
     )
 
     def format_export(self, data: ControllerData, cell_name: str) -> str:

@@ -34,7 +34,7 @@ from robotcell.controllers.data import (
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 
-__all__ = ["format_data", "parse"]
+__all__ = ["format_data", "parse", "tooldata_text", "wobjdata_text"]
 
 #: ABB's ``load0``: the load written for a tool whose mass the cell does not know.
 LOAD0 = "[0.001,[0,0,0.001],[1,0,0,0],0,0,0]"
@@ -57,6 +57,21 @@ def _load_text(s: Slot) -> str:
             "[1,0,0,0],0,0,0]")
 
 
+def tooldata_text(s: Slot) -> str:
+    """A tool's ``tooldata`` value: ``[TRUE,[[x,y,z],[q1,q2,q3,q4]],load]`` (the TCP in the flange
+    frame; ABB's ``load0`` where the cell has no mass for it)."""
+    return f"[TRUE,{pose_text(s.pose)},{_load_text(s)}]"
+
+
+def wobjdata_text(s: Slot, unit: str | None) -> str:
+    """A frame's ``wobjdata`` value: a user frame in world for a frame fixed in the cell, or on
+    the mechanical unit ``unit`` (``ufprog`` FALSE) with the object frame in the unit's frame at
+    axis 0 for a frame on the turntable."""
+    if s.on_table:
+        return f'[FALSE,FALSE,"{unit}",{_IDENTITY},{pose_text(s.pose)}]'
+    return f'[FALSE,TRUE,"",{pose_text(s.pose)},{_IDENTITY}]'
+
+
 def format_data(data: ControllerData, cell_name: str) -> str:
     """RAPID module text for :class:`ControllerData` collected with ``reference="world"``."""
     idents: dict[str, str] = {}
@@ -74,20 +89,19 @@ def format_data(data: ControllerData, cell_name: str) -> str:
     for s in data.tools:
         if s.mass is None:
             L.append(f"    ! {s.name}: mass unknown in the cell, load0 written; set the real load")
-        L.append(f"    PERS tooldata {s.name}:=[TRUE,{pose_text(s.pose)},{_load_text(s)}];")
+        L.append(f"    PERS tooldata {s.name}:={tooldata_text(s)};")
     fixed = [s for s in data.frames if not s.on_table]
     table = [s for s in data.frames if s.on_table]
     if fixed:
         L.append("    ! work objects fixed in the cell: user frame in world")
     for s in fixed:
-        L.append(f'    PERS wobjdata {s.name}:=[FALSE,TRUE,"",{pose_text(s.pose)},{_IDENTITY}];')
+        L.append(f"    PERS wobjdata {s.name}:={wobjdata_text(s, None)};")
     if data.turntable is not None:
         unit = data.turntable.name
         if table:
             L.append(f"    ! work objects on {unit}: object frame in the unit's frame at axis 0")
         for s in table:
-            L.append(f'    PERS wobjdata {s.name}:=[FALSE,FALSE,"{unit}",{_IDENTITY},'
-                     f"{pose_text(s.pose)}];")
+            L.append(f"    PERS wobjdata {s.name}:={wobjdata_text(s, unit)};")
         L.append(f"    ! system parameters, Motion > Single {unit} > base frame (in world, "
                  "z on the table axis):")
         L.append(f"    CONST pose {unit}_base:={pose_text(data.turntable.pose)};")

@@ -6,6 +6,9 @@ Written (sources in ``docs/programs.md``):
   the TCP in the work object (mm, quaternion scalar first), the configuration
   (:mod:`robotcell.programs.config`), the external axes (track mm, table deg; ``9E9`` for axes
   the cell lacks);
+- ``MODULE MOD_NAME`` (RoboDK's ABB post names the module apart from the routine), the program's
+  ``tooldata`` and ``wobjdata`` declared in it as ``LOCAL PERS`` with the values of ``robotcell
+  export`` (local to the module, as RoboDK declares its own);
 - ``PROC NAME()`` with ``ConfJ \\On; ConfL \\On;`` and ``MoveJ``/``MoveL pi, speed, zone,
   tool\\WObj:=wobj;`` where the tool and the work object are the ``tooldata`` and ``wobjdata``
   that ``robotcell export`` writes (``wobj0`` for the world); speeds and zones are ABB's
@@ -23,6 +26,7 @@ import re
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.controllers.abb import export as export_abb
 from robotcell.controllers.abb.reader import EAX, read
 from robotcell.controllers.data import MM_DECIMALS, QUAT_DECIMALS
 from robotcell.controllers.model import Config, Program, ProgramPoint
@@ -75,14 +79,43 @@ def _robtarget(p: ProgramPoint) -> str:
     return f"[[{trans}],[{quat}],{config_text(p.config.values)},[{eax}]]"
 
 
+#: What the module name adds to the program's name: RoboDK's ABB post writes ``MODULE MOD_NAME``
+#: with ``PROC NAME()`` in it, a module and a routine of two names.
+MODULE_PREFIX = "MOD_"
+
+
+def _declarations(program: Program, tool: str, wobj: str) -> list[str]:
+    """``LOCAL PERS`` declarations of the program's tool and work object, with the values of
+    ``robotcell export``, so that the module holds what it moves with (empty where the program
+    carries no cell data, and for ``wobj0``)."""
+    data = program.data
+    if data is None:
+        return []
+    out = []
+    t = next((s for s in data.tools if s.name == tool), None)
+    if t is not None:
+        if t.mass is None:
+            out.append(f"    ! {t.name}: mass unknown in the cell, load0 written; set the real load")
+        out.append(f"    LOCAL PERS tooldata {t.name}:={export_abb.tooldata_text(t)};")
+    w = next((s for s in data.frames if s.name == wobj), None)
+    if w is not None:
+        unit = data.turntable.name if data.turntable is not None else None
+        out.append(f"    LOCAL PERS wobjdata {w.name}:={export_abb.wobjdata_text(w, unit)};")
+    if out:
+        out.insert(0, ("    ! tool and work object as robotcell export writes them, local to this "
+                       "module"))
+    return out
+
+
 def write(program: Program, header: list[str]) -> dict[str, str]:
-    """``NAME.mod`` of a program of Cartesian points.
+    """``NAME.mod`` of a program of Cartesian points: ``MODULE MOD_NAME`` holding the tool and
+    the work object (``LOCAL PERS``), the targets and ``PROC NAME()``.
 
     Parameters
     ----------
     program : Program
         Points with ``pose``, ``config`` (ABB confdata) and ``external`` (``eax_a``..), one tool
-        and one work object (by name).
+        and one work object (by name), and the cell's data (``program.data``) to declare them.
     header : list of str
         Comment lines (without ``!``).
 
@@ -94,7 +127,8 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
     name = program.name
     first = program.points[0]
     tool, wobj = first.tool.name, first.frame.name or "wobj0"
-    L = [f"MODULE {name}", *(f"    ! {h}" for h in header),
+    L = [f"MODULE {MODULE_PREFIX}{name}", *(f"    ! {h}" for h in header),
+         *_declarations(program, tool, wobj),
          ("    ! robtarget: x, y, z (mm) and quaternion [q1,q2,q3,q4] of the TCP in the work "
           "object, confdata [cf1,cf4,cf6,cfx], extax (track mm, table deg; 9E9: no axis)")]
     L += [f"    CONST robtarget {p.name}:={_robtarget(p)};" for p in program.points]

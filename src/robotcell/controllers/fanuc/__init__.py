@@ -79,7 +79,11 @@ class Fanuc(Controller):
          "(irbzavalagit/UB10200_RBT01, sysframe.va), ARRAY[1,110] and $MNUTOOL ARRAY[1,15] "
          "(WILDER-SYSTEMS-LLC/git-ftp, sysframe.va)"),
         ("RoboDK Fanuc_R30iA post (ros-industrial-attic/robodk_postprocessors): program names "
-         "cut to 10 characters, CONFIG flags and turn numbers"),
+         "cut to 10 characters, CONFIG flags and turn numbers, positions 'X =%10.3f  mm', "
+         "'E1=%10.3f  mm'"),
+        ("TP listings saved by FANUC controllers (JuniorNatalin/VASC, Backups/.../*.ls): "
+         "'X =   -63.679  mm', 'P =      .153 deg', 'J1=     0.000  mm': 3 decimals, 10 "
+         "characters"),
     )
 
     def format_export(self, data: ControllerData, cell_name: str) -> str:
@@ -123,7 +127,8 @@ class Fanuc(Controller):
                       ) -> ExternalAxes:
         n, chain = table_count(cell)
         return ExternalAxes(self.name, "E1" if cell.track is not None else None,
-                            tuple(f"GP2:J{i + 1}" for i in range(n)), 1e3, (DEG,) * n, chain)
+                            tuple(f"GP2:J{i + 1}" for i in range(n)), 1e3, (DEG,) * n, chain,
+                            decimals=tp.TP_DECIMALS)
 
     def set_joints(self, lines: list[str], idx: int, q: NDArray[np.float64]) -> bool:
         return tp.set_joints(lines, idx, q)

@@ -4,9 +4,10 @@ Written (sources in ``docs/programs.md``):
 
 - ``/MN``: ``UFRAME_NUM=n``, ``UTOOL_NUM=n`` (the numbers of ``robotcell export``), then
   ``J P[i] 20% FINE`` / ``L P[i] 100mm/sec CNTk`` per point;
-- ``/POS``: ``P[i]{ GP1: UF : n, UT : n, CONFIG : 'N U T, t1, t4, t6', X = .. mm, ..., R = .. deg``
-  and a rail as ``E1 = .. mm`` in group 1 (an integrated extended axis), and the turntable or
-  positioner as group 2, ``GP2: UF, UT, J1 = .. deg, ...``; ``};``.
+- ``/POS``: ``P[i]{ GP1: UF : n, UT : n, CONFIG : 'N U T, t1, t4, t6', X =   -63.679  mm, ...,
+  R =    50.373 deg`` and a rail as ``E1=  4010.288  mm`` in group 1 (an integrated extended
+  axis), and the turntable or positioner as group 2, ``GP2: UF, UT, J1=   191.000 deg, ...``;
+  ``};``. Values as controllers save them: 10 characters, 3 decimals, ``.153`` for 0.153.
 
 Positions are the TCP in the user frame, which ``robotcell export`` writes in FANUC WORLD (the
 robot base at rail position 0); a frame on the turntable is the user frame of its pose at table
@@ -57,24 +58,39 @@ def _cnt(zone: float) -> str:
     return "FINE" if mm <= 0 else f"CNT{min(100, max(1, round(mm)))}"
 
 
+#: Decimals of the values of a position, as controllers save them (mm and deg).
+TP_DECIMALS = 3
+
+
+def tp_number(x: float) -> str:
+    """A value of a position as a controller saves it: 10 characters, 3 decimals, no ``0``
+    before the point of a value below 1 in size (``   -63.679``, ``      .153``,
+    ``     0.000``)."""
+    text = f"{x:10.3f}"
+    if float(text) == 0.0:
+        return f"{0.0:10.3f}"
+    if abs(float(text)) < 1.0:
+        text = text.replace("0.", ".").rjust(10)
+    return text
+
+
 def _position(p: ProgramPoint) -> list[str]:
     assert p.pose is not None and p.config is not None
     v = pose_to_vendor(p.pose, "fanuc")
     uf, ut = p.frame.number or 0, p.tool.number or 0
     L = [f"{p.name}{{", "   GP1:",
          f"\tUF : {uf}, UT : {ut},\t\tCONFIG : {config_text(p.config.values)},",
-         "\t" + ",\t".join(f"{k} = {fmt_num(x, MM_DECIMALS)}  mm" for k, x in
-                           zip(_POSE_KEYS[:3], v[:3])) + ","]
-    rot = ",\t".join(f"{k} = {fmt_num(x, DEG_DECIMALS)} deg" for k, x in
-                     zip(_POSE_KEYS[3:], v[3:]))
+         "\t" + ",\t".join(f"{k} ={tp_number(x)}  mm" for k, x in zip(_POSE_KEYS[:3], v[:3]))
+         + ","]
+    rot = ",\t".join(f"{k} ={tp_number(x)} deg" for k, x in zip(_POSE_KEYS[3:], v[3:]))
     rail = p.external.get("E1")
     L.append(f"\t{rot}" + ("," if rail is not None else ""))
     if rail is not None:
-        L.append(f"\tE1 = {fmt_num(rail, MM_DECIMALS)}  mm")
+        L.append(f"\tE1={tp_number(rail)}  mm")
     table = [(k.split(":")[1], v) for k, v in p.external.items() if k.startswith("GP2:")]
     if table:
-        L += ["   GP2:", f"\tUF : {uf}, UT : {ut},",
-              "\t" + ",\t".join(f"{k} = {fmt_num(x, DEG_DECIMALS)} deg" for k, x in table)]
+        L += ["   GP2:", f"\tUF : {uf}, UT : {ut},\t",
+              "\t" + ",\t".join(f"{k}={tp_number(x)} deg" for k, x in table)]
     L.append("};")
     return L
 

@@ -6,7 +6,8 @@ Written (sources in ``docs/programs.md``):
   (``BAS (#INITMOV,0 )`` after the stop interrupt), ``$TOOL=TOOL_DATA[n]``, ``$BASE=BASE_DATA[n]``
   for a base fixed in the cell or ``$BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,
   BASE_DATA[n])`` for a base on the turntable (the numbers of ``robotcell export``),
-  ``$VEL.CP`` (m/s), ``$APO.CDIS`` (mm), then ``PTP XPi`` / ``LIN XPi`` (``C_DIS`` where the zone
+  ``$ACT_EX_AX=n``, the number of external axes the program moves (track and table axes, as
+  RoboDK's KUKA posts write it), ``$VEL.CP`` (m/s), ``$APO.CDIS`` (mm), then ``PTP XPi`` / ``LIN XPi`` (``C_DIS`` where the zone
   is not 0) and ``END``.
 - ``NAME.dat``: ``DEFDAT NAME`` with one ``DECL E6POS XPi={X ..,Y ..,Z ..,A ..,B ..,C ..,S ..,
   T ..,E1 ..,...,E6 ..}`` per point (mm, deg; ``R = Rz(A) Ry(B) Rx(C)``) and ``ENDDAT``.
@@ -62,6 +63,12 @@ def _base_line(ref: Ref) -> str:
     return f"$BASE=BASE_DATA[{ref.number}]"
 
 
+def _external_axes(program: Program) -> int:
+    """The number of external axes the program moves: the track and the table's axes it
+    writes (``E1``..), the unused ones (written as 0) left out."""
+    return len({k for p in program.points for k in p.external})
+
+
 def write(program: Program, header: list[str]) -> dict[str, str]:
     """``NAME.src`` and ``NAME.dat`` of a program of Cartesian points.
 
@@ -89,8 +96,9 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
            ";ENDFOLD (INI)",
            f"$TOOL=TOOL_DATA[{first.tool.number}]  ; {first.tool.name}",
            _base_line(first.frame) + (f"  ; {first.frame.name}" if first.frame.name else "")]
-    if first.frame.on_table:
-        src.append(f"$ACT_EX_AX={MACHINE_INDEX}")
+    axes = _external_axes(program)
+    if axes:
+        src.append(f"$ACT_EX_AX={axes}")
     speed = zone = None
     for i, p in enumerate(program.points):
         if p.motion == "lin" and p.speed is not None and p.speed != speed:

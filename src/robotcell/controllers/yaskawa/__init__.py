@@ -5,11 +5,12 @@
   coordinates, at the robot base at base-axis 0; frames on the turntable at station axis 0, and
   the table's root as one more user frame.
 - Programs (:mod:`.program`): jobs ``NAME.jbi``.
-- Flags: ``RCONF l,m,n,o,p,q``: flip, lower arm, rear, and R, T, S at 180 deg or more; one
-  ``RCONF`` holds for the points after it.
+- Flags: ``RCONF l,m,n,o,p,q``: flip, lower arm, rear, and R, T, S at 180 deg or more (24
+  values written, the rest 0); one ``RCONF`` holds for the points after it.
 - Slots: tool and user frame numbers 0..23 (NX100 job format); job names of at most 8
   characters, in capitals.
-- External axes: a base axis ``BC1`` (mm), station axes ``EC1..`` in encoder pulses.
+- External axes: a base axis ``BC1`` (mm) in the robot's group, station axes ``EC1..`` in
+  encoder pulses (pulses per degree per axis) in a group of their own, moved with ``+MOVJ``.
 
 Sources: ``docs/export.md`` and ``docs/programs.md``.
 """
@@ -66,6 +67,11 @@ class Yaskawa(Controller):
          "4.3: job data format, station axes in pulses"),
         "Yaskawa knowledge base, 'Information in UFRAME.CND'",
         "RoboDK Motoman post (relative jobs, ///FRAME USER)",
+        ("RoboDK Motoman post 2015-2023 (TetraGenAdmin/TGRoboDKPostProcessors, Motoman.py): "
+         "'MOVL C00008 BC00008 V=166.7 +MOVJ EC00008 VJ=100.00', pulses per degree per "
+         "external axis"),
+        ("jobs written for DX100 and later (e.g. '////FRAME USER 1', '///GROUP1 RB1' with "
+         "'///GROUP2 ST1', '///RCONF 1,0,...' of 24 values): docs/programs.md"),
     )
 
     def format_export(self, data: ControllerData, cell_name: str) -> str:
@@ -96,20 +102,30 @@ class Yaskawa(Controller):
 
     def external_axes(self, cell: Cell, pulses_per_degree: ArrayLike | None = None
                       ) -> ExternalAxes:
-        """Station axes in encoder pulses: ``pulses_per_degree`` (one value, or one per axis)
-        is needed when the cell has a turntable or positioner."""
+        """Station axes in encoder pulses: ``pulses_per_degree``, one value per station axis
+        (each axis has its own gear and encoder), is needed as soon as a station value is
+        written or read; a job that moves no station axis is read without it."""
         n, chain = table_count(cell)
+        need = None
         if n and pulses_per_degree is None:
-            raise InputError("YASKAWA jobs hold station axes in encoder pulses: give "
-                             "pulses_per_degree, the pulses per degree of the turntable's axis "
-                             "(from the station's parameters)")
-        ppd = np.broadcast_to(np.asarray(pulses_per_degree if n else 1.0, dtype=float), (n,))
-        if n and not np.all(np.isfinite(ppd) & (ppd > 0)):
-            raise InputError(f"pulses_per_degree must be positive numbers, got "
-                             f"{pulses_per_degree!r}")
+            need = ("YASKAWA jobs hold station axes in encoder pulses: give pulses_per_degree, "
+                    "the pulses per degree of " + ("the turntable's axis" if n == 1 else
+                                                    f"each of the station's {n} axes")
+                    + " (from the station's parameters)")
+            ppd = np.full(n, np.nan)
+        else:
+            ppd = np.atleast_1d(np.asarray(pulses_per_degree if n else [], dtype=float))
+            if ppd.shape != (n,):
+                raise InputError(f"pulses_per_degree: the station has {n} axes, each with its "
+                                 f"own pulses per degree; give {n} values, got "
+                                 f"{pulses_per_degree!r}")
+            if not np.all(np.isfinite(ppd) & (ppd > 0)):
+                raise InputError(f"pulses_per_degree must be positive numbers, got "
+                                 f"{pulses_per_degree!r}")
         return ExternalAxes(self.name, "BC1" if cell.track is not None else None,
                             tuple(f"EC{i + 1}" for i in range(n)), 1e3,
-                            tuple(float(p) * DEG for p in ppd), chain, whole_units=True)
+                            tuple(float(p) * DEG for p in ppd), chain, whole_units=True,
+                            table_optional=True, unit_needed=need)
 
     def set_pose(self, lines: list[str], idx: int, T: NDArray[np.float64],
                  config: Config | None = None) -> bool:

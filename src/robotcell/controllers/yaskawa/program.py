@@ -5,13 +5,14 @@ Written (sources in ``docs/programs.md``, chiefly the DX100 and NX100 manuals' j
 - ``//POS``: ``///NPOS c,bc,ec,0,0,0``; ``///USER n`` and ``///POSTYPE USER`` for a user frame
   (``///POSTYPE BASE`` for the world, which YASKAWA measures in the base coordinates at base
   axis 0), ``///TOOL n`` (the numbers of ``robotcell export``); ``///RECTAN``, then per point
-  ``///RCONF l,m,n,o,p,q,0,0`` (where it changes) and ``Cxxxxx=X,Y,Z,Rx,Ry,Rz`` (mm, deg with
+  ``///RCONF l,m,n,o,p,q,0,...`` (24 values, where it changes) and ``Cxxxxx=X,Y,Z,Rx,Ry,Rz`` (mm, deg with
   ``R = Rz(Rz) Ry(Ry) Rx(Rx)``); the track as base axis ``BCxxxxx=mm``; then ``///POSTYPE
   PULSE``, ``///PULSE`` and the turntable or positioner as station axes ``ECxxxxx=pulses``;
-- ``//INST``: ``///ATTR SC,RW,RJ`` (Cartesian positions: a relative job) with ``///FRAME USER n``
-  for a user frame,
-  ``///GROUP1 RB1[,BS1][,ST1]``, ``NOP``, ``MOVJ Cxxxxx [BCxxxxx] [ECxxxxx] VJ=20.00`` or
-  ``MOVL ... V=100.0``, ``PL=k`` for a zone, ``END``.
+- ``//INST``: ``///ATTR SC,RW,RJ`` (Cartesian positions: a relative job) with ``////FRAME USER
+  n`` for a user frame, ``///GROUP1 RB1[,BS1]`` (the robot and its base axis) and ``///GROUP2
+  ST1`` (the station, a group of its own), ``NOP``, ``MOVJ Cxxxxx [BCxxxxx] VJ=20.00`` or ``MOVL
+  ... V=100.0``, ``PL=k`` for a zone, the station moved with it as ``+MOVJ ECxxxxx VJ=20.00``,
+  ``END``.
 
 Angles are written with 4 decimals (9e-7 rad), millimetres with 3, pulses as integers.
 
@@ -42,6 +43,8 @@ __all__ = ["config_text", "read", "set_pose", "write"]
 
 #: Decimals written: mm, deg.
 MM_PLACES, DEG_PLACES = 3, 4
+#: Values of a ``///RCONF`` line: DX100 and later write 24, the first 6 used.
+RCONF_VALUES = 24
 #: Longest comment line (characters after ``'``; "up to 32 characters", NX100 job data format).
 COMMENT_CHARS = 32
 
@@ -87,7 +90,7 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
     rconf = None
     for i, p in enumerate(pts):
         assert p.pose is not None and p.config is not None
-        text = config_text(p.config.values) + ",0,0"
+        text = config_text(p.config.values) + ",0" * (RCONF_VALUES - len(p.config.values))
         if text != rconf:
             pos.append(f"///RCONF {text}")
             rconf = text
@@ -99,16 +102,19 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
         pos += ["///POSTYPE PULSE", "///PULSE"]
         pos += [f"EC{i:05d}=" + ",".join(str(round(p.external[k])) for k in station)
                 for i, p in enumerate(pts)]
-    group = "RB1" + (",BS1" if base else "") + (",ST1" if station else "")
     inst = ["//INST", "///DATE 2000/01/01 00:00", "///COMM robotcell", "///ATTR SC,RW,RJ",
-            *([f"///FRAME USER {user}"] if user else []), f"///GROUP1 {group}", "NOP"]
+            *([f"////FRAME USER {user}"] if user else []),
+            "///GROUP1 RB1" + (",BS1" if base else ""), *(["///GROUP2 ST1"] if station else []),
+            "NOP"]
     inst += [f"'{part}" for h in header for part in textwrap.wrap(h, COMMENT_CHARS)]
     for i, p in enumerate(pts):
-        axes = f"C{i:05d}" + (f" BC{i:05d}" if base else "") + (f" EC{i:05d}" if station else "")
+        axes = f"C{i:05d}" + (f" BC{i:05d}" if base else "")
+        zone = _pl(p.zone or 0.0)
         if p.motion == "ptp":
-            inst.append(f"MOVJ {axes} VJ={PTP_SPEED * 100:.2f}{_pl(p.zone or 0.0)}")
+            move = f"MOVJ {axes} VJ={PTP_SPEED * 100:.2f}{zone}"
         else:
-            inst.append(f"MOVL {axes} V={(p.speed or 0.1) * 1e3:.1f}{_pl(p.zone or 0.0)}")
+            move = f"MOVL {axes} V={(p.speed or 0.1) * 1e3:.1f}{zone}"
+        inst.append(move + (f" +MOVJ EC{i:05d} VJ={PTP_SPEED * 100:.2f}" if station else ""))
     inst.append("END")
     return {f"{program.name}.jbi": "\n".join(pos + inst) + "\n"}
 
@@ -215,6 +221,7 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     job = _Job(lines, _pos_section(lines, marks["//POS"] + 1, pos_end))
     for lineno in range(marks["//INST"] + 1, last):
         job.instruction(lines.lines[lineno - 1].strip(), lineno)
+    job.convert()
     return Program(name, "yaskawa", job.points, (str(path),)), job.skipped
 
 
@@ -227,7 +234,14 @@ class _Job:
         self.tools: dict[int, NDArray[np.float64]] = {}  # tools set by SETTOOL from SETE values
         self.elements: dict[str, dict[int, float] | None] = {}  # SETE constants per variable
         self.points: list[ProgramPoint] = []
+        self.values: list[list[float]] = []  # each point's position, converted at the end
         self.skipped: list[str] = []
+
+    def convert(self) -> None:
+        """Every point's pose from its position, converted in one batch."""
+        poses = pose_from_vendor(np.reshape(self.values, (-1, 6)), "yaskawa")
+        for point, pose in zip(self.points, poses):
+            point.pose = pose
 
     def instruction(self, text: str, lineno: int) -> None:
         if m := _SETE_RE.match(text):
@@ -316,14 +330,14 @@ class _Job:
         if c.postype not in ("USER", "BASE", "ROBOT"):
             raise lines.error(lineno, f"{cname}: POSTYPE {c.postype} is not read (USER, BASE, "
                                       "ROBOT or PULSE)")
-        pose = pose_from_vendor(c.values[:6], "yaskawa")
+        self.values.append(c.values[:6])
         config = Config("yaskawa", c.rconf) if c.rconf is not None else None
         speed = re.search(r"\bV\s*=\s*([0-9.]+)", rest)
         zone = re.search(r"\bPL\s*=\s*(\d+)", rest)
         motion = "ptp" if instr.endswith("J") else "lin"
         self.points.append(ProgramPoint(
             cname, lineno, motion, Ref(number=c.tool, pose=self.tools.get(c.tool)), frame,
-            pose, None, config,
+            None, None, config,
             self.external(refs),
             lines.number(speed.group(1), lineno) * 1e-3 if speed and motion == "lin" else None,
             lines.number(zone.group(1), lineno) * 1e-3 if zone else 0.0, c.where))
