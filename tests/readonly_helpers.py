@@ -123,8 +123,8 @@ class ReadOnlyInstall:
     def give(self, path: Path) -> Path:
         """Make ``path`` (and what it holds) the user's, so that it can write there."""
         if os.geteuid() == 0:
-            for p in [path, *path.rglob("*")]:
-                os.chown(p, self.uid, self.gid)
+            for p in [path, *path.rglob("*")]:  # a link's own owner, whether or not it points
+                os.chown(p, self.uid, self.gid, follow_symlinks=False)
         return path
 
 

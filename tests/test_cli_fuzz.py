@@ -153,11 +153,12 @@ def _poses_csv(rng: np.random.Generator) -> str:
 
 
 def _tracker_csv(rng: np.random.Generator) -> str:
-    """20 exact tracker rows of the nominal KR 16: a1..a6 (deg), x, y, z (mm)."""
+    """30 exact tracker rows of the nominal KR 16: a1..a6 (deg), x, y, z (mm); enough for the
+    default 5-fold cross-validation (24 rows per fit, 18 needed)."""
     from robotcell import load_robot
 
     robot = load_robot("kuka_kr16")
-    q = np.radians(rng.uniform([-60, -100, 40, -90, -60, -90], [60, -50, 110, 90, 60, 90], (20, 6)))
+    q = np.radians(rng.uniform([-60, -100, 40, -90, -60, -90], [60, -50, 110, 90, 60, 90], (30, 6)))
     xyz = (robot.fk(q) @ [0.05, 0.02, 0.1, 1.0])[:, :3] * 1e3 + [2000.0, 500.0, 0.0]
     return _csv([f"a{i}" for i in range(1, 7)] + ["x", "y", "z"],
                 [list(map(float, r)) for r in np.hstack([np.degrees(q), xyz])])
