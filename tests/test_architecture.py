@@ -135,7 +135,8 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
 #: package's ``__init__`` and ``errors``.
-CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell", "io",
+CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell",
+            "clearance", "io",
             "controllers", "export", "programs", "iso9283", "accuracy", "studies", "view", "report",
             "demo", "cli",
             "robots"}
@@ -161,7 +162,7 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: ``robotcell.kinematics.jit``); the solvers of ``robotcell.ik`` work on the arm of
 #: ``robotcell.kinematics`` and the robot (an arm with its IK, model files, the library) stands on
 #: both; the estimators stand on the robot, the cell on them (it holds an identified arm, and
-#: calibrates into itself). The features (:data:`FEATURES`): the controllers (one package per
+#: calibrates into itself), and the clearance of its robot from its parts beside the cell. The features (:data:`FEATURES`): the controllers (one package per
 #: vendor: its export, its programs, its limits) and the exports beside them over the cell, the
 #: programs over both, the ISO 9283 acceptance test beside the programs (it writes its cycles
 #: through them); the accuracy (filtered poses and programs) over the programs, the studies
@@ -174,7 +175,7 @@ LAYERS = [
     {"robotcell.kinematics", "robotcell.ik"},
     {"robotcell.robot"},
     {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification"},
-    {"robotcell.cell"},
+    {"robotcell.cell", "robotcell.clearance"},
     {"robotcell.controllers", "robotcell.export"},
     {"robotcell.programs", "robotcell.iso9283"},
     {"robotcell.accuracy", "robotcell.studies"},

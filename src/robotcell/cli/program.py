@@ -161,13 +161,21 @@ def _write_json(cell: Cell, result) -> dict:
 @click.option("--shoulder-margin", "shoulder_margin", type=float, default=20.0,
               show_default=True, callback=in_range(0.0, 1000.0, "mm"),
               help="Closest good distance of the wrist centre from axis 1 (mm).")
+@click.option("--bodies", "bodies_path", type=click.Path(dir_okay=False), default=None,
+              help="The cell's parts as shapes (YAML, docs/clearance.md): check the clearance "
+                   "of every point and motion.")
+@click.option("--clearance", "clearance_mm", type=float, default=10.0, show_default=True,
+              callback=in_range(0.0, 1000.0, "mm"),
+              help="Smallest good distance between the robot and a part, with --bodies (mm).")
 @click.option("--json", "as_json", is_flag=True, help="Print every point as JSON.")
 def check_cmd(program_file: str, cell_path: str, ppd: str | None, singular_margin: float,
-              shoulder_margin: float, as_json: bool) -> None:
+              shoulder_margin: float, bodies_path: str | None, clearance_mm: float,
+              as_json: bool) -> None:
     """Check every point of PROGRAM (KUKA .src with its .dat, ABB .mod, FANUC .ls, YASKAWA
     .jbi) against the cell: reach, limits, configuration as written, distance to singularities;
     and every linear motion as the controller follows it: a configuration change, a
-    singularity, reach or limits left on the way.
+    singularity, reach or limits left on the way. With --bodies, the clearance between the
+    robot and the cell's parts at every point and along every motion.
 
     Exit status 0 when every point is good, 3 with a table of the bad points, 2 for a file that
     cannot be read.
@@ -176,12 +184,15 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, singular_margi
     Example:
       robotcell program check prog/seam_part.src --cell cell.yaml
     """
+    from robotcell.clearance import read_bodies
     from robotcell.programs.check import check_program_file
 
     cell = Cell.load(cell_path)
+    bodies = read_bodies(bodies_path) if bodies_path else None
     with as_flags(FLAGS), _collector_paused():
         report = check_program_file(program_file, cell, _ppd(ppd),
-                                    math.radians(singular_margin), shoulder_margin * 1e-3)
+                                    math.radians(singular_margin), shoulder_margin * 1e-3,
+                                    bodies, clearance_mm * 1e-3)
     if as_json:
         click.echo(json.dumps(report.to_json(cell), indent=2))
     for s in report.skipped:

@@ -44,6 +44,8 @@ from robotcell.ik.result import IKSolutions
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.transforms import invert
+from robotcell.clearance.bodies import BodiesFile
+from robotcell.programs.clearcheck import CLEARANCE, clearance_problems
 from robotcell.programs.config import candidates, config_text, config_values, select
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import Placement, placement, tool_pose_of
@@ -57,7 +59,7 @@ from robotcell.programs.singular import (
 )
 from robotcell.robot.robot import Robot
 
-__all__ = ["SHOULDER_MARGIN", "SINGULAR_MARGIN", "CheckReport", "CheckedPoint", "check_program",
+__all__ = ["CLEARANCE", "SHOULDER_MARGIN", "SINGULAR_MARGIN", "CheckReport", "CheckedPoint", "check_program",
            "check_program_file", "singular_distances"]
 
 #: Rounds of choosing the solutions of points without flags all at once (:func:`_sequential`)
@@ -248,7 +250,8 @@ def _limits(cell: Cell, res: _Resolved) -> None:
 def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | None = None,
                   singular_margin: float = SINGULAR_MARGIN,
                   shoulder_margin: float = SHOULDER_MARGIN,
-                  skipped: list[str] | None = None) -> CheckReport:
+                  skipped: list[str] | None = None, bodies: BodiesFile | None = None,
+                  clearance: float = CLEARANCE) -> CheckReport:
     """Check every point of a program against a cell, and every linear motion between two.
 
     Parameters
@@ -265,6 +268,11 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
         Closest good distance of the wrist centre from axis 1 (m).
     skipped : list of str, optional
         Motions the reader skipped, carried into the report.
+    bodies : BodiesFile, optional
+        The cell's parts as shapes (:func:`robotcell.clearance.read_bodies`): with them every
+        point and motion is checked for clearance (:mod:`robotcell.programs.clearcheck`).
+    clearance : float
+        Smallest good distance between the robot and a part (m).
 
     Returns
     -------
@@ -298,6 +306,11 @@ def check_program(program: Program, cell: Cell, pulses_per_degree: ArrayLike | N
     wrist, elbow, shoulder = singular_distances(robot, np.nan_to_num(q))
     _singular(q, wrist, elbow, shoulder, singular_margin, shoulder_margin, problems)
     _lines(ctrl, pts, res, q, cart, solutions, singular_margin, shoulder_margin)
+    if bodies is not None:
+        near = clearance_problems(cell, [p.motion for p in pts], q, track, table, tools, bodies,
+                                  clearance)
+        for mine, found in zip(problems, near):
+            mine.extend(found)
     known = np.isfinite(q).all(axis=-1)
     wrist, elbow, shoulder = (np.where(known, x, math.nan).tolist()
                               for x in (wrist, elbow, shoulder))
@@ -467,14 +480,16 @@ def _lines(cell: Cell, pts: list[ProgramPoint], res: _Resolved, q: NDArray,
 
 def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLike | None = None,
                        singular_margin: float = SINGULAR_MARGIN,
-                       shoulder_margin: float = SHOULDER_MARGIN) -> CheckReport:
+                       shoulder_margin: float = SHOULDER_MARGIN,
+                       bodies: BodiesFile | None = None, clearance: float = CLEARANCE
+                       ) -> CheckReport:
     """Read a program file (any format, by extension) and check it against a cell.
 
     Parameters
     ----------
     path : str or Path
         KUKA ``.src`` (with its ``.dat``), ABB ``.mod``, FANUC ``.ls``, YASKAWA ``.jbi``.
-    cell, pulses_per_degree, singular_margin, shoulder_margin
+    cell, pulses_per_degree, singular_margin, shoulder_margin, bodies, clearance
         As for :func:`check_program`.
 
     Returns
@@ -493,4 +508,4 @@ def check_program_file(path: str | Path, cell: Cell, pulses_per_degree: ArrayLik
     if not program.points:  # a valid program whose motions all depend on data it lacks
         return CheckReport(program, [], list(skipped) or ["the program moves to no point"])
     return check_program(program, cell, pulses_per_degree, singular_margin, shoulder_margin,
-                         skipped)
+                         skipped, bodies, clearance)
