@@ -153,7 +153,8 @@ def ik(robot: str | None, **options: Any) -> None:
     solver = analytic_solver(r)
     if (a.pose is None) == (a.input_path is None):
         raise InputError("give exactly one of --pose ... or --input poses.csv")
-    T_tool = None if a.tool is None else pose_from_vendor(parse_numbers(a.tool, "--tool", 6), "kuka")
+    T_tool = (None if a.tool is None
+              else pose_from_vendor(parse_numbers(a.tool, "--tool", 6), "kuka"))
     ref = None if a.near is None else joints_to_si(r, np.array(parse_numbers(a.near, "--near",
                                                                              r.n_joints)))
     if a.pose is not None:
@@ -207,8 +208,8 @@ def _scale(r: Robot) -> np.ndarray:
     return np.where(r.prismatic, 1e3, 180.0 / math.pi)
 
 
-def _ik_pose(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs, T_tool: np.ndarray | None,
-             ref: np.ndarray | None) -> None:
+def _ik_pose(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs,
+             T_tool: np.ndarray | None, ref: np.ndarray | None) -> None:
     """``robotcell ik ROBOT --pose``: the table of the solutions (deg)."""
     pose, fmt, show_all, output_path = a.pose, a.fmt, a.show_all, a.output_path
     scale = _scale(r)
@@ -244,8 +245,8 @@ def _ik_pose(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs, T_tool
                  f"degrees\n{format_table(headers, rows)}\n")
 
 
-def _ik_batch(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs, T_tool: np.ndarray | None,
-              ref: np.ndarray | None) -> None:
+def _ik_batch(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs,
+              T_tool: np.ndarray | None, ref: np.ndarray | None) -> None:
     """``robotcell ik ROBOT --input``: the CSV of the solutions (deg)."""
     input_path, fmt, show_all, output_path = a.input_path, a.fmt, a.show_all, a.output_path
     scale = _scale(r)

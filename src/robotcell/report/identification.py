@@ -107,8 +107,8 @@ def _parameters_html(result: IdentificationResult) -> tuple[str, str, str]:
     """The parameters held and why, every parameter with its 1-sigma, the largest
     correlations."""
     fixed = ("<ul>" + "".join(f"<li><b>{html.escape(n)}</b>: {html.escape(w)}</li>"
-                              for n, w in result.fixed)
-             + "</ul>") if result.fixed else "<p>none: every candidate parameter is identifiable</p>"
+                              for n, w in result.fixed) + "</ul>"
+             if result.fixed else "<p>none: every candidate parameter is identifiable</p>")
     prows = []
     for p in result.parameters:
         v, nom, s, unit = p.vendor()
