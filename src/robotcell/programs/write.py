@@ -264,6 +264,7 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
                                  pname, fmt))
     return WriteResult([], programs, q, track, table, breaks, owner, list(targets.warnings))
 
+
 #: Breaks a :class:`PathBreaks` message names (``breaks`` holds them all).
 NAMED_BREAKS = 5
 
