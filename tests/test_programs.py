@@ -17,7 +17,7 @@ from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv
-from robotcell.programs import read_path, write_program
+from robotcell.programs import ProgramOptions, read_path, write_program
 from robotcell.programs.check import check_program_file, singular_distances
 from robotcell.programs.config import config_text, config_values, configs, select
 
@@ -259,7 +259,7 @@ def test_the_written_poses_can_come_from_the_controllers_own_model(cell, tmp_pat
     nominal.set_tool("torch", cell.tools["torch"].T_F_TCP @ pose_from_vendor(
         [1.0, 0.0, 0.0, 0.2, 0.0, 0.0], "kuka"), Provenance())
     result = write_program(SEAM, cell, "torch", "part", "kuka", tmp_path / "p",
-                           controller=nominal)
+                           options=ProgramOptions(controller=nominal))
     report = check_program_file(result.files[0], nominal)  # what the controller does
     q = np.stack([p.q for p in report.points])
     assert report.good and np.abs(q - result.q).max() < 1e-6

@@ -26,6 +26,7 @@ from robotcell.kinematics.transforms import transform_points
 from robotcell.studies.reach import reach_map
 from robotcell.view import (
     Arrows,
+    PathMarks,
     Scene,
     Step,
     Triads,
@@ -293,7 +294,8 @@ def test_path_scene_puts_the_arm_at_each_point_where_fk_does():
     bad[4] = True
     reasons = [""] * n
     reasons[4] = "A5 within 1 deg of its limit"
-    scene = path_scene(cell, path.q, track, table, tool="torch", bad=bad, reasons=reasons)
+    scene = path_scene(cell, path.q, track, table, tool="torch",
+                       marks=PathMarks(bad=bad, reasons=reasons))
     data = figure_from_page(page(scene_figure(scene)))
     assert len(data["frames"]) == n
     assert [s["label"] for s in data["layout"]["sliders"][0]["steps"]] == [str(k + 1) for k in range(n)]
@@ -377,11 +379,12 @@ def test_path_scene_with_points_without_joint_values():
     bad = np.arange(5) == 2
     reasons = ["", "", "unreachable: 40 mm beyond the arm's reach", "", ""]
     # without its position it cannot be marked: a note names it
-    scene = path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad, reasons=reasons)
+    scene = path_scene(cell, q, path.track, np.radians(150), tool="torch",
+                       marks=PathMarks(bad=bad, reasons=reasons))
     assert "bad points" not in [i.name for i in scene.items]
     assert "not drawn, no position: point 3: unreachable: 40 mm beyond the arm's reach" in scene.notes
-    scene = path_scene(cell, q, path.track, np.radians(150), tool="torch", bad=bad,
-                       reasons=reasons, points=where)
+    scene = path_scene(cell, q, path.track, np.radians(150), tool="torch",
+                       marks=PathMarks(bad=bad, reasons=reasons, points=where))
     fig = scene_figure(scene).to_plotly_json()
     np.testing.assert_allclose(xyz(traces(fig, "bad points")[0])[0], where[2] * 1e3, atol=0.005)
     # its step shows the arm of the point before it
@@ -400,11 +403,11 @@ def test_path_scene_with_points_without_joint_values():
         path_scene(cell, np.full((2, 6), np.nan))
     with pytest.raises(InputError, match=r"labels, bad, reasons and hover need one entry per "
                                          r"point \(5\)"):
-        path_scene(cell, path.q, path.track, labels=["a"])
+        path_scene(cell, path.q, path.track, marks=PathMarks(labels=["a"]))
     with pytest.raises(InputError, match=r"tool must have shape \(4, 4\) or \(5, 4, 4\)"):
         path_scene(cell, path.q, path.track, tool=tools[:2])
     with pytest.raises(InputError, match=r"points must have shape \(5, 3\)"):
-        path_scene(cell, path.q, path.track, points=where[:2])
+        path_scene(cell, path.q, path.track, marks=PathMarks(points=where[:2]))
 
 
 def test_reach_map_read_back_from_the_csv_of_reach(tmp_path, capsys):

@@ -36,7 +36,8 @@ from robotcell.accuracy.filter import (
 )
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose
-from robotcell.controllers.model import Program
+from robotcell.controllers.base import Controller
+from robotcell.controllers.model import Config, Program, ProgramPoint
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.identification.uncertainty import position_sigma
@@ -44,7 +45,7 @@ from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.config import ARM_FLAGS, flags_of_branch
 from robotcell.io.fileio import read_text
 from robotcell.kinematics.transforms import invert
-from robotcell.programs.check import check_program
+from robotcell.programs.check import CheckReport, check_program
 from robotcell.programs.config import configs
 from robotcell.programs.files import check_folder, write_all
 from robotcell.programs.formats import read_program
@@ -195,8 +196,7 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
                          "the arm as it is beside the controller's nominal model")
     check_folder(folder)
     program, skipped = read_program(path)
-    vendor = program.vendor
-    ctl = get(vendor, "program format")
+    ctl = get(program.vendor, "program format")
     ctrl = cell.controller()
     checked = check_program(program, ctrl, pulses_per_degree)
     pts = program.points
@@ -204,6 +204,68 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
             if p.pose is not None or (joints == "offline" and p.joints is not None)]
     result = CompensatedProgram(program, kept=len(pts) - len(todo), skipped=list(skipped))
     names = [f"{p.name} (line {p.line})" for p in pts]
+    if not todo:
+        raise InputError(f"{path}: no Cartesian point to filter (joint points taught on the arm "
+                         "stay; joints='offline' filters them)")
+    s = _solve(cell, ctrl, program, checked, todo, names)
+    new, dpos, drot, refused = _corrections(cell, ctrl, ctl, program, s)
+    refused += [(todo[k], why) for k, why in too_large(dpos, drot, s.found, max_correction,
+                                                        max_rotation)]
+    refuse(refused, "point", names)
+    result.points = _compensated_points(cell, pts, s, dpos, drot)
+    texts = {f: read_text(f, "program file").splitlines() for f in program.files}
+    refuse(_edit(texts, ctl, pts, s, new), "point", names)
+    out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}
+    result.files = write_all(folder, out, (*program.files, *inputs))
+    return result
+
+
+@dataclass
+class _Solved:
+    """The points to filter as the controller places them, and the identified arm's joints
+    for the same poses (K points).
+
+    Attributes
+    ----------
+    todo : list of int
+        Index of each into the program's points.
+    T_world : ndarray, shape (K, 4, 4)
+        The TCP the controller computes (m).
+    track : ndarray, shape (K,)
+        Track values (m).
+    table : ndarray, shape (K,) or (K, n)
+        Table values (rad).
+    q_nom : ndarray, shape (K, n)
+        The controller's joints (rad).
+    T_tool : ndarray, shape (K, 4, 4)
+        ``T_F_TCP`` of each point's tool (m).
+    q : ndarray, shape (K, n)
+        The identified arm's joints for the same poses on the same branch (rad).
+    found : ndarray of bool, shape (K,)
+        Whether the identified arm reaches the pose on that branch within its limits.
+    arm_flags : ndarray of int, shape (K, 3)
+        The branch's shoulder, elbow, wrist flags.
+    flags : list of Config
+        The vendor's configuration flags of ``q`` (:func:`robotcell.programs.config.configs`).
+    """
+
+    todo: list[int]
+    T_world: NDArray[np.float64]
+    track: NDArray[np.float64]
+    table: NDArray[np.float64]
+    q_nom: NDArray[np.float64]
+    T_tool: NDArray[np.float64]
+    q: NDArray[np.float64]
+    found: NDArray[np.bool_]
+    arm_flags: NDArray[np.int_]
+    flags: list[Config]
+
+
+def _solve(cell: Cell, ctrl: Cell, program: Program, checked: CheckReport, todo: list[int],
+           names: list[str]) -> _Solved:
+    """The points ``todo`` as the controller places them and the identified arm's joints for
+    them; :class:`FilterRefused` naming the points the controller cannot place."""
+    vendor, pts = program.vendor, program.points
     refused: list[tuple[int, str]] = []
     tools: dict[int, NDArray[np.float64]] = {}
     for i in todo:
@@ -213,9 +275,6 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
             continue
         tools[i] = tool_pose_of(cell, vendor, pts[i].tool)
     refuse(refused, "point", names)
-    if not todo:
-        raise InputError(f"{path}: no Cartesian point to filter (joint points taught on the arm "
-                         "stay; joints='offline' filters them)")
     T_world = np.stack([checked.points[i].T_world_TCP for i in todo])
     track = np.array([checked.points[i].track for i in todo])
     table = np.stack([np.asarray(checked.points[i].table, dtype=float) for i in todo])
@@ -224,53 +283,84 @@ def compensate_program(path: str | Path, cell: Cell, folder: str | Path, joints:
     T_R_F = invert(robot_pose(cell, track)) @ T_world @ invert(T_tool)
     q, found, branch = identified_joints(cell, T_R_F, q_nom)
     arm_flags = flags_of_branch(analytic_solver(cell.nominal_robot).method, branch)
-    refused += [(todo[k], ("the identified arm cannot reach it in the configuration the nominal "
-                           "arm uses (within the axis limits)")) for k in np.flatnonzero(~found)]
-    new = [np.eye(4)] * len(todo)
-    dpos, drot = np.zeros(len(todo)), np.zeros(len(todo))
     flags = configs(ctrl.robot, q, vendor)
-    for k, i in enumerate(todo):
+    return _Solved(todo, T_world, track, table, q_nom, T_tool, q, found, arm_flags, flags)
+
+
+def _corrections(cell: Cell, ctrl: Cell, ctl: Controller, program: Program, s: _Solved
+                 ) -> tuple[list[NDArray[np.float64]], NDArray[np.float64], NDArray[np.float64],
+                            list[tuple[int, str]]]:
+    """The poses written for the identified joints, the size of each correction and the points
+    refused so far.
+
+    Returns
+    -------
+    new : list of ndarray, shape (4, 4)
+        Per point of ``s``: the TCP the controller's model computes for the identified joints,
+        in the point's frame (m); the identity for joint points and points not reached.
+    dpos, drot : ndarray, shape (K,)
+        Size of each correction (m, rad).
+    refused : list of (int, str)
+        Points the identified arm cannot reach in the nominal arm's configuration, and points
+        whose filtered joints need other flags than a format with shared flags writes.
+    """
+    vendor, pts, n = program.vendor, program.points, len(s.todo)
+    refused = [(s.todo[k], ("the identified arm cannot reach it in the configuration the nominal "
+                            "arm uses (within the axis limits)")) for k in np.flatnonzero(~s.found)]
+    new = [np.eye(4)] * n
+    dpos, drot = np.zeros(n), np.zeros(n)
+    for k, i in enumerate(s.todo):
         p = pts[i]
-        if not found[k]:
+        if not s.found[k]:
             continue
         if p.pose is not None:
             where = placement(cell, vendor, p.frame)
-            new[k] = written_poses(ctrl, where, q[k:k + 1], track[k:k + 1], table[k:k + 1],
-                                   T_tool[k])[0]
+            new[k] = written_poses(ctrl, where, s.q[k:k + 1], s.track[k:k + 1],
+                                   s.table[k:k + 1], s.T_tool[k])[0]
             before, after = p.pose, new[k]
-            if ctl.shared_config and p.config is not None and flags[k] != p.config:
+            if ctl.shared_config and p.config is not None and s.flags[k] != p.config:
                 refused.append((i, (f"its filtered joints need other configuration flags than "
                                     f"the program writes for it ({ctl.label} flags hold for the "
                                     "points after it too); change the point")))
         else:
-            before = ctrl.fk(p.joints, track[k], table[k], tool=T_tool[k])
-            after = ctrl.fk(q[k], track[k], table[k], tool=T_tool[k])
+            before = ctrl.fk(p.joints, s.track[k], s.table[k], tool=s.T_tool[k])
+            after = ctrl.fk(s.q[k], s.track[k], s.table[k], tool=s.T_tool[k])
         dpos[k] = float(np.linalg.norm(after[:3, 3] - before[:3, 3]))
         drot[k] = _angle(before, after)
-    refused += [(todo[k], why) for k, why in too_large(dpos, drot, found, max_correction,
-                                                        max_rotation)]
-    refuse(refused, "point", names)
-    T_real = np.stack([cell.fk(q_nom[k], track[k], table[k], tool=T_tool[k])
-                       for k in range(len(todo))])
-    sigma = np.full(len(todo), np.nan)
+    return new, dpos, drot, refused
+
+
+def _compensated_points(cell: Cell, pts: list[ProgramPoint], s: _Solved,
+                        dpos: NDArray[np.float64], drot: NDArray[np.float64]
+                        ) -> list[CompensatedPoint]:
+    """Each filtered point with its correction (``dpos``, ``drot``: m, rad), the error the
+    identified arm predicts without filtering, and the uncertainty of the filtered TCP."""
+    n = len(s.todo)
+    T_real = np.stack([cell.fk(s.q_nom[k], s.track[k], s.table[k], tool=s.T_tool[k])
+                       for k in range(n)])
+    sigma = np.full(n, np.nan)
     if cell.robot.covariance is not None:
-        sigma = np.array([float(position_sigma(cell.robot, q[k], T_tool[k]))
-                          for k in range(len(todo))])
-    texts = {f: read_text(f, "program file").splitlines() for f in program.files}
-    for k, i in enumerate(todo):
+        sigma = np.array([float(position_sigma(cell.robot, s.q[k], s.T_tool[k]))
+                          for k in range(n)])
+    return [CompensatedPoint(
+        pts[i].name, pts[i].line, "cartesian" if pts[i].pose is not None else "joints", dpos[k],
+        drot[k], float(np.linalg.norm(T_real[k, :3, 3] - s.T_world[k, :3, 3])),
+        _angle(s.T_world[k], T_real[k]), float(sigma[k]), s.q_nom[k], s.q[k],
+        tuple(int(v) for v in s.arm_flags[k])) for k, i in enumerate(s.todo)]
+
+
+def _edit(texts: dict[str, list[str]], ctl: Controller, pts: list[ProgramPoint], s: _Solved,
+          new: list[NDArray[np.float64]]) -> list[tuple[int, str]]:
+    """Write the filtered values into the lines of the program's files (``texts``: file ->
+    lines, changed in place): ``new`` poses (m) of Cartesian points, the joints of joint points;
+    the points whose values are not found in the text."""
+    refused = []
+    for k, i in enumerate(s.todo):
         p = pts[i]
         file, _, line = p.where.rpartition(":")
         ok = (ctl.set_pose(texts[file], int(line) - 1, new[k],
-                           flags[k] if p.config is not None and not ctl.shared_config else None)
-              if p.pose is not None else ctl.set_joints(texts[file], int(line) - 1, q[k]))
+                           s.flags[k] if p.config is not None and not ctl.shared_config else None)
+              if p.pose is not None else ctl.set_joints(texts[file], int(line) - 1, s.q[k]))
         if not ok:
             refused.append((i, f"cannot find its values on {file} line {line}"))
-        result.points.append(CompensatedPoint(
-            p.name, p.line, "cartesian" if p.pose is not None else "joints", dpos[k], drot[k],
-            float(np.linalg.norm(T_real[k, :3, 3] - T_world[k, :3, 3])),
-            _angle(T_world[k], T_real[k]), float(sigma[k]), q_nom[k], q[k],
-            tuple(int(v) for v in arm_flags[k])))
-    refuse(refused, "point", names)
-    out = {Path(f).name: "\n".join(lines) + "\n" for f, lines in texts.items()}
-    result.files = write_all(folder, out, (*program.files, *inputs))
-    return result
+    return refused

@@ -10,6 +10,8 @@ turntable, positioner and workpiece.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import click
 import numpy as np
@@ -33,6 +35,25 @@ from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM
 
 
+@dataclass(frozen=True)
+class _TrackGeometry:
+    """What ``calibrate track`` is told of the track.
+
+    Attributes
+    ----------
+    references : tuple of str
+        ``--reference`` points as given (X,Y,Z in mm, in the track frame L).
+    axis : {"x", "z"} or None
+        ``--axis`` of L along which the carriage moves (None: the cell's, else x).
+    roll : {"zero"} or None
+        ``--roll``: the rotation about the track axis by convention.
+    """
+
+    references: tuple[str, ...]
+    axis: str | None
+    roll: str | None
+
+
 @click.command("track", cls=Command)
 @click.argument("measurements", type=click.Path(dir_okay=False))
 @click.option("--reference", "references", multiple=True, metavar="X,Y,Z",
@@ -47,9 +68,9 @@ from robotcell.io.tables import CELL_EXTENT_MM
 @group_tolerance_option("Track positions e1", "mm")
 @cell_option
 @measurement_options
-def track(measurements: str, references: tuple[str, ...], axis: str | None, roll: str | None,
-          group_tolerance: float | None, cell_path: str | None, robot: str | None,
-          tool: str | None, sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+def track(measurements: str, group_tolerance: float | None, cell_path: str | None,
+          robot: str | None, tool: str | None, sigma: float | None, as_json: bool,
+          accept_poor: bool, **given: Any) -> None:
     """Linear track: direction in the robot base, scale, straightness; rotation when determined.
 
     \b
@@ -67,15 +88,18 @@ def track(measurements: str, references: tuple[str, ...], axis: str | None, roll
       robotcell calibrate track touches.csv --cell cell.yaml \\
           --reference 1500,800,300 --reference 2100,-600,100
     """
+    geometry = _TrackGeometry(**given)
     target = CellTarget.open(cell_path, robot)
     model, T_tool = robot_and_tool(robot, tool, target)
-    refs = np.array([parse_numbers(r, "--reference", 3) for r in references]).reshape(-1, 3) * 1e-3
+    refs = np.array([parse_numbers(r, "--reference", 3)
+                     for r in geometry.references]).reshape(-1, 3) * 1e-3
     label, prior, options = cell_of(target)[1], sigma_m(sigma), chain_options(measurements)
     tol = None if group_tolerance is None else group_tolerance * 1e-3
-    finish(lambda cell: cellcal.track(cell, measurements, references=refs, axis=axis, roll=roll,
-                                      robot=None if cell else model, tool=T_tool, sigma=prior,
-                                      source=measurements, cell_label=label, on_note=echo_note,
-                                      group_tol=tol, **options),
+    finish(lambda cell: cellcal.track(cell, measurements, references=refs, axis=geometry.axis,
+                                      roll=geometry.roll, robot=None if cell else model,
+                                      tool=T_tool, sigma=prior, source=measurements,
+                                      cell_label=label, on_note=echo_note, group_tol=tol,
+                                      **options),
            target, as_json, accept_poor)
 
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 import csv
 import io
 import math
-from typing import TextIO
+from dataclasses import dataclass
+from typing import Any, TextIO
 
 import click
 import numpy as np
@@ -45,6 +46,7 @@ from robotcell.controllers.base import IkFlags
 from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, nearest
+from robotcell.ik.analytic import AnalyticSolver, SeededSolver
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
@@ -99,9 +101,7 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
               help="--cell: turntable angle (deg) at which the target is given, or one value "
                    "per positioner axis (e.g. 30,90); 'normal-up': a 2-axis positioner turns "
                    "each target's surface normal (its -Z) straight up. Default 0.")
-def ik(robot: str | None, pose: str | None, input_path: str | None, output_path: str | None, fmt: str,
-       show_all: bool, near: str | None, tool: str | None, cell_path: str | None, frame: str,
-       track_mm: float | None, table_deg: str | None) -> None:
+def ik(robot: str | None, **options: Any) -> None:
     """Inverse kinematics: every arm configuration that reaches a TCP pose.
 
     ROBOT is a library name (see 'robotcell robots') or a model file with an ortho-parallel
@@ -140,61 +140,121 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
       robotcell ik --cell positioner.yaml --frame part --table normal-up --tool torch \\
           --pose 50,0,0,0,180,0
     """
-    check_kind(output_path, "text" if pose is not None else "CSV",
-               "the table of solutions" if pose is not None else "the joint values")
-    if cell_path is not None:
+    a = _IkArgs(**options)
+    check_kind(a.output_path, "text" if a.pose is not None else "CSV",
+               "the table of solutions" if a.pose is not None else "the joint values")
+    if a.cell_path is not None:
         if robot is not None:
             raise InputError("give either ROBOT or --cell CELL.yaml, not both")
-        return _ik_cell(cell_path, pose, input_path, output_path, fmt, show_all, near, tool, frame,
-                        track_mm, table_deg)
+        return _ik_cell(a)
     if robot is None:
         raise InputError("give a ROBOT (library name or model file) or --cell CELL.yaml")
     r = load_robot(robot)
     solver = analytic_solver(r)
-    if (pose is None) == (input_path is None):
+    if (a.pose is None) == (a.input_path is None):
         raise InputError("give exactly one of --pose ... or --input poses.csv")
-    T_tool = None if tool is None else pose_from_vendor(parse_numbers(tool, "--tool", 6), "kuka")
-    deg = 180.0 / math.pi
-    n = r.n_joints
+    T_tool = (None if a.tool is None
+              else pose_from_vendor(parse_numbers(a.tool, "--tool", 6), "kuka"))
+    ref = None if a.near is None else joints_to_si(r, np.array(parse_numbers(a.near, "--near",
+                                                                             r.n_joints)))
+    if a.pose is not None:
+        return _ik_pose(r, solver, a, T_tool, ref)
+    return _ik_batch(r, solver, a, T_tool, ref)
+
+
+@dataclass(frozen=True)
+class _IkArgs:
+    """The options of ``robotcell ik`` as given on the command line (mm, deg, file names).
+
+    Attributes
+    ----------
+    pose : str or None
+        ``--pose``: one target in ``fmt``.
+    input_path, output_path : str or None
+        ``--input`` CSV of targets, ``-o`` file (None: standard output).
+    fmt : str
+        ``--format``: a pose format of :data:`robotcell.io.poseformats.FORMATS`.
+    show_all : bool
+        ``--all``: every branch, also the unreachable and out-of-limit ones.
+    near : str or None
+        ``--near``: the joints (deg) the nearest valid solution is chosen to.
+    tool : str or None
+        ``--tool``: X,Y,Z,A,B,C (mm, deg) or, with ``--cell``, a tool of the cell.
+    cell_path : str or None
+        ``--cell``: the cell file.
+    frame : str
+        ``--frame`` of the target in the cell.
+    track_mm : float or None
+        ``--track`` (mm).
+    table_deg : str or None
+        ``--table``: angle(s) (deg) or ``normal-up``.
+    """
+
+    pose: str | None
+    input_path: str | None
+    output_path: str | None
+    fmt: str
+    show_all: bool
+    near: str | None
+    tool: str | None
+    cell_path: str | None
+    frame: str
+    track_mm: float | None
+    table_deg: str | None
+
+
+def _scale(r: Robot) -> np.ndarray:
+    """Controller values to deg (mm for prismatic axes), per axis."""
+    return np.where(r.prismatic, 1e3, 180.0 / math.pi)
+
+
+def _ik_pose(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs,
+             T_tool: np.ndarray | None, ref: np.ndarray | None) -> None:
+    """``robotcell ik ROBOT --pose``: the table of the solutions (deg)."""
+    pose, fmt, show_all, output_path = a.pose, a.fmt, a.show_all, a.output_path
+    scale = _scale(r)
     names_k = BRANCHES if solver.branches == 8 else BRANCHES_4
-    ref = None if near is None else joints_to_si(r, np.array(parse_numbers(near, "--near", n)))
-    scale = np.where(r.prismatic, 1e3, deg)  # controller values to deg (mm for prismatic axes)
-    if pose is not None:
-        T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
-        sol = solver.solve(T, T_tool)
-        if ref is not None:
-            q, found, branch = nearest(r, sol, ref)
-            if not found:
-                raise InputError("no valid solution (unreachable or outside the joint limits)")
-            q, valid, reach, ks = q[None], np.array([True]), np.array([True]), [int(branch)]
-        else:
-            q, valid, reach = sol.q, sol.valid, sol.reachable
-            ks = [k for k in range(solver.branches) if show_all or valid[k]]
-        flags = _flags(r, solver.method, fmt, q)
-        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.axes)], "valid"]
+    T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
+    sol = solver.solve(T, T_tool)
+    if ref is not None:
+        q, found, branch = nearest(r, sol, ref)
+        if not found:
+            raise InputError("no valid solution (unreachable or outside the joint limits)")
+        q, valid, reach, ks = q[None], np.array([True]), np.array([True]), [int(branch)]
+    else:
+        q, valid, reach = sol.q, sol.valid, sol.reachable
+        ks = [k for k in range(solver.branches) if show_all or valid[k]]
+    flags = _flags(r, solver.method, fmt, q)
+    headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.axes)], "valid"]
+    if flags is not None:
+        headers.append(_ik_flags(solver.method, fmt).label)
+    rows = []
+    for i, k in enumerate(ks):
+        row_i = 0 if ref is not None else k
+        state = "yes" if valid[row_i] else ("limits" if reach[row_i] else "unreachable")
+        vals = [float(v * f) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
+                for v, f in zip(q[row_i], scale)]
+        row = [f"{k} {names_k[k]}", *vals, state]
         if flags is not None:
-            headers.append(_ik_flags(solver.method, fmt).label)
-        rows = []
-        for i, k in enumerate(ks):
-            row_i = 0 if ref is not None else k
-            state = "yes" if valid[row_i] else ("limits" if reach[row_i] else "unreachable")
-            vals = [float(v * f) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
-                    for v, f in zip(q[row_i], scale)]
-            row = [f"{k} {names_k[k]}", *vals, state]
-            if flags is not None:
-                row.append(flags[row_i] if reach[row_i] else "-")
-            rows.append(row)
-        if not rows:
-            raise InputError("no valid solution (unreachable or outside the joint limits); "
-                             "--all lists every branch")
-        write_output(output_path, f"{r.name}, {solver.description}, controller axis values in "
-                     f"degrees\n{format_table(headers, rows)}\n")
-        return
+            row.append(flags[row_i] if reach[row_i] else "-")
+        rows.append(row)
+    if not rows:
+        raise InputError("no valid solution (unreachable or outside the joint limits); "
+                         "--all lists every branch")
+    write_output(output_path, f"{r.name}, {solver.description}, controller axis values in "
+                 f"degrees\n{format_table(headers, rows)}\n")
+
+
+def _ik_batch(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs,
+              T_tool: np.ndarray | None, ref: np.ndarray | None) -> None:
+    """``robotcell ik ROBOT --input``: the CSV of the solutions (deg)."""
+    input_path, fmt, show_all, output_path = a.input_path, a.fmt, a.show_all, a.output_path
+    scale = _scale(r)
     names = [f.lower() for f in FORMATS[fmt].fields]
     cols = read_csv(input_path, known=names)
     T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
     sol = solver.solve(T, T_tool)
-    axes = [f"a{i}" for i in range(1, n + 1)]
+    axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
     if ref is not None:
         q, found, _ = nearest(r, sol, ref)
         header = ["pose", "found", *axes]
@@ -207,7 +267,6 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         header = ["pose", "branch", *axes]
         out_rows = [[i, k, *(sol.q[i, k] * scale).tolist()] for i, k in zip(*np.nonzero(sol.valid))]
     _finish_batch(sol.valid, header, out_rows, output_path)
-
 
 def _finish_batch(valid: np.ndarray, header: list[str], out_rows: list[list[object]],
                   output_path: str | None) -> None:
@@ -237,57 +296,73 @@ def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
     return list(flags.columns), flags.values(robot, np.nan_to_num(q))
 
 
-def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_path: str | None,
-             fmt: str, show_all: bool, near: str | None, tool: str | None, frame: str,
-             track_mm: float | None, table_deg: str | None) -> None:
+def _ik_cell(a: _IkArgs) -> None:
     """``robotcell ik --cell``: :meth:`Cell.ik` for one pose or a batch (mm, deg)."""
-    cell = Cell.load(cell_path)
+    cell = Cell.load(a.cell_path)
     r = cell.robot
-    if (pose is None) == (input_path is None):
+    if (a.pose is None) == (a.input_path is None):
         raise InputError("give exactly one of --pose ... or --input poses.csv")
-    T_tool = cell_tool(tool)
+    T_tool = cell_tool(a.tool)
+    ref = None if a.near is None else np.radians(parse_numbers(a.near, "--near", r.n_joints))
+    if a.pose is not None:
+        return _ik_cell_pose(cell, a, T_tool, ref)
+    return _ik_cell_batch(cell, a, T_tool, ref)
+
+
+def _ik_cell_pose(cell: Cell, a: _IkArgs, T_tool: np.ndarray | None, ref: np.ndarray | None
+                  ) -> None:
+    """``robotcell ik --cell --pose``: the table of the solutions (deg)."""
+    pose, fmt, show_all, frame, tool = a.pose, a.fmt, a.show_all, a.frame, a.tool
+    track_mm, table_deg, output_path = a.track_mm, a.table_deg, a.output_path
+    r = cell.robot
     deg = 180.0 / math.pi
-    ref = None if near is None else np.radians(parse_numbers(near, "--near", r.n_joints))
-    if pose is not None:
-        T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
-        th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-              else table_angles(cell, table_option(cell, table_deg), "warn"))
-        sol = cell.ik(T, frame, track_values(cell, track_mm, "warn"), th, T_tool)
-        valid = sol.valid
-        if ref is not None:
-            q, found, branch = sol.nearest(r, ref)
-            ks, qs = ([int(branch)], q[None]) if found else ([], q[None])
-        else:
-            ks = [k for k in range(8) if show_all or valid[k]]
-            qs = sol.q[ks]
-        if not any(valid[k] for k in ks) and not show_all:
-            raise InputError(f"no valid solution for the target in frame {frame!r}: out of reach, "
-                             "or outside the joint, track or table limits (--all lists every branch)")
-        flags = _flags(r, sol.method, fmt, qs) if ks else None
-        off = _reach_error_mm(sol.reach_error, sol.reachable)
-        off_shown = off is not None and bool(np.any(off[ks] > 0))
-        headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
+    T = target_poses(parse_numbers(pose, "--pose", FORMATS[fmt].size), fmt, "--pose")
+    th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
+          else table_angles(cell, table_option(cell, table_deg), "warn"))
+    sol = cell.ik(T, frame, track_values(cell, track_mm, "warn"), th, T_tool)
+    valid = sol.valid
+    if ref is not None:
+        q, found, branch = sol.nearest(r, ref)
+        ks, qs = ([int(branch)], q[None]) if found else ([], q[None])
+    else:
+        ks = [k for k in range(8) if show_all or valid[k]]
+        qs = sol.q[ks]
+    if not any(valid[k] for k in ks) and not show_all:
+        raise InputError(f"no valid solution for the target in frame {frame!r}: out of reach, "
+                         "or outside the joint, track or table limits (--all lists every branch)")
+    flags = _flags(r, sol.method, fmt, qs) if ks else None
+    off = _reach_error_mm(sol.reach_error, sol.reachable)
+    off_shown = off is not None and bool(np.any(off[ks] > 0))
+    headers = ["branch", *[j.name or f"a{i + 1}" for i, j in enumerate(r.joints)], "valid"]
+    if flags is not None:
+        headers.append(_ik_flags(sol.method, fmt).label)
+    if off_shown:
+        headers.append("reach error mm")
+    rows = []
+    for i, k in enumerate(ks):
+        state = "yes" if valid[k] else ("limits" if sol.reachable[k] else "unreachable")
+        vals = [float(v * deg) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
+                for v in qs[i]]
+        row = [f"{k} {BRANCHES[k]}", *vals, state]
         if flags is not None:
-            headers.append(_ik_flags(sol.method, fmt).label)
+            row.append(flags[i] if sol.reachable[k] else "-")
         if off_shown:
-            headers.append("reach error mm")
-        rows = []
-        for i, k in enumerate(ks):
-            state = "yes" if valid[k] else ("limits" if sol.reachable[k] else "unreachable")
-            vals = [float(v * deg) + 0.0 if abs(v) >= 1e-12 else 0.0 if np.isfinite(v) else "-"
-                    for v in qs[i]]
-            row = [f"{k} {BRANCHES[k]}", *vals, state]
-            if flags is not None:
-                row.append(flags[i] if sol.reachable[k] else "-")
-            if off_shown:
-                row.append(f"{off[k]:.6f}" if sol.reachable[k] else "-")
-            rows.append(row)
-        how = "chosen" if track_mm is None else "given"
-        track = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
-        where = table_text(cell, sol.table, table_deg == NORMAL_UP)
-        write_output(output_path, f"{setup_text(cell, tool, frame, track, where)}; {r.name}, "
-                     f"{sol.method} solver; angles in degrees\n{format_table(headers, rows)}\n")
-        return
+            row.append(f"{off[k]:.6f}" if sol.reachable[k] else "-")
+        rows.append(row)
+    how = "chosen" if track_mm is None else "given"
+    track = (f", track {float(sol.track) * 1e3:.3f} mm ({how})" if cell.track is not None else "")
+    where = table_text(cell, sol.table, table_deg == NORMAL_UP)
+    write_output(output_path, f"{setup_text(cell, tool, frame, track, where)}; {r.name}, "
+                 f"{sol.method} solver; angles in degrees\n{format_table(headers, rows)}\n")
+
+
+def _ik_cell_batch(cell: Cell, a: _IkArgs, T_tool: np.ndarray | None, ref: np.ndarray | None
+                   ) -> None:
+    """``robotcell ik --cell --input``: the CSV of the solutions (deg)."""
+    input_path, fmt, show_all, frame, tool = a.input_path, a.fmt, a.show_all, a.frame, a.tool
+    track_mm, table_deg, output_path = a.track_mm, a.table_deg, a.output_path
+    r = cell.robot
+    deg = 180.0 / math.pi
     names = [f.lower() for f in FORMATS[fmt].fields]
     _, table_names = table_columns(cell)
     cols = read_csv(input_path, known=[*names, "track", *table_names])

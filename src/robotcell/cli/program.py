@@ -102,13 +102,14 @@ def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, fol
     Example:
       robotcell program write examples/seam_part.csv --cell cell.yaml --tool torch --frame part --format abb -o prog
     """
-    from robotcell.programs import PathBreaks, write_program
+    from robotcell.programs import PathBreaks, ProgramOptions, write_program
 
     cell = Cell.load(cell_path)
     with as_flags(FLAGS):
         try:
-            result = write_program(path, cell, tool, frame, vendor, folder, name, split,
-                                   pulses_per_degree=_ppd(ppd), inputs=(cell_path,))
+            result = write_program(path, cell, tool, frame, vendor, folder, name,
+                                   ProgramOptions(split=split), pulses_per_degree=_ppd(ppd),
+                                   inputs=(cell_path,))
         except PathBreaks as exc:
             click.echo(format_table(["point", "why", "cause"],
                                     [[b.index + 1, b.kind, b.message] for b in exc.breaks]),

@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import ExitStack
+from dataclasses import dataclass
+from typing import Any
 
 import click
 
@@ -36,6 +38,35 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
     return None if n == 1 else stack.enter_context(ProcessPoolExecutor(n))
 
 
+@dataclass(frozen=True)
+class _Targets:
+    """Where the targets of ``sweep`` are and how they are reached: the options of
+    :func:`robotcell.cli.reach.target_options`.
+
+    Attributes
+    ----------
+    cell_path : str
+        ``--cell`` file.
+    frame : str
+        ``--frame`` of the targets.
+    tool : str or None
+        ``--tool`` of the cell (None: the robot model's).
+    fmt : str
+        ``--format`` of the pose columns.
+    table_deg : str or None
+        ``--table`` angle(s) (deg) for targets without a table column.
+    choose_table : bool
+        ``--choose-table``: the table angle chosen per target.
+    """
+
+    cell_path: str
+    frame: str
+    tool: str | None
+    fmt: str
+    table_deg: str | None
+    choose_table: bool
+
+
 @click.command(cls=Command)
 @target_options
 @click.option("--targets", "targets", required=True, type=click.Path(dir_okay=False),
@@ -51,9 +82,8 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
 @click.option("--top", type=int, default=10, show_default=True, help="Layouts to print.")
 @click.option("-o", "--output", type=OUTPUT, default=None, callback=output_of("CSV", "the ranking"),
               help="CSV of every layout, ranked (written atomically).")
-def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool: str | None,
-              fmt: str, table_deg: str | None, choose_table: bool, workers: int | None,
-              scheduler: str | None, top: int, output: str | None) -> None:
+def sweep_cmd(targets: str, layouts_path: str, workers: int | None, scheduler: str | None,
+              top: int, output: str | None, **where: Any) -> None:
     """Rank layouts of the cell by how well the robot reaches the targets.
 
     Each layout (one combination of the offsets in --layouts, see docs/reach.md) is scored on
@@ -68,15 +98,17 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --workers 8
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
-    cell = Cell.load(cell_path)
-    T, th, _, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
-    click.echo(setup_text(cell, tool, frame, axes.replace("track chosen per target",
-                                                          "track chosen per target and layout"),
-                          ""), err=True)
+    at = _Targets(**where)
+    cell = Cell.load(at.cell_path)
+    T, th, _, axes = load_targets(targets, cell, at.fmt, at.table_deg, at.choose_table,
+                                  track_column=False)
+    click.echo(setup_text(cell, at.tool, at.frame,
+                          axes.replace("track chosen per target",
+                                       "track chosen per target and layout"), ""), err=True)
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
-        ranked = sweep(cell, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
+        ranked = sweep(cell, T, layouts, frame=at.frame, tool=at.tool, table=th, executor=ex,
                        progress=DeferredProgress(stack, "layouts"), output=output)
     shown = ranked[:max(top, 0)]
     rows_out = [[rank + 1, r.layout.label, f"{100 * r.fraction:.1f}", f"{r.mean_score:.3f}",

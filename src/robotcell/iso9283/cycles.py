@@ -28,7 +28,7 @@ from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.iso9283.planfile import table_names, write_table
 from robotcell.iso9283.testplan import TestPlan
-from robotcell.programs import write_program
+from robotcell.programs import ProgramOptions, write_program
 
 __all__ = [
     "CYCLE_ORDER",
@@ -152,7 +152,7 @@ def write_programs(plan: TestPlan, cell: Cell, folder: str | Path,
         for vendor in vendors:
             for kind, source in sources.items():
                 write_program(source, cell, plan.tool, plan.frame, vendor, staging / vendor,
-                              name=PROGRAM_NAMES[kind], max_step=math.pi,
+                              name=PROGRAM_NAMES[kind], options=ProgramOptions(max_step=math.pi),
                               pulses_per_degree=pulses_per_degree)
         written = []
         out.mkdir(exist_ok=True)

@@ -2,7 +2,7 @@
 
 - :mod:`robotcell.programs.path`: the path file (CSV, mm and deg) in SI units;
 - :mod:`robotcell.programs.write`: :func:`write_program`, a path solved through the cell and
-  written as a program;
+  written as a program (:class:`ProgramOptions`: in pieces, through another cell's model);
 - :mod:`robotcell.programs.check`: :func:`check_program`, every point of a program through the
   cell; :mod:`.lines`, every linear motion followed as the controller follows it; :mod:`.singular`,
   the distances to the singularities;
@@ -20,7 +20,14 @@ sources: ``docs/programs.md``.
 from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
 from robotcell.programs.formats import read_program, vendor_of
 from robotcell.programs.path import PathTargets, read_path
-from robotcell.programs.write import PathBreaks, WriteResult, build_programs, write_program
+from robotcell.programs.write import (
+    PathBreaks,
+    ProgramOptions,
+    WriteResult,
+    build_programs,
+    write_program,
+)
 
-__all__ = ["Config", "PathBreaks", "PathTargets", "Program", "ProgramPoint", "Ref", "WriteResult",
-           "build_programs", "read_path", "read_program", "vendor_of", "write_program"]
+__all__ = ["Config", "PathBreaks", "PathTargets", "Program", "ProgramOptions", "ProgramPoint",
+           "Ref", "WriteResult", "build_programs", "read_path", "read_program", "vendor_of",
+           "write_program"]

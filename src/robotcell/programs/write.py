@@ -41,7 +41,43 @@ from robotcell.programs.files import check_folder, write_all
 from robotcell.programs.frames import Placement, program_refs
 from robotcell.programs.path import PathTargets, read_path
 
-__all__ = ["PathBreaks", "WriteResult", "build_programs", "write_program", "written_poses"]
+__all__ = ["PathBreaks", "ProgramOptions", "WriteResult", "build_programs", "write_program",
+           "written_poses"]
+
+
+@dataclass(frozen=True)
+class ProgramOptions:
+    """How a path is solved into programs and whose model writes their Cartesian values.
+
+    Attributes
+    ----------
+    split : bool
+        Write one program per continuous piece instead of refusing a path that breaks.
+    controller : Cell, optional
+        The cell whose FK gives the Cartesian values written (default ``cell.controller()``: the
+        cell itself, or with an identified arm the cell with its nominal arm, so that the
+        controller's own model takes the written points to the joints solved on the real arm).
+    max_step : float
+        Largest joint change between consecutive targets that counts as continuous (rad).
+    """
+
+    split: bool = False
+    controller: Cell | None = None
+    max_step: float = MAX_STEP
+
+
+@dataclass(frozen=True)
+class _Format:
+    """What every program of a path shares: its controller, the references of its tool and
+    frame, where its frame is (:func:`robotcell.programs.frames.program_refs`) and how its
+    external axes are written."""
+
+    ctl: Controller
+    tool_ref: Ref
+    frame_ref: Ref
+    where: Placement
+    axes: ExternalAxes
+
 
 class PathBreaks(RobotcellError):
     """A path that cannot be one program; ``breaks`` say where and why.
@@ -168,9 +204,8 @@ def _solve(cell: Cell, targets: PathTargets, frame: str, tool: str, max_step: fl
 
 
 def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, tool: str,
-                   frame: str, split: bool = False, controller: Cell | None = None,
-                   pulses_per_degree: ArrayLike | None = None, max_step: float = MAX_STEP
-                   ) -> WriteResult:
+                   frame: str, options: ProgramOptions = ProgramOptions(),
+                   pulses_per_degree: ArrayLike | None = None) -> WriteResult:
     """Solve a path through the cell and build its program(s), without writing files.
 
     Parameters
@@ -181,21 +216,15 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
     vendor : str
         A registered controller (:func:`robotcell.controllers.registry.names`).
     name : str
-        Program name (``NAME_1``, ``NAME_2``, ... with ``split``).
+        Program name (``NAME_1``, ``NAME_2``, ... with ``options.split``).
     tool : str
         A tool of the cell.
     frame : str
         The path's frame: ``world`` or a frame of the cell.
-    split : bool
-        Write one program per continuous piece instead of refusing a path that breaks.
-    controller : Cell, optional
-        The cell whose FK gives the Cartesian values written (default ``cell.controller()``: the
-        cell itself, or with an identified arm the cell with its nominal arm, so that the
-        controller's own model takes the written points to the joints solved on the real arm).
+    options : ProgramOptions
+        Pieces or one program, the controller's model, the largest joint step (rad).
     pulses_per_degree : float or array_like, optional
         YASKAWA: encoder pulses per degree of each station axis.
-    max_step : float
-        Largest joint change between consecutive targets that counts as continuous (rad).
 
     Returns
     -------
@@ -208,31 +237,31 @@ def build_programs(cell: Cell, targets: PathTargets, vendor: str, name: str, too
         A tool or frame the cell lacks, a tool or frame number or a name the controller cannot
         hold, a YASKAWA cell with a turntable and no ``pulses_per_degree``.
     PathBreaks
-        The path breaks (reach, limit, singularity, a jump of the table) and ``split`` is False,
-        or no point of it can be reached.
+        The path breaks (reach, limit, singularity, a jump of the table) and ``options.split``
+        is False, or no point of it can be reached.
     """
     ctl = get(vendor, "program format")
     base_name = ctl.program_name(name)
-    tool_ref, frame_ref, where = program_refs(cell, ctl.name, tool, frame)
-    axes = ctl.external_axes(cell, pulses_per_degree)
-    targets, choice = _with_table(cell, targets, frame, tool, max_step)
-    targets = replace(targets, table=axes.held(targets.table))  # the point goes with the axis
-    pieces, breaks, paths = _solve(cell, targets, frame, tool, max_step)
+    fmt = _Format(ctl, *program_refs(cell, ctl.name, tool, frame),
+                  ctl.external_axes(cell, pulses_per_degree))
+    targets, choice = _with_table(cell, targets, frame, tool, options.max_step)
+    targets = replace(targets, table=fmt.axes.held(targets.table))  # the point goes with the axis
+    pieces, breaks, paths = _solve(cell, targets, frame, tool, options.max_step)
     breaks = _noted(breaks, choice)
     n = len(targets)
     nt = targets.table.shape[1:] if targets.table.ndim > 1 else ()
     q = np.full((n, cell.robot.n_joints), np.nan)
     track, table = np.full(n, np.nan), np.full((n, *nt), np.nan)
     owner = np.full(n, -1)
-    if breaks and (not split or not pieces):
+    if breaks and (not options.split or not pieces):
         raise PathBreaks(_break_message(breaks, pieces), breaks)
     programs = []
     for k, ((a, b), path) in enumerate(zip(pieces, paths)):
         q[a:b], track[a:b], table[a:b] = path.q, path.track, path.table
         owner[a:b] = k
         pname = base_name if len(pieces) == 1 else ctl.piece_name(base_name, k + 1)
-        programs.append(_program(controller or cell.controller(), targets, a, b, path, pname,
-                                 ctl, tool_ref, frame_ref, where, axes))
+        programs.append(_program(options.controller or cell.controller(), targets, (a, b), path,
+                                 pname, fmt))
     return WriteResult([], programs, q, track, table, breaks, owner, list(targets.warnings))
 
 
@@ -259,30 +288,31 @@ def _break_message(breaks: list[PathBreak], pieces: list[tuple[int, int]]) -> st
             f"Change the path there, or {todo}")
 
 
-def _program(cell: Cell, targets: PathTargets, a: int, b: int, path: CellPath, name: str,
-             ctl: Controller, tool_ref: Ref, frame_ref: Ref, where: Placement, axes: ExternalAxes
-             ) -> Program:
-    T_tool = tool_pose(cell, tool_ref.name)
-    poses = written_poses(cell, where, path.q, path.track, path.table, T_tool)
-    flags = configs(cell.robot, path.q, ctl.name)
-    names = ctl.point_names(b - a)
+def _program(cell: Cell, targets: PathTargets, piece: tuple[int, int], path: CellPath,
+             name: str, fmt: _Format) -> Program:
+    """The program of the targets ``piece`` (first, end) of the path, solved as ``path``, with
+    the Cartesian values of ``cell``'s FK."""
+    a, b = piece
+    T_tool = tool_pose(cell, fmt.tool_ref.name)
+    poses = written_poses(cell, fmt.where, path.q, path.track, path.table, T_tool)
+    flags = configs(cell.robot, path.q, fmt.ctl.name)
+    names = fmt.ctl.point_names(b - a)
     points = []
     for i in range(b - a):
         j = a + i
         motion = targets.motion[j]
         points.append(ProgramPoint(
-            names[i], 0, motion, tool_ref, frame_ref, pose=poses[i], config=flags[i],
-            external=axes.to_file(path.track[i], path.table[i]),
+            names[i], 0, motion, fmt.tool_ref, fmt.frame_ref, pose=poses[i], config=flags[i],
+            external=fmt.axes.to_file(path.track[i], path.table[i]),
             speed=float(targets.speed[j]),
             zone=float(targets.zone[j])))
-    return Program(name, ctl.name, points, data=ctl.data(cell))
-
+    return Program(name, fmt.ctl.name, points, data=fmt.ctl.data(cell))
 
 def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: str,
-                  folder: str | Path, name: str | None = None, split: bool = False,
-                  controller: Cell | None = None, pulses_per_degree: ArrayLike | None = None,
-                  max_step: float = MAX_STEP, inputs: tuple[str | Path, ...] = ()
-                  ) -> WriteResult:
+                  folder: str | Path, name: str | None = None,
+                  options: ProgramOptions = ProgramOptions(),
+                  pulses_per_degree: ArrayLike | None = None,
+                  inputs: tuple[str | Path, ...] = ()) -> WriteResult:
     """Write the program of a path file, all of its files or none.
 
     Parameters
@@ -303,8 +333,12 @@ def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: s
         controller does not tell them apart), is refused.
     name : str, optional
         Program name; default: the path file's name, shortened to what the format allows.
-    split, controller, pulses_per_degree, max_step
-        As for :func:`build_programs`.
+    options : ProgramOptions
+        One program or one per continuous piece (``split``), the cell whose FK writes the
+        Cartesian values (``controller``), the largest joint step (``max_step``, rad); e.g.
+        ``ProgramOptions(split=True)``.
+    pulses_per_degree : float or array_like, optional
+        YASKAWA: encoder pulses per degree of each station axis.
     inputs : tuple of str or Path
         Further files the run read (the cell file), which no output may replace.
 
@@ -318,8 +352,8 @@ def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: s
         Bad path file, tool, frame, name or folder, or a file of the program's name in the
         folder that is not an earlier program of this path file: nothing is written.
     PathBreaks
-        The path breaks and ``split`` is False, or no point of it can be reached: nothing is
-        written.
+        The path breaks and ``options.split`` is False, or no point of it can be reached:
+        nothing is written.
     """
     check_folder(folder)
     ctl = get(vendor, "program format")
@@ -327,8 +361,8 @@ def write_program(path: str | Path, cell: Cell, tool: str, frame: str, vendor: s
     default = name is None
     if name is None:
         name = ctl.default_name(Path(path).stem)
-    result = build_programs(cell, targets, ctl.name, name, tool, frame, split, controller,
-                            pulses_per_degree, max_step)
+    result = build_programs(cell, targets, ctl.name, name, tool, frame, options,
+                            pulses_per_degree)
     header = [(f"robotcell program of path {Path(path).name}: cell {cell.name!r}, "
                f"tool {tool!r}, frame {frame!r}")]
     texts: dict[str, str] = {}

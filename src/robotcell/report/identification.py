@@ -73,6 +73,72 @@ def _stats(e: NDArray[np.float64]) -> list[float]:
     return [float(e.mean()), float(math.sqrt(np.mean(e**2))), float(e.max())]
 
 
+def _errors_html(result: IdentificationResult) -> str:
+    """The tables of the position (and orientation) errors of both models."""
+    all0 = np.linalg.norm(result.residuals_before, axis=-1).ravel() * 1e3
+    all1 = np.linalg.norm(result.residuals, axis=-1).ravel() * 1e3
+    errors = table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
+                   [["nominal (base and targets fitted)", *_stats(all0)],
+                    ["identified", *_stats(all1)]])
+    if result.rotation_residuals is not None:
+        r0 = np.degrees(np.linalg.norm(result.rotation_residuals_before, axis=-1))
+        r1 = np.degrees(np.linalg.norm(result.rotation_residuals, axis=-1))
+        errors += table(["model", "orientation mean (deg)", "RMS (deg)", "max (deg)"],
+                        [["nominal (base and target fitted)", *_stats(r0)],
+                         ["identified", *_stats(r1)]])
+    return errors
+
+
+def _cross_validation_html(cross_validation: CrossValidation | None) -> str:
+    """The held-out errors of both models, or that they were not computed."""
+    if cross_validation is None:
+        return "<p>not run (<code>--folds K</code>)</p>"
+    cv = cross_validation
+    b, a = cv.before.max(axis=1) * 1e3, cv.after.max(axis=1) * 1e3
+    fig_cv = _figure_errors(b, a, f"Held-out position error, {cv.folds}-fold cross-validation")
+    return (f"<p>Every row predicted by the models fitted without its fold ({cv.folds} folds).</p>"
+            + table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
+                    [["start model (base and targets fitted)", *_stats(cv.before.ravel() * 1e3)],
+                     ["identified (written)", *_stats(cv.after.ravel() * 1e3)]])
+            + f'<figure><img src="{fig_cv}" alt="cross-validated errors"></figure>')
+
+
+def _parameters_html(result: IdentificationResult) -> tuple[str, str, str]:
+    """The parameters held and why, every parameter with its 1-sigma, the largest
+    correlations."""
+    fixed = ("<ul>" + "".join(f"<li><b>{html.escape(n)}</b>: {html.escape(w)}</li>"
+                              for n, w in result.fixed) + "</ul>"
+             if result.fixed else "<p>none: every candidate parameter is identifiable</p>")
+    prows = []
+    for p in result.parameters:
+        v, nom, s, unit = p.vendor()
+        prows.append([p.name, unit, nom if math.isfinite(nom) else "", v,
+                      v - nom if math.isfinite(nom) else "", s if p.free else "fixed"])
+    params = table(["name", "unit", "nominal", "identified", "change", "1-sigma"], prows)
+    C = result.correlation
+    iu = np.triu_indices(len(result.free), 1)
+    order = np.argsort(-np.abs(C[iu]))[:N_CORRELATIONS]
+    corr = table(["parameter", "parameter", "correlation"],
+                 [[result.free[iu[0][k]], result.free[iu[1][k]], float(C[iu][k])] for k in order])
+    return fixed, params, corr
+
+
+def _observability_html(observability: tuple[float, NDArray[np.float64]] | None) -> str:
+    """O1 of the measured configurations against random sets, or that it was not computed."""
+    if observability is None:
+        return "<p>not computed</p>"
+    o1, rand = observability
+    better = float(np.mean(rand < o1)) * 100
+    return (f"<p>Borm and Menq's O1 (geometric mean of the singular values of the scaled "
+            f"identification Jacobian): measured configurations {o1:.4g}; "
+            f"{len(rand)} random sets of as many configurations within the joint limits: "
+            f"median {np.median(rand):.4g}, best {rand.max():.4g}. The measured set is "
+            f"better than {better:.0f} % of them. <code>select_configurations</code> "
+            f"(<code>robotcell identify --propose N</code>) proposes configurations that "
+            f"maximise O1.</p>"
+            f'<figure><img src="{_figure_observability(o1, rand)}" alt="observability"></figure>')
+
+
 def write_identification_report(
     result: IdentificationResult,
     path: str | Path,
@@ -106,16 +172,7 @@ def write_identification_report(
     grade, why = result.verdict
     e0 = np.linalg.norm(result.residuals_before, axis=-1).max(axis=1) * 1e3
     e1 = result.row_errors * 1e3
-    all0 = np.linalg.norm(result.residuals_before, axis=-1).ravel() * 1e3
-    all1 = np.linalg.norm(result.residuals, axis=-1).ravel() * 1e3
-    errors = table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
-                    [["nominal (base and targets fitted)", *_stats(all0)],
-                     ["identified", *_stats(all1)]])
-    if result.rotation_residuals is not None:
-        r0 = np.degrees(np.linalg.norm(result.rotation_residuals_before, axis=-1))
-        r1 = np.degrees(np.linalg.norm(result.rotation_residuals, axis=-1))
-        errors += table(["model", "orientation mean (deg)", "RMS (deg)", "max (deg)"],
-                         [["nominal (base and target fitted)", *_stats(r0)], ["identified", *_stats(r1)]])
+    errors = _errors_html(result)
     extra = ""
     if result.coupling_check:
         c = result.coupling_check
@@ -124,41 +181,9 @@ def write_identification_report(
     per_row = table(["row", "nominal (mm)", "identified (mm)", "outlier"],
                      [[lab, float(a), float(b), "yes" if i in result.outliers else ""]
                       for i, (lab, a, b) in enumerate(zip(result.labels, e0, e1))])
-    cv_html = "<p>not run (<code>--folds K</code>)</p>"
-    if cross_validation is not None:
-        cv = cross_validation
-        b, a = cv.before.max(axis=1) * 1e3, cv.after.max(axis=1) * 1e3
-        fig_cv = _figure_errors(b, a, f"Held-out position error, {cv.folds}-fold cross-validation")
-        cv_html = (f"<p>Every row predicted by the models fitted without its fold ({cv.folds} folds).</p>"
-                   + table(["model", "mean (mm)", "RMS (mm)", "max (mm)"],
-                            [["start model (base and targets fitted)", *_stats(cv.before.ravel() * 1e3)],
-                             ["identified (written)", *_stats(cv.after.ravel() * 1e3)]])
-                   + f'<figure><img src="{fig_cv}" alt="cross-validated errors"></figure>')
-    fixed = ("<ul>" + "".join(f"<li><b>{html.escape(n)}</b>: {html.escape(w)}</li>" for n, w in result.fixed)
-             + "</ul>") if result.fixed else "<p>none: every candidate parameter is identifiable</p>"
-    prows = []
-    for p in result.parameters:
-        v, nom, s, unit = p.vendor()
-        prows.append([p.name, unit, nom if math.isfinite(nom) else "", v,
-                      v - nom if math.isfinite(nom) else "", s if p.free else "fixed"])
-    params = table(["name", "unit", "nominal", "identified", "change", "1-sigma"], prows)
-    C = result.correlation
-    iu = np.triu_indices(len(result.free), 1)
-    order = np.argsort(-np.abs(C[iu]))[:N_CORRELATIONS]
-    corr = table(["parameter", "parameter", "correlation"],
-                  [[result.free[iu[0][k]], result.free[iu[1][k]], float(C[iu][k])] for k in order])
-    obs_html = "<p>not computed</p>"
-    if observability is not None:
-        o1, rand = observability
-        better = float(np.mean(rand < o1)) * 100
-        obs_html = (f"<p>Borm and Menq's O1 (geometric mean of the singular values of the scaled "
-                    f"identification Jacobian): measured configurations {o1:.4g}; "
-                    f"{len(rand)} random sets of as many configurations within the joint limits: "
-                    f"median {np.median(rand):.4g}, best {rand.max():.4g}. The measured set is "
-                    f"better than {better:.0f} % of them. <code>select_configurations</code> "
-                    f"(<code>robotcell identify --propose N</code>) proposes configurations that "
-                    f"maximise O1.</p>"
-                    f'<figure><img src="{_figure_observability(o1, rand)}" alt="observability"></figure>')
+    cv_html = _cross_validation_html(cross_validation)
+    fixed, params, corr = _parameters_html(result)
+    obs_html = _observability_html(observability)
     scene_html = "" if measurements is None else f"<h2>3D view of the measurements</h2>{SCENE_SLOT}"
     name = html.escape(result.nominal.name)
     page = f"""<!DOCTYPE html>

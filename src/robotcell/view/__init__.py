@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from robotcell.view.calibration import calibration_scene
     from robotcell.view.cellscene import cell_figure, cell_scene, write_cell_view
     from robotcell.view.identification import identification_scene
-    from robotcell.view.path import path_scene
+    from robotcell.view.path import PathMarks, path_scene
     from robotcell.view.plot import page, scene_figure, write_html
     from robotcell.view.program import program_scene, write_program_view
     from robotcell.view.reach import read_reach
@@ -43,7 +43,7 @@ _LAZY = {
     "calibration_scene": "robotcell.view.calibration",
     **dict.fromkeys(["cell_figure", "cell_scene", "write_cell_view"], "robotcell.view.cellscene"),
     "identification_scene": "robotcell.view.identification",
-    "path_scene": "robotcell.view.path",
+    **dict.fromkeys(["PathMarks", "path_scene"], "robotcell.view.path"),
     **dict.fromkeys(["page", "scene_figure", "write_html"], "robotcell.view.plot"),
     **dict.fromkeys(["program_scene", "write_program_view"], "robotcell.view.program"),
     "read_reach": "robotcell.view.reach",
@@ -51,10 +51,10 @@ _LAZY = {
                     "robotcell.view.scene"),
 }
 
-__all__ = ["Arrows", "Lines", "Mesh", "Points", "Scene", "Step", "Triads", "calibration_scene",
-           "cell_figure", "cell_scene", "identification_scene", "page", "path_scene",
-           "program_scene", "read_reach", "scene_figure", "write_cell_view", "write_html",
-           "write_program_view"]
+__all__ = ["Arrows", "Lines", "Mesh", "PathMarks", "Points", "Scene", "Step", "Triads",
+           "calibration_scene", "cell_figure", "cell_scene", "identification_scene", "page",
+           "path_scene", "program_scene", "read_reach", "scene_figure", "write_cell_view",
+           "write_html", "write_program_view"]
 
 
 def __getattr__(name: str) -> Any:

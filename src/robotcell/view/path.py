@@ -28,7 +28,7 @@ are still drawn), and a note says so.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import fields
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,7 +41,7 @@ from robotcell.view.cellscene import cell_items, fixed_items, frame_size
 from robotcell.view.scene import AXIS_COLORS, Item, Lines, Points, Scene, Step, Triads
 from robotcell.view.shapes import OUTLIER_COLOR
 
-__all__ = ["DECIMALS", "MOVING", "ordinal", "path_scene", "triad_line"]
+__all__ = ["DECIMALS", "MOVING", "PathMarks", "ordinal", "path_scene", "triad_line"]
 
 #: Decimals of the millimetre coordinates of a path's view: 0.01 mm.
 DECIMALS = 2
@@ -171,10 +171,62 @@ def _tools(cell: Cell, tool: str | ArrayLike | None, n: int) -> NDArray[np.float
     return np.broadcast_to(cell.robot.tool if T is None else T, (n, 4, 4))
 
 
+@dataclass(frozen=True)
+class PathMarks:
+    """What the scene of a path says of its points: their names, the bad ones and why, where
+    they are. Every field given holds one entry per point (N).
+
+    Attributes
+    ----------
+    labels : sequence of str, optional
+        Name of each point (default ``"1".."N"``), on the slider and in the hover texts.
+    bad : array_like of bool, shape (N,), optional
+        Points to mark (e.g. those a program check finds bad).
+    reasons : sequence of str, optional
+        Why each point is bad (hover text of its mark; ignored for good points).
+    points : array_like, shape (N, 3), optional
+        Position of each point in the world (m; NaN where not known), for the points without
+        joint values or without a known tool; default the TCP of the joint values.
+    hover : sequence of str, optional
+        Hover text of each point of the path (default its label); its position follows.
+    """
+
+    labels: Sequence[str] | None = None
+    bad: ArrayLike | None = None
+    reasons: Sequence[str] | None = None
+    points: ArrayLike | None = None
+    hover: Sequence[str] | None = None
+
+    def resolved(self, n: int) -> tuple[list[str], NDArray[np.bool_], list[str], list[str],
+                                        NDArray[np.float64] | None]:
+        """Labels, bad flags, reasons, hover texts and positions (m) of ``n`` points, with the
+        defaults filled in.
+
+        Raises
+        ------
+        InputError
+            A field that does not hold one entry per point.
+        """
+        labs = [str(i + 1) for i in range(n)] if self.labels is None else [str(s)
+                                                                         for s in self.labels]
+        flag = (np.zeros(n, bool) if self.bad is None
+                else np.asarray(self.bad, dtype=bool).reshape(-1))
+        why = [""] * n if self.reasons is None else [str(r) for r in self.reasons]
+        tips = labs if self.hover is None else [str(h) for h in self.hover]
+        if len(labs) != n or flag.shape != (n,) or len(why) != n or len(tips) != n:
+            raise InputError(f"labels, bad, reasons and hover need one entry per point ({n})")
+        if self.points is None:
+            return labs, flag, why, tips, None
+        given = np.asarray(self.points, dtype=float)
+        if given.shape != (n, 3):
+            raise InputError(f"points must have shape ({n}, 3), got {given.shape}")
+        known = np.all(np.isfinite(given), axis=1)
+        given[known] = as_points(given[known], "points")
+        return labs, flag, why, tips, given
+
+
 def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
-               tool: str | ArrayLike | None = None, labels: Sequence[str] | None = None,
-               bad: ArrayLike | None = None, reasons: Sequence[str] | None = None,
-               points: ArrayLike | None = None, hover: Sequence[str] | None = None,
+               tool: str | ArrayLike | None = None, marks: PathMarks = PathMarks(),
                title: str = "path", every: int = 1) -> Scene:
     """The scene of a path through a cell, with the arm at each point on a slider.
 
@@ -191,17 +243,9 @@ def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLik
     tool : str or array_like of shape (4, 4) or (N, 4, 4), optional
         The tool: a tool of the cell, ``T_F_TCP`` (m), or one ``T_F_TCP`` per point (a row of
         NaN where it is not known: no TCP is drawn there); default the robot model's.
-    labels : sequence of str, optional
-        Name of each point (default ``"1".."N"``), on the slider and in the hover texts.
-    bad : array_like of bool, shape (N,), optional
-        Points to mark (e.g. those a program check finds bad).
-    reasons : sequence of str, optional
-        Why each point is bad (hover text of its mark; ignored for good points).
-    points : array_like, shape (N, 3), optional
-        Position of each point in the world (m; NaN where not known), for the points without
-        joint values or without a known tool; default the TCP of the joint values.
-    hover : sequence of str, optional
-        Hover text of each point of the path (default its label); its position follows.
+    marks : PathMarks, optional
+        The points' names, the bad ones and why, their hover texts and positions, e.g.
+        ``PathMarks(bad=bad, reasons=reasons)``; default: named ``"1".."N"``, none bad.
     title : str
     every : int
         Draw the arm at every ``every``-th point (the first, then every ``every``-th).
@@ -232,23 +276,13 @@ def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLik
     e = np.broadcast_to(np.asarray(track, dtype=float), (n,))
     th = np.asarray(table, dtype=float)
     th = np.broadcast_to(th, (n,) + th.shape[1:] if th.ndim else (n,))
-    labs = [str(i + 1) for i in range(n)] if labels is None else [str(s) for s in labels]
-    flag = np.zeros(n, bool) if bad is None else np.asarray(bad, dtype=bool).reshape(-1)
-    why = [""] * n if reasons is None else [str(r) for r in reasons]
-    tips = labs if hover is None else [str(h) for h in hover]
-    if len(labs) != n or flag.shape != (n,) or len(why) != n or len(tips) != n:
-        raise InputError(f"labels, bad, reasons and hover need one entry per point ({n})")
+    labs, flag, why, tips, given = marks.resolved(n)
     tools = _tools(cell, tool, n)
     T_world_F = np.full((n, 4, 4), np.nan)
     T_world_F[has_q] = cell.fk(qq[has_q], e[has_q], th[has_q], tool=np.eye(4))
     T_tcp = T_world_F @ tools
     where = T_tcp[:, :3, 3]
-    if points is not None:
-        given = np.asarray(points, dtype=float)
-        if given.shape != (n, 3):
-            raise InputError(f"points must have shape ({n}, 3), got {given.shape}")
-        known = np.all(np.isfinite(given), axis=1)
-        given[known] = as_points(given[known], "points")
+    if given is not None:
         where = np.where(np.all(np.isfinite(where), axis=1)[:, None], where, given)
     placed = np.all(np.isfinite(where), axis=1)
     size = frame_size(cell.robot)
@@ -272,31 +306,46 @@ def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLik
     shown = np.maximum.accumulate(np.where(has_q, np.arange(n), -1))
     shown = np.where(shown < 0, int(np.argmax(has_q)), shown)
     steps = np.arange(0, n, int(every))
-    at = []
-    for j in shown[steps]:
-        parts = _one_per_frame(cell_items(cell, qq[j], e[j], th[j], size, detail=False,
-                                          with_tools=False, triads=False))
-        arm = parts[0]  # the robot's links; the tool goes on from the flange in their colour
-        tool_line = Lines("tool", np.vstack([T_world_F[j, :3, 3], T_tcp[j, :3, 3]]),
-                          color=arm.color if isinstance(arm, Lines) else "gray")
-        at.append([arm, tool_line, triad_line("TCP", T_tcp[j], size), *parts[1:]])
-    # what does not move along the path is drawn once
+    at = [_at_point(cell, qq[j], e[j], th[j], size, T_world_F[j], T_tcp[j])
+          for j in shown[steps]]
+    still, frames = _steps(at, [labs[i] for i in steps])
+    items += still
+    if every > 1:
+        notes.append(f"the arm is drawn at every {ordinal(every)} of the {n} points (the path "
+                     "and every mark at all of them)")
+    return Scene(title, items, notes, frames, decimals=DECIMALS)
+
+
+def _at_point(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLike, size: float,
+              T_world_F: NDArray[np.float64], T_tcp: NDArray[np.float64]) -> list[Item]:
+    """The moving parts of the cell at one point: the robot's links, the tool from the flange
+    (``T_world_F``, m) to the TCP (``T_tcp``, m), the TCP as a triad of ``size`` (m), then the
+    rest of the cell (one item per frame), at joints ``q`` (rad), ``track`` (m), ``table``
+    (rad)."""
+    parts = _one_per_frame(cell_items(cell, q, track, table, size, detail=False,
+                                      with_tools=False, triads=False))
+    arm = parts[0]  # the robot's links; the tool goes on from the flange in their colour
+    tool_line = Lines("tool", np.vstack([T_world_F[:3, 3], T_tcp[:3, 3]]),
+                      color=arm.color if isinstance(arm, Lines) else "gray")
+    return [arm, tool_line, triad_line("TCP", T_tcp, size), *parts[1:]]
+
+
+def _steps(at: list[list[Item]], labels: list[str]) -> tuple[list[Item], list[Step]]:
+    """What does not move along the path, drawn once, and one step per point drawn with what
+    moves (``at``: the items at each point drawn, ``labels``: its name)."""
     still = [all(_same(at[0][k], a[k]) for a in at[1:]) for k in range(len(at[0]))]
-    items += [it for it, s in zip(at[0], still) if s]
+    fixed = [it for it, s in zip(at[0], still) if s]
     moving = [[it for it, s in zip(a, still) if not s] for a in at]
     lines = [[it for it in m if isinstance(it, (Lines, Triads))] for m in moving]
     merged = _merge(lines, width=6.0) if lines[0] else [None] * len(at)
     labelled = [[it for it in m if isinstance(it, Triads)] for m in moving]
     others = [[it for it in m if not isinstance(it, (Lines, Triads))] for m in moving]
     frames = []
-    for k, i in enumerate(steps):
+    for k, label in enumerate(labels):
         step: list[Item] = [] if merged[k] is None else [merged[k]]
         if labelled[k]:
             frames_here = [(lab, T) for t in labelled[k] for lab, T in zip(t.labels, t.poses)]
             step.append(Points("moving frames", np.array([T[:3, 3] for _, T in frames_here]),
                                size=2.0, labels=[lab for lab, _ in frames_here]))
-        frames.append(Step(labs[i], (*step, *others[k])))
-    if every > 1:
-        notes.append(f"the arm is drawn at every {ordinal(every)} of the {n} points (the path "
-                     "and every mark at all of them)")
-    return Scene(title, items, notes, frames, decimals=DECIMALS)
+        frames.append(Step(label, (*step, *others[k])))
+    return fixed, frames

@@ -27,7 +27,7 @@ from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write
 from robotcell.kinematics.transforms import invert
 from robotcell.programs.check import CheckReport, check_program_file
-from robotcell.view.path import path_scene
+from robotcell.view.path import PathMarks, path_scene
 from robotcell.view.plot import MAX_PAGE_BYTES, page
 from robotcell.view.scene import Scene
 
@@ -98,9 +98,10 @@ def program_scene(cell: Cell, report: CheckReport, every: int = 1) -> Scene:
         T_world_F = cell.fk(q[placed], track[placed], table[placed], tool=np.eye(4))
         tools[placed] = invert(T_world_F) @ T_world[placed]
     bad = [bool(p.problems) for p in pts]
-    scene = path_scene(cell, q, track, table, tool=tools, labels=[p.name for p in pts], bad=bad,
-                       reasons=["; ".join(p.problems) for p in pts], points=T_world[:, :3, 3],
-                       hover=[f"<b>{p.name}</b> (line {p.line}, {p.motion})" for p in pts],
+    marks = PathMarks(labels=[p.name for p in pts], bad=bad,
+                      reasons=["; ".join(p.problems) for p in pts], points=T_world[:, :3, 3],
+                      hover=[f"<b>{p.name}</b> (line {p.line}, {p.motion})" for p in pts])
+    scene = path_scene(cell, q, track, table, tool=tools, marks=marks,
                        title=(f"{name} ({report.program.vendor}) in {cell.name}: {len(pts)} "
                               f"points, {sum(bad)} bad"), every=every)
     if report.skipped:
