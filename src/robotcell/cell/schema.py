@@ -723,9 +723,13 @@ def _placeholder_parent(rd: _Reader, key: str, value: Any, names: list[str],
     if parent == "robot":
         raise rd.fail(f"{key}.parent", f"must name the robot in a cell with a robots section "
                       f"({', '.join(names) or 'world only: the robots share it'}), got 'robot'")
+    frame = key.startswith("frames.")
+    if frame and parent not in (*names, "world", "turntable"):
+        raise rd.fail(f"{key}.parent", f"must be world, turntable or a robot of the cell "
+                      f"({', '.join(names)}), got {parent!r}")
     if parent not in names:
         return value
-    if key.startswith("frames."):
+    if frame:
         owner[item] = parent
         return {**value, "parent": "world"}
     return {**value, "parent": "robot"}
