@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -56,8 +57,8 @@ def main(n: int) -> None:
         e = rng.uniform(0.5, 2.5, n) if cell.robots[name].track else 0.0
         T = one.fk(q, track=e, table=v, tool="torch", frame="part")
         one.ik_batch(T[:10], "part", table=v[:10], tool="torch")  # first calls, not counted
-        t_cell = best(lambda: cell.ik_batch(T, "part", table=v, tool="torch", robot=name))
-        t_one = best(lambda: one.ik_batch(T, "part", table=v, tool="torch"))
+        t_cell = best(partial(cell.ik_batch, T, "part", table=v, tool="torch", robot=name))
+        t_one = best(partial(one.ik_batch, T, "part", table=v, tool="torch"))
         print(f"{name:<8}{t_cell * 1e3:>13.1f} ms{t_one * 1e3:>9.1f} ms{t_cell / t_one:>8.2f}")
 
 

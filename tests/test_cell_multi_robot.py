@@ -147,12 +147,12 @@ def _text(tmp_path: Path, old: str, new: str) -> Path:
     ("axis: x", "axis: w", r"robot 'kuka': key 'track.axis' must be x, y or z"),
     ("model: abb_irb2400", "model: abb_nonexistent", r"robot 'abb': key 'robot.model'"),
     ("    parent: kuka ", "    parent: fanuc ",
-     r"key 'frames.cleaner.parent' must be world, turntable or a robot of the cell "
-     r"\(kuka, abb\), got 'fanuc'"),
+     (r"key 'frames.cleaner.parent' must be world, turntable or a robot of the cell "
+      r"\(kuka, abb\), got 'fanuc'")),
     ("    parent: kuka ", "    parent: robot ",
      r"key 'frames.cleaner.parent' must name the robot .*kuka, abb.*got 'robot'"),
-    ("  abb:\n", "  world:\n", r"key 'robots.world' is not a valid name: robot name 'world' is "
-                               r"reserved"),
+    ("  abb:\n", "  world:\n",
+     r"key 'robots.world' is not a valid name: robot name 'world' is reserved"),
     ("        number: 2\n        frame: {x: 250", "        number: 1\n        frame: {x: 250",
      r"key 'robots.abb' is invalid: tools 'torch' and 'pointer' have the same number 1"),
     ("  parent: world\n  frame: {x: 1100", "  parent: kuka\n  frame: {x: 1100",

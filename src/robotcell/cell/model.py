@@ -245,6 +245,40 @@ class Cell:
             {key: self.robots[key]}, self.turntable, frames, self.name)
         return view
 
+    def with_view(self, view: Cell, robot: str | None = None) -> Cell:
+        """This cell with the changes made to the view :meth:`for_robot` gave of robot ``robot``.
+
+        The robot (arm, base or track, tools) is the view's; frames the view fixes to its robot
+        are written back fixed to this robot; a frame the view changed or added is written as
+        the view has it; frames the view placed in the world for another robot, unchanged, and
+        frames it left out stay as they are. The turntable or positioner is the view's.
+
+        Parameters
+        ----------
+        view : Cell
+            A one-robot cell from :meth:`for_robot`, changed (e.g. by a calibration).
+        robot : str, optional
+            The robot it is the view of (None: the only robot).
+
+        Returns
+        -------
+        Cell
+            A new cell (this one is unchanged); ``view`` itself for a one-robot cell.
+        """
+        key = self.robot_key(robot)
+        if len(self.robots) == 1:
+            return view
+        frames = dict(self.frames)
+        for fname, fr in view.frames.items():
+            old = self.frames.get(fname)
+            if fr.parent == "robot":
+                frames[fname] = replace(fr, parent=key)
+            elif not (old is not None and old.parent in self.robots
+                      and fr.provenance is old.provenance and fr.number == old.number):
+                frames[fname] = fr  # a frame the view changed (a placed one keeps its provenance)
+        return Cell(robots={**self.robots, key: view.robots[view.robot_name]},
+                    turntable=view.turntable, frames=frames, name=self.name)
+
     def set_robot_base(self, robot: str | None, pose: ArrayLike, provenance: Provenance,
                        reference: str | None = None, reference_track: float = 0.0) -> CellRobot:
         """Place a robot's base, e.g. from a robot-to-robot calibration.

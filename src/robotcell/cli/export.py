@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import click
 
-from robotcell.cell import Cell
 from robotcell.cli.common import check_kind, check_output, write_output
 from robotcell.cli.files import OUTPUT, Command, LiveChoice, refuse_overwriting_inputs
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.export import (
     URDF,
     export_cell,
@@ -19,6 +19,7 @@ from robotcell.export import (
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file (YAML, mm/deg).")
 @click.option("--format", "fmt", required=True, type=LiveChoice(write_formats),
@@ -47,7 +48,7 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     """
     check_kind(output, "URDF" if fmt == URDF else "text", f"the {fmt} export",
                named=other_kinds(fmt), ending=output_ending(fmt))
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     if output is None:
         write_output(None, export_cell(cell, fmt))
         return

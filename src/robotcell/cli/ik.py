@@ -10,7 +10,6 @@ from typing import TextIO
 import click
 import numpy as np
 
-from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
     batch_outside,
@@ -41,6 +40,7 @@ from robotcell.cli.common import (
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.controllers.base import IkFlags
 from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
@@ -77,6 +77,7 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
@@ -241,7 +242,7 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
              fmt: str, show_all: bool, near: str | None, tool: str | None, frame: str,
              track_mm: float | None, table_deg: str | None) -> None:
     """``robotcell ik --cell``: :meth:`Cell.ik` for one pose or a batch (mm, deg)."""
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     r = cell.robot
     if (pose is None) == (input_path is None):
         raise InputError("give exactly one of --pose ... or --input poses.csv")

@@ -8,12 +8,12 @@ from contextlib import ExitStack
 
 import click
 
-from robotcell.cell import Cell
 from robotcell.cli.cellargs import setup_text
 from robotcell.cli.common import format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.errors import InputError
 from robotcell.studies.sweep import read_layouts, sweep
 
@@ -37,6 +37,7 @@ def _executor(stack: ExitStack, workers: int | None, scheduler: str | None) -> E
 
 
 @click.command(cls=Command)
+@robot_name_option
 @target_options
 @click.option("--targets", "targets", required=True, type=click.Path(dir_okay=False),
               help="CSV of target poses (columns of --format; optional 'table' in deg, a "
@@ -68,7 +69,7 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --workers 8
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     T, th, _, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
     click.echo(setup_text(cell, tool, frame, axes.replace("track chosen per target",
                                                           "track chosen per target and layout"),
