@@ -217,3 +217,40 @@ def test_cell_of_two_robots_built_in_python_saves_a_robots_section(tmp_path):
     assert np.allclose(back.frame_pose("gauge", robot="left"), cell.robots["right"].T_world_R)
     with pytest.raises(InputError, match="give each its tools in its CellRobot"):
         Cell(robots=cell.robots, tools={})
+
+
+def test_reach_map_and_table_choice_take_the_robot_name():
+    from robotcell.cell.tablechoice import choose_table
+    from robotcell.studies.reach import reach_map
+
+    cell = Cell.load(TWO)
+    alone = _alone(cell, "abb")
+    q = np.radians([[0, 10, 10, 0, 50, 0], [5, 12, 8, 0, 48, 5], [10, 14, 6, 0, 46, 10]])
+    T = alone.fk(q, table=[0.1, 0.2], tool="torch", frame="part")
+    got = reach_map(cell, T, "part", "torch", table=[0.1, 0.2], robot="abb")
+    ref = reach_map(alone, T, "part", "torch", table=[0.1, 0.2])
+    assert np.array_equal(got.score, ref.score) and got.fraction == 1.0
+    path = choose_table(cell, T, "part", tool="torch", robot="abb")
+    assert np.array_equal(path.table, choose_table(alone, T, "part", tool="torch").table)
+    with pytest.raises(InputError, match="no robot 'fanuc'"):
+        reach_map(cell, T, "part", "torch", robot="fanuc")
+
+
+def test_a_sweep_places_several_robots_and_scores_the_named_one():
+    from robotcell.studies.sweep import apply_layout, read_layouts, sweep
+
+    cell = Cell.load(TWO)
+    layouts = read_layouts({"kuka": {"y": [0, -200]}, "abb": {"x": [0, 300]}})
+    moved = apply_layout(cell, layouts[-1])
+    assert np.allclose(moved.robots["abb"].T_world_R[:3, 3] - cell.robots["abb"].T_world_R[:3, 3],
+                       [0.3, 0, 0])
+    assert np.allclose(moved.robots["kuka"].track.T_world_L[:3, 3]
+                       - cell.robots["kuka"].track.T_world_L[:3, 3], [0, -0.2, 0])
+    assert np.array_equal(cell.robots["abb"].T_world_R, Cell.load(TWO).robots["abb"].T_world_R)
+    T = cell.fk(np.radians([0, 10, 10, 0, 50, 0]), table=[0.1, 0.2], tool="torch",
+                frame="part", robot="abb")[None]
+    ranked = sweep(cell, T, layouts, frame="part", tool="torch", table=[0.1, 0.2], robot="abb")
+    assert len(ranked) == 4 and ranked[0].fraction == 1.0
+    with pytest.raises(InputError, match="the layout moves 'robot', which the cell does not "
+                                         "have; it has: kuka, abb, turntable"):
+        apply_layout(cell, read_layouts({"robot": {"y": [0]}})[0])

@@ -57,7 +57,7 @@ def test_ik_of_a_named_robot_prints_what_the_robot_alone_prints(capsys, two, tmp
 ])
 def test_unknown_robot_name_exits_2_listing_the_robots(capsys, two, command):
     where = ["--cell", two] if command[0] != "cell" else [two]
-    code, out, err = run(capsys, *command, *where, "--robot-name", "fanuc")
+    code, _, err = run(capsys, *command, *where, "--robot-name", "fanuc")
     assert code == 2
     assert "no robot 'fanuc'; its robots: kuka, abb" in err
     assert "Traceback" not in err

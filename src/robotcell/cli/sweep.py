@@ -8,12 +8,13 @@ from contextlib import ExitStack
 
 import click
 
+from robotcell.cell import Cell
 from robotcell.cli.cellargs import setup_text
 from robotcell.cli.common import format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
-from robotcell.cli.robotname import load_cell, robot_name_option
+from robotcell.cli.robotname import robot_name_option, robot_of
 from robotcell.errors import InputError
 from robotcell.studies.sweep import read_layouts, sweep
 
@@ -69,7 +70,9 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
       robotcell sweep --cell cell.yaml --targets seam.csv --layouts l.yaml --workers 8
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
-    cell = load_cell(cell_path)
+    full = Cell.load(cell_path)  # a layout may move several robots; one reaches
+    name = robot_of(full, cell_path)
+    cell = full.for_robot(name)
     T, th, _, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_column=False)
     click.echo(setup_text(cell, tool, frame, axes.replace("track chosen per target",
                                                           "track chosen per target and layout"),
@@ -77,8 +80,9 @@ def sweep_cmd(cell_path: str, targets: str, layouts_path: str, frame: str, tool:
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
-        ranked = sweep(cell, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
-                       progress=DeferredProgress(stack, "layouts"), output=output)
+        ranked = sweep(full, T, layouts, frame=frame, tool=tool, table=th, executor=ex,
+                       progress=DeferredProgress(stack, "layouts"), output=output,
+                       robot=name)
     shown = ranked[:max(top, 0)]
     rows_out = [[rank + 1, r.layout.label, f"{100 * r.fraction:.1f}", f"{r.mean_score:.3f}",
                  f"{r.min_score:.3f}"] for rank, r in enumerate(shown)]
