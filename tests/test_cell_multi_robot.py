@@ -254,3 +254,34 @@ def test_a_sweep_places_several_robots_and_scores_the_named_one():
     with pytest.raises(InputError, match="the layout moves 'robot', which the cell does not "
                                          "have; it has: kuka, abb, turntable"):
         apply_layout(cell, read_layouts({"robot": {"y": [0]}})[0])
+
+
+def test_urdf_holds_every_robot_its_track_and_the_shared_positioner():
+    from test_export_urdf import assert_same, parsed_fk
+    from urdf_parser_py.urdf import URDF
+
+    from robotcell.export import export_cell
+
+    cell = Cell.load(TWO)
+    model = URDF.from_xml_string(export_cell(cell, "urdf").encode())
+    links = {link.name for link in model.links}
+    assert {"kuka_base_link", "kuka_track_carriage", "kuka_flange", "kuka_tool_torch",
+            "abb_base_link", "abb_flange", "abb_tool_pointer", "turntable"} <= links
+    assert "base_link" not in links
+    rng = np.random.default_rng(3)
+    v = rng.uniform(-1, 1, 2)
+    for name in cell.robot_names:
+        unit = cell.robots[name]
+        q = rng.uniform(-1, 1, unit.robot.n_joints)
+        e = 1.2 if unit.track else 0.0
+        qm = unit.robot.model_values(q)
+        values = {f"{name}_{j.name}": qm[i] for i, j in enumerate(unit.robot.joints)
+                  if not j.passive}
+        values.update({"kuka_track_axis": 1.2, "turntable_axis_1": v[0], "turntable_axis_2": v[1]})
+        for tool in unit.tools:
+            assert_same(parsed_fk(model, f"{name}_tool_{tool}", values),
+                        cell.fk(q, track=e, table=v, tool=tool, robot=name))
+    assert_same(parsed_fk(model, "frame_cleaner", values),
+                cell.frame_pose("cleaner", track=1.2, robot="kuka"))
+    assert_same(parsed_fk(model, "frame_part", values), cell.frame_pose("part", table=v,
+                                                                        robot="abb"))
