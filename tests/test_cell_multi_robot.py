@@ -285,3 +285,24 @@ def test_urdf_holds_every_robot_its_track_and_the_shared_positioner():
                 cell.frame_pose("cleaner", track=1.2, robot="kuka"))
     assert_same(parsed_fk(model, "frame_part", values), cell.frame_pose("part", table=v,
                                                                         robot="abb"))
+
+
+def test_3d_view_shows_every_robot_its_track_and_the_shared_positioner():
+    from robotcell.view.cellscene import cell_scene, robot_items
+
+    cell = Cell.load(TWO)
+    q = np.radians([5, 20, 10, 0, 30, 0])
+    scene = cell_scene(cell, joints={"abb": q}, track={"kuka": 1.5}, table=[0.2, 0.3])
+    names = [item.name for item in scene.items]
+    assert {"kuka: track KL1500: travel of R", "kuka: robot kuka_kr16: links",
+            "abb: robot abb_irb2400: links", "positioner DKP_2: plate", "kuka: frames",
+            "frames"} <= set(names)
+    by_name = {item.name: item for item in scene.items}
+    flange = by_name["abb: robot abb_irb2400: flange F"].poses[0]
+    assert np.allclose(flange, cell.fk(q, table=[0.2, 0.3], tool=np.eye(4), robot="abb"))
+    assert np.allclose(by_name["kuka: frames"].poses[0],
+                       cell.frame_pose("cleaner", track=1.5, robot="kuka"))
+    alone = robot_items(_alone(cell, "abb"), q, 0.0, 0.1)
+    assert [i.name for i in alone][1] == "robot abb_irb2400: links"
+    with pytest.raises(InputError, match="no robot 'fanuc'"):
+        cell_scene(cell, joints={"fanuc": q})

@@ -108,3 +108,27 @@ def test_calibrate_with_an_unknown_robot_name_writes_nothing(capsys, two, tmp_pa
     assert "no robot 'fanuc'; its robots: kuka, abb" in err
     assert two.read_bytes() == TWO.read_bytes()
     assert not list(tmp_path.glob("*.bak"))
+
+
+def test_view_draws_every_robot_and_needs_a_name_for_joints(capsys, two, tmp_path):
+    code, _, err = run(capsys, "view", two, "-o", tmp_path / "all.html")
+    assert code == 0, err
+    page = (tmp_path / "all.html").read_text()
+    assert "kuka: robot kuka_kr16" in page and "abb: robot abb_irb2400" in page
+    code, _, err = run(capsys, "view", two, "--joints", "0,10,10,0,30,0", "-o",
+                       tmp_path / "one.html")
+    assert code == 2 and "say which one with --robot-name NAME" in err
+    assert not (tmp_path / "one.html").exists()
+    code, _, err = run(capsys, "view", two, "--robot-name", "abb", "--joints", "0,10,10,0,30,0",
+                       "-o", tmp_path / "one.html")
+    assert code == 0, err
+
+
+def test_export_urdf_writes_every_robot(capsys, two, tmp_path):
+    code, _, err = run(capsys, "export", "--cell", two, "--format", "urdf", "-o",
+                       tmp_path / "cell.urdf")
+    assert code == 0, err
+    text = (tmp_path / "cell.urdf").read_text()
+    assert 'link name="kuka_base_link"' in text and 'link name="abb_base_link"' in text
+    code, _, err = run(capsys, "export", "--cell", two, "--format", "kuka")
+    assert code == 2 and "--robot-name" in err
