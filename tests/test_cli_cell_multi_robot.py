@@ -97,6 +97,8 @@ def test_calibrate_tcp_writes_the_tool_under_the_named_robot(capsys, two, tmp_pa
     assert "pointer" not in after.robots["kuka"].tools
     text, was = two.read_text().splitlines(), TWO.read_text().splitlines()
     assert text[:text.index("  abb:")] == was[:was.index("  abb:")]  # the KUKA's lines unchanged
+    code, out, _ = run(capsys, "cell", "history", two)
+    assert code == 0 and "abb: tool pointer (tcp" in out.splitlines()[-1]
 
 
 def test_calibrate_with_an_unknown_robot_name_writes_nothing(capsys, two, tmp_path):
