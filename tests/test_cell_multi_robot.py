@@ -92,8 +92,11 @@ def test_frame_on_a_robot_track_moves_with_that_robot():
     T = cell.frame_pose("cleaner", track=e, robot="kuka")
     R = cell.frame_pose("robot", track=e, robot="kuka")
     assert np.allclose(T, R @ cell.frames["cleaner"].pose)
-    with pytest.raises(InputError, match="cleaner"):  # the other robot cannot know where it is
+    with pytest.raises(InputError, match="frame 'cleaner' is fixed to robot 'kuka', which "
+                       "moves on its track: robot 'abb' does not know where it is"):
         cell.frame_pose("cleaner", robot="abb")
+    with pytest.raises(InputError, match="frame 'cleaner' is fixed to robot 'kuka'"):
+        cell.ik(np.eye(4), frame="cleaner", robot="abb")
 
 
 def test_track_choice_is_per_robot():

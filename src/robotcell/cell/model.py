@@ -279,6 +279,16 @@ class Cell:
         return Cell(robots={**self.robots, key: view.robots[view.robot_name]},
                     turntable=view.turntable, frames=frames, name=self.name)
 
+    def _view(self, robot: str | None, frame: str) -> Cell:
+        """:meth:`for_robot`, refusing a frame on another robot's track by name."""
+        view = self.for_robot(robot)
+        if frame in self.frames and frame not in view.frames:
+            raise InputError(f"frame {frame!r} is fixed to robot {self.frames[frame].parent!r}, "
+                             f"which moves on its track: robot {view.robot_name!r} does not know "
+                             "where it is; give that robot, or a frame in the world or on the "
+                             "positioner")
+        return view
+
     def set_robot_base(self, robot: str | None, pose: ArrayLike, provenance: Provenance,
                        reference: str | None = None, reference_track: float = 0.0) -> CellRobot:
         """Place a robot's base, e.g. from a robot-to-robot calibration.
@@ -536,7 +546,7 @@ class Cell:
         ``robot``: the robot whose track position ``track`` is, and whose base ``robot`` and
         ``track`` name (None: the only robot; see :meth:`for_robot`).
         """
-        return kinematics.frame_pose(self.for_robot(robot), name, track, table)
+        return kinematics.frame_pose(self._view(robot, name), name, track, table)
 
     def fk(self, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
            tool: str | ArrayLike | None = None, frame: str = "world", robot: str | None = None
@@ -548,7 +558,7 @@ class Cell:
         ``track`` are (None: the only robot; an unknown name raises InputError naming the cell's
         robots).
         """
-        return kinematics.fk(self.for_robot(robot), q, track, table, tool, frame)
+        return kinematics.fk(self._view(robot, frame), q, track, table, tool, frame)
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
            table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
@@ -566,7 +576,7 @@ class Cell:
         from robotcell.cell import ik as cell_ik  # the IK package only for commands that solve IK
 
         if robot is not None and len(self.robots) > 1:
-            return self.for_robot(robot).ik(T, frame, track, table, tool, samples)
+            return self._view(robot, frame).ik(T, frame, track, table, tool, samples)
         self.robot_key(robot)
         if not isinstance(table, str):
             return cell_ik.ik(self, T, frame, track, table, tool, samples)
@@ -617,7 +627,8 @@ class Cell:
             Shapes ``(N, 8, n)``, ``(N, 8)``, track ``(N,)``, table ``(N,)`` or ``(N, n)``.
         """
         if robot is not None and len(self.robots) > 1:
-            return self.for_robot(robot).ik_batch(T, frame, track, table, tool, chunk, progress)
+            return self._view(robot, frame).ik_batch(T, frame, track, table, tool, chunk,
+                                                         progress)
         self.robot_key(robot)
         T = validate_pose(T, "T")
         if T.ndim != 3:
@@ -671,7 +682,7 @@ class Cell:
         the robot that follows it, None: the only robot)."""
         from robotcell.cell import ik as cell_ik
 
-        return cell_ik.ik_path(self.for_robot(robot), T, frame, track, table, tool, q_start,
+        return cell_ik.ik_path(self._view(robot, frame), T, frame, track, table, tool, q_start,
                                cell_ik.MAX_STEP if max_step is None else max_step, samples,
                                track_motion)
 
