@@ -298,7 +298,11 @@ def test_component_validation():
     with pytest.raises(InputError, match="tool mass must be a finite number > 0"):
         Tool(np.eye(4), mass=0.0)
     with pytest.raises(InputError, match="frame parent must be"):
-        Frame(np.eye(4), parent="floor")
+        Frame(np.eye(4), parent="the floor")
+    with pytest.raises(InputError, match="parent 'floor'; the parent must be world, turntable or "
+                       "a robot of the cell: robot"):  # a name: the cell knows its robots
+        Cell(robot=load_robot("kuka_kr16"), robot_model="kuka_kr16",
+             frames={"fix": Frame(np.eye(4), parent="floor")})
     with pytest.raises(InputError, match="provenance source must be a non-empty string"):
         Provenance("")
     with pytest.raises(InputError, match="single pose of shape"):

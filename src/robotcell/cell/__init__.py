@@ -1,7 +1,8 @@
 """The robot cell: its data model, its file, coupled kinematics, and calibrating into it.
 
 - :mod:`robotcell.cell.parts`: :class:`Tool`, :class:`Frame`, :class:`Track`,
-  :class:`Turntable`, :class:`Positioner`, :class:`Provenance`, :class:`IdentifiedArm` (SI units);
+  :class:`Turntable`, :class:`Positioner`, :class:`Provenance`, :class:`IdentifiedArm`,
+  :class:`CellRobot` (one robot of a cell: arm, base or track, tools) (SI units);
 - :mod:`robotcell.cell.schema`: the YAML cell file (millimetres, degrees), its reader and writer,
   and the atomic save that keeps comments and layout;
 - :mod:`robotcell.cell.validation`: values given for a cell checked against its limits and size;
@@ -20,7 +21,9 @@
 from robotcell.cell.kinematics import RESERVED_FRAMES
 from robotcell.cell.model import Cell, cell_from_dict
 from robotcell.cell.parts import (
+    DEFAULT_ROBOT,
     NAME_RE,
+    CellRobot,
     Frame,
     IdentifiedArm,
     Positioner,
@@ -31,5 +34,5 @@ from robotcell.cell.parts import (
 )
 from robotcell.cell.schema import cell_to_dict
 
-__all__ = ["NAME_RE", "RESERVED_FRAMES", "Cell", "Frame", "IdentifiedArm", "Positioner",
+__all__ = ["DEFAULT_ROBOT", "NAME_RE", "RESERVED_FRAMES", "Cell", "CellRobot", "Frame", "IdentifiedArm", "Positioner",
            "Provenance", "Tool", "Track", "Turntable", "cell_from_dict", "cell_to_dict"]

@@ -185,7 +185,7 @@ def _items(data: Any) -> dict[str, dict[str, Any]]:
     """Item label -> provenance of every item of a parsed cell file that records one."""
     if not isinstance(data, Mapping):
         return {}
-    out: dict[str, dict[str, Any]] = {}
+    out: dict[str, dict[str, Any]] = _robots_items(data)
     robot = data.get("robot")
     if isinstance(robot, Mapping) and robot.get("identified"):
         out[f"robot {robot['identified']}"] = dict(robot.get("provenance") or {})
@@ -197,6 +197,20 @@ def _items(data: Any) -> dict[str, dict[str, Any]]:
         for name, entry in (data.get(section) or {}).items():
             if isinstance(entry, Mapping):
                 out[f"{kind} {name}"] = dict(entry.get("provenance") or {})
+    return out
+
+
+def _robots_items(data: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """The items of the robots of a ``robots`` section, labelled ``<robot>: tool torch``."""
+    out: dict[str, dict[str, Any]] = {}
+    robots = data.get("robots")
+    for name, entry in (robots.items() if isinstance(robots, Mapping) else ()):
+        if not isinstance(entry, Mapping):
+            continue
+        one = {"robot": entry, "track": entry.get("track"), "tools": entry.get("tools")}
+        out.update({f"{name}: {k}": v for k, v in _items(one).items()})
+        if isinstance(entry.get("base_provenance"), Mapping):
+            out[f"{name}: base"] = dict(entry["base_provenance"])
     return out
 
 

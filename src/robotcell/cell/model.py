@@ -19,8 +19,9 @@ them, and :meth:`Cell.ik` and :meth:`Cell.ik_path` call :mod:`robotcell.cell.ik`
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -30,6 +31,8 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.cell import kinematics
 from robotcell.cell.kinematics import RESERVED_FRAMES
 from robotcell.cell.parts import (
+    DEFAULT_ROBOT,
+    CellRobot,
     Frame,
     IdentifiedArm,
     Positioner,
@@ -40,11 +43,12 @@ from robotcell.cell.parts import (
     check_identified,
     check_name,
     single_pose,
+    unique_numbers,
 )
 from robotcell.cell.schema import cell_fields, read_cell_file, save_cell
 from robotcell.cell.validation import check_lengths
 from robotcell.errors import InputError
-from robotcell.kinematics.transforms import validate_pose
+from robotcell.kinematics.transforms import invert, validate_pose
 from robotcell.robot.robot import Robot
 
 if TYPE_CHECKING:
@@ -57,12 +61,47 @@ IK_CHUNK = 500
 
 
 # -- the cell -------------------------------------------------------------------------------------
-@dataclass
+#: A keyword of :class:`Cell` not given (``None`` is a value: ``track=None`` removes the track).
+_KEEP: Any = object()
+
+#: The keywords of :class:`Cell` that describe its one robot, and the :class:`CellRobot` field each sets.
+_ROBOT_KEYWORDS = {"robot": "robot", "robot_model": "model", "T_world_R": "T_world_R",
+                   "track": "track", "tools": "tools", "identified": "identified"}
+
+
+def _robot_attribute(key: str) -> property:
+    """An attribute of the cell's only robot (``cell.robot``, ``cell.track``, ...)."""
+    attr = _ROBOT_KEYWORDS[key]
+
+    def get(self: Cell) -> Any:
+        return getattr(self.robots[self.robot_name], attr)
+
+    def set_(self: Cell, value: Any) -> None:
+        name = self.robot_name
+        unit = copy.copy(self.robots[name])  # a copy of the cell keeps its robot as it was
+        setattr(unit, attr, value)
+        self.robots = {**self.robots, name: unit}
+
+    return property(get, set_, doc=f"``{attr}`` of the cell's only robot (:class:`CellRobot`); "
+                    "InputError in a cell of several robots: use ``cell.robots[name]``.")
+
+
+@dataclass(init=False)
 class Cell:
-    """A robot cell in SI units.
+    """A robot cell in SI units: one or several robots, what carries the work, and the frames.
+
+    ``Cell(robot=..., robot_model=..., track=..., tools=...)`` is a cell of one robot (named
+    :data:`~robotcell.cell.parts.DEFAULT_ROBOT`, ``"robot"``); ``Cell(robots={name:
+    CellRobot(...)}, ...)`` a cell of several, sharing the world, the turntable or positioner
+    and the frames. The one-robot attributes (``robot``, ``robot_model``, ``T_world_R``,
+    ``track``, ``tools``, ``identified``, ``nominal_robot``) are those of the only robot; in a
+    cell of several robots they raise InputError naming the robots, and :meth:`for_robot` (or
+    the ``robot=`` keyword of :meth:`fk`, :meth:`ik`, ...) says which robot is meant.
 
     Attributes
     ----------
+    robots : dict of str to CellRobot
+        The robots by name: arm, model name, base pose or track, tools, identified arm.
     robot : Robot
         The arm. Its default tool applies when :meth:`fk` gets no tool.
     robot_model : str
@@ -76,6 +115,8 @@ class Cell:
         :attr:`positioner`). Frames with parent ``turntable`` are carried by its last axis.
     tools : dict of str to Tool
     frames : dict of str to Frame
+        Shared by the robots. The parent of a frame fixed to a robot base is ``robot`` in a
+        one-robot cell and the robot's name in a cell of several.
     name : str
     identified : IdentifiedArm or None
         Set when ``robot`` is an identified arm: then ``robot`` says where the TCP goes (FK, IK,
@@ -85,46 +126,226 @@ class Cell:
         file names none (a model written by another tool): its IK branches are the nominal's.
     """
 
-    robot: Robot
-    robot_model: str
-    T_world_R: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
-    track: Track | None = None
-    turntable: Turntable | Positioner | None = None
-    tools: dict[str, Tool] = field(default_factory=dict)
-    frames: dict[str, Frame] = field(default_factory=dict)
-    name: str = "cell"
-    identified: IdentifiedArm | None = None
+    robots: dict[str, CellRobot]
+    turntable: Turntable | Positioner | None
+    frames: dict[str, Frame]
+    name: str
 
-    def __post_init__(self) -> None:
-        self.T_world_R = single_pose(self.T_world_R, "robot T_world_R")
-        if self.identified is not None:
-            check_identified(self.identified.nominal, self.robot)
-            if not np.array_equal(self.robot.tool, self.identified.nominal.tool):
-                self.robot = self.robot.with_tool(self.identified.nominal.tool)
-            if self.robot.ik_seed is None:  # a model from another tool: the nominal seeds its IK
-                self.robot = replace(self.robot, ik_seed=self.identified.nominal)
-        if self.track is not None and not np.allclose(self.T_world_R, np.eye(4), atol=0):
-            raise InputError("a robot on a track is placed by the track (track frame and "
-                             "robot_at_zero); do not give the robot a frame as well")
-        for name in self.tools:
-            check_name(name, "tool")
+    def __init__(self, robot: Robot = _KEEP, robot_model: str = _KEEP,
+                 T_world_R: ArrayLike = _KEEP, track: Track | None = _KEEP,
+                 turntable: Turntable | Positioner | None = None,
+                 tools: dict[str, Tool] = _KEEP, frames: dict[str, Frame] | None = None,
+                 name: str = "cell", identified: IdentifiedArm | None = _KEEP, *,
+                 robots: dict[str, CellRobot] | None = None) -> None:
+        given = {_ROBOT_KEYWORDS[k]: v for k, v in (
+            ("robot", robot), ("robot_model", robot_model), ("T_world_R", T_world_R),
+            ("track", track), ("tools", tools), ("identified", identified)) if v is not _KEEP}
+        self.robots = _robots(robots, given)
+        self.turntable = turntable
+        self.frames = dict(frames or {})
+        self.name = name
+        self._check()
+
+    def _check(self) -> None:
+        several = len(self.robots) > 1
+        for rname in self.robots:
+            if several or rname != DEFAULT_ROBOT:
+                check_name(rname, "robot")
+        if several and self.turntable is not None and self.turntable.parent != "world":
+            raise InputError(f"the turntable or positioner of a cell of several robots "
+                             f"({', '.join(self.robots)}) is shared: its parent must be world, "
+                             f"got {self.turntable.parent!r}")
         for name, fr in self.frames.items():
             check_name(name, "frame")
-            self._check_parent(name, fr)
-        _unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
-        _unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
+            self.frames[name] = self._check_parent(name, fr)
+        unique_numbers({k: f.number for k, f in self.frames.items()}, "frame")
+
+    robot = _robot_attribute("robot")
+    robot_model = _robot_attribute("robot_model")
+    T_world_R = _robot_attribute("T_world_R")
+    track = _robot_attribute("track")
+    tools = _robot_attribute("tools")
+    identified = _robot_attribute("identified")
+
+    # -- the robots -------------------------------------------------------------------------------
+    @property
+    def robot_names(self) -> tuple[str, ...]:
+        """The names of the cell's robots, in the file's order (``("robot",)`` for one robot
+        given as ``robot:``)."""
+        return tuple(self.robots)
+
+    @property
+    def robot_name(self) -> str:
+        """The name of the cell's only robot.
+
+        Raises
+        ------
+        InputError
+            The cell has several robots: the message names them.
+        """
+        if len(self.robots) == 1:
+            return next(iter(self.robots))
+        raise InputError(f"the cell has {len(self.robots)} robots ({', '.join(self.robots)}); "
+                         "say which one is meant (robot=NAME)")
+
+    def robot_key(self, robot: str | None) -> str:
+        """The name of robot ``robot`` of the cell (None: the only robot).
+
+        Raises
+        ------
+        InputError
+            No robot of that name (the message lists the cell's robots), or None in a cell of
+            several robots.
+        """
+        if robot is None:
+            return self.robot_name
+        if robot not in self.robots:
+            raise InputError(f"the cell has no robot {robot!r}; its robots: "
+                             f"{', '.join(self.robots)}")
+        return robot
+
+    def for_robot(self, robot: str | None = None) -> Cell:
+        """The cell as one robot sees it: a one-robot cell with that robot, the shared
+        turntable or positioner and the frames.
+
+        In a one-robot cell this is the cell itself. In a cell of several robots, frames fixed
+        to this robot's base get parent ``robot``; frames fixed to the base of another robot
+        without a track are placed in the world; frames fixed to another robot on a track are
+        left out (where they are depends on that robot's track). The tools are the robot's.
+
+        Parameters
+        ----------
+        robot : str, optional
+            A name of :attr:`robot_names`; None: the only robot.
+
+        Returns
+        -------
+        Cell
+
+        Raises
+        ------
+        InputError
+            An unknown name (the cell's robots are listed), or None in a cell of several robots.
+        """
+        key = self.robot_key(robot)
+        if len(self.robots) == 1:
+            return self
+        frames: dict[str, Frame] = {}
+        for fname, fr in self.frames.items():
+            if fr.parent == key:
+                frames[fname] = replace(fr, parent="robot")
+            elif fr.parent in self.robots:
+                other = self.robots[fr.parent]
+                if other.track is None:
+                    frames[fname] = replace(fr, pose=other.T_world_R @ fr.pose, parent="world")
+            else:
+                frames[fname] = fr
+        view = object.__new__(Cell)  # the parts were checked when this cell was made
+        view.robots, view.turntable, view.frames, view.name = (
+            {key: self.robots[key]}, self.turntable, frames, self.name)
+        return view
+
+    def with_view(self, view: Cell, robot: str | None = None) -> Cell:
+        """This cell with the changes made to the view :meth:`for_robot` gave of robot ``robot``.
+
+        The robot (arm, base or track, tools) is the view's; frames the view fixes to its robot
+        are written back fixed to this robot; a frame the view changed or added is written as
+        the view has it; frames the view placed in the world for another robot, unchanged, and
+        frames it left out stay as they are. The turntable or positioner is the view's.
+
+        Parameters
+        ----------
+        view : Cell
+            A one-robot cell from :meth:`for_robot`, changed (e.g. by a calibration).
+        robot : str, optional
+            The robot it is the view of (None: the only robot).
+
+        Returns
+        -------
+        Cell
+            A new cell (this one is unchanged); ``view`` itself for a one-robot cell.
+        """
+        key = self.robot_key(robot)
+        if len(self.robots) == 1:
+            return view
+        frames = dict(self.frames)
+        for fname, fr in view.frames.items():
+            old = self.frames.get(fname)
+            if fr.parent == "robot":
+                frames[fname] = replace(fr, parent=key)
+            elif not (old is not None and old.parent in self.robots
+                      and fr.provenance is old.provenance and fr.number == old.number):
+                frames[fname] = fr  # a frame the view changed (a placed one keeps its provenance)
+        return Cell(robots={**self.robots, key: view.robots[view.robot_name]},
+                    turntable=view.turntable, frames=frames, name=self.name)
+
+    def _view(self, robot: str | None, frame: str) -> Cell:
+        """:meth:`for_robot`, refusing a frame on another robot's track by name."""
+        view = self.for_robot(robot)
+        if frame in self.frames and frame not in view.frames:
+            raise InputError(f"frame {frame!r} is fixed to robot {self.frames[frame].parent!r}, "
+                             f"which moves on its track: robot {view.robot_name!r} does not know "
+                             "where it is; give that robot, or a frame in the world or on the "
+                             "positioner")
+        return view
+
+    def set_robot_base(self, robot: str | None, pose: ArrayLike, provenance: Provenance,
+                       reference: str | None = None, reference_track: float = 0.0) -> CellRobot:
+        """Place a robot's base, e.g. from a robot-to-robot calibration.
+
+        Parameters
+        ----------
+        robot : str or None
+            The robot placed (None: the only robot).
+        pose : array_like, shape (4, 4)
+            ``T_world_R`` (metres), or ``T_Rref_R``, the base in the base of robot
+            ``reference``. For a robot on a track, the base at track position 0: written into
+            ``track.robot_at_zero`` (the track frame stays).
+        provenance : Provenance
+            Where the pose comes from.
+        reference : str, optional
+            Another robot of the cell whose base ``pose`` is given in.
+        reference_track : float
+            The reference robot's track position (m) at which ``pose`` holds, if it has a track.
+
+        Returns
+        -------
+        CellRobot
+            The robot as placed.
+
+        Raises
+        ------
+        InputError
+            An unknown robot, a reference that is the robot itself, or a pose that is not a
+            rigid transform.
+        """
+        key = self.robot_key(robot)
+        T = single_pose(pose, "robot base pose")
+        if reference is not None:
+            ref = self.robot_key(reference)
+            if ref == key:
+                raise InputError(f"robot {key!r} cannot be placed relative to itself")
+            T = self.for_robot(ref).frame_pose("robot", track=reference_track) @ T
+        unit = self.robots[key]
+        if unit.track is None:
+            unit = replace(unit, T_world_R=T, base_provenance=provenance)
+        else:
+            unit = replace(unit, track=replace(unit.track, T_L_R0=invert(unit.track.T_world_L) @ T,
+                                               provenance=provenance))
+        self.robots = {**self.robots, key: unit}
+        return unit
 
     @property
     def nominal_robot(self) -> Robot:
         """The model the controller computes with: the nominal of an identified arm, else ``robot``."""
-        return self.robot if self.identified is None else self.identified.nominal
+        return self.robots[self.robot_name].nominal_robot
 
     def controller(self) -> Cell:
         """The cell as the controller computes it: with the nominal arm (``self`` without an
         identified one). Its FK of joint values is what a program's Cartesian point says."""
-        if self.identified is None:
+        if all(u.identified is None for u in self.robots.values()):
             return self
-        return replace(self, robot=self.identified.nominal, identified=None)
+        return replace(self, robots={k: u.controller() for k, u in self.robots.items()})
 
     def set_identified(self, robot: Robot, model: str, provenance: Provenance) -> None:
         """Make ``robot`` (an identification of the cell's arm) the arm the cell computes with.
@@ -144,23 +365,37 @@ class Cell:
         """
         nominal = self.nominal_robot
         check_identified(nominal, robot)
-        self.identified = IdentifiedArm(nominal, model, provenance)
-        self.robot = robot.with_tool(nominal.tool)
+        self.robots = {**self.robots, self.robot_name: replace(
+            self.robots[self.robot_name], robot=robot.with_tool(nominal.tool),
+            identified=IdentifiedArm(nominal, model, provenance))}
 
     @property
     def positioner(self) -> Turntable | Positioner | None:
         """The external axes carrying the work (the same object as :attr:`turntable`)."""
         return self.turntable
 
-    def _check_parent(self, name: str, fr: Frame) -> None:
+    def _check_parent(self, name: str, fr: Frame) -> Frame:
+        """``fr`` checked against the cell; a one-robot cell spells a robot parent ``robot``."""
         if fr.parent == "turntable" and self.turntable is None:
             raise InputError(f"frame {name!r} is carried by the turntable, but the cell has none")
+        if fr.parent in ("world", "turntable"):
+            return fr
+        if len(self.robots) == 1:
+            if fr.parent == "robot" or fr.parent in self.robots:
+                return fr if fr.parent == "robot" else replace(fr, parent="robot")
+        elif fr.parent in self.robots:
+            return fr
+        raise InputError(f"frame {name!r} has parent {fr.parent!r}; the parent must be world, "
+                         f"turntable or a robot of the cell: {', '.join(self._robot_parents())}")
+
+    def _robot_parents(self) -> list[str]:
+        return ["robot"] if len(self.robots) == 1 else list(self.robots)
 
     # -- editing (used by calibration commands) -------------------------------------------------
     def set_tool(self, name: str, T_F_TCP: ArrayLike, provenance: Provenance,
                  number: int | None = None, mass: float | None = None,
-                 cog: ArrayLike | None = None) -> Tool:
-        """Add or replace a tool; an existing tool keeps its number and load unless given.
+                 cog: ArrayLike | None = None, robot: str | None = None) -> Tool:
+        """Add or replace a tool of a robot; an existing tool keeps its number and load unless given.
 
         Parameters
         ----------
@@ -175,13 +410,16 @@ class Cell:
             Tool mass (kg).
         cog : array_like, shape (3,), optional
             Centre of gravity in the flange frame (metres).
+        robot : str, optional
+            The robot whose tool it is (None: the only robot).
 
         Returns
         -------
         Tool
         """
         check_name(name, "tool")
-        old = self.tools.get(name)
+        tools = self.robots[self.robot_key(robot)].tools
+        old = tools.get(name)
         tool = Tool(
             T_F_TCP=np.asarray(T_F_TCP, dtype=float),
             number=number if number is not None else (old.number if old else None),
@@ -189,12 +427,12 @@ class Cell:
             cog=np.asarray(cog, dtype=float) if cog is not None else (old.cog if old else None),
             provenance=provenance,
         )
-        _unique_numbers({**{k: t.number for k, t in self.tools.items()}, name: tool.number}, "tool")
-        self.tools[name] = tool
+        unique_numbers({**{k: t.number for k, t in tools.items()}, name: tool.number}, "tool")
+        tools[name] = tool
         return tool
 
     def update_frame(self, name: str, pose: ArrayLike, provenance: Provenance,
-                     parent: Literal["world", "robot", "turntable"] | None = None,
+                     parent: str | None = None,
                      number: int | None = None) -> Frame:
         """Add or replace a frame; an existing frame keeps its parent and number unless given.
 
@@ -207,8 +445,9 @@ class Cell:
             Pose of the frame in its parent (metres); in B at table angle 0 for a frame on the
             turntable.
         provenance : Provenance
-        parent : {"world", "robot", "turntable"}, optional
-            Default: the existing frame's parent, else ``world``.
+        parent : str, optional
+            ``world``, ``turntable``, ``robot`` (one-robot cell) or a robot's name. Default:
+            the existing frame's parent, else ``world``.
         number : int, optional
             Controller slot.
 
@@ -224,18 +463,21 @@ class Cell:
             number=number if number is not None else (old.number if old else None),
             provenance=provenance,
         )
-        self._check_parent(name, fr)
-        _unique_numbers({**{k: f.number for k, f in self.frames.items()}, name: fr.number}, "frame")
+        fr = self._check_parent(name, fr)
+        unique_numbers({**{k: f.number for k, f in self.frames.items()}, name: fr.number}, "frame")
         self.frames[name] = fr
         return fr
 
-    def update_track(self, provenance: Provenance, **changes: Any) -> Track:
-        """Replace fields of the track (``T_world_L``, ``T_L_R0``, ``axis``, ``scale``, ...).
+    def update_track(self, provenance: Provenance, robot: str | None = None, **changes: Any
+                     ) -> Track:
+        """Replace fields of a robot's track (``T_world_L``, ``T_L_R0``, ``axis``, ``scale``, ...).
 
         Parameters
         ----------
         provenance : Provenance
             Provenance of the new track calibration.
+        robot : str, optional
+            The robot on the track (None: the only robot).
         **changes
             :class:`Track` attributes to change (SI units).
 
@@ -243,10 +485,14 @@ class Cell:
         -------
         Track
         """
-        if self.track is None:
-            raise InputError("the cell has no track to update")
-        self.track = replace(self.track, provenance=provenance, **changes)
-        return self.track
+        key = self.robot_key(robot)
+        unit = self.robots[key]
+        if unit.track is None:
+            raise InputError("the cell has no track to update" if len(self.robots) == 1
+                             else f"robot {key!r} has no track to update")
+        track = replace(unit.track, provenance=provenance, **changes)
+        self.robots = {**self.robots, key: replace(unit, track=track)}
+        return track
 
     def update_turntable(self, provenance: Provenance, **changes: Any) -> Turntable:
         """Replace fields of the turntable (``T_parent_B``, ``parent``, limits, ``name``).
@@ -293,24 +539,33 @@ class Cell:
         return self.turntable
 
     # -- kinematics -----------------------------------------------------------------------------
-    def frame_pose(self, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0
-                   ) -> NDArray[np.float64]:
-        """Pose of a frame of the cell in the world; see :func:`robotcell.cell.kinematics.frame_pose`."""
-        return kinematics.frame_pose(self, name, track, table)
+    def frame_pose(self, name: str, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
+                   robot: str | None = None) -> NDArray[np.float64]:
+        """Pose of a frame of the cell in the world; see :func:`robotcell.cell.kinematics.frame_pose`.
+
+        ``robot``: the robot whose track position ``track`` is, and whose base ``robot`` and
+        ``track`` name (None: the only robot; see :meth:`for_robot`).
+        """
+        return kinematics.frame_pose(self._view(robot, name), name, track, table)
 
     def fk(self, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLike = 0.0,
-           tool: str | ArrayLike | None = None, frame: str = "world") -> NDArray[np.float64]:
+           tool: str | ArrayLike | None = None, frame: str = "world", robot: str | None = None
+           ) -> NDArray[np.float64]:
         """TCP pose in a frame of the cell; see :func:`robotcell.cell.kinematics.fk`.
 
         ``table`` is the table angle ``(...)`` of a turntable, or the axis values ``(..., n)`` of
-        a positioner chain (radians).
+        a positioner chain (radians). ``robot``: the robot whose joints ``q`` and track position
+        ``track`` are (None: the only robot; an unknown name raises InputError naming the cell's
+        robots).
         """
-        return kinematics.fk(self, q, track, table, tool, frame)
+        return kinematics.fk(self._view(robot, frame), q, track, table, tool, frame)
 
     def ik(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
            table: ArrayLike | Literal["normal_up"] = 0.0, tool: str | ArrayLike | None = None,
-           samples: int | None = None) -> CellIKSolutions:
+           samples: int | None = None, robot: str | None = None) -> CellIKSolutions:
         """Every arm solution for targets in a frame of the cell; see :func:`robotcell.cell.ik.ik`.
+
+        ``robot``: the robot solved for (None: the only robot; see :meth:`for_robot`).
 
         ``table``: the table angle ``(...)``, the positioner's axis values ``(..., n)``, or, for a
         2-axis positioner and targets in a frame it carries, ``"normal_up"``: the axis values
@@ -320,6 +575,9 @@ class Cell:
         """
         from robotcell.cell import ik as cell_ik  # the IK package only for commands that solve IK
 
+        if robot is not None and len(self.robots) > 1:
+            return self._view(robot, frame).ik(T, frame, track, table, tool, samples)
+        self.robot_key(robot)
         if not isinstance(table, str):
             return cell_ik.ik(self, T, frame, track, table, tool, samples)
         values, ok = self._normal_up(T, frame, track)
@@ -342,7 +600,8 @@ class Cell:
     def ik_batch(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                  table: ArrayLike | Literal["normal_up"] = 0.0,
                  tool: str | ArrayLike | None = None, chunk: int = IK_CHUNK,
-                 progress: Callable[[int], None] | None = None) -> CellIKSolutions:
+                 progress: Callable[[int], None] | None = None, robot: str | None = None
+                 ) -> CellIKSolutions:
         """:meth:`ik` of a long list of targets, ``chunk`` targets per call (bounded memory).
 
         Parameters
@@ -359,12 +618,18 @@ class Cell:
             Targets per call of :meth:`ik` (at least 1).
         progress : callable, optional
             Called with the number of targets solved after each chunk.
+        robot : str, optional
+            The robot solved for (None: the only robot; see :meth:`for_robot`).
 
         Returns
         -------
         CellIKSolutions
             Shapes ``(N, 8, n)``, ``(N, 8)``, track ``(N,)``, table ``(N,)`` or ``(N, n)``.
         """
+        if robot is not None and len(self.robots) > 1:
+            return self._view(robot, frame).ik_batch(T, frame, track, table, tool, chunk,
+                                                         progress)
+        self.robot_key(robot)
         T = validate_pose(T, "T")
         if T.ndim != 3:
             raise InputError(f"T must be a list of poses, shape (N, 4, 4), got {T.shape}")
@@ -410,12 +675,14 @@ class Cell:
     def ik_path(self, T: ArrayLike, frame: str = "world", track: ArrayLike | None = None,
                 table: ArrayLike = 0.0, tool: str | ArrayLike | None = None,
                 q_start: ArrayLike | None = None, max_step: float | None = None,
-                samples: int = 33, track_motion: str = "fixed") -> CellPath:
+                samples: int = 33, track_motion: str = "fixed", robot: str | None = None
+                ) -> CellPath:
         """A continuous trajectory through targets; see :func:`robotcell.cell.ik.ik_path`
-        (``max_step`` None: its default, :data:`robotcell.cell.ik.MAX_STEP`, rad)."""
+        (``max_step`` None: its default, :data:`robotcell.cell.ik.MAX_STEP`, rad; ``robot``:
+        the robot that follows it, None: the only robot)."""
         from robotcell.cell import ik as cell_ik
 
-        return cell_ik.ik_path(self, T, frame, track, table, tool, q_start,
+        return cell_ik.ik_path(self._view(robot, frame), T, frame, track, table, tool, q_start,
                                cell_ik.MAX_STEP if max_step is None else max_step, samples,
                                track_motion)
 
@@ -510,15 +777,25 @@ def cell_from_dict(data: Any, origin: str = "cell", base_dir: str | Path = ".") 
         cell = Cell(**fields)
     except InputError as exc:
         raise InputError(f"{origin}: {exc}") from None
-    check_lengths(cell, origin)
+    for name in cell.robot_names:
+        check_lengths(cell.for_robot(name),
+                      origin if len(cell.robots) == 1 else f"{origin}: robot {name!r}")
     return cell
 
 
-def _unique_numbers(numbers: dict[str, int | None], what: str) -> None:
-    seen: dict[int, str] = {}
-    for name, n in numbers.items():
-        if n is None:
-            continue
-        if n in seen:
-            raise InputError(f"{what}s {seen[n]!r} and {name!r} have the same number {n}")
-        seen[n] = name
+def _robots(robots: dict[str, CellRobot] | None, given: dict[str, Any]) -> dict[str, CellRobot]:
+    """The robots of a new cell: ``robots``, with the one-robot keywords ``given`` applied."""
+    if robots is None:
+        if "robot" not in given or "model" not in given:
+            raise InputError("a cell needs its robot and the robot's model name (robot=..., "
+                             "robot_model=...), or its robots (robots={name: CellRobot(...)})")
+        return {DEFAULT_ROBOT: CellRobot(**given)}
+    if not robots:
+        raise InputError("a cell needs at least one robot")
+    if not given:
+        return dict(robots)
+    if len(robots) != 1:
+        raise InputError(f"the cell has {len(robots)} robots ({', '.join(robots)}); give each "
+                         f"its {', '.join(given)} in its CellRobot")
+    (name, unit), = robots.items()
+    return {name: replace(unit, **given)}

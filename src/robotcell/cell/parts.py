@@ -16,7 +16,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -29,9 +29,9 @@ from robotcell.kinematics.bounds import within
 from robotcell.kinematics.transforms import finite_array, validate_pose
 from robotcell.robot.robot import Joint, Robot
 
-__all__ = ["IDENTIFIED_MAX_ANGLE", "IDENTIFIED_MAX_OFFSET", "NAME_RE", "Frame", "IdentifiedArm",
-           "Positioner", "Provenance", "Tool", "Track", "Turntable", "check_identified",
-           "check_name", "single_pose"]
+__all__ = ["DEFAULT_ROBOT", "IDENTIFIED_MAX_ANGLE", "IDENTIFIED_MAX_OFFSET", "NAME_RE", "CellRobot",
+           "Frame", "IdentifiedArm", "Positioner", "Provenance", "Tool", "Track", "Turntable",
+           "check_identified", "check_name", "single_pose", "unique_numbers"]
 
 #: Names of tools and frames: a letter, then letters, digits or underscores, at most 24 in all
 #: (KUKA keeps 24 characters of a tool or base name; RAPID identifiers allow 32).
@@ -410,24 +410,26 @@ class Frame:
     pose : ndarray, shape (4, 4)
         Pose of the frame in its parent (metres): ``T_world_X``, ``T_R_X`` or ``T_B_X`` (for a
         frame on the turntable, at table angle 0).
-    parent : {"world", "robot", "turntable"}
-        What carries the frame: nothing (fixed in the world), the robot base (moves with the
-        track), or the turntable (turns with it).
+    parent : str
+        What carries the frame: ``world`` (nothing: fixed in the world), ``robot`` (the robot
+        base of a one-robot cell: moves with the track), ``turntable`` (turns with it), or, in a
+        cell of several robots, the name of the robot whose base carries it.
     number : int or None
         Controller slot (KUKA ``BASE_DATA[n]``, Fanuc ``UFRAME[n]``); None: numbered in order.
     provenance : Provenance
     """
 
     pose: NDArray[np.float64]
-    parent: Literal["world", "robot", "turntable"] = "world"
+    parent: str = "world"
     number: int | None = None
     provenance: Provenance = field(default_factory=Provenance)
 
     def __post_init__(self) -> None:
         self.pose = single_pose(self.pose, "frame pose")
-        if self.parent not in ("world", "robot", "turntable"):
-            raise InputError(f"frame parent must be 'world', 'robot' or 'turntable', "
-                             f"got {self.parent!r}")
+        if self.parent not in ("world", "robot", "turntable") and not (
+                isinstance(self.parent, str) and NAME_RE.match(self.parent)):
+            raise InputError(f"frame parent must be 'world', 'robot', 'turntable' or the name of "
+                             f"a robot of the cell, got {self.parent!r}")
         _check_number(self.number, "frame number")
 
 
@@ -515,8 +517,8 @@ def check_name(name: Any, what: str) -> None:
     Parameters
     ----------
     name : str
-    what : {"tool", "frame"}
-        What the name is of, for the message (frames may not take the names of
+    what : {"tool", "frame", "robot"}
+        What the name is of, for the message (frames and robots may not take the names of
         :data:`~robotcell.cell.kinematics.RESERVED_FRAMES`).
 
     Raises
@@ -526,6 +528,100 @@ def check_name(name: Any, what: str) -> None:
     if not isinstance(name, str) or not NAME_RE.match(name):
         raise InputError(f"{what} name {name!r} is invalid: use a letter, then letters, digits "
                          "or '_', at most 24 characters")
-    if what == "frame" and name in RESERVED_FRAMES:
-        raise InputError(f"frame name {name!r} is reserved (reserved: "
+    if what in ("frame", "robot") and name in RESERVED_FRAMES:
+        raise InputError(f"{what} name {name!r} is reserved (reserved: "
                          f"{', '.join(sorted(RESERVED_FRAMES))})")
+
+
+def unique_numbers(numbers: dict[str, int | None], what: str) -> None:
+    """Refuse two items with the same controller number.
+
+    Parameters
+    ----------
+    numbers : dict of str to int or None
+        Controller number of each named item (None: numbered in order).
+    what : str
+        What the items are (``tool``, ``frame``), for the message.
+
+    Raises
+    ------
+    InputError
+        Naming the two items and their number.
+    """
+    seen: dict[int, str] = {}
+    for name, n in numbers.items():
+        if n is None:
+            continue
+        if n in seen:
+            raise InputError(f"{what}s {seen[n]!r} and {name!r} have the same number {n}")
+        seen[n] = name
+
+
+#: The name of the robot of a one-robot cell (a cell file with ``robot:``, not ``robots:``).
+DEFAULT_ROBOT = "robot"
+
+
+@dataclass
+class CellRobot:
+    """One robot of a cell: its arm, where it stands (a track or a fixed base), its tools.
+
+    A cell holds one or several (:attr:`robotcell.cell.Cell.robots`); each has its own
+    controller, so tool numbers are unique per robot.
+
+    Attributes
+    ----------
+    robot : Robot
+        The arm. Its default tool applies when FK gets no tool.
+    model : str
+        How the cell file names the arm: a library name, or a model file path.
+    T_world_R : ndarray, shape (4, 4)
+        Pose of the robot base in the world for a robot without track (metres).
+    track : Track or None
+        The linear track carrying this robot (it then places the robot).
+    tools : dict of str to Tool
+        This robot's tools (``T_F_TCP`` in its flange frame).
+    identified : IdentifiedArm or None
+        Set when ``robot`` is an identified arm (see :class:`robotcell.cell.Cell`).
+    base_provenance : Provenance
+        Where ``T_world_R`` comes from (``nominal``, or e.g. a robot-to-robot calibration).
+    """
+
+    robot: Robot
+    model: str
+    T_world_R: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    track: Track | None = None
+    tools: dict[str, Tool] = field(default_factory=dict)
+    identified: IdentifiedArm | None = None
+    base_provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.T_world_R = single_pose(self.T_world_R, "robot T_world_R")
+        if self.identified is not None:
+            check_identified(self.identified.nominal, self.robot)
+            if not np.array_equal(self.robot.tool, self.identified.nominal.tool):
+                self.robot = self.robot.with_tool(self.identified.nominal.tool)
+            if self.robot.ik_seed is None:  # a model from another tool: the nominal seeds its IK
+                self.robot = replace(self.robot, ik_seed=self.identified.nominal)
+        if self.track is not None and not np.allclose(self.T_world_R, np.eye(4), atol=0):
+            raise InputError("a robot on a track is placed by the track (track frame and "
+                             "robot_at_zero); do not give the robot a frame as well")
+        for name in self.tools:
+            check_name(name, "tool")
+        unique_numbers({k: t.number for k, t in self.tools.items()}, "tool")
+
+    @property
+    def nominal_robot(self) -> Robot:
+        """The model the controller computes with: the nominal of an identified arm, else ``robot``."""
+        return self.robot if self.identified is None else self.identified.nominal
+
+    def controller(self) -> CellRobot:
+        """This robot as its controller computes it: with the nominal arm."""
+        if self.identified is None:
+            return self
+        return replace(self, robot=self.identified.nominal, identified=None)
+
+    def T_world_R0(self) -> NDArray[np.float64]:
+        """Pose of the robot base in the world at track position 0 (metres), shape ``(4, 4)``."""
+        if self.track is None:
+            return self.T_world_R
+        return self.track.T_world_L @ self.track.T_L_R0

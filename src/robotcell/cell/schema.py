@@ -38,6 +38,8 @@ from numpy.typing import NDArray
 from robotcell.cell.history import keep_version
 from robotcell.cell.kinematics import CellModel
 from robotcell.cell.parts import (
+    DEFAULT_ROBOT,
+    CellRobot,
     Frame,
     IdentifiedArm,
     Positioner,
@@ -55,7 +57,8 @@ from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.yamlfile import parse_yaml, update_document, written_yaml
 from robotcell.robot.models import load_robot, robot_from_dict, robot_to_dict
 
-__all__ = ["CellRecord", "cell_fields", "cell_to_dict", "read_cell_file", "save_cell"]
+__all__ = ["CellRecord", "cell_fields", "cell_to_dict", "read_cell_file", "robots_fields",
+           "robots_to_dict", "save_cell"]
 
 
 class CellRecord(CellModel, Protocol):
@@ -78,6 +81,9 @@ class CellRecord(CellModel, Protocol):
 
     @property
     def name(self) -> str: ...
+
+    @property
+    def robots(self) -> dict[str, CellRobot]: ...
 
 _POSE_KEYS = ("x", "y", "z", "a", "b", "c")
 
@@ -362,6 +368,8 @@ def cell_fields(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> 
     if not isinstance(data, dict):
         raise InputError(f"{origin}: a cell file must be a YAML mapping with keys robot, tools, "
                          "frames, ...")
+    if "robots" in data:
+        return robots_fields(data, origin, base_dir)
     if "joints" in data and "robot" not in data:
         raise InputError(f"{origin}: this is a robot model file (it has 'joints'), not a cell "
                          "file; a cell file names it as robot: {model: FILE} (docs/cell.md)")
@@ -569,6 +577,8 @@ def cell_to_dict(cell: CellRecord, base_dir: str | Path = ".") -> dict[str, Any]
     -------
     dict
     """
+    if tuple(cell.robots) != (DEFAULT_ROBOT,):
+        return robots_to_dict(cell, base_dir)
     rob: dict[str, Any] = {"model": _relative(cell.robot_model, base_dir)}
     if not np.allclose(cell.T_world_R, np.eye(4), atol=0):
         rob["frame"] = _pose_dict(cell.T_world_R)
@@ -622,3 +632,154 @@ def cell_to_dict(cell: CellRecord, base_dir: str | Path = ".") -> dict[str, Any]
         frames[name] = entry
     data["frames"] = frames
     return data
+
+
+# -- a cell of several robots: the robots section -------------------------------------------------
+_ROBOT_KEYS = {"model", "frame", "identified", "provenance", "base_provenance", "track", "tools"}
+
+
+def robots_fields(data: dict, origin: str = "cell", base_dir: str | Path = ".") -> dict[str, Any]:
+    """The keyword arguments of :class:`~robotcell.cell.model.Cell` that a cell file with a
+    ``robots`` section gives: ``robots`` (name -> :class:`CellRobot`), ``turntable``, ``frames``
+    and ``name``.
+
+    Each robot's entry is read as the one-robot sections are (``robot`` keys, ``track``,
+    ``tools``), its messages prefixed by the robot's name; a frame's parent (and the turntable's
+    or positioner's, in a cell of one robot) may be a robot's name.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed YAML (millimetres, degrees).
+    origin : str
+        What to call the source in error messages (a file name).
+    base_dir : str or Path
+        Directory against which a relative robot model path is resolved.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    InputError
+        Naming ``origin``, the robot and the key at fault.
+    """
+    rd = _Reader(origin, base_dir)
+    top = rd.mapping(data, "", {"name", "robots", "turntable", "positioner", "frames"})
+    entries = rd.mapping(top["robots"], "robots", set(top["robots"] or {}))
+    if not entries:
+        raise rd.fail("robots", "must name at least one robot: {NAME: {model: ..., ...}}")
+    robots: dict[str, CellRobot] = {}
+    for name, entry in entries.items():
+        _named(rd, name, f"robots.{name}", "robot")
+        robots[name] = _robot_entry(rd, name, entry, base_dir)
+    names = list(robots)
+    shared = {k: v for k, v in top.items() if k != "robots"}
+    owner: dict[str, str] = {}
+    frames = rd.mapping(top.get("frames") or {}, "frames", set(top.get("frames") or {}))
+    shared["frames"] = {f: _placeholder_parent(rd, f"frames.{f}", fd, names, owner, f)
+                        for f, fd in frames.items()}
+    for key in ("turntable", "positioner"):
+        if top.get(key) is not None:
+            shared[key] = _placeholder_parent(rd, key, top[key], names[:1] if len(names) == 1
+                                              else [], {}, key)
+    shared["robot"] = {"model": entries[names[0]]["model"]}
+    fields = cell_fields(shared, origin, base_dir)
+    out = {"robots": robots, "frames": fields["frames"]}
+    for key in ("turntable", "name"):
+        if key in fields:
+            out[key] = fields[key]
+    for f, rname in owner.items():
+        out["frames"][f].parent = rname
+    return out
+
+
+def _robot_entry(rd: _Reader, name: str, entry: Any, base_dir: str | Path) -> CellRobot:
+    """One robot of the ``robots`` section, read as a one-robot cell's robot, track and tools."""
+    key = f"robots.{name}"
+    m = rd.mapping(entry, key, _ROBOT_KEYS, ("model",))
+    one = {"robot": {k: m[k] for k in ("model", "frame", "identified", "provenance") if k in m},
+           **{k: m[k] for k in ("track", "tools") if k in m}}
+    fields = cell_fields(one, f"{rd.origin}: robot {name!r}", base_dir)
+    prov = (rd.provenance(m["base_provenance"], f"{key}.base_provenance")
+            if "base_provenance" in m else Provenance())
+    try:
+        return CellRobot(robot=fields["robot"], model=fields["robot_model"],
+                         T_world_R=fields.get("T_world_R", np.eye(4)), track=fields.get("track"),
+                         tools=fields["tools"], identified=fields.get("identified"),
+                         base_provenance=prov)
+    except InputError as exc:
+        raise rd.fail(key, f"is invalid: {exc}") from None
+
+
+def _placeholder_parent(rd: _Reader, key: str, value: Any, names: list[str],
+                        owner: dict[str, str], item: str) -> Any:
+    """``value`` with a robot's name as ``parent`` read as the one-robot reader's ``robot``
+    (frames: ``world``, the robot noted in ``owner``); ``parent: robot`` is refused."""
+    if not isinstance(value, dict) or "parent" not in value:
+        return value
+    parent = value["parent"]
+    if parent == "robot":
+        raise rd.fail(f"{key}.parent", f"must name the robot in a cell with a robots section "
+                      f"({', '.join(names) or 'world only: the robots share it'}), got 'robot'")
+    frame = key.startswith("frames.")
+    if frame and parent not in (*names, "world", "turntable"):
+        raise rd.fail(f"{key}.parent", f"must be world, turntable or a robot of the cell "
+                      f"({', '.join(names)}), got {parent!r}")
+    if parent not in names:
+        return value
+    if frame:
+        owner[item] = parent
+        return {**value, "parent": "world"}
+    return {**value, "parent": "robot"}
+
+
+def robots_to_dict(cell: CellRecord, base_dir: str | Path = ".") -> dict[str, Any]:
+    """The content of a cell file with a ``robots`` section (millimetres, degrees).
+
+    Parameters
+    ----------
+    cell : CellRecord
+        A :class:`~robotcell.cell.model.Cell` (SI units).
+    base_dir : str or Path
+        Directory of the file to be written; a robot model path is written relative to it.
+
+    Returns
+    -------
+    dict
+    """
+    names = list(cell.robots)
+    robots: dict[str, Any] = {}
+    for name, unit in cell.robots.items():
+        one = cell_to_dict(_OneRobot(unit, None, {}, cell.name), base_dir)
+        entry = dict(one["robot"])
+        if _prov_dict(unit.base_provenance) != {"source": "nominal"}:
+            entry["base_provenance"] = _prov_dict(unit.base_provenance, base_dir)
+        if "track" in one:
+            entry["track"] = one["track"]
+        entry["tools"] = one["tools"]
+        robots[name] = entry
+    first = cell.robots[names[0]]
+    shared = cell_to_dict(_OneRobot(first, cell.turntable, cell.frames, cell.name), base_dir)
+    data: dict[str, Any] = {"name": cell.name, "robots": robots}
+    for key in ("turntable", "positioner"):
+        if key in shared:
+            data[key] = shared[key]
+            if data[key]["parent"] == "robot":
+                data[key]["parent"] = names[0]
+    data["frames"] = shared["frames"]
+    for entry in data["frames"].values():
+        if entry["parent"] == "robot":
+            entry["parent"] = names[0]
+    return data
+
+
+class _OneRobot:
+    """One robot of a cell with the shared parts, as :func:`cell_to_dict` reads a cell."""
+
+    def __init__(self, unit: CellRobot, turntable: Any, frames: dict[str, Frame], name: str):
+        self.robots = {DEFAULT_ROBOT: unit}
+        self.robot_model, self.T_world_R, self.identified = unit.model, unit.T_world_R, unit.identified
+        self.robot, self.track, self.tools = unit.robot, unit.track, unit.tools
+        self.turntable, self.frames, self.name = turntable, frames, name

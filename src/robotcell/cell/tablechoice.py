@@ -300,7 +300,8 @@ def _smoothed(values: NDArray[np.float64], cut: NDArray[np.bool_], grid: float
 
 def choose_table(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None = None,
                  tool: str | ArrayLike | None = None, max_step: float = MAX_STEP,
-                 samples: int = TABLE_SAMPLES, normal_tol: float = NORMAL_TOL) -> TableChoice:
+                 samples: int = TABLE_SAMPLES, normal_tol: float = NORMAL_TOL,
+                 robot: str | None = None) -> TableChoice:
     """Table values along a path in a frame the table carries, for one continuous motion.
 
     See the module docstring for the candidates, the costs and the dynamic programme.
@@ -323,6 +324,9 @@ def choose_table(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None =
         Candidate values per turn of a table axis (>= 4).
     normal_tol : float
         A 2-axis positioner: largest angle between a target's normal and straight up (rad).
+    robot : str, optional
+        The robot of the cell that follows the path (None: the only robot;
+        :meth:`Cell.for_robot <robotcell.cell.Cell.for_robot>`).
 
     Returns
     -------
@@ -334,6 +338,7 @@ def choose_table(cell: Cell, T: ArrayLike, frame: str, track: ArrayLike | None =
         A frame the table does not carry, a positioner of 3 axes, bad targets, ``track``,
         ``max_step``, ``samples`` or ``normal_tol``.
     """
+    cell = cell.for_robot(robot)
     if not carried_by_table(cell, frame):
         raise InputError(f"frame {frame!r} is not carried by the turntable: the table values do "
                          "not move its targets; give them")

@@ -36,6 +36,7 @@ from robotcell.cell.update import update_cell_file
 from robotcell.cli import load_command
 from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, Group, refuse_overwriting_inputs
+from robotcell.cli.robotname import robot_name_option, robot_of
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.robot.models import load_robot
@@ -159,6 +160,7 @@ def _keep_nominal(ctx: click.Context, param: click.Parameter, value: str | None)
 def cell_option(func: Callable) -> Callable:
     """Options ``--cell CELL.yaml`` and ``--nominal-accuracy`` of the subcommands that can
     update a cell file."""
+    func = robot_name_option(func)
     func = click.option(
         "--nominal-accuracy", default=None, metavar="MM,DEG[,SCALE]", expose_value=False,
         callback=_keep_nominal,
@@ -203,16 +205,21 @@ class CellTarget:
 
     path: str
     cell: Cell
+    robot: str | None = None
 
     @classmethod
     def open(cls, path: str | None, robot: str | None) -> CellTarget | None:
-        """Load ``--cell`` (None without it), refusing ``--robot`` next to it."""
+        """Load ``--cell`` (None without it), refusing ``--robot`` next to it; in a cell of
+        several robots, as the robot of ``--robot-name`` sees it (its result is written under
+        that robot)."""
         if path is None:
             return None
         if robot is not None:
             raise InputError(f"--robot and --cell both give the robot model: with --cell the "
                              f"robot is the cell's (robot.model in {path}); drop --robot")
-        return cls(path, Cell.load(path))
+        cell = Cell.load(path)
+        name = robot_of(cell, path)
+        return cls(path, cell.for_robot(name), name)
 
     def tool(self, text: str) -> str | NDArray[np.float64]:
         """``--tool``: the name of a tool of the cell (its uncertainty goes with it), or
@@ -243,12 +250,18 @@ class CellTarget:
         -------
         The value of the change that was written.
         """
-        done = update_cell_file(self.path, change, on_note=echo_note)
+        name = self.robot
+
+        def change_robot(cell: Cell) -> tuple[Cell | None, T]:
+            new, value = change(cell.for_robot(name))  # this robot's view of the file as it is
+            return (None if new is None else cell.with_view(new, name)), value
+
+        done = update_cell_file(self.path, change_robot, on_note=echo_note)
         if done.cell is not None:
             what, notes = said(done.value)
             for note in notes:
                 echo_note(note)
-            self.cell = done.cell
+            self.cell = done.cell.for_robot(name)
             kept = f" (previous version: {done.backup})" if done.backup is not None else ""
             click.echo(f"updated {self.path}: {what}{kept}", err=True)
         return done.value

@@ -7,6 +7,7 @@ import click
 from robotcell.cell import Cell
 from robotcell.cli.common import check_kind, check_output, write_output
 from robotcell.cli.files import OUTPUT, Command, LiveChoice, refuse_overwriting_inputs
+from robotcell.cli.robotname import robot_name_option, robot_of
 from robotcell.export import (
     URDF,
     export_cell,
@@ -19,6 +20,7 @@ from robotcell.export import (
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
               help="Cell file (YAML, mm/deg).")
 @click.option("--format", "fmt", required=True, type=LiveChoice(write_formats),
@@ -47,7 +49,9 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     """
     check_kind(output, "URDF" if fmt == URDF else "text", f"the {fmt} export",
                named=other_kinds(fmt), ending=output_ending(fmt))
-    cell = Cell.load(cell_path)
+    cell = Cell.load(cell_path)  # the URDF holds every robot, a controller's export its own
+    if fmt != URDF:
+        cell = cell.for_robot(robot_of(cell, cell_path))
     if output is None:
         write_output(None, export_cell(cell, fmt))
         return

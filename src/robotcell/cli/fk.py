@@ -8,7 +8,6 @@ import sys
 import click
 import numpy as np
 
-from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     batch_outside,
     batch_table,
@@ -32,6 +31,7 @@ from robotcell.cli.common import (
     write_csv,
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import outside_limits
@@ -55,6 +55,7 @@ def tool_option(text: str | None) -> np.ndarray | None:
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--joints", "joints", help="Joint values a1,a2,... (deg; mm for prismatic joints).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV with columns a1..an, one pose per row.")
@@ -170,7 +171,7 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
              fmt: str, tool: str | None, frame: str, track_mm: float | None,
              table_deg: str | None) -> None:
     """``robotcell fk --cell``: :meth:`Cell.fk` for one configuration or a batch (mm, deg)."""
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     r = cell.robot
     T_tool = cell_tool(tool)
     if (joints is None) == (input_path is None):

@@ -11,7 +11,6 @@ from typing import Any, TextIO
 import click
 import numpy as np
 
-from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
     batch_outside,
@@ -42,6 +41,7 @@ from robotcell.cli.common import (
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.controllers.base import IkFlags
 from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
@@ -79,6 +79,7 @@ def _write(out: TextIO, header: list[str], rows: list[list[object]]) -> None:
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.argument("robot", required=False, type=NAME_OR_FILE)
 @click.option("--pose", "pose", help="Target TCP pose in the robot base frame, in --format (mm, deg).")
 @click.option("--input", "input_path", type=click.Path(), help="CSV of poses, columns named as in --format.")
@@ -298,7 +299,7 @@ def _cell_flag_columns(robot: Robot, method: str, fmt: str, q: np.ndarray
 
 def _ik_cell(a: _IkArgs) -> None:
     """``robotcell ik --cell``: :meth:`Cell.ik` for one pose or a batch (mm, deg)."""
-    cell = Cell.load(a.cell_path)
+    cell = load_cell(a.cell_path)
     r = cell.robot
     if (a.pose is None) == (a.input_path is None):
         raise InputError("give exactly one of --pose ... or --input poses.csv")

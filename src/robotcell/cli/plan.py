@@ -9,9 +9,9 @@ from typing import Any
 
 import click
 
-from robotcell.cell import Cell
 from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
+from robotcell.cli.robotname import load_cell
 from robotcell.cli.simulate import (
     ProcedureChoice,
     calibrate_hint,
@@ -99,7 +99,7 @@ def plan(procedure: str, cell_path: str, noise: float, runs: int, output: str | 
     if not 0 < noise <= NOISE_MAX_MM:
         raise InputError(f"--noise must be a positive number of millimetres, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     common = common_keywords(procedure, given["tool"], given["frame"], given["track_mm"])
     common.update(design_keywords(procedure, {"touches": given["touches"],
                                               "repeats": given["repeats"]}))

@@ -22,6 +22,7 @@ from robotcell.cli.common import (
     parse_numbers,
 )
 from robotcell.cli.files import Group, LiveChoice, OutputPath
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.controllers.registry import names
 
 #: Library parameters as the command line names them.
@@ -34,6 +35,7 @@ def _ppd(text: str | None) -> list[float] | None:
 
 
 def _cell_option(f: Callable) -> Callable:
+    f = robot_name_option(f)
     return click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
                         help="Cell file (YAML, mm/deg).")(f)
 
@@ -104,7 +106,7 @@ def write_cmd(path: str, cell_path: str, tool: str, frame: str, vendor: str, fol
     """
     from robotcell.programs import PathBreaks, ProgramOptions, write_program
 
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     with as_flags(FLAGS):
         try:
             result = write_program(path, cell, tool, frame, vendor, folder, name,
@@ -188,7 +190,7 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, singular_margi
     from robotcell.clearance import read_bodies
     from robotcell.programs.check import check_program_file
 
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     bodies = read_bodies(bodies_path) if bodies_path else None
     with as_flags(FLAGS), _collector_paused():
         report = check_program_file(program_file, cell, _ppd(ppd),
@@ -302,7 +304,7 @@ def compensate_cmd(program_file: str, cell_path: str, folder: str, joints: str,
     from robotcell.report.accuracy import write_program_report
 
     check_kind(report, "HTML", "the accuracy report", "--report")
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     with as_flags(FLAGS):
         try:
             result = compensate_program(program_file, cell, folder, joints, _ppd(ppd),

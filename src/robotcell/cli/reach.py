@@ -32,6 +32,7 @@ from robotcell.cli.common import (
 )
 from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS
 from robotcell.io.tables import require_columns
@@ -93,6 +94,7 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.argument("targets", type=click.Path(dir_okay=False))
 @target_options
 @click.option("--track", "track_mm", type=float, default=None,
@@ -125,7 +127,7 @@ def reach(targets: str, cell_path: str, frame: str, tool: str | None, fmt: str,
     if html_path is None and output:
         html_path = str(Path(output).with_suffix(".html"))
         refuse_overwriting_inputs(click.get_current_context(), [("the map written next to -o", html_path)])
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     T, th, track, axes = load_targets(targets, cell, fmt, table_deg, choose_table, track_mm)
     click.echo(setup_text(cell, tool, frame, axes, ""), err=True)
     with ExitStack() as stack:

@@ -15,9 +15,9 @@ from typing import Any
 import click
 import numpy as np
 
-from robotcell.cell import Cell
 from robotcell.cli.common import NOISE_MAX_MM, output_of, parse_numbers
 from robotcell.cli.files import OUTPUT, Command
+from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM
 from robotcell.studies.simulate import PROCEDURES, Touches
@@ -101,7 +101,7 @@ def cell_options(func: Callable) -> Callable:
     ]
     for opt in reversed(opts):
         func = opt(func)
-    return func
+    return robot_name_option(func)
 
 
 def design_options(func: Callable) -> Callable:
@@ -234,7 +234,7 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
     if not 0 <= noise <= NOISE_MAX_MM:
         raise InputError(f"--noise must be a number of millimetres >= 0, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     kw = common_keywords(procedure, tool, frame, track_mm)
     kw.update(design_keywords(procedure, design))
     t = simulate_touches(cell, procedure, noise=noise * 1e-3, seed=seed, **kw)

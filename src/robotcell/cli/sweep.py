@@ -16,6 +16,7 @@ from robotcell.cli.common import format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.reach import load_targets, target_options
+from robotcell.cli.robotname import robot_name_option, robot_of
 from robotcell.errors import InputError
 from robotcell.studies.sweep import read_layouts, sweep
 
@@ -68,6 +69,7 @@ class _Targets:
 
 
 @click.command(cls=Command)
+@robot_name_option
 @target_options
 @click.option("--targets", "targets", required=True, type=click.Path(dir_okay=False),
               help="CSV of target poses (columns of --format; optional 'table' in deg, a "
@@ -99,7 +101,9 @@ def sweep_cmd(targets: str, layouts_path: str, workers: int | None, scheduler: s
       robotcell sweep --cell c.yaml --targets t.csv --layouts l.yaml --scheduler tcp://head:8786
     """
     at = _Targets(**where)
-    cell = Cell.load(at.cell_path)
+    full = Cell.load(at.cell_path)  # a layout may move several robots; one reaches
+    name = robot_of(full, at.cell_path)
+    cell = full.for_robot(name)
     T, th, _, axes = load_targets(targets, cell, at.fmt, at.table_deg, at.choose_table,
                                   track_column=False)
     click.echo(setup_text(cell, at.tool, at.frame,
@@ -108,8 +112,9 @@ def sweep_cmd(targets: str, layouts_path: str, workers: int | None, scheduler: s
     layouts = read_layouts(layouts_path)
     with ExitStack() as stack:
         ex = _executor(stack, workers, scheduler)
-        ranked = sweep(cell, T, layouts, frame=at.frame, tool=at.tool, table=th, executor=ex,
-                       progress=DeferredProgress(stack, "layouts"), output=output)
+        ranked = sweep(full, T, layouts, frame=at.frame, tool=at.tool, table=th, executor=ex,
+                       progress=DeferredProgress(stack, "layouts"), output=output,
+                       robot=name)
     shown = ranked[:max(top, 0)]
     rows_out = [[rank + 1, r.layout.label, f"{100 * r.fraction:.1f}", f"{r.mean_score:.3f}",
                  f"{r.min_score:.3f}"] for rank, r in enumerate(shown)]

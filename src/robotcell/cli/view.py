@@ -12,6 +12,7 @@ from robotcell.cli.cellargs import cell_tool, table_angles, table_option, track_
 from robotcell.cli.common import output_of, parse_numbers
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
+from robotcell.cli.robotname import load_cell, robot_name, robot_name_option, robot_of
 from robotcell.errors import InputError
 from robotcell.robot.robot import Robot
 from robotcell.view.cellscene import write_cell_view
@@ -34,6 +35,7 @@ def joint_option(robot: Robot, text: str | None) -> np.ndarray | None:
 
 
 @click.command(cls=Command)
+@robot_name_option
 @click.argument("cell_path", metavar="CELL.yaml", type=click.Path(dir_okay=False))
 @click.option("--joints", default=None, metavar="A1,A2,...",
               help="Arm axis values (deg; mm for a prismatic axis); default the robot model's "
@@ -88,7 +90,7 @@ def view(cell_path: str, joints: str | None, track_mm: float | None, table_deg: 
         if given:
             raise InputError(f"--program draws the arm at the program's points: leave out "
                              f"{', '.join(given)}")
-        cell = Cell.load(cell_path)
+        cell = load_cell(cell_path)
         pulses = None if ppd is None else parse_numbers(ppd, "--pulses-per-degree")
         try:
             made = write_program_view(cell, program_path, output, pulses)
@@ -102,9 +104,16 @@ def view(cell_path: str, joints: str | None, track_mm: float | None, table_deg: 
                    f"{made.size / 1e6:.1f} MB; open it in a browser", err=True)
         return
     cell = Cell.load(cell_path)
-    q = joint_option(cell.robot, joints)
-    e = float(track_values(cell, track_mm or 0.0))
-    th = table_angles(cell, table_option(cell, table_deg))
-    path = write_cell_view(cell, output, q, e, th, reach_path, cell_tool(tool))
+    every = len(cell.robots) > 1 and robot_name() is None and (joints, track_mm, reach_path) == (
+        None, None, None)  # every robot at home: a robot's values need its name
+    one = cell.for_robot(cell.robot_names[0] if every else robot_of(cell, cell_path))
+    q = joint_option(one.robot, joints)
+    e = float(track_values(one, track_mm or 0.0))
+    th = table_angles(one, table_option(one, table_deg))
+    if len(cell.robots) == 1 or reach_path is not None:  # a reach map: the robot that reaches
+        path = write_cell_view(one, output, q, e, th, reach_path, cell_tool(tool))
+    else:
+        path = write_cell_view(cell, output, None if every else {one.robot_name: q},
+                               {} if every else {one.robot_name: e}, th)
     click.echo(f"{path}: 3D view of {cell.name}, {path.stat().st_size / 1e6:.1f} MB; open it "
                "in a browser", err=True)

@@ -216,9 +216,10 @@ def cell_ur_kinematics(cell: Cell) -> URKinematics | None:
     """The calibration file of a cell whose identified arm is a UR-type arm, else None.
 
     An arm identified with axis scales gets the file of its geometry without them, and the
-    warning of :func:`scale_left_out`.
+    warning of :func:`scale_left_out`. A cell of several robots gets none (the UR description
+    describes one arm).
     """
-    if cell.identified is None or not is_ur_arm(cell.robot):
+    if len(cell.robots) > 1 or cell.identified is None or not is_ur_arm(cell.robot):
         return None
     left_out = scale_left_out(cell.robot)
     text = ur_kinematics(replace(cell.robot, coupling=None))

@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.cell import Cell, Turntable
+from robotcell.cell import Cell, CellRobot, Turntable
 from robotcell.cell.axischain import axis_frames
 from robotcell.errors import InputError
 from robotcell.robot.robot import Robot
@@ -253,6 +253,11 @@ def _mapping_comments(robot: Robot, names: list[str],
 def export(cell: Cell) -> str:
     """URDF text of ``cell`` (metres, radians; see the module docstring for the tree).
 
+    A cell of several robots writes every robot, each with its track and tools, its links and
+    joints prefixed by its name (``kuka_base_link``, ``kuka_A1``, ``kuka_track_axis``,
+    ``kuka_tool_torch``), beside the shared turntable or positioner and frames; a frame fixed
+    to a robot hangs from that robot's ``<name>_base_link``.
+
     Parameters
     ----------
     cell : Cell
@@ -264,22 +269,9 @@ def export(cell: Cell) -> str:
     """
     root = ET.Element("robot", name=cell.name)
     _link(root, "world")
-    _link(root, "base_link")
-    if cell.track is not None:
-        t = cell.track
-        _link(root, "track")
-        _joint(root, "track_frame", "fixed", "world", "track", t.T_world_L)
-        T_L_J = np.eye(4)  # the joint frame: at the robot base at position 0, Z along the motion
-        T_L_J[:3, :3] = _Z_TO[t.axis]
-        T_L_J[:3, 3] = t.T_L_R0[:3, 3]
-        _link(root, "track_carriage")
-        _joint(root, "track_axis", "prismatic", "track", "track_carriage", T_L_J,
-               np.array([0.0, 0.0, 1.0]), t.lower * t.scale, t.upper * t.scale)
-        _joint(root, "robot_on_track", "fixed", "track_carriage", "base_link",
-               np.linalg.solve(T_L_J, t.T_L_R0))
-    else:
-        _joint(root, "robot_frame", "fixed", "world", "base_link", cell.T_world_R)
-    chain_elements(root, cell.robot, "base_link", "", "flange")
+    prefix = {n: "" if len(cell.robots) == 1 else f"{n}_" for n in cell.robots}
+    for name, unit in cell.robots.items():
+        _robot_elements(root, unit, prefix[name])
     if cell.turntable is not None:
         b = cell.turntable
         _link(root, "turntable_root")
@@ -289,13 +281,39 @@ def export(cell: Cell) -> str:
                  else [f"turntable_axis_{i + 1}" for i in range(b.n_axes)])
         chain_elements(root, b.chain.with_base(np.eye(4)), "turntable_root", "turntable_",
                        "turntable", names)
-    for name, tool in cell.tools.items():
-        _link(root, f"tool_{name}")
-        _joint(root, f"tool_{name}_fixed", "fixed", "flange", f"tool_{name}", tool.T_F_TCP)
-    parents = {"world": "world", "robot": "base_link", "turntable": "turntable"}
+    for name, unit in cell.robots.items():
+        p = prefix[name]
+        for tname, tool in unit.tools.items():
+            _link(root, f"{p}tool_{tname}")
+            _joint(root, f"{p}tool_{tname}_fixed", "fixed", f"{p}flange", f"{p}tool_{tname}",
+                   tool.T_F_TCP)
+    parents = {"world": "world", "robot": "base_link", "turntable": "turntable",
+               **{n: f"{p}base_link" for n, p in prefix.items()}}
     for name, fr in cell.frames.items():
         _link(root, f"frame_{name}")
         _joint(root, f"frame_{name}_fixed", "fixed", parents[fr.parent], f"frame_{name}",
                fr.pose)
     ET.indent(root)
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _robot_elements(root: ET.Element, unit: CellRobot, p: str) -> None:
+    """A robot's base link, its track or fixed base, and its arm, names prefixed by ``p``."""
+    _link(root, f"{p}base_link")
+    if unit.track is not None:
+        t = unit.track
+        _link(root, f"{p}track")
+        _joint(root, f"{p}track_frame", "fixed", "world", f"{p}track", t.T_world_L)
+        T_L_J = np.eye(4)  # the joint frame: at the robot base at position 0, Z along the motion
+        T_L_J[:3, :3] = _Z_TO[t.axis]
+        T_L_J[:3, 3] = t.T_L_R0[:3, 3]
+        _link(root, f"{p}track_carriage")
+        _joint(root, f"{p}track_axis", "prismatic", f"{p}track", f"{p}track_carriage", T_L_J,
+               np.array([0.0, 0.0, 1.0]), t.lower * t.scale, t.upper * t.scale)
+        _joint(root, f"{p}robot_on_track", "fixed", f"{p}track_carriage", f"{p}base_link",
+               np.linalg.solve(T_L_J, t.T_L_R0))
+    else:
+        _joint(root, f"{p}robot_frame", "fixed", "world", f"{p}base_link", unit.T_world_R)
+    names = None if not p else [f"{p}{j.name or f'joint_{i + 1}'}"
+                                for i, j in enumerate(unit.robot.joints)]
+    chain_elements(root, unit.robot, f"{p}base_link", p, f"{p}flange", names)

@@ -141,7 +141,8 @@ def _table_grid(cell: Cell, samples: int) -> NDArray[np.float64]:
 def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayLike | None = None,
               table: ArrayLike | None = 0.0, track: ArrayLike | None = None,
               table_samples: int = 36,
-              progress: Callable[[int, int], None] | None = None) -> ReachMap:
+              progress: Callable[[int, int], None] | None = None,
+              robot: str | None = None) -> ReachMap:
     """Score every target: reachable or not, axis values, limit margin, manipulability.
 
     Parameters
@@ -164,11 +165,15 @@ def reach_map(cell: Cell, T: ArrayLike, frame: str = "world", tool: str | ArrayL
     progress : callable, optional
         With it, the targets are solved in blocks of :data:`BLOCK` and ``progress(done, total)``
         is called after each.
+    robot : str, optional
+        The robot of the cell that reaches (None: the only robot;
+        :meth:`Cell.for_robot <robotcell.cell.Cell.for_robot>`).
 
     Returns
     -------
     ReachMap
     """
+    cell = cell.for_robot(robot)
     arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
     if progress is not None:
         n = arr.shape[0]

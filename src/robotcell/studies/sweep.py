@@ -13,8 +13,9 @@ file's placement; the sweep takes every combination (the Cartesian product)::
       z: [0, 50]
 
 Components: ``robot``, ``track`` (the same as ``robot`` in a cell with a track), ``turntable``
-or the name of a frame of the cell. ``x, y, z`` move the component along the axes of its parent
-frame; ``a, b, c`` turn it about its own origin by ``Rz(a) Ry(b) Rx(c)`` in its own frame.
+or the name of a frame of the cell; in a cell of several robots, each robot by its name (a
+layout can place several robots; one of them, ``robot=``, is scored). ``x, y, z`` move the
+component along the axes of its parent frame; ``a, b, c`` turn it about its own origin by ``Rz(a) Ry(b) Rx(c)`` in its own frame.
 
 Each layout is scored by :func:`robotcell.studies.reach.reach_map` on the same targets: the fraction of
 reachable targets, the mean score (0 for an unreachable target) and the smallest score. Layouts
@@ -205,6 +206,10 @@ def _moved(T: NDArray[np.float64], off: tuple[float, ...]) -> NDArray[np.float64
 def apply_layout(cell: Cell, layout: Layout) -> Cell:
     """A copy of ``cell`` with its components moved by ``layout`` (the input is unchanged).
 
+    A component is ``robot`` (or ``track``) in a one-robot cell, a robot's name in a cell of
+    several robots (each robot named moves: its track, or its base without one), ``turntable``,
+    or a frame of the cell.
+
     Raises
     ------
     InputError
@@ -212,11 +217,10 @@ def apply_layout(cell: Cell, layout: Layout) -> Cell:
     """
     new = copy.copy(cell)
     new.frames = dict(cell.frames)
+    one = len(cell.robots) == 1
     for comp, off in layout.offsets.items():
-        if comp in ("robot", "track") and cell.track is not None:
-            new.track = replace(new.track, T_world_L=_moved(new.track.T_world_L, off))
-        elif comp == "robot":
-            new.T_world_R = _moved(new.T_world_R, off)
+        if comp in cell.robots or (one and comp in ("robot", "track")):
+            _move_robot(new, comp if comp in cell.robots else cell.robot_name, off)
         elif comp == "turntable" and cell.turntable is not None:
             tt = new.turntable
             if hasattr(tt, "T_parent_B"):
@@ -227,17 +231,29 @@ def apply_layout(cell: Cell, layout: Layout) -> Cell:
             fr = new.frames[comp]
             new.frames[comp] = replace(fr, pose=_moved(fr.pose, off))
         else:
-            known = ["robot"] + (["track"] if cell.track else []) + (
-                ["turntable"] if cell.turntable else []) + sorted(cell.frames)
+            robots = (["robot"] + (["track"] if cell.track else [])) if one else list(cell.robots)
+            known = robots + (["turntable"] if cell.turntable else []) + sorted(cell.frames)
             raise InputError(f"the layout moves {comp!r}, which the cell does not have; it has: "
                              f"{', '.join(known)}")
     return new
 
 
+def _move_robot(cell: Cell, name: str, off: tuple[float, ...]) -> None:
+    """Move robot ``name`` of ``cell`` by ``off``: its whole track, or its base without one."""
+    unit = cell.robots[name]
+    if unit.track is not None:
+        unit = replace(unit, track=replace(unit.track, T_world_L=_moved(unit.track.T_world_L, off)))
+    else:
+        unit = replace(unit, T_world_R=_moved(unit.T_world_R, off))
+    cell.robots = {**cell.robots, name: unit}
+
+
 def evaluate_layout(cell: Cell, layout: Layout, index: int, T: NDArray[np.float64], frame: str,
-                    tool: str | ArrayLike | None, table: ArrayLike | None) -> LayoutScore:
+                    tool: str | ArrayLike | None, table: ArrayLike | None,
+                    robot: str | None = None) -> LayoutScore:
     """Score one layout on the targets (a pure function: the unit of work of :func:`sweep`)."""
-    rm = reach_map(apply_layout(cell, layout), T, frame=frame, tool=tool, table=table)
+    rm = reach_map(apply_layout(cell, layout), T, frame=frame, tool=tool, table=table,
+                   robot=robot)
     score = rm.score
     return LayoutScore(index, layout, rm.fraction, float(np.mean(score)) if score.size else 0.0,
                        float(np.min(score)) if score.size else 0.0)
@@ -247,7 +263,7 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
           tool: str | ArrayLike | None = None, table: ArrayLike | None = 0.0,
           executor: Executor | None = None,
           progress: Callable[[int, int], None] | None = None,
-          output: str | Path | None = None) -> list[LayoutScore]:
+          output: str | Path | None = None, robot: str | None = None) -> list[LayoutScore]:
     """Score every layout on the targets and rank them, best first.
 
     Parameters
@@ -267,6 +283,9 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
         Called as ``progress(done, total)`` after each finished layout.
     output : str or Path, optional
         Also write the ranking as CSV, atomically (:func:`ranking_columns`).
+    robot : str, optional
+        The robot of the cell that reaches the targets (None: the only robot); a layout may
+        move several robots of the cell.
 
     Returns
     -------
@@ -275,17 +294,18 @@ def sweep(cell: Cell, T: ArrayLike, layouts: list[Layout], frame: str = "world",
     """
     arr = np.asarray(T, dtype=float).reshape(-1, 4, 4)
     table = None if table is None else np.asarray(table, dtype=float)
+    cell.for_robot(robot)  # refuse an unknown robot before sending work anywhere
     if layouts:  # refuse a component the cell lacks before sending work anywhere
         apply_layout(cell, layouts[0])
     total = len(layouts)
     results: list[LayoutScore] = []
     if executor is None:
         for i, lay in enumerate(layouts):
-            results.append(evaluate_layout(cell, lay, i, arr, frame, tool, table))
+            results.append(evaluate_layout(cell, lay, i, arr, frame, tool, table, robot))
             if progress:
                 progress(i + 1, total)
     else:
-        futures = [executor.submit(evaluate_layout, cell, lay, i, arr, frame, tool, table)
+        futures = [executor.submit(evaluate_layout, cell, lay, i, arr, frame, tool, table, robot)
                    for i, lay in enumerate(layouts)]
         for done, fut in enumerate(as_completed(futures), start=1):
             results.append(fut.result())

@@ -14,6 +14,8 @@ kinematics, :mod:`robotcell.cell.kinematics`):
   plate P as a disk through the frames it carries (the cell file has no plate size: the disk
   reaches 100 mm past the farthest of them, and is at least twice the frame size across);
 - every frame of the cell (``Cell.frame_pose``);
+- in a cell of several robots (:func:`robots_scene`), every robot with its track and tools, its
+  items named after it, beside the shared turntable or positioner and frames;
 - optionally, a reachability map (:mod:`robotcell.view.reach`).
 
 Hover texts give each frame's pose in the world, and tools and frames also their pose as the
@@ -23,6 +25,8 @@ Rx(c)``).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -44,7 +48,7 @@ if TYPE_CHECKING:
     import plotly.graph_objects as go
 
 __all__ = ["axes_text", "cell_figure", "cell_items", "cell_scene", "degrees", "fixed_items",
-           "frame_size", "joint_values", "write_cell_view"]
+           "frame_size", "joint_values", "robot_items", "robots_scene", "write_cell_view"]
 
 #: Margin of the drawn plate beyond the farthest frame it carries (m).
 PLATE_MARGIN = 0.1
@@ -129,10 +133,21 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
         The robot base R, the arm, the tools, the turntable or positioner and the cell's frames
         (the track's frame L, the world axes and the fixed geometry are not among them).
     """
+    return (robot_items(cell, q, track, size, detail, with_tools, triads)
+            + _work_items(cell, track, table, size, detail, triads))
+
+
+def robot_items(cell: Cell, q: NDArray[np.float64], track: float, size: float,
+                detail: bool = True, with_tools: bool = True, triads: bool = True,
+                label: str = "") -> list[Item]:
+    """The robot of a one-robot cell (a view, :meth:`Cell.for_robot`) at one configuration:
+    its base R, arm and tools; see :func:`cell_items` for the parameters. ``label`` goes before
+    every name (``"kuka: "`` in a cell of several robots)."""
     T_world_R = robot_pose(cell, track)
-    items: list[Item] = [Triads("robot R", T_world_R, ["robot R"], length=size,
-                                hover=[_hover("robot base R", T_world_R)])] if triads else []
-    arm = chain_items(cell.robot, q, T_world_R, name=f"robot {cell.robot.name}",
+    items: list[Item] = [Triads(f"{label}robot R", T_world_R, [f"{label}robot R"], length=size,
+                                hover=[_hover(f"{label}robot base R", T_world_R)])
+                         ] if triads else []
+    arm = chain_items(cell.robot, q, T_world_R, name=f"{label}robot {cell.robot.name}",
                       axis_length=0.6 * size, frame_length=0.5 * size, detail=detail)
     items += arm if triads else arm[:-1]
     T_world_F = arm[-1].poses[0]
@@ -143,10 +158,19 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
     if poses:
         body = np.vstack([np.stack([T_world_F[:3, 3], T[:3, 3], np.full(3, np.nan)])
                           for T in poses])
-        items.append(Lines("tools: flange to TCP", body, color="gray", width=3.0, dash="dash"))
-    items += _triads("tools", poses, list(tools), [
-        _hover(f"tool {name}", T, "T_F_TCP (cell file)", tools[name])
+        items.append(Lines(f"{label}tools: flange to TCP", body, color="gray", width=3.0,
+                           dash="dash"))
+    items += _triads(f"{label}tools", poses, list(tools), [
+        _hover(f"{label}tool {name}", T, "T_F_TCP (cell file)", tools[name])
         for name, T in zip(tools, poses)], size)
+    return items
+
+
+def _work_items(cell: Cell, track: float, table: ArrayLike, size: float, detail: bool,
+                triads: bool, frames: list[str] | None = None) -> list[Item]:
+    """The turntable or positioner and the frames (``frames``: the names drawn, default all)."""
+    items: list[Item] = []
+    T_world_R = robot_pose(cell, track)
     pos = cell.turntable
     if pos is not None:
         kind = "positioner" if isinstance(pos, Positioner) else "turntable"
@@ -167,12 +191,14 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
         radius = max([size, *(float(np.linalg.norm(p)) + PLATE_MARGIN for p in carried)])
         items.append(disk(f"{kind} {pos.name}: plate", T_world_P, radius,
                           hover=f"plate of {pos.name} (drawn radius {radius * 1e3:.0f} mm)"))
-    names = list(cell.frames)
+    names = list(cell.frames) if frames is None else frames
     poses = [cell.frame_pose(n, track, table) for n in names]
     items += _triads("frames", poses, names, [
         _hover(f"frame {n}", T, f"in {cell.frames[n].parent} (cell file)", cell.frames[n].pose)
         for n, T in zip(names, poses)], size)
     return items
+
+
 
 
 def fixed_items(cell: Cell, size: float) -> list[Item]:
@@ -200,6 +226,8 @@ def cell_scene(cell: Cell, joints: ArrayLike | None = None, track: float = 0.0,
     Parameters
     ----------
     cell : Cell
+        A cell of several robots is drawn by :func:`robots_scene` (``joints`` and ``track``
+        then map robot names to their values).
     joints : array_like, shape (n,), optional
         Arm axis values (rad; m for a prismatic axis); default the robot model's home
         configuration, else all zero. Values outside the limits are drawn, and named in a note.
@@ -223,6 +251,11 @@ def cell_scene(cell: Cell, joints: ArrayLike | None = None, track: float = 0.0,
         Joints of the wrong number, NaN, more than one track position, a track or table the
         cell does not have.
     """
+    if len(cell.robots) > 1:
+        if reach is not None:
+            raise InputError("a reach map is drawn in the view of the robot that reaches: give "
+                             "cell.for_robot(name)")
+        return robots_scene(cell, joints, track, table)  # type: ignore[arg-type]
     q = joint_values(cell.robot, joints)
     e_arr = finite_array(track, "track")
     if e_arr.ndim:
@@ -249,6 +282,64 @@ def cell_scene(cell: Cell, joints: ArrayLike | None = None, track: float = 0.0,
         notes.append("reach map: each reachable target at its TCP in the world"
                      + (f"; {missing} unreachable target(s) not drawn (no axis values)"
                         if missing else ""))
+    return Scene(f"{cell.name}: {'; '.join(state)}", items, notes)
+
+
+def robots_scene(cell: Cell, joints: Mapping[str, ArrayLike] | None = None,
+                 track: Mapping[str, float] | None = None, table: ArrayLike = 0.0) -> Scene:
+    """The scene of a cell of several robots: every robot with its track and tools, the shared
+    turntable or positioner and the frames, in the world (m).
+
+    Parameters
+    ----------
+    cell : Cell
+    joints : mapping of str to array_like of shape (n,), optional
+        Axis values of robots by name (rad; m for a prismatic axis); a robot not named is drawn
+        at its model's home configuration, else all zero.
+    track : mapping of str to float, optional
+        Track positions of robots by name (m); 0 for a robot not named.
+    table : array_like, shape () or (k,)
+        Table angle (rad), or one value per positioner axis; 0 without one.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    InputError
+        A robot name the cell lacks, joints of the wrong number, a track position for a robot
+        without a track.
+    """
+    joints, track = dict(joints or {}), dict(track or {})
+    for name in [*joints, *track]:
+        cell.robot_key(name)
+    views = {name: cell.for_robot(name) for name in cell.robot_names}
+    size = max(frame_size(v.robot) for v in views.values())
+    th = cell.turntable.axis_values(table) if cell.turntable is not None else table
+    items: list[Item] = [Triads("world", np.eye(4), ["world"], length=2 * size)]
+    state, notes = [], [("lengths in mm; hover over a frame for its pose (x, y, z mm; a, b, c "
+                         "deg, R = Rz(a) Ry(b) Rx(c)); click a legend entry to hide or show it")]
+    for name, view in views.items():
+        q = joint_values(view.robot, joints.get(name))
+        e = float(finite_array(track.get(name, 0.0), "track"))
+        view.frame_pose("robot", e, th)  # refuses a track the robot does not have
+        items += [replace(it, name=f"{name}: {it.name}") for it in fixed_items(view, size)[1:]]
+        items += robot_items(view, q, e, size, label=f"{name}: ")
+        mine = [f for f, fr in view.frames.items() if fr.parent == "robot"]  # on its base
+        items += [replace(it, name=f"{name}: {it.name}") for it in _work_items(
+            replace(view, turntable=None, frames={f: view.frames[f] for f in mine}), e, 0.0, size,
+            True, True)]
+        state.append(f"{name} axes {axes_text(view.robot, q)}"
+                     + (f", track {e * 1e3:g} mm" if view.track is not None else ""))
+        outside = [j.name or f"A{i + 1}" for i, (j, v) in enumerate(zip(view.robot.axes, q))
+                   if not j.lower <= v <= j.upper]
+        if outside:
+            notes.append(f"{name}: outside their limits: {', '.join(outside)}")
+    shared = [f for f, fr in cell.frames.items() if fr.parent in ("world", "turntable")]
+    items += _work_items(views[cell.robot_names[0]], 0.0, th, size, True, True, shared)
+    if cell.turntable is not None:
+        state.append(f"table {degrees(th)} deg")
     return Scene(f"{cell.name}: {'; '.join(state)}", items, notes)
 
 
