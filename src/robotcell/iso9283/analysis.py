@@ -19,6 +19,7 @@ from scipy.spatial import cKDTree
 
 from robotcell.calibration.fitting import kabsch
 from robotcell.errors import IllPosedError, InputError
+from robotcell.kinematics.arm import Arm
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.iso9283.cube import POSE_NAMES
 from robotcell.iso9283.cycles import MIN_CYCLES, PATH_CYCLES, POSE_CYCLES
@@ -34,7 +35,7 @@ from robotcell.iso9283.figures import (
 from robotcell.iso9283.log import Log, read_log
 from robotcell.iso9283.planfile import read_plan
 from robotcell.iso9283.testplan import TestPlan
-from robotcell.iso9283.verdict import Limits, Verdict, judge
+from robotcell.iso9283.verdict import Limits, Verdict, datasheet_limits, judge
 
 __all__ = ["DRIFT_CYCLES", "MAX_OFFSET", "DistanceResult", "Iso9283Result", "PathResult",
            "PoseResult", "analyse", "fit_device_frame"]
@@ -290,7 +291,8 @@ def _path_results(log: Log, plan: TestPlan) -> list[PathResult]:
 
 
 def analyse(measurements: str | Path | Log, plan: str | Path | TestPlan,
-            device_frame: bool = False, limits: Limits | None = None) -> Iso9283Result:
+            device_frame: bool = False, limits: Limits | None = None,
+            robot: Arm | None = None) -> Iso9283Result:
     """Evaluate an ISO 9283 test: the figures of every pose, distance and path, and a verdict.
 
     Parameters
@@ -304,6 +306,9 @@ def analyse(measurements: str | Path | Log, plan: str | Path | TestPlan,
         (:func:`fit_device_frame`).
     limits : Limits, optional
         Limits of AP, RP, AT, RT for the verdict (m); none: the verdict says so.
+    robot : Arm, optional
+        The arm tested: where ``limits`` has no RP and its model carries the datasheet's pose
+        repeatability, that is the limit of RP (a note says so).
 
     Returns
     -------
@@ -333,8 +338,8 @@ def analyse(measurements: str | Path | Log, plan: str | Path | TestPlan,
     _check_offsets(log, plan, device_frame)
     poses = _pose_results(log, plan)
     paths = _path_results(log, plan)
-    limits = limits or Limits()
-    notes = _notes(poses, paths, log, device_frame)
+    limits, datasheet = datasheet_limits(limits or Limits(), robot)
+    notes = _notes(poses, paths, log, device_frame) + ([datasheet] if datasheet else [])
     figures = {"AP": [(r.figures.AP_p, r.pose) for r in poses],
                "RP": [(r.figures.RP_l, r.pose) for r in poses],
                "AT": [(r.figures.AT_p, r.path) for r in paths],
