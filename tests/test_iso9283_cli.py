@@ -50,7 +50,9 @@ def test_analyse_prints_the_documented_json(made, capsys, tmp_path):
     assert {d["from"] for d in data["distances"]} == {"P1"}
     assert [p["path"] for p in data["paths"]] == ["line", "circle"]
     for p in data["paths"]:
-        assert set(p) == {"path", "cycles", "points", "AT_p_mm", "AT_at", "RT_p_mm", "RT_at"}
+        assert set(p) == {"path", "cycles", "points", "AT_p_mm", "AT_at", "RT_p_mm", "RT_at",
+                          "AT_a_deg", "AT_b_deg", "AT_c_deg"}
+        assert p["AT_a_deg"] is not None and abs(p["AT_c_deg"]) < 0.01
         assert p["cycles"] == 10 and p["AT_p_mm"] < 0.05
     assert data["verdict"]["level"] == "pass" and len(data["verdict"]["reasons"]) == 2
     assert data["limits"] == {"AP_mm": 0.5, "RP_mm": 0.2, "AT_mm": None, "RT_mm": None}

@@ -28,8 +28,10 @@ from robotcell.iso9283.figures import (
     PoseFigures,
     crossings,
     distance_figures,
+    nearest_samples,
     orientation_figures,
     path_figures,
+    path_orientation_figures,
     pose_figures,
 )
 from robotcell.iso9283.log import Log, read_log
@@ -91,13 +93,15 @@ class DistanceResult:
 
 @dataclass
 class PathResult:
-    """The figures of one path: its command points and :class:`PathFigures` (m)."""
+    """The figures of one path: its command points and :class:`PathFigures` (m); ``AT_abc``
+    the orientation path accuracy about x, y, z (rad), when the log has orientations."""
 
     path: str
     cycles: int
     names: list[str]
     command: NDArray[np.float64]
     figures: PathFigures
+    AT_abc: NDArray[np.float64] | None = None
 
 
 @dataclass
@@ -176,9 +180,12 @@ def _pose_json(r: PoseResult) -> dict[str, Any]:
 
 def _path_json(r: PathResult) -> dict[str, Any]:
     f = r.figures
-    return {"path": r.path, "cycles": r.cycles, "points": len(r.names),
-            "AT_p_mm": f.AT_p * 1e3, "AT_at": r.names[int(np.argmax(f.deviation))],
-            "RT_p_mm": f.RT_p * 1e3, "RT_at": r.names[int(np.argmax(f.repeatability))]}
+    out = {"path": r.path, "cycles": r.cycles, "points": len(r.names),
+           "AT_p_mm": f.AT_p * 1e3, "AT_at": r.names[int(np.argmax(f.deviation))],
+           "RT_p_mm": f.RT_p * 1e3, "RT_at": r.names[int(np.argmax(f.repeatability))]}
+    for k, axis in enumerate("abc"):
+        out[f"AT_{axis}_deg"] = None if r.AT_abc is None else float(np.degrees(r.AT_abc[k]))
+    return out
 
 
 def fit_device_frame(log: Log, plan: TestPlan) -> tuple[NDArray[np.float64], float]:
@@ -278,15 +285,20 @@ def _path_results(log: Log, plan: TestPlan) -> list[PathResult]:
         if cycles.size == 0:
             continue
         c = T[:, :3, 3]
-        x = []
+        x, R = [], []
         for k in cycles:
             rows = idx[log.cycle[idx] == k]
             if len(rows) < 2:
                 raise InputError(f"{log.source}: line {log.line[rows[0]]}: {path} of cycle {k} "
                                  "has one sample; a path needs its samples along it")
             x.append(crossings(log.p[rows], c))
+            if log.R is not None:
+                R.append(log.R[rows[nearest_samples(log.p[rows], x[-1])]])
         names = [f"{path}_{i + 1}" for i in range(len(c))]
-        out.append(PathResult(path, int(cycles.size), names, c, path_figures(np.array(x), c)))
+        result = PathResult(path, int(cycles.size), names, c, path_figures(np.array(x), c))
+        if R:
+            result.AT_abc = path_orientation_figures(np.array(R), T[:, :3, :3])[1]
+        out.append(result)
     return out
 
 
