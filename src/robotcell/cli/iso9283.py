@@ -171,10 +171,12 @@ def analyse_cmd(measurements: str, plan_path: str, cell_path: str | None, device
     from robotcell.iso9283 import Limits, analyse
 
     cell = None if cell_path is None else Cell.load(cell_path)
+    # the datasheet belongs to the robot's nominal model (an identified arm's is its nominal)
+    robot = None if cell is None else (cell.identified.nominal if cell.identified else cell.robot)
     with as_flags(FLAGS):
         result = analyse(measurements, plan_path, device_frame, Limits(
             **{k[-2:].upper(): None if v is None else v * 1e-3 for k, v in limits.items()}),
-            None if cell is None else (cell.identified.nominal if cell.identified else cell.robot))
+            robot)
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     if output is not None:

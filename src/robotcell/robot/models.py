@@ -128,7 +128,8 @@ def _repeatability(value: Any, origin: str) -> tuple[float, str]:
     (mm) and where it is stated; returns metres and the citation."""
     where = f"{origin}: key 'repeatability'"
     entry = _mapping(value, where, {"mm", "source"},
-                     f"{where} must be a mapping {{mm: RP, source: the datasheet}}", ("mm", "source"))
+                     f"{where} must be a mapping {{mm: RP, source: the datasheet}}",
+                     ("mm", "source"))
     rp = _number(entry["mm"], f"{where}: key 'mm'")
     if not 0 < rp <= 10:
         raise InputError(f"{where}: key 'mm' must be a repeatability from 0 to 10 mm, got {rp:g}")
