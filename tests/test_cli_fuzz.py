@@ -3,7 +3,8 @@
 Every case starts from valid inputs of one command (calibrate tcp, frame, external-tcp, track,
 turntable, workpiece, positioner, also into a cell; fk, ik, also --cell; export, also URDF;
 report; cell show, cell history; identify, also --propose; reach; sweep; simulate; plan; dh
-from-urdf, dh convert; robots show; demo; view, also --reach and --program) and applies one or
+from-urdf, dh convert; robots show; demo; view, also --reach and --program; iso9283 plan and
+analyse, simulate iso9283, whose logs also get the faults of a tracker's log) and applies one or
 two seeded mutations to a file (measurement CSV, cell YAML and its backups, report JSON, URDF,
 robot model YAML, layouts YAML, reach CSV, KUKA, ABB and FANUC programs: truncation, wrong types, huge
 values, NaN, other encodings, swapped or misspelt columns, empty files, binary junk, European
@@ -814,6 +815,165 @@ CASES.update({"cell-refit": (3, 30), "cell-lock": (3, 30), "cell-link": (3, 30)}
 BUILDERS.update({"cell-refit": _cell_refit, "cell-lock": _cell_lock, "cell-link": _cell_link})
 
 
+# -- the ISO 9283 test: plan, analyse, simulate --------------------------------------------------
+def _mutate_log(text: str, rng: np.random.Generator) -> tuple[bytes | str, str]:
+    """A mutation of a measurement log: one a log of ISO 9283 can have (a pose the plan lacks,
+    too few cycles, one value in metres, a NaN, a column missing), else a CSV mutation."""
+    rows = _split(text)
+    head = rows[0]
+    i = int(rng.integers(1, len(rows)))
+    kind = str(rng.choice(["unknown-pose", "few-cycles", "metres-value", "nan", "no-column",
+                           "csv", "csv", "csv"]))
+    if kind == "unknown-pose":
+        rows[i][head.index("pose")] = str(rng.choice(["P6", "p1", "", "line_3", "arc"]))
+    elif kind == "few-cycles":
+        rows = [head, *(r for r in rows[1:] if r[0] in ("1", "2", "3"))]
+    elif kind == "metres-value":
+        j = head.index(str(rng.choice(["x", "y", "z"])))
+        rows[i][j] = repr(float(rows[i][j]) / 1e3)
+    elif kind == "nan":
+        rows[i][int(rng.integers(0, len(head)))] = "nan"
+    elif kind == "no-column":
+        j = head.index(str(rng.choice(["cycle", "pose", "x", "a"])))
+        rows = [r[:j] + r[j + 1:] for r in rows]
+    else:
+        return mutate_csv(text, rng)
+    return _join(rows), kind
+
+
+#: Options of ``iso9283 analyse`` mutated (limits without -o: a FAIL writes its report).
+ISO_LIMITS = {"--limit-ap": BAD_FLOATS + ["0.001", "5"], "--limit-rp": BAD_FLOATS + ["5"],
+              "--limit-at": BAD_FLOATS, "--limit-rt": BAD_FLOATS}
+
+
+def _iso_analyse(rng, d, good, out):
+    """iso9283 analyse: the log (mostly) or the plan mutated; a limit, or the report written."""
+    meas, plan = d / "meas.csv", d / "plan.csv"
+    shutil.copy(good["iso_plan.csv"], plan)
+    if rng.random() < 0.8:
+        content, what = _mutate_log(good["iso_meas.csv"].read_text(), rng)
+        _write(meas, content)
+        what = f"meas.csv: {what}"
+    else:
+        shutil.copy(good["iso_meas.csv"], meas)
+        plan, what = _mutated(good["iso_plan.csv"].read_text(), rng, d, "plan.csv")
+    opts = _maybe(rng, 0.3, ISO_LIMITS) + (["--device-frame"] if rng.random() < 0.1 else [])
+    report = d / "report.html"
+    output = [] if any(o.startswith("--limit") for o in opts) else ["-o", report]
+    json_flag = ["--json"] if rng.random() < 0.5 else []
+    return (["iso9283", "analyse", meas, "--plan", plan, *json_flag, *opts, *output],
+            f"{what} {' '.join(opts)}", [meas, plan], [report] if output else [])
+
+
+def _iso_plan(rng, d, good, out):
+    """iso9283 plan of a 400 mm cube (fast), the cell or an option mutated, sometimes with the
+    KUKA programs."""
+    cell, what = _cell_for("iso9283-plan", rng, d)
+    opts = _maybe(rng, 0.7, {"--size": BAD_FLOATS + ["5000", "1"], "--centre": BAD_LISTS,
+                             "--orientation": BAD_LISTS, "--track": BAD_FLOATS + ["7000"],
+                             "--table": BAD_LISTS, "--cycles": ["-1", "0", "abc", "1e300"],
+                             "--path-cycles": ["-1", "abc"], "--speed": BAD_FLOATS,
+                             "--frame": ["nosuch", "part"], "--tool": ["nosuch", ""]})
+    size = [] if "--size" in opts else ["--size", "400"]
+    tool = [] if "--tool" in opts else ["--tool", "torch"]
+    plan_out = d / "plan_out.csv"
+    progs = ["--programs", d / "prog", "--format", "kuka"] if rng.random() < 0.3 else []
+    return (["iso9283", "plan", "--cell", cell, *tool, *size, *opts, "-o", plan_out, *progs],
+            f"{what} {' '.join(opts)}", [cell], [plan_out, d / "prog"])
+
+
+def _simulate_iso(rng, d, good, out):
+    """simulate iso9283: the true cell or the plan mutated, or an option."""
+    cell, what = _cell_for("simulate-iso9283", rng, d)
+    plan = d / "plan.csv"
+    if rng.random() < 0.3:
+        plan, w = _mutated(good["iso_plan.csv"].read_text(), rng, d, "plan.csv")
+        what = f"{what}; {w}"
+    else:
+        shutil.copy(good["iso_plan.csv"], plan)
+    opts = _maybe(rng, 0.6, {"--noise": BAD_FLOATS, "--angle-noise": BAD_FLOATS,
+                             "--cycles": ["-1", "0", "9", "abc", "100000"],
+                             "--path-cycles": ["-1", "5", "abc"], "--spacing": BAD_FLOATS,
+                             "--seed": ["-1", "abc", "1.5"]})
+    log = d / "meas_out.csv"
+    return (["simulate", "iso9283", "--cell", cell, "--plan", plan, "--spacing", "10", *opts,
+             "-o", log], f"{what} {' '.join(opts)}", [cell, plan], [log])
+
+
+CASES.update({"iso9283-analyse": (6, 80), "iso9283-plan": (2, 20), "simulate-iso9283": (3, 30)})
+BUILDERS.update({"iso9283-analyse": _iso_analyse, "iso9283-plan": _iso_plan,
+                 "simulate-iso9283": _simulate_iso})
+
+
+
+def _edit_rows(text: str, edit) -> str:
+    return _join(edit(_split(text)))
+
+
+def _set(rows: list[list[str]], i: int, column: str, value: str) -> list[list[str]]:
+    rows[i][rows[0].index(column)] = value
+    return rows
+
+
+#: Bad inputs of the ISO 9283 commands, each refused with exit status 2 on one 'error:' line
+#: naming the file (and the line where there is one), nothing written: (the command's
+#: arguments after the files, the file edited, its edit, what the message says).
+ISO_BAD = {
+    "log NaN": ("analyse", "meas", lambda t: _edit_rows(t, lambda r: _set(r, 4, "y", "nan")),
+                r"meas\.csv: line 5: column 'y' is NaN"),
+    "log missing column": ("analyse", "meas",
+                           lambda t: _edit_rows(t, lambda r: [c[:2] + c[3:] for c in r]),
+                           r"meas\.csv: missing column\(s\) x"),
+    "log pose not in plan": ("analyse", "meas",
+                             lambda t: _edit_rows(t, lambda r: _set(r, 7, "pose", "P6")),
+                             r"meas\.csv: line 8: pose 'P6' is not in the plan"),
+    "log too few cycles": ("analyse", "meas",
+                           lambda t: _edit_rows(t, lambda r: [r[0], *(c for c in r[1:]
+                                                                      if c[0] in "1234")]),
+                           r"meas\.csv: P\d has 4 cycles \(its last on line \d+\)"),
+    "log mixed units": ("analyse", "meas",
+                        lambda t: _edit_rows(t, lambda r: _set(r, 9, "x",
+                                                               repr(float(r[9][2]) / 1e3))),
+                        r"meas\.csv: line 10: P\d lies [0-9.]+ mm from the median.*mixed units"),
+    "log binary garbage": ("analyse", "meas",
+                           lambda t: bytes(np.random.default_rng(5).integers(0, 256, 300,
+                                                                              dtype=np.uint8)),
+                           r"meas\.csv: "),
+    "log empty": ("analyse", "meas", lambda t: "",
+                  r"meas\.csv: needs a header line and at least one data line"),
+    "plan NaN (analyse)": ("analyse", "plan",
+                           lambda t: _edit_rows(t, lambda r: _set(r, 2, "x", "nan")),
+                           r"plan\.csv: line 3: column 'x' has 'nan'"),
+    "plan pose twice (simulate)": ("simulate", "plan",
+                                   lambda t: _edit_rows(t, lambda r: _set(r, 3, "pose", "P2")),
+                                   r"plan\.csv: line 4: pose 'P2' is named twice"),
+    "plan empty (simulate)": ("simulate", "plan", lambda t: "",
+                              r"plan\.csv: needs a header line"),
+}
+
+
+@pytest.mark.parametrize("case", list(ISO_BAD))
+def test_cli_fuzz_iso9283_bad_inputs_exit_2_naming_the_line(case, good, tmp_path, capsys,
+                                                           monkeypatch):
+    command, which, edit, message = ISO_BAD[case]
+    monkeypatch.chdir(tmp_path)
+    files = {"meas": tmp_path / "meas.csv", "plan": tmp_path / "plan.csv"}
+    shutil.copy(good["iso_meas.csv"], files["meas"])
+    shutil.copy(good["iso_plan.csv"], files["plan"])
+    _write(files[which], edit(files[which].read_text()))
+    shutil.copy(EXAMPLE, tmp_path / "truth.yaml")
+    before = _files(tmp_path)
+    args = (["iso9283", "analyse", files["meas"], "--plan", files["plan"], "--json", "-o",
+             tmp_path / "report.html"] if command == "analyse" else
+            ["simulate", "iso9283", "--cell", tmp_path / "truth.yaml", "--plan", files["plan"],
+             "-o", tmp_path / "log.csv"])
+    code, out, err = run(capsys, *args)
+    assert code == 2, err
+    assert err.startswith("error: ") and len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in out + err and re.search(message, err), err
+    assert out == "" and _files(tmp_path) == before
+
+
 def _write(path: Path, content: bytes | str) -> Path:
     if isinstance(content, str):
         path.write_bytes(content.encode("utf-8", errors="surrogatepass"))
@@ -857,6 +1017,14 @@ def good(tmp_path_factory) -> dict[str, Path]:
     simulate(Cell.load(POSITIONER), "positioner", seed=SEED, tool="pointer").write_csv(
         d / "positioner.csv")
     save_robot(load_robot("kuka_kr16"), d / "model.yaml")
+    from robotcell.iso9283 import plan as iso_plan
+    from robotcell.iso9283 import simulate as iso_simulate
+    from robotcell.iso9283 import write_log, write_plan
+
+    iso = iso_plan(cell, "torch", size=0.4)
+    write_plan(iso, d / "iso_plan.csv")
+    write_log(iso_simulate(cell, iso, cycles=10, path_cycles=10, spacing=0.01, seed=SEED),
+              d / "iso_meas.csv")
     from robotcell.cli import main
     from robotcell.programs import write_program
 

@@ -134,6 +134,15 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
     assert m and float(m.group(1)) > 0.5 and float(m.group(2)) < 0.05, out[-600:]
     assert Cell.load(tmp_path / "accuracy" / "cell.yaml").identified.provenance.source == "identify"
     assert (tmp_path / "accuracy" / "commanded.csv").is_file()
+    # it ends with the acceptance test: the nominal cell fails, the calibrated one passes
+    assert re.search(r"nominal cell: verdict: FAIL: AP_p [0-9.]+ mm \(P\d\) > 0.5 mm", out)
+    m = re.search(r"calibrated cell: verdict: PASS: AP_p ([0-9.]+) mm", out)
+    assert m and float(m.group(1)) < 0.3, out[-900:]
+    assert "iso9283.html: the acceptance report" in out.rstrip().splitlines()[-3]
+    for name in ("plan.csv", "nominal.csv", "calibrated.csv", "kuka/ISOPOSES.src",
+                 "kuka/ISOPATHS.src"):
+        assert (tmp_path / "iso9283" / name).is_file(), name
+    assert "verdict: PASS" in (tmp_path / "iso9283.html").read_text(encoding="utf-8")
     truth, nominal = demo_cells()
     cell = Cell.load(tmp_path / "cell.yaml")
     # The 3D view shows the calibrated cell: the torch 50 mm above the part's origin.

@@ -50,7 +50,9 @@ def test_analyse_prints_the_documented_json(made, capsys, tmp_path):
     assert {d["from"] for d in data["distances"]} == {"P1"}
     assert [p["path"] for p in data["paths"]] == ["line", "circle"]
     for p in data["paths"]:
-        assert set(p) == {"path", "cycles", "points", "AT_p_mm", "AT_at", "RT_p_mm", "RT_at"}
+        assert set(p) == {"path", "cycles", "points", "AT_p_mm", "AT_at", "RT_p_mm", "RT_at",
+                          "AT_a_deg", "AT_b_deg", "AT_c_deg"}
+        assert p["AT_a_deg"] is not None and abs(p["AT_c_deg"]) < 0.01
         assert p["cycles"] == 10 and p["AT_p_mm"] < 0.05
     assert data["verdict"]["level"] == "pass" and len(data["verdict"]["reasons"]) == 2
     assert data["limits"] == {"AP_mm": 0.5, "RP_mm": 0.2, "AT_mm": None, "RT_mm": None}
@@ -217,3 +219,63 @@ def test_an_identified_arm_compensates_the_real_arm_that_the_nominal_misses():
     assert max(r.figures.AP_p for r in missed.poses) > 0.3e-3
     assert kept.verdict.level == "pass"
     assert max(r.figures.AP_p for r in kept.poses) < 0.03e-3
+
+
+def _model_with_repeatability(folder: Path, block: str) -> Path:
+    """The library's KR 16 model file with ``block`` appended, in ``folder``."""
+    text = (ROOT / "src" / "robotcell" / "robots" / "kuka_kr16.yaml").read_text(encoding="utf-8")
+    path = folder / "kr16_sheet.yaml"
+    path.write_text(text + block, encoding="utf-8")
+    return path
+
+
+SHEET = "repeatability: {mm: 0.04, source: 'Datasheet KR 16, example.com/kr16.pdf'}\n"
+
+
+def test_the_datasheet_repeatability_is_the_default_limit_of_rp(made, capsys, tmp_path):
+    model = _model_with_repeatability(tmp_path, SHEET)
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(TRACK_CELL.read_text(encoding="utf-8").replace(
+        "  model: kuka_kr16", f"  model: {model.name}"), encoding="utf-8")
+    code, out, err = run(capsys, "iso9283", "analyse", made / "meas.csv", "--plan",
+                         made / "plan.csv", "--cell", cell, "--json")
+    data = json.loads(out)
+    assert data["limits"]["RP_mm"] == pytest.approx(0.04)
+    assert any("limit of RP_l 0.04 mm: the pose repeatability of the KUKA KR 16-2 datasheet "
+               "(Datasheet KR 16, example.com/kr16.pdf)" in n for n in data["notes"])
+    assert code == (3 if data["verdict"]["level"] == "fail" else 0)
+    # a limit given wins; without --cell there is no default
+    code, out, _ = run(capsys, "iso9283", "analyse", made / "meas.csv", "--plan",
+                       made / "plan.csv", "--cell", cell, "--limit-rp", "0.5", "--json")
+    data = json.loads(out)
+    assert code == 0 and data["limits"]["RP_mm"] == 0.5
+    assert not any("datasheet" in n for n in data["notes"])
+    code, out, _ = run(capsys, "iso9283", "analyse", made / "meas.csv", "--plan",
+                       made / "plan.csv", "--json")
+    assert code == 0 and json.loads(out)["limits"]["RP_mm"] is None
+
+
+@pytest.mark.parametrize("block, message", [
+    ("repeatability: 0.04\n", "key 'repeatability' must be a mapping"),
+    ("repeatability: {mm: 0.04}\n", "key 'repeatability': missing key 'source'"),
+    ("repeatability: {mm: -1, source: x}\n", "key 'mm' must be a repeatability from 0 to 10 mm"),
+    ("repeatability: {mm: 0.04, source: ''}\n", "key 'source' must name the datasheet"),
+    ("repeatability: {mm: 0.04, source: x, accuracy: 1}\n", "unknown key\\(s\\) \\['accuracy'\\]"),
+])
+def test_a_repeatability_without_its_datasheet_is_refused(tmp_path, block, message):
+    from robotcell.errors import InputError
+    from robotcell.robot.models import load_robot
+
+    with pytest.raises(InputError, match=message):
+        load_robot(_model_with_repeatability(tmp_path, block))
+
+
+def test_the_datasheet_repeatability_survives_a_model_file_round_trip(tmp_path):
+    from robotcell.robot.models import load_robot, save_robot
+
+    robot = load_robot(_model_with_repeatability(tmp_path, SHEET))
+    assert robot.repeatability == pytest.approx(4e-5)
+    save_robot(robot, tmp_path / "again.yaml")
+    again = load_robot(tmp_path / "again.yaml")
+    assert again.repeatability == robot.repeatability
+    assert again.repeatability_source == "Datasheet KR 16, example.com/kr16.pdf"

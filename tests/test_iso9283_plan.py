@@ -154,3 +154,8 @@ def test_a_refused_plan_writes_nothing(tmp_path, capsys, monkeypatch):
     assert code == 2 and "pulses" in err and "Traceback" not in err
     assert not Path("plan.csv").exists() and not Path("iso").exists()
     assert [p.name for p in tmp_path.iterdir()] == []
+
+
+def test_a_plan_without_a_table_value_is_refused():
+    with pytest.raises(InputError, match="no table value given: give the turntable's angle"):
+        plan(Cell.load(TRACK_CELL), "torch", size=0.4, table=[])

@@ -133,14 +133,16 @@ def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs
 @click.option("--plan", "plan_path", required=True, type=click.Path(dir_okay=False),
               help="The plan file the log measured.")
 @click.option("--cell", "cell_path", default=None, type=click.Path(dir_okay=False),
-              help="The cell file: the report then draws the cube in the cell.")
+              help="The cell file: the report then draws the cube in the cell; its robot's "
+                   "datasheet repeatability, if its model has one, is the default --limit-rp.")
 @click.option("--device-frame", is_flag=True,
               help="The log is in the tracker's own frame: fit it onto the plan's frame from "
                    "the barycentres of P1..P5 first.")
 @click.option("--limit-ap", type=float, default=None, callback=_positive, metavar="MM",
               help="Largest acceptable pose accuracy AP_p.")
 @click.option("--limit-rp", type=float, default=None, callback=_positive, metavar="MM",
-              help="Largest acceptable pose repeatability RP_l.")
+              help="Largest acceptable pose repeatability RP_l (default with --cell: the "
+                   "datasheet's, where the robot's model file states it).")
 @click.option("--limit-at", type=float, default=None, callback=_positive, metavar="MM",
               help="Largest acceptable path accuracy AT_p.")
 @click.option("--limit-rt", type=float, default=None, callback=_positive, metavar="MM",
@@ -169,9 +171,12 @@ def analyse_cmd(measurements: str, plan_path: str, cell_path: str | None, device
     from robotcell.iso9283 import Limits, analyse
 
     cell = None if cell_path is None else Cell.load(cell_path)
+    # the datasheet belongs to the robot's nominal model (an identified arm's is its nominal)
+    robot = None if cell is None else (cell.identified.nominal if cell.identified else cell.robot)
     with as_flags(FLAGS):
         result = analyse(measurements, plan_path, device_frame, Limits(
-            **{k[-2:].upper(): None if v is None else v * 1e-3 for k, v in limits.items()}))
+            **{k[-2:].upper(): None if v is None else v * 1e-3 for k, v in limits.items()}),
+            robot)
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     if output is not None:

@@ -21,7 +21,10 @@ from its layout position, a workpiece clamped off its nominal place. The demo
    the arm at each of its points (``program.html``, as ``robotcell view --program`` does).
 7. identifies a virtual arm that is not quite its drawing from simulated laser-tracker data and
    filters a path through it (:mod:`robotcell.demo.accuracy`), printing how far the real
-   arm misses the path without filtering and with it.
+   arm misses the path without filtering and with it;
+8. plans the ISO 9283 acceptance test in the calibrated cell, simulates the tracker's log with
+   the controller computing in the nominal and in the calibrated cell, and prints both verdicts
+   (:mod:`robotcell.demo.acceptance`; the report ``iso9283.html``).
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ from numpy.typing import NDArray
 from robotcell.cell import Cell, Provenance
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.history import backups
+from robotcell.demo.acceptance import acceptance_step
 from robotcell.demo.accuracy import accuracy_step
 from robotcell.errors import InputError, RobotcellError
 from robotcell.export import EXPORT_FORMATS, export_cell
@@ -187,6 +191,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     echo(_comparison_table(comparisons))
     _write_outputs(out, calibrated, results, echo)
     accuracy_step(out, seed, echo)
+    acceptance_step(out, truth, nominal, calibrated, seed, echo)
     echo(f"\ndone in {time.perf_counter() - t_start:.1f} s; everything is in {out}/")
     return comparisons
 

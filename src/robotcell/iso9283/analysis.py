@@ -19,6 +19,7 @@ from scipy.spatial import cKDTree
 
 from robotcell.calibration.fitting import kabsch
 from robotcell.errors import IllPosedError, InputError
+from robotcell.kinematics.arm import Arm
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.iso9283.cube import POSE_NAMES
 from robotcell.iso9283.cycles import MIN_CYCLES, PATH_CYCLES, POSE_CYCLES
@@ -27,14 +28,16 @@ from robotcell.iso9283.figures import (
     PoseFigures,
     crossings,
     distance_figures,
+    nearest_samples,
     orientation_figures,
     path_figures,
+    path_orientation_figures,
     pose_figures,
 )
 from robotcell.iso9283.log import Log, read_log
 from robotcell.iso9283.planfile import read_plan
 from robotcell.iso9283.testplan import TestPlan
-from robotcell.iso9283.verdict import Limits, Verdict, judge
+from robotcell.iso9283.verdict import Limits, Verdict, datasheet_limits, judge
 
 __all__ = ["DRIFT_CYCLES", "MAX_OFFSET", "DistanceResult", "Iso9283Result", "PathResult",
            "PoseResult", "analyse", "fit_device_frame"]
@@ -90,13 +93,15 @@ class DistanceResult:
 
 @dataclass
 class PathResult:
-    """The figures of one path: its command points and :class:`PathFigures` (m)."""
+    """The figures of one path: its command points and :class:`PathFigures` (m); ``AT_abc``
+    the orientation path accuracy about x, y, z (rad), when the log has orientations."""
 
     path: str
     cycles: int
     names: list[str]
     command: NDArray[np.float64]
     figures: PathFigures
+    AT_abc: NDArray[np.float64] | None = None
 
 
 @dataclass
@@ -175,9 +180,12 @@ def _pose_json(r: PoseResult) -> dict[str, Any]:
 
 def _path_json(r: PathResult) -> dict[str, Any]:
     f = r.figures
-    return {"path": r.path, "cycles": r.cycles, "points": len(r.names),
-            "AT_p_mm": f.AT_p * 1e3, "AT_at": r.names[int(np.argmax(f.deviation))],
-            "RT_p_mm": f.RT_p * 1e3, "RT_at": r.names[int(np.argmax(f.repeatability))]}
+    out = {"path": r.path, "cycles": r.cycles, "points": len(r.names),
+           "AT_p_mm": f.AT_p * 1e3, "AT_at": r.names[int(np.argmax(f.deviation))],
+           "RT_p_mm": f.RT_p * 1e3, "RT_at": r.names[int(np.argmax(f.repeatability))]}
+    for k, axis in enumerate("abc"):
+        out[f"AT_{axis}_deg"] = None if r.AT_abc is None else float(np.degrees(r.AT_abc[k]))
+    return out
 
 
 def fit_device_frame(log: Log, plan: TestPlan) -> tuple[NDArray[np.float64], float]:
@@ -277,20 +285,26 @@ def _path_results(log: Log, plan: TestPlan) -> list[PathResult]:
         if cycles.size == 0:
             continue
         c = T[:, :3, 3]
-        x = []
+        x, R = [], []
         for k in cycles:
             rows = idx[log.cycle[idx] == k]
             if len(rows) < 2:
                 raise InputError(f"{log.source}: line {log.line[rows[0]]}: {path} of cycle {k} "
                                  "has one sample; a path needs its samples along it")
             x.append(crossings(log.p[rows], c))
+            if log.R is not None:
+                R.append(log.R[rows[nearest_samples(log.p[rows], x[-1])]])
         names = [f"{path}_{i + 1}" for i in range(len(c))]
-        out.append(PathResult(path, int(cycles.size), names, c, path_figures(np.array(x), c)))
+        result = PathResult(path, int(cycles.size), names, c, path_figures(np.array(x), c))
+        if R:
+            result.AT_abc = path_orientation_figures(np.array(R), T[:, :3, :3])[1]
+        out.append(result)
     return out
 
 
 def analyse(measurements: str | Path | Log, plan: str | Path | TestPlan,
-            device_frame: bool = False, limits: Limits | None = None) -> Iso9283Result:
+            device_frame: bool = False, limits: Limits | None = None,
+            robot: Arm | None = None) -> Iso9283Result:
     """Evaluate an ISO 9283 test: the figures of every pose, distance and path, and a verdict.
 
     Parameters
@@ -304,6 +318,9 @@ def analyse(measurements: str | Path | Log, plan: str | Path | TestPlan,
         (:func:`fit_device_frame`).
     limits : Limits, optional
         Limits of AP, RP, AT, RT for the verdict (m); none: the verdict says so.
+    robot : Arm, optional
+        The arm tested: where ``limits`` has no RP and its model carries the datasheet's pose
+        repeatability, that is the limit of RP (a note says so).
 
     Returns
     -------
@@ -333,8 +350,8 @@ def analyse(measurements: str | Path | Log, plan: str | Path | TestPlan,
     _check_offsets(log, plan, device_frame)
     poses = _pose_results(log, plan)
     paths = _path_results(log, plan)
-    limits = limits or Limits()
-    notes = _notes(poses, paths, log, device_frame)
+    limits, datasheet = datasheet_limits(limits or Limits(), robot)
+    notes = _notes(poses, paths, log, device_frame) + ([datasheet] if datasheet else [])
     figures = {"AP": [(r.figures.AP_p, r.pose) for r in poses],
                "RP": [(r.figures.RP_l, r.pose) for r in poses],
                "AT": [(r.figures.AT_p, r.path) for r in paths],

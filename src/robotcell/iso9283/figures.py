@@ -14,7 +14,11 @@ Formulas as restated in the public literature (``docs/iso9283.md`` cites each):
 - path accuracy and repeatability: at each command point i the crossings ``x_ij`` of the
   measured paths with the plane through the point normal to the command path, their barycentre
   ``xbar_i``, ``AT_p = max_i |xbar_i - c_i|`` and ``RT_p = max_i (lbar_i + 3 S_li)`` with
-  ``l_ij = |x_ij - xbar_i|``.
+  ``l_ij = |x_ij - xbar_i|``;
+- orientation path accuracy (a choice: the pose's orientation deviation at the path's
+  crossings): at each command point i the deviation of cycle j is the rotation vector of
+  ``R_ij R_ci^T``, ``R_ij`` the orientation of the cycle's sample nearest its crossing;
+  ``AT_a = max_i |mean_j a_ij|`` (likewise b, c).
 """
 
 from __future__ import annotations
@@ -25,8 +29,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-__all__ = ["PathFigures", "PoseFigures", "crossings", "distance_figures", "orientation_figures",
-           "path_figures", "pose_figures", "tangents"]
+__all__ = ["PathFigures", "PoseFigures", "crossings", "distance_figures", "nearest_samples",
+           "orientation_figures", "path_orientation_figures", "path_figures", "pose_figures",
+           "tangents"]
 
 
 @dataclass(frozen=True)
@@ -226,3 +231,47 @@ def path_figures(x: ArrayLike, command: ArrayLike) -> PathFigures:
     l = np.linalg.norm(xs - bar, axis=2)
     rep = l.mean(axis=0) + 3 * np.std(l, axis=0, ddof=1)
     return PathFigures(bar, dev, rep, float(dev.max()), float(rep.max()))
+
+
+def nearest_samples(samples: ArrayLike, points: ArrayLike) -> NDArray[np.int_]:
+    """Index of the sample nearest each point.
+
+    Parameters
+    ----------
+    samples : array_like, shape (K, 3)
+        A measured path (m).
+    points : array_like, shape (M, 3)
+        Its crossings (m).
+
+    Returns
+    -------
+    ndarray of int, shape (M,)
+    """
+    s = np.asarray(samples, dtype=float)
+    x = np.asarray(points, dtype=float)
+    return np.argmin(np.linalg.norm(s[None] - x[:, None], axis=-1), axis=1)
+
+
+def path_orientation_figures(R: ArrayLike, command: ArrayLike
+                             ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Orientation path accuracy from the orientations of n cycles at the M command points.
+
+    Parameters
+    ----------
+    R : array_like, shape (n, M, 3, 3)
+        Measured orientation of each cycle at each command point.
+    command : array_like, shape (M, 3, 3)
+        Commanded orientations.
+
+    Returns
+    -------
+    mean : ndarray, shape (M, 3)
+        Mean deviation about x, y, z of the frame at each point (rad).
+    AT_abc : ndarray, shape (3,)
+        ``AT_a, AT_b, AT_c``: the largest magnitude of each over the points (rad).
+    """
+    dev = Rotation.from_matrix(
+        (np.asarray(R) @ np.swapaxes(np.asarray(command), -1, -2)[None]).reshape(-1, 3, 3)
+    ).as_rotvec().reshape(np.shape(R)[:2] + (3,))
+    mean = dev.mean(axis=0)
+    return mean, np.abs(mean).max(axis=0)

@@ -117,6 +117,9 @@ def _table_value(cell: Cell, table: ArrayLike) -> NDArray[np.float64] | None:
     """The table's values of the plan (rad), checked against its limits; None without one."""
     tt = cell.turntable
     values = np.asarray(table, dtype=float)
+    if values.size == 0:
+        raise InputError("no table value given: give the turntable's angle, or one value per "
+                         "positioner axis")
     if tt is None:
         if np.any(values != 0):
             raise InputError("the cell has no turntable or positioner; give no table value")

@@ -2,8 +2,9 @@
 
 A figure passes when its largest value over the poses (AP_p, RP_l) or paths (AT_p, RT_p) is at
 most its limit. The verdict is ``pass`` when every limit given is met, ``fail`` when one is not
-(or its figure was not measured), ``none`` when no limit is given. No robot model of the
-library carries a datasheet repeatability, so no limit has a default.
+(or its figure was not measured), ``none`` when no limit is given. The limit of RP defaults to
+the pose repeatability the robot's datasheet states, where its model carries one with its
+source (:func:`datasheet_limits`); the others have no default.
 """
 
 from __future__ import annotations
@@ -14,8 +15,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from robotcell.errors import InputError
+from robotcell.kinematics.arm import Arm
 
-__all__ = ["Limits", "Verdict", "judge"]
+__all__ = ["Limits", "Verdict", "datasheet_limits", "judge"]
 
 
 @dataclass(frozen=True)
@@ -95,3 +97,27 @@ def judge(figures: Mapping[str, Sequence[tuple[float, str]]], limits: Limits) ->
     if not reasons:
         return Verdict("none", ["no limit given for AP_p, RP_l, AT_p or RT_p"])
     return Verdict("fail" if failed else "pass", reasons)
+
+
+def datasheet_limits(limits: Limits, robot: Arm | None) -> tuple[Limits, str | None]:
+    """The limits with RP from the robot's datasheet where none is given.
+
+    Parameters
+    ----------
+    limits : Limits
+    robot : Arm or None
+        The arm tested; its ``repeatability`` (m) and ``repeatability_source``, when it has one.
+
+    Returns
+    -------
+    limits : Limits
+        ``limits``, its RP the datasheet's when it had none.
+    note : str or None
+        Where the RP limit came from, when it came from the datasheet.
+    """
+    if limits.RP is not None or robot is None or robot.repeatability is None:
+        return limits, None
+    rp = robot.repeatability
+    note = (f"limit of RP_l {rp * 1e3:g} mm: the pose repeatability of the "
+            f"{robot.title or robot.name} datasheet ({robot.repeatability_source})")
+    return Limits(limits.AP, rp, limits.AT, limits.RT), note

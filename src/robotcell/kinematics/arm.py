@@ -116,6 +116,12 @@ class Arm:
     covariance : ParameterCovariance or None
         An identified model's: the covariance of the constants the identification moved
         (docs/accuracy.md).
+    repeatability : float or None
+        Pose repeatability RP that the robot's datasheet states (m; the "±" value), with its
+        citation ``repeatability_source``; the default limit of an ISO 9283 test
+        (docs/iso9283.md). None when no public datasheet gives it.
+    repeatability_source : str
+        Where ``repeatability`` is stated (document and address).
     """
 
     name: str
@@ -132,6 +138,8 @@ class Arm:
     coupling: Coupling | None = None
     ik_seed: Arm | None = None
     covariance: ParameterCovariance | None = None
+    repeatability: float | None = None
+    repeatability_source: str = ""
 
     def __post_init__(self) -> None:
         if self.convention not in ("standard", "modified"):

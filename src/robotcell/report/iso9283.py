@@ -177,8 +177,9 @@ def write_iso9283_report(path: str | Path, result: Iso9283Result, cell: Cell | N
              for d in result.distances])]
     if result.paths:
         parts += ["<h2>Paths</h2>", table(
-            ["path", "cycles", "points", "AT_p (mm)", "RT_p (mm)"],
-            [[r.path, r.cycles, len(r.names), r.figures.AT_p * 1e3, r.figures.RT_p * 1e3]
+            ["path", "cycles", "points", "AT_p (mm)", "RT_p (mm)", "AT_a, AT_b, AT_c (deg)"],
+            [[r.path, r.cycles, len(r.names), r.figures.AT_p * 1e3, r.figures.RT_p * 1e3,
+              "" if r.AT_abc is None else ", ".join(f"{v:.4f}" for v in np.degrees(r.AT_abc))]
              for r in result.paths]),
             f'<figure><img src="{_path_figure(result)}" alt="path deviations"></figure>']
     j = result.to_json()

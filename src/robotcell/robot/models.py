@@ -46,7 +46,8 @@ _POSE_KEYS = {"x", "y", "z", "a", "b", "c"}
 _ANGLE_DECIMALS = 12
 _ANGLE_KEYS = {"alpha", "theta", "beta"}
 _TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
-             "source", "verified", "verification", "coupling", "ik_seed", "covariance"}
+             "source", "verified", "verification", "coupling", "ik_seed", "covariance",
+             "repeatability"}
 
 
 def _library_dir():
@@ -120,6 +121,21 @@ def _mapping(value: Any, where: str, allowed: set[str], not_mapping: str,
         if key not in value:
             raise InputError(f"{where}: missing key '{key}'")
     return value
+
+
+def _repeatability(value: Any, origin: str) -> tuple[float, str]:
+    """Key ``repeatability``: ``{mm: RP, source: citation}``, the datasheet's pose repeatability
+    (mm) and where it is stated; returns metres and the citation."""
+    where = f"{origin}: key 'repeatability'"
+    entry = _mapping(value, where, {"mm", "source"},
+                     f"{where} must be a mapping {{mm: RP, source: the datasheet}}",
+                     ("mm", "source"))
+    rp = _number(entry["mm"], f"{where}: key 'mm'")
+    if not 0 < rp <= 10:
+        raise InputError(f"{where}: key 'mm' must be a repeatability from 0 to 10 mm, got {rp:g}")
+    if not str(entry["source"]).strip():
+        raise InputError(f"{where}: key 'source' must name the datasheet that states it")
+    return rp * 1e-3, str(entry["source"])
 
 
 def _pose(value: Any, where: str, lscale: float, ascale: float) -> np.ndarray:
@@ -211,6 +227,9 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         kwargs["ik_seed"] = _ik_seed(data["ik_seed"], origin)
     if "covariance" in data:
         kwargs["covariance"] = _covariance(data["covariance"], origin, ls, as_)
+    if "repeatability" in data:
+        kwargs["repeatability"], kwargs["repeatability_source"] = _repeatability(
+            data["repeatability"], origin)
     for key in ("base", "flange", "tool"):
         if key in data:
             kwargs[key] = _pose(data[key], f"{origin}: key '{key}'", ls, as_)
@@ -437,6 +456,9 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
             _clean(v * (1e3 if j.prismatic else 180 / math.pi)) for v, j in zip(robot.home, robot.axes)
         ]
     data.update(source=robot.source, verified=robot.verified, verification=robot.verification)
+    if robot.repeatability is not None:
+        data["repeatability"] = {"mm": _clean(robot.repeatability * 1e3),
+                                 "source": robot.repeatability_source}
     return data
 
 
