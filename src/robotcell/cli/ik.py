@@ -13,20 +13,20 @@ import numpy as np
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
-    batch_outside,
     batch_table,
     batch_track,
     cell_tool,
     check_axis_columns,
     check_normal_up,
+    output_table_columns,
     progress,
-    row_values,
+    read_batch,
     setup_text,
     table_angles,
-    table_columns,
     table_option,
     table_rows,
     table_text,
+    track_rows,
     track_values,
 )
 from robotcell.cli.common import (
@@ -34,9 +34,6 @@ from robotcell.cli.common import (
     check_output,
     format_table,
     parse_numbers,
-    read_csv,
-    require_columns,
-    target_poses,
     write_output,
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
@@ -46,6 +43,7 @@ from robotcell.controllers.registry import CONTROLLERS
 from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, nearest
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.targets import target_poses
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
 
@@ -190,9 +188,7 @@ def ik(robot: str | None, pose: str | None, input_path: str | None, output_path:
         write_output(output_path, f"{r.name}, {solver.description}, controller axis values in "
                      f"degrees\n{format_table(headers, rows)}\n")
         return
-    names = [f.lower() for f in FORMATS[fmt].fields]
-    cols = read_csv(input_path, known=names)
-    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
+    T = read_batch(input_path, fmt).poses
     sol = solver.solve(T, T_tool)
     axes = [f"a{i}" for i in range(1, n + 1)]
     if ref is not None:
@@ -288,18 +284,15 @@ def _ik_cell(cell_path: str, pose: str | None, input_path: str | None, output_pa
         write_output(output_path, f"{setup_text(cell, tool, frame, track, where)}; {r.name}, "
                      f"{sol.method} solver; angles in degrees\n{format_table(headers, rows)}\n")
         return
-    names = [f.lower() for f in FORMATS[fmt].fields]
-    _, table_names = table_columns(cell)
-    cols = read_csv(input_path, known=[*names, "track", *table_names])
-    check_axis_columns(cell, cols, input_path, warn=True)
-    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
-    n = len(T)
-    e = track_values(cell, row_values(cols, "track", track_mm, n), batch_outside(cols, ["track"]))
+    table_names = output_table_columns(cell)
+    t = read_batch(input_path, fmt, cell)
+    check_axis_columns(cell, t.track, t.table, input_path, warn=True)
+    T, n = t.poses, len(t)
+    e = track_rows(cell, t.track, track_mm, n)
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n),
-                            batch_outside(cols, table_names)))
-    click.echo(setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "chosen per pose"),
-                          batch_table(cell, cols, table_deg)), err=True)
+          else table_rows(cell, t.table, table_option(cell, table_deg), n))
+    click.echo(setup_text(cell, tool, frame, batch_track(cell, t.track, track_mm, "chosen per pose"),
+                          batch_table(cell, t.table, table_deg)), err=True)
     with progress(n, "ik") as done:
         sol = cell.ik_batch(T, frame, e, th, T_tool, progress=done)
     q, valid, reach, method = sol.q, sol.valid, sol.reachable, sol.method
