@@ -15,7 +15,9 @@ is given. Among the valid arm configurations the one with the best score is kept
   target scores 1 when the arm is as far from singularities as it gets and every axis is at least
   :data:`LIMIT_REF` from its limits.
 
-:func:`robotcell.report.reach.reach_html` draws the map into a page, and
+Targets from a file: :func:`robotcell.io.targets.read_targets` (poses, and the ``table`` or a
+positioner's ``e1..en`` as ``table``). :func:`robotcell.report.reach.reach_html` draws the map
+into a page, and
 :func:`robotcell.report.reach.write_reach_map` writes the map's CSV and page in one call.
 """
 
