@@ -134,13 +134,13 @@ def test_library_module_imports_neither_the_cli_nor_click(name):
 
 
 #: The concept packages (docs/conventions.md, "Layout"); the top level holds only these, the
-#: package's ``__init__`` and ``errors``.
+#: package's ``__init__``, ``errors`` and ``_lazy`` (the imports put off until first use).
 CONCEPTS = {"kinematics", "ik", "robot", "dhprocedure", "calibration", "identification", "cell",
             "clearance", "io",
             "controllers", "export", "programs", "iso9283", "accuracy", "studies", "view", "report",
             "demo", "cli",
             "robots"}
-TOP_MODULES = {"__init__.py", "errors.py"}
+TOP_MODULES = {"__init__.py", "errors.py", "_lazy.py"}
 
 
 def test_the_top_level_holds_only_the_concept_packages():
@@ -162,16 +162,16 @@ def test_the_top_level_holds_only_the_concept_packages():
 #: ``robotcell.kinematics.jit``); the solvers of ``robotcell.ik`` work on the arm of
 #: ``robotcell.kinematics`` and the robot (an arm with its IK, model files, the library) stands on
 #: both; the estimators stand on the robot, the cell on them (it holds an identified arm, and
-#: calibrates into itself), and the clearance of its robot from its parts beside the cell. The features (:data:`FEATURES`): the controllers (one package per
-#: vendor: its export, its programs, its limits) and the exports beside them over the cell, the
+#: calibrates into itself), and the clearance of its robot from its parts beside the cell. The
+#: features (:data:`FEATURES`): the controllers (one package per vendor: its export, its programs, its limits) and the exports beside them over the cell, the
 #: programs over both, the ISO 9283 acceptance test beside the programs (it writes its cycles
 #: through them); the accuracy (filtered poses and programs) over the programs, the studies
 #: beside it. The presentation: the 3D views of cells, paths, programs and results, the HTML
 #: reports, which embed them, over the views, and the demo walk-through, which writes both, over
 #: the reports. The command line on top.
 LAYERS = [
-    {"robotcell.errors", "robotcell.kinematics.jit", "robotcell.kinematics.transforms",
-     "robotcell.io"},
+    {"robotcell.errors", "robotcell._lazy", "robotcell.kinematics.jit",
+     "robotcell.kinematics.transforms", "robotcell.io"},
     {"robotcell.kinematics", "robotcell.ik"},
     {"robotcell.robot"},
     {"robotcell.calibration", "robotcell.dhprocedure", "robotcell.identification"},

@@ -12,7 +12,8 @@ from cli_helpers import run
 
 from robotcell import InputError
 from robotcell.cell import Cell
-from robotcell.studies.reach import LIMIT_REF, manipulability_scale, reach_map, read_targets
+from robotcell.io.targets import read_targets
+from robotcell.studies.reach import LIMIT_REF, manipulability_scale, reach_map
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 CELL = EXAMPLES / "cell_kr16_track_turntable.yaml"
@@ -21,7 +22,7 @@ SEAM = EXAMPLES / "seam_part.csv"
 
 def test_reach_map_of_the_example_seam_reproduces_every_target():
     cell = Cell.load(CELL)
-    T, table = read_targets(SEAM)
+    T, table = (t := read_targets(SEAM)).poses, t.table
     rm = reach_map(cell, T, frame="part", tool="torch", table=table)
     assert rm.reachable.all()
     back = cell.fk(rm.q, track=rm.track, table=rm.table, tool="torch", frame="part")
@@ -66,7 +67,7 @@ def test_cli_writes_csv_and_a_self_contained_html_map(capsys, tmp_path):
     assert [r["target"] for r in rows[:3]] == ["0", "1", "2"]
     assert {r["reachable"] for r in rows} == {"true"} and rows[0]["branch"] in map(str, range(8))
     cell = Cell.load(CELL)
-    T, table = read_targets(SEAM)
+    T, table = (t := read_targets(SEAM)).poses, t.table
     rm = reach_map(cell, T, frame="part", tool="torch", table=table)
     assert float(rows[5]["track"]) == pytest.approx(rm.track[5] * 1e3, abs=1e-6)
     assert float(rows[5]["a2"]) == pytest.approx(math.degrees(rm.q[5, 1]), abs=1e-6)
@@ -131,7 +132,7 @@ def test_progress_in_blocks_gives_the_same_map(capsys, tmp_path, monkeypatch):
     from robotcell.studies import reach
 
     cell = Cell.load(CELL)
-    T, table = read_targets(SEAM)
+    T, table = (t := read_targets(SEAM)).poses, t.table
     whole = reach_map(cell, T, frame="part", tool="torch", table=table)
     monkeypatch.setattr(reach, "BLOCK", 10)
     calls = []
@@ -152,7 +153,7 @@ def test_write_reach_map_is_the_reach_command_as_one_call(tmp_path, capsys):
     from robotcell.report.reach import write_reach_map
 
     cell = Cell.load(CELL)
-    T, table = read_targets(SEAM)
+    T, table = (t := read_targets(SEAM)).poses, t.table
     rm = write_reach_map(cell, T, tmp_path / "lib.csv", tmp_path / "lib.html", frame="part",
                          tool="torch", table=table)
     cols = read_csv(tmp_path / "lib.csv")

@@ -12,7 +12,8 @@ from cli_helpers import run
 import robotcell.cli.progress as cli_progress
 from robotcell import InputError
 from robotcell.cell import Cell
-from robotcell.studies.reach import reach_map, read_targets
+from robotcell.io.targets import read_targets
+from robotcell.studies.reach import reach_map
 from robotcell.studies.sweep import apply_layout, read_layouts, sweep
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
@@ -23,7 +24,7 @@ GRID = {"robot": {"y": [-600, 0, 300]}, "turntable": {"a": {"from": 0, "to": 90,
 
 def small_sweep(executor=None):
     cell = Cell.load(CELL)
-    T, table = read_targets(SEAM)
+    T, table = (t := read_targets(SEAM)).poses, t.table
     return sweep(cell, T[::3], read_layouts(GRID), frame="part", tool="torch", table=table[::3],
                  executor=executor)
 
@@ -220,7 +221,7 @@ def test_sweep_writes_its_ranking(tmp_path):
     from robotcell.io.tables import read_csv
 
     cell = Cell.load(CELL)
-    T, table = read_targets(SEAM)
+    T, table = (t := read_targets(SEAM)).poses, t.table
     layouts = read_layouts({"robot": {"y": [0, 300]}})
     ranked = sweep(cell, T[:6], layouts, frame="part", tool="torch", table=table[:6],
                    output=tmp_path / "rank.csv")

@@ -419,9 +419,9 @@ def test_reach_map_read_back_from_the_csv_of_reach(tmp_path, capsys):
     cell = Cell.load(EXAMPLE)
     table = read_reach(out, cell)
     # the same map in Python: each reachable target at the TCP its axis values give
-    from robotcell.studies.reach import read_targets
+    from robotcell.io.targets import read_targets
 
-    T, th = read_targets(seam_csv)
+    T, th = (t := read_targets(seam_csv)).poses, t.table
     rm = reach_map(cell, T, frame="part", tool="torch", table=th)
     assert np.array_equal(table.reachable, rm.reachable) and table.reachable.all()
     mine = reach_points(cell, table, tool="torch")

@@ -10,9 +10,9 @@ The modules live in concept packages (``docs/conventions.md``, "Layout").
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from robotcell._lazy import module_getattr
 from robotcell.errors import IllPosedError, InputError, RobotcellError
 
 if TYPE_CHECKING:
@@ -71,13 +71,8 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """Import a public name from its module on first access (PEP 562)."""
-    if name not in _LAZY:
-        raise AttributeError(f"module 'robotcell' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_LAZY[name]), name)
-    globals()[name] = value
-    return value
+#: Import a public name from its module on first access (PEP 562).
+__getattr__ = module_getattr(_LAZY, __name__, globals())
 
 
 def __dir__() -> list[str]:

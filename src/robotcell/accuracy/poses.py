@@ -28,14 +28,15 @@ from numpy.typing import NDArray
 
 from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_poses
 from robotcell.cell import Cell
+from robotcell.cell.validation import table_columns
 from robotcell.controllers.model import Config
 from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
 from robotcell.ik.analytic import analytic_solver
 from robotcell.ik.config import ARM_FLAGS
 from robotcell.io.poseformats import pose_to_vendor
-from robotcell.io.tables import read_csv, refuse_empty, require_columns, write_columns
-from robotcell.programs.path import read_path, table_columns
+from robotcell.io.tables import refuse_empty, require_columns, write_columns
+from robotcell.programs.path import read_path
 
 __all__ = ["CompensatedPoses", "compensate_poses"]
 #: Decimals of the output (mm, deg): 1e-9 mm and deg, as the program formats.
@@ -220,10 +221,9 @@ def compensate_poses(path: str | Path, cell: Cell, tool: str, frame: str = "worl
         Poses that cannot be filtered, each named (nothing written).
     """
     p = str(path)
-    cols = read_csv(path)
-    config, near, chosen_by = _configuration(p, cols, cell)
     extra = (*(k for c in _with_columns() for k in c.csv_config), *ARM_FLAGS, *_near_columns(cell))
     targets = read_path(path, cell, extra)
+    config, near, chosen_by = _configuration(p, targets.extra, cell)
     if tool not in cell.tools:
         raise InputError(f"tool {tool!r} is not a tool of the cell (tools: "
                          f"{', '.join(cell.tools) or 'none'})")

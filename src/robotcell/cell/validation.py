@@ -4,6 +4,9 @@ size of any real cell.
 - :func:`check_axis_limits`: track positions and table or positioner axis values of a table of
   touches or targets against the limits of the cell's track, turntable or positioner, named by
   line and column (mm, deg).
+- :func:`table_columns`, :func:`table_label`: the columns of a file that hold the table's values
+  for the cell, and how messages name its positioner
+  (:func:`robotcell.io.targets.read_targets`).
 - :func:`check_lengths`: every position of a cell (frames, tools, track, turntable, positioner)
   within :data:`~robotcell.io.tables.CELL_EXTENT_MM` (100 m) of its parent, named by its key in
   the cell file: a frame 1e308 mm away is a typing or unit error, and no computation with it
@@ -24,11 +27,34 @@ from robotcell.errors import InputError
 from robotcell.io.tables import CELL_EXTENT_MM, MAX_ABS_VALUE, outside_limits
 
 __all__ = ["SCALE_RANGE", "axis_limit_violation", "axis_range", "check_axis_limits",
-           "check_lengths"]
+           "check_lengths", "table_columns", "table_label"]
 
 #: Track scales (displacement per unit of the controller's track value) a real track has: a
 #: factor 10 from 1 is a unit error.
 SCALE_RANGE = (0.1, 10.0)
+
+
+def table_columns(cell: CellModel) -> tuple[str, ...]:
+    """The columns of a targets or joints file that hold the table's values for ``cell``.
+
+    Returns
+    -------
+    tuple of str
+        ``()`` for a cell without a table, ``("table",)`` for a turntable (deg),
+        ``("e1", ..., "en")`` for a positioner of n axes (deg).
+    """
+    tt = cell.turntable
+    if tt is None:
+        return ()
+    if isinstance(tt, Positioner):
+        return tuple(f"e{i + 1}" for i in range(tt.n_axes))
+    return ("table",)
+
+
+def table_label(cell: CellModel) -> str:
+    """The cell's positioner as messages name it (``"positioner 'DKP_2'"``)."""
+    tt = cell.turntable
+    return f"positioner {tt.name!r}" if isinstance(tt, Positioner) else "the positioner"
 
 
 def axis_range(axis: Track | Turntable | Positioner) -> tuple[np.ndarray, np.ndarray]:

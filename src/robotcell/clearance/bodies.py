@@ -23,11 +23,11 @@ from numpy.typing import NDArray
 
 from robotcell.clearance.skeleton import LinkModel
 from robotcell.errors import InputError
-from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.fileio import read_text
+from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.yamlfile import parse_yaml
 
-__all__ = ["Body", "BodiesFile", "SHAPES", "read_bodies"]
+__all__ = ["SHAPES", "BodiesFile", "Body", "read_bodies"]
 
 #: The shapes and the sizes each takes (m).
 SHAPES = {"box": ("x", "y", "z"), "cylinder": ("radius", "length"), "sphere": ("radius",),

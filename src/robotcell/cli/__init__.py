@@ -8,7 +8,6 @@ from its source instead of importing it (and numpy, scipy with it).
 from __future__ import annotations
 
 import ast
-import importlib
 import importlib.util
 import os
 import sys
@@ -18,6 +17,7 @@ from pathlib import Path
 import click
 
 from robotcell import __version__
+from robotcell._lazy import load
 from robotcell.cli.terms import CLI_TERMS
 from robotcell.errors import RobotcellError, terms
 
@@ -56,11 +56,7 @@ def load_command(target: str) -> click.Command:
         The module or the attribute is missing: a registered command that is not there is a
         broken installation, never left out of the listing in silence.
     """
-    module, attr = target.split(":")
-    try:
-        return getattr(importlib.import_module(module), attr)
-    except (ImportError, AttributeError) as exc:
-        raise ImportError(f"the command registered as {target!r} cannot be loaded: {exc}") from exc
+    return load(target, "the command")
 
 
 class LazyGroup(click.Group):

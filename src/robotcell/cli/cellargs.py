@@ -19,29 +19,36 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Positioner, Track, Turntable
-from robotcell.cell.validation import axis_limit_violation, axis_range, check_axis_limits
+from robotcell.cell.validation import (
+    axis_limit_violation,
+    axis_range,
+    check_axis_limits,
+    table_columns,
+    table_label,
+)
 from robotcell.cli.common import parse_numbers
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
-from robotcell.io.tables import CELL_EXTENT_MM, refuse_empty
+from robotcell.io.tables import CELL_EXTENT_MM
+from robotcell.io.targets import Targets, read_targets
 
 __all__ = [
     "NORMAL_UP",
     "PROGRESS_MIN",
-    "batch_outside",
     "batch_table",
     "batch_track",
     "cell_tool",
     "check_axis_columns",
     "check_normal_up",
+    "output_table_columns",
     "progress",
-    "row_values",
+    "read_batch",
     "setup_text",
     "table_angles",
-    "table_columns",
     "table_option",
     "table_rows",
     "table_text",
+    "track_rows",
     "track_values",
 ]
 
@@ -175,56 +182,41 @@ def check_normal_up(cell: Cell, frame: str) -> str:
     return "normal_up"
 
 
-def table_columns(cell: Cell) -> tuple[tuple[int, ...], list[str]]:
-    """Trailing shape of the table values and their batch columns: ``table``, or ``e1..en``."""
-    pos = cell.turntable
-    if isinstance(pos, Positioner):
-        return (pos.n_axes,), [f"e{i + 1}" for i in range(pos.n_axes)]
-    return (), ["table"]
+def read_batch(path: str, fmt: str, cell: Cell | None = None, track: bool = True) -> Targets:
+    """The targets of a batch file (:func:`robotcell.io.targets.read_targets`) for ``cell``,
+    naming each column the command does not use in a warning line on stderr.
+
+    ``cell`` None: a bare robot's targets (no ``track`` or table columns); ``track`` False: a
+    command that chooses the track itself (column ``track`` not used)."""
+    if cell is None:
+        t = read_targets(path, fmt, track=False, table=None)
+    else:
+        t = read_targets(path, fmt, track=track, table=table_columns(cell),
+                         positioner=table_label(cell))
+    for w in t.warnings:
+        click.echo(f"warning: {w}", err=True)
+    return t
 
 
-def table_rows(cell: Cell, cols: dict, option: NDArray[np.float64] | float, n: int
-               ) -> NDArray[np.float64]:
-    """Per-row table values of a batch file (deg), else the option's value for every row.
-
-    A turntable reads column ``table``; a positioner chain columns ``e1..en`` (one per axis,
-    as in the calibration CSV), shape ``(rows, n_axes)``.
-    """
-    pos = cell.turntable
-    if not isinstance(pos, Positioner):
-        return row_values(cols, "table", float(option), n)
-    names = [f"e{i + 1}" for i in range(pos.n_axes)]
-    if "table" in cols:
-        raise InputError(f"column 'table' holds a turntable angle; positioner {pos.name!r} has "
-                         f"{pos.n_axes} axes: give columns {', '.join(names)} (deg)")
-    given = [c for c in names if c in cols]
-    if not given:
-        return np.broadcast_to(np.asarray(option, dtype=float), (n, pos.n_axes))
-    if len(given) != len(names):
-        missing = ", ".join(c for c in names if c not in cols)
-        raise InputError(f"positioner {pos.name!r} has {pos.n_axes} axes: missing column(s) "
-                         f"{missing} (deg)")
-    return np.column_stack([row_values(cols, c, None, n) for c in names])
+def output_table_columns(cell: Cell) -> list[str]:
+    """The table columns of a command's output for ``cell``: ``e1..en`` for a positioner, else
+    ``table`` (0 for a cell without a table)."""
+    return list(table_columns(cell) or ("table",))
 
 
-def check_axis_columns(cell: Cell, cols: dict, source: str, track: bool = True,
-                       warn: bool = False) -> None:
-    """Refuse the ``track`` (unless ``track`` is False: a column the command does not use) and
-    table columns (``table``, or a positioner's ``e1..en``) of a batch file whose values are
-    outside the limits of the cell's axes, naming line and column. With ``warn`` they are named
-    in a warning line instead; a track position beyond 100 m is refused still. An empty cell in
-    these columns is refused, naming its line: a line has no track position or table angle of
-    its own to default to."""
+def check_axis_columns(cell: Cell, track: NDArray[np.float64] | None,
+                       table: NDArray[np.float64] | None, source: str, warn: bool = False
+                       ) -> None:
+    """Refuse the track positions (m) and table values (rad) a batch file gives in its columns
+    (:func:`robotcell.io.targets.axis_columns`) outside the limits of the cell's axes, naming
+    line and column. With ``warn`` they are named in a warning line instead; a track position
+    beyond 100 m is refused still."""
     label = f"cell {cell.name!r}"
-    refuse_empty(cols, [*(["track"] if track else []), *table_columns(cell)[1]], source,
-                 optional=True)
     checks = []
-    if track and cell.track is not None and isinstance(cols.get("track"), np.ndarray):
-        checks.append((cell.track, cols["track"] * 1e-3, ["track"]))
-    _, names = table_columns(cell)
-    if cell.turntable is not None and all(isinstance(cols.get(c), np.ndarray) for c in names):
-        checks.append((cell.turntable, np.radians(np.column_stack([cols[c] for c in names])),
-                       names))
+    if track is not None and cell.track is not None:
+        checks.append((cell.track, track, ["track"]))
+    if table is not None and cell.turntable is not None:
+        checks.append((cell.turntable, table, list(table_columns(cell))))
     for axis, values, columns in checks:
         if not warn:
             check_axis_limits(axis, values, columns, source, label)
@@ -237,21 +229,28 @@ def check_axis_columns(cell: Cell, cols: dict, source: str, track: bool = True,
             click.echo(f"warning: {bad}; {OUTSIDE}", err=True)
 
 
-def batch_outside(cols: dict, names: list[str]) -> str:
-    """``outside`` of :func:`track_values` and :func:`table_angles` for a batch whose columns
-    ``names`` :func:`check_axis_columns` checked with ``warn``: ``"said"`` when the file has
-    them, else ``"warn"`` (the option's value, named once)."""
-    return "said" if any(c in cols for c in names) else "warn"
+def track_rows(cell: Cell, track: NDArray[np.float64] | None, track_mm: float | None, n: int
+               ) -> NDArray[np.float64] | None:
+    """Track positions (m) of the ``n`` rows of a batch file: its column ``track`` (checked by
+    :func:`check_axis_columns`), else the option's value (mm) for every row, else None."""
+    if track is None:
+        return track_values(cell, None if track_mm is None else np.full(n, float(track_mm)),
+                            "warn")
+    return _checked(track, 1e3, "mm", cell.track, "track position", "track", "said")
 
 
-def row_values(cols: dict, name: str, option: float | None, n: int) -> NDArray[np.float64] | None:
-    """A per-row column of a batch file (``track`` mm, ``table`` deg), else the option's value."""
-    if name in cols:
-        v = cols[name]
-        if not isinstance(v, np.ndarray):
-            raise InputError(f"column '{name}' must hold numbers")
-        return v
-    return None if option is None else np.full(n, float(option))
+def table_rows(cell: Cell, table: NDArray[np.float64] | None,
+               option: NDArray[np.float64] | float, n: int) -> NDArray[np.float64]:
+    """Table values (rad) of the ``n`` rows of a batch file: its table columns (checked by
+    :func:`check_axis_columns`), else the option's value (deg) for every row, shape ``(n,)``
+    for a turntable, ``(n, n_axes)`` for a positioner."""
+    pos = cell.turntable
+    if table is not None:
+        return table
+    if isinstance(pos, Positioner):
+        return table_angles(cell, np.broadcast_to(np.asarray(option, dtype=float),
+                                                  (n, pos.n_axes)), "warn")
+    return table_angles(cell, np.full(n, float(option)), "warn")
 
 
 @contextmanager
@@ -304,22 +303,24 @@ def setup_text(cell: Cell, tool: str | None, frame: str, track: str, table: str)
     return f"{cell.name}: TCP of {what} in frame {frame!r}{track}{table}"
 
 
-def batch_track(cell: Cell, cols: dict, track_mm: float | None, default: str) -> str:
-    """How the rows of a batch file set the track, for :func:`setup_text`."""
+def batch_track(cell: Cell, track: NDArray[np.float64] | None, track_mm: float | None,
+                default: str) -> str:
+    """How the rows of a batch file set the track (``track``: its column, or None), for
+    :func:`setup_text`."""
     if cell.track is None:
         return ""
-    if "track" in cols:
+    if track is not None:
         return ", track from column 'track' (mm)"
     return f", track {default}" if track_mm is None else f", track {track_mm:g} mm (given)"
 
 
-def batch_table(cell: Cell, cols: dict, table_deg: str | None) -> str:
-    """How the rows of a batch file set the table, for :func:`setup_text`."""
+def batch_table(cell: Cell, table: NDArray[np.float64] | None, table_deg: str | None) -> str:
+    """How the rows of a batch file set the table (``table``: its columns, or None), for
+    :func:`setup_text`."""
     if cell.turntable is None:
         return ""
-    names = table_columns(cell)[1]
-    if any(c in cols for c in names):
-        return f", table from column(s) {', '.join(names)} (deg)"
+    if table is not None:
+        return f", table from column(s) {', '.join(table_columns(cell))} (deg)"
     if table_deg == NORMAL_UP:
         return ", positioner chosen per pose: normal up"
     given = "0 (default)" if table_deg is None else f"{table_deg} (given)"

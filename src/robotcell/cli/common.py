@@ -14,16 +14,12 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import click
-import numpy as np
 
 from robotcell.errors import InputError, RobotcellError
 from robotcell.io import tables
 from robotcell.io.fileio import atomic_write, check_destination
-from robotcell.io.poseformats import FORMATS, pose_from_vendor
 from robotcell.io.tables import (
-    CELL_EXTENT_MM,
     format_table,
-    outside_limits,
     require_columns,
     write_csv,
 )
@@ -44,7 +40,6 @@ __all__ = [
     "parse_numbers",
     "read_csv",
     "require_columns",
-    "target_poses",
     "write_csv",
     "write_output",
 ]
@@ -156,23 +151,6 @@ def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]
         raise InputError(f"{what} has a value beyond {tables.MAX_ABS_VALUE:.0e} in size: no "
                          "length in mm or angle in deg is that large")
     return values
-
-
-def target_poses(values: np.ndarray, fmt: str, source: str) -> np.ndarray:
-    """Poses (m) from values of vendor format ``fmt`` (mm, deg), refusing a position beyond
-    the size of any real cell (no target is that far), named by line and column of the file
-    ``source`` (``(N, k)`` values) or by field of the option ``source`` (``(k,)`` values)."""
-    f = FORMATS[fmt]
-    limit = CELL_EXTENT_MM * 1e-3 / f.length_scale
-    unit = "m" if f.length_scale == 1.0 else "mm"
-    v = np.asarray(values, dtype=float)
-    names = [n.lower() for n in f.fields[:3]]
-    bad = outside_limits(np.atleast_2d(v)[:, :3], names, [-limit] * 3, [limit] * 3, [unit] * 3,
-                         lines=v.ndim == 2)
-    if bad is not None:
-        raise InputError(f"{source}: a target beyond {CELL_EXTENT_MM * 1e-3:g} m, the size of any "
-                         f"real cell: {bad}; correct the value (a typing or unit error?)")
-    return pose_from_vendor(v, fmt)
 
 
 def read_csv(path: str, known: Iterable[str] | None = None) -> dict:

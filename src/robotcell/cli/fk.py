@@ -8,19 +8,18 @@ import sys
 import click
 import numpy as np
 
+from robotcell.cell.validation import table_columns, table_label
 from robotcell.cli.cellargs import (
-    batch_outside,
     batch_table,
     batch_track,
     cell_tool,
     check_axis_columns,
-    row_values,
     setup_text,
     table_angles,
-    table_columns,
     table_option,
     table_rows,
     table_text,
+    track_rows,
     track_values,
 )
 from robotcell.cli.common import (
@@ -35,6 +34,7 @@ from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import outside_limits
+from robotcell.io.targets import axis_columns
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
 
@@ -187,14 +187,15 @@ def _fk_cell(cell_path: str, joints: str | None, input_path: str | None, output_
                                                    cell.turntable is not None else ""))
     else:
         names = [f"a{i}" for i in range(1, r.n_joints + 1)]
-        cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)[1]])
-        check_axis_columns(cell, cols, input_path, warn=True)
+        cols = read_csv(input_path, known=[*names, "track", *table_columns(cell)])
+        e_col, th_col, _ = axis_columns(cols, input_path, table=table_columns(cell),
+                                        positioner=table_label(cell))
+        check_axis_columns(cell, e_col, th_col, input_path, warn=True)
         q = joints_to_si(r, require_columns(cols, names, input_path))
-        e = track_values(cell, row_values(cols, "track", track, len(q)), batch_outside(cols, ["track"]))
-        th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(q)),
-                          batch_outside(cols, table_columns(cell)[1]))
-        setup = setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "0 mm (default)"),
-                           batch_table(cell, cols, table_deg))
+        e = track_rows(cell, e_col, track, len(q))
+        th = table_rows(cell, th_col, table_option(cell, table_deg), len(q))
+        setup = setup_text(cell, tool, frame, batch_track(cell, e_col, track_mm, "0 mm (default)"),
+                           batch_table(cell, th_col, table_deg))
     T = cell.fk(q, e, th, T_tool, frame)
     warn_joint_limits(r, q, input_path)
     if joints is not None and output_path is None:

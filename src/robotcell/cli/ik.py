@@ -11,22 +11,23 @@ from typing import Any, TextIO
 import click
 import numpy as np
 
+from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
     NORMAL_UP,
-    batch_outside,
     batch_table,
     batch_track,
     cell_tool,
     check_axis_columns,
     check_normal_up,
+    output_table_columns,
     progress,
-    row_values,
+    read_batch,
     setup_text,
     table_angles,
-    table_columns,
     table_option,
     table_rows,
     table_text,
+    track_rows,
     track_values,
 )
 from robotcell.cli.common import (
@@ -34,9 +35,6 @@ from robotcell.cli.common import (
     check_output,
     format_table,
     parse_numbers,
-    read_csv,
-    require_columns,
-    target_poses,
     write_output,
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
@@ -48,6 +46,7 @@ from robotcell.errors import InputError
 from robotcell.ik import analytic_solver, nearest
 from robotcell.ik.analytic import AnalyticSolver, SeededSolver
 from robotcell.io.poseformats import FORMATS, pose_from_vendor
+from robotcell.io.targets import target_poses
 from robotcell.robot.models import load_robot
 from robotcell.robot.robot import Robot
 
@@ -251,9 +250,7 @@ def _ik_batch(r: Robot, solver: AnalyticSolver | SeededSolver, a: _IkArgs,
     """``robotcell ik ROBOT --input``: the CSV of the solutions (deg)."""
     input_path, fmt, show_all, output_path = a.input_path, a.fmt, a.show_all, a.output_path
     scale = _scale(r)
-    names = [f.lower() for f in FORMATS[fmt].fields]
-    cols = read_csv(input_path, known=names)
-    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
+    T = read_batch(input_path, fmt).poses
     sol = solver.solve(T, T_tool)
     axes = [f"a{i}" for i in range(1, r.n_joints + 1)]
     if ref is not None:
@@ -364,18 +361,15 @@ def _ik_cell_batch(cell: Cell, a: _IkArgs, T_tool: np.ndarray | None, ref: np.nd
     track_mm, table_deg, output_path = a.track_mm, a.table_deg, a.output_path
     r = cell.robot
     deg = 180.0 / math.pi
-    names = [f.lower() for f in FORMATS[fmt].fields]
-    _, table_names = table_columns(cell)
-    cols = read_csv(input_path, known=[*names, "track", *table_names])
-    check_axis_columns(cell, cols, input_path, warn=True)
-    T = target_poses(require_columns(cols, names, input_path), fmt, input_path)
-    n = len(T)
-    e = track_values(cell, row_values(cols, "track", track_mm, n), batch_outside(cols, ["track"]))
+    table_names = output_table_columns(cell)
+    t = read_batch(input_path, fmt, cell)
+    check_axis_columns(cell, t.track, t.table, input_path, warn=True)
+    T, n = t.poses, len(t)
+    e = track_rows(cell, t.track, track_mm, n)
     th = (check_normal_up(cell, frame) if table_deg == NORMAL_UP
-          else table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), n),
-                            batch_outside(cols, table_names)))
-    click.echo(setup_text(cell, tool, frame, batch_track(cell, cols, track_mm, "chosen per pose"),
-                          batch_table(cell, cols, table_deg)), err=True)
+          else table_rows(cell, t.table, table_option(cell, table_deg), n))
+    click.echo(setup_text(cell, tool, frame, batch_track(cell, t.track, track_mm, "chosen per pose"),
+                          batch_table(cell, t.table, table_deg)), err=True)
     with progress(n, "ik") as done:
         sol = cell.ik_batch(T, frame, e, th, T_tool, progress=done)
     q, valid, reach, method = sol.q, sol.valid, sol.reachable, sol.method

@@ -135,7 +135,7 @@ def _deg(v: float) -> float | None:
 
 
 def _write_json(cell: Cell, result) -> dict:
-    from robotcell.programs.path import table_columns
+    from robotcell.cell.validation import table_columns
 
     tcols = table_columns(cell)
     points = []

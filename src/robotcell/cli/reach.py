@@ -13,29 +13,21 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.cli.cellargs import (
-    batch_outside,
     batch_table,
     batch_track,
     check_axis_columns,
-    row_values,
+    read_batch,
     setup_text,
-    table_angles,
-    table_columns,
     table_option,
     table_rows,
-    track_values,
+    track_rows,
 )
-from robotcell.cli.common import (
-    output_of,
-    read_csv,
-    target_poses,
-)
+from robotcell.cli.common import output_of
 from robotcell.cli.files import OUTPUT, Command, refuse_overwriting_inputs
 from robotcell.cli.progress import DeferredProgress
 from robotcell.cli.robotname import load_cell, robot_name_option
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS
-from robotcell.io.tables import require_columns
 from robotcell.report.reach import write_reach_map
 
 
@@ -68,29 +60,23 @@ def load_targets(path: str, cell: Cell, fmt: str, table_deg: str | None, choose_
                  ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, str]:
     """Targets (m), table angles (rad; None: to be chosen), track positions (m; None: to be
     chosen) and how the track and table were set (``", track chosen per target, table 0 deg"``)
-    from the targets file, with the columns of ``ik --cell``: the pose columns of ``fmt``,
-    ``track`` (mm, when ``track_column``), ``table`` or a positioner's ``e1..en`` (deg). A
-    column the command does not use is named in a warning."""
-    names = [f.lower() for f in FORMATS[fmt].fields]
-    _, table_names = table_columns(cell)
-    cols = read_csv(path, known=[*names, *(["track"] if track_column else []), *table_names])
-    check_axis_columns(cell, cols, path, track=track_column, warn=True)
-    T = target_poses(require_columns(cols, names, path), fmt, path)
-    track = track_values(cell, row_values(cols, "track", track_mm, len(T)) if track_column
-                         else track_mm, batch_outside(cols, ["track"] if track_column else []))
-    if choose_table:
-        given = [c for c in table_names if c in cols]
-        if given:
-            raise InputError(f"{path} has a '{given[0]}' column; leave it out to --choose-table")
-    axes = (batch_track(cell, cols if track_column else {}, track_mm, "chosen per target")
+    from the targets file (:func:`robotcell.io.targets.read_targets`, with ``track`` when
+    ``track_column``). Values outside the axis limits and a column the command does not use
+    are named in a warning."""
+    t = read_batch(path, fmt, cell, track_column)
+    check_axis_columns(cell, t.track, t.table, path, warn=True)
+    track = track_rows(cell, t.track, track_mm, len(t))
+    if choose_table and t.table is not None:
+        raise InputError(f"{path} has a '{t.table_columns[0]}' column; leave it out to "
+                         "--choose-table")
+    axes = (batch_track(cell, t.track, track_mm, "chosen per target")
             + (", table chosen per target (--choose-table)"
                if choose_table and cell.turntable is not None
-               else batch_table(cell, cols, table_deg)))
+               else batch_table(cell, t.table, table_deg)))
     if choose_table:
-        return T, None, track, axes
-    th = table_angles(cell, table_rows(cell, cols, table_option(cell, table_deg), len(T)),
-                      batch_outside(cols, table_names))
-    return T, th, track, axes
+        return t.poses, None, track, axes
+    th = table_rows(cell, t.table, table_option(cell, table_deg), len(t))
+    return t.poses, th, track, axes
 
 
 @click.command(cls=Command)

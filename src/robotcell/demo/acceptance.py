@@ -18,8 +18,16 @@ from pathlib import Path
 
 from robotcell.cell import Cell
 from robotcell.cell.history import backups
-from robotcell.iso9283 import Iso9283Result, Limits, analyse, plan, simulate, write_log, \
-    write_plan, write_programs
+from robotcell.iso9283 import (
+    Iso9283Result,
+    Limits,
+    analyse,
+    plan,
+    simulate,
+    write_log,
+    write_plan,
+    write_programs,
+)
 from robotcell.report.iso9283 import write_iso9283_report
 
 __all__ = ["LIMITS", "acceptance_step"]

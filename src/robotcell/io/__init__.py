@@ -4,6 +4,8 @@ stands on it; controller exports are the package :mod:`robotcell.export`, over t
 
 - :mod:`robotcell.io.tables`: CSV measurement tables with named columns;
 - :mod:`robotcell.io.poseformats`: vendor pose conventions (KUKA, ABB, FANUC, YASKAWA);
+- :mod:`robotcell.io.targets`: targets files, TCP poses with the external axes of each
+  (the one reader of every command that takes targets);
 - :mod:`robotcell.io.fileio`: reading text and writing files atomically;
 - :mod:`robotcell.io.yamlfile`: YAML read strictly, updated keeping comments, read back when
   written;

@@ -32,6 +32,7 @@ __all__ = [
     "optional_column",
     "outside_limits",
     "read_csv",
+    "read_csv_lines",
     "refuse_empty",
     "require_columns",
     "spreadsheet_number",
@@ -103,6 +104,27 @@ def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray 
         with ``_``; each naming its line (as the file counts them, the header being line 1
         when nothing is above it).
     """
+    return read_csv_lines(path, allow_nan)[0]
+
+
+def read_csv_lines(path: str | Path, allow_nan: bool = False
+                   ) -> tuple[dict[str, np.ndarray | list[str]], NDArray[np.intp]]:
+    """:func:`read_csv`, and the line of the file each data row stands on.
+
+    Parameters
+    ----------
+    path : str or Path
+    allow_nan : bool
+        As for :func:`read_csv`.
+
+    Returns
+    -------
+    cols : dict of str to ndarray or list of str
+        As :func:`read_csv` returns them.
+    lines : ndarray of int, shape (N,)
+        The line of each row, as the file counts them (blank lines skipped by the reader
+        counted too): for messages naming a row's line.
+    """
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{path}: no such file" + (" (it is a folder)" if p.is_dir() else ""))
@@ -119,7 +141,8 @@ def read_csv(path: str | Path, allow_nan: bool = False) -> dict[str, np.ndarray 
     header = _header(rows, path, semicolon)
     cells = _cells(rows, header, path, semicolon)
     lines = [line for line, _ in rows[1:]]
-    return {h: _column(v, h, lines, path, semicolon, allow_nan) for h, v in cells.items()}
+    return ({h: _column(v, h, lines, path, semicolon, allow_nan) for h, v in cells.items()},
+            np.array(lines, dtype=np.intp))
 
 
 #: A number as a spreadsheet writes it: a sign, digits 0-9 with a decimal point, an exponent;

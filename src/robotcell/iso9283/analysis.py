@@ -19,7 +19,6 @@ from scipy.spatial import cKDTree
 
 from robotcell.calibration.fitting import kabsch
 from robotcell.errors import IllPosedError, InputError
-from robotcell.kinematics.arm import Arm
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.iso9283.cube import POSE_NAMES
 from robotcell.iso9283.cycles import MIN_CYCLES, PATH_CYCLES, POSE_CYCLES
@@ -38,6 +37,7 @@ from robotcell.iso9283.log import Log, read_log
 from robotcell.iso9283.planfile import read_plan
 from robotcell.iso9283.testplan import TestPlan
 from robotcell.iso9283.verdict import Limits, Verdict, datasheet_limits, judge
+from robotcell.kinematics.arm import Arm
 
 __all__ = ["DRIFT_CYCLES", "MAX_OFFSET", "DistanceResult", "Iso9283Result", "PathResult",
            "PoseResult", "analyse", "fit_device_frame"]

@@ -29,9 +29,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-__all__ = ["PathFigures", "PoseFigures", "crossings", "distance_figures", "nearest_samples",
-           "orientation_figures", "path_orientation_figures", "path_figures", "pose_figures",
-           "tangents"]
+__all__ = [
+    "PathFigures",
+    "PoseFigures",
+    "crossings",
+    "distance_figures",
+    "nearest_samples",
+    "orientation_figures",
+    "path_figures",
+    "path_orientation_figures",
+    "pose_figures",
+    "tangents",
+]
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import robot_pose
+from robotcell.cell.validation import table_columns
+from robotcell.clearance.bodies import BodiesFile
 from robotcell.controllers.axes import ExternalAxes
 from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
 from robotcell.controllers.registry import get
@@ -44,13 +46,11 @@ from robotcell.ik.result import IKSolutions
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.transforms import invert
-from robotcell.clearance.bodies import BodiesFile
 from robotcell.programs.clearcheck import CLEARANCE, clearance_problems
 from robotcell.programs.config import candidates, config_text, config_values, select
 from robotcell.programs.formats import read_program
 from robotcell.programs.frames import Placement, placement, tool_pose_of
 from robotcell.programs.lines import LineData, line_problems
-from robotcell.programs.path import table_columns
 from robotcell.programs.singular import (
     SHOULDER_MARGIN,
     SINGULAR_MARGIN,

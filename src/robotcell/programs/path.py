@@ -1,24 +1,21 @@
 """A path to program: TCP targets in a frame of the cell, with how to move to each.
 
-The path file is CSV with a header (millimetres, degrees; ``docs/programs.md``):
+The path file is a targets file (``docs/targets.md``, read by
+:func:`robotcell.io.targets.read_targets`: ``x, y, z`` mm, ``a, b, c`` deg, optional ``track``
+mm and ``table`` or ``e1..en`` deg, ``name``) with the columns of a motion
+(``docs/programs.md``):
 
 | column | | meaning |
 |---|---|---|
-| ``x, y, z`` | required | TCP position in the frame (mm) |
-| ``a, b, c`` | required | TCP orientation, ``R = Rz(a) Ry(b) Rx(c)`` (deg), the cell's convention |
 | ``motion`` | optional | ``ptp`` or ``lin`` (default: ``ptp`` to the first point, ``lin`` after) |
 | ``speed`` | optional | TCP speed of a linear motion (mm/s; default 100) |
 | ``zone`` | optional | corner distance (mm; default 0, an exact stop) |
-| ``track`` | optional | track position (mm); otherwise chosen along the path |
-| ``table`` | optional | turntable angle (deg); a positioner's axes are ``e1..en`` (see below) |
 
-Without ``table`` (or ``e1..en``) the writer chooses the table's values along a path in a frame
-the table carries (:func:`robotcell.cell.tablechoice.choose_table`); a path in another frame
-keeps the table at 0.
+Without ``track`` the track is chosen along the path. Without ``table`` (or ``e1..en``) the
+writer chooses the table's values along a path in a frame the table carries
+(:func:`robotcell.cell.tablechoice.choose_table`); a path in another frame keeps the table at 0.
 
-A line may leave ``motion``, ``speed`` or ``zone`` empty: it takes the default above. The pose
-columns, and ``track`` and the table's columns when the file has them, need a value on every
-line (a track or table value has no default for one line alone).
+A line may leave ``motion``, ``speed`` or ``zone`` empty: it takes the default above.
 
 :func:`read_path` reads it into SI units and checks every value against the cell.
 """
@@ -32,23 +29,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell, Positioner
+from robotcell.cell.validation import table_columns, table_label
 from robotcell.controllers.model import MOTIONS
 from robotcell.errors import InputError
-from robotcell.io.poseformats import pose_from_vendor
-from robotcell.io.tables import (
-    optional_column,
-    read_csv,
-    refuse_empty,
-    require_columns,
-    unknown_columns,
-)
+from robotcell.io.tables import optional_column
+from robotcell.io.targets import read_targets
 
-__all__ = ["DEFAULT_SPEED", "PathTargets", "read_path", "table_columns"]
+__all__ = ["DEFAULT_SPEED", "PathTargets", "read_path"]
 
 #: TCP speed of linear motions when the path gives none (m/s).
 DEFAULT_SPEED = 0.1
 
-_POSE = ("x", "y", "z", "a", "b", "c")
+_MOTION = ("motion", "speed", "zone")
 _MOTION_WORDS = {"ptp": "ptp", "lin": "lin", "j": "ptp", "l": "lin", "joint": "ptp",
                  "linear": "lin", "movej": "ptp", "movel": "lin"}
 
@@ -78,6 +70,8 @@ class PathTargets:
         The file, for messages.
     warnings : list of str
         Columns the reader does not use (misspelt?).
+    extra : dict of str to ndarray or list of str
+        The caller's further columns (``extra`` of :func:`read_path`) the file has, as read.
     """
 
     T: NDArray[np.float64]
@@ -89,31 +83,18 @@ class PathTargets:
     table_given: bool = True
     source: str = ""
     warnings: list[str] = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
 
     def __len__(self) -> int:
         return self.T.shape[0]
 
 
-def table_columns(cell: Cell) -> list[str]:
-    """The path's table columns for ``cell``: ``table``, a positioner's ``e1..en``, or none."""
-    tt = cell.turntable
-    if tt is None:
-        return []
-    if isinstance(tt, Positioner):
-        return [f"e{i + 1}" for i in range(tt.n_axes)]
-    return ["table"]
-
-
-def _numeric(cols: dict, name: str, path: str) -> NDArray[np.float64]:
-    return require_columns(cols, [name], path)[:, 0]
-
-
 def _limits(values: NDArray[np.float64], lo: float, hi: float, what: str, unit: float,
-            path: str, column: str) -> None:
+            lines: NDArray[np.intp], path: str, column: str) -> None:
     bad = np.flatnonzero((values < lo) | (values > hi))
     if bad.size:
         i = int(bad[0])
-        raise InputError(f"{path}: line {i + 2}: column '{column}' has {values[i] * unit:g}, "
+        raise InputError(f"{path}: line {lines[i]}: column '{column}' has {values[i] * unit:g}, "
                          f"outside the {what} limits [{lo * unit:g}, {hi * unit:g}]")
 
 
@@ -123,11 +104,13 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
     Parameters
     ----------
     path : str or Path
-        CSV with the columns of the module's table.
+        A targets file (:func:`robotcell.io.targets.read_targets`) with the columns of the
+        module's table.
     cell : Cell
         Says which external axis columns exist and their limits.
     extra : tuple of str
-        Further columns the caller reads itself (not named as unused).
+        Further columns the caller reads itself (not named as unused; in
+        :attr:`PathTargets.extra`).
 
     Returns
     -------
@@ -141,74 +124,57 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
         for a cell without one, or a value outside the track's or table's limits; the message
         names the file, line and column.
     """
-    p = str(path)
-    cols = read_csv(path)
-    tcols = table_columns(cell)
-    known = [*_POSE, "motion", "speed", "zone", "track", *tcols, "name", *extra]
-    warnings = [f"{p}: column(s) {', '.join(unknown)} not used and ignored; check the spelling"
-                for unknown in [unknown_columns(cols, known)] if unknown]
-    T = pose_from_vendor(require_columns(cols, _POSE, p), "kuka")
-    n = T.shape[0]
-    motion = _motion(cols, n, p)
+    t = read_targets(path, "kuka", table=table_columns(cell), positioner=table_label(cell),
+                     extra=(*_MOTION, *extra))
+    p, cols, n = t.source, t.extra, len(t)
+    motion = _motion(cols, t.lines, p)
     speed = optional_column(cols, "speed", DEFAULT_SPEED * 1e3, p)
     speed = np.full(n, DEFAULT_SPEED) if speed is None else speed * 1e-3
     bad = np.flatnonzero(~(speed > 0))
     if bad.size:
-        raise InputError(f"{p}: line {bad[0] + 2}: column 'speed' must be positive (mm/s)")
+        raise InputError(f"{p}: line {t.lines[bad[0]]}: column 'speed' must be positive (mm/s)")
     zone = optional_column(cols, "zone", 0.0, p)
     zone = np.zeros(n) if zone is None else zone * 1e-3
     bad = np.flatnonzero(zone < 0)
     if bad.size:
-        raise InputError(f"{p}: line {bad[0] + 2}: column 'zone' must not be negative (mm)")
-    track = None
-    if "track" in cols:
+        raise InputError(f"{p}: line {t.lines[bad[0]]}: column 'zone' must not be negative (mm)")
+    if t.track is not None:
         if cell.track is None:
             raise InputError(f"{p}: column 'track', but the cell has no track; leave it out")
-        refuse_empty(cols, ["track"], p, optional=True)
-        track = _numeric(cols, "track", p) * 1e-3
-        _limits(track, cell.track.lower, cell.track.upper, "track", 1e3, p, "track")
-    table = _table(cols, cell, n, p)
-    given = cell.turntable is None or any(c in cols for c in tcols)
-    return PathTargets(T, motion, speed, zone, track, table, given, p, warnings)
+        _limits(t.track, cell.track.lower, cell.track.upper, "track", 1e3, t.lines, p, "track")
+    table = _table(t.table, cell, n, t.lines, p)
+    given = cell.turntable is None or t.table is not None
+    return PathTargets(t.poses, motion, speed, zone, t.track, table, given, p, t.warnings,
+                       {k: v for k, v in cols.items() if k in extra})
 
 
-def _motion(cols: dict, n: int, path: str) -> list[str]:
+def _motion(cols: dict, lines: NDArray[np.intp], path: str) -> list[str]:
     """Column ``motion`` as ``ptp``/``lin`` per target; a line that leaves it empty, or a file
     without it, moves ``ptp`` to the first target and ``lin`` after it."""
-    default = ["ptp"] + ["lin"] * (n - 1)
+    default = ["ptp"] + ["lin"] * (len(lines) - 1)
     if "motion" not in cols:
         return default
     motion = []
     for i, word in enumerate(cols["motion"]):
         key = "" if isinstance(word, float) and np.isnan(word) else str(word).strip().lower()
         if key and key not in _MOTION_WORDS:
-            raise InputError(f"{path}: line {i + 2}: column 'motion' has {word!r}; use one of "
+            raise InputError(f"{path}: line {lines[i]}: column 'motion' has {word!r}; use one of "
                              f"{', '.join(MOTIONS)}")
         motion.append(_MOTION_WORDS[key] if key else default[i])
     return motion
 
 
-def _table(cols: dict, cell: Cell, n: int, path: str) -> NDArray[np.float64]:
+def _table(values: NDArray[np.float64] | None, cell: Cell, n: int, lines: NDArray[np.intp],
+           path: str) -> NDArray[np.float64]:
+    """The table's values of the path (rad), each within the limits of its axis; 0 where the
+    file gives none."""
     tt = cell.turntable
     names = table_columns(cell)
-    foreign = [c for c in ("table", "e1", "e2", "e3") if c in cols and c not in names]
-    if foreign:
-        what = ("the cell has no turntable" if tt is None else
-                f"the cell's table axes are column(s) {', '.join(names)}")
-        raise InputError(f"{path}: column '{foreign[0]}', but {what}")
-    if tt is None:
-        return np.zeros(n)
-    given = [c for c in names if c in cols]
-    if not given:
+    if values is None:
         return np.zeros((n, len(names))) if isinstance(tt, Positioner) else np.zeros(n)
-    if len(given) != len(names):
-        missing = ", ".join(c for c in names if c not in cols)
-        raise InputError(f"{path}: positioner {tt.name!r} has {len(names)} axes: missing "
-                         f"column(s) {missing} (deg)")
-    refuse_empty(cols, names, path, optional=True)
-    values = np.column_stack([np.radians(_numeric(cols, c, path)) for c in names])
+    v = values.reshape(n, -1)
     lo, hi = np.atleast_1d(tt.lower), np.atleast_1d(tt.upper)
     for j, c in enumerate(names):
-        _limits(values[:, j], lo[j], hi[j], f"{c} axis" if len(names) > 1 else "table",
-                180 / np.pi, path, c)
-    return values if isinstance(tt, Positioner) else values[:, 0]
+        _limits(v[:, j], lo[j], hi[j], f"{c} axis" if len(names) > 1 else "table",
+                180 / np.pi, lines, path, c)
+    return values

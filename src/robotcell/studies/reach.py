@@ -15,7 +15,9 @@ is given. Among the valid arm configurations the one with the best score is kept
   target scores 1 when the arm is as far from singularities as it gets and every axis is at least
   :data:`LIMIT_REF` from its limits.
 
-:func:`robotcell.report.reach.reach_html` draws the map into a page, and
+Targets from a file: :func:`robotcell.io.targets.read_targets` (poses, and the ``table`` or a
+positioner's ``e1..en`` as ``table``). :func:`robotcell.report.reach.reach_html` draws the map
+into a page, and
 :func:`robotcell.report.reach.write_reach_map` writes the map's CSV and page in one call.
 """
 
@@ -25,7 +27,6 @@ import math
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, fields
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -33,19 +34,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell.ik import ik
 from robotcell.cell.kinematics import tool_pose
-from robotcell.cell.parts import Positioner
+from robotcell.cell.validation import table_columns
 from robotcell.errors import InputError
 from robotcell.ik.limits import TWO_PI
 from robotcell.ik.trackchoice import arm_manipulability
-from robotcell.io.poseformats import FORMATS, pose_from_vendor
-from robotcell.io.tables import read_csv, refuse_empty, require_columns
 from robotcell.robot.robot import Robot
 
 if TYPE_CHECKING:
     from robotcell.cell import Cell
 
-__all__ = ["LIMIT_REF", "ReachMap", "manipulability_scale", "reach_columns", "reach_map",
-           "read_targets"]
+__all__ = ["LIMIT_REF", "ReachMap", "manipulability_scale", "reach_columns", "reach_map"]
 
 #: Distance to the joint limits (rad) from which a target counts as fully clear of them.
 LIMIT_REF = math.radians(10.0)
@@ -245,9 +243,7 @@ def reach_columns(rm: ReachMap, cell: Cell) -> dict[str, NDArray]:
     ``robotcell fk --cell CELL --input``. ``target`` and ``branch`` are integers, ``reachable``
     is ``true``/``false``; ``track_margin_mm`` only for a cell with a track.
     """
-    pos = cell.turntable
-    names = ([f"e{i + 1}" for i in range(pos.n_axes)] if isinstance(pos, Positioner)
-             else ["table"])
+    names = table_columns(cell) or ("table",)
     table = np.degrees(rm.table).reshape(rm.reachable.size, -1)
     columns: dict[str, NDArray] = {
         "target": np.arange(rm.reachable.size), "reachable": rm.reachable.astype(bool),
@@ -261,30 +257,3 @@ def reach_columns(rm: ReachMap, cell: Cell) -> dict[str, NDArray]:
         columns["track_margin_mm"] = rm.track_margin * 1e3
     columns["manipulability_m3"] = rm.manipulability
     return columns
-
-
-def read_targets(path: str | Path, fmt: str = "kuka"
-                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-    """Targets from a CSV file: the pose columns of ``fmt`` (mm, deg), optional ``table`` (deg).
-
-    Parameters
-    ----------
-    path : str or Path
-    fmt : str
-        A pose format of :data:`robotcell.io.poseformats.FORMATS` (``kuka``: ``x,y,z,a,b,c``).
-
-    Returns
-    -------
-    T : ndarray, shape (N, 4, 4)
-        Target poses (m).
-    table : ndarray, shape (N,), or None
-        Table angles (rad) from a column ``table``, if there is one.
-    """
-    cols = read_csv(path)
-    names = [f.lower() for f in FORMATS[fmt].fields]
-    T = pose_from_vendor(require_columns(cols, names, path), fmt)
-    table = None
-    if "table" in cols:
-        refuse_empty(cols, ["table"], path, optional=True)
-        table = np.radians(require_columns(cols, ["table"], path)[:, 0])
-    return T, table

@@ -25,8 +25,9 @@ See docs/view.md.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from robotcell._lazy import module_getattr
 
 if TYPE_CHECKING:
     from robotcell.view.calibration import calibration_scene
@@ -57,10 +58,8 @@ __all__ = ["Arrows", "Lines", "Mesh", "PathMarks", "Points", "Scene", "Step", "T
            "write_html", "write_program_view"]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: Import a public name from its module on first access (PEP 562).
+__getattr__ = module_getattr(_LAZY, __name__, globals())
 
 
 def __dir__() -> list[str]:
