@@ -65,6 +65,17 @@ def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
                      np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
 
 
+def _rotation(d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``exp([d]x)`` of one rotation vector (Rodrigues), as
+    :func:`~robotcell.calibration.fitting.perturb_rotation` applies it: the fit's residuals
+    call it thousands of times, where scipy's general conversion costs more than the rest."""
+    theta = float(np.linalg.norm(d))
+    K = _skew(d)
+    if theta < 1e-8:
+        return np.eye(3) + K + 0.5 * K @ K
+    return np.eye(3) + np.sin(theta) / theta * K + (1.0 - np.cos(theta)) / theta**2 * K @ K
+
+
 def _tool_sources(tool_sigma: Sources | ArrayLike, name: str) -> Sources:
     """The tool's error sources over its TCP position (3) or its pose (6)."""
     if isinstance(tool_sigma, Sources):
@@ -257,9 +268,9 @@ def _solve(ref: RobotTouches, other: RobotTouches, common: list[str], sigma: flo
     ib = np.array([common.index(n) for n in other.names])
 
     def resid(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        T = perturb_pose(T0, x[:6])
+        R = _rotation(x[3:6]) @ T0[:3, :3]
         c = x[6:].reshape(-1, 3)
-        return np.concatenate([ref.points - c[ia], other.points - (c[ib] - T[:3, 3]) @ T[:3, :3]])
+        return np.concatenate([ref.points - c[ia], other.points - (c[ib] - x[:3]) @ R])
 
     names = [f"{other.robot or 'other'} base {c}" for c in ("x", "y", "z")]
     names += [f"{other.robot or 'other'} base rotation about {c}" for c in "xyz"]
