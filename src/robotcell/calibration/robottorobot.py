@@ -40,7 +40,8 @@ from robotcell.calibration.uncertainty import Inputs, Sources, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points, transform_points, validate_pose
 
-__all__ = ["FEWEST_POINTS", "MAX_DISTANCE", "RobotTouches", "robot_to_robot"]
+__all__ = ["FEWEST_POINTS", "MAX_DISTANCE", "RobotTouches", "common_points", "joined_inputs",
+           "point_means", "robot_to_robot", "small_rotation"]
 
 #: Fewest common points: 3 not on one line fix a rigid pose (the controllers' procedures ask
 #: for 3 or more, see ``docs/calibration.md``).
@@ -65,15 +66,17 @@ def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
                      np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
 
 
-def _rotation(d: NDArray[np.float64]) -> NDArray[np.float64]:
+def small_rotation(d: NDArray[np.float64]) -> NDArray[np.float64]:
     """``exp([d]x)`` of one rotation vector (Rodrigues), as
     :func:`~robotcell.calibration.fitting.perturb_rotation` applies it: the fit's residuals
     call it thousands of times, where scipy's general conversion costs more than the rest."""
-    theta = float(np.linalg.norm(d))
-    K = _skew(d)
-    if theta < 1e-8:
+    x, y, z = (float(v) for v in d)
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    theta2 = x * x + y * y + z * z
+    if theta2 < 1e-16:
         return np.eye(3) + K + 0.5 * K @ K
-    return np.eye(3) + np.sin(theta) / theta * K + (1.0 - np.cos(theta)) / theta**2 * K @ K
+    theta = theta2**0.5
+    return np.eye(3) + np.sin(theta) / theta * K + (1.0 - np.cos(theta)) / theta2 * K @ K
 
 
 def _tool_sources(tool_sigma: Sources | ArrayLike, name: str) -> Sources:
@@ -188,7 +191,7 @@ class RobotTouches:
         return cls(p_L, tuple(names), inputs, robot)
 
 
-def _matched(ref: RobotTouches, other: RobotTouches) -> list[str]:
+def common_points(ref: RobotTouches, other: RobotTouches) -> list[str]:
     """The common points, in the order the reference robot first touched them; refuses points
     touched by one robot only and fewer than :data:`FEWEST_POINTS` common points."""
     a, b = ref.robot or "the reference robot", other.robot or "the other robot"
@@ -209,7 +212,7 @@ def _matched(ref: RobotTouches, other: RobotTouches) -> list[str]:
     return common
 
 
-def _means(t: RobotTouches, common: list[str]) -> NDArray[np.float64]:
+def point_means(t: RobotTouches, common: list[str]) -> NDArray[np.float64]:
     """Mean position of each common point as one robot touched it, (K, 3)."""
     idx = np.array([common.index(n) for n in t.names])
     out = np.zeros((len(common), 3))
@@ -233,27 +236,30 @@ def _spread(a: NDArray[np.float64]) -> tuple[float, str]:
     return ratio, ""
 
 
-def _joined_inputs(ref: RobotTouches, other: RobotTouches) -> Inputs | None:
-    """Both robots' inputs over all touches (reference first), each zero on the other's rows."""
-    n_a, n_b = len(ref.points), len(other.points)
-    parts = [(t.inputs, rows) for t, rows in ((ref, slice(0, n_a)), (other, slice(n_a, None)))
-             if t.inputs is not None]
-    if not parts:
-        return None
+def joined_inputs(touches: Sequence[RobotTouches]) -> Inputs | None:
+    """The inputs of several sets of touches over all their rows, in order, each zero on the
+    rows of the others; a source named alike in two sets (one robot's tool in its touches of
+    common points and of a turntable) is one error."""
+    sizes = [len(t.points) for t in touches]
+    rows = np.cumsum([0] + sizes)
     sens, srcs, names = [], [], []
-    for inp, rows in parts:
-        s = np.zeros((n_a + n_b, 3, inp.size))
-        s[rows] = inp.sensitivity
+    for t, start, stop in zip(touches, rows[:-1], rows[1:], strict=True):
+        if t.inputs is None:
+            continue
+        s = np.zeros((rows[-1], 3, t.inputs.size))
+        s[start:stop] = t.inputs.sensitivity
         sens.append(s)
-        srcs.append(inp.sources)
-        names += inp.names
+        srcs.append(t.inputs.sources)
+        names += t.inputs.names
+    if not sens:
+        return None
     return Inputs(np.concatenate(sens, axis=2), Sources.stack(srcs), names)
 
 
 def _solve(ref: RobotTouches, other: RobotTouches, common: list[str], sigma: float | None,
            inputs: Inputs | None) -> tuple[Fit, NDArray[np.float64]]:
     """The ML fit over ``T_ref_other`` (origin, rotation vector) and the common points."""
-    a, b = _means(ref, common), _means(other, common)
+    a, b = point_means(ref, common), point_means(other, common)
     T0 = kabsch(b, a)
     if np.linalg.norm(T0[:3, 3]) > MAX_DISTANCE:
         raise IllPosedError(
@@ -268,7 +274,7 @@ def _solve(ref: RobotTouches, other: RobotTouches, common: list[str], sigma: flo
     ib = np.array([common.index(n) for n in other.names])
 
     def resid(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        R = _rotation(x[3:6]) @ T0[:3, :3]
+        R = small_rotation(x[3:6]) @ T0[:3, :3]
         c = x[6:].reshape(-1, 3)
         return np.concatenate([ref.points - c[ia], other.points - (c[ib] - x[:3]) @ R])
 
@@ -324,9 +330,9 @@ def robot_to_robot(reference: RobotTouches, other: RobotTouches, *, sigma: float
     """
     if method not in ("common points", "pointer"):
         raise InputError(f"method must be 'common points' or 'pointer', got {method!r}")
-    common = _matched(reference, other)
-    _, warning = _spread(_means(reference, common))
-    res, T = _solve(reference, other, common, sigma, _joined_inputs(reference, other))
+    common = common_points(reference, other)
+    _, warning = _spread(point_means(reference, common))
+    res, T = _solve(reference, other, common, sigma, joined_inputs([reference, other]))
     return _result(reference, other, common, res, T, [warning] if warning else [], method)
 
 
