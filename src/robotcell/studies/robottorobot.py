@@ -14,6 +14,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import csv
+import io
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -22,8 +25,13 @@ from robotcell.errors import InputError
 from robotcell.kinematics.transforms import invert, make_pose, transform_points
 from robotcell.robot.robot import Robot
 
-__all__ = ["Design", "SimulatedRobot", "flange_poses", "simulate_robot_to_robot", "touch_design",
-           "touch_table"]
+__all__ = ["SPREAD", "Design", "SimulatedRobot", "default_points", "flange_poses",
+           "simulate_robot_to_robot", "table_text", "touch_design", "touch_table"]
+
+#: Where the common points lie by default (m): about the point on the floor midway between the
+#: two bases, in the reference base's axes; a triangle of 300 mm or more in every view.
+SPREAD = np.array([[0.0, 0.3, 0.35], [-0.05, -0.35, 0.3], [0.15, 0.0, 0.6], [0.05, 0.3, 0.65],
+                   [-0.1, -0.05, 0.45]])
 
 
 @dataclass(frozen=True)
@@ -178,3 +186,21 @@ def simulate_robot_to_robot(robots: Sequence[SimulatedRobot], points: ArrayLike,
         flange = flange_poses(robot, design, p, rng.normal(0.0, noise, p.shape))
         out.append(touch_table(robot, design, flange, names))
     return out
+
+
+def default_points(T_ref_other: ArrayLike) -> NDArray[np.float64]:
+    """The default common points (K, 3) in the reference base (m): :data:`SPREAD` about the
+    point on the floor midway between the two bases."""
+    mid = 0.5 * np.asarray(T_ref_other, dtype=float)[:3, 3] * np.array([1.0, 1.0, 0.0])
+    return mid + SPREAD
+
+
+def table_text(table: dict[str, object]) -> str:
+    """A touch table as CSV text: joint values with 6 decimals (deg), the point's name."""
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(list(table))
+    columns = [list(v) if isinstance(v, list) else [f"{x:.6f}" for x in np.asarray(v)]
+               for v in table.values()]
+    w.writerows(zip(*columns, strict=True))
+    return buf.getvalue()
