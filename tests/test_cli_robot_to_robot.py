@@ -4,9 +4,9 @@ touch files written from a true layout, and the pose recovered from them."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
-
 from cli_helpers import run
 
 TOOLS = ["--robot-ref", "kuka_kr16", "--tool-ref", "0,0,200,0,0,0", "--robot-other",
@@ -57,7 +57,6 @@ def test_bad_input_exits_2_with_one_error_line_and_writes_nothing(capsys, tmp_pa
         ([r1, r2], "r1.csv: joint values a1..a6 need the robot's model \\(--robot-ref"),
         ([r1, r2, *TOOLS, "--tool-sigma", "0"], "--tool-sigma must be a positive number"),
     ]
-    import re
     for args, message in cases:
         code, _, err = run(capsys, "calibrate", "robot-to-robot", *args, "--json", "-o", out)
         assert code == 2

@@ -11,11 +11,10 @@ tables of every robot (joint values ``a1..a6`` in degrees and column ``point``),
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
-
 import csv
 import io
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
