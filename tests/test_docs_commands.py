@@ -187,6 +187,11 @@ def prepare(capsys, argv: list[str]) -> None:
                                "--sigma", "0.1", *extra)
             assert code == 0, err
         return
+    if argv[:2] == ["calibrate", "robot-to-robot"]:  # two robots' files, simulated as documented
+        code, _, err = run(capsys, "simulate", "robot-to-robot", "--seed", "1", "--ref-output",
+                           argv[2], "--other-output", argv[3])
+        assert code == 0, err
+        return
     if argv[0] == "calibrate":
         proc, data = argv[1], argv[2]
         tool = argv[argv.index("--tool") + 1] if "--tool" in argv else "pointer"

@@ -622,5 +622,6 @@ REGISTERED: dict[str, str] = {
     "turntable": "robotcell.cli.calibrate_axes:turntable",
     "positioner": "robotcell.cli.calibrate_axes:positioner",
     "workpiece": "robotcell.cli.calibrate_axes:workpiece",
+    "robot-to-robot": "robotcell.cli.robottorobot:calibrate_robot_to_robot",
 }
 # ------------------------------------------------------------------------------------------------

@@ -194,7 +194,9 @@ def calibrate_hint(t: Touches, csv_name: str, cell_path: str) -> str:
 
 class _Simulate(Command):
     """``simulate``, which hands ``simulate iso9283 ...`` to the acceptance test's simulation
-    (:func:`robotcell.cli.iso9283.simulate_iso9283`)."""
+    (:func:`robotcell.cli.iso9283.simulate_iso9283`) and ``simulate robot-to-robot ...`` to two
+    robots touching common points (:func:`robotcell.cli.robottorobot.simulate_robot_to_robot_cmd`),
+    neither of which needs a cell."""
 
     def make_context(self, info_name: str | None, args: list[str],
                      parent: click.Context | None = None, **extra: Any) -> click.Context:
@@ -203,6 +205,11 @@ class _Simulate(Command):
 
             return simulate_iso9283.make_context(f"{info_name} iso9283", args[1:], parent,
                                                  **extra)
+        if args[:1] == ["robot-to-robot"]:
+            from robotcell.cli.robottorobot import simulate_robot_to_robot_cmd
+
+            return simulate_robot_to_robot_cmd.make_context(f"{info_name} robot-to-robot",
+                                                            args[1:], parent, **extra)
         return super().make_context(info_name, args, parent, **extra)
 
 
@@ -223,7 +230,8 @@ def simulate(procedure: str, cell_path: str, noise: float, seed: int | None, too
     (mm, robot's track position), point. The command line that calibrates the file is printed
     on stderr. Procedures: tcp, frame, track, turntable, workpiece, positioner (a 2-axis
     positioner: one point on the plate at every combination of --tilts and --rotates).
-    'robotcell simulate iso9283 --help': the log of an ISO 9283 acceptance test.
+    'robotcell simulate iso9283 --help': the log of an ISO 9283 acceptance test;
+    'robotcell simulate robot-to-robot --help': two robots touching common points.
 
     \b
     Examples:

@@ -1,0 +1,162 @@
+"""``robotcell calibrate robot-to-robot`` and ``robotcell simulate robot-to-robot``.
+
+``calibrate robot-to-robot REF.csv OTHER.csv`` reads the touches of two robots (mm, deg; column
+``point`` names the common point of every touch) and prints the pose of the other robot's base in
+the reference robot's base (KUKA X,Y,Z,A,B,C in mm and deg) with the report, or ``--json``.
+``simulate robot-to-robot`` writes such a pair of files for two arms of the robot library at a
+stated pose. Registered in :data:`robotcell.cli.calibrate.REGISTERED` and dispatched by
+:class:`robotcell.cli.simulate` (see ``docs/calibration.md`` and ``docs/simulate.md``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from robotcell.calibration.robottorobot_tables import RobotTable, robot_to_robot_tables
+from robotcell.cli.calibrate import emit, gate, result_options, robot_and_tool, sigma_m
+from robotcell.cli.common import NOISE_MAX_MM, output_of, parse_numbers, read_csv
+from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
+from robotcell.errors import InputError
+from robotcell.io.fileio import atomic_write
+from robotcell.io.poseformats import pose_from_vendor
+from robotcell.robot.models import load_robot
+from robotcell.studies.robottorobot import (
+    SimulatedRobot,
+    default_points,
+    simulate_robot_to_robot,
+    table_text,
+)
+
+
+def _table(path: str, robot: str | None, tool: str | None, option: str) -> RobotTable:
+    """One robot's file with its model and tool (``--robot-ref``/``--tool-ref`` or ``-other``)."""
+    try:
+        model, T = robot_and_tool(robot, tool)
+    except InputError as exc:
+        raise InputError(str(exc).replace("--tool", f"--tool-{option}").replace(
+            "--robot", f"--robot-{option}")) from None
+    cols = read_csv(path)
+    if "a1" in cols and model is None:
+        raise InputError(f"{path}: joint values a1..a6 need the robot's model (--robot-{option} "
+                         f"NAME_OR_FILE) and the tool it touched with (--tool-{option} "
+                         "X,Y,Z,A,B,C)")
+    return RobotTable(cols, path, Path(path).stem, model, T)
+
+
+@click.command("robot-to-robot", cls=Command)
+@click.argument("reference", type=click.Path(dir_okay=False))
+@click.argument("other", type=click.Path(dir_okay=False))
+@click.option("--robot-ref", default=None, metavar="NAME_OR_FILE", type=NAME_OR_FILE,
+              help="Model of the reference robot, for joint values a1..a6 in REFERENCE.")
+@click.option("--tool-ref", default=None, metavar="X,Y,Z,A,B,C",
+              help="Tool the reference robot touched with (KUKA, mm/deg), for joint values.")
+@click.option("--robot-other", default=None, metavar="NAME_OR_FILE", type=NAME_OR_FILE,
+              help="Model of the other robot, for joint values a1..a6 in OTHER.")
+@click.option("--tool-other", default=None, metavar="X,Y,Z,A,B,C",
+              help="Tool the other robot touched with (KUKA, mm/deg), for joint values.")
+@click.option("--tool-sigma", type=float, default=None, metavar="MM",
+              help="Accuracy of both tools' TCP, 1-sigma per coordinate (mm); default 1 mm, "
+                   "reported as assumed.")
+@click.option("--pointer", is_flag=True,
+              help="The reference robot held a pointer at several poses and the other robot "
+                   "touched its tip (REFERENCE: the pointer's tip, OTHER: the touches).")
+@click.option("--sigma", type=float, default=None, metavar="MM",
+              help="Touch-up accuracy of both robots, 1-sigma per coordinate (mm; default 0.5).")
+@result_options
+@click.option("--accept-poor", is_flag=True,
+              help="Print and write -o even when the verdict is poor (exit 0).")
+def calibrate_robot_to_robot(reference: str, other: str, robot_ref: str | None,
+                             tool_ref: str | None, robot_other: str | None,
+                             tool_other: str | None, tool_sigma: float | None, pointer: bool,
+                             sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+    """Pose of one robot's base relative to another's, from touches both made.
+
+    \b
+    REFERENCE.csv and OTHER.csv: one row per touch of each robot, TCP positions x,y,z (mm, in
+    that robot's base) or joint values a1..a6 (deg) with --robot-ref/--robot-other and
+    --tool-ref/--tool-other, and column 'point' naming the common point touched (the same
+    names in both files; 3 or more points, not on one line, each touched by both robots).
+    Prints T_ref_other: the other robot's base in the reference robot's base.
+
+    \b
+    Example:
+      robotcell calibrate robot-to-robot r1.csv r2.csv --robot-ref kuka_kr16 --tool-ref 0,0,200,0,0,0 --robot-other abb_irb2400 --tool-other 50,0,180,0,0,0 --sigma 0.1
+    """
+    if tool_sigma is not None and not 0 < tool_sigma <= 1000:
+        raise InputError(f"--tool-sigma must be a positive number of millimetres up to 1000, "
+                         f"got {tool_sigma:g}")
+    ref = _table(reference, robot_ref, tool_ref, "ref")
+    oth = _table(other, robot_other, tool_other, "other")
+    result = robot_to_robot_tables(
+        ref, oth, sigma=sigma_m(sigma), tool_sigma=None if tool_sigma is None else tool_sigma * 1e-3,
+        method="pointer" if pointer else "common points",
+        on_note=lambda note: click.echo(note, err=True))
+    gate(result, as_json, accept_poor)
+    emit(result, as_json)
+
+
+def _pose_option(text: str, option: str) -> np.ndarray:
+    return pose_from_vendor(parse_numbers(text, option, 6), "kuka")
+
+
+@click.command("robot-to-robot", cls=Command)
+@click.option("--robot-ref", default="kuka_kr16", show_default=True, metavar="NAME_OR_FILE",
+              type=NAME_OR_FILE, help="Model of the reference robot.")
+@click.option("--robot-other", default="abb_irb2400", show_default=True, metavar="NAME_OR_FILE",
+              type=NAME_OR_FILE, help="Model of the other robot.")
+@click.option("--pose", default="1600,100,0,180,0,0", show_default=True, metavar="X,Y,Z,A,B,C",
+              help="The true pose of the other robot's base in the reference base (KUKA, mm/deg).")
+@click.option("--tool-ref", default="0,0,200,0,0,0", show_default=True, metavar="X,Y,Z,A,B,C",
+              help="The reference robot's tool (KUKA, mm/deg).")
+@click.option("--tool-other", default="50,0,180,0,0,0", show_default=True, metavar="X,Y,Z,A,B,C",
+              help="The other robot's tool (KUKA, mm/deg).")
+@click.option("--point", "points", multiple=True, metavar="X,Y,Z",
+              help="A common point in the reference base (mm); repeat for each (default: 5 "
+                   "points between the robots).")
+@click.option("--repeats", type=click.IntRange(1, 20), default=2, show_default=True,
+              help="Touches of each point by each robot.")
+@click.option("--noise", type=float, default=0.1, show_default=True, metavar="MM",
+              help="Touch-up error, 1-sigma per coordinate (mm).")
+@click.option("--seed", type=click.IntRange(min=0), default=None, help="Seed of the errors.")
+@click.option("--ref-output", required=True, type=OUTPUT, callback=output_of("CSV", "the "
+              "reference robot's touches"), help="CSV of the reference robot's touches.")
+@click.option("--other-output", required=True, type=OUTPUT, callback=output_of("CSV", "the "
+              "other robot's touches"), help="CSV of the other robot's touches.")
+def simulate_robot_to_robot_cmd(robot_ref: str, robot_other: str, pose: str, tool_ref: str,
+                                tool_other: str, points: tuple[str, ...], repeats: int,
+                                noise: float, seed: int | None, ref_output: str,
+                                other_output: str) -> None:
+    """Simulate two robots touching common points: one CSV per robot.
+
+    \b
+    Joint values a1..a6 (deg) that reach each point with the tool pointing down, plus the
+    touch-up error --noise, and column 'point' (P1, P2, ...). Both files are written only when
+    both robots reach every point. The command that calibrates them is printed on stderr.
+
+    \b
+    Example:
+      robotcell simulate robot-to-robot --seed 1 --ref-output r1.csv --other-output r2.csv
+    """
+    if not 0 <= noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a number of millimetres >= 0, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
+    T = _pose_option(pose, "--pose")
+    p = (np.array([parse_numbers(v, "--point", 3) for v in points]) * 1e-3 if points
+         else default_points(T))
+    robots = [SimulatedRobot(load_robot(robot_ref), np.eye(4), _pose_option(tool_ref, "--tool-ref"),
+                             f"the reference robot ({robot_ref})"),
+              SimulatedRobot(load_robot(robot_other), T, _pose_option(tool_other, "--tool-other"),
+                             f"the other robot ({robot_other})")]
+    tables = simulate_robot_to_robot(robots, p, noise=noise * 1e-3,
+                                     rng=np.random.default_rng(seed), repeats=repeats)
+    texts = [table_text(t) for t in tables]
+    atomic_write(ref_output, texts[0])
+    atomic_write(other_output, texts[1])
+    click.echo(f"simulated {len(p)} common points touched {repeats} times by each robot with a "
+               f"touch-up error of {noise:g} mm; wrote {ref_output} and {other_output}", err=True)
+    click.echo(f"calibrate them:\n  robotcell calibrate robot-to-robot {ref_output} "
+               f"{other_output} --robot-ref {robot_ref} --tool-ref {tool_ref} --robot-other "
+               f"{robot_other} --tool-other {tool_other} --sigma {max(noise, 0.001):g}", err=True)
