@@ -10,13 +10,32 @@ stated pose. Registered in :data:`robotcell.cli.calibrate.REGISTERED` and dispat
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import click
 import numpy as np
 
 from robotcell.calibration.robottorobot_tables import RobotTable, robot_to_robot_tables
-from robotcell.cli.calibrate import emit, gate, result_options, robot_and_tool, sigma_m
+from robotcell.cell import Cell
+from robotcell.cell.calibrate.robottorobot import (
+    RobotTouchFile,
+    place_robot,
+)
+from robotcell.cell.calibrate.robottorobot import (
+    calibrate_robot_to_robot as calibrate_in_cell,
+)
+from robotcell.cell.update import update_cell_file
+from robotcell.cli.calibrate import (
+    OUTPUT_KEY,
+    echo_note,
+    emit,
+    gate,
+    result_options,
+    robot_and_tool,
+    sigma_m,
+)
 from robotcell.cli.common import NOISE_MAX_MM, output_of, parse_numbers, read_csv
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
@@ -46,17 +65,37 @@ def _table(path: str, robot: str | None, tool: str | None, option: str) -> Robot
     return RobotTable(cols, path, Path(path).stem, model, T)
 
 
+@dataclass(frozen=True)
+class _Given:
+    """The options of ``calibrate robot-to-robot`` besides the files and the output."""
+
+    robot_ref: str | None
+    tool_ref: str | None
+    robot_other: str | None
+    tool_other: str | None
+    tool_sigma: float | None
+    pointer: bool
+    sigma: float | None
+    cell_path: str | None
+    robot: str | None
+    reference_robot: str | None
+    track_ref: float
+    track_other: float
+
+
 @click.command("robot-to-robot", cls=Command)
 @click.argument("reference", type=click.Path(dir_okay=False))
 @click.argument("other", type=click.Path(dir_okay=False))
 @click.option("--robot-ref", default=None, metavar="NAME_OR_FILE", type=NAME_OR_FILE,
               help="Model of the reference robot, for joint values a1..a6 in REFERENCE.")
 @click.option("--tool-ref", default=None, metavar="X,Y,Z,A,B,C",
-              help="Tool the reference robot touched with (KUKA, mm/deg), for joint values.")
+              help="Tool the reference robot touched with (KUKA, mm/deg), for joint values; "
+                   "with --cell the name of one of its tools in the cell.")
 @click.option("--robot-other", default=None, metavar="NAME_OR_FILE", type=NAME_OR_FILE,
               help="Model of the other robot, for joint values a1..a6 in OTHER.")
 @click.option("--tool-other", default=None, metavar="X,Y,Z,A,B,C",
-              help="Tool the other robot touched with (KUKA, mm/deg), for joint values.")
+              help="Tool the other robot touched with (KUKA, mm/deg), for joint values; with "
+                   "--cell the name of one of its tools in the cell.")
 @click.option("--tool-sigma", type=float, default=None, metavar="MM",
               help="Accuracy of both tools' TCP, 1-sigma per coordinate (mm); default 1 mm, "
                    "reported as assumed.")
@@ -65,13 +104,22 @@ def _table(path: str, robot: str | None, tool: str | None, option: str) -> Robot
                    "touched its tip (REFERENCE: the pointer's tip, OTHER: the touches).")
 @click.option("--sigma", type=float, default=None, metavar="MM",
               help="Touch-up accuracy of both robots, 1-sigma per coordinate (mm; default 0.5).")
+@click.option("--cell", "cell_path", default=None, type=click.Path(dir_okay=False),
+              help="A cell of several robots: the robots' models and tools are the cell's, and "
+                   "the other robot's base is written into it.")
+@click.option("--robot", default=None, metavar="NAME",
+              help="With --cell: the robot of OTHER, whose base is placed.")
+@click.option("--reference", "reference_robot", default=None, metavar="NAME",
+              help="With --cell: the robot of REFERENCE, the base the result is in.")
+@click.option("--track-ref", type=float, default=0.0, show_default=True, metavar="MM",
+              help="With --cell: the reference robot's track position during its touches (mm).")
+@click.option("--track-other", type=float, default=0.0, show_default=True, metavar="MM",
+              help="With --cell: the other robot's track position during its touches (mm).")
 @result_options
 @click.option("--accept-poor", is_flag=True,
-              help="Print and write -o even when the verdict is poor (exit 0).")
-def calibrate_robot_to_robot(reference: str, other: str, robot_ref: str | None,
-                             tool_ref: str | None, robot_other: str | None,
-                             tool_other: str | None, tool_sigma: float | None, pointer: bool,
-                             sigma: float | None, as_json: bool, accept_poor: bool) -> None:
+              help="Print, write -o and the cell even when the verdict is poor (exit 0).")
+def calibrate_robot_to_robot(reference: str, other: str, as_json: bool, accept_poor: bool,
+                             **options: Any) -> None:
     """Pose of one robot's base relative to another's, from touches both made.
 
     \b
@@ -79,22 +127,70 @@ def calibrate_robot_to_robot(reference: str, other: str, robot_ref: str | None,
     that robot's base) or joint values a1..a6 (deg) with --robot-ref/--robot-other and
     --tool-ref/--tool-other, and column 'point' naming the common point touched (the same
     names in both files; 3 or more points, not on one line, each touched by both robots).
-    Prints T_ref_other: the other robot's base in the reference robot's base.
+    Prints T_ref_other: the other robot's base in the reference robot's base. With --cell
+    CELL.yaml --robot NAME --reference NAME the robots and tools are the cell's and the other
+    robot's base is written into the cell (for a robot on a track: its base at track 0).
 
     \b
     Example:
       robotcell calibrate robot-to-robot r1.csv r2.csv --robot-ref kuka_kr16 --tool-ref 0,0,200,0,0,0 --robot-other abb_irb2400 --tool-other 50,0,180,0,0,0 --sigma 0.1
     """
-    if tool_sigma is not None and not 0 < tool_sigma <= 1000:
+    given = _Given(**options)
+    if given.tool_sigma is not None and not 0 < given.tool_sigma <= 1000:
         raise InputError(f"--tool-sigma must be a positive number of millimetres up to 1000, "
-                         f"got {tool_sigma:g}")
-    ref = _table(reference, robot_ref, tool_ref, "ref")
-    oth = _table(other, robot_other, tool_other, "other")
+                         f"got {given.tool_sigma:g}")
+    if given.cell_path is not None:
+        return _into_cell(reference, other, given, as_json, accept_poor)
+    for option, value in (("--robot", given.robot), ("--reference", given.reference_robot)):
+        if value is not None:
+            raise InputError(f"{option} names a robot of a cell; it needs --cell CELL.yaml")
+    if given.track_ref or given.track_other:
+        raise InputError("--track-ref and --track-other are track positions of a cell's robots; "
+                         "they need --cell CELL.yaml")
+    ref = _table(reference, given.robot_ref, given.tool_ref, "ref")
+    oth = _table(other, given.robot_other, given.tool_other, "other")
     result = robot_to_robot_tables(
-        ref, oth, sigma=sigma_m(sigma), tool_sigma=None if tool_sigma is None else tool_sigma * 1e-3,
-        method="pointer" if pointer else "common points",
+        ref, oth, sigma=sigma_m(given.sigma), tool_sigma=_tool_sigma_m(given),
+        method="pointer" if given.pointer else "common points",
         on_note=lambda note: click.echo(note, err=True))
     gate(result, as_json, accept_poor)
+    emit(result, as_json)
+
+
+def _tool_sigma_m(given: _Given) -> float | None:
+    return None if given.tool_sigma is None else given.tool_sigma * 1e-3
+
+
+def _into_cell(reference: str, other: str, given: _Given, as_json: bool,
+               accept_poor: bool) -> None:
+    """``--cell``: calibrate with the cell's robots and tools, then place the other robot."""
+    for option, value in (("--robot-ref", given.robot_ref), ("--robot-other", given.robot_other)):
+        if value is not None:
+            raise InputError(f"{option} and --cell both give a robot model: with --cell the "
+                             f"models are the cell's; drop {option}")
+    for option, value in (("--robot", given.robot), ("--reference", given.reference_robot),
+                          ("--tool-ref", given.tool_ref), ("--tool-other", given.tool_other)):
+        if value is None:
+            raise InputError(f"--cell needs {option}: " + (
+                "the name of a robot of the cell" if "tool" not in option
+                else "the name of the tool that robot touched with, in the cell"))
+    output = click.get_current_context().meta.get(OUTPUT_KEY)
+    if output is not None and Path(output).resolve() == Path(given.cell_path).resolve():
+        raise InputError(f"-o {output} is the cell file; name another file for the result")
+    cell = Cell.load(given.cell_path)
+    ref = RobotTouchFile(given.reference_robot, reference, given.tool_ref.strip(),
+                         given.track_ref * 1e-3)
+    oth = RobotTouchFile(given.robot, other, given.tool_other.strip(), given.track_other * 1e-3)
+    result = calibrate_in_cell(cell, ref, oth, sigma=sigma_m(given.sigma),
+                               tool_sigma=_tool_sigma_m(given),
+                               method="pointer" if given.pointer else "common points",
+                               on_note=echo_note)
+    gate(result, as_json, accept_poor)
+    done = update_cell_file(given.cell_path,
+                            lambda c: (place_robot(c, result, ref, oth), None), on_note=echo_note)
+    kept = f" (previous version: {done.backup})" if done.backup is not None else ""
+    click.echo(f"updated {given.cell_path}: base of robot {given.robot!r} from robot "
+               f"{given.reference_robot!r}{kept}", err=True)
     emit(result, as_json)
 
 
