@@ -119,3 +119,19 @@ def test_robot_names_without_a_cell_are_refused(capsys, tmp_path):
     r_csv, o_csv = _touches(capsys, tmp_path, Cell.load(EXAMPLE), "kuka", "abb", {}, 4)
     code, _, err = run(capsys, "calibrate", "robot-to-robot", r_csv, o_csv, "--reference", "kuka")
     assert code == 2 and "--reference names a robot of a cell; it needs --cell" in err
+
+
+def test_the_report_of_a_robot_to_robot_result_shows_both_bases_and_the_1_sigma(capsys, tmp_path):
+    r_csv, o_csv = _touches(capsys, tmp_path, Cell.load(EXAMPLE), "kuka", "abb", {}, 5)
+    result = tmp_path / "r2r.json"
+    code, _, err = run(capsys, "calibrate", "robot-to-robot", r_csv, o_csv, "--robot-ref",
+                       "kuka_kr16", "--tool-ref", TOOLS["kuka"], "--robot-other", "abb_irb2400",
+                       "--tool-other", TOOLS["abb"], "--sigma", "0.1", "--json", "-o", result)
+    assert code == 0, err
+    code, _, err = run(capsys, "report", result, "-o", tmp_path / "r2r.html")
+    assert code == 0, err
+    page = (tmp_path / "r2r.html").read_text()
+    assert "position of the other robot&#x27;s base in the reference robot&#x27;s base" in page \
+        or "position of the other robot's base in the reference robot's base" in page
+    assert "<td>not available</td>" not in page and "Plotly.newPlot" in page
+    assert "the other robot&#x27;s base" in page or "the other robot's base" in page

@@ -234,7 +234,13 @@ def remove(name: str) -> None:
     _SPECS.pop(name, None)
 
 
+#: Results of calibrations between robots, each from two robots' touch files with a command of
+#: its own (``calibrate robot-to-robot``), not a procedure of one touch file in :data:`SPECS`.
+BETWEEN_ROBOTS = ("robot-to-robot",)
+
+
 def result_procedures() -> tuple[str, ...]:
     """The ``procedure`` of every result robotcell's calibrations write, in the order of
-    :data:`SPECS` (e.g. ``"frame-3point"`` of the frame procedure)."""
-    return tuple(r for spec in _SPECS.values() for r in spec.results)
+    :data:`SPECS` (e.g. ``"frame-3point"`` of the frame procedure), then
+    :data:`BETWEEN_ROBOTS`."""
+    return (*(r for spec in _SPECS.values() for r in spec.results), *BETWEEN_ROBOTS)

@@ -71,9 +71,11 @@ def verdict(result: dict[str, Any]) -> tuple[str, list[str]]:
 
 #: Names of the frames of docs/conventions.md, for figure labels.
 _FRAME_NAMES = {"R": "robot base R", "world": "world", "L": "track L", "B": "turntable B",
-                "F": "flange F", "W": "workpiece W", "TCP": "TCP"}
+                "F": "flange F", "W": "workpiece W", "TCP": "TCP",
+                "ref": "the reference robot's base", "other": "the other robot's base"}
 #: A key of a result's pose ``T_a_b`` (its sigma or covariance), giving frames a and b.
-_POSE_KEY = re.compile(r"T_(R|world|L|B|F)_(\w+?)_(?:position_mm|rotation_deg|covariance_mm_rad)")
+_POSE_KEY = re.compile(
+    r"T_(R|world|L|B|F|ref)_(\w+?)_(?:position_mm|rotation_deg|covariance_mm_rad)")
 
 
 def _frames(result: dict[str, Any]) -> tuple[str, list[tuple[str, np.ndarray]]]:
