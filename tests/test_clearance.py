@@ -134,6 +134,8 @@ def test_a_bodies_file_reads_mm_and_deg(tmp_path):
     ("bodies:\n  a: {cone: 3}\n", r"unknown key.*cone"),
     ("bodies:\n  a: {sphere: -3}\n", r"sphere takes radius > 0"),
     ("bodies:\n  a: {sphere: .nan}\n", r"finite number"),
+    ("bodies:\n  a: {sphere: 1e300}\n", r"beyond the 100 m of any cell"),
+    ("bodies:\n  a: {sphere: 3, frame: {x: 1e300}}\n", r"within 100 m"),
     ("bodies:\n  a: {sphere: 3, frame: {x: one}}\n", r"bodies\.a\.frame"),
     ("links: {radius: -1}\n", r"radius must be a finite length >= 0"),
     ("ignore: [tool]\n", r"ignore.*\[name, name\] pairs"),

@@ -29,6 +29,7 @@ the same exit status and output as the same cases run here.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -905,6 +906,81 @@ BUILDERS.update({"iso9283-analyse": _iso_analyse, "iso9283-plan": _iso_plan,
                  "simulate-iso9283": _simulate_iso})
 
 
+TWO_ROBOTS = EXAMPLES / "cell_two_robots_positioner.yaml"
+
+
+@functools.lru_cache(maxsize=1)
+def _robot_to_robot_tables() -> tuple[str, str]:
+    """The two robots of the two-robot example touching 5 common points twice with their torches
+    (joint values, 0.05 mm touch error): the reference (kuka, its track at 0) and the other."""
+    from robotcell.cell import Cell
+    from robotcell.kinematics.transforms import invert
+    from robotcell.studies.robottorobot import (
+        SimulatedRobot,
+        default_points,
+        simulate_robot_to_robot,
+        table_text,
+    )
+
+    cell = Cell.load(TWO_ROBOTS)
+    kuka, abb = cell.for_robot("kuka"), cell.for_robot("abb")
+    T = invert(kuka.frame_pose("robot")) @ abb.frame_pose("robot")
+    robots = [SimulatedRobot(kuka.robot, np.eye(4), kuka.tools["torch"].T_F_TCP, "kuka"),
+              SimulatedRobot(abb.robot, T, abb.tools["torch"].T_F_TCP, "abb")]
+    tables = simulate_robot_to_robot(robots, default_points(T), noise=5e-5,
+                                     rng=np.random.default_rng(SEED), repeats=2)
+    return table_text(tables[0]), table_text(tables[1])
+
+
+def _robot_to_robot(rng, d, good, out):
+    """calibrate robot-to-robot: one robot's touches mutated, with the two-robot cell (mutated
+    in 15 %) or with the models and tools given, and an option sometimes wrong."""
+    ref_text, other_text = _robot_to_robot_tables()
+    ref, what = ((_mutated(ref_text, rng, d, "r1.csv")) if rng.random() < 0.5
+                 else (_write(d / "r1.csv", ref_text), "r1.csv valid"))
+    other, w = ((_mutated(other_text, rng, d, "r2.csv")) if rng.random() < 0.7
+                else (_write(d / "r2.csv", other_text), "r2.csv valid"))
+    what += f"; {w}"
+    inputs = [ref, other]
+    if rng.random() < 0.5:
+        cell = _write(d / "cell.yaml", TWO_ROBOTS.read_text(encoding="utf-8"))
+        if rng.random() < 0.15:
+            cell, w = _mutated(TWO_ROBOTS.read_text(encoding="utf-8"), rng, d, "cell.yaml")
+            what += f"; {w}"
+        args = ["--cell", cell, "--robot", "abb", "--reference", "kuka", "--tool-ref", "torch",
+                "--tool-other", "torch"]
+        inputs.append(cell)
+        opts = _maybe(rng, 0.3, {"--robot": ["kuka", "nosuch", ""], "--tool-other": ["nosuch"],
+                                 "--track-ref": BAD_FLOATS + ["9000"],
+                                 "--track-other": ["100", "abc"]})
+    else:
+        args = ["--robot-ref", "kuka_kr16", "--tool-ref", "312.5,-1.2,95,0,45,0",
+                "--robot-other", "abb_irb2400", "--tool-other", "300,0,90,0,45,0"]
+        opts = _maybe(rng, 0.3, {"--tool-ref": BAD_LISTS, "--robot-other": ["nosuch", ""],
+                                 "--reference": ["kuka"]})
+    opts += _maybe(rng, 0.2, {"--sigma": BAD_FLOATS + ["0.05"],
+                              "--tool-sigma": BAD_FLOATS + ["0.2"]})
+    json_out = ["--json", "-o", out] if rng.random() < 0.4 else []
+    return (["calibrate", "robot-to-robot", ref, other, *args, *opts, *json_out],
+            f"{what} {' '.join(opts)}", inputs, [out] if json_out else [])
+
+
+def _program_bodies(rng, d, good, out):
+    """program check --bodies: the example's bodies file mutated, or a clearance option."""
+    text = (EXAMPLES / "bodies_kr16_track_turntable.yaml").read_text(encoding="utf-8")
+    bodies, what = ((_mutated(text, rng, d, "bodies.yaml")) if rng.random() < 0.8
+                    else (_write(d / "bodies.yaml", text), "bodies.yaml valid"))
+    opts = _maybe(rng, 0.3, {"--clearance": BAD_FLOATS + ["2000", "180"]})
+    shutil.copytree(good["prog_kuka"], d / "prog")
+    src = next((d / "prog").glob("*.src"))
+    return (["program", "check", src, "--cell", EXAMPLE, "--bodies", bodies, *opts],
+            f"{what} {' '.join(opts)}", [bodies, d / "prog"], [])
+
+
+CASES.update({"robot-to-robot": (4, 60), "program-bodies": (3, 40)})
+BUILDERS.update({"robot-to-robot": _robot_to_robot, "program-bodies": _program_bodies})
+
+
 
 def _edit_rows(text: str, edit) -> str:
     return _join(edit(_split(text)))
@@ -1425,3 +1501,4 @@ def test_cli_fuzz_spreadsheet_cells(kind, tmp_path, capsys, monkeypatch):
         shutil.rmtree(d)
     assert not failures, (f"seed {SEED}, {len(failures)} cases failed:\n"
                           + "\n".join(failures[:8]))
+

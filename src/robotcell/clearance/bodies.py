@@ -111,9 +111,15 @@ def _mapping(value: Any, origin: str, key: str, allowed: set[str]) -> dict:
     return value
 
 
+#: The largest length a bodies file may hold (mm): 100 m, as for a cell file.
+MAX_MM = 100_000.0
+
+
 def _mm(value: Any, origin: str, key: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
         raise _fail(origin, key, f"must be a finite number (mm), got {value!r}")
+    if abs(value) > MAX_MM:
+        raise _fail(origin, key, f"is {value:g} mm, beyond the {MAX_MM / 1000:g} m of any cell")
     return float(value) / 1000.0
 
 
@@ -137,8 +143,9 @@ def _body(name: str, value: Any, origin: str) -> Body:
     frame = _mapping(m.get("frame") or {}, origin, f"{key}.frame", set(_POSE_KEYS))
     values = [frame.get(k, 0) for k in _POSE_KEYS]
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
-               for v in values):
-        raise _fail(origin, f"{key}.frame", f"must hold finite numbers (mm, deg), got {frame!r}")
+               and abs(v) <= MAX_MM for v in values):
+        raise _fail(origin, f"{key}.frame", f"must hold finite numbers (mm, deg) within "
+                    f"{MAX_MM / 1000:g} m, got {frame!r}")
     parent = m.get("parent", "world")
     if not isinstance(parent, str) or not parent.strip():
         raise _fail(origin, f"{key}.parent", f"must be a frame's name, got {parent!r}")
