@@ -85,7 +85,7 @@ def test_monte_carlo_sigma_agrees_with_spread():
         assert np.all(np.abs(ratio - 1) < 0.25), ratio
 
 
-def test_prior_sigma_used_when_given():
+def test_stated_sigma_used_when_given():
     rng = np.random.default_rng(13)
     touches = noisy([pose_for(R, TCP) for R in design(rng, 4)], rng, 1e-4)
     r = calibrate_tool(touches, sigma=5e-4)
