@@ -38,7 +38,7 @@ def measure(repeats: int = REPEATS):
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        res = identify(nominal, meas, point_sigma=NOISE)
+        res = identify(nominal, meas, sigma=NOISE)
         times.append(time.perf_counter() - t0)
     return times, res
 

@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from robotcell.identification import Measurements
+from robotcell.identification import TargetMeasurements
 from robotcell.identification.chain import Chain
 from robotcell.kinematics.transforms import make_pose
 from robotcell.robot.robot import Robot
@@ -62,17 +62,17 @@ def configurations(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray
 
 
 def measure(ch: Chain, x: np.ndarray, q: np.ndarray, rng: np.random.Generator, noise: float,
-            angle_noise: float = 0.0) -> Measurements:
+            angle_noise: float = 0.0) -> TargetMeasurements:
     """Simulated measurements with Gaussian noise (m per coordinate, rad per axis)."""
     pts, R = ch.predict(x, q)
     pts = pts + rng.normal(0.0, noise, pts.shape)
     rot = None
     if ch.pose_target:
         rot = Rotation.from_rotvec(rng.normal(0.0, angle_noise, (len(q), 3))).as_matrix() @ R
-    return Measurements(q, pts, rot)
+    return TargetMeasurements(q, pts, rot)
 
 
-def write_csv(path, meas: Measurements, prismatic=None) -> None:
+def write_csv(path, meas: TargetMeasurements, prismatic=None) -> None:
     """Write measurements as the CLI's CSV (deg / mm)."""
     n, K = meas.q.shape[1], meas.n_targets
     pris = np.zeros(n, dtype=bool) if prismatic is None else np.asarray(prismatic)

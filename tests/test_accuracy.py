@@ -22,7 +22,7 @@ from programs_helpers import EXT
 from robotcell import load_robot, save_robot
 from robotcell.accuracy import filter_poses
 from robotcell.cell import Cell, Provenance
-from robotcell.identification import identify, read_measurements
+from robotcell.identification import identify, read_target_measurements
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv
@@ -39,7 +39,7 @@ def kr16(tmp_path_factory):
     rng = np.random.default_rng(24)
     truth = kr16_truth(rng)
     tracker_csv(d / "tracker.csv", truth, 50, rng)
-    result = identify(NOMINAL, read_measurements(d / "tracker.csv"), point_sigma=2e-5)
+    result = identify(NOMINAL, read_target_measurements(d / "tracker.csv"), sigma=2e-5)
     return truth, d / "tracker.csv", result
 
 
@@ -111,7 +111,7 @@ def test_the_identified_model_file_reads_as_an_arm(kr16, tmp_path):
         assert getattr(j, key) == pytest.approx(p.value, abs=1e-11), p.name
     assert np.array_equal(arm.tool, NOMINAL.tool) and np.array_equal(arm.base, NOMINAL.base)
     # and the same FK as the identification's own prediction
-    q = read_measurements(kr16[1]).q[:20]
+    q = read_target_measurements(kr16[1]).q[:20]
     pred = (res.base @ arm.fk(q, tool=res.target_tool))[:, :3, 3]
     assert np.abs(pred - res.predict(q)[0][:, 0]).max() < 1e-9
 
@@ -351,7 +351,7 @@ def test_export_of_an_identified_ur5e_writes_the_calibration_file_the_descriptio
     from accuracy_helpers import NOISE
     from identification_helpers import REFLECTORS, T_D_R
 
-    from robotcell.identification import Measurements
+    from robotcell.identification import TargetMeasurements
 
     nominal = load_robot("ur5e")
     rng = np.random.default_rng(5)
@@ -363,8 +363,8 @@ def test_export_of_an_identified_ur5e_writes_the_calibration_file_the_descriptio
     q = rng.uniform(-math.pi, math.pi, (40, 6))
     T = T_D_R @ truth.fk(q)
     pts = np.einsum("nij,kj->nki", T[:, :3, :3], REFLECTORS) + T[:, None, :3, 3]
-    res = identify(nominal, Measurements(q, pts + rng.normal(0, NOISE, pts.shape)),
-                   point_sigma=NOISE)
+    res = identify(nominal, TargetMeasurements(q, pts + rng.normal(0, NOISE, pts.shape)),
+                   sigma=NOISE)
     save_robot(res.robot, tmp_path / "ur5e_identified.yaml")
     (tmp_path / "cell.yaml").write_text("name: ur_cell\nrobot:\n  model: ur5e\n"
                                         "  identified: ur5e_identified.yaml\n")
@@ -393,7 +393,7 @@ def test_the_predicted_sigma_agrees_with_a_monte_carlo_of_the_identification():
     arm's constants, plus the model error, pooled over the points). Its standard deviation follows from
     the predicted covariance S of the stacked errors (Var of a Gaussian quadratic form,
     2 tr(S^2)): the bounds 0.8 and 1.25 are more than 3 of it away."""
-    from robotcell.identification import Measurements
+    from robotcell.identification import TargetMeasurements
     from robotcell.identification.uncertainty import position_jacobian, position_sigma
     from robotcell.kinematics.transforms import make_pose
     from robotcell.robot.robot import Joint, Robot
@@ -411,15 +411,15 @@ def test_the_predicted_sigma_agrees_with_a_monte_carlo_of_the_identification():
     def measure(q, sigma):
         T = truth.fk(q)
         p = np.einsum("nij,kj->nki", T[:, :3, :3], reflectors) + T[:, None, :3, 3]
-        return Measurements(q, p + rng.normal(0.0, sigma, p.shape))
+        return TargetMeasurements(q, p + rng.normal(0.0, sigma, p.shape))
 
-    exact = identify(nominal, measure(rng.uniform(-1.5, 1.5, (400, 3)), 0.0), point_sigma=noise)
+    exact = identify(nominal, measure(rng.uniform(-1.5, 1.5, (400, 3)), 0.0), sigma=noise)
     q_test, tool = rng.uniform(-1.5, 1.5, (8, 3)), make_pose(None, [0.1, 0.05, 0.15])
     ref = (exact.base @ exact.robot.fk(q_test, tool=tool))[:, :3, 3]
     q = rng.uniform(-1.5, 1.5, (20, 3))
     trials, squares, S, sigmas = 50, [], 0.0, []
     for _ in range(trials):
-        res = identify(nominal, measure(q, noise), point_sigma=noise)
+        res = identify(nominal, measure(q, noise), sigma=noise)
         # the TCP as the identification locates it in the measuring frame (base and arm)
         squares.append(np.sum(((res.base @ res.robot.fk(q_test, tool=tool))[:, :3, 3] - ref) ** 2))
         cov = res.robot.covariance

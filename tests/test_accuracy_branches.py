@@ -23,7 +23,7 @@ from cli_helpers import run
 from robotcell import load_robot, save_robot
 from robotcell.accuracy import filter_poses
 from robotcell.cell import Cell
-from robotcell.identification import identify, read_measurements
+from robotcell.identification import identify, read_target_measurements
 from robotcell.ik.config import branch_of_flags, flags_of_branch
 from robotcell.io.poseformats import pose_to_vendor
 
@@ -39,9 +39,9 @@ def ur5(tmp_path_factory):
     """A cell whose arm is the real UR5 as identified from a third of its rows, and 20 held-out
     measured configurations with the poses the arm had there (its identified FK)."""
     d = tmp_path_factory.mktemp("ur5")
-    meas = read_measurements(DATA / "jacobi_ur5_grid_poses.csv")
+    meas = read_target_measurements(DATA / "jacobi_ur5_grid_poses.csv")
     nominal = load_robot(DATA / "ur5_cb3.yaml")
-    res = identify(nominal, meas.subset(np.isin(np.arange(meas.n_rows), TRAIN)), point_sigma=0.1e-3)
+    res = identify(nominal, meas.subset(np.isin(np.arange(meas.n_rows), TRAIN)), sigma=0.1e-3)
     save_robot(res.robot, d / "ur5_identified.yaml")
     (d / "cell.yaml").write_text(f"name: ur5_cell\nrobot:\n  model: {DATA / 'ur5_cb3.yaml'}\n"
                                  "  identified: ur5_identified.yaml\ntools:\n  probe:\n"

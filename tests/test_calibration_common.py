@@ -41,7 +41,7 @@ def test_fit_sigma_matches_monte_carlo_spread():
     for _ in range(400):
         meas = line_model(s)(truth) + rng.normal(scale=noise, size=(8, 3))
         res = fit(lambda x, m=meas: m - line_model(s)(x), np.zeros(6), list("abcdef"),
-                  prior_sigma=noise)
+                  sigma=noise)
         errors.append(res.x - truth)
         sigmas.append(res.sigma)
         noise_est.append(res.residual_sigma)
@@ -59,11 +59,11 @@ def test_fit_prior_and_no_redundancy():
     # No redundancy and no stated accuracy: the default 0.5 mm, never an unknown sigma.
     assert res.dof == 0 and res.noise_source == "default" and res.chi2 is None
     np.testing.assert_allclose(res.sigma, 0.5e-3)
-    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-3)
+    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], sigma=1e-3)
     assert res.noise_source == "prior"
     np.testing.assert_allclose(res.sigma, 1e-3)
     with pytest.raises(InputError, match="positive"):
-        fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=-1.0)
+        fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], sigma=-1.0)
 
 
 def test_fit_refuses_unobservable_parameter_and_names_it():
@@ -77,12 +77,12 @@ def test_outlier_is_named_and_clean_data_rarely_flagged():
     flagged = 0
     for _ in range(200):
         meas = rng.normal(scale=1e-4, size=(10, 3))
-        res = fit(lambda x, m=meas: m - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-4)
+        res = fit(lambda x, m=meas: m - x, np.zeros(3), ["x", "y", "z"], sigma=1e-4)
         flagged += len(outlier_warnings(res, [str(i) for i in range(10)]))
     assert flagged / 2000 < 0.01
     meas = rng.normal(scale=1e-4, size=(10, 3))
     meas[6] += [1.5e-3, 0, 0]
-    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], prior_sigma=1e-4)
+    res = fit(lambda x: meas - x, np.zeros(3), ["x", "y", "z"], sigma=1e-4)
     warnings = outlier_warnings(res, [f"row {i}" for i in range(10)])
     assert len(warnings) == 1 and "row 6" in warnings[0] and "3 sigma" in warnings[0]
     # The others single it out: it is left out, and the estimate is their mean.

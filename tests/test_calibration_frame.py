@@ -5,7 +5,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from robotcell import IllPosedError, InputError
-from robotcell.calibration import external_tcp, frame_3point, frame_npoint
+from robotcell.calibration import calibrate_external_tcp as external_tcp
+from robotcell.calibration import frame_3point, frame_npoint
 from robotcell.kinematics.transforms import transform_points
 
 R_TRUE = Rotation.from_euler("ZYX", [40, 5, -3], degrees=True).as_matrix()
@@ -93,11 +94,11 @@ def test_collinear_points_refused_with_cause_and_fix():
 
 def test_nearly_collinear_and_short_x_warn():
     pts = transform_points(T_TRUE, [[0, 0, 0], [0.06, 0, 0], [0.3, 0.03, 0]])
-    r = frame_3point(pts, ROLES, prior_sigma=1e-4)
+    r = frame_3point(pts, ROLES, sigma=1e-4)
     assert any("nearly collinear" in w for w in r.warnings)
     assert any("only 60 mm" in w for w in r.warnings)
     q = np.array([[0, 0, 0], [0.3, 0, 0], [0.6, 0.03, 0], [0.9, 0, 0]])
-    r = frame_npoint(transform_points(T_TRUE, q), q, prior_sigma=1e-4)
+    r = frame_npoint(transform_points(T_TRUE, q), q, sigma=1e-4)
     assert any("nearly collinear" in w for w in r.warnings)
 
 

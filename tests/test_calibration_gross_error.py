@@ -46,11 +46,11 @@ GRID = np.radians([[t, r] for t in (-30.0, 0.0, 30.0) for r in (0.0, 90.0, 180.0
 
 
 def track(f):
-    return calibrate_track(E, f, references=REFS, point=POINT, prior_sigma=NOISE)
+    return calibrate_track(E, f, references=REFS, point=POINT, sigma=NOISE)
 
 
 def turntable(f):
-    return calibrate_turntable(THETA, f, prior_sigma=NOISE)
+    return calibrate_turntable(THETA, f, sigma=NOISE)
 
 
 def frame(f):
@@ -61,11 +61,11 @@ WP_THETA = np.radians([10.0, 100.0, 200.0, 250.0, 310.0, 35.0])
 
 
 def workpiece(f):
-    return calibrate_workpiece(WP_THETA, f, ROLES, T_R_B, prior_sigma=NOISE)
+    return calibrate_workpiece(WP_THETA, f, ROLES, T_R_B, sigma=NOISE)
 
 
 def positioner(f):
-    return calibrate_positioner(GRID, f, nominal=POSITIONER, prior_sigma=NOISE).result
+    return calibrate_positioner(GRID, f, nominal=POSITIONER, sigma=NOISE).result
 
 
 CLEAN = {
@@ -108,7 +108,7 @@ def test_the_bad_touch_is_left_out_and_the_result_says_so():
     r = calibrate(f)
     assert r.excluded == [4] and r.outliers == []
     clean_fit = calibrate_turntable(np.delete(THETA, 4), np.delete(f, 4, axis=0),
-                                    prior_sigma=NOISE)
+                                    sigma=NOISE)
     np.testing.assert_allclose(r.values["T_R_B"], clean_fit.values["T_R_B"], atol=1e-9)
     assert r.rms < 2 * NOISE and r.residual_norms[4] > 4e-3  # against the others' fit
     assert "touch 5 is an outlier at 3 sigma" in r.warnings[0] and "left out" in r.warnings[0]

@@ -60,7 +60,7 @@ def flange(rng, n, tool_points):
 
 def tcp(n):
     def make(rng, prior):
-        return tcp_mod.calibrate_tool(flange(rng, n, np.tile(TCP, (n, 1))), prior_sigma=prior)
+        return tcp_mod.calibrate_tool(flange(rng, n, np.tile(TCP, (n, 1))), sigma=prior)
     return make
 
 
@@ -68,7 +68,7 @@ def tcp_abc(rng, prior):
     axis = TCP - np.outer([0.06, 0.1], R_TOOL[:, 0])
     plane = TCP + np.array([[0.02, 0.07], [0.05, 0.04]]) @ R_TOOL[:, :2].T
     return tcp_mod.calibrate_tool(flange(rng, 5, np.tile(TCP, (5, 1))), flange(rng, 2, axis),
-                                  flange(rng, 2, plane), prior_sigma=prior)
+                                  flange(rng, 2, plane), sigma=prior)
 
 
 LOCAL = np.array([[0, 0, 0]] * 2 + [[0.3, 0, 0], [0.15, 0, 0], [0.1, 0.2, 0], [0.25, 0.1, 0]])
@@ -92,7 +92,7 @@ def external_tcp(roles):
                       for r in roles], dtype=float)
 
     def make(rng, prior):
-        return frame_mod.external_tcp(noisy(rng, transform_points(T_FRAME, local)), roles, prior)
+        return frame_mod.calibrate_external_tcp(noisy(rng, transform_points(T_FRAME, local)), roles, prior)
     return make
 
 
@@ -101,7 +101,7 @@ E = np.linspace(0.0, 2.0, 6)
 
 def track(rng, prior):
     return track_mod.calibrate_track(E, noisy(rng, (REF - np.outer(E, [1, 0, 0])) @ Q),
-                                     prior_sigma=prior)
+                                     sigma=prior)
 
 
 REF2 = np.array([2.1, -0.6, 0.1])
@@ -112,7 +112,7 @@ def track_references(rng, prior):
     k = np.arange(len(E)) % 2
     r = np.array([REF, REF2])[k]
     return track_mod.calibrate_track(E, noisy(rng, (r - np.outer(E, [1, 0, 0])) @ Q),
-                                     references=[REF, REF2], point=k, prior_sigma=prior)
+                                     references=[REF, REF2], point=k, sigma=prior)
 
 
 THETA = np.radians([0.0, 60.0, 130.0, 200.0, 270.0, 320.0])
@@ -120,7 +120,7 @@ THETA = np.radians([0.0, 60.0, 130.0, 200.0, 270.0, 320.0])
 
 def turntable(rng, prior):
     f = transform_points(T_R_B, np.einsum("nij,j->ni", rot_z(THETA), [0.3, 0, 0]))
-    return turntable_mod.calibrate_turntable(THETA, noisy(rng, f), prior_sigma=prior)
+    return turntable_mod.calibrate_turntable(THETA, noisy(rng, f), sigma=prior)
 
 
 def workpiece(rng, prior):
@@ -130,7 +130,7 @@ def workpiece(rng, prior):
     theta = np.radians([10.0, 100.0, 200.0, 250.0, 310.0, 35.0])
     f = transform_points(T_R_B, np.einsum("nij,nj->ni", rot_z(theta), on_table))
     return workpiece_mod.calibrate_workpiece(theta, noisy(rng, f), roles, T_R_B,
-                                             prior_sigma=prior)
+                                             sigma=prior)
 
 
 PROCEDURES = {

@@ -37,7 +37,7 @@ def test_clean_touches_are_flagged_at_the_three_sigma_rate():
     binomial quantile of 1.5 times the rate."""
     rng = np.random.default_rng(11)
     res = calibrate_positioner(GRID, POINTS + rng.normal(0.0, NOISE, POINTS.shape),
-                               nominal=CHAIN, prior_sigma=NOISE).result
+                               nominal=CHAIN, sigma=NOISE).result
     J = res.fit.jacobian
     Q = np.linalg.qr(J)[0]
     e = rng.normal(0.0, NOISE, (6000, J.shape[0]))
@@ -48,7 +48,7 @@ def test_clean_touches_are_flagged_at_the_three_sigma_rate():
     flagged = 0
     for _ in range(60):
         out = calibrate_positioner(GRID, POINTS + rng.normal(0.0, NOISE, POINTS.shape),
-                                   nominal=CHAIN, prior_sigma=NOISE).result
+                                   nominal=CHAIN, sigma=NOISE).result
         flagged += len(out.outliers) + len(out.excluded) + len(out.disagreeing)
     assert flagged <= binom.ppf(0.999, 60 * len(GRID), 1.5 * RATE)
 
@@ -60,7 +60,7 @@ def test_default_accuracy_and_one_count_per_flagged_touch():
     assert plain.noise_source == "default" and plain.noise_sigma == 0.5e-3
     assert plain.accuracy_source == "default" and plain.residual_sigma < 3 * NOISE
     f[5] += [0.004, -0.003, 0.0]
-    out = calibrate_positioner(GRID, f, nominal=CHAIN, prior_sigma=NOISE).result
+    out = calibrate_positioner(GRID, f, nominal=CHAIN, sigma=NOISE).result
     assert out.excluded == [5] and out.outliers == []
     assert sum("outlier" in w for w in out.warnings) == 1
     reasons = out.verdict.reasons

@@ -21,7 +21,7 @@ def _turntable() -> CalibrationResult:
     rng = np.random.default_rng(11)
     theta = np.radians(np.arange(0.0, 360.0, 45.0))
     f = transform_points(T_R_B, rot_z(theta) @ [0.35, 0.0, 0.05])
-    return calibrate_turntable(theta, f + rng.normal(0.0, 5e-5, f.shape), prior_sigma=5e-5)
+    return calibrate_turntable(theta, f + rng.normal(0.0, 5e-5, f.shape), sigma=5e-5)
 
 
 def test_to_json_from_json_round_trip():

@@ -9,7 +9,7 @@ import pytest
 from cli_helpers import run
 
 from robotcell.calibration import spec
-from robotcell.calibration.measurements import read_measurements
+from robotcell.calibration.measurements import read_touch_table
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.cell import Cell
 from robotcell.errors import InputError
@@ -39,7 +39,7 @@ def test_a_column_added_to_a_spec_is_written_read_and_known(touches, monkeypatch
     assert touches.columns()[0][-2:] == ["e1", "track"]
     table = touches.to_table()
     notes = []
-    m = read_measurements("turntable", table, "t.csv", robot, on_note=notes.append)
+    m = read_touch_table("turntable", table, "t.csv", robot, on_note=notes.append)
     np.testing.assert_allclose(m.track, touches.track, atol=1e-6)
     assert notes == []
     csv = tmp_path / "t.csv"
@@ -52,7 +52,7 @@ def test_a_column_added_to_a_spec_is_written_read_and_known(touches, monkeypatch
     # The same procedure without it: not written, not read, named as unknown when given.
     _without_track(monkeypatch)
     assert "track" not in touches.columns()[0]
-    m = read_measurements("turntable", table, "t.csv", robot, on_note=notes.append)
+    m = read_touch_table("turntable", table, "t.csv", robot, on_note=notes.append)
     assert m.track is None
     assert notes == [("warning: t.csv: column(s) 'track' not used by the turntable calibration "
                       "and ignored; check the spelling")]
@@ -67,7 +67,7 @@ def test_the_minimum_is_the_specs(monkeypatch, touches):
     cell = Cell.load(EXAMPLE)
     with pytest.raises(InputError, match="needs at least 7 table angles"):
         simulate(cell, "turntable", touches=6, tool=next(iter(cell.tools)))
-    m = read_measurements("turntable", touches.to_table(), "t.csv", cell.robot)
+    m = read_touch_table("turntable", touches.to_table(), "t.csv", cell.robot)
     with pytest.raises(InputError, match=r"t.csv: touches: 6 given, at least 7 needed"):
         m.check_count()
     with pytest.raises(InputError, match=r"touches: 6 given, at least 7 needed at different"):

@@ -72,7 +72,7 @@ def test_monte_carlo_sigma_agrees_with_spread():
             [pose_for(R, TCP + R_TOOL @ [0.02, 0.09, 0]) for R in Rp])
     err_t, err_c, err_r, s_t, s_c, s_r = [], [], [], [], [], []
     for _ in range(300):
-        r = calibrate_tool(*(noisy(b, rng, sigma) for b in base), prior_sigma=sigma)
+        r = calibrate_tool(*(noisy(b, rng, sigma) for b in base), sigma=sigma)
         err_t.append(r.values["tcp"] - TCP)
         err_c.append(r.values["pivot"] - PIVOT)
         err_r.append(angle_error(r.values["T_F_TCP"][:3, :3], R_TOOL))
@@ -85,12 +85,12 @@ def test_monte_carlo_sigma_agrees_with_spread():
         assert np.all(np.abs(ratio - 1) < 0.25), ratio
 
 
-def test_prior_sigma_used_when_given():
+def test_stated_sigma_used_when_given():
     rng = np.random.default_rng(13)
     touches = noisy([pose_for(R, TCP) for R in design(rng, 4)], rng, 1e-4)
-    r = calibrate_tool(touches, prior_sigma=5e-4)
+    r = calibrate_tool(touches, sigma=5e-4)
     assert r.noise_source == "prior" and r.noise_sigma == 5e-4
-    r2 = calibrate_tool(touches, prior_sigma=1e-4)
+    r2 = calibrate_tool(touches, sigma=1e-4)
     np.testing.assert_allclose(r.sigma["tcp"], 5 * r2.sigma["tcp"])
 
 
@@ -98,7 +98,7 @@ def test_outlier_touch_is_named():
     rng = np.random.default_rng(14)
     touches = noisy([pose_for(R, TCP) for R in design(rng, 10)], rng, 5e-5)
     touches[7, :3, 3] += [2e-3, 0, 0]
-    r = calibrate_tool(touches, prior_sigma=5e-5)
+    r = calibrate_tool(touches, sigma=5e-5)
     assert any("touch 8 is an outlier" in w for w in r.warnings)
     # Singled out by the others, it is left out of the result, which says so.
     assert r.excluded == [7] and r.rms < 2e-4 and "left out" in r.summary()

@@ -123,7 +123,7 @@ def test_unknown_point_sigmas_match_monte_carlo():
     cell = Track()
 
     def run(rng):
-        r = calibrate_track(E, cell.touches(REF, E, rng), prior_sigma=SIGMA)
+        r = calibrate_track(E, cell.touches(REF, E, rng), sigma=SIGMA)
         return (np.r_[r.values["direction"][1:], r.values["scale"]],
                 np.r_[r.sigma["direction"][1:], r.sigma["scale"]])
 
@@ -139,7 +139,7 @@ def test_known_points_sigmas_match_monte_carlo():
     def run(rng):
         f = np.vstack([cell.touches(REF, E, rng), cell.touches(REF2, e2, rng)])
         r = calibrate_track(np.r_[E, e2], f, references=[REF, REF2], point=point,
-                            prior_sigma=SIGMA)
+                            sigma=SIGMA)
         T = r.values["T_L_R"]
         return (np.r_[rot_error(T[:3, :3], cell.Q), r.values["scale"], T[:3, 3]],
                 np.r_[r.sigma["T_L_R_rotation"], r.sigma["scale"], r.sigma["T_L_R_position"]])
@@ -155,7 +155,7 @@ def test_straightness_and_outlier_are_reported():
     f = cell.touches(REF, E, rng)
     across = np.cross(cell.direction, [0.0, 0.0, 1.0])
     f[3] += 0.002 * across / np.linalg.norm(across)  # a 2 mm kink across the track at touch 4
-    r = calibrate_track(E, f, prior_sigma=SIGMA)
+    r = calibrate_track(E, f, sigma=SIGMA)
     assert int(np.argmax(r.json_fields["straightness_mm"])) == 3
     assert r.json_fields["straightness_mm"][3] > 1.0
     assert any(w.startswith("touch 4 is an outlier") for w in r.warnings)
@@ -163,7 +163,7 @@ def test_straightness_and_outlier_are_reported():
 
 def test_scale_warning_and_sigma_prior():
     cell = Track(scale=1.05)
-    r = calibrate_track(E, cell.touches(REF, E), prior_sigma=SIGMA)
+    r = calibrate_track(E, cell.touches(REF, E), sigma=SIGMA)
     assert any("scale 1.05000" in w for w in r.warnings)
     assert r.noise_source == "prior" and r.sigma["scale"] > 0
 

@@ -62,7 +62,7 @@ def test_sigmas_match_monte_carlo():
     rng = np.random.default_rng(7)
     errs, sigmas = [], []
     for _ in range(200):
-        r = calibrate_turntable(THETA, touches(T, THETA, rng=rng), prior_sigma=SIGMA)
+        r = calibrate_turntable(THETA, touches(T, THETA, rng=rng), sigma=SIGMA)
         Te = r.values["T_R_B"]
         errs.append(np.r_[Te[:3, 3] - T[:3, 3], rot_error(Te[:3, :3], T[:3, :3]),
                           r.values["radius"] - 0.35, r.values["tilt"] - np.arccos(T[2, 2])])
@@ -86,7 +86,7 @@ def test_outlier_is_named():
     theta = np.radians(np.arange(0.0, 360.0, 30.0))
     f = touches(T, theta, rng=np.random.default_rng(2))
     f[2] += 0.002 * (f[2] - T[:3, 3]) / np.linalg.norm(f[2] - T[:3, 3])  # 2 mm off the circle
-    r = calibrate_turntable(theta, f, prior_sigma=SIGMA)
+    r = calibrate_turntable(theta, f, sigma=SIGMA)
     assert any(w.startswith("touch 3 is an outlier") for w in r.warnings)
 
 

@@ -85,11 +85,11 @@ def test_chi_square_bound_against_stated_and_default_accuracy():
     rng = np.random.default_rng(2)
     T = flange_poses(rng, 10, noise=0.4e-3)  # a rough technician, within the 0.5 mm default
     assert calibrate_tool(T).verdict.level == "good"
-    v = calibrate_tool(T, prior_sigma=0.1e-3).verdict  # ... but not the 0.1 mm stated
+    v = calibrate_tool(T, sigma=0.1e-3).verdict  # ... but not the 0.1 mm stated
     assert v.level == "check" and v.accuracy_source == "stated" and v.touch_sigma_mm == 0.1
     assert "larger than the stated touch accuracy 0.1 mm explains (chi-square" in v.reasons[0]
     assert v.chi2 > v.chi2_bound
-    v = calibrate_tool(T, prior_sigma=0.05e-3).verdict  # more than 3x the stated accuracy
+    v = calibrate_tool(T, sigma=0.05e-3).verdict  # more than 3x the stated accuracy
     assert v.level == "poor" and "far beyond the stated touch accuracy 0.05 mm" in v.reasons[0]
     assert calibrate_tool(flange_poses(rng, 10, noise=3e-3)).verdict.level == "poor"
     assert DEFAULT_TOUCH_SIGMA_MM == 0.5
@@ -138,14 +138,14 @@ def test_with_the_named_touch_count_an_outlier_is_caught():
     for _ in range(40):
         f = table_touches(rng, theta)
         f[rng.integers(6)] += rng.normal(size=3) / np.sqrt(3) * 5e-3
-        r = calibrate_turntable(theta, f, prior_sigma=NOISE)
+        r = calibrate_turntable(theta, f, sigma=NOISE)
         seen += any("outlier" in w for w in r.warnings) or r.verdict.level == "poor"
     assert seen >= 36
     seen = 0
     for _ in range(40):
         T = flange_poses(rng, 5)
         T[rng.integers(5), :3, 3] += rng.normal(size=3) / np.sqrt(3) * 5e-3
-        r = calibrate_tool(T, prior_sigma=NOISE)
+        r = calibrate_tool(T, sigma=NOISE)
         seen += any("outlier" in w for w in r.warnings) or r.verdict.level == "poor"
     assert seen >= 36
 
@@ -265,7 +265,7 @@ def normalised_errors(make, truth, key, trials=200, seed=20):
 
 
 def assert_consistent(z):
-    # The touch noise is given (prior_sigma), so z is unit normal. 200 trials x 3 components:
+    # The touch noise is given (sigma), so z is unit normal. 200 trials x 3 components:
     # the pooled standard deviation is within 1 +- 0.15 (about 3 times its own scatter).
     assert 0.85 < z.std() < 1.15 and abs(z.mean()) < 0.2, (z.std(), z.mean())
 
@@ -279,9 +279,9 @@ def test_track_touches_4_2_mm_apart_and_61_positions_1_mm_apart():
     assert r.warnings == [] and r.dof == 3 * 61 - 6
     truth = REF @ Q  # the touched point in R with the track at 0
     assert_consistent(normalised_errors(
-        lambda g: calibrate_track(e, track_touches(g, e), prior_sigma=NOISE), truth, "point"))
+        lambda g: calibrate_track(e, track_touches(g, e), sigma=NOISE), truth, "point"))
     assert_consistent(normalised_errors(
-        lambda g: calibrate_track(dense, track_touches(g, dense), prior_sigma=NOISE), truth,
+        lambda g: calibrate_track(dense, track_touches(g, dense), sigma=NOISE), truth,
         "point"))
 
 
@@ -291,7 +291,7 @@ def test_same_table_angle_twice():
         r = calibrate_turntable(theta, table_touches(np.random.default_rng(23), theta))
         assert r.verdict.level in ("good", "check")
         assert_consistent(normalised_errors(
-            lambda g, t=theta: calibrate_turntable(t, table_touches(g, t), prior_sigma=NOISE),
+            lambda g, t=theta: calibrate_turntable(t, table_touches(g, t), sigma=NOISE),
             T_R_B[:3, 3], "T_R_B"))
 
 
@@ -306,7 +306,7 @@ def test_identical_rows_are_used(tmp_path, capsys):
 
     def make(g):
         T = flange_poses(g, 6)
-        return calibrate_tool(np.concatenate([T, T[:2]]), prior_sigma=NOISE)  # two rows twice
+        return calibrate_tool(np.concatenate([T, T[:2]]), sigma=NOISE)  # two rows twice
 
     # Identical rows share their noise, so the reported sigma (which assumes independent touches)
     # is too small by design: the errors stay within the sigma of the 6 distinct touches.

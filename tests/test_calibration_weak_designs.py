@@ -2,7 +2,7 @@
 geometry that determines nothing is refused (docs/calibration.md, "Refused input").
 
 Each case was refused by a "too close" / "too small" threshold before. A seeded Monte Carlo over
-synthetic truth plus Gaussian noise (the noise given as ``prior_sigma``) checks that the reported
+synthetic truth plus Gaussian noise (the noise given as ``sigma``) checks that the reported
 1-sigma describes the actual error: the mean of ``(error / sigma)^2`` over trials and components
 is 1 for an honest linearised covariance (here within [0.6, 1.6], about 4 standard errors for
 the trial counts used). The verdict grades the weak design "check" (not "good"), with a reason.
@@ -59,7 +59,7 @@ def test_tcp_orientations_1_degree_apart_are_computed():
     for _ in range(TRIALS):
         Tn = T.copy()
         Tn[:, :3, 3] += rng.normal(0.0, s, (len(T), 3))
-        r = calibrate_tool(Tn, prior_sigma=s)
+        r = calibrate_tool(Tn, sigma=s)
         z2.append(((r.values["tcp"] - TCP) / r.sigma["tcp"]) ** 2)
     assert_consistent(z2, "TCP, 1 deg spread")
     assert r.sigma["tcp"].max() > 20 * s  # weak: the sigma says so
@@ -87,7 +87,7 @@ def test_abc_2point_touch_5_mm_from_the_tcp_is_computed():
         noisy = [P.copy() for P in (T, Ta, Tp)]
         for P in noisy:
             P[:, :3, 3] += rng.normal(0.0, s, (len(P), 3))
-        r = calibrate_tool(*noisy, prior_sigma=s)
+        r = calibrate_tool(*noisy, sigma=s)
         err = rot_error(r.values["T_F_TCP"][:3, :3], R_TOOL)
         z2.append((err / r.sigma["T_F_TCP_rotation"]) ** 2)
     assert_consistent(z2, "ABC 2-point, -X touch 5 mm")
@@ -133,7 +133,7 @@ def test_workpiece_points_5_mm_apart_are_computed():
     z2 = []
     for _ in range(TRIALS):
         r = calibrate_workpiece(theta, clean + rng.normal(0.0, s, clean.shape), roles, T_R_B,
-                                prior_sigma=s)
+                                sigma=s)
         err = rot_error(r.values["T_B_W"][:3, :3], T_B_W[:3, :3])
         z2.append((err / r.sigma["T_B_W_rotation"]) ** 2)
     assert_consistent(z2, "workpiece, points 5 mm apart")
@@ -148,7 +148,7 @@ def test_turntable_point_5_mm_from_the_axis_is_computed():
     s = 2e-5
     z2 = []
     for _ in range(TRIALS):
-        r = calibrate_turntable(theta, clean + rng.normal(0.0, s, clean.shape), prior_sigma=s)
+        r = calibrate_turntable(theta, clean + rng.normal(0.0, s, clean.shape), sigma=s)
         err = rot_error(r.values["T_R_B"][:3, :3], T_R_B[:3, :3])
         z2.append((err / r.sigma["T_R_B_rotation"]) ** 2)
         z2.append([((r.values["radius"] - radius) / r.sigma["radius"]) ** 2])
@@ -166,7 +166,7 @@ def test_track_reference_20_mm_from_the_axis_is_computed():
     z2 = []
     for _ in range(TRIALS):
         r = calibrate_track(e, clean + rng.normal(0.0, s, clean.shape), references=[ref],
-                            prior_sigma=s)
+                            sigma=s)
         err = rot_error(r.values["T_L_R"][:3, :3], Q)
         z2.append((err / r.sigma["T_L_R_rotation"]) ** 2)
     assert_consistent(z2, "track, lever 20 mm")

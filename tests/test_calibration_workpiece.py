@@ -68,7 +68,7 @@ def test_n_point_fit_uses_every_touch_and_estimates_noise():
     np.testing.assert_allclose(r.values["T_B_W"], T_B_W, atol=1e-10)
     assert r.dof == 3 * 2 + 2 * 3 + 3 - 6
     f = touch(roles, theta, offsets, rng=np.random.default_rng(1))
-    r = calibrate_workpiece(theta, f, roles, T_R_B, prior_sigma=SIGMA)
+    r = calibrate_workpiece(theta, f, roles, T_R_B, sigma=SIGMA)
     assert r.noise_source == "prior" and 0.3 * SIGMA < r.residual_sigma < 3 * SIGMA
     assert r.residuals.shape == (8, 3) and r.rms > 0
 
@@ -84,9 +84,9 @@ def test_sigmas_including_the_turntable_match_monte_carlo(roles, theta):
     rng = np.random.default_rng(11)
     errs, sigmas = [], []
     for _ in range(150):
-        tt = calibrate_turntable(TABLE_THETA, table_touches(rng), prior_sigma=SIGMA)
+        tt = calibrate_turntable(TABLE_THETA, table_touches(rng), sigma=SIGMA)
         r = calibrate_workpiece(theta, touch(roles, theta, rng=rng), roles, tt.values["T_R_B"],
-                                T_R_B_covariance=tt.covariance[:6, :6], prior_sigma=SIGMA)
+                                T_R_B_covariance=tt.covariance[:6, :6], sigma=SIGMA)
         T = r.values["T_B_W"]
         errs.append(np.r_[T[:3, 3] - T_B_W[:3, 3], rot_error(T[:3, :3], T_B_W[:3, :3])])
         sigmas.append(np.r_[r.sigma["T_B_W_position"], r.sigma["T_B_W_rotation"]])
@@ -145,9 +145,9 @@ def test_three_points_rest_on_the_stated_accuracy_and_carry_the_turntable_source
     theta = np.radians([15.0, 140.0, 250.0])
     f = touch(roles, theta)
     cov = np.diag([1e-8, 2e-8, 1e-8, 1e-8, 4e-8, 1e-8])
-    plain = calibrate_workpiece(theta, f, roles, T_R_B, T_R_B_covariance=cov, prior_sigma=2e-4)
+    plain = calibrate_workpiece(theta, f, roles, T_R_B, T_R_B_covariance=cov, sigma=2e-4)
     named = calibrate_workpiece(theta, f, roles, T_R_B,
-                                T_R_B_covariance=Sources.of("turntable DKP", cov), prior_sigma=2e-4)
+                                T_R_B_covariance=Sources.of("turntable DKP", cov), sigma=2e-4)
     assert plain.noise_source == "prior" and plain.noise_sigma == pytest.approx(2e-4)
     np.testing.assert_allclose(named.sigma["T_B_W_rotation"], plain.sigma["T_B_W_rotation"])
     sources = named.estimates["T_B_W"].sources.factors

@@ -106,7 +106,7 @@ def test_a_folder_or_a_missing_folder_as_output(args, output, tmp_path, capsys):
     (["identify", "--propose", "0", "--robot", "kuka_kr16"], "must be positive"),
     (["identify", "--propose", "1000", "--robot", "kuka_kr16"], "at most 999"),
     (["identify", "TRACKER", "--robot", "kuka_kr16", "--accuracy", "0"],
-     "--accuracy must be a positive number"),
+     "--sigma must be a positive number"),
     (["identify", "TRACKER", "--robot", "kuka_kr16", "--j23-factor", "nan"],
      "--j23-factor must be a finite number"),
     (["sweep", "--cell", CELL, "--targets", SEAM, "--layouts", LAYOUTS, "--workers", "0"],

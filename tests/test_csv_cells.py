@@ -13,9 +13,9 @@ import pytest
 from cli_helpers import run
 
 from robotcell import InputError, load_robot, pose_from_vendor
-from robotcell.calibration.measurements import read_measurements
+from robotcell.calibration.measurements import read_touch_table
 from robotcell.cell import Cell
-from robotcell.identification.measurements import read_measurements as read_tracker
+from robotcell.identification.measurements import read_target_measurements as read_tracker
 from robotcell.io.tables import (
     optional_column,
     read_csv,
@@ -125,11 +125,11 @@ def test_a_tool_touch_with_an_empty_point_is_a_tcp_touch_a_frame_touch_is_refuse
     rows = _tcp_rows(np.random.default_rng(2))
     p.write_text(_text([*"xyzabc", "point"], [[*r, "" if k % 2 else "tcp"]
                                               for k, r in enumerate(rows)]))
-    m = read_measurements("tcp", read_csv(p), str(p))
+    m = read_touch_table("tcp", read_csv(p), str(p))
     assert m.point == ("tcp",) * 6
     p.write_text("point,x,y,z\norigin,0,0,0\n,300,0,0\nxy,100,200,0\n")
     with pytest.raises(InputError, match=r"line 3: empty value in column 'point'"):
-        read_measurements("frame", read_csv(p), str(p))
+        read_touch_table("frame", read_csv(p), str(p))
 
 
 def test_an_empty_track_cell_of_a_touch_is_refused_the_column_may_be_left_out(tmp_path):
@@ -138,14 +138,14 @@ def test_an_empty_track_cell_of_a_touch_is_refused_the_column_may_be_left_out(tm
     with pytest.raises(InputError, match=r"tt.csv: line 3: empty value in column 'track', which "
                                          r"needs a value on every line; fill it in on every "
                                          r"line, or leave the column out"):
-        read_measurements("turntable", read_csv(p), str(p))
+        read_touch_table("turntable", read_csv(p), str(p))
 
 
 def test_touch_columns_left_empty_beside_joint_values_are_not_given(tmp_path):
     robot = load_robot("kuka_kr16")
     p = tmp_path / "j.csv"
     p.write_text("x,y,z,a1,a2,a3,a4,a5,a6\n,,,0,-90,90,0,0,0\n,,,10,-80,80,0,10,0\n")
-    m = read_measurements("frame", {**read_csv(p), "point": ["origin", "x"]}, str(p), robot)
+    m = read_touch_table("frame", {**read_csv(p), "point": ["origin", "x"]}, str(p), robot)
     assert m.joints.shape == (2, 6) and m.points is None
 
 

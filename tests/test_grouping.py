@@ -26,7 +26,7 @@ from robotcell.calibration.grouping import (
 from robotcell.calibration.track import calibrate_track
 from robotcell.calibration.turntable import calibrate_turntable
 from robotcell.errors import IllPosedError, InputError
-from robotcell.identification import Measurements, identify
+from robotcell.identification import TargetMeasurements, identify
 from robotcell.identification.chain import Chain
 from robotcell.identification.circles import start_model
 from robotcell.identification.positioner import calibrate_positioner
@@ -105,14 +105,14 @@ def test_positioner_with_read_back_jitter_calibrates_as_well_as_the_commanded_gr
     errors = []
     for q in (GRID, read):
         ch, x, f = _positioner_touches(q)
-        cal = calibrate_positioner(q, f, prior_sigma=NOISE)
+        cal = calibrate_positioner(q, f, sigma=NOISE)
         errors.append(_held_out_rms(lambda t, c=cal: c.robot.fk(t)[:, :3, 3], ch, x))
     # measured: 0.0122 mm both; the unjittered grid is the reference
     assert errors[1] < 1.1 * errors[0] + 1e-6, errors
     assert errors[1] < 0.5 * NOISE
     # a stated tolerance finer than the jitter finds no touches moving one axis alone
     with pytest.raises(IllPosedError, match=r"joint 1: no rows move it alone.*\(stated\)"):
-        calibrate_positioner(read, f, prior_sigma=NOISE, group_tol=math.radians(1e-5))
+        calibrate_positioner(read, f, sigma=NOISE, group_tol=math.radians(1e-5))
 
 
 def _touches_csv(path, q, f):
@@ -133,7 +133,7 @@ def test_calibrate_positioner_and_identify_take_read_back_values(tmp_path, capsy
                        "--group-tolerance", "0.00001")
     assert code == 2 and "no 3 touches turn e1 (tilt) alone" in err and "1e-05 deg" in err
     # the same rows as an identification of a 2-joint chain without a nominal model
-    write_csv(tmp_path / "grid.csv", Measurements(read, f))
+    write_csv(tmp_path / "grid.csv", TargetMeasurements(read, f))
     code, out, err = run(capsys, "identify", tmp_path / "grid.csv", "--accuracy", "0.05",
                          "--folds", "3", "-o", tmp_path / "positioner.yaml")
     assert code == 0, err
@@ -148,9 +148,9 @@ def test_identification_of_the_positioner_with_jitter_reaches_the_noise():
     rng = np.random.default_rng(6)
     read = GRID + rng.normal(0.0, JITTER, GRID.shape)
     _, _, f = _positioner_touches(read)
-    meas = Measurements(read, f)
+    meas = TargetMeasurements(read, f)
     start = start_model(meas, np.zeros(2, dtype=bool))
-    res = identify(start, meas, point_sigma=NOISE)
+    res = identify(start, meas, sigma=NOISE)
     assert res.rms_after < 1.2 * math.sqrt(3) * NOISE
     assert res.verdict[0] in ("good", "check")
 
@@ -168,9 +168,9 @@ def test_circle_point_analysis_of_an_arm_on_jittered_sweeps():
     truth = perturbed(nominal, rng)
     reflector = np.array([0.05, 0.02, 0.1, 1.0])
     pts = (T_D_R @ truth.fk(read) @ reflector)[:, :3] + rng.normal(0.0, 2e-5, (len(read), 3))
-    meas = Measurements(read, pts)
+    meas = TargetMeasurements(read, pts)
     model = start_model(meas)
-    res = identify(model, meas, point_sigma=2e-5)
+    res = identify(model, meas, sigma=2e-5)
     assert res.rms_after < 1.5 * math.sqrt(3) * 2e-5
     assert res.verdict[0] in ("good", "check")
     with pytest.raises(IllPosedError, match=r"joint 1: no rows move it alone.*within 1e-05 deg"):
@@ -187,7 +187,7 @@ def test_turntable_and_track_count_read_back_values_as_commanded():
     theta = np.radians([0.0, 90.0, 180.0, 270.0]) + rng.normal(0.0, JITTER, 4)
     touched = np.column_stack([0.3 * np.cos(theta), 0.3 * np.sin(theta), np.zeros(4)])
     touched += rng.normal(0.0, NOISE, touched.shape)
-    assert calibrate_turntable(theta, touched, prior_sigma=NOISE).values["radius"] == \
+    assert calibrate_turntable(theta, touched, sigma=NOISE).values["radius"] == \
         pytest.approx(0.3, abs=1e-3)
     e = 1.0 + rng.normal(0.0, 0.01e-3, 5)  # one track position, read back within 0.01 mm
     with pytest.raises(IllPosedError, match=r"all 5 touches are at the same track position "
@@ -202,7 +202,7 @@ def test_jittered_repeats_of_a_configuration_count_once_for_the_redundancy():
     q += rng.normal(0.0, JITTER, q.shape)
     pts = (nominal.fk(q) @ np.array([0.05, 0.02, 0.1, 1.0]))[:, :3]
     with pytest.raises(IllPosedError, match=r"40 rows in 8 distinct configuration\(s\)"):
-        identify(nominal, Measurements(q, pts))
+        identify(nominal, TargetMeasurements(q, pts))
 
 
 def test_turntable_and_track_commands_take_a_stated_tolerance(tmp_path, capsys):

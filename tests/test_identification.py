@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 from robotcell import load_robot, save_robot
 from robotcell.dhprocedure import convert_convention
 from robotcell.errors import IllPosedError, InputError
-from robotcell.identification import Measurements, identify
+from robotcell.identification import TargetMeasurements, identify
 from robotcell.identification.chain import Chain
 from robotcell.identification.ik import solve_identified
 from robotcell.kinematics.transforms import make_pose, rot_y
@@ -55,7 +55,7 @@ def test_synthetic_arm_identified_to_the_noise_floor(name):
     truth = perturbed(nominal, rng)
     ch, x = truth_chain(truth, 3, False, rng)
     res = identify(nominal, measure(ch, x, configurations(nominal, 50, rng), rng, NOISE),
-                   point_sigma=NOISE)
+                   sigma=NOISE)
     # 500 other configurations, measured with the same noise: the identified model's error is
     # at most 1.5x the noise floor (RMS length of a 3-D noise vector), the nominal's 100x that.
     qv = configurations(nominal, 500, rng)
@@ -65,7 +65,7 @@ def test_synthetic_arm_identified_to_the_noise_floor(name):
     rms = math.sqrt(np.mean(np.sum(err**2, axis=-1)))
     assert rms <= 1.5 * floor
     # Nominal links with the best base and reflectors: error against the noise-free truth.
-    before = identify(nominal, measure(ch, x, qv[:60], rng, NOISE), point_sigma=NOISE).rms_before
+    before = identify(nominal, measure(ch, x, qv[:60], rng, NOISE), sigma=NOISE).rms_before
     assert before >= 100 * _prediction_rms(res, ch, x, qv)
     assert res.rms_before > 50 * res.rms_after
     assert res.verdict[0] == "good"
@@ -80,7 +80,7 @@ def test_synthetic_arm_identified_to_the_noise_floor(name):
     # Parameters recovered within 3 reported sigma of the truth expressed in the same
     # parameterisation (the noise-free identification of the truth from 400 configurations).
     exact = identify(nominal, measure(ch, x, configurations(nominal, 400, rng), rng, 0.0),
-                     point_sigma=NOISE)
+                     sigma=NOISE)
     assert exact.rms_after < 1e-9
     assert exact.free == res.free
     for p in res.parameters:
@@ -105,7 +105,7 @@ def test_positioner_with_pose_measurements():
     ch, x = truth_chain(truth, 1, True, rng)
     angle_noise = math.radians(0.01)
     meas = measure(ch, x, configurations(nominal, 50, rng), rng, NOISE, angle_noise)
-    res = identify(nominal, meas, point_sigma=NOISE, angle_sigma=angle_noise)
+    res = identify(nominal, meas, sigma=NOISE, angle_sigma=angle_noise)
     qv = configurations(nominal, 500, rng)
     noisy = measure(ch, x, qv, rng, NOISE, angle_noise)
     rms = math.sqrt(np.mean(np.sum((res.predict(qv)[0] - noisy.points) ** 2, axis=-1)))
@@ -119,7 +119,7 @@ def test_positioner_with_pose_measurements():
     assert {p.name for p in res.parameters if p.free and p.name.startswith(("tilt", "rotate"))} == {
         "tilt.a", "tilt.alpha"}
     exact = identify(nominal, measure(ch, x, configurations(nominal, 300, rng), rng, 0.0, 0.0),
-                     point_sigma=NOISE, angle_sigma=angle_noise)
+                     sigma=NOISE, angle_sigma=angle_noise)
     for p in res.parameters:
         if p.free and not p.name.startswith(("base.", "target.")):
             assert abs(p.value - exact.parameter(p.name).value) <= 3 * p.sigma, p.name
@@ -135,7 +135,7 @@ def kr16_result():
     nominal = load_robot("kuka_kr16")
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
-    return nominal, ch, x, meas, identify(nominal, meas, point_sigma=NOISE)
+    return nominal, ch, x, meas, identify(nominal, meas, sigma=NOISE)
 
 
 def test_model_file_round_trip_predicts_the_measurements(kr16_result, tmp_path):
@@ -172,7 +172,7 @@ def test_outlier_row_is_flagged():
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
     pts = meas.points.copy()
     pts[17, 0, 2] += 0.5e-3
-    res = identify(nominal, Measurements(meas.q, pts), point_sigma=NOISE)
+    res = identify(nominal, TargetMeasurements(meas.q, pts), sigma=NOISE)
     assert res.outliers == [17]
     assert res.verdict[0] == "check"
     assert "outlier" in res.summary()
@@ -186,9 +186,9 @@ def test_coupling_and_scale_are_identified():
     scale = np.array([0.0, 2e-4, -3e-4, 0.0, 0.0, 0.0])
     ch, x = truth_chain(perturbed(nominal, rng), 3, False, rng, coupling=-1.0, scale=scale)
     meas = measure(ch, x, configurations(nominal, 60, rng), rng, NOISE)
-    wrong = identify(nominal, meas, point_sigma=NOISE)
+    wrong = identify(nominal, meas, sigma=NOISE)
     assert wrong.verdict[0] == "poor"
-    res = identify(nominal, meas, point_sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
+    res = identify(nominal, meas, sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
     k = res.parameter("j23_factor")
     assert abs(k.value + 1.0) <= 3 * k.sigma
     for j, s in zip(("A2", "A3"), scale[1:3]):
@@ -207,7 +207,7 @@ def test_scale_and_coupling_round_trip_through_the_model_file(tmp_path):
     scale = np.array([0.0, 2e-4, -3e-4, 0.0, 0.0, 0.0])
     ch, x = truth_chain(perturbed(nominal, rng), 3, False, rng, coupling=-1.0, scale=scale)
     meas = measure(ch, x, configurations(nominal, 60, rng), rng, NOISE)
-    res = identify(nominal, meas, point_sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
+    res = identify(nominal, meas, sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
     C = res.robot.coupling.matrix
     assert np.allclose(np.diag(C), 1.0 + res.scale)
     assert C[2, 1] == pytest.approx(res.coupling * (1.0 + res.scale[2]))
@@ -235,7 +235,7 @@ def test_nominal_j23_coupling_is_used_and_kept():
     nominal = load_robot("fanuc_m20ia")
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng, coupling=1.0)
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
-    res = identify(nominal, meas, point_sigma=NOISE)
+    res = identify(nominal, meas, sigma=NOISE)
     assert res.rms_after < 2 * NOISE * math.sqrt(3)
     assert res.robot.coupling.j23_factor == 1.0
     q = configurations(nominal, 5, rng)
@@ -246,25 +246,25 @@ def test_nominal_j23_coupling_is_used_and_kept():
 def test_nominal_with_passive_joints_is_refused():
     nominal = load_robot("abb_irb460")
     with pytest.raises(InputError, match="only 'coupling: {j23_factor: k}'"):
-        identify(nominal, Measurements(np.zeros((30, 4)), np.zeros((30, 3))))
+        identify(nominal, TargetMeasurements(np.zeros((30, 4)), np.zeros((30, 3))))
 
 
 def test_refused_input():
     nominal = load_robot("kuka_kr16")
     q = np.zeros((5, 6))
     with pytest.raises(InputError, match="6 joints"):
-        identify(nominal, Measurements(np.zeros((5, 5)), np.zeros((5, 3))))
-    with pytest.raises(InputError, match="point_sigma must be a positive number"):
-        identify(nominal, Measurements(q, np.zeros((5, 3))), point_sigma=0.0)
+        identify(nominal, TargetMeasurements(np.zeros((5, 5)), np.zeros((5, 3))))
+    with pytest.raises(InputError, match="sigma must be a positive number"):
+        identify(nominal, TargetMeasurements(q, np.zeros((5, 3))), sigma=0.0)
     with pytest.raises(InputError, match=r"max_sigma_angle must be a positive number \(math.inf"):
-        identify(nominal, Measurements(q, np.zeros((5, 3))), max_sigma_angle=0.0)
+        identify(nominal, TargetMeasurements(q, np.zeros((5, 3))), max_sigma_angle=0.0)
     with pytest.raises(IllPosedError, match="measure at least"):
         rng = np.random.default_rng(0)
-        identify(nominal, Measurements(rng.uniform(-1, 1, (5, 6)), rng.uniform(-1, 1, (5, 3))))
+        identify(nominal, TargetMeasurements(rng.uniform(-1, 1, (5, 6)), rng.uniform(-1, 1, (5, 3))))
     with pytest.raises(InputError, match="shape"):
-        Measurements(q, np.zeros((4, 3)))
+        TargetMeasurements(q, np.zeros((4, 3)))
     with pytest.raises(InputError, match="not a proper rotation"):
-        Measurements(q, np.zeros((5, 3)), np.tile(np.diag([1.0, 1.0, -1.0]), (5, 1, 1)))
+        TargetMeasurements(q, np.zeros((5, 3)), np.tile(np.diag([1.0, 1.0, -1.0]), (5, 1, 1)))
 
 
 def test_modified_dh_nominal_with_hayati_beta(tmp_path):
@@ -273,7 +273,7 @@ def test_modified_dh_nominal_with_hayati_beta(tmp_path):
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
     assert ch.beta_joints == [2]  # A3: its axis parallel to A2's, Craig's row 3
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
-    res = identify(nominal, meas, point_sigma=NOISE)
+    res = identify(nominal, meas, sigma=NOISE)
     assert res.parameter("A3.beta").free
     qv = configurations(nominal, 200, rng)
     assert _prediction_rms(res, ch, x, qv) < NOISE
@@ -293,9 +293,9 @@ def test_reported_sigma_matches_the_errors_over_seeds():
         rng = np.random.default_rng(100 + seed)
         ch, x = truth_chain(perturbed(nominal, rng), 3, False, rng)
         res = identify(nominal, measure(ch, x, configurations(nominal, 50, rng), rng, NOISE),
-                       point_sigma=NOISE)
+                       sigma=NOISE)
         exact = identify(nominal, measure(ch, x, configurations(nominal, 400, rng), rng, 0.0),
-                         point_sigma=NOISE)
+                         sigma=NOISE)
         z += [(p.value - exact.parameter(p.name).value) / p.sigma for p in res.parameters
               if p.free and not p.name.startswith("base.")]
         fixed_sets.add(tuple(n for n, _ in res.fixed))
@@ -351,7 +351,7 @@ def test_seeded_ik_at_the_edge_of_the_nominal_workspace():
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
     x[ch.index("A4.d")] += 1e-3
     robot = identify(nominal, measure(ch, x, configurations(nominal, 40, rng), rng, NOISE),
-                     point_sigma=NOISE).robot
+                     sigma=NOISE).robot
     q3 = np.radians(np.linspace(-10, 10, 2001))
     qs = np.zeros((len(q3), 6))
     qs[:, 1], qs[:, 2], qs[:, 4] = -math.pi / 4, q3, 0.5

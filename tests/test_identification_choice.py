@@ -12,7 +12,7 @@ from cli_helpers import run
 from identification_helpers import T_D_R, configurations, measure, perturbed, truth_chain, write_csv
 
 from robotcell import load_robot
-from robotcell.identification import Measurements, cross_validate, identify_validated
+from robotcell.identification import TargetMeasurements, cross_validate, identify_validated
 from robotcell.identification.chain import Chain
 from robotcell.identification.coupling import identify_with_coupling
 from robotcell.identification.result import CV_HELD, MAX_CHANGE_LENGTH
@@ -22,7 +22,7 @@ NOISE = 0.02e-3
 STATED = 0.3e-3
 
 
-def _overfit_measurements(seed: int, n: int = 36) -> Measurements:
+def _overfit_measurements(seed: int, n: int = 36) -> TargetMeasurements:
     """A KR 16 exactly as drawn, with a gear error of 0.02 deg on every axis that no constant
     models (``q + A sin(2 q + phase)``), measured at ``n`` random configurations."""
     rng = np.random.default_rng(seed)
@@ -32,7 +32,7 @@ def _overfit_measurements(seed: int, n: int = 36) -> Measurements:
     x[ch.target_params[0]] = [0.05, 0.1, 0.08]
     q = rng.uniform(nominal.lower * 0.8, nominal.upper * 0.8, (n, 6))
     turned = q + math.radians(0.02) * np.sin(2 * q + rng.uniform(0, 6, 6))
-    return Measurements(q, ch.predict(x, turned)[0] + rng.normal(0.0, NOISE, (n, 1, 3)))
+    return TargetMeasurements(q, ch.predict(x, turned)[0] + rng.normal(0.0, NOISE, (n, 1, 3)))
 
 
 def test_few_poses_with_unmodelled_errors_never_write_a_model_worse_than_the_start():
@@ -42,7 +42,7 @@ def test_few_poses_with_unmodelled_errors_never_write_a_model_worse_than_the_sta
     nominal = load_robot("kuka_kr16")
     meas = _overfit_measurements(0)
     t0 = time.perf_counter()
-    choice = identify_validated(nominal, meas, folds=6, point_sigma=STATED)
+    choice = identify_validated(nominal, meas, folds=6, sigma=STATED)
     seconds = time.perf_counter() - t0
     start, full = choice.candidates[:2]
     assert full.label == "identified" and full.rms > start.rms  # it would overfit
@@ -52,7 +52,7 @@ def test_few_poses_with_unmodelled_errors_never_write_a_model_worse_than_the_sta
     held = dict(choice.result.fixed)
     by_cv = [w for w in held.values() if w.startswith(CV_HELD)]
     assert by_cv and all("held-out RMS" in w for w in by_cv)
-    again = cross_validate(nominal, meas, folds=6, point_sigma=STATED, hold=held).stats()
+    again = cross_validate(nominal, meas, folds=6, sigma=STATED, hold=held).stats()
     assert again["after_rms_mm"] <= again["before_rms_mm"]
     assert again["after_rms_mm"] == pytest.approx(choice.chosen.rms * 1e3, rel=1e-6)
     assert choice.result.verdict[0] == "good"
@@ -60,7 +60,7 @@ def test_few_poses_with_unmodelled_errors_never_write_a_model_worse_than_the_sta
                                         "6-fold cross-validation")
     assert seconds < 60.0  # 36 fits of 30 rows; about 3 s on an idle core
     # another draw: the two most significant constants free predict best
-    other = identify_validated(nominal, _overfit_measurements(3), folds=6, point_sigma=STATED)
+    other = identify_validated(nominal, _overfit_measurements(3), folds=6, sigma=STATED)
     assert other.chosen.label == "reduced" and other.chosen.rms < other.candidates[0].rms
 
 
@@ -72,7 +72,7 @@ def test_enough_poses_free_every_constant():
     joints[1] = replace(joints[1], a=joints[1].a + 0.5e-3)
     ch, x = truth_chain(replace(nominal, joints=tuple(joints)), 1, False, rng)
     meas = measure(ch, x, configurations(nominal, 150, rng), rng, NOISE)
-    choice = identify_validated(nominal, meas, folds=5, point_sigma=NOISE)
+    choice = identify_validated(nominal, meas, folds=5, sigma=NOISE)
     assert choice.chosen.label == "identified" and len(choice.candidates) == 2
     assert choice.chosen.rms < 0.2 * choice.candidates[0].rms
     assert not any(w.startswith(CV_HELD) for _, w in choice.result.fixed)
@@ -125,11 +125,11 @@ def test_the_coupling_message_is_absent_when_the_stated_factor_fits(name, k):
     ch, x = truth_chain(perturbed(nominal, rng), 1, False, rng, coupling=k,
                         scale=np.array([0.0, 0.0, 1e-4, 0.0, 0.0, 0.0]))
     meas = measure(ch, x, configurations(nominal, 200, rng), rng, NOISE)
-    check = identify_with_coupling(nominal, meas, k, point_sigma=NOISE).coupling_check
+    check = identify_with_coupling(nominal, meas, k, sigma=NOISE).coupling_check
     assert abs(check["k_fitted"] - k) > 3 * check["k_sigma"]  # the old test refused it
     assert check["supported"] and "do not support" not in check["verdict"]
     assert check["rms_without_mm"] > 1000 * check["rms_with_mm"]
-    wrong = identify_with_coupling(nominal, meas, -k, point_sigma=NOISE).coupling_check
+    wrong = identify_with_coupling(nominal, meas, -k, sigma=NOISE).coupling_check
     assert not wrong["supported"]
     assert "check the controller's J2/J3 convention (FANUC: +1" in wrong["verdict"]
 

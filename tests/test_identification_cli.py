@@ -18,7 +18,7 @@ from identification_helpers import (
 )
 
 from robotcell import load_robot, save_robot
-from robotcell.identification import Measurements
+from robotcell.identification import TargetMeasurements
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.kinematics.transforms import make_pose, rot_y
 from robotcell.robot.robot import Joint, Robot
@@ -84,7 +84,7 @@ def test_identify_report_and_poor_result(kr16_truth, tmp_path, capsys):
     # Joint values off by a gross amount in one axis (a scale of 2): exit 3, no model file.
     q = meas.q.copy()
     q[:, 1] *= 2.0
-    write_csv(csv, Measurements(q, meas.points))
+    write_csv(csv, TargetMeasurements(q, meas.points))
     out = tmp_path / "bad.yaml"
     code, _, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "-o", out)
     assert code == 3
@@ -161,7 +161,7 @@ def test_identify_without_nominal_groups_rows_in_model_values_of_a_coupled_arm(t
     data = json.loads(stdout)
     assert data["coupling_check"]["supported"]
     # the reference: the same rows converted to the chain's values by hand, no coupling
-    write_csv(tmp_path / "model.csv", Measurements(model_rows, meas.points))
+    write_csv(tmp_path / "model.csv", TargetMeasurements(model_rows, meas.points))
     code, ref, stderr = run(capsys, "identify", tmp_path / "model.csv", "--json", "--accuracy", "0.02")
     assert code == 0, stderr
     ref = json.loads(ref)
@@ -197,7 +197,7 @@ def test_identify_refuses_bad_csv(tmp_path, capsys, content, message):
 def test_identify_without_nominal_needs_one_joint_rows(tmp_path, capsys):
     rng = np.random.default_rng(1)
     csv = tmp_path / "random.csv"
-    write_csv(csv, Measurements(rng.uniform(-1, 1, (30, 6)), rng.uniform(-1, 1, (30, 3))))
+    write_csv(csv, TargetMeasurements(rng.uniform(-1, 1, (30, 6)), rng.uniform(-1, 1, (30, 3))))
     code, _, stderr = run(capsys, "identify", csv)
     assert code == 2 and "joint 1: no rows move it alone" in stderr
 
@@ -331,7 +331,7 @@ def test_identify_file_is_the_workflow_of_the_command(kr16_truth, tmp_path):
     nominal, ch, x, _ = kr16_truth
     _, csv = tracker_csv(kr16_truth, tmp_path, 40)
     out = tmp_path / "arm.yaml"
-    run_ = identify_file(csv, "kuka_kr16", point_sigma=0.02e-3, folds=4, offsets_for="kuka",
+    run_ = identify_file(csv, "kuka_kr16", sigma=0.02e-3, folds=4, offsets_for="kuka",
                          output=out)
     assert run_.written and out.exists() and run_.folds == 4
     assert run_.cross_stats["after_rms_mm"] < 0.06 < run_.cross_stats["before_rms_mm"]
@@ -345,3 +345,29 @@ def test_identify_file_is_the_workflow_of_the_command(kr16_truth, tmp_path):
     assert "--" not in str(exc.value)
     with pytest.raises(InputError, match="cell needs output"):
         identify_file(csv, cell=tmp_path / "cell.yaml")
+
+
+def test_identify_accuracy_is_an_alias_of_sigma(kr16_truth, tmp_path, capsys):
+    nominal, ch, x, rng = kr16_truth
+    csv = tmp_path / "tracker.csv"
+    write_csv(csv, measure(ch, x, configurations(nominal, 30, rng), rng, NOISE))
+    outs = []
+    for names in (("--sigma", "--angle-sigma"), ("--accuracy", "--angle-accuracy")):
+        code, stdout, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--json",
+                                   "--folds", "0", names[0], "0.02", names[1], "0.01")
+        assert code == 0, stderr
+        outs.append(json.loads(stdout))
+    assert outs[0] == outs[1]
+    assert outs[0]["rms_after_mm"] < 0.06
+    code, default, stderr = run(capsys, "identify", csv, "--robot", "kuka_kr16", "--json",
+                                "--folds", "0")
+    assert code == 0, stderr
+    assert json.loads(default) != outs[0]  # the stated accuracy reaches the fit
+
+
+def test_identify_help_says_accuracy_is_an_alias(capsys):
+    code, stdout, _ = run(capsys, "identify", "--help")
+    assert code == 0
+    text = " ".join(stdout.split())
+    assert "--sigma, --accuracy FLOAT" in text and "--accuracy is an alias" in text
+    assert "--angle-sigma, --angle-accuracy FLOAT" in text and "--angle-accuracy is an alias" in text

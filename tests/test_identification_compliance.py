@@ -10,7 +10,7 @@ from identification_helpers import configurations, measure, perturbed, truth_cha
 
 from robotcell import load_robot, save_robot
 from robotcell.errors import InputError
-from robotcell.identification import Measurements, identify
+from robotcell.identification import TargetMeasurements, identify
 from robotcell.identification.chain import Chain
 from robotcell.identification.gravity import gravity_torques
 from robotcell.kinematics.transforms import make_pose
@@ -71,9 +71,9 @@ def test_compliance_reaches_the_noise_floor():
     def held_out(res):
         return math.sqrt(np.mean(np.sum((res.predict(qv)[0] - noisy) ** 2, axis=-1)))
 
-    without = identify(nominal, meas, point_sigma=NOISE)
+    without = identify(nominal, meas, sigma=NOISE)
     assert without.verdict[0] == "poor" and held_out(without) > 10 * floor
-    res = identify(nominal, meas, point_sigma=NOISE, compliance=True)
+    res = identify(nominal, meas, sigma=NOISE, compliance=True)
     assert res.verdict[0] == "good"
     assert held_out(res) <= 1.5 * floor
     for name, value in zip(("A2.compliance", "A3.compliance"), truth):
@@ -91,7 +91,7 @@ def test_masses_round_trip_and_compliance_refused_without_them(tmp_path, capsys)
     assert np.allclose([j.com for j in back.joints], [c for _, c in MASSES])
     nominal = load_robot("kuka_kr16")
     with pytest.raises(InputError, match="needs the link masses of kuka_kr16.*'mass' \\(kg\\) and 'com'"):
-        identify(nominal, Measurements(np.zeros((30, 6)), np.zeros((30, 3))), compliance=True)
+        identify(nominal, TargetMeasurements(np.zeros((30, 6)), np.zeros((30, 3))), compliance=True)
     rng = np.random.default_rng(1)
     ch, x = truth_chain(nominal, 1, False, rng)
     write_csv(tmp_path / "m.csv", measure(ch, x, configurations(nominal, 30, rng), rng, NOISE))

@@ -4,7 +4,7 @@ import numpy as np
 from identification_helpers import configurations, measure, perturbed, truth_chain
 
 from robotcell import load_robot
-from robotcell.identification import Measurements, identify
+from robotcell.identification import TargetMeasurements, identify
 
 NOISE = 0.02e-3
 
@@ -17,7 +17,7 @@ def _with_bad_rows(rows: list[int]):
     meas = measure(ch, x, configurations(nominal, 100, rng), rng, NOISE)
     pts = meas.points.copy()
     pts[rows, 0, 2] += 0.3e-3
-    return identify(nominal, Measurements(meas.q, pts), point_sigma=NOISE)
+    return identify(nominal, TargetMeasurements(meas.q, pts), sigma=NOISE)
 
 
 def test_the_verdict_counts_the_outlier_rows_it_does_not_name():

@@ -37,7 +37,7 @@ def test_positioner_geometry_and_robot():
     ch, x = _truth(rng)
     f = ch.predict(x, GRID)[0][:, 0] + rng.normal(0, NOISE, (len(GRID), 3))
     for nominal in (NOMINAL, None):  # None: circle point analysis of the grid
-        cal = calibrate_positioner(GRID, f, nominal=nominal, prior_sigma=NOISE)
+        cal = calibrate_positioner(GRID, f, nominal=nominal, sigma=NOISE)
         # X_B: along -z_tilt x z_rotate as the nominal's DH writes it, else +.
         truth = _geometry(SimpleNamespace(_chain=ch), x, 1.0 if nominal is None else -1.0)
         v, s = cal.result.values, cal.result.sigma
@@ -64,7 +64,7 @@ def test_positioner_sigma_matches_monte_carlo():
     z = {k: [] for k in keys + ("tilt_axis_y", "origin_y")}
     for _ in range(120):
         cal = calibrate_positioner(GRID, clean + rng.normal(0, NOISE, clean.shape), nominal=NOMINAL,
-                                   prior_sigma=NOISE)
+                                   sigma=NOISE)
         v, s = cal.result.values, cal.result.sigma
         for k in keys:  # angles compared on the circle (the zero may lie near 180 deg)
             z[k].append(math.remainder(v[k] - float(truth[k]), 2 * math.pi) / s[k])

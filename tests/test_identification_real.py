@@ -19,7 +19,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2
 
 from robotcell import load_robot
-from robotcell.identification import cross_validate, identify, read_measurements
+from robotcell.identification import cross_validate, identify, read_target_measurements
 
 DATA = Path(__file__).resolve().parents[1] / "examples" / "identification"
 
@@ -40,7 +40,7 @@ def test_ur10_laser_tracker_before_after_and_cross_validated(tmp_path, capsys):
     assert data["verdict"] in ("good", "check")
     # The identified UR10 is no longer exactly a UR-type arm: its IK is seeded by the nominal's.
     robot = load_robot(out)
-    meas = read_measurements(csv)
+    meas = read_target_measurements(csv)
     T = robot.fk(meas.q[1:6])  # row 1 is the straight-up pose, a wrist singularity
     sol = robot.ik(T)
     assert sol.valid.any(axis=-1).all() and sol.method == "ur"
@@ -48,9 +48,9 @@ def test_ur10_laser_tracker_before_after_and_cross_validated(tmp_path, capsys):
 
 def test_ur10_library_cross_validation_matches_the_cli():
     nominal = load_robot(DATA / "ur10_cb3.yaml")
-    meas = read_measurements(DATA / "ipa_ur10_random_poses.csv")
+    meas = read_target_measurements(DATA / "ipa_ur10_random_poses.csv")
     assert meas.n_rows == 62 and meas.rotations is not None
-    s = cross_validate(nominal, meas, folds=5, point_sigma=0.5e-3).stats()
+    s = cross_validate(nominal, meas, folds=5, sigma=0.5e-3).stats()
     assert s["after_rms_mm"] < 0.65 * s["before_rms_mm"]
 
 
@@ -126,10 +126,10 @@ class IndependentFit:
 
 def test_ur5_laser_tracker_unobservable_wrist_constants_are_held_and_named():
     nominal = load_robot(DATA / "ur5_cb3.yaml")
-    meas = read_measurements(DATA / "jacobi_ur5_grid_poses.csv")
+    meas = read_target_measurements(DATA / "jacobi_ur5_grid_poses.csv")
     assert meas.n_rows == 334 and meas.n_targets == 1
     test = np.arange(meas.n_rows) % 4 == 3  # every 4th row held out
-    res = identify(nominal, meas.subset(~test), point_sigma=0.1e-3)
+    res = identify(nominal, meas.subset(~test), sigma=0.1e-3)
     # The reflector sits 0.2 mm from the wrist-3 axis: the axis's direction, i.e. the wrist-2
     # twist and zero, cannot be seen (1-sigma of degrees to tens of degrees); they are named and
     # held at the nominal, not fitted.
@@ -162,7 +162,7 @@ def test_ur5_stated_error_holds_for_held_out_rows():
     # of the time, and within 1 and 2 times the stated 3D RMS as often as a 3D Gaussian does,
     # within 10 points (measured: 94.3 %, 65.0 %, 97.9 %; Gaussian 60.8 %, 99.3 %).
     nominal = load_robot(DATA / "ur5_cb3.yaml")
-    meas = read_measurements(DATA / "jacobi_ur5_grid_poses.csv")
+    meas = read_target_measurements(DATA / "jacobi_ur5_grid_poses.csv")
     n, folds = meas.n_rows, 5
     fold = np.empty(n, dtype=int)
     fold[np.random.default_rng(0).permutation(n)] = np.arange(n) % folds

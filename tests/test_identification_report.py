@@ -101,7 +101,7 @@ def test_the_scene_shows_the_targets_the_residuals_and_both_arms():
     nominal = load_robot("kuka_kr16")
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
     meas = measure(ch, x, configurations(nominal, 40, rng), rng, NOISE)
-    result = identify(nominal, meas, point_sigma=NOISE)
+    result = identify(nominal, meas, sigma=NOISE)
     scene = identification_scene(result, meas.q, meas.points)
     fig = figure_from_page(page(scene))
     # every measured target, to 1 um, the outlier rows apart

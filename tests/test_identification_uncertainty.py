@@ -9,7 +9,7 @@ from scipy.stats import chi2
 
 from robotcell import load_robot
 from robotcell.errors import InputError
-from robotcell.identification import Measurements, identify
+from robotcell.identification import TargetMeasurements, identify
 from robotcell.identification.uncertainty import (
     PredictedError,
     error_radius,
@@ -53,22 +53,22 @@ def _kr16(noise, unmodelled=0.0, n=80, seed=5):
     ch, x = truth_chain(perturbed(nominal, rng), 1, False, rng)
     meas = measure(ch, x, configurations(nominal, n, rng), rng, noise)
     shaken = meas.points + rng.normal(0.0, unmodelled, meas.points.shape)
-    return nominal, Measurements(meas.q, shaken)
+    return nominal, TargetMeasurements(meas.q, shaken)
 
 
 def test_the_model_error_is_the_scatter_beyond_the_stated_accuracy():
     # 0.02 mm noise stated as such: no model error; the same data with 0.05 mm more scatter
     # than stated: the model error is that scatter (per coordinate)
     nominal, meas = _kr16(0.02e-3)
-    res = identify(nominal, meas, point_sigma=0.02e-3)
+    res = identify(nominal, meas, sigma=0.02e-3)
     assert res.unexplained == pytest.approx(0.02e-3, rel=0.25)
     assert res.model_error < 0.012e-3
     nominal, meas = _kr16(0.02e-3, 0.05e-3)
-    res = identify(nominal, meas, point_sigma=0.02e-3)
+    res = identify(nominal, meas, sigma=0.02e-3)
     assert res.model_error == pytest.approx(0.05e-3, rel=0.25)
     assert res.robot.covariance.model_error == res.model_error
     # a stated accuracy above the scatter: no model error, the measurement part is the scatter
-    res = identify(nominal, meas, point_sigma=0.2e-3)
+    res = identify(nominal, meas, sigma=0.2e-3)
     assert res.model_error == 0.0 and res.unexplained < 0.1e-3
     q = meas.q[:5]
     true_error = res.predicted_error(q).rms
@@ -78,7 +78,7 @@ def test_the_model_error_is_the_scatter_beyond_the_stated_accuracy():
 
 def test_the_tcp_error_carries_the_base_and_the_model_error(tmp_path):
     nominal, meas = _kr16(0.02e-3, 0.05e-3)
-    res = identify(nominal, meas, point_sigma=0.02e-3)
+    res = identify(nominal, meas, sigma=0.02e-3)
     cov = res.robot.covariance
     assert cov.names[:6] == ("base.x", "base.y", "base.z", "base.rx", "base.ry", "base.rz")
     q = meas.q[:10]

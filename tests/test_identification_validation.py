@@ -19,7 +19,7 @@ def test_cross_validation_before_and_after():
     nominal = load_robot("kuka_kr16")
     ch, x = truth_chain(perturbed(nominal, rng), 2, False, rng)
     meas = measure(ch, x, configurations(nominal, 50, rng), rng, NOISE)
-    cv = cross_validate(nominal, meas, folds=5, point_sigma=NOISE)
+    cv = cross_validate(nominal, meas, folds=5, sigma=NOISE)
     assert cv.after.shape == (50, 2) and set(cv.fold) == set(range(5))
     s = cv.stats()
     floor = NOISE * math.sqrt(3.0) * 1e3
@@ -42,7 +42,7 @@ def test_selected_configurations_beat_random_ones():
     truth = ch.predict(x, qv)[0]
 
     def rms(q):
-        res = identify(nominal, measure(ch, x, q, rng, NOISE), point_sigma=NOISE)
+        res = identify(nominal, measure(ch, x, q, rng, NOISE), sigma=NOISE)
         return math.sqrt(np.mean(np.sum((res.predict(qv)[0] - truth) ** 2, axis=-1)))
 
     random_rms = [rms(configurations(nominal, 15, rng)) for _ in range(3)]

@@ -62,7 +62,7 @@ def _trial(rng: np.random.Generator, r2_tool_error: np.ndarray | None = None) ->
                                        err[name], rng, [f"P{i // 2 + 1}" for i in range(8)])
     for name in TOOLS:
         t = out[name + " table"]
-        out[name + " turntable"] = calibrate_turntable(ANGLES, t.points, prior_sigma=NOISE,
+        out[name + " turntable"] = calibrate_turntable(ANGLES, t.points, sigma=NOISE,
                                                        inputs=t.inputs)
     out["link"] = robot_to_robot(out["r1 points"], out["r2 points"], sigma=NOISE)
     out["joint"] = shared_turntable(out["r1 table"], ANGLES, out["r2 table"], ANGLES,

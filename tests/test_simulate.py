@@ -367,7 +367,7 @@ def test_calibration_recovers_the_truth(case):
     if t.procedure == "tcp":
         F = cell.robot.fk(q, tool=np.eye(4))
         r = np.array(roles)
-        res = calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=NOISE)
+        res = calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], sigma=NOISE)
         assert_pose_within(res.values["T_F_TCP"], t.truth["T_F_TCP"],
                            res.sigma["T_F_TCP_position"], res.sigma["T_F_TCP_rotation"])
         # The reference point: the design's point in the robot base.
@@ -376,7 +376,7 @@ def test_calibration_recovers_the_truth(case):
         f = cell.fk(q, e, tool=t.tool, frame="robot")[:, :3, 3]
         refs = [[float(v) * 1e-3 for v in o.split("=", 1)[1].split(",")] for o in t.options]
         res = calibrate_track(e, f, references=refs, point=[int(p) - 1 for p in roles],
-                              prior_sigma=NOISE)
+                              sigma=NOISE)
         assert_pose_within(res.values["T_L_R"], t.truth["T_L_R"], res.sigma["T_L_R_position"],
                            res.sigma["T_L_R_rotation"])
         assert abs(res.values["scale"] - t.truth["scale"]) <= 4 * res.sigma["scale"]
@@ -384,14 +384,14 @@ def test_calibration_recovers_the_truth(case):
         # Touches in the frame the table is fixed in; --height in mm.
         f = cell.fk(q, e, tool=t.tool, frame=t.truth["parent"])[:, :3, 3]
         height = float(t.options[0].split("=", 1)[1]) * 1e-3
-        res = calibrate_turntable(table, f, height=height, prior_sigma=NOISE)
+        res = calibrate_turntable(table, f, height=height, sigma=NOISE)
         assert_pose_within(res.values["T_R_B"], t.truth["pose"], res.sigma["T_R_B_position"],
                            res.sigma["T_R_B_rotation"])
         assert abs(res.values["radius"] - t.truth["radius"]) <= 4 * res.sigma["radius"]
     elif t.procedure == "workpiece":
         tt = cell.turntable
         f = cell.fk(q, e, tool=t.tool, frame=tt.parent)[:, :3, 3]
-        res = calibrate_workpiece(table, f, roles, tt.T_parent_B, prior_sigma=NOISE)
+        res = calibrate_workpiece(table, f, roles, tt.T_parent_B, sigma=NOISE)
         assert_pose_within(res.values["T_B_W"], t.truth["pose"], res.sigma["T_B_W_position"],
                            res.sigma["T_B_W_rotation"])
     elif t.procedure == "frame":

@@ -62,7 +62,7 @@ def turntable_touches(seed=0, outlier=3):
 
 def test_turntable_calibration_scene_shows_touches_circle_and_magnified_residuals():
     theta, f, _ = turntable_touches()
-    res = calibrate_turntable(theta, f, prior_sigma=5e-5)  # the touches' stated accuracy
+    res = calibrate_turntable(theta, f, sigma=5e-5)  # the touches' stated accuracy
     T, radius = res.values["T_R_B"], res.values["radius"]
     outliers = np.array([f"touch {lab} is an outlier" in " ".join(res.warnings)
                          for lab in res.labels])
@@ -145,7 +145,7 @@ def test_calibration_scenes_of_each_procedure():
     # a tilt-rotate positioner: both axes and their common normal, as the result gives them
     ch, x = _truth(np.random.default_rng(31))
     f = ch.predict(x, GRID)[0][:, 0] + np.random.default_rng(2).normal(0, NOISE, (len(GRID), 3))
-    pos = calibrate_positioner(GRID, f, nominal=NOMINAL, prior_sigma=NOISE).result.to_json()
+    pos = calibrate_positioner(GRID, f, nominal=NOMINAL, sigma=NOISE).result.to_json()
     got = items(calibration_scene(pos, "robot base R", [("robot base R", R),
                                                         ("turntable B", pos["matrix"])]))
     for name, point, axis in (("tilt axis", "tilt_point_mm", "tilt_axis"),

@@ -38,8 +38,10 @@ def term(key: str, python: str) -> str:
     Parameters
     ----------
     key : str
-        What is named, e.g. ``"sigma"`` or ``"references"`` (a parameter of the library call,
-        possibly with the form of its value, ``"tool=X,Y,Z,A,B,C"``).
+        What is named, in the library's terms, never a command line: a parameter of the
+        library call (``"sigma"``, ``"references"``), possibly with the form of its value
+        (``"tool=X,Y,Z,A,B,C"``), or a procedure (``"procedure:turntable"``; ``"procedure"``:
+        the one running).
     python : str
         The words for a Python caller at this place of the message, e.g. ``"sigma"`` or
         ``"references (K, 3), m"``.

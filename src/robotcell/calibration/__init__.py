@@ -5,7 +5,7 @@ and returns a :class:`CalibrationResult` (SI units inside; mm and degrees in its
 report). Shared pieces: :mod:`.result` (the result), :mod:`.fitting` (least squares, covariance,
 conditioning, outliers, rotation parameterisation), :mod:`.measurements` (CSV columns to SI).
 Procedures: :func:`calibrate_tool` (TCP, ABC 2-point, ABC World), :func:`frame_3point`,
-:func:`frame_npoint`, :func:`external_tcp`, :func:`robot_to_robot`.
+:func:`frame_npoint`, :func:`calibrate_external_tcp`, :func:`robot_to_robot`.
 See ``docs/calibration.md``.
 """
 
@@ -19,7 +19,7 @@ from robotcell.calibration.fitting import (
     perturb_rotation,
     pose_sigma,
 )
-from robotcell.calibration.frame import external_tcp, frame_3point, frame_npoint
+from robotcell.calibration.frame import calibrate_external_tcp, frame_3point, frame_npoint
 from robotcell.calibration.result import CalibrationResult, pose_fields, to_jsonable
 from robotcell.calibration.robottorobot import RobotTouches, robot_to_robot
 from robotcell.calibration.tcp import calibrate_tool
@@ -28,8 +28,8 @@ __all__ = [
     "CalibrationResult",
     "Fit",
     "RobotTouches",
+    "calibrate_external_tcp",
     "calibrate_tool",
-    "external_tcp",
     "fit",
     "frame_3point",
     "frame_npoint",

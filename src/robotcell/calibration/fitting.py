@@ -257,7 +257,7 @@ def fit(
     fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     x0: ArrayLike,
     names: Sequence[str],
-    prior_sigma: float | None = None,
+    sigma: float | None = None,
     advice: str = "take touches that differ in position and orientation in more directions",
     *,
     measured: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
@@ -266,7 +266,7 @@ def fit(
 ) -> Fit:
     """Maximum-likelihood fit of a point model, robust to one gross error.
 
-    The uncertainty rests on the touch accuracy ``s``: ``prior_sigma``, or
+    The uncertainty rests on the touch accuracy ``s``: ``sigma``, or
     :data:`DEFAULT_TOUCH_SIGMA` when none is stated. The residuals are a check against it
     (chi-square with the redundancy as degrees of freedom, inputs' errors included); only when
     they fail that check at the verdict's level (:data:`~robotcell.calibration.verdict.CHI2_P`)
@@ -285,7 +285,7 @@ def fit(
         Starting point (e.g. from a linear solution).
     names : sequence of str
         Name of each parameter, used in the error raised when the data do not determine them.
-    prior_sigma : float, optional
+    sigma : float, optional
         Stated touch accuracy (metres per coordinate); default :data:`DEFAULT_TOUCH_SIGMA`.
     advice : str
         What to measure instead, ending the error raised when the data do not determine the
@@ -314,9 +314,9 @@ def fit(
         A touch accuracy that is not a positive number.
     """
     x0 = np.asarray(x0, dtype=float)
-    if prior_sigma is not None and not (np.isfinite(prior_sigma) and prior_sigma > 0):
-        raise InputError(f"the measurement sigma must be a positive number, got {prior_sigma}")
-    s = float(prior_sigma) if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
+    if sigma is not None and not (np.isfinite(sigma) and sigma > 0):
+        raise InputError(f"the measurement sigma must be a positive number, got {sigma}")
+    s = float(sigma) if sigma is not None else DEFAULT_TOUCH_SIGMA
     n = len(np.asarray(fun(x0), dtype=float).reshape(-1, 3))
     if inputs is not None and len(inputs.sensitivity) != n:
         raise InputError(f"the inputs give {len(inputs.sensitivity)} touches, the model {n}")
@@ -340,7 +340,7 @@ def fit(
         other = _solve(fun, sol.x, keep, measured, inputs, factor, s)
         if keeps_out(other, worst):
             sol = other
-    return _finish(sol, s, prior_sigma is not None, inputs, factor)
+    return _finish(sol, s, sigma is not None, inputs, factor)
 
 
 def keeps_out(result: Fit | _Solved, worst: int) -> bool:
@@ -357,7 +357,7 @@ def keeps_out(result: Fit | _Solved, worst: int) -> bool:
 
 
 def solution_fit(x: ArrayLike, J: ArrayLike, r: ArrayLike, *, used: ArrayLike | None = None,
-                 prior_sigma: float | None = None, inputs: Inputs | None = None) -> Fit:
+                 sigma: float | None = None, inputs: Inputs | None = None) -> Fit:
     """The :class:`Fit` of a least-squares solution found elsewhere (its uncertainty and tests).
 
     For an estimator with its own solver (the identification engine): the same noise level,
@@ -373,7 +373,7 @@ def solution_fit(x: ArrayLike, J: ArrayLike, r: ArrayLike, *, used: ArrayLike | 
         Residuals at ``x`` (m); for a touch left out, its residual against the others' fit.
     used : array_like of bool, shape (N,), optional
         Touches the solution was fitted to (default all).
-    prior_sigma : float, optional
+    sigma : float, optional
         Stated touch accuracy (m); default :data:`DEFAULT_TOUCH_SIGMA`.
     inputs : Inputs, optional
         Earlier calibrations the touches rest on (derivative of each residual).
@@ -385,11 +385,11 @@ def solution_fit(x: ArrayLike, J: ArrayLike, r: ArrayLike, *, used: ArrayLike | 
     J = np.asarray(J, dtype=float)
     n = len(J)
     used = np.ones(n, dtype=bool) if used is None else np.asarray(used, dtype=bool)
-    s = float(prior_sigma) if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
+    s = float(sigma) if sigma is not None else DEFAULT_TOUCH_SIGMA
     factor = inputs.sources.matrix()[0] if inputs is not None else np.zeros((0, 0))
     sol = _analyse(np.asarray(x, dtype=float), J, np.asarray(r, dtype=float),
                    np.broadcast_to(np.eye(3), (n, 3, 3)), used, inputs, factor, s)
-    return _finish(sol, s, prior_sigma is not None, inputs, factor)
+    return _finish(sol, s, sigma is not None, inputs, factor)
 
 
 def _solve(fun, x0, used, measured, inputs, factor, s) -> _Solved:

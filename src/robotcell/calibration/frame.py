@@ -31,7 +31,7 @@ from robotcell.calibration.uncertainty import Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points
 
-__all__ = ["external_tcp", "frame_3point", "frame_npoint"]
+__all__ = ["calibrate_external_tcp", "frame_3point", "frame_npoint"]
 
 #: Below this distance (m) from origin to the +X touch a warning recommends spreading further.
 GOOD_X_DISTANCE = 0.100
@@ -90,7 +90,7 @@ def role_projectors(R: NDArray[np.float64], roles: NDArray[np.str_]) -> NDArray[
     return P
 
 
-def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | None,
+def _role_fit(p: NDArray[np.float64], roles: list[str], sigma: float | None,
               inputs: Inputs | None):
     """ML fit of origin and rotation; each +X / XY-plane touch's free coordinates eliminated.
 
@@ -114,7 +114,7 @@ def _role_fit(p: NDArray[np.float64], roles: list[str], prior_sigma: float | Non
 
     names = ["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
              "rotation about z"]
-    res = fit(resid, np.concatenate([o0, np.zeros(3)]), names, prior_sigma, measured=measured,
+    res = fit(resid, np.concatenate([o0, np.zeros(3)]), names, sigma, measured=measured,
               inputs=inputs)
     T = np.eye(4)
     T[:3, :3] = perturb_rotation(R0, res.x[3:6])
@@ -143,7 +143,7 @@ def _common(procedure: str, key: str, T: NDArray[np.float64], res, labels: list[
     )
 
 
-def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,
+def frame_3point(points: ArrayLike, roles: Sequence[str], sigma: float | None = None,
                  labels: Sequence[str] | None = None, *,
                  inputs: Inputs | None = None) -> CalibrationResult:
     """Frame from touches of its origin, a point on +X, and a point in the XY plane with Y > 0.
@@ -159,7 +159,7 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
         Touched TCP positions in the robot base frame (metres).
     roles : sequence of str, length N
         ``"origin"``, ``"x"`` or ``"xy"`` for each touch; each role at least once.
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch-up accuracy (metres, 1-sigma per coordinate) the uncertainties rest on; default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
@@ -191,7 +191,7 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
                          + (f"; missing {', '.join(missing)}" if missing else ""))
     _check_roles(p, roles)
     labs = _labels(len(p), labels, roles)
-    res, T = _role_fit(p, roles, prior_sigma, inputs)
+    res, T = _role_fit(p, roles, sigma, inputs)
     warnings = []
     r = np.array(roles)
     lx = np.linalg.norm(p[r == "x"].mean(axis=0) - p[r == "origin"].mean(axis=0))
@@ -212,7 +212,7 @@ def frame_3point(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
                    "jogging along the new X and Y axes over the workpiece", points=p)
 
 
-def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | None = None,
+def frame_npoint(points: ArrayLike, nominal: ArrayLike, sigma: float | None = None,
                  labels: Sequence[str] | None = None, *,
                  inputs: Inputs | None = None) -> CalibrationResult:
     """Best-fit frame to touched points whose coordinates in the frame are known.
@@ -227,7 +227,7 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
         Touched TCP positions in the robot base frame (metres), N >= 3.
     nominal : array_like, shape (N, 3)
         Coordinates of the same points in the frame W, e.g. from the drawing (metres).
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch-up accuracy (metres); default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
@@ -265,7 +265,7 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
 
     names = ["origin x", "origin y", "origin z", "rotation about x", "rotation about y",
              "rotation about z"]
-    res = fit(resid, np.concatenate([T0[:3, 3], np.zeros(3)]), names, prior_sigma, inputs=inputs)
+    res = fit(resid, np.concatenate([T0[:3, 3], np.zeros(3)]), names, sigma, inputs=inputs)
     T = np.eye(4)
     T[:3, :3] = perturb_rotation(R0, res.x[3:6])
     T[:3, 3] = res.x[:3]
@@ -280,7 +280,7 @@ def frame_npoint(points: ArrayLike, nominal: ArrayLike, prior_sigma: float | Non
                    points=p)
 
 
-def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | None = None,
+def calibrate_external_tcp(points: ArrayLike, roles: Sequence[str], sigma: float | None = None,
                  labels: Sequence[str] | None = None, *,
                  inputs: Inputs | None = None) -> CalibrationResult:
     """Pose of a fixed (external) tool in the robot base frame, touched with a reference tool.
@@ -299,7 +299,7 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
         Reference-tool TCP positions in the robot base frame (metres).
     roles : sequence of str, length N
         ``"tcp"``, ``"x"`` or ``"xy"``.
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch-up accuracy (metres); default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
@@ -330,7 +330,7 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
                  "tool) and check by moving a workpiece point to the fixed TCP in two orientations")
     if "x" not in roles and "xy" not in roles:
         pt = p[np.array(roles) == "tcp"]
-        res = fit(lambda x: pt - x, pt.mean(axis=0), ["x", "y", "z"], prior_sigma,
+        res = fit(lambda x: pt - x, pt.mean(axis=0), ["x", "y", "z"], sigma,
                   inputs=None if inputs is None else inputs.subset(np.array(roles) == "tcp"))
         T = np.eye(4)
         T[:3, 3] = res.x
@@ -343,7 +343,7 @@ def external_tcp(points: ArrayLike, roles: Sequence[str], prior_sigma: float | N
     if "x" not in roles or "xy" not in roles:
         raise IllPosedError("the fixed tool's orientation needs touches of both a point on its +X axis "
                             "(role x) and a point in its XY plane with positive Y (role xy)")
-    out = frame_3point(p, ["origin" if r == "tcp" else r for r in roles], prior_sigma, labs,
+    out = frame_3point(p, ["origin" if r == "tcp" else r for r in roles], sigma, labs,
                        inputs=inputs).renamed("T_R_W", "T_R_TCP")
     T = out.values["T_R_TCP"]
     out.procedure = "external-tcp"

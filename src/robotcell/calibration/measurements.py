@@ -4,8 +4,8 @@ A table is a mapping of lower-case column name to one value per touch: numbers (
 or text (a list of str), as :func:`robotcell.io.tables.read_csv` returns a CSV file with a header
 (see ``docs/calibration.md``). What a procedure reads from it, the roles and units of its columns
 and its fewest touches, is its :class:`~robotcell.calibration.spec.TableSpec`
-(:data:`~robotcell.calibration.spec.SPECS`); :func:`read_measurements` reads a table by it, once,
-into :class:`Measurements` (SI): the touches (TCP positions, flange poses or joint values), the
+(:data:`~robotcell.calibration.spec.SPECS`); :func:`read_touch_table` reads a table by it, once,
+into :class:`TouchTable` (SI): the touches (TCP positions, flange poses or joint values), the
 external axis values, the robot's track positions, the touched points and their known
 coordinates. The column readers below (:func:`tcp_positions`, :func:`external_axis`, ...) are
 its pieces, each refusing what its column cannot hold (metres or radians by mistake, values
@@ -46,7 +46,7 @@ from robotcell.robot.robot import Robot
 
 __all__ = [
     "MM_LOOKS_LIKE_M",
-    "Measurements",
+    "TouchTable",
     "check_count",
     "columns_of",
     "external_axis",
@@ -55,7 +55,7 @@ __all__ = [
     "line_labels",
     "nominal_points",
     "point_roles",
-    "read_measurements",
+    "read_touch_table",
     "repeated_rows",
     "tcp_positions",
     "track_column",
@@ -72,7 +72,7 @@ Columns = Mapping[str, Any]
 
 
 @dataclass(frozen=True, eq=False)
-class Measurements:
+class TouchTable:
     """The touches of one procedure, read from a measurement table, in SI units.
 
     Exactly one of ``points``, ``poses`` and ``joints`` holds the touches.
@@ -175,7 +175,7 @@ class Measurements:
         Returns
         -------
         dict
-            Column name to a float array (text: a list of str), as :func:`read_measurements`
+            Column name to a float array (text: a list of str), as :func:`read_touch_table`
             reads it back.
         """
         out: dict[str, Any] = {}
@@ -252,9 +252,9 @@ def columns_of(table: Any, source: str) -> dict[str, Any]:
     return cols
 
 
-def read_measurements(procedure: TableSpec | str, cols: Columns, source: str,
+def read_touch_table(procedure: TableSpec | str, cols: Columns, source: str,
                       robot: Robot | None = None,
-                      on_note: Callable[[str], None] | None = None) -> Measurements:
+                      on_note: Callable[[str], None] | None = None) -> TouchTable:
     """Read a measurement table by a procedure's specification, into SI units.
 
     Parameters
@@ -275,7 +275,7 @@ def read_measurements(procedure: TableSpec | str, cols: Columns, source: str,
 
     Returns
     -------
-    Measurements
+    TouchTable
 
     Raises
     ------
@@ -293,12 +293,12 @@ def read_measurements(procedure: TableSpec | str, cols: Columns, source: str,
             on_note(text)
 
     unused = unknown_columns_warning(source, cols, spec.known,
-                                     term("the calibration", f"the {spec.name} calibration"))
+                                     term("procedure", f"the {spec.name} calibration"))
     if unused:
         note(unused)
     for name, why in spec.unused.items():
         if name in cols and len(empty_rows(cols[name])) < len(cols[name]):  # a value given
-            procedure = term(f"calibrate {spec.name}", f"the {spec.name} calibration")
+            procedure = term(f"procedure:{spec.name}", f"the {spec.name} calibration")
             raise InputError(f"{source}: column '{name}' {why.format(procedure=procedure)}")
     touches = _touches(cols, source, spec.pose, robot)
     n = len(next(v for v in touches.values() if v is not None))
@@ -314,7 +314,7 @@ def read_measurements(procedure: TableSpec | str, cols: Columns, source: str,
     track = track_column(cols, source) if spec.role("track") else None
     for text in repeated_rows(raw_rows(cols, spec.names), source):
         note(f"note: {text}")
-    return Measurements(spec, source, **touches, robot=robot, axes=values, track=track,
+    return TouchTable(spec, source, **touches, robot=robot, axes=values, track=track,
                         point=point, reference=reference, nominal=nominal, notes=tuple(notes))
 
 

@@ -593,7 +593,7 @@ def fit_fields(res: Fit) -> dict[str, Any]:
 def result_json() -> str:
     """What a result given as JSON must be, for messages: the output of :meth:`to_json
     <CalibrationResult.to_json>` (on the command line: of ``calibrate ... --json``)."""
-    return term("result=output", "output of CalibrationResult.to_json()")
+    return term("result=json", "output of CalibrationResult.to_json()")
 
 
 def pose_covariance(value: object, where: str) -> NDArray[np.float64]:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.calibration.measurements import read_measurements
+from robotcell.calibration.measurements import read_touch_table
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.robottorobot import RobotTouches, robot_to_robot
 from robotcell.calibration.sigmaparts import ASSUMED_SUFFIX
@@ -82,7 +82,7 @@ def _names(table: RobotTable, n: int) -> tuple[str, ...]:
 def _touches(table: RobotTable, tool_sigma: float | None,
              on_note: Callable[[str], None] | None) -> RobotTouches:
     """One robot's touches: TCP positions, or flange poses with the tool and its error."""
-    m = read_measurements(SPEC, table.columns, table.source, table.robot, on_note)
+    m = read_touch_table(SPEC, table.columns, table.source, table.robot, on_note)
     names = _names(table, m.n)
     if m.points is not None:
         if on_note is not None:

@@ -4,7 +4,7 @@ One :class:`TableSpec` per procedure (:data:`SPECS`) says which columns its meas
 has, the role of each (what it is), its unit in the table (the vendor boundary: mm, deg), which
 values column ``point`` takes, and the fewest touches the procedure can use. Everything that
 reads, writes or counts touches takes them from here: the reader of measurement tables
-(:func:`robotcell.calibration.measurements.read_measurements`, and with it the warning about
+(:func:`robotcell.calibration.measurements.read_touch_table`, and with it the warning about
 columns a procedure does not use), the tables :mod:`robotcell.studies.simulate` writes, and the
 estimators' and the simulation's smallest counts. A column added to a procedure here is read,
 known and written by all of them.

@@ -114,7 +114,7 @@ def calibrate_tool(
     plane_touches: ArrayLike | None = None,
     world_touches: ArrayLike | None = None,
     world_mode: str = "6d",
-    prior_sigma: float | None = None,
+    sigma: float | None = None,
     labels: Sequence[str] | None = None,
     inputs: Inputs | None = None,
 ) -> CalibrationResult:
@@ -139,7 +139,7 @@ def calibrate_tool(
         ``"6d"``: tool +X along world -Z, +Y along world +Y, +Z along world +X.
         ``"5d"``: only tool +X along world -Z; the rotation about the tool axis is fixed by the
         convention "smallest rotation from the flange X axis" and reported as undetermined.
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch-up accuracy (metres, 1-sigma per coordinate) the uncertainties rest on; default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
@@ -182,7 +182,7 @@ def calibrate_tool(
         names += ["tool rotation about flange x", "tool rotation about flange y",
                   "tool rotation about flange z"]
     flipped = None if inputs is None else Inputs(-inputs.sensitivity, inputs.sources, inputs.names)
-    res = fit(resid, x0, names, prior_sigma, advice=SIMILAR, measured=measured, inputs=flipped)
+    res = fit(resid, x0, names, sigma, advice=SIMILAR, measured=measured, inputs=flipped)
     warnings = outlier_warnings(res, labels)
     spread = orientation_spread(T[:, :3, :3])
     if spread < GOOD_SPREAD:

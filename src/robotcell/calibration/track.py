@@ -216,7 +216,7 @@ def calibrate_track(
     axis: str = "x",
     roll: str | None = None,
     labels: Sequence[str] | None = None,
-    prior_sigma: float | None = None,
+    sigma: float | None = None,
     inputs: Inputs | None = None,
     group_tol: float | None = None,
 ) -> CalibrationResult:
@@ -247,7 +247,7 @@ def calibrate_track(
         Not allowed with references (the rotation is then measured).
     labels : sequence of str, optional
         Name of each touch for messages and reports (default ``"1".."N"``).
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch accuracy (metres per coordinate) the uncertainties rest on; default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     inputs : Inputs, optional
@@ -288,9 +288,9 @@ def calibrate_track(
     travel = _check_positions(e, group_tol)
     warnings: list[str] = [] if refs is None else _check_references(refs, d)
     if refs is None:
-        tf = _unknown_point_track(e, f, d, axis, roll, prior_sigma, inputs)
+        tf = _unknown_point_track(e, f, d, axis, roll, sigma, inputs)
     else:
-        tf = _known_points_track(e, f, refs, groups, d, prior_sigma, inputs)
+        tf = _known_points_track(e, f, refs, groups, d, sigma, inputs)
     warnings += _track_warnings(tf, travel)
     return _track_result(tf, f, refs, axis, labels, warnings)
 
@@ -360,15 +360,15 @@ def _track_touches(e: ArrayLike, f: ArrayLike, references: ArrayLike | None,
 
 
 def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDArray[np.float64],
-                         axis: str, roll: str | None, prior_sigma: float | None,
+                         axis: str, roll: str | None, sigma: float | None,
                          inputs: Inputs | None) -> _TrackFit:
     """The track from touches of one unknown point: direction, scale and the point; the rotation
     only by the zero-roll convention (``roll="zero"``)."""
     values: dict = {}
-    sigma: dict = {}
+    sigmas: dict = {}
     estimates: dict = {}
     undetermined: list[str] = []
-    res, e_mean = _fit_unknown_point(e, f, prior_sigma, inputs)
+    res, e_mean = _fit_unknown_point(e, f, sigma, inputs)
 
     def derived(x: NDArray[np.float64]) -> NDArray[np.float64]:
         s = np.linalg.norm(x[3:])
@@ -379,7 +379,7 @@ def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDAr
     sd = np.sqrt(np.abs(np.diag(cov)))
     direction, scale = y[:3], float(y[3])
     values.update(direction=direction, scale=scale, point=y[4:7])
-    sigma.update(direction=sd[:3], scale=float(sd[3]), point=sd[4:7])
+    sigmas.update(direction=sd[:3], scale=float(sd[3]), point=sd[4:7])
     direction_cov = cov[:3, :3]
     undetermined.append(
         "rotation of L_Q_R about the track axis: touches of one unknown point cannot see it"
@@ -396,7 +396,7 @@ def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDAr
         A = np.zeros((7, 6))
         A[3:6] = jacobian(roll_rotvec, res.x)
         A[6] = jacobian(lambda x: [np.linalg.norm(x[3:])], res.x)
-        sigma["T_L_R_rotation"] = np.sqrt(np.abs(np.diag(A[3:6] @ res.covariance @ A[3:6].T)))
+        sigmas["T_L_R_rotation"] = np.sqrt(np.abs(np.diag(A[3:6] @ res.covariance @ A[3:6].T)))
         across = np.eye(3) - np.outer(d, d)
         U = np.linalg.svd(across)[0][:, :2]
         determined = np.zeros((7, 3))
@@ -413,20 +413,20 @@ def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDAr
                      "the track axis (two or more also give the carriage offset) and pass them "
                      f"with {term('reference', 'references')}, or accept the zero-roll "
                      f"convention ({term('roll=zero', 'roll=' + repr('zero'))})")
-    return _TrackFit(res, values, sigma, estimates, undetermined, direction, direction_cov, scale,
+    return _TrackFit(res, values, sigmas, estimates, undetermined, direction, direction_cov, scale,
                      Q, source, offset, next_step)
 
 
 def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: NDArray[np.float64],
                         groups: NDArray[np.int_], d: NDArray[np.float64],
-                        prior_sigma: float | None, inputs: Inputs | None) -> _TrackFit:
+                        sigma: float | None, inputs: Inputs | None) -> _TrackFit:
     """The track from touches of reference points known in L: its pose ``T_L_R`` and scale (the
     carriage offset with two or more points)."""
     values: dict = {}
-    sigma: dict = {}
+    sigmas: dict = {}
     estimates: dict = {}
     undetermined: list[str] = []
-    res, unpack = _fit_known_points(e, f, refs, groups, d, prior_sigma, inputs)
+    res, unpack = _fit_known_points(e, f, refs, groups, d, sigma, inputs)
     Q, scale, c = unpack(res.x)
     scale = float(scale)
     A = np.zeros((7, len(res.x)))
@@ -445,9 +445,9 @@ def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: ND
     direction = Q.T @ d
     direction_cov = cov[:3, :3]
     values.update(direction=direction, scale=scale, T_L_R=make_pose(Q, c))
-    sigma.update(direction=sd[:3], scale=float(res.sigma[3]), T_L_R_rotation=res.sigma[:3])
+    sigmas.update(direction=sd[:3], scale=float(res.sigma[3]), T_L_R_rotation=res.sigma[:3])
     if len(refs) >= 2:
-        sigma["T_L_R_position"] = sd[3:6]
+        sigmas["T_L_R_position"] = sd[3:6]
         offset = c
     else:
         undetermined.append("carriage offset (position of R in L at track position 0): taken "
@@ -458,7 +458,7 @@ def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: ND
     next_step = ("enter T_L_R (robot base on the carriage at track position 0) and the scale in "
                  "the controller's track machine data, then verify by touching a reference "
                  "point at both ends of the track")
-    return _TrackFit(res, values, sigma, estimates, undetermined, direction, direction_cov, scale,
+    return _TrackFit(res, values, sigmas, estimates, undetermined, direction, direction_cov, scale,
                      Q, source, offset, next_step)
 
 

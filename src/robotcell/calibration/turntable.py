@@ -107,7 +107,7 @@ def calibrate_turntable(
     *,
     height: float = 0.0,
     labels: Sequence[str] | None = None,
-    prior_sigma: float | None = None,
+    sigma: float | None = None,
     inputs: Inputs | None = None,
     group_tol: float | None = None,
 ) -> CalibrationResult:
@@ -128,7 +128,7 @@ def calibrate_turntable(
         (metres): e.g. ``-0.02`` puts it on the table top when the touched point is 20 mm above it.
     labels : sequence of str, optional
         Name of each touch (default ``"1".."N"``).
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch accuracy (metres per coordinate) the uncertainties rest on; default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     inputs : Inputs, optional
@@ -177,7 +177,7 @@ def calibrate_turntable(
     names = ["origin x", "origin y", "origin z", "rotation about R x", "rotation about R y",
              "rotation about R z", "radius"]
     x0 = np.concatenate([b_plane + height * R0[:, 2], np.zeros(3), [r0]])
-    res = fit(residuals, x0, names, prior_sigma, inputs=inputs)
+    res = fit(residuals, x0, names, sigma, inputs=inputs)
     return _turntable_result(res, unpack, f, height, spread, labels)
 
 

@@ -91,7 +91,7 @@ def calibrate_workpiece(
     *,
     T_R_B_covariance: ArrayLike | Sources | None = None,
     inputs: Inputs | None = None,
-    prior_sigma: float | None = None,
+    sigma: float | None = None,
     labels: Sequence[str] | None = None,
 ) -> CalibrationResult:
     """Calibrate the workpiece frame ``T_B_W`` on a calibrated turntable.
@@ -115,7 +115,7 @@ def calibrate_workpiece(
         uncertainty of ``T_B_W``.
     inputs : Inputs, optional
         Earlier calibrations the touched points ``f`` rest on (the tool, a track).
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch accuracy (metres per coordinate) the uncertainties rest on; default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
@@ -150,7 +150,7 @@ def calibrate_workpiece(
         moved = jacobian(lambda t: table_points(perturb_pose(T_R_B, t), theta, f), t0)
         to_b = joined(to_b, moved.reshape(n, 3, 6), turntable,
                       [f"turntable {k}" for k in ("x", "y", "z", "rx", "ry", "rz")])
-    out = frame_3point(p, list(roles), prior_sigma, labels, inputs=to_b).renamed("T_R_W", "T_B_W")
+    out = frame_3point(p, list(roles), sigma, labels, inputs=to_b).renamed("T_R_W", "T_B_W")
     out.residuals = np.einsum("nij,nj->ni", back, out.residuals)
     if out.points is not None:
         out.points = f

@@ -6,6 +6,8 @@ import json
 import math
 import re
 import sys
+from types import SimpleNamespace
+from typing import Any
 
 import click
 import numpy as np
@@ -50,20 +52,19 @@ def _print_offsets(offsets: dict, vendor: str) -> None:
     click.echo(format_table(head, rows))
 
 
-#: Range of ``--accuracy`` (mm) and ``--angle-accuracy`` (deg): 0.1 um (0.1 mdeg) is finer than
+#: Range of ``--sigma`` (mm) and ``--angle-sigma`` (deg): 0.1 um (0.1 mdeg) is finer than
 #: any measuring device, 1 m (1000 deg) coarser than any measurement worth a fit.
 ACCURACY_MIN, ACCURACY_MAX = 1e-4, 1e3
 #: Largest ``|--j23-factor|``: a J2/J3 linkage moves axis 3 by about as much as axis 2 (FANUC: 1).
 J23_MAX = 10.0
 
-def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientation: bool,
-             seed: int, accuracy: float, angle_accuracy: float, box: str | None,
-             output: str | None, as_json: bool) -> None:
+def _propose(o: SimpleNamespace) -> None:
     """``--propose N``: write the selected configurations (deg, mm) and print O1 against random."""
-    box_m = None if box is None else np.array(parse_numbers(box, "--box", 6)) * 1e-3
+    box_m = None if o.box is None else np.array(parse_numbers(o.box, "--box", 6)) * 1e-3
     with as_flags({"n": "--propose", "n_targets": "--targets", "pose": "--orientation"}):
-        prop = propose_configurations(n, robot, cell, targets, orientation, seed,
-                                      accuracy * 1e-3, math.radians(angle_accuracy), box_m)
+        prop = propose_configurations(o.propose, o.robot, o.cell_path, o.targets, o.orientation,
+                                      o.seed, o.sigma * 1e-3, math.radians(o.angle_sigma), box_m)
+    n, output, as_json = o.propose, o.output, o.as_json
     nominal, sel = prop.robot, prop.selection
     q = np.where(nominal.prismatic, sel.q * 1e3, np.degrees(sel.q))
     header = [f"a{i}" for i in range(1, nominal.n_joints + 1)]
@@ -85,8 +86,8 @@ def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientat
                f"{rand.max():.4g} ({(sel.o1 / rand.max() - 1) * 100:+.0f} % over the best)",
                err=output is None)
     if output is not None:
-        cols = "x,y,z" if targets == 1 else "x1,y1,z1,x2,..."
-        cols += ",qw,qx,qy,qz" if orientation else ""
+        cols = "x,y,z" if o.targets == 1 else "x1,y1,z1,x2,..."
+        cols += ",qw,qx,qy,qz" if o.orientation else ""
         click.echo(f"configurations written to {output} (a1..a{nominal.n_joints}, deg; mm for "
                    f"prismatic joints); measure them and add the columns {cols}")
 
@@ -102,10 +103,11 @@ def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientat
 @click.option("--j23-factor", "j23", type=float, help="J2/J3 coupling k: q3_model = J3 + k * J2 "
               "(FANUC: 1, as the ROS-Industrial driver's J23_factor; docs/robots.md). The report "
               "compares the fits with it, without it and with k fitted, in mm.")
-@click.option("--accuracy", "accuracy", type=float, default=0.05, show_default=True,
-              help="Accuracy of a measured coordinate (mm).")
-@click.option("--angle-accuracy", "angle_accuracy", type=float, default=0.02, show_default=True,
-              help="Accuracy of a measured orientation (deg).")
+@click.option("--sigma", "--accuracy", "sigma", type=float, default=0.05, show_default=True,
+              help="Accuracy of a measured coordinate, 1-sigma (mm); --accuracy is an alias.")
+@click.option("--angle-sigma", "--angle-accuracy", "angle_sigma", type=float, default=0.02,
+              show_default=True, help="Accuracy of a measured orientation, 1-sigma (deg); "
+              "--angle-accuracy is an alias.")
 @click.option("--scale", "scale", is_flag=True, help="Also identify a scale error (gear ratio) per axis.")
 @click.option("--compliance", "compliance", is_flag=True, help="Also identify the gravity compliance "
               "of axes 2 and 3 (needs the link masses: joint keys mass, com in the model file).")
@@ -140,12 +142,7 @@ def _propose(n: int, robot: str | None, cell: str | None, targets: int, orientat
                    "(--folds); its robot.model is the nominal when --robot is not given. "
                    "With --propose: its robot.model and its floor.")
 @group_tolerance_option("Joint values")
-def identify(measurements: str | None, robot: str | None, output: str | None, as_json: bool,
-             j23: float | None, accuracy: float, angle_accuracy: float, scale: bool,
-             compliance: bool, force: bool, folds: int, report: str | None,
-             offsets_for: str | None, propose: int | None, targets: int, orientation: bool,
-             seed: int, box: str | None, cell_path: str | None,
-             group_tolerance: float | None) -> None:
+def identify(measurements: str | None, **options: Any) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
     MEASUREMENTS.csv has joint values a1..aN (deg, mm for prismatic joints), the measured target
@@ -175,42 +172,54 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
       robotcell identify tracker.csv --robot fanuc_m20ia --j23-factor 1 --json
       robotcell identify --propose 30 --robot kuka_kr16 --targets 3 -o to_measure.csv
     """
-    for name, value, unit in (("--accuracy", accuracy, "mm"),
-                              ("--angle-accuracy", angle_accuracy, "deg")):
-        if not ACCURACY_MIN <= value <= ACCURACY_MAX:
-            raise InputError(f"{name} must be a positive number of {unit} from {ACCURACY_MIN:g} "
-                             f"to {ACCURACY_MAX:g}, got {value:g}")
-    if j23 is not None and not abs(j23) <= J23_MAX:
-        raise InputError(f"--j23-factor must be a finite number from -{J23_MAX:g} to {J23_MAX:g} "
-                         f"(a linkage's ratio; FANUC: 1), got {j23:g}")
-    if propose is not None:
+    o = SimpleNamespace(**options)
+    _check_numbers(o)
+    if o.propose is not None:
         if measurements is not None:
             raise InputError("--propose N writes configurations to measure; give no MEASUREMENTS.csv")
-        if robot is None and cell_path is None:
+        if o.robot is None and o.cell_path is None:
             raise InputError("--propose needs --robot NOMINAL (library name or model file) or "
                              "--cell CELL.yaml (its robot.model)")
-        check_kind(output, "CSV", "the proposed configurations")
-        return _propose(propose, robot, cell_path, targets, orientation, seed, accuracy,
-                        angle_accuracy, box, output, as_json)
-    if box is not None:
+        check_kind(o.output, "CSV", "the proposed configurations")
+        return _propose(o)
+    if o.box is not None:
         raise InputError("--box goes with --propose: where the proposed configurations may put "
                          "the flange and the reflectors")
     if measurements is None:
         raise InputError("give MEASUREMENTS.csv (or --propose N --robot NOMINAL to plan them)")
-    check_kind(output, "YAML", "the identified model file")
-    if cell_path is not None and output is None:
+    check_kind(o.output, "YAML", "the identified model file")
+    if o.cell_path is not None and o.output is None:
         raise InputError("--cell needs -o FILE.yaml: the identified model file the cell will name")
-    if offsets_for is not None and robot is None:
+    if o.offsets_for is not None and o.robot is None:
         raise InputError("--offsets-for needs --robot NOMINAL: the offsets correct the nominal model "
                          "the controller uses")
     _check_columns(measurements)
+    _identify(measurements, o)
+
+
+def _check_numbers(o: SimpleNamespace) -> None:
+    """Refuse accuracies and a J2/J3 factor outside what a measurement can mean."""
+    for name, value, unit in (("--sigma", o.sigma, "mm"), ("--angle-sigma", o.angle_sigma, "deg")):
+        if not ACCURACY_MIN <= value <= ACCURACY_MAX:
+            raise InputError(f"{name} must be a positive number of {unit} from {ACCURACY_MIN:g} "
+                             f"to {ACCURACY_MAX:g}, got {value:g}")
+    if o.j23 is not None and not abs(o.j23) <= J23_MAX:
+        raise InputError(f"--j23-factor must be a finite number from -{J23_MAX:g} to {J23_MAX:g} "
+                         f"(a linkage's ratio; FANUC: 1), got {o.j23:g}")
+
+
+def _identify(measurements: str, o: SimpleNamespace) -> None:
+    """Identify from ``measurements``, write what the options ask for and print the report."""
+    report, output, cell_path, as_json = o.report, o.output, o.cell_path, o.as_json
     with as_flags({"the nominal model as robot": "the nominal model with --robot",
                    "folds=0": "--folds 0", "folds": "--folds",
                    "state the grouping tolerance": "state it with --group-tolerance"}):
-        run = identify_file(measurements, robot, cell_path, j23, accuracy * 1e-3,
-                            math.radians(angle_accuracy), scale, compliance, folds,
-                            report is not None, offsets_for, output, force,
-                            None if group_tolerance is None else math.radians(group_tolerance))
+        run = identify_file(
+            measurements, o.robot, cell_path, folds=o.folds, report=report is not None,
+            offsets_for=o.offsets_for, output=output, force=o.force, sigma=o.sigma * 1e-3,
+            angle_sigma=math.radians(o.angle_sigma), scale=o.scale, compliance=o.compliance,
+            coupling=o.j23,
+            group_tol=None if o.group_tolerance is None else math.radians(o.group_tolerance))
     if report is not None:
         write_identification_report(run.result, report, run.cross, run.observability,
                                     run.measurements)
@@ -221,7 +230,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     else:
         click.echo(result.summary())
         if offsets is not None:
-            _print_offsets(offsets, offsets_for)
+            _print_offsets(offsets, o.offsets_for)
         if cv is not None:
             click.echo(f"cross-validation, {run.folds} folds (held-out rows, mm): start model mean "
                        f"{cv['before_mean_mm']:.4f} RMS {cv['before_rms_mm']:.4f} max "
@@ -234,6 +243,7 @@ def identify(measurements: str | None, robot: str | None, output: str | None, as
     if report is not None and not as_json:
         click.echo(f"report written to {report}")
     if verdict == "poor":
-        kept = " (written anyway: --force)" if output and force else (" (model file not written)" if output else "")
+        kept = (" (written anyway: --force)" if output and o.force
+                else (" (model file not written)" if output else ""))
         click.echo(f"poor result: {why}{kept}", err=True)
         sys.exit(3)

@@ -9,9 +9,12 @@ from __future__ import annotations
 
 __all__ = ["CLI_TERMS"]
 
-#: Key of a message's input (see the calls of :func:`robotcell.errors.term`) to the options.
+#: Key of a message's input (see the calls of :func:`robotcell.errors.term`) to the command
+#: line's words. A key is a parameter (``sigma``), a parameter with the form of its value
+#: (``tool=NAME``) or a procedure (``procedure:NAME``; ``procedure``: the one running), never a
+#: command line: only this table spells commands (``tests/test_message_terms.py``).
 CLI_TERMS = {
-    "the calibration": "this command",
+    "procedure": "this command",
     "sigma": "--sigma",
     "nominal": "--nominal-accuracy",
     "tool": "--tool",
@@ -23,11 +26,11 @@ CLI_TERMS = {
     "cell=FILE": "--cell CELL.yaml",
     "cell=FILE (Cell)": "--cell CELL.yaml (in Python: a Cell)",
     "cell (Cell)": "--cell (in Python: a Cell)",
-    "with cell": "with --cell",
-    "calibrate workpiece": "'robotcell calibrate workpiece'",
-    "calibrate external-tcp": "'calibrate external-tcp'",
-    "calibrate track": "'calibrate track'",
-    "calibrate turntable --cell": "calibrate turntable --cell",
+    "cell:into": "with --cell",
+    "procedure:workpiece": "'robotcell calibrate workpiece'",
+    "procedure:external-tcp": "'calibrate external-tcp'",
+    "procedure:track": "'calibrate track'",
+    "procedure:turntable(cell)": "calibrate turntable --cell",
     "parent=world": "--parent world",
     "parent=robot": "--parent robot",
     "axis": "--axis",
@@ -38,5 +41,5 @@ CLI_TERMS = {
     "turntable": "--turntable",
     "turntable=JSON": ("--turntable TURNTABLE.json (the --json output of 'robotcell calibrate "
                        "turntable')"),
-    "result=output": "output of 'robotcell calibrate ... --json'",
+    "result=json": "output of 'robotcell calibrate ... --json'",
 }

@@ -23,7 +23,7 @@ import numpy as np
 from robotcell.accuracy.poses import compensate_poses
 from robotcell.cell import Cell, Tool
 from robotcell.cell.identified import adopt_identified, identification_provenance
-from robotcell.identification import cross_validate, identify, read_measurements
+from robotcell.identification import cross_validate, identify, read_target_measurements
 from robotcell.ik.select import nearest
 from robotcell.io.poseformats import pose_to_vendor
 from robotcell.io.tables import write_csv
@@ -106,9 +106,9 @@ def accuracy_step(out: Path, seed: int, echo: Callable[[str], None]) -> tuple[fl
     echo("  $ robotcell " + shlex.join(["identify", "accuracy/tracker.csv", "--robot",
                                         "kuka_kr16", "--accuracy", "0.02", "--folds", "2", "-o",
                                         "accuracy/arm.yaml", "--cell", "accuracy/cell.yaml"]))
-    meas = read_measurements(d / "tracker.csv")
-    result = identify(nominal, meas, point_sigma=TRACKER_NOISE)
-    cross = cross_validate(nominal, meas, folds=2, point_sigma=TRACKER_NOISE)
+    meas = read_target_measurements(d / "tracker.csv")
+    result = identify(nominal, meas, sigma=TRACKER_NOISE)
+    cross = cross_validate(nominal, meas, folds=2, sigma=TRACKER_NOISE)
     adopt_identified(d / "cell.yaml", result, d / "arm.yaml",
                      identification_provenance(result, cross))
     echo(f"  nominal model {result.rms_before * 1e3:.3f} mm RMS, identified "

@@ -7,7 +7,8 @@ from robotcell.identification.choice import ValidatedIdentification, identify_va
 from robotcell.identification.coupling import identify_with_coupling
 from robotcell.identification.engine import identify
 from robotcell.identification.ik import solve_identified
-from robotcell.identification.measurements import Measurements, read_measurements
+from robotcell.identification.measurements import TargetMeasurements, read_target_measurements
+from robotcell.identification.options import IdentifyOptions
 from robotcell.identification.positioner import PositionerCalibration, calibrate_positioner
 from robotcell.identification.result import IdentificationResult, Parameter
 from robotcell.identification.validation import (
@@ -19,8 +20,23 @@ from robotcell.identification.validation import (
     select_configurations,
 )
 
-__all__ = ["CrossValidation", "IdentificationResult", "Measurements", "Parameter", "PoseSelection",
-           "PositionerCalibration", "ValidatedIdentification", "calibrate_positioner",
-           "compare_observability", "cross_validate", "identify", "identify_validated",
-           "identify_with_coupling", "observability", "read_measurements", "select_configurations",
-           "solve_identified"]
+__all__ = [
+    "CrossValidation",
+    "IdentificationResult",
+    "IdentifyOptions",
+    "Parameter",
+    "PoseSelection",
+    "PositionerCalibration",
+    "TargetMeasurements",
+    "ValidatedIdentification",
+    "calibrate_positioner",
+    "compare_observability",
+    "cross_validate",
+    "identify",
+    "identify_validated",
+    "identify_with_coupling",
+    "observability",
+    "read_target_measurements",
+    "select_configurations",
+    "solve_identified",
+]

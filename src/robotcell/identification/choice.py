@@ -29,7 +29,7 @@ import numpy as np
 
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.engine import identify
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
 from robotcell.identification.result import CV_HELD, IdentificationResult, Parameter
 from robotcell.identification.validation import CrossValidation, cross_validate
 from robotcell.robot.robot import Robot
@@ -122,7 +122,7 @@ def _holding(result: IdentificationResult, keep: list[str], why: str) -> dict[st
             if not p.name.startswith(("base.", "target")) and p.name not in keep}
 
 
-def _validate(nominal: Robot, meas: Measurements, folds: int, seed: int, options: dict
+def _validate(nominal: Robot, meas: TargetMeasurements, folds: int, seed: int, options: dict
               ) -> CrossValidation:
     try:
         return cross_validate(nominal, meas, folds=folds, seed=seed, **options)
@@ -133,7 +133,7 @@ def _validate(nominal: Robot, meas: Measurements, folds: int, seed: int, options
             "identification without it)") from None
 
 
-def identify_validated(nominal: Robot, measurements: Measurements, *, folds: int = DEFAULT_FOLDS,
+def identify_validated(nominal: Robot, measurements: TargetMeasurements, *, folds: int = DEFAULT_FOLDS,
                        seed: int = 0, **options) -> ValidatedIdentification:
     """Identify, and free only the constants that predict held-out rows better (see the module).
 
@@ -141,7 +141,7 @@ def identify_validated(nominal: Robot, measurements: Measurements, *, folds: int
     ----------
     nominal : Robot
         Start model, as for :func:`~robotcell.identification.identify`.
-    measurements : Measurements
+    measurements : TargetMeasurements
     folds : int
         K of the K-fold cross-validation, from 2 to the number of rows.
     seed : int

@@ -25,7 +25,7 @@ from robotcell.calibration.grouping import alone_groups, joint_tolerances, resol
 from robotcell.dhprocedure import AxisChain, dh_from_axes
 from robotcell.errors import IllPosedError
 from robotcell.identification.chain import PARALLEL_TOL
-from robotcell.identification.measurements import Measurements, read_measurements
+from robotcell.identification.measurements import TargetMeasurements, read_target_measurements
 from robotcell.identification.result import GEOMETRIC_SOURCE
 from robotcell.robot.robot import Robot
 
@@ -89,14 +89,14 @@ def _back(pts, dirs, types, q, j) -> NDArray[np.float64]:
     return B
 
 
-def axis_lines(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
+def axis_lines(meas: TargetMeasurements, prismatic: NDArray[np.bool_] | None = None,
                group_tol: ArrayLike | None = None,
                ) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
     """Joint axes at ``q = 0`` in the device frame from rows moving one joint at a time.
 
     Parameters
     ----------
-    meas : Measurements
+    meas : TargetMeasurements
         Joint values (rad, m for prismatic joints).
     prismatic : ndarray of bool, shape (n,), optional
         Known prismatic joints. When not given, every joint value is taken as an angle and the
@@ -166,7 +166,7 @@ def _tolerance_text(q: NDArray[np.float64], j: int, tol: NDArray[np.float64] | N
 
 
 def first_estimate(path: str | Path, name: str = "identified", j23_factor: float = 0.0,
-                   group_tol: float | None = None) -> tuple[Robot, Measurements]:
+                   group_tol: float | None = None) -> tuple[Robot, TargetMeasurements]:
     """Start model and measurements from a CSV without a nominal model.
 
     Parameters
@@ -193,7 +193,7 @@ def first_estimate(path: str | Path, name: str = "identified", j23_factor: float
         See :func:`start_model`; its joint values are the chain's (model) values, without the
         coupling, as :func:`~robotcell.identification.identify` with ``coupling=j23_factor``
         expects of a nominal model.
-    measurements : Measurements
+    measurements : TargetMeasurements
         The CSV in SI units, prismatic joints in metres: controller values, as in the file.
 
     Raises
@@ -201,14 +201,14 @@ def first_estimate(path: str | Path, name: str = "identified", j23_factor: float
     IllPosedError
         A joint that no rows move alone (in model values).
     """
-    raw = read_measurements(path)
+    raw = read_target_measurements(path)
     types = axis_lines(_model_values(raw, j23_factor), group_tol=group_tol)[2]
     pris = np.array([t == "prismatic" for t in types])
-    meas = read_measurements(path, pris) if pris.any() else raw
+    meas = read_target_measurements(path, pris) if pris.any() else raw
     return start_model(_model_values(meas, j23_factor), pris, name, group_tol), meas
 
 
-def _model_values(meas: Measurements, k: float) -> Measurements:
+def _model_values(meas: TargetMeasurements, k: float) -> TargetMeasurements:
     """``meas`` with joint 3 replaced by the chain's ``a3 + k * a2`` (unchanged for ``k = 0``)."""
     if not k or meas.q.shape[1] < 3:
         return meas
@@ -217,13 +217,13 @@ def _model_values(meas: Measurements, k: float) -> Measurements:
     return replace(meas, q=q)
 
 
-def start_model(meas: Measurements, prismatic: NDArray[np.bool_] | None = None,
+def start_model(meas: TargetMeasurements, prismatic: NDArray[np.bool_] | None = None,
                 name: str = "identified", group_tol: ArrayLike | None = None) -> Robot:
     """Standard-DH start model from rows moving one joint at a time (circle point analysis).
 
     Parameters
     ----------
-    meas : Measurements
+    meas : TargetMeasurements
         Joint values (rad, m) and measured targets in the device frame (m).
     prismatic : ndarray of bool, shape (n,), optional
         Known prismatic joints (default: from the fits, see :func:`axis_lines`).

@@ -24,7 +24,7 @@ from __future__ import annotations
 from typing import Any
 
 from robotcell.identification.engine import identify
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.robot.robot import Robot
 
@@ -37,12 +37,12 @@ EXPLAINED_SHARE = 0.001
 RMS_SHARE = 0.1
 
 
-def practical_tolerance(point_sigma: float, rms_free: float, rms_without: float) -> float:
+def practical_tolerance(sigma: float, rms_free: float, rms_without: float) -> float:
     """How much larger (RMS, m) the fit with the stated factor may be than with it fitted.
 
     Parameters
     ----------
-    point_sigma : float
+    sigma : float
         Stated accuracy of a measured coordinate (m).
     rms_free : float
         RMS position error of the fit with the factor free (m).
@@ -52,26 +52,27 @@ def practical_tolerance(point_sigma: float, rms_free: float, rms_without: float)
     Returns
     -------
     float
-        ``max(EXPLAINED_SHARE * (rms_without - rms_free), point_sigma, RMS_SHARE * rms_free)``
+        ``max(EXPLAINED_SHARE * (rms_without - rms_free), sigma, RMS_SHARE * rms_free)``
         (m).
     """
-    return max(EXPLAINED_SHARE * (rms_without - rms_free), point_sigma, RMS_SHARE * rms_free)
+    return max(EXPLAINED_SHARE * (rms_without - rms_free), sigma, RMS_SHARE * rms_free)
 
 
-def coupling_check(nominal: Robot, measurements: Measurements, k: float,
+def coupling_check(nominal: Robot, measurements: TargetMeasurements, k: float,
                    with_k: IdentificationResult, **options: Any) -> dict[str, Any]:
     """Compare the fit with the stated J2/J3 factor with the fits without it and with it free.
 
     Parameters
     ----------
     nominal : Robot
-    measurements : Measurements
+    measurements : TargetMeasurements
     k : float
         Stated factor: ``q3_model = J3 + k * J2`` (FANUC: +1, see the module).
     with_k : IdentificationResult
         The identification with ``k`` held.
     **options
-        Passed to :func:`~robotcell.identification.identify` (accuracies, ``scale``, ...).
+        Passed to :func:`~robotcell.identification.identify` (accuracies, ``scale``, ...,
+        ``options``); its ``coupling``, ``fit_coupling`` and ``hold`` are this check's own.
 
     Returns
     -------
@@ -80,11 +81,11 @@ def coupling_check(nominal: Robot, measurements: Measurements, k: float,
         ``k_fitted``, ``k_sigma``, ``tolerance_mm``, ``supported`` and a ``verdict`` sentence.
     """
     options = {n: v for n, v in options.items() if n not in ("coupling", "fit_coupling", "hold")}
-    without = identify(nominal, measurements, coupling=0.0, **options)
+    without = identify(nominal, measurements, coupling=0.0, fit_coupling=False, **options)
     free = identify(nominal, measurements, coupling=k, fit_coupling=True, **options)
     p = free.parameter("j23_factor")
     rms_with, rms_without, rms_free = with_k.rms_after, without.rms_after, free.rms_after
-    tol = practical_tolerance(with_k.point_sigma, rms_free, rms_without)
+    tol = practical_tolerance(with_k.touch_sigma, rms_free, rms_without)
     supported = rms_with - rms_free <= tol
     fitted = (f"fitted k = {p.value:.5f} +- {p.sigma:.2g}" if p.free
               else "k cannot be fitted from these rows")
@@ -102,14 +103,14 @@ def coupling_check(nominal: Robot, measurements: Measurements, k: float,
             "tolerance_mm": tol * 1e3, "supported": supported, "verdict": verdict}
 
 
-def identify_with_coupling(nominal: Robot, measurements: Measurements, k: float,
+def identify_with_coupling(nominal: Robot, measurements: TargetMeasurements, k: float,
                            **options: Any) -> IdentificationResult:
     """Identify with a stated J2/J3 coupling ``k`` and say whether the data support it.
 
     Parameters
     ----------
     nominal : Robot
-    measurements : Measurements
+    measurements : TargetMeasurements
     k : float
         Stated factor: ``q3_model = J3 + k * J2`` (FANUC: +1, the forearm's angle to the
         horizontal; see the module).

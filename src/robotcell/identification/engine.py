@@ -33,6 +33,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -46,7 +47,8 @@ from robotcell.calibration.grouping import joint_tolerances
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.chain import COMPLIANT_JOINTS, Chain
 from robotcell.identification.gravity import require_masses
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
+from robotcell.identification.options import IdentifyOptions
 from robotcell.identification.result import IdentificationResult, Parameter, beyond_accuracy
 from robotcell.ik import analytic_solver
 from robotcell.ik.seeded import SeededSolver
@@ -56,15 +58,8 @@ from robotcell.robot.robot import Robot
 
 __all__ = ["Problem", "identifiable", "identify"]
 
-#: Default measurement accuracies: a laser tracker (m per coordinate) and a 6D probe (rad).
-POINT_SIGMA = 0.05e-3
-ANGLE_SIGMA = math.radians(0.02)
 #: Probability inside "3 sigma" for a 1-D Gaussian: the outlier test level.
 _THREE_SIGMA_P = 0.9973
-#: Largest 1-sigma of a free link length (m) and angle (rad): several times what the link
-#: constants of an industrial arm can plausibly be off by (well under 1 mm and 0.5 deg).
-MAX_SIGMA_LENGTH = 5e-3
-MAX_SIGMA_ANGLE = math.radians(2.0)
 #: Parameter name endings that are lengths (the others of a link are angles).
 _LENGTHS = ("a", "d", "x", "y", "z")
 
@@ -72,9 +67,9 @@ _LENGTHS = ("a", "d", "x", "y", "z")
 class Problem:
     """Weighted residuals and analytic Jacobian of one measurement set over a free subset."""
 
-    def __init__(self, chain: Chain, meas: Measurements, point_sigma: float, angle_sigma: float):
+    def __init__(self, chain: Chain, meas: TargetMeasurements, sigma: float, angle_sigma: float):
         self.chain, self.meas = chain, meas
-        self.wp, self.wr = 1.0 / point_sigma, 1.0 / angle_sigma
+        self.wp, self.wr = 1.0 / sigma, 1.0 / angle_sigma
         self.N, self.K = meas.n_rows, meas.n_targets
         self.pose = meas.rotations is not None
         self.ncomp = 3 * self.K + (3 if self.pose else 0)
@@ -123,7 +118,7 @@ def _right_jacobian_inv(e: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.eye(3) + 0.5 * K + c[:, None, None] * (K @ K)
 
 
-def _start_base(chain: Chain, meas: Measurements, x: NDArray[np.float64]):
+def _start_base(chain: Chain, meas: TargetMeasurements, x: NDArray[np.float64]):
     """Closed-form ``T_D_R`` and targets (points) or ``T_F_T`` (poses) for the nominal links."""
     ev = chain.evaluate(x, meas.q, jac=False, base=False)
     Rf, pf = ev.R, ev.p  # target frame at tool_start = I, in R
@@ -314,20 +309,12 @@ def _too_uncertain(J: NDArray[np.float64], kept: Sequence[int], bound: NDArray[n
 
 def identify(
     nominal: Robot,
-    measurements: Measurements,
+    measurements: TargetMeasurements,
     *,
-    point_sigma: float = POINT_SIGMA,
-    angle_sigma: float = ANGLE_SIGMA,
-    scale: bool = False,
-    compliance: bool = False,
-    coupling: float | None = None,
-    fit_coupling: bool = False,
-    rank_tol: float = 1e-6,
-    max_sigma_length: float = MAX_SIGMA_LENGTH,
-    max_sigma_angle: float = MAX_SIGMA_ANGLE,
     name: str | None = None,
     hold: Mapping[str, str] | None = None,
-    group_tol: ArrayLike | None = None,
+    options: IdentifyOptions | None = None,
+    **keywords: Any,
 ) -> IdentificationResult:
     """Identify the kinematic parameters of a serial chain from measured points or poses.
 
@@ -336,40 +323,20 @@ def identify(
     nominal : Robot
         Start model (library model, model file, or the circle point analysis): its convention,
         joint types, signs, names and limits are kept.
-    measurements : Measurements
+    measurements : TargetMeasurements
         Joint values (rad, m) and measured targets in the device frame (m); with orientations,
         one target per row.
-    point_sigma : float
-        Accuracy of a measured coordinate (m); weights the point residuals.
-    angle_sigma : float
-        Accuracy of a measured orientation (rad per axis); weights the rotation residuals.
-    scale : bool
-        Also identify a scale error per axis (gear ratio): ``qm = (1 + scale) q``.
-    compliance : bool
-        Also identify the gravity compliance of axes 2 and 3 (rad per N m), multiplied by the
-        gravity torque of the nominal link masses (``Joint.mass``, ``Joint.com``).
-    coupling : float, optional
-        J2/J3 coupling factor ``k`` with ``q3_model = J3 + k J2`` (0: none). Held unless
-        ``fit_coupling``. Default: the nominal model's ``j23_factor`` (0 without a coupling).
-    fit_coupling : bool
-        Identify ``k`` too (starting at ``coupling``).
-    rank_tol : float
-        A scaled Jacobian column closer than this (sine of the angle) to the span of the columns
-        kept before it is fixed as not identifiable.
-    max_sigma_length, max_sigma_angle : float
-        A link constant whose 1-sigma exceeds this (m, rad; default 5 mm and 2 deg, several
-        times any plausible manufacturing error) is held at its nominal value and named in
-        ``fixed``: the measurements see it too weakly to move it (``math.inf``: never).
     name : str, optional
         Name of the identified model (default ``<nominal>_identified``).
     hold : mapping of str to str, optional
         Constants to hold at their nominal values (link constants, scales, compliances or the
         J2/J3 factor, by name: ``A2.a``), each with the reason reported in ``fixed``.
-    group_tol : float or array_like, shape (n,), optional
-        Joint values within this of each other are the same commanded value, for the count of
-        distinct configurations that the redundancy check rests on: one number (rad, a
-        prismatic joint taking as many mm as that is deg) or one per joint (rad, m); default
-        derived from the data (:func:`robotcell.calibration.grouping.resolution`).
+    options : IdentifyOptions, optional
+        The accuracies (``sigma``, m; ``angle_sigma``, rad) and what may be freed; default
+        :class:`~robotcell.identification.options.IdentifyOptions` ().
+    **keywords
+        Fields of :class:`~robotcell.identification.options.IdentifyOptions` that replace those
+        of ``options`` (``sigma=2e-5, scale=True``).
 
     Returns
     -------
@@ -383,28 +350,9 @@ def identify(
     IllPosedError
         Too few rows for the unknowns, or orientations that do not change.
     """
-    if measurements.q.shape[1] != nominal.n_joints:
-        raise InputError(f"the measurements have {measurements.q.shape[1]} joint values per row, "
-                         f"{nominal.name} has {nominal.n_joints} joints")
-    for label, s in (("point_sigma", point_sigma), ("angle_sigma", angle_sigma)):
-        if not (math.isfinite(s) and s > 0):
-            raise InputError(f"{label} must be a positive number, got {s}")
-    for label, s in (("max_sigma_length", max_sigma_length), ("max_sigma_angle", max_sigma_angle)):
-        if not s > 0:
-            raise InputError(f"{label} must be a positive number (math.inf: no limit), got {s}")
+    opts = IdentifyOptions.of(options, **keywords)
+    coupling = _checked(nominal, measurements, opts)
     pose = measurements.rotations is not None
-    if nominal.coupling is not None and nominal.coupling.j23_factor is None:
-        raise InputError(f"{nominal.name} has a joint coupling other than a J2/J3 factor (passive "
-                         "joints or a general matrix); identification handles only "
-                         "'coupling: {j23_factor: k}'")
-    if coupling is None:
-        coupling = 0.0 if nominal.coupling is None else nominal.coupling.j23_factor
-    if compliance:
-        if nominal.n_joints < 3 or any(nominal.joints[j].prismatic for j in COMPLIANT_JOINTS):
-            raise InputError("gravity compliance needs revolute axes 2 and 3")
-        require_masses(nominal, COMPLIANT_JOINTS)
-    if coupling and nominal.n_joints < 3:
-        raise InputError("a J2/J3 coupling needs a chain with at least 3 joints")
     chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, np.eye(4), np.eye(4))
     x = chain.values.copy()
     if chain.coupling_param >= 0:
@@ -413,38 +361,27 @@ def identify(
     chain = Chain(nominal, 0 if pose else measurements.n_targets, pose, B, X)
     if not pose:
         x[np.array(chain.target_params).ravel()] = r.ravel()
-    prob = Problem(chain, measurements, point_sigma, angle_sigma)
+    prob = Problem(chain, measurements, opts.sigma, opts.angle_sigma)
     groups = np.array(chain.groups)
     prio = np.flatnonzero(np.isin(groups, ("base", "target")))
     x1 = _solve(prob, x, prio)
     rp0, rr0 = prob.raw(x1)
 
     cand = list(prio) + list(np.flatnonzero(groups == "link"))
-    if scale:
+    if opts.scale:
         cand += list(np.flatnonzero(groups == "scale"))
-    if compliance:
+    if opts.compliance:
         cand += list(np.flatnonzero(groups == "compliance"))
-    if fit_coupling and chain.coupling_param >= 0:
+    if opts.fit_coupling and chain.coupling_param >= 0:
         cand.append(chain.coupling_param)
     cand, chosen = _unheld(cand, hold or {}, chain)
     J1 = prob.jacobian(x1)
-    kept, fixed = identifiable(J1, cand, set(prio), chain.names, rank_tol)
+    kept, fixed = identifiable(J1, cand, set(prio), chain.names, opts.rank_tol)
     fixed.update(chosen)
-    # Rows that repeat a configuration measure it again (to what the joint values resolve, so
-    # read-back jitter does not make a repeat new); they say nothing more about the chain.
-    tol = None if group_tol is None else joint_tolerances(group_tol, nominal.prismatic)
-    distinct = count_distinct(measurements.q, tol, nominal.prismatic)
-    m = distinct * prob.ncomp
-    if m < 2 * kept.size:
-        rows = (f"{prob.N} rows" if distinct == prob.N else
-                f"{prob.N} rows in {distinct} distinct configuration(s) (the others repeat them)")
-        raise IllPosedError(
-            f"{rows} give {m} measured coordinates for {kept.size} identifiable unknowns; "
-            f"at least twice as many coordinates as unknowns are needed to check the result: "
-            f"measure at least {-(-2 * kept.size // prob.ncomp)} configurations (better 3 to 5 times "
-            "as many, spread over the joint ranges)")
+    m = _measured_coordinates(prob, nominal, opts.group_tol, kept.size)
     length = np.array([nm.split(".")[-1] in _LENGTHS for nm in chain.names])
-    bound = np.where(groups == "link", np.where(length, max_sigma_length, max_sigma_angle), np.inf)
+    bound = np.where(groups == "link",
+                     np.where(length, opts.max_sigma_length, opts.max_sigma_angle), np.inf)
     free, held = _too_uncertain(J1, kept, bound, chain.names)  # at the stated accuracies
     while True:
         fixed.update(held)
@@ -457,6 +394,55 @@ def identify(
             break
     return _result(nominal, chain, prob, x2, np.array(sorted(free), dtype=int), fixed, rp0, rr0,
                    name, x1)
+
+
+def _checked(nominal: Robot, measurements: TargetMeasurements, opts: IdentifyOptions) -> float:
+    """Refuse what :func:`identify` cannot do; the J2/J3 factor to start from."""
+    if measurements.q.shape[1] != nominal.n_joints:
+        raise InputError(f"the measurements have {measurements.q.shape[1]} joint values per row, "
+                         f"{nominal.name} has {nominal.n_joints} joints")
+    for label, s in (("sigma", opts.sigma), ("angle_sigma", opts.angle_sigma)):
+        if not (math.isfinite(s) and s > 0):
+            raise InputError(f"{label} must be a positive number, got {s}")
+    for label, s in (("max_sigma_length", opts.max_sigma_length),
+                     ("max_sigma_angle", opts.max_sigma_angle)):
+        if not s > 0:
+            raise InputError(f"{label} must be a positive number (math.inf: no limit), got {s}")
+    if nominal.coupling is not None and nominal.coupling.j23_factor is None:
+        raise InputError(f"{nominal.name} has a joint coupling other than a J2/J3 factor (passive "
+                         "joints or a general matrix); identification handles only "
+                         "'coupling: {j23_factor: k}'")
+    coupling = opts.coupling
+    if coupling is None:
+        coupling = 0.0 if nominal.coupling is None else nominal.coupling.j23_factor
+    if opts.compliance:
+        if nominal.n_joints < 3 or any(nominal.joints[j].prismatic for j in COMPLIANT_JOINTS):
+            raise InputError("gravity compliance needs revolute axes 2 and 3")
+        require_masses(nominal, COMPLIANT_JOINTS)
+    if coupling and nominal.n_joints < 3:
+        raise InputError("a J2/J3 coupling needs a chain with at least 3 joints")
+    return coupling
+
+
+def _measured_coordinates(prob: Problem, nominal: Robot, group_tol: ArrayLike | None,
+                          unknowns: int) -> int:
+    """Coordinates measured at distinct configurations; refuse fewer than twice ``unknowns``.
+
+    Rows that repeat a configuration measure it again (to what the joint values resolve, so
+    read-back jitter does not make a repeat new); they say nothing more about the chain.
+    """
+    tol = None if group_tol is None else joint_tolerances(group_tol, nominal.prismatic)
+    distinct = count_distinct(prob.meas.q, tol, nominal.prismatic)
+    m = distinct * prob.ncomp
+    if m < 2 * unknowns:
+        rows = (f"{prob.N} rows" if distinct == prob.N else
+                f"{prob.N} rows in {distinct} distinct configuration(s) (the others repeat them)")
+        raise IllPosedError(
+            f"{rows} give {m} measured coordinates for {unknowns} identifiable unknowns; "
+            f"at least twice as many coordinates as unknowns are needed to check the result: "
+            f"measure at least {-(-2 * unknowns // prob.ncomp)} configurations (better 3 to 5 "
+            "times as many, spread over the joint ranges)")
+    return m
 
 
 def _unheld(cand: list[int], hold: Mapping[str, str], chain: Chain
@@ -528,7 +514,7 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
         labels=list(prob.meas.labels),
         scale=x[chain.scale_params].copy(),
         coupling=float(x[chain.coupling_param]) if chain.coupling_param >= 0 else 0.0,
-        point_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, unexplained=unexplained,
+        touch_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, unexplained=unexplained,
         _q=prob.meas.q, _chain=chain, _x=x, _x_nominal=x_nominal,
     )
 

@@ -1,7 +1,7 @@
 """Measurements for kinematic identification: joint values with measured points or poses.
 
 In SI units (metres, radians) in the measuring device's frame D. The CSV form (millimetres and
-degrees) is read by :func:`read_measurements`; see ``docs/identification.md``.
+degrees) is read by :func:`read_target_measurements`; see ``docs/identification.md``.
 """
 
 from __future__ import annotations
@@ -17,11 +17,11 @@ from scipy.spatial.transform import Rotation
 from robotcell.errors import InputError
 from robotcell.io.tables import read_csv, require_columns
 
-__all__ = ["Measurements", "read_measurements"]
+__all__ = ["TargetMeasurements", "read_target_measurements"]
 
 
 @dataclass(frozen=True, eq=False)
-class Measurements:
+class TargetMeasurements:
     """Joint values and what a measuring device saw of the last link, per row.
 
     Attributes
@@ -82,10 +82,10 @@ class Measurements:
         """Number of targets K per row."""
         return self.points.shape[1]
 
-    def subset(self, rows: ArrayLike) -> Measurements:
+    def subset(self, rows: ArrayLike) -> TargetMeasurements:
         """The measurements of the given row indices (or boolean mask)."""
         idx = np.arange(self.n_rows)[rows]
-        return Measurements(self.q[idx], self.points[idx],
+        return TargetMeasurements(self.q[idx], self.points[idx],
                             None if self.rotations is None else self.rotations[idx],
                             tuple(self.labels[i] for i in idx))
 
@@ -93,7 +93,7 @@ class Measurements:
 _POINT = re.compile(r"^([xyz])(\d*)$")
 
 
-def read_measurements(path: str | Path, prismatic: ArrayLike | None = None) -> Measurements:
+def read_target_measurements(path: str | Path, prismatic: ArrayLike | None = None) -> TargetMeasurements:
     """Read a measurement CSV (mm, deg; see ``docs/identification.md``).
 
     Parameters
@@ -106,7 +106,7 @@ def read_measurements(path: str | Path, prismatic: ArrayLike | None = None) -> M
 
     Returns
     -------
-    Measurements
+    TargetMeasurements
         In SI units.
 
     Raises
@@ -157,4 +157,4 @@ def read_measurements(path: str | Path, prismatic: ArrayLike | None = None) -> M
             raise InputError(f"{src}: row {bad[0] + 1}: quaternion qw,qx,qy,qz has length "
                              f"{norm[bad[0]]:.4f}, not 1")
         R = Rotation.from_quat(wxyz[:, [1, 2, 3, 0]]).as_matrix()
-    return Measurements(q, p, R, tuple(f"row {i}" for i in range(1, n_rows + 1)))
+    return TargetMeasurements(q, p, R, tuple(f"row {i}" for i in range(1, n_rows + 1)))

@@ -53,7 +53,7 @@ from robotcell.calibration.uncertainty import Estimate, Inputs, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.identification.circles import start_model
 from robotcell.identification.engine import identify
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.kinematics.transforms import as_points
 from robotcell.robot.robot import Robot
@@ -280,7 +280,7 @@ def _imputed(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.
 
 
 def _fit_of(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.float64],
-            used: NDArray[np.bool_], prior_sigma: float | None, inputs: Inputs | None) -> Fit:
+            used: NDArray[np.bool_], sigma: float | None, inputs: Inputs | None) -> Fit:
     """The uncertainty and the touch tests of an identification, over every touch.
 
     The Jacobian of the touched point with respect to the identified (free) parameters, at all
@@ -290,7 +290,7 @@ def _fit_of(ident: IdentificationResult, q: NDArray[np.float64], f: NDArray[np.f
     kept = _free_index(ident)
     pts = ch.predict(x, q)[0]
     J = -ch.point_jacobian(x, q, ch.evaluate(x, q), pts)[:, 0][..., kept]
-    return solution_fit(x[kept], J, f - pts[:, 0], used=used, prior_sigma=prior_sigma,
+    return solution_fit(x[kept], J, f - pts[:, 0], used=used, sigma=sigma,
                         inputs=inputs)
 
 
@@ -299,14 +299,14 @@ def calibrate_positioner(
     points: ArrayLike,
     *,
     nominal: Robot | None = None,
-    prior_sigma: float | None = None,
+    sigma: float | None = None,
     labels: Sequence[str] | None = None,
     inputs: Inputs | None = None,
     group_tol: float | None = None,
 ) -> PositionerCalibration:
     """Calibrate a tilt-rotate positioner from touches of one point on its table.
 
-    The uncertainty rests on the touch accuracy (``prior_sigma``, or the default 0.5 mm), the
+    The uncertainty rests on the touch accuracy (``sigma``, or the default 0.5 mm), the
     residuals being its chi-square check, and every touch gets the leave-one-out test of every
     calibration (:func:`robotcell.calibration.fitting.solution_fit`): one flagged touch that the
     others single out is left out and the chain identified again.
@@ -322,7 +322,7 @@ def calibrate_positioner(
         for each axis, at least 3 that move that axis alone over 10 deg or more (e.g. a grid of 3
         tilt by 4 rotate values), and the circle point analysis gives the start. With it, of the
         equivalent ways to write the identified axes the one nearest the nominal is returned.
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch accuracy (m per coordinate) the uncertainties rest on; default
         :data:`~robotcell.calibration.fitting.DEFAULT_TOUCH_SIGMA`.
     labels : sequence of str, optional
@@ -363,10 +363,10 @@ def calibrate_positioner(
         raise InputError(f"a 2-axis positioner needs a 2-joint nominal model, {nominal.name} has "
                          f"{nominal.n_joints}")
     labels = list(labels) if labels is not None else [str(i + 1) for i in range(len(f))]
-    meas = Measurements(q, f, None, tuple(labels))
+    meas = TargetMeasurements(q, f, None, tuple(labels))
     start = (nominal if nominal is not None
              else start_model(meas, np.zeros(2, dtype=bool), "positioner", group_tol))
-    ident, res = _identified(start, meas, f, prior_sigma, inputs, group_tol)
+    ident, res = _identified(start, meas, f, sigma, inputs, group_tol)
     side = 1.0 if nominal is None else _normal_side(nominal)
     geometry = _geometry_sigmas(ident, res, side)
     robot = replace(ident.robot, base=ident.base @ ident.robot.base, tool=ident.target_tool)
@@ -376,30 +376,30 @@ def calibrate_positioner(
     return PositionerCalibration(result=result, robot=robot, identification=ident)
 
 
-def _identified(start: Robot, meas: Measurements, f: NDArray[np.float64],
-                prior_sigma: float | None, inputs: Inputs | None, group_tol: float | None
+def _identified(start: Robot, meas: TargetMeasurements, f: NDArray[np.float64],
+                sigma: float | None, inputs: Inputs | None, group_tol: float | None
                 ) -> tuple[IdentificationResult, Fit]:
     """The chain identified from ``start`` on the touches ``meas`` (of points ``f``, (N, 3)),
     and its fit; one touch that the others single out is left out and the chain identified
     again. ``group_tol`` as for :func:`calibrate_positioner`."""
     q, labels = meas.q, meas.labels
-    sigma = prior_sigma if prior_sigma is not None else DEFAULT_TOUCH_SIGMA
+    s = sigma if sigma is not None else DEFAULT_TOUCH_SIGMA
     name = f"{start.name}_calibrated"
-    ident = identify(start, meas, point_sigma=sigma, name=name, group_tol=group_tol)
+    ident = identify(start, meas, sigma=s, name=name, group_tol=group_tol)
     used = np.ones(len(f), dtype=bool)
-    res = _fit_of(ident, q, f, used, prior_sigma, inputs)
+    res = _fit_of(ident, q, f, used, sigma, inputs)
     if len(res.suspects) == 1:
         worst = res.suspects[0]
         keep = used.copy()
         keep[worst] = False
         try:
-            other = identify(start, Measurements(q, _imputed(ident, q, f, keep), None,
-                                                 tuple(labels)), point_sigma=sigma, name=name,
+            other = identify(start, TargetMeasurements(q, _imputed(ident, q, f, keep), None,
+                                                 tuple(labels)), sigma=s, name=name,
                              group_tol=group_tol)
         except IllPosedError:
             other = None
         if other is not None:
-            res_other = _fit_of(other, q, f, keep, prior_sigma, inputs)
+            res_other = _fit_of(other, q, f, keep, sigma, inputs)
             if keeps_out(res_other, worst):
                 ident, res = other, res_other
     return ident, res

@@ -113,7 +113,7 @@ class IdentificationResult:
         Per-axis scale errors (0 when not identified).
     coupling : float
         J2/J3 factor ``k`` (``q3_model = J3 + k J2``).
-    point_sigma, angle_sigma : float
+    touch_sigma, angle_sigma : float
         Accuracies used as weights (m, rad).
     unexplained : float
         Scatter per coordinate (m) of a measured point held out of the fit that no parameter
@@ -145,7 +145,7 @@ class IdentificationResult:
     labels: list[str]
     scale: NDArray[np.float64]
     coupling: float
-    point_sigma: float
+    touch_sigma: float
     angle_sigma: float
     unexplained: float = float("nan")
     _q: Any = None
@@ -200,7 +200,7 @@ class IdentificationResult:
         errors), as the leave-one-out cross-validated residuals show it
         (:func:`beyond_accuracy`); 0 when they are within the stated accuracy.
         """
-        return beyond_accuracy(self.unexplained, self.point_sigma, self.dof)
+        return beyond_accuracy(self.unexplained, self.touch_sigma, self.dof)
 
     def predicted_error(self, q: ArrayLike, measured: bool = False) -> PredictedError:
         """The predicted error of the identified model's position of each target at ``q``.
@@ -227,7 +227,7 @@ class IdentificationResult:
         ev = ch.evaluate(x, qq)
         pts, _ = ch.predict(x, qq)
         J = ch.point_jacobian(x, qq, ev, pts)[..., kept]
-        u = self.unexplained if math.isfinite(self.unexplained) else self.point_sigma
+        u = self.unexplained if math.isfinite(self.unexplained) else self.touch_sigma
         floor = u if measured else self.model_error
         S = J @ self.covariance @ np.swapaxes(J, -1, -2) + floor**2 * np.eye(3)
         return PredictedError(S)
@@ -427,7 +427,7 @@ class IdentificationResult:
                          f"{math.degrees(self._rms(self.rotation_residuals)):.4f}")
         lines.append(f"condition number {self.condition:.1f}, redundancy {self.dof}, variance factor "
                      f"{self.variance_factor:.3f} (1 when the stated accuracy "
-                     f"{self.point_sigma * 1e3:.3f} mm is right)")
+                     f"{self.touch_sigma * 1e3:.3f} mm is right)")
         lines += self.error_lines()
         if self.outliers:
             lines.append("outlier rows (3 sigma): " + ", ".join(self.labels[i] for i in self.outliers))
@@ -444,7 +444,7 @@ class IdentificationResult:
         lines = [(f"model error (what the geometric model does not explain): "
                   f"{f['model_error_mm']:.4f} mm per coordinate (the leave-one-out residuals "
                   f"scatter by {f['unexplained_mm']:.4f} mm, the stated accuracy is "
-                  f"{self.point_sigma * 1e3:.4f} mm)")]
+                  f"{self.touch_sigma * 1e3:.4f} mm)")]
         if "rms_mm" in f:
             x, y, z = f["per_axis_mm"]
             lines.append(f"predicted error of a target position (median over the rows; whole "

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from robotcell.errors import InputError
 from robotcell.identification.chain import Chain
 from robotcell.identification.engine import Problem, identifiable, identify
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
 from robotcell.robot.robot import Robot
 
 __all__ = ["CrossValidation", "PoseSelection", "compare_observability", "cross_validate", "observability",
@@ -61,14 +61,14 @@ class CrossValidation:
         return out
 
 
-def cross_validate(nominal: Robot, measurements: Measurements, folds: int = 5, seed: int = 0,
+def cross_validate(nominal: Robot, measurements: TargetMeasurements, folds: int = 5, seed: int = 0,
                    **options) -> CrossValidation:
     """K-fold cross-validation of :func:`~robotcell.identification.identify`.
 
     Parameters
     ----------
     nominal : Robot
-    measurements : Measurements
+    measurements : TargetMeasurements
     folds : int
         K >= 2; the rows are shuffled with ``np.random.default_rng(seed)`` and dealt into K folds.
     seed : int
@@ -105,7 +105,7 @@ def reflector_spots(n_targets: int) -> NDArray[np.float64]:
 
 
 def _jacobian_blocks(nominal: Robot, q: NDArray[np.float64], n_targets: int, pose: bool,
-                     point_sigma: float, angle_sigma: float):
+                     sigma: float, angle_sigma: float):
     """Weighted identification Jacobian at the nominal model, rows grouped per configuration."""
     ch = Chain(nominal, 0 if pose else n_targets, pose, np.eye(4), np.eye(4))
     x = ch.values.copy()
@@ -114,7 +114,7 @@ def _jacobian_blocks(nominal: Robot, q: NDArray[np.float64], n_targets: int, pos
     for k, spot in enumerate(reflector_spots(ch.n_targets)):
         x[ch.target_params[k]] = spot
     pts, R = ch.predict(x, q)
-    prob = Problem(ch, Measurements(q, pts, R if pose else None), point_sigma, angle_sigma)
+    prob = Problem(ch, TargetMeasurements(q, pts, R if pose else None), sigma, angle_sigma)
     groups = np.array(ch.groups)
     prio = np.flatnonzero(np.isin(groups, ("base", "target")))
     cand = list(prio) + list(np.flatnonzero(groups == "link"))
@@ -159,7 +159,7 @@ def random_configurations(nominal: Robot, rng: np.random.Generator, m: int) -> N
 
 def compare_observability(nominal: Robot, q: NDArray[np.float64], *, n_targets: int = 1,
                           pose: bool = False, n_random: int = 20, seed: int = 0,
-                          point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
+                          sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
                           ) -> tuple[float, NDArray[np.float64]]:
     """O1 of measured configurations against random sets of the same size within the limits.
 
@@ -168,7 +168,7 @@ def compare_observability(nominal: Robot, q: NDArray[np.float64], *, n_targets: 
     nominal : Robot
     q : ndarray, shape (N, n)
         The measured configurations (rad, m).
-    n_targets, pose, point_sigma, angle_sigma
+    n_targets, pose, sigma, angle_sigma
         As in :func:`select_configurations`.
     n_random : int
         Number of random sets.
@@ -184,7 +184,7 @@ def compare_observability(nominal: Robot, q: NDArray[np.float64], *, n_targets: 
     q = np.asarray(q, dtype=float)
     N = len(q)
     rand = random_configurations(nominal, np.random.default_rng(seed), N * n_random)
-    B = _jacobian_blocks(nominal, np.concatenate([q, rand]), n_targets, pose, point_sigma, angle_sigma)
+    B = _jacobian_blocks(nominal, np.concatenate([q, rand]), n_targets, pose, sigma, angle_sigma)
     p = B.shape[2]
     B = B / np.linalg.norm(B.reshape(-1, p), axis=0)
     o1 = observability(B[:N].reshape(-1, p))
@@ -195,7 +195,7 @@ def compare_observability(nominal: Robot, q: NDArray[np.float64], *, n_targets: 
 def select_configurations(
     nominal: Robot, n: int, *, n_targets: int = 1, pose: bool = False,
     candidates: NDArray[np.float64] | None = None, n_candidates: int = 1000, seed: int = 0,
-    point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02), n_random: int = 20,
+    sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02), n_random: int = 20,
 ) -> PoseSelection:
     """Choose ``n`` configurations maximising the observability of the identifiable parameters.
 
@@ -214,7 +214,7 @@ def select_configurations(
         uniform random ones within the limits.
     seed : int
         Seed of ``np.random.default_rng`` for the candidates and the random comparison sets.
-    point_sigma, angle_sigma : float
+    sigma, angle_sigma : float
         Accuracies (m, rad) weighting positions against orientations.
     n_random : int
         Random sets of ``n`` candidates whose O1 is reported for comparison.
@@ -229,7 +229,7 @@ def select_configurations(
     cand = np.asarray(candidates, dtype=float)
     if cand.ndim != 2 or cand.shape[1] != nominal.n_joints or len(cand) < n:
         raise InputError(f"candidates must have shape (C, {nominal.n_joints}) with C >= {n}, got {cand.shape}")
-    B = _jacobian_blocks(nominal, cand, n_targets, pose, point_sigma, angle_sigma)
+    B = _jacobian_blocks(nominal, cand, n_targets, pose, sigma, angle_sigma)
     C, r, p = B.shape
     if n * r < p:
         raise InputError(f"{n} configurations give {n * r} coordinates for {p} identifiable "

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
@@ -144,7 +144,7 @@ def write_identification_report(
     path: str | Path,
     cross_validation: CrossValidation | None = None,
     observability: tuple[float, NDArray[np.float64]] | None = None,
-    measurements: Measurements | None = None,
+    measurements: TargetMeasurements | None = None,
 ) -> Path:
     """Write the HTML report of an identification (one file, figures embedded).
 
@@ -158,7 +158,7 @@ def write_identification_report(
     observability : (float, ndarray), optional
         O1 of the measured configurations and of random sets
         (:func:`~robotcell.identification.compare_observability`).
-    measurements : Measurements, optional
+    measurements : TargetMeasurements, optional
         The measurements identified: given, the page shows their 3D scene
         (:func:`~robotcell.view.identification.identification_scene`).
 
@@ -192,7 +192,7 @@ def write_identification_report(
 <body>
 <h1>Kinematic identification of {name}</h1>
 <p>{len(result.labels)} rows, {result.residuals.shape[1]} target(s) per row; stated accuracy
-{result.point_sigma * 1e3:.4f} mm per coordinate.</p>
+{result.touch_sigma * 1e3:.4f} mm per coordinate.</p>
 <div class="verdict {grade}"><b>{grade.upper()}</b>: {html.escape(why)}</div>
 <h2>Position error before and after identification</h2>{errors}
 <p>Condition number {result.condition:.1f}, redundancy {result.dof}, variance factor

@@ -9,7 +9,6 @@ command ``robotcell identify`` prints what it returns.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,7 +20,7 @@ from robotcell.cell import Cell
 from robotcell.cell.identified import adopt_identified, identification_provenance
 from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
-from robotcell.identification import identify, read_measurements
+from robotcell.identification import identify, read_target_measurements
 from robotcell.identification.choice import (
     DEFAULT_FOLDS,
     ValidatedIdentification,
@@ -29,8 +28,9 @@ from robotcell.identification.choice import (
 )
 from robotcell.identification.circles import first_estimate
 from robotcell.identification.coupling import coupling_check
-from robotcell.identification.measurements import Measurements
+from robotcell.identification.measurements import TargetMeasurements
 from robotcell.identification.offsets import JointOffset, joint_offsets
+from robotcell.identification.options import IdentifyOptions
 from robotcell.identification.result import IdentificationResult
 from robotcell.identification.validation import CrossValidation, compare_observability
 from robotcell.robot.models import load_robot, save_robot
@@ -98,7 +98,7 @@ class IdentificationRun:
         Whether the model file (and the cell) was written.
     observability : (float, ndarray) or None
         O1 of the measured configurations and of random sets, when asked for (``report``).
-    measurements : Measurements or None
+    measurements : TargetMeasurements or None
         The measurements identified, when asked for (``report``).
     """
 
@@ -108,7 +108,7 @@ class IdentificationRun:
     offsets: dict[str, Any] | None
     written: bool
     observability: tuple[float, NDArray[np.float64]] | None = None
-    measurements: Measurements | None = None
+    measurements: TargetMeasurements | None = None
     choice: ValidatedIdentification | None = None
 
     @property
@@ -133,12 +133,10 @@ class IdentificationRun:
 
 
 def identify_file(measurements: str | Path, robot: str | Path | None = None,
-                  cell: str | Path | None = None, j23_factor: float | None = None,
-                  point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
-                  scale: bool = False, compliance: bool = False, folds: int = DEFAULT_FOLDS,
+                  cell: str | Path | None = None, *, folds: int = DEFAULT_FOLDS,
                   report: bool = False, offsets_for: str | None = None,
                   output: str | Path | None = None, force: bool = False,
-                  group_tol: float | None = None) -> IdentificationRun:
+                  options: IdentifyOptions | None = None, **keywords: Any) -> IdentificationRun:
     """Identify the kinematic model of an arm or positioner from a measurement CSV.
 
     Parameters
@@ -151,15 +149,6 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
     cell : str or Path, optional
         A cell file: its ``robot.model`` is the nominal when ``robot`` is not given, and the
         identified model written to ``output`` becomes its ``robot.identified``.
-    j23_factor : float, optional
-        A stated J2/J3 coupling ``q3_model = J3 + k J2`` (FANUC: 1), checked against the fits
-        without it and with it free (:func:`~robotcell.identification.coupling.coupling_check`).
-    point_sigma : float
-        Accuracy of a measured coordinate (m).
-    angle_sigma : float
-        Accuracy of a measured orientation (rad).
-    scale, compliance : bool
-        Also identify a scale per axis; the gravity compliance of axes 2 and 3.
     folds : int
         Folds of the cross-validation that chooses the constants to free (at most the rows;
         :func:`~robotcell.identification.identify_validated`); 0: none, every identifiable
@@ -175,10 +164,15 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         Identified model file (YAML) to write, unless the verdict is poor and not ``force``.
     force : bool
         Write ``output`` even when the verdict is poor.
-    group_tol : float, optional
-        Joint values within this of each other are the same commanded value (rad; a prismatic
-        joint takes as many mm as that is deg); default derived from the data
-        (:func:`robotcell.calibration.grouping.resolution`).
+    options : IdentifyOptions, optional
+        The accuracies (``sigma``, m; ``angle_sigma``, rad), ``scale``, ``compliance``,
+        ``group_tol`` (rad; a prismatic joint takes as many mm as that is deg) and a stated
+        J2/J3 factor ``coupling`` (``q3_model = J3 + k J2``, FANUC: 1; also the start of the
+        circle point analysis), which is checked against the fits without it and with it free
+        (:func:`~robotcell.identification.coupling.coupling_check`).
+    **keywords
+        Fields of :class:`~robotcell.identification.options.IdentifyOptions` that replace those
+        of ``options`` (``sigma=2e-5, coupling=1.0``).
 
     Returns
     -------
@@ -197,30 +191,27 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
                          "nominal model the controller uses")
     if folds < 0 or folds == 1:
         raise InputError(f"folds must be 0 (no cross-validation) or at least 2, got {folds}")
-    options: dict[str, Any] = {"point_sigma": point_sigma, "angle_sigma": angle_sigma,
-                               "scale": scale, "compliance": compliance, "group_tol": group_tol}
+    opts = IdentifyOptions.of(options, **keywords)
     if robot is not None or cell is not None:
         nominal = load_robot(robot) if robot is not None else Cell.load(cell).nominal_robot
-        meas = read_measurements(measurements, nominal.prismatic)
+        meas = read_target_measurements(measurements, nominal.prismatic)
     else:
-        nominal, meas = first_estimate(measurements, j23_factor=j23_factor or 0.0,
-                                       group_tol=group_tol)
-    if j23_factor is not None:
-        options["coupling"] = j23_factor
+        nominal, meas = first_estimate(measurements, j23_factor=opts.coupling or 0.0,
+                                       group_tol=opts.group_tol)
     choice, cross = None, None
     if folds:
         folds = min(folds, meas.n_rows)
-        choice = identify_validated(nominal, meas, folds=folds, **options)
+        choice = identify_validated(nominal, meas, folds=folds, options=opts)
         result, cross = choice.result, choice.cross
     else:
-        result = identify(nominal, meas, **options)
-    if j23_factor is not None:
-        result.coupling_check = coupling_check(nominal, meas, j23_factor, result, **options)
+        result = identify(nominal, meas, options=opts)
+    if opts.coupling is not None:
+        result.coupling_check = coupling_check(nominal, meas, opts.coupling, result, options=opts)
     obs = None
     if report:
         obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
-                                    pose=meas.rotations is not None, point_sigma=point_sigma,
-                                    angle_sigma=angle_sigma)
+                                    pose=meas.rotations is not None, sigma=opts.sigma,
+                                    angle_sigma=opts.angle_sigma)
     offsets = (None if offsets_for is None
                else controller_offsets(joint_offsets(result), offsets_for))
     written = output is not None and (result.verdict[0] != "poor" or force)

@@ -3,7 +3,7 @@
 For a virtual cell (its values taken as the truth) and a touch-up accuracy ``noise``, each
 candidate touch design of a procedure (:data:`DESIGNS`: tool tilt, size of the 3-point
 triangle, track travel, table angles and radius) is simulated without error, and the
-calibration of those exact touches with ``prior_sigma = noise`` gives the *predicted*
+calibration of those exact touches with ``sigma = noise`` gives the *predicted*
 uncertainty (first-order propagation, the same covariance every calibration reports). The design
 with the smallest predicted uncertainty of the calibrated pose wins. A Monte Carlo run then
 repeats simulate-with-error and calibrate ``runs`` times at that design and compares the spread
@@ -57,7 +57,7 @@ def _design_to_simulation(procedure: str, design: dict[str, Any]) -> dict[str, A
     return PLANNERS[procedure].simulation(dict(design))
 
 
-def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = None
+def calibrate_touches(cell: Cell, touches: Touches, sigma: float | None = None
                       ) -> CalibrationResult:
     """Calibrate simulated touches with the library, the cell giving robot, tool and axes.
 
@@ -72,14 +72,14 @@ def calibrate_touches(cell: Cell, touches: Touches, prior_sigma: float | None = 
     cell : Cell
         The cell as known at calibration time (e.g. with an already calibrated tool).
     touches : Touches
-    prior_sigma : float, optional
+    sigma : float, optional
         Touch-up accuracy (m) used for the uncertainties instead of the residuals.
 
     Returns
     -------
     CalibrationResult
     """
-    return PLANNERS[touches.procedure].calibrate(cell, touches, prior_sigma)
+    return PLANNERS[touches.procedure].calibrate(cell, touches, sigma)
 
 
 def _pose_sigma(result: CalibrationResult, key: str) -> tuple[float, float]:
@@ -242,7 +242,7 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
         kw = _design_to_simulation(procedure, {**common, **design})
         try:
             exact = simulate(cell, procedure, noise=0.0, **kw)
-            res = calibrate_touches(cell, exact, prior_sigma=noise)
+            res = calibrate_touches(cell, exact, sigma=noise)
         except RobotcellError as exc:
             cand.reason = str(exc)
         else:

@@ -78,7 +78,7 @@ def work_volume(box: ArrayLike | None = None, cell: Cell | None = None) -> WorkV
 
 def propose_configurations(n: int, robot: str | Path | None = None, cell: str | Path | None = None,
                            n_targets: int = 1, pose: bool = False, seed: int = 0,
-                           point_sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
+                           sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
                            box: ArrayLike | None = None) -> Proposal:
     """Propose ``n`` configurations to measure: the most observable inside the work volume.
 
@@ -96,7 +96,7 @@ def propose_configurations(n: int, robot: str | Path | None = None, cell: str | 
         The orientation is measured too (one target).
     seed : int
         Seed of the candidates and of the random comparison sets.
-    point_sigma, angle_sigma : float
+    sigma, angle_sigma : float
         Accuracies (m, rad).
     box : array_like, shape (6,), optional
         The work volume, ``xmin, ymin, zmin, xmax, ymax, zmax`` in the robot base frame (m)
@@ -126,5 +126,5 @@ def propose_configurations(n: int, robot: str | Path | None = None, cell: str | 
     volume = work_volume(box, the_cell)
     candidates = configurations_within(nominal, volume, CANDIDATES, n_targets, pose, seed)
     sel = select_configurations(nominal, n, n_targets=n_targets, pose=pose, candidates=candidates,
-                                seed=seed, point_sigma=point_sigma, angle_sigma=angle_sigma)
+                                seed=seed, sigma=sigma, angle_sigma=angle_sigma)
     return Proposal(nominal, sel, volume)

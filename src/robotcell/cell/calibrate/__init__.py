@@ -2,7 +2,7 @@
 
 ``cellcal.tcp``, ``cellcal.frame``, ``cellcal.track``, ``cellcal.turntable`` and
 ``cellcal.workpiece`` take a :class:`~robotcell.cell.Cell`, the measurements (a CSV file, a
-table in mm and deg, or :class:`~robotcell.calibration.measurements.Measurements` read by the
+table in mm and deg, or :class:`~robotcell.calibration.measurements.TouchTable` read by the
 procedure's :mod:`~robotcell.calibration.spec`), options in SI units and the keywords every
 calibration shares (:class:`CalibrationContext`, or its fields as keywords), and return a
 :class:`CellCalibration`: the result, the updated cell (a new object) and its provenance.

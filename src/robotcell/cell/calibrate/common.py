@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import Measurements
+from robotcell.calibration.measurements import TouchTable
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.uncertainty import Sources
 from robotcell.cell import Cell, Provenance
@@ -172,7 +172,7 @@ def recorded_options(sigma: float | None, tool: str | ArrayLike | None = None, *
     return out
 
 
-def chained_inputs(cell: Cell | None, m: Measurements, p_R: NDArray[np.float64],
+def chained_inputs(cell: Cell | None, m: TouchTable, p_R: NDArray[np.float64],
                    tool: str | ArrayLike | None, track: NDArray[np.float64] | None,
                    nominal: NominalAccuracy, notes: Notes) -> Chained:
     """The tool and track the touches rest on (nothing without a cell); notes go to ``notes``."""
@@ -190,7 +190,7 @@ def copied(cell: Cell) -> Cell:
     return replace(cell, tools=dict(cell.tools), frames=dict(cell.frames))
 
 
-def refuse_track_column(m: Measurements, why: str) -> None:
+def refuse_track_column(m: TouchTable, why: str) -> None:
     """Refuse column ``track`` of touches that cannot use it, saying ``why``."""
     if m.track is not None:
         raise InputError(f"{m.source}: column 'track' (track position of each touch) {why}")
@@ -208,7 +208,7 @@ _FRAMES = {"F": "on the flange", "R": "in the robot base", "world": "in frame 'w
            "P": "in the positioner's plate P"}
 
 
-def _tool_text(m: Measurements, tool: str | ArrayLike | None) -> str:
+def _tool_text(m: TouchTable, tool: str | ArrayLike | None) -> str:
     """Which tool touched, as the touches say it."""
     if m.points is not None:
         return "the controller's tool (TCP positions x, y, z)"
@@ -224,7 +224,7 @@ def _tool_text(m: Measurements, tool: str | ArrayLike | None) -> str:
     return f"tool {xyzabc} (X,Y,Z,A,B,C mm, deg; joint values a1..a6)"
 
 
-def assumption(cell: Cell | None, m: Measurements, tool: str | ArrayLike | None, value: str,
+def assumption(cell: Cell | None, m: TouchTable, tool: str | ArrayLike | None, value: str,
                mapped: bool = False) -> str:
     """What a calibration took the touches with: tool, frame of the result, track, table.
 

@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import Measurements
+from robotcell.calibration.measurements import TouchTable
 from robotcell.cell import Cell, Turntable
 from robotcell.cell.calibrate.chain import Chained
 from robotcell.cell.calibrate.common import (
@@ -42,7 +42,7 @@ def cell_turntable(cell: Cell, label: str) -> Turntable:
     return cell.turntable
 
 
-def _table_touches(cell: Cell | None, m: Measurements, f: NDArray[np.float64],
+def _table_touches(cell: Cell | None, m: TouchTable, f: NDArray[np.float64],
                    label: str) -> NDArray[np.float64]:
     """Touches in the turntable's parent frame: mapped to the world for a table in the world."""
     if cell is None:
@@ -54,7 +54,7 @@ def _table_touches(cell: Cell | None, m: Measurements, f: NDArray[np.float64],
     return f
 
 
-def on_table(cell: Cell | None, m: Measurements, context: CalibrationContext, notes: Notes,
+def on_table(cell: Cell | None, m: TouchTable, context: CalibrationContext, notes: Notes,
              check: Callable[[], None]
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], Chained]:
     """Touches of a point on a turntable: its angles (rad), the touches in its parent frame
@@ -70,7 +70,7 @@ def on_table(cell: Cell | None, m: Measurements, context: CalibrationContext, no
     return theta, f, chained_inputs(cell, m, f_R, tool, world_track(cell, m), nominal, notes)
 
 
-def world_track(cell: Cell | None, m: Measurements) -> NDArray[np.float64] | None:
+def world_track(cell: Cell | None, m: TouchTable) -> NDArray[np.float64] | None:
     """Track positions of touches mapped to the world through the track of a turntable cell."""
     if not _in_world(cell):
         return None
@@ -85,7 +85,7 @@ def _in_world(cell: Cell | None) -> bool:
             and cell.turntable.parent == "world")
 
 
-def positioner_points(cell: Cell, m: Measurements, tool: str | ArrayLike | None, label: str
+def positioner_points(cell: Cell, m: TouchTable, tool: str | ArrayLike | None, label: str
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The axis values (rad) of touches of a point on a positioner and the point in its parent
     frame (m), checked against the axes' limits (as

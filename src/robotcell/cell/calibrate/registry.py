@@ -55,7 +55,7 @@ class Planner:
         Key of the true pose in :attr:`Touches.truth <robotcell.cell.calibrate.simulation.Touches>`,
         in the frame :attr:`calibrate` gives its result in.
     calibrate : callable
-        ``calibrate(cell, touches, prior_sigma)``: the estimator on simulated touches, the cell
+        ``calibrate(cell, touches, sigma)``: the estimator on simulated touches, the cell
         giving robot, tool and axes, returning a
         :class:`~robotcell.calibration.result.CalibrationResult`.
     simulation : callable

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.calibration.measurements import Measurements, columns_of
+from robotcell.calibration.measurements import TouchTable, columns_of
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell, Turntable
 from robotcell.cell.kinematics import robot_pose, tool_pose
@@ -109,7 +109,7 @@ class Touches:
     track_column: bool = True
     moves_track: bool = False
 
-    def measurements(self, robot: Robot | None = None) -> Measurements:
+    def measurements(self, robot: Robot | None = None) -> TouchTable:
         """The touches as the procedure's measurements (SI), which write the measurement CSV.
 
         Each column of the procedure's specification (:data:`~robotcell.calibration.spec.SPECS`)
@@ -127,7 +127,7 @@ class Touches:
 
         Returns
         -------
-        Measurements
+        TouchTable
         """
         spec = SPECS[self.procedure]
         axes = self.track if self.moves_track else self.table
@@ -136,7 +136,7 @@ class Touches:
             reference = np.array([float(r) for r in self.roles])
         elif self.roles is not None:
             point = tuple(self.roles)
-        return Measurements(
+        return TouchTable(
             spec, "simulated touches", joints=self.q, robot=robot,
             axes=None if axes is None else np.reshape(axes, (len(self.q), -1)),
             track=self.track if self.track_column else None,
@@ -371,7 +371,7 @@ def table_angles(cell: Cell, angles: ArrayLike | None, n: int) -> NDArray[np.flo
     return th
 
 
-def touched_in_parent(cell: Cell, touches: Touches, m: Measurements) -> NDArray[np.float64]:
+def touched_in_parent(cell: Cell, touches: Touches, m: TouchTable) -> NDArray[np.float64]:
     """The TCP positions of simulated touches (m) in the parent frame of what they calibrate.
 
     The frame's parent (``touches.truth["parent"]``; a workpiece's is the turntable's): the

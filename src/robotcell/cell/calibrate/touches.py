@@ -3,7 +3,7 @@
 A calibration reads its measurements once (:func:`read_touches`): a CSV file through
 :func:`robotcell.io.tables.read_csv`, or a table given in Python (column name to values in the
 units of the measurement CSV, mm and deg), by the procedure's specification into
-:class:`~robotcell.calibration.measurements.Measurements` (SI). The mapping that turns touches
+:class:`~robotcell.calibration.measurements.TouchTable` (SI). The mapping that turns touches
 taken in a cell into the robot base and world frames: the robot's track position at each touch
 (column ``track``) gives ``T_world_R`` per touch through the cell's track (:func:`robot_in_world`).
 """
@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import Measurements, columns_of, read_measurements
+from robotcell.calibration.measurements import TouchTable, columns_of, read_touch_table
 from robotcell.calibration.spec import SPECS, TableSpec
 from robotcell.cell import Cell
 from robotcell.cell.kinematics import tool_pose
@@ -34,7 +34,7 @@ __all__ = ["MeasurementInput", "Table", "load_table", "read_touches", "robot_in_
 Table = Mapping[str, Any]
 
 #: What a calibration takes as its measurements: read touches, a table, or a CSV file.
-MeasurementInput = Measurements | Table | str | Path
+MeasurementInput = TouchTable | Table | str | Path
 
 
 def load_table(measurements: Table | str | Path, source: str | None = None
@@ -63,14 +63,14 @@ def load_table(measurements: Table | str | Path, source: str | None = None
 
 def read_touches(procedure: TableSpec | str, measurements: MeasurementInput,
                  source: str | None = None, robot: Robot | None = None,
-                 on_note: Callable[[str], None] | None = None) -> Measurements:
+                 on_note: Callable[[str], None] | None = None) -> TouchTable:
     """The measurements of a calibration, read once by the procedure's specification.
 
     Parameters
     ----------
     procedure : TableSpec or str
         The procedure (:data:`~robotcell.calibration.spec.SPECS`).
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         Touches read before (returned as they are; their notes go to ``on_note`` again), a
         table, or a CSV file.
     source : str, optional
@@ -79,14 +79,14 @@ def read_touches(procedure: TableSpec | str, measurements: MeasurementInput,
         The arm, for joint values.
     on_note : callable, optional
         Receives each note on the table as it arises
-        (:func:`~robotcell.calibration.measurements.read_measurements`).
+        (:func:`~robotcell.calibration.measurements.read_touch_table`).
 
     Returns
     -------
-    Measurements
+    TouchTable
     """
     spec = SPECS[procedure] if isinstance(procedure, str) else procedure
-    if isinstance(measurements, Measurements):
+    if isinstance(measurements, TouchTable):
         if measurements.procedure.name != spec.name:
             raise InputError(f"{measurements.source}: touches of the "
                              f"{measurements.procedure.name} procedure, not of {spec.name}")
@@ -95,11 +95,11 @@ def read_touches(procedure: TableSpec | str, measurements: MeasurementInput,
                 on_note(note)
         return measurements
     cols, source = load_table(measurements, source)
-    return read_measurements(spec, cols, source, robot, on_note)
+    return read_touch_table(spec, cols, source, robot, on_note)
 
 
 def tool_transform(cell: Cell | None, tool: str | ArrayLike | None,
-                   touches: Measurements | None = None) -> NDArray[np.float64] | None:
+                   touches: TouchTable | None = None) -> NDArray[np.float64] | None:
     """``T_F_TCP`` (m) of the tool that touched: a tool of the cell by name, a pose, or None.
 
     With ``touches``: touches given as joint values in a cell that has tools need the tool said,
@@ -120,14 +120,14 @@ def tool_transform(cell: Cell | None, tool: str | ArrayLike | None,
     return None if tool is None else validate_pose(tool, "tool")
 
 
-def track_positions(cell: Cell, touches: Measurements, label: str = "the cell"
+def track_positions(cell: Cell, touches: TouchTable, label: str = "the cell"
                     ) -> NDArray[np.float64] | None:
     """Column ``track`` (m), or None; refused with non-zero values in a cell without track.
 
     Parameters
     ----------
     cell : Cell
-    touches : Measurements
+    touches : TouchTable
         The touches; ``track`` the robot's track position at each (m).
     label : str
         Name of the cell in messages (its file name).
@@ -147,14 +147,14 @@ def track_positions(cell: Cell, touches: Measurements, label: str = "the cell"
     return e
 
 
-def robot_in_world(cell: Cell, touches: Measurements, label: str = "the cell"
+def robot_in_world(cell: Cell, touches: TouchTable, label: str = "the cell"
                    ) -> NDArray[np.float64]:
     """``T_world_R`` at each touch, shape (N, 4, 4) (m), from column ``track``.
 
     Parameters
     ----------
     cell : Cell
-    touches : Measurements
+    touches : TouchTable
         The touches; their track positions are required when the robot is on a track.
     label : str
         Name of the cell in messages (its file name).

@@ -228,7 +228,7 @@ def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
                          + ". Restore the files, or calibrate those items again")
     if not out:
         raise InputError(f"{label} records no calibration with its touch file: calibrate its "
-                         f"items {term('with cell', 'into the cell')} first (each calibration "
+                         f"items {term('cell:into', 'into the cell')} first (each calibration "
                          "then records its file)")
     return out
 

@@ -10,7 +10,7 @@ Each call (``tcp.tcp``, ``frame.frame``, ...; :mod:`robotcell.cell.calibrate` ha
 a :class:`~robotcell.cell.Cell` (or None for a plain calibration in the robot base), the
 measurements (the CSV's path; a table, column name to values in the units of the measurement
 CSV, mm and deg, as :func:`robotcell.io.tables.read_csv` returns it; or touches read before,
-:class:`~robotcell.calibration.measurements.Measurements`), read once by the procedure's table,
+:class:`~robotcell.calibration.measurements.TouchTable`), read once by the procedure's table,
 the procedure's options in SI units, and the keywords every calibration shares
 (:class:`~robotcell.cell.calibrate.context.CalibrationContext`). It maps the touches into the
 frames of the cell (through column ``track`` when the robot is on a track), runs the estimator

@@ -21,7 +21,7 @@ def external_tcp(cell: Cell | None, measurements: MeasurementInput, *,
     cell : Cell or None
         A cell whose robot and tools the touches were taken with (the result is in its robot
         base and is not written into it); None: the context's ``robot`` and ``tool`` give them.
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         Reference-tool TCP positions ``x,y,z`` (mm) or joint values ``a1..an`` (deg); column
         ``point``: ``tcp`` (the fixed TCP, the default), ``x`` (a point on its +X axis), ``xy``
         (a point in its XY plane with +Y).
@@ -39,9 +39,9 @@ def external_tcp(cell: Cell | None, measurements: MeasurementInput, *,
     -------
     CellCalibration
         ``result.values["T_R_TCP"]``: the fixed tool in the robot base (see
-        :func:`robotcell.calibration.frame.external_tcp`); no cell.
+        :func:`robotcell.calibration.frame.calibrate_external_tcp`); no cell.
     """
-    from robotcell.calibration.frame import external_tcp as calibrate_external_tcp
+    from robotcell.calibration.frame import calibrate_external_tcp
 
     ctx = CalibrationContext.of(context, **keywords)
     notes = Notes(ctx.on_note)

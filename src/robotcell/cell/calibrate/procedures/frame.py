@@ -61,7 +61,7 @@ def _frame_parent(cell: Cell, name: str | None, parent: str | None, label: str) 
     if old.parent == "turntable":
         raise InputError(
             f"frame {name!r} of {label} is carried by the turntable: calibrate it with "
-            f"{term('calibrate workpiece', 'robotcell.cell.calibrate.workpiece')}, or pass "
+            f"{term('procedure:workpiece', 'robotcell.cell.calibrate.workpiece')}, or pass "
             f"{term('parent=world', 'parent=' + repr('world'))} or "
             f"{term('parent=robot', 'parent=' + repr('robot'))} to replace it by a frame fixed "
             "there")
@@ -77,7 +77,7 @@ def frame(cell: Cell | None, measurements: MeasurementInput, name: str | None = 
     ----------
     cell : Cell or None
         The cell whose frame ``name`` is calibrated; None: a plain calibration in the robot base.
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         TCP positions ``x,y,z`` (mm, robot base) or joint values ``a1..an`` (deg); column
         ``point`` (``origin``, ``x``, ``xy``) or ``nominal_x, nominal_y, nominal_z`` (mm); in a
         cell with a track, for a frame in the world, ``track`` (mm).
@@ -179,13 +179,13 @@ def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
     return frame(cell, file, name, parent=options.get("parent"), context=context)
 
 
-def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+def _estimate(cell: Cell, touches: Touches, sigma: float | None) -> CalibrationResult:
     """The estimator on simulated touches (:attr:`Planner.calibrate
     <robotcell.cell.calibrate.registry.Planner>`): 3-point, in the frame's parent."""
     from robotcell.calibration.frame import frame_3point
 
     m = touches.measurements(cell.robot)
-    return frame_3point(touched_in_parent(cell, touches, m), m.point, prior_sigma)
+    return frame_3point(touched_in_parent(cell, touches, m), m.point, sigma)
 
 
 PROCEDURE = Procedure(

@@ -51,7 +51,7 @@ def positioner_touches(cell: Cell, measurements: MeasurementInput, *,
     ----------
     cell : Cell
         A cell with a positioner (or a turntable, the 1-axis case).
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg), the axis values ``e1..en`` (deg, one
         column per positioner axis) and, for a positioner in the world of a cell with a track,
         ``track`` (mm).
@@ -112,7 +112,7 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
         A cell with a positioner of 2 axes. None: a plain calibration in the robot base, started
         from the circle point analysis of the touches (which then need, for each axis, at least
         3 that move that axis alone, e.g. a grid of 3 tilt by 4 rotate values); nothing written.
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         As for :func:`positioner_touches`: one point on the table touched at several (tilt,
         rotate) values ``e1``, ``e2`` (deg).
     group_tol : float, optional
@@ -143,7 +143,7 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
         refuse_track_column(m, no_cell_track())
         points = m.tcp(tool_transform(None, tool))
         _check_alone(m.axes, m.source, group_tol)
-        done = calibrate_positioner(m.axes, points, prior_sigma=sigma, labels=m.labels(),
+        done = calibrate_positioner(m.axes, points, sigma=sigma, labels=m.labels(),
                                     group_tol=group_tol)
         return CellCalibration(done.result, notes=tuple(notes),
                                assumed=assumption(None, m, tool, "T_R_B"))
@@ -154,7 +154,7 @@ def positioner(cell: Cell | None, measurements: MeasurementInput, *,
     values, points = positioner_points(cell, m, tool, label)
     chained = chained_inputs(cell, m, m.tcp(tool_transform(cell, tool, m)), tool,
                              world_track(cell, m), nominal, notes)
-    done = calibrate_positioner(values, points, nominal=pos.chain, prior_sigma=sigma,
+    done = calibrate_positioner(values, points, nominal=pos.chain, sigma=sigma,
                                 labels=m.labels(), inputs=chained.inputs, group_tol=group_tol)
     key = "T_world_B" if pos.parent == "world" else "T_R_B"
     result = done.result.renamed("T_R_B", key)

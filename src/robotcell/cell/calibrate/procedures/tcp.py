@@ -74,7 +74,7 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
     cell : Cell or None
         The cell whose tool ``name`` is calibrated; its robot computes flange poses from joint
         values. None: a plain calibration (flange poses in the robot base).
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         Flange poses ``x,y,z,a,b,c`` (KUKA, mm/deg, no tool active) or joint values ``a1..an``
         (deg); optional column ``point`` (``tcp``, ``-x``, ``xy``, ``world``) and, in a cell with
         a track, ``track`` (mm): the touches are then mapped to the world.
@@ -125,7 +125,7 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
     labels = m.labels(points=True)
     order = [i for k in ("tcp", "-x", "xy") for i in np.flatnonzero(r == k)]
     result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
-                            world_mode=world_mode, prior_sigma=ctx.sigma,
+                            world_mode=world_mode, sigma=ctx.sigma,
                             labels=[labels[i] for i in order])
     chained = Chained()
     if cell is not None and e is not None and cell.track is not None:
@@ -135,7 +135,7 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
         chained = touch_inputs(cell, c_R, track=e[order], nominal=ctx.nominal)
         notes.add(list(chained.notes))
         result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
-                                world_mode=world_mode, prior_sigma=ctx.sigma,
+                                world_mode=world_mode, sigma=ctx.sigma,
                                 labels=[labels[i] for i in order], inputs=chained.inputs)
     key = f"tools.{name}" if cell is not None and name is not None else ""
     assumed = assumption(cell, m, None, "T_F_TCP")
@@ -207,7 +207,7 @@ def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
     return tcp(cell, file, name, world_mode=options.get("world", "6d"), context=context)
 
 
-def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+def _estimate(cell: Cell, touches: Touches, sigma: float | None) -> CalibrationResult:
     """The estimator on simulated touches (:attr:`Planner.calibrate
     <robotcell.cell.calibrate.registry.Planner>`): the flange poses in the robot base."""
     from robotcell.calibration.tcp import calibrate_tool
@@ -215,7 +215,7 @@ def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> Calibr
     m = touches.measurements(cell.robot)
     F = m.flange()
     r = np.array(m.point)
-    return calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], prior_sigma=prior_sigma)
+    return calibrate_tool(F[r == "tcp"], F[r == "-x"], F[r == "xy"], sigma=sigma)
 
 
 PROCEDURE = Procedure(

@@ -9,7 +9,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import Measurements
+from robotcell.calibration.measurements import TouchTable
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell
@@ -59,7 +59,7 @@ def _cell_track_axis(cell: Cell, axis: str | None, references: NDArray[np.float6
     return tr.axis
 
 
-def _reference_indices(m: Measurements, n_refs: int) -> NDArray[np.int_] | None:
+def _reference_indices(m: TouchTable, n_refs: int) -> NDArray[np.int_] | None:
     """0-based reference index per touch from column ``point`` (1-based in the table)."""
     if m.reference is None:
         if n_refs > 1:
@@ -88,7 +88,7 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
     cell : Cell or None
         The cell whose track's ``robot_at_zero`` (``T_L_R0``) and scale are calibrated; None: a
         plain calibration.
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) of fixed reference point(s) at track
         positions ``e1`` (mm); column ``point`` (1, 2, ...) with several references.
     references : array_like, shape (K, 3), optional
@@ -141,7 +141,7 @@ def track(cell: Cell | None, measurements: MeasurementInput, *,
     chained = chained_inputs(cell, m, f, tool, None, nominal, notes)
     result = calibrate_track(e, f, references=refs if len(refs) else None, point=idx,
                              axis=axis or "x", roll=roll, labels=m.labels(),
-                             prior_sigma=sigma, inputs=chained.inputs,
+                             sigma=sigma, inputs=chained.inputs,
                              group_tol=group_tol)
     assumed = assumption(cell, m, tool, "T_L_R")
     if cell is None:
@@ -240,7 +240,7 @@ def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
                  axis=options.get("axis"), roll=options.get("roll"), context=context)
 
 
-def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+def _estimate(cell: Cell, touches: Touches, sigma: float | None) -> CalibrationResult:
     """The estimator on simulated touches (:attr:`Planner.calibrate
     <robotcell.cell.calibrate.registry.Planner>`): the TCP positions in the robot base with the
     true reference points."""
@@ -252,7 +252,7 @@ def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> Calibr
     assert t is not None
     return calibrate_track(m.axes[:, 0], p_R, references=touches.truth["references"],
                            point=m.reference.astype(int) - 1, axis=t.axis,
-                           prior_sigma=prior_sigma)
+                           sigma=sigma)
 
 
 PROCEDURE = Procedure(

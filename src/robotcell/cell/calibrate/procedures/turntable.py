@@ -110,7 +110,7 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     ----------
     cell : Cell or None
         The cell whose turntable frame (``T_parent_B``) is calibrated; None: ``T_R_B`` only.
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) with the table angle ``e1`` (deg); for a
         turntable in the world of a cell with a track, ``track`` (mm).
     height : float
@@ -139,7 +139,7 @@ def turntable(cell: Cell | None, measurements: MeasurementInput, *, height: floa
     m = read_touches("turntable", measurements, ctx.source, ctx.arm(cell), notes.one)
     theta, f, chained = on_table(cell, m, ctx, notes, m.check_count)
     result = calibrate_turntable(theta, f, height=height, labels=m.labels(),
-                                 prior_sigma=sigma, inputs=chained.inputs, group_tol=group_tol)
+                                 sigma=sigma, inputs=chained.inputs, group_tol=group_tol)
     key = "T_world_B" if parent == "world" else "T_R_B"
     assumed = assumption(cell, m, tool, key, mapped=parent == "world")
     if cell is None:
@@ -203,14 +203,14 @@ def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
     return turntable(cell, file, height=options.get("height_mm", 0.0) * 1e-3, context=context)
 
 
-def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+def _estimate(cell: Cell, touches: Touches, sigma: float | None) -> CalibrationResult:
     """The estimator on simulated touches (:attr:`Planner.calibrate
     <robotcell.cell.calibrate.registry.Planner>`), in the turntable's parent frame."""
     from robotcell.calibration.turntable import calibrate_turntable
 
     m = touches.measurements(cell.robot)
     return calibrate_turntable(m.axes[:, 0], touched_in_parent(cell, touches, m),
-                               height=-touches.truth["height"], prior_sigma=prior_sigma)
+                               height=-touches.truth["height"], sigma=sigma)
 
 
 def _simulation(design: dict[str, Any]) -> dict[str, Any]:

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robotcell.calibration.measurements import Measurements
+from robotcell.calibration.measurements import TouchTable
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.spec import SPECS
 from robotcell.cell import Cell, Positioner
@@ -85,7 +85,7 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
         raise InputError(f"{given.source} holds the turntable in the "
                          f"{'world' if given.frame == 'world' else 'robot base'}, but the "
                          f"turntable of {label} has parent {tt.parent}: calibrate the turntable "
-                         f"{term('with cell', 'into')} {label}, or omit "
+                         f"{term('cell:into', 'into')} {label}, or omit "
                          f"{term('turntable', 'turntable')} to use the cell's turntable")
     dT = invert(tt.T_parent_B) @ given.T
     dist = float(np.linalg.norm(dT[:3, 3]))
@@ -98,11 +98,11 @@ def _workpiece_turntable(cell: Cell | None, given: TurntablePose | None, label: 
     return given, [f"warning: the turntable of {given.source} differs from the one in "
                     f"{label} by {dist * 1e3:.3f} mm and {np.degrees(angle):.4f} deg; "
                     f"T_B_W is relative to {given.source}'s. Write that turntable into the "
-                    "cell (" + term("calibrate turntable --cell",
+                    "cell (" + term("procedure:turntable(cell)",
                                     "robotcell.cell.calibrate.turntable") + ") so that the two agree"]
 
 
-def _positioner_workpiece(cell: Cell, m: Measurements, name: str | None,
+def _positioner_workpiece(cell: Cell, m: TouchTable, name: str | None,
                           context: CalibrationContext, notes: Notes, file: str | None
                           ) -> CellCalibration:
     """:func:`workpiece` on a positioner chain: the touches taken into its plate frame P, with
@@ -146,7 +146,7 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
         On a positioner chain the touches, with its axis values ``e1..en`` (deg), are taken
         into its plate frame P through the cell's chain and give ``T_P_W`` (3-point), whose
         uncertainty includes the chain's (its recorded error sources, or the nominal accuracy).
-    measurements : Measurements, mapping, str or Path
+    measurements : TouchTable, mapping, str or Path
         TCP touches ``x,y,z`` (mm) or ``a1..an`` (deg) with the table angle ``e1`` (deg) and
         column ``point`` (``origin``, ``x``, ``xy``); for a turntable in the world of a cell with
         a track, ``track`` (mm).
@@ -189,7 +189,7 @@ def workpiece(cell: Cell | None, measurements: MeasurementInput, name: str | Non
     m = read_touches("workpiece", measurements, ctx.source, model, notes.one)
     theta, f, chained = on_table(cell, m, ctx, notes, m.check_points)
     result = calibrate_workpiece(theta, f, m.point, tt.T, T_R_B_covariance=tt.covariance,
-                                 inputs=chained.inputs, prior_sigma=sigma,
+                                 inputs=chained.inputs, sigma=sigma,
                                  labels=m.labels(points=True))
     inputs = chained.keys + (("turntable",) if cell is not None and turntable is None else ())
     item = "" if cell is None or name is None else f"frames.{name}"
@@ -253,7 +253,7 @@ def _repeat(cell: Cell, file: str, name: str | None, options: Mapping[str, Any],
     return workpiece(cell, file, name, context=context)
 
 
-def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> CalibrationResult:
+def _estimate(cell: Cell, touches: Touches, sigma: float | None) -> CalibrationResult:
     """The estimator on simulated touches (:attr:`Planner.calibrate
     <robotcell.cell.calibrate.registry.Planner>`), on the cell's turntable."""
     from robotcell.calibration.workpiece import calibrate_workpiece
@@ -261,7 +261,7 @@ def _estimate(cell: Cell, touches: Touches, prior_sigma: float | None) -> Calibr
     m = touches.measurements(cell.robot)
     assert cell.turntable is not None
     return calibrate_workpiece(m.axes[:, 0], touched_in_parent(cell, touches, m), m.point,
-                               cell.turntable.T_parent_B, prior_sigma=prior_sigma)
+                               cell.turntable.T_parent_B, sigma=sigma)
 
 
 PROCEDURE = Procedure(
