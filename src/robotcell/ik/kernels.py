@@ -219,8 +219,8 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
 def _opw_shoulder(sh, cx, cy, n, b, inv, a1):
     """``(cos t1, sin t1, X)`` of an ortho-parallel arm for the wrist centre ``(cx, cy)`` in O:
     shoulder ``sh`` 0 (wrist centre in front of axis 1) or 1 (behind), ``n`` its distance from
-    axis 1 in the arm plane, ``inv = 1 / (cx^2 + cy^2)``; ``X`` its distance in front of axis 2
-    (m)."""
+    axis 1 in the arm plane, ``inv`` the inverse of ``cx^2 + cy^2`` (the caller's choice where
+    that is 0); ``X`` the wrist centre's distance in front of axis 2 (m)."""
     if sh == 0:
         return (cx * n + cy * b) * inv, (cy * n - cx * b) * inv, n - a1
     return -(cx * n - cy * b) * inv, -(cy * n + cx * b) * inv, -(n + a1)
