@@ -71,6 +71,18 @@ def test_a_kernel_calls_its_helpers_in_python_and_compiled(monkeypatch):
         jit.Kernel(_triple_sum).compile()(x)
 
 
+def _halve(x):
+    return 0.5 * x
+
+
+def test_a_helper_compiled_inline_is_inlined_into_its_callers():
+    # A helper split out of a hot compiled kernel costs no call: numba inlines it.
+    helper = jit.compiled(inline=True)(_halve)
+    assert helper.targetoptions["inline"] == "always"
+    assert helper(3.0) == 1.5
+    assert jit.compiled(_halve).targetoptions["inline"] == "never"
+
+
 def test_a_few_poses_never_load_numba_and_a_loop_does():
     # A fresh process: one-pose FK and the pose check stay Python (no 0.5 s to load numba);
     # past the budget the chain is compiled, and gives the same bits.

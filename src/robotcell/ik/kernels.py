@@ -235,7 +235,7 @@ def _arm_plane_rows(cs1, sn1, R):
             cs1 * R[1][1] - sn1 * R[0][1], cs1 * R[1][2] - sn1 * R[0][2])
 
 
-@compiled
+@compiled(inline=True)
 def _opw_wrist(q, k, ang, M, R, cs23, sing, has_ref, straight_ref) -> None:
     """Axes 4, 5, 6 of branch ``k`` of :func:`_opw` and of its flipped wrist ``k + 1`` (t4 + pi,
     -t5, t6 + pi) into ``q`` (8, 6), for the target ``R`` (3x3) seen from the arm plane ``M``

@@ -47,13 +47,18 @@ _CACHE_WRITABLE: dict[str, bool] = {}
 _JITABLE: set[Callable[..., Any]] = set()
 
 
-def compiled(fn: Callable[..., Any]) -> Callable[..., Any]:
+def compiled(fn: Callable[..., Any] | None = None, *, inline: bool = False) -> Any:
     """``fn`` compiled by numba: the one place that sets the options of robotcell's machine code.
+
+    Used as ``@compiled``, or ``@compiled(inline=True)`` for a helper split out of a hot kernel.
 
     Parameters
     ----------
     fn : callable
         Plain Python that numba can compile in nopython mode.
+    inline : bool
+        Inline ``fn`` into the compiled functions that call it (numba's ``inline="always"``), so
+        that splitting a kernel costs no call.
 
     Returns
     -------
@@ -64,9 +69,12 @@ def compiled(fn: Callable[..., Any]) -> Callable[..., Any]:
         on disk where numba can write a cache for ``fn``'s source file, else compiled in memory
         for this process (:func:`_cache_writable`).
     """
+    if fn is None:
+        return lambda f: compiled(f, inline=inline)
     import numba
 
-    return numba.njit(cache=_cache_writable(fn), error_model="numpy")(fn)
+    return numba.njit(cache=_cache_writable(fn), error_model="numpy",
+                      inline="always" if inline else "never")(fn)
 
 
 def _cache_writable(fn: Callable[..., Any]) -> bool:
@@ -106,7 +114,8 @@ class Kernel:
         robotcell but ``helpers``.
     helpers : tuple of callable, optional
         Functions of ``fn``'s source file that ``fn`` calls, written like it: Python calls them
-        as they are; the compiled ``fn`` calls them compiled (numba's ``register_jitable``).
+        as they are; the compiled ``fn`` has them compiled into it (inlined; numba's
+        ``register_jitable``).
 
     Attributes
     ----------
@@ -144,12 +153,12 @@ class Kernel:
 
 
 def _jitable(fn: Callable[..., Any]) -> None:
-    """Let compiled functions call the plain Python ``fn`` (compiled with them, with the options of
-    :func:`compiled`); ``fn`` itself stays Python. Once per function."""
+    """Let compiled functions call the plain Python ``fn``: compiled into them (inlined, with the
+    options of :func:`compiled`); ``fn`` itself stays Python. Once per function."""
     if fn not in _JITABLE:
         from numba.extending import register_jitable
 
-        register_jitable(error_model="numpy")(fn)
+        register_jitable(error_model="numpy", inline="always")(fn)
         _JITABLE.add(fn)
 
 
