@@ -207,10 +207,8 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
             k = 4 * sh + 2 * el
             t2q = _angle(ang[1], ang[7], ang[13], ang[19], sn2, cs2)
             t3q = _angle(ang[2], ang[8], ang[14], ang[20], sn3, cs3)
-            q[k, 0], q[k, 1], q[k, 2] = t1q, t2q, t3q
-            q[k + 1, 0], q[k + 1, 1], q[k + 1, 2] = t1q, t2q, t3q
-            _opw_wrist(q, k, ang, M, R, (cs2 * cs3 - sn2 * sn3, sn2 * cs3 + cs2 * sn3), sing,
-                       has_ref, straight_ref)
+            _opw_wrist(q, k, ang, (t1q, t2q, t3q), M, R,
+                       (cs2 * cs3 - sn2 * sn3, sn2 * cs3 + cs2 * sn3), sing, (has_ref, straight_ref))
             reach[k] = reach[k + 1] = ok
             err[k] = err[k + 1] = e
 
@@ -236,12 +234,14 @@ def _arm_plane_rows(cs1, sn1, R):
 
 
 @compiled(inline=True)
-def _opw_wrist(q, k, ang, M, R, cs23, sing, has_ref, straight_ref) -> None:
-    """Axes 4, 5, 6 of branch ``k`` of :func:`_opw` and of its flipped wrist ``k + 1`` (t4 + pi,
-    -t5, t6 + pi) into ``q`` (8, 6), for the target ``R`` (3x3) seen from the arm plane ``M``
-    (:func:`_arm_plane_rows`) and ``cs23`` (cos, sin) of the paper's t2 + t3. At the wrist
-    singularity (``sin t5`` below ``sing``) axis 4 takes ``straight_ref`` (the paper's angle of
-    the reference's axis 4) when ``has_ref``, else 0 of the paper; axis 6 takes the rest."""
+def _opw_wrist(q, k, ang, q123, M, R, cs23, sing, ref4) -> None:
+    """Branch ``k`` of :func:`_opw` and its flipped wrist ``k + 1`` (t4 + pi, -t5, t6 + pi) into
+    ``q`` (8, 6): the controller values ``q123`` of axes 1-3 and those of axes 4-6 for the target
+    ``R`` (3x3) seen from the arm plane ``M`` (:func:`_arm_plane_rows`), ``cs23`` (cos, sin) of
+    the paper's t2 + t3. At the wrist singularity (``sin t5`` below ``sing``) axis 4 takes the
+    paper's angle of the reference's axis 4 when ``ref4`` ``(has_ref, that angle)`` has one,
+    else 0 of the paper; axis 6 takes the rest."""
+    has_ref, straight_ref = ref4
     c23, s23 = cs23
     M00, M01, M02, M10, M11, M12 = M
     r02 = c23 * M02 - s23 * R[2][2]
@@ -259,9 +259,11 @@ def _opw_wrist(q, k, ang, M, R, cs23, sing, has_ref, straight_ref) -> None:
         else:
             cs4 = 1.0
     n6, d6 = cs4 * M10 - sn4 * r00, cs4 * M11 - sn4 * r01
+    q[k, 0], q[k, 1], q[k, 2] = q123
     q[k, 3] = _angle(ang[3], ang[9], ang[15], ang[21], sn4, cs4)
     q[k, 4] = _angle(ang[4], ang[10], ang[16], ang[22], h, r22)
     q[k, 5] = _angle(ang[5], ang[11], ang[17], ang[23], n6, d6)
+    q[k + 1, 0], q[k + 1, 1], q[k + 1, 2] = q123
     q[k + 1, 3] = _angle(ang[3], ang[9], ang[15], ang[21], -sn4, -cs4)
     q[k + 1, 4] = _angle(ang[4], ang[10], ang[16], ang[22], -h, r22)
     q[k + 1, 5] = _angle(ang[5], ang[11], ang[17], ang[23], -n6, -d6)
