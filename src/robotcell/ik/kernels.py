@@ -207,8 +207,8 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
             k = 4 * sh + 2 * el
             t2q = _angle(ang[1], ang[7], ang[13], ang[19], sn2, cs2)
             t3q = _angle(ang[2], ang[8], ang[14], ang[20], sn3, cs3)
-            _opw_wrist(q, k, ang, (t1q, t2q, t3q), M, R,
-                       (cs2 * cs3 - sn2 * sn3, sn2 * cs3 + cs2 * sn3), sing, (has_ref, straight_ref))
+            cs23 = (cs2 * cs3 - sn2 * sn3, sn2 * cs3 + cs2 * sn3)
+            _opw_wrist(q, k, ang, (t1q, t2q, t3q), M, R, cs23, sing, (has_ref, straight_ref))
             reach[k] = reach[k + 1] = ok
             err[k] = err[k + 1] = e
 
