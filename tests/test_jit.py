@@ -34,6 +34,55 @@ def test_a_kernel_runs_as_python_until_its_budget_then_compiled(monkeypatch):
     assert jit._KERNELS == [k]
 
 
+def _double(x):
+    return 2.0 * x
+
+
+def _double_sum(x):
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += _double(x[i])
+    return s
+
+
+def _triple(x):
+    return 3.0 * x
+
+
+def _triple_sum(x):
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += _triple(x[i])
+    return s
+
+
+def test_a_kernel_calls_its_helpers_in_python_and_compiled(monkeypatch):
+    # A kernel split into functions of its file: the batch calls them as Python (on arrays), the
+    # compiled kernel compiled; a helper not given to the Kernel is refused by numba.
+    from numba.core.errors import TypingError
+
+    monkeypatch.setattr(jit, "_KERNELS", [])
+    x = np.array([1.0, 2.0, 3.0])
+    k = jit.Kernel(_double_sum, (_double,))
+    assert k.fn(x) == 12.0
+    assert k.compile()(x) == 12.0
+    np.testing.assert_array_equal(k.fn(np.array([x, -x]).T), [12.0, -12.0])  # still Python
+    with pytest.raises(TypingError, match="_triple"):
+        jit.Kernel(_triple_sum).compile()(x)
+
+
+def _halve(x):
+    return 0.5 * x
+
+
+def test_a_helper_compiled_inline_is_inlined_into_its_callers():
+    # A helper split out of a hot compiled kernel costs no call: numba inlines it.
+    helper = jit.compiled(inline=True)(_halve)
+    assert helper.targetoptions["inline"] == "always"
+    assert helper(3.0) == 1.5
+    assert jit.compiled(_halve).targetoptions["inline"] == "never"
+
+
 def test_a_few_poses_never_load_numba_and_a_loop_does():
     # A fresh process: one-pose FK and the pose check stay Python (no 0.5 s to load numba);
     # past the budget the chain is compiled, and gives the same bits.

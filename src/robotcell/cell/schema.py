@@ -377,6 +377,28 @@ def cell_fields(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> 
                                 "frames"}, ("robot",))
     rob = rd.mapping(top["robot"], "robot", {"model", "frame", "identified", "provenance"},
                      ("model",))
+    kwargs = _robot_fields(rd, rob, base_dir)
+    if "name" in top:
+        kwargs["name"] = rd.string(top["name"], "name")
+    if top.get("track") is not None:
+        kwargs["track"] = _track_from_dict(rd, top["track"], "frame" in rob)
+    if top.get("turntable") is not None:
+        kwargs["turntable"] = _turntable_from_dict(rd, top["turntable"])
+    if top.get("positioner") is not None:
+        if "turntable" in kwargs:
+            raise rd.fail("positioner", "and key 'turntable' both describe the axes carrying the "
+                          "work; keep one (a turntable is a positioner of one axis)")
+        kwargs["turntable"] = _positioner_from_dict(rd, top["positioner"])
+    tools = {name: _tool_from_dict(rd, name, td) for name, td in
+             rd.mapping(top.get("tools") or {}, "tools", set(top.get("tools") or {})).items()}
+    frames = {name: _frame_from_dict(rd, name, fd, "turntable" in kwargs) for name, fd in
+              rd.mapping(top.get("frames") or {}, "frames", set(top.get("frames") or {})).items()}
+    return {**kwargs, "tools": tools, "frames": frames}
+
+
+def _robot_fields(rd: _Reader, rob: dict, base_dir: str | Path) -> dict[str, Any]:
+    """``robot``, ``robot_model`` and those of ``identified`` and ``T_world_R`` the ``robot``
+    section ``rob`` gives."""
     model, robot = _robot(rd, rob["model"], "robot.model", base_dir)
     kwargs: dict[str, Any] = {"robot": robot, "robot_model": model}
     if rob.get("identified") is not None:
@@ -393,80 +415,84 @@ def cell_fields(data: Any, origin: str = "cell", base_dir: str | Path = ".") -> 
                       "robot.identified (the identified model file) or remove it")
     if "frame" in rob:
         kwargs["T_world_R"] = rd.pose(rob["frame"], "robot.frame")
-    if "name" in top:
-        kwargs["name"] = rd.string(top["name"], "name")
-    if top.get("track") is not None:
-        t = rd.mapping(top["track"], "track", {"name", "frame", "robot_at_zero", "axis", "scale",
-                                               "min", "max", "provenance"})
-        if "frame" in rob:
-            raise rd.fail("robot.frame", "must be omitted when the cell has a track: the track "
-                          "places the robot (track.frame and track.robot_at_zero)")
-        axis = t.get("axis", "x")
-        if axis not in ("x", "y", "z"):
-            raise rd.fail("track.axis", f"must be x, y or z, got {axis!r}")
-        lo, hi = rd.limits(t, "track", 1e-3)
-        scale = rd.number(t.get("scale", 1.0), "track.scale")
-        if scale <= 0:
-            raise rd.fail("track.scale", f"must be > 0, got {scale}")
-        kwargs["track"] = Track(
-            T_world_L=rd.pose(t.get("frame", {}), "track.frame"),
-            T_L_R0=rd.pose(t.get("robot_at_zero", {}), "track.robot_at_zero"),
-            axis=axis, scale=scale, lower=lo, upper=hi,
-            name=rd.string(t.get("name", "track"), "track.name"),
-            provenance=rd.provenance(t.get("provenance"), "track.provenance"),
-        )
-    if top.get("turntable") is not None:
-        t = rd.mapping(top["turntable"], "turntable", {"name", "frame", "parent", "min", "max",
-                                                       "provenance"})
-        parent = t.get("parent", "world")
-        if parent not in ("world", "robot"):
-            raise rd.fail("turntable.parent", f"must be world or robot, got {parent!r}")
-        lo, hi = rd.limits(t, "turntable", math.pi / 180)
-        kwargs["turntable"] = Turntable(
-            T_parent_B=rd.pose(t.get("frame", {}), "turntable.frame"), parent=parent,
-            lower=lo, upper=hi, name=rd.string(t.get("name", "turntable"), "turntable.name"),
-            provenance=rd.provenance(t.get("provenance"), "turntable.provenance"),
-        )
-    if top.get("positioner") is not None:
-        if "turntable" in kwargs:
-            raise rd.fail("positioner", "and key 'turntable' both describe the axes carrying the "
-                          "work; keep one (a turntable is a positioner of one axis)")
-        kwargs["turntable"] = _positioner_from_dict(rd, top["positioner"])
-    tools: dict[str, Tool] = {}
-    for name, td in rd.mapping(top.get("tools") or {}, "tools", set(top.get("tools") or {})).items():
-        key = f"tools.{name}"
-        _named(rd, name, key, "tool")
-        td = rd.mapping(td, key, {"number", "frame", "mass", "cog", "provenance"}, ("frame",))
-        cog = td.get("cog")
-        if cog is not None and (not isinstance(cog, list) or len(cog) != 3):
-            raise rd.fail(f"{key}.cog", f"must be a list [x, y, z] in mm, got {cog!r}")
-        mass = rd.number(td["mass"], f"{key}.mass") if "mass" in td else None
-        if mass is not None and mass <= 0:
-            raise rd.fail(f"{key}.mass", f"must be > 0 kg, got {td['mass']}")
-        tools[name] = Tool(
-            T_F_TCP=rd.pose(td["frame"], f"{key}.frame"),
-            number=rd.integer(td["number"], f"{key}.number") if "number" in td else None,
-            mass=mass,
-            cog=None if cog is None else np.array(
-                [rd.number(v, f"{key}.cog[{i}]") for i, v in enumerate(cog)]) * 1e-3,
-            provenance=rd.provenance(td.get("provenance"), f"{key}.provenance"),
-        )
-    frames: dict[str, Frame] = {}
-    for name, fd in rd.mapping(top.get("frames") or {}, "frames", set(top.get("frames") or {})).items():
-        key = f"frames.{name}"
-        _named(rd, name, key, "frame")
-        fd = rd.mapping(fd, key, {"number", "parent", "frame", "provenance"}, ("frame",))
-        parent = fd.get("parent", "world")
-        if parent not in ("world", "robot", "turntable"):
-            raise rd.fail(f"{key}.parent", f"must be world, robot or turntable, got {parent!r}")
-        if parent == "turntable" and "turntable" not in kwargs:
-            raise rd.fail(f"{key}.parent", "is turntable, but the cell has no turntable")
-        frames[name] = Frame(
-            pose=rd.pose(fd["frame"], f"{key}.frame"), parent=parent,
-            number=rd.integer(fd["number"], f"{key}.number") if "number" in fd else None,
-            provenance=rd.provenance(fd.get("provenance"), f"{key}.provenance"),
-        )
-    return {**kwargs, "tools": tools, "frames": frames}
+    return kwargs
+
+
+def _track_from_dict(rd: _Reader, value: Any, robot_placed: bool) -> Track:
+    """The ``track`` section (mm); ``robot_placed``: whether the ``robot`` section gives a frame
+    (refused: the track places the robot)."""
+    t = rd.mapping(value, "track", {"name", "frame", "robot_at_zero", "axis", "scale", "min",
+                                    "max", "provenance"})
+    if robot_placed:
+        raise rd.fail("robot.frame", "must be omitted when the cell has a track: the track "
+                      "places the robot (track.frame and track.robot_at_zero)")
+    axis = t.get("axis", "x")
+    if axis not in ("x", "y", "z"):
+        raise rd.fail("track.axis", f"must be x, y or z, got {axis!r}")
+    lo, hi = rd.limits(t, "track", 1e-3)
+    scale = rd.number(t.get("scale", 1.0), "track.scale")
+    if scale <= 0:
+        raise rd.fail("track.scale", f"must be > 0, got {scale}")
+    return Track(
+        T_world_L=rd.pose(t.get("frame", {}), "track.frame"),
+        T_L_R0=rd.pose(t.get("robot_at_zero", {}), "track.robot_at_zero"),
+        axis=axis, scale=scale, lower=lo, upper=hi,
+        name=rd.string(t.get("name", "track"), "track.name"),
+        provenance=rd.provenance(t.get("provenance"), "track.provenance"),
+    )
+
+
+def _turntable_from_dict(rd: _Reader, value: Any) -> Turntable:
+    """The ``turntable`` section (mm, deg)."""
+    t = rd.mapping(value, "turntable", {"name", "frame", "parent", "min", "max", "provenance"})
+    parent = t.get("parent", "world")
+    if parent not in ("world", "robot"):
+        raise rd.fail("turntable.parent", f"must be world or robot, got {parent!r}")
+    lo, hi = rd.limits(t, "turntable", math.pi / 180)
+    return Turntable(
+        T_parent_B=rd.pose(t.get("frame", {}), "turntable.frame"), parent=parent,
+        lower=lo, upper=hi, name=rd.string(t.get("name", "turntable"), "turntable.name"),
+        provenance=rd.provenance(t.get("provenance"), "turntable.provenance"),
+    )
+
+
+def _tool_from_dict(rd: _Reader, name: Any, value: Any) -> Tool:
+    """The entry ``name`` of the ``tools`` section (mm, kg)."""
+    key = f"tools.{name}"
+    _named(rd, name, key, "tool")
+    td = rd.mapping(value, key, {"number", "frame", "mass", "cog", "provenance"}, ("frame",))
+    cog = td.get("cog")
+    if cog is not None and (not isinstance(cog, list) or len(cog) != 3):
+        raise rd.fail(f"{key}.cog", f"must be a list [x, y, z] in mm, got {cog!r}")
+    mass = rd.number(td["mass"], f"{key}.mass") if "mass" in td else None
+    if mass is not None and mass <= 0:
+        raise rd.fail(f"{key}.mass", f"must be > 0 kg, got {td['mass']}")
+    return Tool(
+        T_F_TCP=rd.pose(td["frame"], f"{key}.frame"),
+        number=rd.integer(td["number"], f"{key}.number") if "number" in td else None,
+        mass=mass,
+        cog=None if cog is None else np.array(
+            [rd.number(v, f"{key}.cog[{i}]") for i, v in enumerate(cog)]) * 1e-3,
+        provenance=rd.provenance(td.get("provenance"), f"{key}.provenance"),
+    )
+
+
+def _frame_from_dict(rd: _Reader, name: Any, value: Any, has_turntable: bool) -> Frame:
+    """The entry ``name`` of the ``frames`` section (mm, deg); ``has_turntable``: whether the
+    cell has a turntable or positioner to carry it."""
+    key = f"frames.{name}"
+    _named(rd, name, key, "frame")
+    fd = rd.mapping(value, key, {"number", "parent", "frame", "provenance"}, ("frame",))
+    parent = fd.get("parent", "world")
+    if parent not in ("world", "robot", "turntable"):
+        raise rd.fail(f"{key}.parent", f"must be world, robot or turntable, got {parent!r}")
+    if parent == "turntable" and not has_turntable:
+        raise rd.fail(f"{key}.parent", "is turntable, but the cell has no turntable")
+    return Frame(
+        pose=rd.pose(fd["frame"], f"{key}.frame"), parent=parent,
+        number=rd.integer(fd["number"], f"{key}.number") if "number" in fd else None,
+        provenance=rd.provenance(fd.get("provenance"), f"{key}.provenance"),
+    )
 
 
 _AXIS_KEYS = {"name", "a", "alpha", "d", "theta", "beta", "sign", "min", "max"}

@@ -114,8 +114,9 @@ class AnalyticSolver:
             return k.opw_params(pa.a1, pa.a2, pa.b, pa.c1, pa.c2, pa.c3, pa.c4, pa.signs, pa.offsets)
         if self.method == "ur":
             return k.ur_params(pa.d1, pa.a2, pa.a3, pa.d4, pa.d5, pa.d6, pa.signs, pa.offsets)
-        return k.palletizer_params(pa.A_r, pa.A_h, pa.b, pa.L2, pa.L3, pa.s1, pa.s4, pa.g22,
-                                   pa.o2, pa.g32, pa.g33, pa.o3, pa.v_n, pa.R_n0)
+        planar = (pa.A_r, pa.A_h, pa.b, pa.L2, pa.L3, pa.s1, pa.s4, pa.g22, pa.o2, pa.g32, pa.g33,
+                  pa.o3)
+        return k.palletizer_params(planar, pa.v_n, pa.R_n0)
 
     def end(self, tool: ArrayLike | None) -> NDArray[np.float64]:
         """``T_TCP_end = inv(T_end_n @ flange @ tool)``: the solver's end frame seen from the TCP,

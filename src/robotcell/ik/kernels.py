@@ -151,7 +151,7 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
     elbow 1 = behind the line of axes 2 and 3, wrist 1 = negative paper angle t5. Where axis 1 is
     free (wrist centre on it) it takes the reference's value (behind: + pi), else the one that puts
     axis 6 in the arm plane, inside its limits; where axis 4 is free (wrist singularity) it keeps
-    the reference's value, else 0 of the paper.
+    the reference's value, else 0 of the paper (:func:`_opw_wrist`).
     """
     a1, a2, b, c1_, c2, c3, c4 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     ang = p[7:]
@@ -177,14 +177,7 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
         q1_free = ref[0] if has_ref else ang[0] * math.atan2(R[1][2], R[0][2])
     straight_ref = ang[3] * ref[3] + ang[9] if has_ref else 0.0
     for sh in range(2):
-        if sh == 0:
-            cs1 = (cx * n + cy * b) * inv
-            sn1 = (cy * n - cx * b) * inv
-            X = n - a1
-        else:
-            cs1 = -(cx * n - cy * b) * inv
-            sn1 = -(cy * n + cx * b) * inv
-            X = -(n + a1)
+        cs1, sn1, X = _opw_shoulder(sh, cx, cy, n, b, inv, a1)
         if axial:
             lo1, hi1 = cfg[_LIMITS], cfg[_LIMITS + 6]
             t1 = ang[0] * _clamp_circular(q1_free + sh * math.pi, lo1, hi1, cfg[_LIMIT_TOL]) + ang[6]
@@ -196,12 +189,7 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
         ok = e <= reach_tol
         K = min(max((s_2 - base) * denom, -1.0), 1.0)
         S = math.sqrt(1.0 - K * K)
-        M00 = cs1 * R[0][0] + sn1 * R[1][0]
-        M01 = cs1 * R[0][1] + sn1 * R[1][1]
-        M02 = cs1 * R[0][2] + sn1 * R[1][2]
-        M10 = cs1 * R[1][0] - sn1 * R[0][0]
-        M11 = cs1 * R[1][1] - sn1 * R[0][1]
-        M12 = cs1 * R[1][2] - sn1 * R[0][2]
+        M = _arm_plane_rows(cs1, sn1, R)
         wz = c2 + kappa * K
         t1q = _angle(ang[0], ang[6], ang[12], ang[18], sn1, cs1)
         for el in range(2):
@@ -216,37 +204,69 @@ def _opw(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
             inv_norm = 1.0 / (1.0 if flat else norm)
             cs2 = 1.0 if flat else cu * inv_norm
             sn2 = su * inv_norm
-            c23 = cs2 * cs3 - sn2 * sn3
-            s23 = sn2 * cs3 + cs2 * sn3
-            r02 = c23 * M02 - s23 * R[2][2]
-            r22 = s23 * M02 + c23 * R[2][2]
-            r00 = c23 * M00 - s23 * R[2][0]
-            r01 = c23 * M01 - s23 * R[2][1]
-            h = math.sqrt(r02 * r02 + M12 * M12)
-            straight = h < sing
-            inv_h = 1.0 / (1.0 if straight else h)
-            cs4 = r02 * inv_h
-            sn4 = M12 * inv_h
-            if straight:
-                if has_ref:  # axis 4 keeps the reference's value, axis 6 takes the rest
-                    cs4, sn4 = math.cos(straight_ref), math.sin(straight_ref)
-                else:
-                    cs4 = 1.0
             k = 4 * sh + 2 * el
             t2q = _angle(ang[1], ang[7], ang[13], ang[19], sn2, cs2)
             t3q = _angle(ang[2], ang[8], ang[14], ang[20], sn3, cs3)
-            n6, d6 = cs4 * M10 - sn4 * r00, cs4 * M11 - sn4 * r01
-            q[k, 0], q[k, 1], q[k, 2] = t1q, t2q, t3q
-            q[k, 3] = _angle(ang[3], ang[9], ang[15], ang[21], sn4, cs4)
-            q[k, 4] = _angle(ang[4], ang[10], ang[16], ang[22], h, r22)
-            q[k, 5] = _angle(ang[5], ang[11], ang[17], ang[23], n6, d6)
-            # The flipped wrist: t4 + pi, -t5, t6 + pi.
-            q[k + 1, 0], q[k + 1, 1], q[k + 1, 2] = t1q, t2q, t3q
-            q[k + 1, 3] = _angle(ang[3], ang[9], ang[15], ang[21], -sn4, -cs4)
-            q[k + 1, 4] = _angle(ang[4], ang[10], ang[16], ang[22], -h, r22)
-            q[k + 1, 5] = _angle(ang[5], ang[11], ang[17], ang[23], -n6, -d6)
+            cs23 = (cs2 * cs3 - sn2 * sn3, sn2 * cs3 + cs2 * sn3)
+            _opw_wrist(q, k, ang, (t1q, t2q, t3q), M, R, cs23, sing, (has_ref, straight_ref))
             reach[k] = reach[k + 1] = ok
             err[k] = err[k + 1] = e
+
+
+@compiled
+def _opw_shoulder(sh, cx, cy, n, b, inv, a1):
+    """``(cos t1, sin t1, X)`` of an ortho-parallel arm for the wrist centre ``(cx, cy)`` in O:
+    shoulder ``sh`` 0 (wrist centre in front of axis 1) or 1 (behind), ``n`` its distance from
+    axis 1 in the arm plane, ``inv`` the inverse of ``cx^2 + cy^2`` (the caller's choice where
+    that is 0); ``X`` the wrist centre's distance in front of axis 2 (m)."""
+    if sh == 0:
+        return (cx * n + cy * b) * inv, (cy * n - cx * b) * inv, n - a1
+    return -(cx * n - cy * b) * inv, -(cy * n + cx * b) * inv, -(n + a1)
+
+
+@compiled
+def _arm_plane_rows(cs1, sn1, R):
+    """The first two rows of ``Rz(t1)^T R`` (``cs1``, ``sn1`` the cosine and sine of t1): the
+    target orientation ``R`` (3x3) seen from the arm plane, ``(M00, M01, M02, M10, M11, M12)``."""
+    return (cs1 * R[0][0] + sn1 * R[1][0], cs1 * R[0][1] + sn1 * R[1][1],
+            cs1 * R[0][2] + sn1 * R[1][2], cs1 * R[1][0] - sn1 * R[0][0],
+            cs1 * R[1][1] - sn1 * R[0][1], cs1 * R[1][2] - sn1 * R[0][2])
+
+
+@compiled(inline=True)
+def _opw_wrist(q, k, ang, q123, M, R, cs23, sing, ref4) -> None:
+    """Branch ``k`` of :func:`_opw` and its flipped wrist ``k + 1`` (t4 + pi, -t5, t6 + pi) into
+    ``q`` (8, 6): the controller values ``q123`` of axes 1-3 and those of axes 4-6 for the target
+    ``R`` (3x3) seen from the arm plane ``M`` (:func:`_arm_plane_rows`), ``cs23`` (cos, sin) of
+    the paper's t2 + t3. At the wrist singularity (``sin t5`` below ``sing``) axis 4 takes the
+    paper's angle of the reference's axis 4 when ``ref4`` ``(has_ref, that angle)`` has one,
+    else 0 of the paper; axis 6 takes the rest."""
+    has_ref, straight_ref = ref4
+    c23, s23 = cs23
+    M00, M01, M02, M10, M11, M12 = M
+    r02 = c23 * M02 - s23 * R[2][2]
+    r22 = s23 * M02 + c23 * R[2][2]
+    r00 = c23 * M00 - s23 * R[2][0]
+    r01 = c23 * M01 - s23 * R[2][1]
+    h = math.sqrt(r02 * r02 + M12 * M12)
+    straight = h < sing
+    inv_h = 1.0 / (1.0 if straight else h)
+    cs4 = r02 * inv_h
+    sn4 = M12 * inv_h
+    if straight:
+        if has_ref:  # axis 4 keeps the reference's value, axis 6 takes the rest
+            cs4, sn4 = math.cos(straight_ref), math.sin(straight_ref)
+        else:
+            cs4 = 1.0
+    n6, d6 = cs4 * M10 - sn4 * r00, cs4 * M11 - sn4 * r01
+    q[k, 0], q[k, 1], q[k, 2] = q123
+    q[k, 3] = _angle(ang[3], ang[9], ang[15], ang[21], sn4, cs4)
+    q[k, 4] = _angle(ang[4], ang[10], ang[16], ang[22], h, r22)
+    q[k, 5] = _angle(ang[5], ang[11], ang[17], ang[23], n6, d6)
+    q[k + 1, 0], q[k + 1, 1], q[k + 1, 2] = q123
+    q[k + 1, 3] = _angle(ang[3], ang[9], ang[15], ang[21], -sn4, -cs4)
+    q[k + 1, 4] = _angle(ang[4], ang[10], ang[16], ang[22], -h, r22)
+    q[k + 1, 5] = _angle(ang[5], ang[11], ang[17], ang[23], -n6, -d6)
 
 
 # -- Universal-Robots-type arm --------------------------------------------------------------------
@@ -368,11 +388,11 @@ def _ur(cfg, p, R, P, ref, has_ref, q, err, reach) -> None:
 
 
 # -- 4-axis palletizer ----------------------------------------------------------------------------
-def palletizer_params(A_r, A_h, b, L2, L3, s1, s4, g22, o2, g32, g33, o3, v_n, R_n0
-                      ) -> NDArray[np.float64]:
-    """Parameters of :func:`_palletizer` (m, rad; ``v_n`` (3,), ``R_n0`` (3, 3))."""
-    return np.concatenate([[A_r, A_h, b, L2, L3, s1, s4, g22, o2, g32, g33, o3],
-                           np.ravel(v_n), np.ravel(R_n0)])
+def palletizer_params(planar, v_n, R_n0) -> NDArray[np.float64]:
+    """Parameters of :func:`_palletizer`: ``planar`` the 12 numbers ``(A_r, A_h, b, L2, L3, s1,
+    s4, g22, o2, g32, g33, o3)`` of :class:`robotcell.ik.palletizer.PalletizerParameters` (m,
+    rad), ``v_n`` (3,) (m), ``R_n0`` (3, 3)."""
+    return np.concatenate([np.asarray(planar, dtype=float), np.ravel(v_n), np.ravel(R_n0)])
 
 
 @compiled
@@ -661,10 +681,7 @@ def _manipulability_at(cfg, p, tc, k, R02, R12, R22, cx, cy, cz) -> float:
     Z = cz - c1_
     best = 0.0
     for sh in range(2):
-        if sh == 0:
-            cs1, sn1, X = (cx * n + cy * b) * inv, (cy * n - cx * b) * inv, n - a1
-        else:
-            cs1, sn1, X = -(cx * n - cy * b) * inv, -(cy * n + cx * b) * inv, -(n + a1)
+        cs1, sn1, X = _opw_shoulder(sh, cx, cy, n, b, inv, a1)
         s_2 = X * X + Z * Z
         K = (s_2 - base) * denom
         if not (n2 >= 0 and abs(K) <= 1.0 and _cone(tc[_CONES:_CONES + 4], cs1, sn1)):
@@ -770,9 +787,15 @@ def _argmax(a, n: int) -> int:
 
 
 @compiled
-def _refine(cfg, p, tc, k, R, C, centre, half, lo, hi, lin_f, xs, ms, at) -> None:
-    """Grids of ``len(lin_f)`` values around ``centre``, +-``half``, shrinking around the best for
-    each stage; every value tried and its score into ``xs``, ``ms`` from index ``at``."""
+def _refine(arm, target, centre, half, bounds, lin_f, buf, at) -> None:
+    """Grids of ``len(lin_f)`` values around ``centre``, +-``half``, within ``bounds`` (lower,
+    upper), shrinking around the best for each stage; every value tried and its score into the
+    scratch ``buf`` (values, scores) from index ``at``. ``arm`` is ``(cfg, p, tc, k)`` and
+    ``target`` ``(R, C)`` of :func:`_score`."""
+    cfg, p, tc, k = arm
+    R, C = target
+    lo, hi = bounds
+    xs, ms = buf
     nf = lin_f.shape[0]
     for stage in range(int(tc[_STAGES])):
         i0 = at + stage * nf
@@ -787,9 +810,15 @@ def _refine(cfg, p, tc, k, R, C, centre, half, lo, hi, lin_f, xs, ms, at) -> Non
 
 
 @compiled
-def _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer, prefer, xs, ms):
-    """The track value of one target and whether the scan found one where the arm reaches it
-    (see :func:`robotcell.ik.trackchoice.choose_track`); ``xs``, ``ms`` are scratch."""
+def _choose(cfg, p, tc, target, lins, preference, buf):
+    """The track value of one target ``(R, C)`` (:func:`_wrist_line`) and whether the scan found
+    one where the arm reaches it (see :func:`robotcell.ik.trackchoice.choose_track`); ``lins`` as
+    in :func:`choose_poses`, ``preference`` ``(has_prefer, preferred value)``, ``buf`` the scratch
+    ``(values, scores)``."""
+    R, C = target
+    lin_c, lin_f, lin_d = lins
+    has_prefer, prefer = preference
+    xs, ms = buf
     lo, hi = _scan_interval(cfg, p, tc, C)
     ac = _arm_constants(p)
     K = lin_c.shape[0]
@@ -810,11 +839,11 @@ def _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer, prefer, xs, ms):
             k2, m2 = k, ms[k]
     nr = int(tc[_STAGES]) * lin_f.shape[0]
     c1 = xs[k1] if not np.isnan(xs[k1]) else 0.0
-    _refine(cfg, p, tc, ac, R, C, c1, step, lo, hi, lin_f, xs, ms, K)
+    _refine((cfg, p, tc, ac), target, c1, step, (lo, hi), lin_f, buf, K)
     total = K + nr
     if m2 >= tc[_SECOND] * ms[k1]:
         c2 = xs[k2] if not np.isnan(xs[k2]) else 0.0
-        _refine(cfg, p, tc, ac, R, C, c2, step, lo, hi, lin_f, xs, ms, total)
+        _refine((cfg, p, tc, ac), target, c2, step, (lo, hi), lin_f, buf, total)
     else:
         for i in range(total, total + nr):
             xs[i], ms[i] = np.nan, -1.0
@@ -851,8 +880,7 @@ def _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer, prefer, xs, ms):
 
 
 @compiled
-def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q, err, reach,
-                 valid, manipulability) -> int:
+def choose_poses(cfg, tc, T, T_tcp_end, lins, prefer, out) -> int:
     """The track value of every target, and (for an arm without coupling) its branches there.
 
     Parameters
@@ -865,21 +893,18 @@ def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q
         ``T_L_TCP``, targets in the track frame (m), validated.
     T_tcp_end : ndarray, shape (4, 4)
         The solver's end frame seen from the TCP (m).
-    lin_c, lin_f, lin_d : ndarray
+    lins : tuple of three ndarrays
         ``np.linspace`` of the coarse scan (0..1), of a refinement stage (-1..1) and of the dense
         second look (0..1).
     prefer : ndarray, shape (N,) or (0,)
         Preferred track values (m), or none.
-    x : ndarray, shape (N,)
-        Receives the chosen track values (m).
-    found : ndarray of bool, shape (N,)
-        Receives whether the scan found a value where the arm reaches the target.
-    q, err, reach, valid : ndarray, shape (N, 8, 7), (N, 8), (N, 8), (N, 8)
-        Receive the branches at the chosen values (track value first; finished as by
-        :func:`solve_poses`) when the configuration finishes (an arm without coupling); else
-        untouched.
-    manipulability : ndarray, shape (N,)
-        Receives, with the branches, ``|det J|`` of the best valid one (:func:`best_valid_rows`).
+    out : tuple of ndarrays ``(x, found, q, err, reach, valid, manipulability)``
+        ``x`` (N,) receives the chosen track values (m); ``found`` (N,) of bool whether the scan
+        found a value where the arm reaches the target. ``q``, ``err``, ``reach``, ``valid``
+        ((N, 8, 7), (N, 8), (N, 8) and (N, 8) of bool) receive the branches at the chosen values
+        (track value first; finished as by :func:`solve_poses`) when the configuration finishes
+        (an arm without coupling), else stay untouched; with them ``manipulability`` (N,)
+        receives ``|det J|`` of the best valid branch (:func:`best_valid_rows`).
 
     Returns
     -------
@@ -888,10 +913,11 @@ def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q
         of axis 4 or 6), to be searched again; else 0.
     """
     p = cfg_params(cfg)
+    x, found, q, err, reach, valid, manipulability = out
     finish = cfg[_FINISH] != 0.0
     has_prefer = prefer.shape[0] > 0
-    nbuf = lin_c.shape[0] + 2 * int(tc[_STAGES]) * lin_f.shape[0]
-    xs, ms = np.empty(nbuf), np.empty(nbuf)
+    nbuf = lins[0].shape[0] + 2 * int(tc[_STAGES]) * lins[1].shape[0]
+    buf = (np.empty(nbuf), np.empty(nbuf))
     lower, upper = cfg[_LIMITS:_LIMITS + 6], cfg[_LIMITS + 6:_LIMITS + 12]
     modes = cfg[_LIMITS + 12:_LIMITS + 18]
     no_ref = np.empty(0)
@@ -900,8 +926,8 @@ def choose_poses(cfg, tc, T, T_tcp_end, lin_c, lin_f, lin_d, prefer, x, found, q
     again = 0
     for i in range(T.shape[0]):
         R, P, C = _wrist_line(cfg, tc, T[i], T_tcp_end)
-        xi, fi = _choose(cfg, p, tc, R, C, lin_c, lin_f, lin_d, has_prefer,
-                         prefer[i] if has_prefer else 0.0, xs, ms)
+        xi, fi = _choose(cfg, p, tc, (R, C), lins, (has_prefer, prefer[i] if has_prefer else 0.0),
+                         buf)
         x[i], found[i] = xi, fi
         if not finish:
             continue

@@ -103,26 +103,14 @@ def solve_numeric(
     batch = arr.shape[:-2]
     target = arr.reshape(-1, 4, 4)
     N, n = target.shape[0], robot.n_joints
-    lower, upper = robot.lower, robot.upper
-    if q0 is None:
-        mid = np.where(np.isfinite(lower) & np.isfinite(upper), (lower + upper) / 2, 0.0)
-        start = robot.home if robot.home is not None else mid
-        q = np.broadcast_to(start, (N, n)).copy()
-    else:
-        q = np.broadcast_to(robot._joints(q0, "q0"), batch + (n,)).reshape(N, n).copy()
-    q = np.clip(q, lower, upper)
+    q = _start(robot, q0, batch, N)
+    tol = (tol_position, tol_orientation)
     rng = np.random.default_rng(seed)
     iterations = np.zeros(N, dtype=int)
     used_restarts = np.zeros(N, dtype=int)
     best_q = q.copy()
     best_cost = np.full(N, np.inf)
     done = np.zeros(N, dtype=bool)
-    eye = np.eye(6)
-
-    def converged(e: NDArray[np.float64]) -> NDArray[np.bool_]:
-        return ((np.linalg.norm(e[:, :3], axis=1) <= tol_position)
-                & (np.linalg.norm(e[:, 3:], axis=1) <= tol_orientation))
-
     for attempt in range(restarts + 1):
         idx = np.flatnonzero(~done)
         if idx.size == 0:
@@ -130,36 +118,13 @@ def solve_numeric(
         if attempt > 0:
             q[idx] = _random_in_limits(robot, rng, idx.size)
             used_restarts[idx] += 1
-        qa = q[idx]
-        ta = target[idx]
-        e = _error(robot, qa, ta, tool_T)
-        cost = np.einsum("ij,ij->i", e, e)
-        lam = np.full(idx.size, _LAMBDA0)
-        live = ~converged(e)
-        for _ in range(max_iterations):
-            act = np.flatnonzero(live)
-            if act.size == 0:
-                break
-            iterations[idx[act]] += 1
-            J = robot.jacobian(qa[act], tool=tool_T).reshape(-1, 6, n)
-            A = J @ np.swapaxes(J, -1, -2) + lam[act, None, None] * eye
-            dq = (np.swapaxes(J, -1, -2) @ np.linalg.solve(A, e[act][..., None]))[..., 0]
-            cand = np.clip(qa[act] + dq, lower, upper)
-            ec = _error(robot, cand, ta[act], tool_T)
-            cc = np.einsum("ij,ij->i", ec, ec)
-            better = cc < cost[act]
-            acc = act[better]
-            qa[acc], e[acc], cost[acc] = cand[better], ec[better], cc[better]
-            lam[acc] = np.maximum(lam[acc] / 3.0, _LAMBDA_MIN)
-            rej = act[~better]
-            lam[rej] *= 4.0
-            live[acc] = ~converged(e[acc])
-            live[rej] &= lam[rej] < _LAMBDA_MAX
+        qa, e, cost = _attempt(robot, q[idx], target[idx], tool_T, tol, max_iterations,
+                               iterations, idx)
         q[idx] = qa
         improved = cost < best_cost[idx]
         best_q[idx[improved]] = qa[improved]
         best_cost[idx[improved]] = cost[improved]
-        done[idx] = converged(e)
+        done[idx] = _converged(e, tol)
     e = _error(robot, best_q, target, tool_T)
     pos = np.linalg.norm(e[:, :3], axis=1)
     ang = np.linalg.norm(e[:, 3:], axis=1)
@@ -169,3 +134,65 @@ def solve_numeric(
     return NumericIKResult(best_q.reshape(batch + (n,)), success.reshape(batch),
                            pos.reshape(batch), ang.reshape(batch), iterations.reshape(batch),
                            used_restarts.reshape(batch))
+
+
+def _start(robot: Arm, q0: ArrayLike | None, batch: tuple[int, ...], N: int
+           ) -> NDArray[np.float64]:
+    """The first configuration of each of the ``N`` targets of batch shape ``batch``: ``q0``, or
+    the robot's home, or the middle of its limits (0 for unlimited joints); clipped to the
+    limits, (N, n) (rad, m)."""
+    n, lower, upper = robot.n_joints, robot.lower, robot.upper
+    if q0 is None:
+        mid = np.where(np.isfinite(lower) & np.isfinite(upper), (lower + upper) / 2, 0.0)
+        start = robot.home if robot.home is not None else mid
+        q = np.broadcast_to(start, (N, n)).copy()
+    else:
+        q = np.broadcast_to(robot._joints(q0, "q0"), batch + (n,)).reshape(N, n).copy()
+    return np.clip(q, lower, upper)
+
+
+def _converged(e: NDArray[np.float64], tol: tuple[float, float]) -> NDArray[np.bool_]:
+    """Whether each error ``e`` (N, 6) is within ``tol`` (position in m, orientation in rad)."""
+    return ((np.linalg.norm(e[:, :3], axis=1) <= tol[0])
+            & (np.linalg.norm(e[:, 3:], axis=1) <= tol[1]))
+
+
+def _attempt(robot: Arm, qa: NDArray[np.float64], ta: NDArray[np.float64],
+             tool: NDArray[np.float64] | None, tol: tuple[float, float], max_iterations: int,
+             iterations: NDArray[np.int_], idx: NDArray[np.int_]
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """One attempt of damped least squares from ``qa`` (M, n) towards the targets ``ta``
+    (M, 4, 4), at most ``max_iterations`` steps per target.
+
+    A target stops when it is within ``tol`` (m, rad) or its damping passes ``_LAMBDA_MAX``.
+    ``iterations`` (N,) counts the steps, in place, at the targets' indices ``idx`` (M,).
+    Returns the final configurations (M, n) (``qa``, changed in place), their errors (M, 6) and
+    costs ``|e|^2`` (M,).
+    """
+    n = robot.n_joints
+    lower, upper = robot.lower, robot.upper
+    eye = np.eye(6)
+    e = _error(robot, qa, ta, tool)
+    cost = np.einsum("ij,ij->i", e, e)
+    lam = np.full(len(qa), _LAMBDA0)
+    live = ~_converged(e, tol)
+    for _ in range(max_iterations):
+        act = np.flatnonzero(live)
+        if act.size == 0:
+            break
+        iterations[idx[act]] += 1
+        J = robot.jacobian(qa[act], tool=tool).reshape(-1, 6, n)
+        A = J @ np.swapaxes(J, -1, -2) + lam[act, None, None] * eye
+        dq = (np.swapaxes(J, -1, -2) @ np.linalg.solve(A, e[act][..., None]))[..., 0]
+        cand = np.clip(qa[act] + dq, lower, upper)
+        ec = _error(robot, cand, ta[act], tool)
+        cc = np.einsum("ij,ij->i", ec, ec)
+        better = cc < cost[act]
+        acc = act[better]
+        qa[acc], e[acc], cost[acc] = cand[better], ec[better], cc[better]
+        lam[acc] = np.maximum(lam[acc] / 3.0, _LAMBDA_MIN)
+        rej = act[~better]
+        lam[rej] *= 4.0
+        live[acc] = ~_converged(e[acc], tol)
+        live[rej] &= lam[rej] < _LAMBDA_MAX
+    return qa, e, cost

@@ -281,9 +281,9 @@ def choose_track(track: TrackRobot, T: ArrayLike, tool: ArrayLike | None = None,
     x, found, manip = np.empty(n), np.empty(n, dtype=bool), np.empty(n)
     q, err = np.empty((n, 8, 7)), np.empty((n, 8))
     reach, valid = np.empty((n, 8), dtype=bool), np.empty((n, 8), dtype=bool)
-    again = ch.kernels.choose_poses(ch.solver._cfg, ch.config, flat, ch.solver.end(tool),
-                                    ch.grid(samples), ch.fine, ch.grid(DENSE * samples), pref, x,
-                                    found, q, err, reach, valid, manip)
+    lins = (ch.grid(samples), ch.fine, ch.grid(DENSE * samples))
+    again = ch.kernels.choose_poses(ch.solver._cfg, ch.config, flat, ch.solver.end(tool), lins,
+                                    pref, (x, found, q, err, reach, valid, manip))
     coupled = track.arm.coupling is not None
     if coupled:  # mapped to controller values and checked by the solver
         sol = _solve_at(track, flat, x, tool)

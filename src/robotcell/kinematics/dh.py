@@ -284,7 +284,8 @@ def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
     """``start @ T_0_n(q) @ tail``, or every frame, on a batch or on one pose.
 
     The one implementation of the chain: run by numpy on a batch (each variable below is then an
-    array over the poses) and compiled by numba for one pose (:data:`CHAIN`).
+    array over the poses) and compiled by numba for one pose (:data:`CHAIN`), with its helpers
+    :func:`_put_frame` and :func:`_times_tail`.
 
     Parameters
     ----------
@@ -324,10 +325,7 @@ def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
     r = 0
     for k in range(program.shape[0] + 1):
         if ends is not None and (k == 0 or k == ends[f - 1]):
-            out[f, 0, 0], out[f, 0, 1], out[f, 0, 2], out[f, 0, 3] = a0, b0, c0, p0
-            out[f, 1, 0], out[f, 1, 1], out[f, 1, 2], out[f, 1, 3] = a1, b1, c1, p1
-            out[f, 2, 0], out[f, 2, 1], out[f, 2, 2], out[f, 2, 3] = a2, b2, c2, p2
-            out[f, 3, 0], out[f, 3, 1], out[f, 3, 2], out[f, 3, 3] = 0.0, 0.0, 0.0, 1.0
+            _put_frame(out, f, (a0, a1, a2), (b0, b1, b2), (c0, c1, c2), (p0, p1, p2))
             f += 1
         if k == program.shape[0]:
             break
@@ -376,13 +374,32 @@ def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
             b0, b1, b2, c0, c1, c2 = u0, u1, u2, w0, w1, w2
         else:
             c0, c1, c2, a0, a1, a2 = u0, u1, u2, w0, w1, w2
-    if ends is not None:
-        return True
-    # [R p] @ tail, column by column, skipping zero coefficients and multiplications by +-1 (a
-    # vendor's flange is a signed permutation)
+    if ends is None:
+        _times_tail(out, (a0, a1, a2), (b0, b1, b2), (c0, c1, c2), (p0, p1, p2), tail)
+    return True
+
+
+def _put_frame(out, f, a, b, c, p) -> None:
+    """Write the pose with rotation columns ``a``, ``b``, ``c`` and position ``p`` (each ``(x, y,
+    z)``, m) as frame ``f`` of ``out`` (frames, 4, 4) or (frames, 4, 4, N): a helper of
+    :func:`chain_kernel`."""
+    out[f, 0, 0], out[f, 0, 1], out[f, 0, 2], out[f, 0, 3] = a[0], b[0], c[0], p[0]
+    out[f, 1, 0], out[f, 1, 1], out[f, 1, 2], out[f, 1, 3] = a[1], b[1], c[1], p[1]
+    out[f, 2, 0], out[f, 2, 1], out[f, 2, 2], out[f, 2, 3] = a[2], b[2], c[2], p[2]
+    out[f, 3, 0], out[f, 3, 1], out[f, 3, 2], out[f, 3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+def _times_tail(out, a, b, c, p, tail) -> None:
+    """``out = [a b c p] @ tail``, the pose with rotation columns ``a``, ``b``, ``c`` and position
+    ``p`` (each ``(x, y, z)``, m) times the constant pose ``tail`` (4, 4), into ``out`` (4, 4) or
+    (4, 4, N): a helper of :func:`chain_kernel`.
+
+    Column by column, skipping zero coefficients and multiplications by +-1 (a vendor's flange is
+    a signed permutation).
+    """
     for col in range(4):
         if col == 3:
-            x0, x1, x2 = p0, p1, p2
+            x0, x1, x2 = p[0], p[1], p[2]
         else:
             x0, x1, x2 = 0.0, 0.0, 0.0
         for row in range(3):
@@ -390,11 +407,11 @@ def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
             if t == 0.0:
                 continue
             if row == 0:
-                v0, v1, v2 = a0, a1, a2
+                v0, v1, v2 = a[0], a[1], a[2]
             elif row == 1:
-                v0, v1, v2 = b0, b1, b2
+                v0, v1, v2 = b[0], b[1], b[2]
             else:
-                v0, v1, v2 = c0, c1, c2
+                v0, v1, v2 = c[0], c[1], c[2]
             if t == 1.0:
                 x0, x1, x2 = x0 + v0, x1 + v1, x2 + v2
             elif t == -1.0:
@@ -403,11 +420,10 @@ def chain_kernel(program, q, start, shift, tail, out, ends, cs) -> bool:
                 x0, x1, x2 = x0 + t * v0, x1 + t * v1, x2 + t * v2
         out[0, col], out[1, col], out[2, col] = x0, x1, x2
         out[3, col] = 1.0 if col == 3 else 0.0
-    return True
 
 
 #: :func:`chain_kernel` for one pose (Python first, compiled once single-pose calls add up).
-CHAIN = Kernel(chain_kernel)
+CHAIN = Kernel(chain_kernel, (_put_frame, _times_tail))
 
 
 def jacobian_kernel(F, tail, first, sign, prismatic, out) -> None:

@@ -18,8 +18,9 @@ directory), so only the first process after an install or an edit compiles. Wher
 is writable (a read-only install run by a user without a writable home), it is compiled in
 memory, in each process, without a message.
 
-A kernel must not call another function of robotcell: numba's cache notices changes of the
-kernel's own source file only.
+A kernel calls no function of robotcell but its helpers, defined in its own source file (numba's
+cache notices changes of the kernel's own source file only) and given to :class:`Kernel`: plain
+Python for the batch, compiled with the kernel for one pose.
 """
 
 from __future__ import annotations
@@ -42,15 +43,22 @@ PYTHON_BUDGET = 0.5
 _KERNELS: list[Kernel] = []
 #: Per source folder: whether numba can cache the machine code of the functions it holds.
 _CACHE_WRITABLE: dict[str, bool] = {}
+#: Kernel helpers compiled functions may call (:func:`_jitable`).
+_JITABLE: set[Callable[..., Any]] = set()
 
 
-def compiled(fn: Callable[..., Any]) -> Callable[..., Any]:
+def compiled(fn: Callable[..., Any] | None = None, *, inline: bool = False) -> Any:
     """``fn`` compiled by numba: the one place that sets the options of robotcell's machine code.
+
+    Used as ``@compiled``, or ``@compiled(inline=True)`` for a helper split out of a hot kernel.
 
     Parameters
     ----------
     fn : callable
         Plain Python that numba can compile in nopython mode.
+    inline : bool
+        Inline ``fn`` into the compiled functions that call it (numba's ``inline="always"``), so
+        that splitting a kernel costs no call.
 
     Returns
     -------
@@ -61,9 +69,12 @@ def compiled(fn: Callable[..., Any]) -> Callable[..., Any]:
         on disk where numba can write a cache for ``fn``'s source file, else compiled in memory
         for this process (:func:`_cache_writable`).
     """
+    if fn is None:
+        return lambda f: compiled(f, inline=inline)
     import numba
 
-    return numba.njit(cache=_cache_writable(fn), error_model="numpy")(fn)
+    return numba.njit(cache=_cache_writable(fn), error_model="numpy",
+                      inline="always" if inline else "never")(fn)
 
 
 def _cache_writable(fn: Callable[..., Any]) -> bool:
@@ -99,8 +110,12 @@ class Kernel:
     Parameters
     ----------
     fn : callable
-        Plain Python that numba can compile in nopython mode and that calls no other function of
-        robotcell.
+        Plain Python that numba can compile in nopython mode and that calls no function of
+        robotcell but ``helpers``.
+    helpers : tuple of callable, optional
+        Functions of ``fn``'s source file that ``fn`` calls, written like it: Python calls them
+        as they are; the compiled ``fn`` has them compiled into it (inlined; numba's
+        ``register_jitable``).
 
     Attributes
     ----------
@@ -109,8 +124,10 @@ class Kernel:
         version of ``fn``.
     """
 
-    def __init__(self, fn: Callable[..., Any]) -> None:
+    def __init__(self, fn: Callable[..., Any], helpers: tuple[Callable[..., Any], ...] = ()
+                 ) -> None:
         self.fn = fn
+        self.helpers = helpers
         self.spent = 0.0
         self.call: Callable[..., Any] = self._python
         _KERNELS.append(self)
@@ -129,8 +146,20 @@ class Kernel:
     def compile(self) -> Callable[..., Any]:
         """Compile ``fn`` (or load it from the cache) and call the compiled version from now on."""
         if self.call == self._python:
+            for helper in self.helpers:
+                _jitable(helper)
             self.call = compiled(self.fn)
         return self.call
+
+
+def _jitable(fn: Callable[..., Any]) -> None:
+    """Let compiled functions call the plain Python ``fn``: compiled into them (inlined, with the
+    options of :func:`compiled`); ``fn`` itself stays Python. Once per function."""
+    if fn not in _JITABLE:
+        from numba.extending import register_jitable
+
+        register_jitable(error_model="numpy", inline="always")(fn)
+        _JITABLE.add(fn)
 
 
 def compile_all() -> None:

@@ -164,6 +164,33 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
     _mapping(data, origin, _TOP_KEYS,
              f"{origin}: a model file must be a YAML mapping with keys name, joints, ...",
              ("name", "joints"))
+    ls, as_ = _units(data, origin)
+    joints_data = data["joints"]
+    if not isinstance(joints_data, list) or not joints_data:
+        raise InputError(f"{origin}: key 'joints' must be a non-empty list")
+    joints = [_joint(jd, f"{origin}: joint {i}", i, ls, as_)
+              for i, jd in enumerate(joints_data, start=1)]
+    kwargs = _robot_options(data, joints, origin, ls, as_)
+    convention = data.get("convention", "standard")
+    if convention not in ("standard", "modified"):
+        raise InputError(f"{origin}: key 'convention' must be 'standard' or 'modified', got {convention!r}")
+    verified = data.get("verified", False)
+    if not isinstance(verified, bool):
+        raise InputError(f"{origin}: key 'verified' must be true or false, got {verified!r}")
+    try:
+        robot = Robot(
+            name=str(data["name"]), joints=tuple(joints), convention=convention,
+            title=str(data.get("title", data["name"])), source=str(data.get("source", "")),
+            verified=verified, verification=str(data.get("verification", "")), **kwargs,
+        )
+    except InputError as exc:
+        raise InputError(f"{origin}: {exc}") from None
+    _check_lengths(robot, origin)
+    return robot
+
+
+def _units(data: dict, origin: str) -> tuple[float, float]:
+    """The model file's ``units``: metres and radians per file length and angle unit."""
     units = data.get("units", {"length": "mm", "angle": "deg"})
     if not isinstance(units, dict):
         raise InputError(f"{origin}: key 'units' must be a mapping like {{length: mm, angle: deg}}")
@@ -172,51 +199,56 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
         raise InputError(f"{origin}: units.length must be 'mm' or 'm', got {lunit!r}")
     if aunit not in _ANGLE:
         raise InputError(f"{origin}: units.angle must be 'deg' or 'rad', got {aunit!r}")
-    ls, as_ = _LENGTH[lunit], _ANGLE[aunit]
-    joints_data = data["joints"]
-    if not isinstance(joints_data, list) or not joints_data:
-        raise InputError(f"{origin}: key 'joints' must be a non-empty list")
-    joints = []
-    for i, jd in enumerate(joints_data, start=1):
-        where = f"{origin}: joint {i}"
-        _mapping(jd, where, _JOINT_KEYS,
-                 f"{where} must be a mapping with keys type, a, alpha, d, theta",
-                 ("type", "a", "alpha", "d", "theta"))
-        jtype = jd["type"]
-        if jtype not in ("revolute", "prismatic"):
-            raise InputError(f"{where}: key 'type' must be 'revolute' or 'prismatic', got {jtype!r}")
-        qscale = ls if jtype == "prismatic" else as_
-        sign = _number(jd.get("sign", 1), f"{where}: key 'sign'")
-        if sign not in (1.0, -1.0):
-            raise InputError(f"{where}: key 'sign' must be +1 or -1, got {jd['sign']!r}")
-        lo = _number(jd["min"], f"{where}: key 'min'") * qscale if "min" in jd else -math.inf
-        hi = _number(jd["max"], f"{where}: key 'max'") * qscale if "max" in jd else math.inf
-        if not lo < hi:
-            raise InputError(f"{where}: key 'min' ({jd.get('min')}) must be below key 'max' ({jd.get('max')})")
-        passive = jd.get("passive", False)
-        if not isinstance(passive, bool):
-            raise InputError(f"{where}: key 'passive' must be true or false, got {passive!r}")
-        if passive and ("min" in jd or "max" in jd):
-            raise InputError(f"{where}: a passive joint has no limits of its own (remove 'min', 'max'); "
-                             "state limits on the controller axes or under coupling.interaction")
-        mass = _number(jd.get("mass", 0.0), f"{where}: key 'mass'")
-        if mass < 0:
-            raise InputError(f"{where}: key 'mass' must be >= 0 (kg), got {jd['mass']!r}")
-        com = jd.get("com", [0.0, 0.0, 0.0])
-        if not isinstance(com, list) or len(com) != 3:
-            raise InputError(f"{where}: key 'com' must be [x, y, z], the centre of mass in the "
-                             "link's DH frame (file length unit)")
-        joints.append(Joint(
-            mass=mass, com=tuple(_number(v, f"{where}: key 'com'") * ls for v in com),
-            type=jtype,
-            a=_number(jd["a"], f"{where}: key 'a'") * ls,
-            alpha=_number(jd["alpha"], f"{where}: key 'alpha'") * as_,
-            d=_number(jd["d"], f"{where}: key 'd'") * ls,
-            theta=_number(jd["theta"], f"{where}: key 'theta'") * as_,
-            beta=_number(jd.get("beta", 0.0), f"{where}: key 'beta'") * as_,
-            sign=sign, lower=lo, upper=hi, name=str(jd.get("name", f"P{i}" if passive else f"A{i}")),
-            passive=passive,
-        ))
+    return _LENGTH[lunit], _ANGLE[aunit]
+
+
+def _joint(jd: Any, where: str, i: int, ls: float, as_: float) -> Joint:
+    """Joint ``i`` (from 1) of a model file, ``where`` naming it in messages; ``ls``, ``as_``:
+    metres and radians per file unit (:func:`_units`)."""
+    _mapping(jd, where, _JOINT_KEYS,
+             f"{where} must be a mapping with keys type, a, alpha, d, theta",
+             ("type", "a", "alpha", "d", "theta"))
+    jtype = jd["type"]
+    if jtype not in ("revolute", "prismatic"):
+        raise InputError(f"{where}: key 'type' must be 'revolute' or 'prismatic', got {jtype!r}")
+    qscale = ls if jtype == "prismatic" else as_
+    sign = _number(jd.get("sign", 1), f"{where}: key 'sign'")
+    if sign not in (1.0, -1.0):
+        raise InputError(f"{where}: key 'sign' must be +1 or -1, got {jd['sign']!r}")
+    lo = _number(jd["min"], f"{where}: key 'min'") * qscale if "min" in jd else -math.inf
+    hi = _number(jd["max"], f"{where}: key 'max'") * qscale if "max" in jd else math.inf
+    if not lo < hi:
+        raise InputError(f"{where}: key 'min' ({jd.get('min')}) must be below key 'max' ({jd.get('max')})")
+    passive = jd.get("passive", False)
+    if not isinstance(passive, bool):
+        raise InputError(f"{where}: key 'passive' must be true or false, got {passive!r}")
+    if passive and ("min" in jd or "max" in jd):
+        raise InputError(f"{where}: a passive joint has no limits of its own (remove 'min', 'max'); "
+                         "state limits on the controller axes or under coupling.interaction")
+    mass = _number(jd.get("mass", 0.0), f"{where}: key 'mass'")
+    if mass < 0:
+        raise InputError(f"{where}: key 'mass' must be >= 0 (kg), got {jd['mass']!r}")
+    com = jd.get("com", [0.0, 0.0, 0.0])
+    if not isinstance(com, list) or len(com) != 3:
+        raise InputError(f"{where}: key 'com' must be [x, y, z], the centre of mass in the "
+                         "link's DH frame (file length unit)")
+    return Joint(
+        mass=mass, com=tuple(_number(v, f"{where}: key 'com'") * ls for v in com),
+        type=jtype,
+        a=_number(jd["a"], f"{where}: key 'a'") * ls,
+        alpha=_number(jd["alpha"], f"{where}: key 'alpha'") * as_,
+        d=_number(jd["d"], f"{where}: key 'd'") * ls,
+        theta=_number(jd["theta"], f"{where}: key 'theta'") * as_,
+        beta=_number(jd.get("beta", 0.0), f"{where}: key 'beta'") * as_,
+        sign=sign, lower=lo, upper=hi, name=str(jd.get("name", f"P{i}" if passive else f"A{i}")),
+        passive=passive,
+    )
+
+
+def _robot_options(data: dict, joints: list[Joint], origin: str, ls: float, as_: float
+                   ) -> dict[str, Any]:
+    """The optional :class:`Robot` arguments a model file gives: ``coupling``, ``ik_seed``,
+    ``covariance``, ``base``, ``flange``, ``tool`` and ``home`` (SI units)."""
     kwargs: dict[str, Any] = {}
     if "coupling" in data:
         kwargs["coupling"] = _coupling(data["coupling"], joints, origin, ls, as_)
@@ -242,22 +274,7 @@ def robot_from_dict(data: Any, origin: str = "model") -> Robot:
             _number(v, f"{origin}: key 'home' value {k}") * (ls if j.prismatic else as_)
             for k, (v, j) in enumerate(zip(home, axes), start=1)
         ])
-    convention = data.get("convention", "standard")
-    if convention not in ("standard", "modified"):
-        raise InputError(f"{origin}: key 'convention' must be 'standard' or 'modified', got {convention!r}")
-    verified = data.get("verified", False)
-    if not isinstance(verified, bool):
-        raise InputError(f"{origin}: key 'verified' must be true or false, got {verified!r}")
-    try:
-        robot = Robot(
-            name=str(data["name"]), joints=tuple(joints), convention=convention,
-            title=str(data.get("title", data["name"])), source=str(data.get("source", "")),
-            verified=verified, verification=str(data.get("verification", "")), **kwargs,
-        )
-    except InputError as exc:
-        raise InputError(f"{origin}: {exc}") from None
-    _check_lengths(robot, origin)
-    return robot
+    return kwargs
 
 
 def _check_lengths(robot: Robot, origin: str) -> None:
