@@ -178,7 +178,7 @@ def test_identify_says_its_predicted_error_is_relative_to_the_measuring_device(
     assert code == 0, err
     basis = "relative to the measuring device's frame, from its own measurements only"
     line = next(s for s in out.splitlines() if s.startswith("predicted error of a target"))
-    assert line.endswith(f"; {basis})") and f"parameters (1-sigma {basis}):" in out
+    assert line.endswith(f"; {basis}") and f"parameters (1-sigma {basis}):" in out
     code, out, err = run(capsys, *args, "--json")
     data = json.loads(out)
     assert data["sigma_relative_to"] == "device"

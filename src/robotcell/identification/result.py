@@ -462,7 +462,7 @@ class IdentificationResult:
                          f"covariance and model error): 1-sigma per axis x {x:.4f} y {y:.4f} "
                          f"z {z:.4f} mm, 3D RMS {f['rms_mm']:.4f} mm, 95 % radius "
                          f"{f['radius95_mm']:.4f} mm; "
-                         f"{sigma_basis(SIGMA_RELATIVE_TO, own=OWN_MEASUREMENTS)})")
+                         f"{sigma_basis(SIGMA_RELATIVE_TO, own=OWN_MEASUREMENTS)}")
         return lines
 
 
