@@ -165,10 +165,12 @@ def part_lines(parts: Mapping[str, Any]) -> list[str]:
         e.g. ``"inherited from items with no recorded uncertainty (ASSUMED accuracy) [track]:
         14.559, 2.837, 14.030 / 0.5008, 0.5007, 0.5013"``.
     """
-    pose = any(isinstance(p, Mapping) and "rotation_deg" in p for p in parts.values())
+    present = [p for p in parts.values() if isinstance(p, Mapping)]
+    pose = any("rotation_deg" in p for p in present)
     unit = str(parts.get("unit", ""))
-    lines = [f"its parts ({'position mm / rotation deg' if pose else unit or 'unitless'}, "
-             "adding in quadrature):"]
+    what = (("position mm / " if any("position_mm" in p for p in present) else "")
+            + "rotation deg" if pose else unit or "unitless")
+    lines = [f"its parts ({what}, adding in quadrature):"]
     for part, what in PARTS.items():
         p = parts.get(part)
         if not isinstance(p, Mapping):

@@ -23,7 +23,11 @@ from numpy.typing import NDArray
 
 from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.identification.measurements import Measurements
-from robotcell.identification.result import OWN_MEASUREMENTS, SIGMA_RELATIVE_TO, IdentificationResult
+from robotcell.identification.result import (
+    OWN_MEASUREMENTS,
+    SIGMA_RELATIVE_TO,
+    IdentificationResult,
+)
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
 from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, scene_figure, table
