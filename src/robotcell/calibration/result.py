@@ -17,7 +17,14 @@ from numpy.typing import NDArray
 
 from robotcell.calibration.fitting import Fit
 from robotcell.calibration.resultcheck import REQUIRED, TOUCH_LISTS, malformed
-from robotcell.calibration.sigmaparts import PARTS, part_lines, pose_parts, sigma_basis, value_parts
+from robotcell.calibration.sigmaparts import (
+    DECIMALS,
+    PARTS,
+    part_lines,
+    pose_parts,
+    sigma_basis,
+    value_parts,
+)
 from robotcell.calibration.sigmaparts import numbers as _fmt
 from robotcell.calibration.uncertainty import OWN, Estimate, Sources
 from robotcell.calibration.verdict import (
@@ -345,6 +352,7 @@ class CalibrationResult:
         return "R" if pose is None else pose.split("_")[1]
 
     def _has_sigma(self, key: str) -> bool:
+        """Whether value ``key`` has a 1-sigma (a pose: of its position or rotation)."""
         if self._kind(key) == "pose":
             return key + "_position" in self.sigma or key + "_rotation" in self.sigma
         return key in self.sigma
@@ -565,7 +573,7 @@ class CalibrationResult:
                     lines += [f"      {d}" for d in detail[1:]]
                 continue
             scale, unit = _UNITS[kind]
-            dec = {"mm": 3, "deg": 4, "": 6}[unit]
+            dec = DECIMALS[unit]
             text = _fmt(np.asarray(v, dtype=float) * scale, dec)
             s = self.sigma.get(key)
             if s is not None:

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from robotcell.calibration.uncertainty import OWN, Sources
 
-__all__ = ["ASSUMED_SUFFIX", "FRAMES", "PARTS", "frame_text", "numbers", "part_lines",
+__all__ = ["ASSUMED_SUFFIX", "DECIMALS", "FRAMES", "PARTS", "frame_text", "numbers", "part_lines",
            "pose_parts", "sigma_basis", "value_parts"]
 
 #: The name ending of a source taken at an assumed (nominal) accuracy.
@@ -54,7 +54,7 @@ _INHERITED = {"recorded": "recorded", "assumed": "ASSUMED"}
 
 
 #: Decimals of a printed 1-sigma by unit.
-_DECIMALS = {"mm": 3, "deg": 4, "": 6}
+DECIMALS = {"mm": 3, "deg": 4, "": 6}
 
 
 def numbers(values: Any, decimals: int) -> str:
@@ -180,6 +180,6 @@ def part_lines(parts: Mapping[str, Any]) -> list[str]:
             text = ((numbers(p["position_mm"], 3) + " / " if "position_mm" in p else "")
                     + numbers(p.get("rotation_deg"), 4))
         else:
-            text = numbers(p.get("sigma"), _DECIMALS.get(unit, 6))
+            text = numbers(p.get("sigma"), DECIMALS.get(unit, 6))
         lines.append(f"{what}{names}: {text}")
     return lines
