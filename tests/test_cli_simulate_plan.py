@@ -71,6 +71,8 @@ def test_plan_table_best_design_monte_carlo_and_touches(tmp_path, capsys):
                          "--runs", "8", "--seed", "2", "-o", path)
     assert code == 0, err
     assert "<- best" in out and "best: tilt" in out
+    assert ("predicted 1-sigma of the calibrated pose (relative to the flange, from its own "
+            "touches only):") in out
     assert "Monte Carlo (8 simulated calibrations): RMS error" in out
     # Progress of both stages is shown on stderr.
     assert "predicting tcp designs" in err and "Monte Carlo, 8 runs" in err

@@ -113,6 +113,15 @@ def test_demo_track_cell_end_to_end(tmp_path, capsys):
     code, out, err = run(capsys, "demo", "-o", tmp_path)
     assert code == 0, err
     assert "calibrated vs true cell" in out
+    # it states the accuracy it simulates and calibrates at, and what each 1-sigma holds
+    assert ("touch-up error 0.1 mm (1-sigma per coordinate), simulated and stated to every "
+            "calibration (--sigma 0.1)") in out and out.count("--sigma 0.1 ") == 4
+    assert "(noise 0.02 mm, 1-sigma per coordinate)" in out and "--accuracy 0.02 " in out
+    assert "  tool torch: relative to the flange, from its own touches only" in out
+    assert ("  turntable DKP_400 (T_world_B): relative to frame 'world', from its own touches "
+            "and inherited errors (recorded)") in out
+    assert ("relative to the measuring device's frame, from the arm's identification only, not "
+            "the tool's and frames' calibrations)") in out
     for name in ["cell.yaml", *(f"cell.yaml.{i}.bak" for i in range(1, 5)), "truth.yaml", *EXPORT_FILES.values(),
                  *(f"{p}.{ext}" for p in ("tcp", "track", "turntable", "workpiece")
                    for ext in ("csv", "json")),

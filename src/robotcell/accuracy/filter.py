@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.cell import Cell
 from robotcell.cell.ik import CellIKSolutions
 from robotcell.cell.kinematics import robot_pose, tool_pose
@@ -46,13 +47,23 @@ from robotcell.kinematics.transforms import invert, validate_pose
 from robotcell.programs.config import config_text, select
 from robotcell.robot.robot import Robot
 
-__all__ = ["MAX_CORRECTION", "MAX_ROTATION", "FilterRefused", "FilteredPoses", "filter_poses",
-           "identified_joints", "refuse", "too_large"]
+__all__ = ["MAX_CORRECTION", "MAX_ROTATION", "SIGMA_RELATIVE_TO", "FilterRefused", "FilteredPoses",
+           "filter_poses", "identified_joints", "refuse", "sigma_text", "too_large"]
 
 #: Largest position correction taken (m): beyond it the identified model is wrong.
 MAX_CORRECTION = 5e-3
 #: Largest orientation correction taken (rad).
 MAX_ROTATION = math.radians(1.0)
+#: What the predicted error of a filtered point is relative to (JSON ``sigma_relative_to``):
+#: the measuring device's frame the identification located the arm in.
+SIGMA_RELATIVE_TO = "device"
+
+
+def sigma_text() -> str:
+    """What the predicted 1-sigma of a filtered point is relative to and made of, as printed:
+    the arm's identification alone (docs/accuracy.md, "How good it will be")."""
+    return (sigma_basis(SIGMA_RELATIVE_TO, own="the arm's identification")
+            + ", not the tool's and frames' calibrations")
 
 
 class FilterRefused(RobotcellError):

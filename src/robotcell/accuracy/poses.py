@@ -26,7 +26,12 @@ from typing import Any, TextIO
 import numpy as np
 from numpy.typing import NDArray
 
-from robotcell.accuracy.filter import MAX_CORRECTION, FilteredPoses, filter_poses
+from robotcell.accuracy.filter import (
+    MAX_CORRECTION,
+    SIGMA_RELATIVE_TO,
+    FilteredPoses,
+    filter_poses,
+)
 from robotcell.cell import Cell
 from robotcell.cell.validation import table_columns
 from robotcell.controllers.model import Config
@@ -80,7 +85,8 @@ class CompensatedPoses:
         "sigma_axes_mm": [..], "radius95_mm": ..}, ...], "configuration": .., ...}`` (mm, deg;
         ``sigma_mm`` the 3D RMS of the filtered position's error, ``sigma_axes_mm`` its 1-sigma
         along the robot base's x, y, z, ``radius95_mm`` the radius holding it with 95 %
-        probability; null without a covariance)."""
+        probability; null without a covariance; ``sigma_relative_to`` the frame they are relative
+        to, ``"device"``, see :func:`~robotcell.accuracy.filter.sigma_text`)."""
         r = self.result
         points = []
         for i, row in enumerate(self.rows):
@@ -95,6 +101,7 @@ class CompensatedPoses:
                                 else float(r.radius95[i] * 1e3))
             points.append(d)
         return {"points": points, "configuration": self.chosen_by,
+                "sigma_relative_to": SIGMA_RELATIVE_TO,
                 "max_dpos_mm": float(r.dpos.max(initial=0.0) * 1e3),
                 "max_error_mm": float(r.error.max(initial=0.0) * 1e3),
                 "max_sigma_mm": (None if not np.isfinite(r.sigma).all() or r.sigma.size == 0

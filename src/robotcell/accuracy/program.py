@@ -30,6 +30,7 @@ from scipy.spatial.transform import Rotation
 from robotcell.accuracy.filter import (
     MAX_CORRECTION,
     MAX_ROTATION,
+    SIGMA_RELATIVE_TO,
     identified_joints,
     refuse,
     too_large,
@@ -133,6 +134,7 @@ class CompensatedProgram:
 
         return {
             "program": self.program.name, "format": self.program.vendor, "files": self.files,
+            "sigma_relative_to": SIGMA_RELATIVE_TO,
             "kept": self.kept, "skipped": self.skipped,
             "largest": None if big is None else {"name": big.name, "dpos": big.dpos * 1e3,
                                                  "drot": math.degrees(big.drot)},

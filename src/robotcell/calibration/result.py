@@ -17,8 +17,16 @@ from numpy.typing import NDArray
 
 from robotcell.calibration.fitting import Fit
 from robotcell.calibration.resultcheck import REQUIRED, TOUCH_LISTS, malformed
-from robotcell.calibration.sigmaparts import PARTS, pose_parts
-from robotcell.calibration.uncertainty import OWN, Estimate
+from robotcell.calibration.sigmaparts import (
+    DECIMALS,
+    PARTS,
+    part_lines,
+    pose_parts,
+    sigma_basis,
+    value_parts,
+)
+from robotcell.calibration.sigmaparts import numbers as _fmt
+from robotcell.calibration.uncertainty import OWN, Estimate, Sources
 from robotcell.calibration.verdict import (
     CONDITION_GOOD,
     CONDITION_POOR,
@@ -92,10 +100,8 @@ def pose_fields(T: NDArray[np.float64]) -> dict[str, Any]:
     return {"matrix": M.tolist(), "xyzabc": pose_to_vendor(T, "kuka").tolist()}
 
 
-def _fmt(values: Any, decimals: int) -> str:
-    """Comma-separated fixed-decimal numbers, without a minus sign on values that round to zero."""
-    arr = np.round(np.atleast_1d(np.asarray(values, dtype=float)), decimals) + 0.0
-    return ", ".join(f"{c:.{decimals}f}" for c in arr)
+#: Scale from SI and unit of a value in the JSON and the terminal, by its kind.
+_UNITS = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "number": (1.0, "")}
 
 
 @dataclass
@@ -181,6 +187,14 @@ class CalibrationResult:
     fit : Fit or None
         The least-squares fit behind the result (its linearisation, for a fit of several
         calibrations together).
+    value_sources : dict of str to Sources
+        Error sources of the values that are not poses (a scale, a radius, an axis; the
+        elements of ``values[key]`` flattened, SI), for the split of their 1-sigma into own,
+        recorded and assumed parts (:mod:`robotcell.calibration.sigmaparts`).
+    frames : dict of str to str
+        The frame a value that is not a pose is expressed in, which its 1-sigma is relative to
+        (e.g. ``{"tcp": "F", "pivot": "R"}``); by default the frame ``a`` of the result's first
+        pose ``T_a_b`` (see :meth:`relative_to`).
     """
 
     procedure: str
@@ -211,6 +225,8 @@ class CalibrationResult:
     gross: list[int] = field(default_factory=list)
     estimates: dict[str, Estimate] = field(default_factory=dict)
     fit: Fit | None = None
+    value_sources: dict[str, Sources] = field(default_factory=dict)
+    frames: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.residuals = np.asarray(self.residuals, dtype=float).reshape(-1, 3)
@@ -290,6 +306,8 @@ class CalibrationResult:
                       if k.startswith(old_key + "_")}
         return replace(self, values=swap(self.values, {old_key: new_key}),
                        estimates=swap(self.estimates, {old_key: new_key}),
+                       value_sources=swap(self.value_sources, {old_key: new_key}),
+                       frames=swap(self.frames, {old_key: new_key}),
                        sigma=swap(self.sigma, sigma_names),
                        kinds=swap(self.kinds, {old_key: new_key}),
                        json_fields=swap(self.json_fields, json_names),
@@ -322,16 +340,72 @@ class CalibrationResult:
                     out[key] = s
         return out
 
+    def relative_to(self, key: str) -> str:
+        """The frame the 1-sigma of value ``key`` is relative to: ``a`` of a pose ``T_a_b``; for
+        another value its entry of :attr:`frames`, else the frame of the result's first pose
+        (the robot base ``"R"`` without one)."""
+        if self._kind(key) == "pose":
+            return key.split("_")[1]
+        if key in self.frames:
+            return self.frames[key]
+        pose = next((k for k in self.values if self._kind(k) == "pose"), None)
+        return "R" if pose is None else pose.split("_")[1]
+
+    def _has_sigma(self, key: str) -> bool:
+        """Whether value ``key`` has a 1-sigma (a pose: of its position or rotation)."""
+        if self._kind(key) == "pose":
+            return key + "_position" in self.sigma or key + "_rotation" in self.sigma
+        return key in self.sigma
+
+    def _parts_of(self, key: str) -> dict[str, Any] | None:
+        """The parts of the 1-sigma of value ``key`` (JSON units), or None when not known: from
+        its error sources, or all its own when the fit inherits nothing."""
+        kind = self._kind(key)
+        est = self.estimates.get(key)
+        own_only = self.fit is not None and set(self.fit.sources.factors) <= {OWN}
+        if kind == "pose":
+            if est is not None and est.sources.size >= 6:
+                parts: dict[str, Any] = pose_parts(est.sources)
+            elif own_only:
+                sp = self.sigma.get(key + "_position", np.full(3, np.nan))
+                sr = self.sigma.get(key + "_rotation", np.full(3, np.nan))
+                parts = {"own": {"position_mm": np.asarray(sp) * 1e3,
+                                 "rotation_deg": np.degrees(sr), "sources": []}}
+            else:
+                return None
+            if key + "_position" not in self.sigma:  # not determined: no figure to split
+                parts = {k: {n: v for n, v in p.items() if n != "position_mm"}
+                         for k, p in parts.items()}
+            return parts
+        scale, unit = _UNITS[kind]
+        src = self.value_sources.get(key)
+        if src is not None:
+            split = value_parts(src)
+        elif own_only:
+            split = {"own": {"sigma": np.ravel(self.sigma[key]), "sources": []}}
+        else:
+            return None
+        one = np.ndim(self.values[key]) == 0
+        return {"unit": unit, **{k: {"sigma": float(p["sigma"][0]) * scale if one
+                                     else p["sigma"] * scale, "sources": p["sources"]}
+                                 for k, p in split.items()}}
+
     def _sigma_parts(self) -> dict[str, Any]:
-        """The 1-sigma of each pose with inherited error sources, split into its parts
-        (:mod:`robotcell.calibration.sigmaparts`), with the frame the total is relative to."""
+        """The 1-sigma of each value split into its parts (:mod:`robotcell.calibration.sigmaparts`),
+        with the frame it is relative to; values whose split is not known are left out."""
         out: dict[str, Any] = {}
-        for key, est in self.estimates.items():
-            if (key not in self.values or self._kind(key) != "pose" or est.sources.size != 6
-                    or set(est.sources.factors) <= {OWN}):
-                continue
-            out[key] = {"relative_to": key.split("_")[1], **pose_parts(est.sources)}
+        for key in self.values:
+            if self._has_sigma(key) and (parts := self._parts_of(key)) is not None:
+                out[key] = {"relative_to": self.relative_to(key), **parts}
         return out
+
+    def _basis(self, key: str, parts: dict[str, Any]) -> tuple[str, list[str]]:
+        """What the 1-sigma of ``key`` is relative to and made of (:func:`sigma_basis`), and the
+        lines of its parts when it inherits any (``parts``: :meth:`_sigma_parts`)."""
+        mine = parts.get(key)
+        present = [] if mine is None else [p for p in PARTS if p in mine]
+        detail = part_lines(mine) if mine is not None and set(present) - {"own"} else []
+        return sigma_basis(self.relative_to(key), present), detail
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict in vendor units (mm, deg).
@@ -345,9 +419,11 @@ class CalibrationResult:
             ``touch_sigma_mm`` and ``accuracy_source`` (the accuracy the residuals are tested
             against), ``residual_sigma_mm`` (the residuals' estimate) and ``chi2``, the touches
             ``excluded``, ``unchecked``, ``outliers`` and ``gross_outliers`` (labels), ``sigma`` (1-sigma of each estimated
-            quantity, keys with units), ``sigma_parts`` (for a pose with inherited error
-            sources: what its 1-sigma is relative to, and its parts ``own``, ``recorded`` and
-            ``assumed``, see :mod:`robotcell.calibration.sigmaparts`), ``undetermined``,
+            quantity, keys with units), ``sigma_relative_to`` (per quantity with a 1-sigma, the
+            frame it is relative to: ``F`` the flange, ``R`` the robot base, ``L`` the track
+            frame, ``B`` the turntable frame, ``world``, or a frame's name), ``sigma_parts`` (per
+            quantity whose split is known: that frame, and the parts ``own``, ``recorded`` and
+            ``assumed`` of its 1-sigma, see :mod:`robotcell.calibration.sigmaparts`), ``undetermined``,
             ``warnings``, ``next_step``,
             ``points_mm`` (N x 3, when the procedure records its measured points), then the
             procedure's own fields (``json_fields``), and ``verdict`` (level, reasons, the
@@ -374,7 +450,8 @@ class CalibrationResult:
             "disagreeing": [self.labels[i] for i in self.disagreeing],
             "gross_outliers": [self.labels[i] for i in self.gross],
             "sigma": self._sigma_json(),
-            **({"sigma_parts": parts} if (parts := self._sigma_parts()) else {}),
+            "sigma_relative_to": {k: self.relative_to(k) for k in self.values if self._has_sigma(k)},
+            "sigma_parts": self._sigma_parts(),
             "undetermined": list(self.undetermined),
             "warnings": list(self.warnings),
             "next_step": self.next_step,
@@ -477,8 +554,10 @@ class CalibrationResult:
 
     def _value_lines(self) -> list[str]:
         lines = []
+        parts = self._sigma_parts()
         for key, v in self.values.items():
             kind = self._kind(key)
+            basis, detail = self._basis(key, parts)
             if kind == "pose":
                 xyzabc = pose_to_vendor(v, "kuka")
                 lines.append(f"  {key} (KUKA X,Y,Z mm, A,B,C deg): {_fmt(xyzabc, 3)}")
@@ -488,30 +567,21 @@ class CalibrationResult:
                     lines.append(f"    1-sigma position (mm):      {_fmt(np.asarray(sp) * 1e3, 3)}")
                 if sr is not None:
                     lines.append(f"    1-sigma rotation (deg):     {_fmt(np.degrees(sr), 4)}")
-                lines += self._part_lines(key)
+                if self._has_sigma(key):
+                    lines.append(f"    the 1-sigma above is {basis}"
+                                 + (f"; {detail[0]}" if detail else ""))
+                    lines += [f"      {d}" for d in detail[1:]]
                 continue
-            scale, unit, dec = {"length": (1e3, " mm", 3), "angle": (180 / math.pi, " deg", 4),
-                                "number": (1.0, "", 6)}[kind]
+            scale, unit = _UNITS[kind]
+            dec = DECIMALS[unit]
             text = _fmt(np.asarray(v, dtype=float) * scale, dec)
             s = self.sigma.get(key)
             if s is not None:
-                text += f"  (1-sigma {_fmt(np.asarray(s, dtype=float) * scale, dec)})"
-            lines.append(f"  {key}{unit and ' (' + unit.strip() + ')'}: {text}")
-        return lines
-
-    def _part_lines(self, key: str) -> list[str]:
-        """The parts of the 1-sigma of pose ``key`` when it inherits error sources."""
-        parts = self._sigma_parts().get(key)
-        if parts is None:
-            return []
-        lines = [(f"    the 1-sigma above is relative to frame {parts['relative_to']!r}; its "
-                  "parts (position mm / rotation deg, adding in quadrature):")]
-        for part, what in PARTS.items():
-            if part in parts:
-                p = parts[part]
-                names = f" [{', '.join(p['sources'])}]" if p["sources"] else ""
-                lines.append(f"      {what}{names}: {_fmt(p['position_mm'], 3)} / "
-                             f"{_fmt(p['rotation_deg'], 4)}")
+                text += f"  (1-sigma {_fmt(np.asarray(s, dtype=float) * scale, dec)}, {basis})"
+            lines.append(f"  {key}{unit and ' (' + unit + ')'}: {text}")
+            if detail:
+                lines.append(f"    {detail[0]}")
+                lines += [f"      {d}" for d in detail[1:]]
         return lines
 
     def _noise_line(self) -> str:

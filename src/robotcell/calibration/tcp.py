@@ -384,5 +384,7 @@ def _tool_result(res: Fit, orientation: _Orientation, labels: Sequence[str], nam
         procedure="tcp", values=values, sigma=sigma, labels=list(labels),
         undetermined=orientation.undetermined, warnings=warnings, next_step=next_step,
         json_fields=extra, covariance=res.covariance, parameter_names=names,
-        estimates={"T_F_TCP": Estimate(tool, A @ res.input_gain, determined)}, **fit_fields(res),
+        estimates={"T_F_TCP": Estimate(tool, A @ res.input_gain, determined)},
+        value_sources={"tcp": res.sources.select([0, 1, 2]), "pivot": res.sources.select([3, 4, 5])},
+        frames={"tcp": "F", "pivot": "R"}, **fit_fields(res),
     )

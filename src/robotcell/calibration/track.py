@@ -23,7 +23,7 @@ points off one common line parallel to the axis also determine ``c``.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -40,7 +40,7 @@ from robotcell.calibration.fitting import (
     perturb_rotation,
 )
 from robotcell.calibration.grouping import distinct
-from robotcell.calibration.propagate import jacobian, propagate
+from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.result import CONDITION_LIMIT, CalibrationResult, fit_fields
 from robotcell.calibration.spec import SPECS
 from robotcell.calibration.uncertainty import Inputs, estimate
@@ -312,6 +312,7 @@ class _TrackFit:
     source: str | None
     offset: NDArray[np.float64] | None
     next_step: str
+    value_sources: dict = field(default_factory=dict)
 
 
 def _track_touches(e: ArrayLike, f: ArrayLike, references: ArrayLike | None,
@@ -375,7 +376,8 @@ def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDAr
         return np.concatenate([x[3:] / s, [s], x[:3] + e_mean * x[3:]])
 
     y = derived(res.x)
-    cov = propagate(derived, res.x, res.covariance)
+    derived_sources = res.sources.map(jacobian(derived, res.x))
+    cov = derived_sources.covariance
     sd = np.sqrt(np.abs(np.diag(cov)))
     direction, scale = y[:3], float(y[3])
     values.update(direction=direction, scale=scale, point=y[4:7])
@@ -414,7 +416,9 @@ def _unknown_point_track(e: NDArray[np.float64], f: NDArray[np.float64], d: NDAr
                      f"with {term('reference', 'references')}, or accept the zero-roll "
                      f"convention ({term('roll=zero', 'roll=' + repr('zero'))})")
     return _TrackFit(res, values, sigmas, estimates, undetermined, direction, direction_cov, scale,
-                     Q, source, offset, next_step)
+                     Q, source, offset, next_step,
+                     {k: derived_sources.select(rows) for k, rows in
+                      (("direction", [0, 1, 2]), ("scale", [3]), ("point", [4, 5, 6]))})
 
 
 def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: NDArray[np.float64],
@@ -440,7 +444,8 @@ def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: ND
         Qx, _, cx = unpack(x)
         return np.concatenate([Qx.T @ d, cx])
 
-    cov = propagate(derived, res.x, res.covariance)
+    derived_sources = res.sources.map(jacobian(derived, res.x))
+    cov = derived_sources.covariance
     sd = np.sqrt(np.abs(np.diag(cov)))
     direction = Q.T @ d
     direction_cov = cov[:3, :3]
@@ -459,7 +464,9 @@ def _known_points_track(e: NDArray[np.float64], f: NDArray[np.float64], refs: ND
                  "the controller's track machine data, then verify by touching a reference "
                  "point at both ends of the track")
     return _TrackFit(res, values, sigmas, estimates, undetermined, direction, direction_cov, scale,
-                     Q, source, offset, next_step)
+                     Q, source, offset, next_step,
+                     {"direction": derived_sources.select([0, 1, 2]),
+                      "scale": res.sources.select([3])})
 
 
 def _track_warnings(tf: _TrackFit, travel: float) -> list[str]:
@@ -512,7 +519,9 @@ def _track_result(tf: _TrackFit, f: NDArray[np.float64], refs: NDArray[np.float6
         warnings=warnings, next_step=next_step,
         kinds={"direction": "number", "scale": "number", "point": "length"},
         json_fields=json_fields, covariance=res.covariance,
-        parameter_names=_names(refs), points=f, estimates=estimates, **fit_fields(res),
+        parameter_names=_names(refs), points=f, estimates=estimates,
+        value_sources=tf.value_sources, frames=dict.fromkeys(tf.value_sources, "R"),
+        **fit_fields(res),
     )
 
 

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.calibration.fitting import SAME_POINT, Fit, fit, outlier_warnings, perturb_rotation
 from robotcell.calibration.grouping import distinct as count_distinct
-from robotcell.calibration.propagate import propagate
+from robotcell.calibration.propagate import jacobian
 from robotcell.calibration.result import (
     CONDITION_LIMIT,
     CalibrationResult,
@@ -31,7 +31,7 @@ from robotcell.calibration.result import (
     pose_fields,
 )
 from robotcell.calibration.spec import SPECS
-from robotcell.calibration.uncertainty import Inputs, estimate
+from robotcell.calibration.uncertainty import Inputs, Sources, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import as_points, make_pose, rot_z
 
@@ -214,13 +214,15 @@ def _turntable_result(res: Fit, unpack: Callable[[NDArray[np.float64]],
     def axis_of(x: NDArray[np.float64]) -> NDArray[np.float64]:
         return unpack(x)[0][:3, 2]
 
-    axis_cov = propagate(axis_of, res.x, res.covariance)
+    axis_sources = res.sources.map(jacobian(axis_of, res.x))
+    axis_cov = axis_sources.covariance
     axis_sigma = float(np.sqrt(np.abs(np.trace(axis_cov))))
     if tilt > 3.0 * axis_sigma and np.pi - tilt > 3.0 * axis_sigma:
-        tilt_sigma = float(np.sqrt(np.abs(propagate(
-            lambda x: np.arccos(np.clip(axis_of(x)[2], -1.0, 1.0)), res.x, res.covariance)[0, 0])))
-    else:
-        tilt_sigma = axis_sigma
+        tilt_sources = res.sources.map(jacobian(
+            lambda x: np.arccos(np.clip(axis_of(x)[2], -1.0, 1.0)), res.x))
+    else:  # the angular 1-sigma of the axis: each source's factor as one row (its trace)
+        tilt_sources = Sources(1, {k: f.reshape(1, -1) for k, f in axis_sources.factors.items()})
+    tilt_sigma = float(tilt_sources.sigma[0])
 
     warnings = _turntable_warnings(res, spread, radius, tilt)
     warnings += outlier_warnings(res, labels)
@@ -251,6 +253,8 @@ def _turntable_result(res: Fit, unpack: Callable[[NDArray[np.float64]],
         parameter_names=["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z",
                          "radius"],
         estimates={"T_R_B": estimate(res.sources, res.input_gain, np.eye(6, 7))},
+        value_sources={"radius": res.sources.select([6]), "axis": axis_sources,
+                       "tilt": tilt_sources},
         **fit_fields(res),
     )
 

@@ -310,19 +310,23 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
 
 
 def _assumed_parts(result: Mapping[str, Any]) -> list[str]:
-    """A reason per pose whose 1-sigma holds an assumed part (``sigma_parts``), with the part
-    its own touches determine: an assumed figure must not read as a measured one."""
+    """A reason per quantity whose 1-sigma holds an assumed part (``sigma_parts``: a pose's
+    position, else its rotation; a value's ``sigma`` in its ``unit``), with the part its own
+    touches determine: an assumed figure must not read as a measured one."""
     out = []
     parts = result.get("sigma_parts")
     for key, p in (parts.items() if isinstance(parts, Mapping) else ()):
         try:
-            assumed = float(np.max(_floats(p["assumed"]["position_mm"])))
-            own = float(np.max(_floats(p["own"]["position_mm"])))
+            field_, unit = next((f, u) for f, u in (("position_mm", " mm"), ("rotation_deg", " deg"),
+                                                    ("sigma", f" {p.get('unit') or ''}".rstrip()))
+                                if f in p["assumed"])
+            assumed = float(np.nanmax(_floats(p["assumed"][field_])))
+            own = float(np.nanmax(_floats(p["own"][field_])))
             names = ", ".join(str(n) for n in p["assumed"]["sources"])
-        except (KeyError, TypeError, ValueError):
+        except (KeyError, TypeError, ValueError, StopIteration, AttributeError):
             continue
-        out.append(f"{key}: up to {assumed:.3g} mm of its 1-sigma is ASSUMED ({names}: no "
-                   f"recorded uncertainty); its own touches determine it to {own:.3g} mm "
+        out.append(f"{key}: up to {assumed:.3g}{unit} of its 1-sigma is ASSUMED ({names}: no "
+                   f"recorded uncertainty); its own touches determine it to {own:.3g}{unit} "
                    "relative to what touched")
     return out
 

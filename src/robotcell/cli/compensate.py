@@ -63,7 +63,7 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
     Example:
       robotcell compensate examples/seam_part.csv --cell cell.yaml --tool torch --frame part -o commanded.csv
     """
-    from robotcell.accuracy.filter import FilterRefused
+    from robotcell.accuracy.filter import FilterRefused, sigma_text
     from robotcell.accuracy.poses import compensate_poses
     from robotcell.report.accuracy import write_poses_report
 
@@ -89,7 +89,8 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
                    f"{data['max_dpos_mm']:.4f} mm; predicted error without filtering up to "
                    f"{data['max_error_mm']:.4f} mm"
                    + (f", after filtering 3D RMS error up to {sigma:.4f} mm and 95 % radius up "
-                      f"to {data['max_radius95_mm']:.4f} mm" if sigma is not None else "") + f"; configurations: {_configurations(result)}"
+                      f"to {data['max_radius95_mm']:.4f} mm ({sigma_text()})"
+                      if sigma is not None else "") + f"; configurations: {_configurations(result)}"
                    + (f"; wrote {output}" if output else ""), err=output is None)
 
 

@@ -12,6 +12,7 @@ from typing import Any
 import click
 import numpy as np
 
+from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.cli.common import (
     as_flags,
     check_kind,
@@ -25,6 +26,7 @@ from robotcell.cli.common import (
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, LiveChoice
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
+from robotcell.identification.result import OWN_MEASUREMENTS, SIGMA_RELATIVE_TO
 from robotcell.io.tables import format_table, write_csv
 from robotcell.report.identification import write_identification_report
 from robotcell.studies.identify import DEFAULT_FOLDS, identify_file, zero_offset_controllers
@@ -50,6 +52,7 @@ def _print_offsets(offsets: dict, vendor: str) -> None:
              "-" if math.isnan(a["sigma"]) else f"{a['sigma']:.6f}", a["unit"],
              "not determined: " + a["why"] if a["why"] else ""] for a in offsets["axes"]]
     click.echo(format_table(head, rows))
+    click.echo(f"1-sigma {sigma_basis(SIGMA_RELATIVE_TO, own=OWN_MEASUREMENTS)}")
 
 
 #: Range of ``--sigma`` (mm) and ``--angle-sigma`` (deg): 0.1 um (0.1 mdeg) is finer than

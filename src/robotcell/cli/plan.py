@@ -9,6 +9,7 @@ from typing import Any
 
 import click
 
+from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.robotname import load_cell
@@ -20,7 +21,7 @@ from robotcell.cli.simulate import (
     design_keywords,
 )
 from robotcell.errors import InputError
-from robotcell.studies.plan import DESIGNS, LEVER, Candidate
+from robotcell.studies.plan import DESIGNS, LEVER, POSE_KEY, Candidate
 from robotcell.studies.plan import plan as make_plan
 
 
@@ -106,8 +107,9 @@ def plan(procedure: str, cell_path: str, noise: float, runs: int, output: str | 
     designs = _designs(procedure, given["max_size"], given["max_radius"])
     p = make_plan(cell, procedure, noise * 1e-3, runs=runs, seed=given["seed"],
                   progress=_progress, designs=designs, **common)
+    frame = POSE_KEY[procedure].split("_")[1]
     click.echo(f"plan for '{procedure}' with a touch-up error of {noise:g} mm (1-sigma per "
-               "coordinate); predicted 1-sigma of the calibrated pose:")
+               f"coordinate); predicted 1-sigma of the calibrated pose ({sigma_basis(frame)}):")
     click.echo(format_table(["design", "position mm", "rotation deg",
                              f"at {LEVER * 1e3:.0f} mm", "condition", ""],
                             [_row(c, p.best) for c in p.candidates]))

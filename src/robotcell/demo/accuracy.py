@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from robotcell.accuracy.filter import sigma_text
 from robotcell.accuracy.poses import compensate_poses
 from robotcell.cell import Cell, Tool
 from robotcell.cell.identified import adopt_identified, identification_provenance
@@ -102,9 +103,10 @@ def accuracy_step(out: Path, seed: int, echo: Callable[[str], None]) -> tuple[fl
     write_csv(d / "tracker.csv", head, np.hstack([np.degrees(q), pts * 1e3]), 6)
     echo("\nabsolute accuracy: the virtual arm is not quite the drawing (link constants off by up "
          "to 0.5 mm, 0.05 deg);\n  a laser tracker measured 3 reflectors at 40 configurations "
-         f"(0.02 mm noise) -> {(d / 'tracker.csv').relative_to(out)}")
+         f"(noise {TRACKER_NOISE * 1e3:g} mm, 1-sigma per coordinate) -> "
+         f"{(d / 'tracker.csv').relative_to(out)}")
     echo("  $ robotcell " + shlex.join(["identify", "accuracy/tracker.csv", "--robot",
-                                        "kuka_kr16", "--accuracy", "0.02", "--folds", "2", "-o",
+                                        "kuka_kr16", "--accuracy", f"{TRACKER_NOISE * 1e3:g}", "--folds", "2", "-o",
                                         "accuracy/arm.yaml", "--cell", "accuracy/cell.yaml"]))
     meas = read_target_measurements(d / "tracker.csv")
     result = identify(nominal, meas, sigma=TRACKER_NOISE)
@@ -135,5 +137,5 @@ def accuracy_step(out: Path, seed: int, echo: Callable[[str], None]) -> tuple[fl
     unfiltered, filtered = rms(q_plain), rms(q_filtered)
     echo(f"  the real arm along the path: {unfiltered * 1e3:.3f} mm RMS from it without "
          f"filtering, {filtered * 1e3:.3f} mm filtered (1-sigma predicted "
-         f"{done.result.sigma.max() * 1e3:.3f} mm)")
+         f"{done.result.sigma.max() * 1e3:.3f} mm, {sigma_text()})")
     return unfiltered, filtered

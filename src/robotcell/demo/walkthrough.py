@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.calibration.sigmaparts import PARTS, sigma_basis
 from robotcell.cell import Cell, Provenance
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.history import backups
@@ -89,6 +90,9 @@ class Comparison:
         Length of the reported 1-sigma position vector (m).
     rotation_sigma : float
         Length of the reported 1-sigma rotation vector (rad).
+    basis : str
+        What the reported 1-sigma is relative to and made of
+        (:func:`~robotcell.calibration.sigmaparts.sigma_basis`).
     """
 
     item: str
@@ -98,6 +102,7 @@ class Comparison:
     rotation_error: float
     position_sigma: float
     rotation_sigma: float
+    basis: str = ""
 
 
 def _sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
@@ -106,6 +111,13 @@ def _sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
     r = s.get(key + "_rotation_deg")
     return (float(np.linalg.norm(p)) * 1e-3 if p is not None else math.nan,
             math.radians(float(np.linalg.norm(r))) if r is not None else math.nan)
+
+
+def _basis(result: dict[str, Any], key: str) -> str:
+    """What the 1-sigma of ``key`` in a result's JSON is relative to and made of."""
+    parts = (result.get("sigma_parts") or {}).get(key) or {}
+    return sigma_basis((result.get("sigma_relative_to") or {}).get(key, key.split("_")[1]),
+                       [p for p in PARTS if p in parts])
 
 
 def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
@@ -189,6 +201,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     comparisons = _compare(calibrated, truth, results)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
     echo(_comparison_table(comparisons))
+    echo("each reported 1-sigma:\n" + "\n".join(f"  {c.item}: {c.basis}" for c in comparisons))
     _write_outputs(out, calibrated, results, echo)
     accuracy_step(out, seed, echo)
     acceptance_step(out, truth, nominal, calibrated, seed, echo)
@@ -213,7 +226,7 @@ def _compare(calibrated: Cell, truth: Cell,
     for item, est, true, res, key in rows:
         dp, dr = pose_error(est, true)
         sp, sr = _sigma(res, key)
-        out.append(Comparison(item, est, true, dp, dr, sp, sr))
+        out.append(Comparison(item, est, true, dp, dr, sp, sr, _basis(res, key)))
     return out
 
 

@@ -464,6 +464,7 @@ def _positioner_result(ident: IdentificationResult, res: Fit, geometry: _Geometr
         warnings.append(f"condition number {res.condition:.0f} is above {CONDITION_LIMIT:.0f}: touch "
                         "at more tilt and rotate values, spread over their ranges")
     warnings += outlier_warnings(res, labels)
+    mapped, ends = res.sources.map(A), np.cumsum([np.size(geo[k]) for k in keys])
     result = CalibrationResult(
         procedure="positioner-2axis", values=values, sigma=sigma_out,
         labels=labels, undetermined=[f"{n}: {w}" for n, w in ident.fixed], warnings=warnings,
@@ -485,6 +486,8 @@ def _positioner_result(ident: IdentificationResult, res: Fit, geometry: _Geometr
         + ["origin_x", "origin_y", "origin_z", "rotvec_x", "rotvec_y", "rotvec_z"],
         points=f, estimates={"T_R_B": estimate(res.sources, res.input_gain, A[-6:]),
                              "chain": _chain_estimate(ident, res, robot, q)},
+        value_sources={k: mapped.select(np.arange(e - np.size(geo[k]), e))
+                       for k, e in zip(keys, ends)},
         **fit_fields(res),
     )
     return result

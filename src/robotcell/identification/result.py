@@ -11,9 +11,16 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
 from robotcell.calibration.result import CONDITION_LIMIT, to_jsonable
+from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.identification.uncertainty import PredictedError
 from robotcell.io.tables import format_table
 from robotcell.robot.robot import Robot
+
+#: What every 1-sigma of an identification is relative to: the measuring device's frame
+#: (:data:`robotcell.calibration.sigmaparts.FRAMES`).
+SIGMA_RELATIVE_TO = "device"
+#: What determines it, for :func:`~robotcell.calibration.sigmaparts.sigma_basis`.
+OWN_MEASUREMENTS = "its own measurements"
 
 __all__ = ["CV_HELD", "GEOMETRIC_SOURCE", "MAX_CHANGE_ANGLE", "MAX_CHANGE_LENGTH", "OUTLIERS_NAMED",
            "IdentificationResult", "Parameter", "beyond_accuracy"]
@@ -242,10 +249,13 @@ class IdentificationResult:
             identified position of a target at the measured configurations (not a measurement
             of it, :meth:`predicted_error`), the medians over rows and targets of ``per_axis_mm``
             (1-sigma along x, y, z of the device frame), ``rms_mm`` (3D RMS) and
-            ``radius95_mm`` (95 % radius), and the largest ``rms_max_mm``.
+            ``radius95_mm`` (95 % radius), and the largest ``rms_max_mm``; ``sigma_relative_to``
+            is ``"device"``: every figure is relative to the measuring device's frame, from the
+            identification's own measurements only.
         """
         out: dict[str, Any] = {"model_error_mm": self.model_error * 1e3,
-                               "unexplained_mm": self.unexplained * 1e3}
+                               "unexplained_mm": self.unexplained * 1e3,
+                               "sigma_relative_to": SIGMA_RELATIVE_TO}
         if self._q is not None:
             e = self.predicted_error(self._q)
             out.update(per_axis_mm=np.median(e.per_axis.reshape(-1, 3), axis=0) * 1e3,
@@ -379,6 +389,7 @@ class IdentificationResult:
             "labels": self.labels,
             "j23_factor": self.coupling,
             "predicted_error": self.error_figures(),
+            "sigma_relative_to": SIGMA_RELATIVE_TO,
             "verdict": self.verdict[0],
             "verdict_why": self.verdict[1],
         }
@@ -410,7 +421,7 @@ class IdentificationResult:
             rows.append([p.name, unit, f"{nom:.4f}" if math.isfinite(nom) else "",
                          f"{v:.4f}", f"{v - nom:+.4f}" if math.isfinite(nom) else "",
                          f"{s:.4f}" if p.free else "fixed"])
-        lines += ["", "parameters:", format_table(["name", "unit", "nominal", "identified", "change", "1-sigma"], rows)]
+        lines += ["", f"parameters (1-sigma {sigma_basis(SIGMA_RELATIVE_TO, own=OWN_MEASUREMENTS)}):", format_table(["name", "unit", "nominal", "identified", "change", "1-sigma"], rows)]
         if self.fixed:
             lines += ["", "held at nominal (not identifiable from these measurements):"]
             lines += [f"  - {n}: {w}" for n, w in self.fixed]
@@ -450,7 +461,8 @@ class IdentificationResult:
             lines.append(f"predicted error of a target position (median over the rows; whole "
                          f"covariance and model error): 1-sigma per axis x {x:.4f} y {y:.4f} "
                          f"z {z:.4f} mm, 3D RMS {f['rms_mm']:.4f} mm, 95 % radius "
-                         f"{f['radius95_mm']:.4f} mm")
+                         f"{f['radius95_mm']:.4f} mm; "
+                         f"{sigma_basis(SIGMA_RELATIVE_TO, own=OWN_MEASUREMENTS)}")
         return lines
 
 

@@ -67,6 +67,8 @@ def write_accuracy_report(path: str | Path, title: str, names: list[str], error:
     -------
     Path
     """
+    from robotcell.accuracy.filter import sigma_text
+
     e, d, s = (np.asarray(v, dtype=float) * 1e3 for v in (error, dpos, sigma))
     known = np.isfinite(s).all() and s.size > 0
     rms = float(math.sqrt(np.mean(e**2))) if e.size else 0.0
@@ -74,7 +76,8 @@ def write_accuracy_report(path: str | Path, title: str, names: list[str], error:
             f"{e.max(initial=0.0):.3f} mm at most (predicted: the identified arm against the "
             "controller's nominal model). Filtered, it lands within the identification's "
             + (f"uncertainty: 3D RMS error {s.max():.4f} mm at most (the RMS length of the "
-               "error the identification's covariance and model error predict).</p>" if known else
+               "error the identification's covariance and model error predict, "
+               f"{html.escape(sigma_text())}).</p>" if known else
                "uncertainty (the identified model carries no covariance to state it).</p>"))
     rows = [[n, float(a), float(b), float(c) if known else "-"] for n, a, b, c in zip(names, e, d, s)]
     rows_html = table(["point", "error without filtering (mm)", "correction (mm)",

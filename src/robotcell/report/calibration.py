@@ -21,6 +21,7 @@ import numpy as np
 
 from robotcell.calibration.result import CalibrationResult, result_json
 from robotcell.calibration.resultcheck import is_points
+from robotcell.calibration.sigmaparts import PARTS, part_lines, sigma_basis
 from robotcell.calibration.verdict import CONDITION_GOOD, CONDITION_POOR
 from robotcell.calibration.verdict import verdict as judge
 from robotcell.cell.calibrate.registry import attach, for_result
@@ -157,7 +158,8 @@ _UNITS = {"_covariance_mm_rad": "6x6 over the origin x, y, z (mm) and the rotati
 
 #: Fields shown elsewhere in the page (verdict, residual table, lists).
 _SKIP = {"procedure", "residuals_mm", "residuals_xyz_mm", "labels", "points_mm", "warnings",
-         "undetermined", "next_step", "sigma", "verdict", "xyzabc"}
+         "undetermined", "next_step", "sigma", "verdict", "xyzabc", "sigma_relative_to",
+         "sigma_parts"}
 
 #: Result fields a technician reads, in the order shown: what each is and its unit. Its 1-sigma
 #: is ``sigma[field]``, or ``<field without unit>_sigma_deg`` (the angle of a unit vector).
@@ -261,6 +263,28 @@ def _result_rows(result: dict[str, Any]) -> tuple[str, set[str], set[str]]:
     return "".join(rows), used, used_sigma
 
 
+def _sigma_bases(result: dict[str, Any]) -> str:
+    """A list: per quantity what its 1-sigma is relative to and made of
+    (:func:`~robotcell.calibration.sigmaparts.sigma_basis`), with its parts when it inherits
+    errors (``sigma_relative_to`` and ``sigma_parts`` of the JSON)."""
+    frames = result.get("sigma_relative_to")
+    given = result.get("sigma_parts")
+    every = given if isinstance(given, dict) else {}
+    items = []
+    for key, frame in (frames.items() if isinstance(frames, dict) else ()):
+        parts = every.get(key) if isinstance(every.get(key), dict) else {}
+        present = [p for p in PARTS if p in parts]
+        try:
+            lines = part_lines(parts) if set(present) - {"own"} else []
+        except (TypeError, ValueError, KeyError):  # a hand-edited file: the total alone
+            lines = []
+        text = f"{key}: 1-sigma {sigma_basis(str(frame), present)}"
+        sub = "".join(f"<li>{html.escape(line)}</li>" for line in lines[1:])
+        items.append(f"<li>{html.escape(text + ('; ' + lines[0] if lines else ''))}"
+                     + (f"<ul>{sub}</ul>" if sub else "") + "</li>")
+    return f"<ul class=\"basis\">{''.join(items)}</ul>" if items else ""
+
+
 def _quality_rows(result: dict[str, Any]) -> str:
     rows = [_row("touches", str(len(result["residuals_mm"])), "", "")]
     rows += [_row(name, _numbers(result[k], unit), "", unit)
@@ -322,6 +346,7 @@ def write_report(result: dict[str, Any], path: str | Path) -> list[Path]:
 <h2>Result</h2>
 <table class="result"><tr><th>quantity</th><th>value</th><th>1-sigma</th><th>unit</th></tr>
 {quantities or '<tr><td colspan="4">no calibrated quantity</td></tr>'}</table>
+{_sigma_bases(result)}
 <h2>Fit quality</h2>
 <table class="result"><tr><th>quantity</th><th>value</th><th></th><th>unit</th></tr>
 {_quality_rows(result)}</table>

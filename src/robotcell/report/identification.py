@@ -21,8 +21,13 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.identification.measurements import TargetMeasurements
-from robotcell.identification.result import IdentificationResult
+from robotcell.identification.result import (
+    OWN_MEASUREMENTS,
+    SIGMA_RELATIVE_TO,
+    IdentificationResult,
+)
 from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write
 from robotcell.report.page import CSS, SCENE_SLOT, SCRIPT, png, scene_figure, table
@@ -202,7 +207,8 @@ def write_identification_report(
 {extra}{scene_html}
 <h2>Cross-validation</h2>{cv_html}
 <h2>Parameters held at their nominal value, and why</h2>{fixed}
-<h2>Parameters (mm, deg) with 1-sigma</h2>{params}
+<h2>Parameters (mm, deg) with 1-sigma</h2>
+<p>Each 1-sigma {html.escape(sigma_basis(SIGMA_RELATIVE_TO, own=OWN_MEASUREMENTS))}.</p>{params}
 <h2>Largest correlations</h2>{corr}
 <h2>Observability of the measured configurations</h2>{obs_html}
 <h2>Errors per row (mm)</h2>{per_row}

@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from robotcell.calibration.result import to_jsonable
+from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.calibration.uncertainty import OWN, Sources, factor_of
 from robotcell.calibration.verdict import Verdict
 from robotcell.cell import Cell, Positioner, Provenance
@@ -63,6 +64,8 @@ CONVERGED = 1e-4
 #: The procedures that ``calibrate cell`` repeats, by name (those a cell records).
 _PROCEDURES = having(lambda p: p.repeat)
 _LEVELS = ("good", "check", "poor")
+#: What an item's 1-sigma in the whole-cell fit comes from, for :func:`sigma_basis`.
+_OWN = "its own touches, with the cell's other calibrations,"
 
 
 @dataclass(frozen=True)
@@ -136,6 +139,21 @@ class CellRecalibration:
         reasons = [f"{k}: {'; '.join(v.reasons)}" for k, v in verdicts if v.level == level]
         return Verdict(level=level, reasons=reasons)
 
+    def relative_to(self, key: str) -> str:
+        """The frame the 1-sigma of item ``key`` is relative to: its parent (``F`` the flange for
+        a tool, ``L`` for the track, ``B`` or ``P`` for a frame on the turntable or positioner,
+        ``R`` for the robot base, ``world``)."""
+        if key.startswith("tools."):
+            return "F"
+        if key == "track":
+            return "L"
+        if key == "turntable":
+            parent = self.cell.turntable.parent if self.cell.turntable is not None else "world"
+        else:
+            parent = self.cell.frames[key.split(".", 1)[1]].parent
+        table = "P" if isinstance(self.cell.turntable, Positioner) else "B"
+        return {"robot": "R", "turntable": table}.get(parent, parent)
+
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict (mm, deg): ``items`` with their change, 1-sigma and change in
         sigmas, ``steps`` (each calibration's result), ``verdict``."""
@@ -146,7 +164,8 @@ class CellRecalibration:
                      "after_xyzabc": pose_to_vendor(c.after, "kuka"),
                      "change_mm_deg": c.change * to_mm, "sigma_mm_deg": c.sigma * to_mm,
                      "sigma_before_mm_deg": c.sigma_before * to_mm,
-                     "change_sigmas": c.change_sigmas}
+                     "change_sigmas": c.change_sigmas,
+                     "sigma_relative_to": self.relative_to(c.key)}
             items.append(entry)
         v = self.verdict
         return to_jsonable({"procedure": "cell", "iterations": self.iterations, "items": items,
@@ -172,7 +191,10 @@ class CellRecalibration:
                   "before):"),
                  format_table(["item", "moved mm", "turned deg", "1-sigma mm", "1-sigma deg",
                                "max |change|/sigma", "1-sigma before mm"], rows), "",
-                 "calibrations (at the fitted values):"]
+                 "each 1-sigma:"]
+        lines += [f"  {c.key}: {sigma_basis(self.relative_to(c.key), (), _OWN)}"
+                  for c in self.changes]
+        lines += ["", "calibrations (at the fitted values):"]
         for s in self.steps:
             r = s.result
             lines.append(f"  {s.key or r.procedure}: RMS {r.rms * 1e3:.3f} mm over "

@@ -137,6 +137,8 @@ def tcp(cell: Cell | None, measurements: MeasurementInput, name: str | None = No
         result = calibrate_tool(T[r == "tcp"], T[r == "-x"], T[r == "xy"], T[r == "world"],
                                 world_mode=world_mode, sigma=ctx.sigma,
                                 labels=[labels[i] for i in order], inputs=chained.inputs)
+    if cell is not None and e is not None and cell.track is not None:
+        result.frames["pivot"] = "world"  # the flange poses were mapped through the track
     key = f"tools.{name}" if cell is not None and name is not None else ""
     assumed = assumption(cell, m, None, "T_F_TCP")
     if cell is None or name is None:
