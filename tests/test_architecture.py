@@ -368,3 +368,45 @@ def test_no_module_imports_another_modules_private_name(name):
     it public (documented, in ``__all__``) or moved to where both can import it."""
     tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
     assert not private_imports(name, tree), f"{name} imports {private_imports(name, tree)}"
+
+
+#: Limits on a function in ``src/``: its lines (``def`` to its last line) and its parameters.
+MAX_LINES = 100
+MAX_PARAMETERS = 10
+
+
+def oversized_functions(tree: ast.AST) -> list[str]:
+    """Functions of a syntax tree over :data:`MAX_LINES` lines or :data:`MAX_PARAMETERS`
+    parameters (positional, keyword-only, ``*args`` and ``**kwargs``; ``self`` and ``cls`` not
+    counted), as ``line: name (lines, parameters)``."""
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        a = node.args
+        positional = [p.arg for p in (*a.posonlyargs, *a.args)]
+        count = (len(positional) - (positional[:1] in (["self"], ["cls"])) + len(a.kwonlyargs)
+                 + (a.vararg is not None) + (a.kwarg is not None))
+        length = node.end_lineno - node.lineno + 1
+        if length > MAX_LINES or count > MAX_PARAMETERS:
+            found.append(f"{node.lineno}: {node.name} ({length} lines, {count} parameters)")
+    return found
+
+
+def test_oversized_functions_are_found():
+    # a guard that the check below sees what it is meant to forbid, and lets the rest through
+    body = "\n".join(f"    x{i} = {i}" for i in range(100))
+    code = (f"def long():\n{body}\n"
+            "def wide(a, b, c, d, e, f, g, h, i, *, j, k):\n    pass\n"
+            "class C:\n    def ten(self, a, b, c, d, e, f, g, h, i, j):\n        pass\n"
+            "def ok(*args, **kwargs):\n    pass\n")
+    assert oversized_functions(ast.parse(code)) == ["1: long (101 lines, 0 parameters)",
+                                                    "102: wide (2 lines, 11 parameters)"]
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_function_is_over_100_lines_or_10_parameters(name):
+    """A function a reader can hold in view: at most 100 lines and 10 parameters; a longer one
+    is split into named steps, a wider one takes its related options as one object."""
+    tree = ast.parse(MODULES[name].read_text(encoding="utf-8"))
+    assert not oversized_functions(tree), f"{name}: {oversized_functions(tree)}"

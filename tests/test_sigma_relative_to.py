@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 from robotcell import load_robot, pose_from_vendor, pose_to_vendor, save_robot
 from robotcell.calibration.sigmaparts import sigma_basis
 from robotcell.calibration.workpiece import workpiece_pose
-from robotcell.identification import identify, read_measurements
+from robotcell.identification import identify, read_target_measurements
 from robotcell.kinematics.transforms import make_pose, rot_z, transform_points
 
 OWN_ONLY = "from its own touches only"
@@ -162,7 +162,7 @@ def identified(tmp_path_factory):
     truth = kr16_truth(rng)
     tracker_csv(d / "tracker.csv", truth, 40, rng)
     return d / "tracker.csv", identify(load_robot("kuka_kr16"),
-                                       read_measurements(d / "tracker.csv"), point_sigma=2e-5)
+                                       read_target_measurements(d / "tracker.csv"), sigma=2e-5)
 
 
 def test_identify_says_its_predicted_error_is_relative_to_the_measuring_device(

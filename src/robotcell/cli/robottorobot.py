@@ -221,10 +221,8 @@ def _pose_option(text: str, option: str) -> np.ndarray:
               "reference robot's touches"), help="CSV of the reference robot's touches.")
 @click.option("--other-output", required=True, type=OUTPUT, callback=output_of("CSV", "the "
               "other robot's touches"), help="CSV of the other robot's touches.")
-def simulate_robot_to_robot_cmd(robot_ref: str, robot_other: str, pose: str, tool_ref: str,
-                                tool_other: str, points: tuple[str, ...], repeats: int,
-                                noise: float, seed: int | None, ref_output: str,
-                                other_output: str) -> None:
+def simulate_robot_to_robot_cmd(points: tuple[str, ...], repeats: int, noise: float,
+                                seed: int | None, **layout: str) -> None:
     """Simulate two robots touching common points: one CSV per robot.
 
     \b
@@ -236,6 +234,9 @@ def simulate_robot_to_robot_cmd(robot_ref: str, robot_other: str, pose: str, too
     Example:
       robotcell simulate robot-to-robot --seed 1 --ref-output r1.csv --other-output r2.csv
     """
+    robot_ref, robot_other, pose = layout["robot_ref"], layout["robot_other"], layout["pose"]
+    tool_ref, tool_other = layout["tool_ref"], layout["tool_other"]
+    ref_output, other_output = layout["ref_output"], layout["other_output"]
     if not 0 <= noise <= NOISE_MAX_MM:
         raise InputError(f"--noise must be a number of millimetres >= 0, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
