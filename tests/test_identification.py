@@ -188,7 +188,7 @@ def test_coupling_and_scale_are_identified():
     meas = measure(ch, x, configurations(nominal, 60, rng), rng, NOISE)
     wrong = identify(nominal, meas, sigma=NOISE)
     assert wrong.verdict[0] == "poor"
-    res = identify(nominal, meas, sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
+    res = identify(nominal, meas, sigma=NOISE, j23_factor=-1.0, fit_j23_factor=True, scale=True)
     k = res.parameter("j23_factor")
     assert abs(k.value + 1.0) <= 3 * k.sigma
     for j, s in zip(("A2", "A3"), scale[1:3]):
@@ -207,10 +207,10 @@ def test_scale_and_coupling_round_trip_through_the_model_file(tmp_path):
     scale = np.array([0.0, 2e-4, -3e-4, 0.0, 0.0, 0.0])
     ch, x = truth_chain(perturbed(nominal, rng), 3, False, rng, coupling=-1.0, scale=scale)
     meas = measure(ch, x, configurations(nominal, 60, rng), rng, NOISE)
-    res = identify(nominal, meas, sigma=NOISE, coupling=-1.0, fit_coupling=True, scale=True)
+    res = identify(nominal, meas, sigma=NOISE, j23_factor=-1.0, fit_j23_factor=True, scale=True)
     C = res.robot.coupling.matrix
     assert np.allclose(np.diag(C), 1.0 + res.scale)
-    assert C[2, 1] == pytest.approx(res.coupling * (1.0 + res.scale[2]))
+    assert C[2, 1] == pytest.approx(res.j23_factor * (1.0 + res.scale[2]))
     path = tmp_path / "identified.yaml"
     save_robot(res.robot, path)
     assert "coupling:" in path.read_text() and "matrix:" in path.read_text()

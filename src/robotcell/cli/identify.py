@@ -221,7 +221,7 @@ def _identify(measurements: str, o: SimpleNamespace) -> None:
             measurements, o.robot, cell_path, folds=o.folds, report=report is not None,
             offsets_for=o.offsets_for, output=output, force=o.force, sigma=o.sigma * 1e-3,
             angle_sigma=math.radians(o.angle_sigma), scale=o.scale, compliance=o.compliance,
-            coupling=o.j23,
+            j23_factor=o.j23,
             group_tol=None if o.group_tolerance is None else math.radians(o.group_tolerance))
     if report is not None:
         write_identification_report(run.result, report, run.cross, run.observability,

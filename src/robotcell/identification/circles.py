@@ -191,7 +191,7 @@ def first_estimate(path: str | Path, name: str = "identified", j23_factor: float
     -------
     robot : Robot
         See :func:`start_model`; its joint values are the chain's (model) values, without the
-        coupling, as :func:`~robotcell.identification.identify` with ``coupling=j23_factor``
+        coupling, as :func:`~robotcell.identification.identify` with ``j23_factor=j23_factor``
         expects of a nominal model.
     measurements : TargetMeasurements
         The CSV in SI units, prismatic joints in metres: controller values, as in the file.

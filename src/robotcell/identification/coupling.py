@@ -72,7 +72,7 @@ def coupling_check(nominal: Robot, measurements: TargetMeasurements, k: float,
         The identification with ``k`` held.
     **options
         Passed to :func:`~robotcell.identification.identify` (accuracies, ``scale``, ...,
-        ``options``); its ``coupling``, ``fit_coupling`` and ``hold`` are this check's own.
+        ``options``); its ``j23_factor``, ``fit_j23_factor`` and ``hold`` are this check's own.
 
     Returns
     -------
@@ -80,9 +80,9 @@ def coupling_check(nominal: Robot, measurements: TargetMeasurements, k: float,
         ``k``, ``rms_with_mm``, ``rms_without_mm`` (``k = 0``), ``rms_fitted_mm`` (``k`` free),
         ``k_fitted``, ``k_sigma``, ``tolerance_mm``, ``supported`` and a ``verdict`` sentence.
     """
-    options = {n: v for n, v in options.items() if n not in ("coupling", "fit_coupling", "hold")}
-    without = identify(nominal, measurements, coupling=0.0, fit_coupling=False, **options)
-    free = identify(nominal, measurements, coupling=k, fit_coupling=True, **options)
+    options = {n: v for n, v in options.items() if n not in ("j23_factor", "fit_j23_factor", "hold")}
+    without = identify(nominal, measurements, j23_factor=0.0, fit_j23_factor=False, **options)
+    free = identify(nominal, measurements, j23_factor=k, fit_j23_factor=True, **options)
     p = free.parameter("j23_factor")
     rms_with, rms_without, rms_free = with_k.rms_after, without.rms_after, free.rms_after
     tol = practical_tolerance(with_k.touch_sigma, rms_free, rms_without)
@@ -123,6 +123,6 @@ def identify_with_coupling(nominal: Robot, measurements: TargetMeasurements, k: 
     IdentificationResult
         The fit with ``k`` held; its ``coupling_check`` is :func:`coupling_check`'s.
     """
-    with_k = identify(nominal, measurements, coupling=k, **options)
+    with_k = identify(nominal, measurements, j23_factor=k, **options)
     with_k.coupling_check = coupling_check(nominal, measurements, k, with_k, **options)
     return with_k

@@ -372,7 +372,7 @@ def identify(
         cand += list(np.flatnonzero(groups == "scale"))
     if opts.compliance:
         cand += list(np.flatnonzero(groups == "compliance"))
-    if opts.fit_coupling and chain.coupling_param >= 0:
+    if opts.fit_j23_factor and chain.coupling_param >= 0:
         cand.append(chain.coupling_param)
     cand, chosen = _unheld(cand, hold or {}, chain)
     J1 = prob.jacobian(x1)
@@ -412,7 +412,7 @@ def _checked(nominal: Robot, measurements: TargetMeasurements, opts: IdentifyOpt
         raise InputError(f"{nominal.name} has a joint coupling other than a J2/J3 factor (passive "
                          "joints or a general matrix); identification handles only "
                          "'coupling: {j23_factor: k}'")
-    coupling = opts.coupling
+    coupling = opts.j23_factor
     if coupling is None:
         coupling = 0.0 if nominal.coupling is None else nominal.coupling.j23_factor
     if opts.compliance:
@@ -513,7 +513,7 @@ def _result(nominal, chain, prob, x, kept, fixed, rp0, rr0, name, x_nominal) -> 
         condition=scaled_condition(J), dof=dof, variance_factor=s0, outliers=outliers,
         labels=list(prob.meas.labels),
         scale=x[chain.scale_params].copy(),
-        coupling=float(x[chain.coupling_param]) if chain.coupling_param >= 0 else 0.0,
+        j23_factor=float(x[chain.coupling_param]) if chain.coupling_param >= 0 else 0.0,
         touch_sigma=1.0 / prob.wp, angle_sigma=1.0 / prob.wr, unexplained=unexplained,
         _q=prob.meas.q, _chain=chain, _x=x, _x_nominal=x_nominal,
     )

@@ -83,8 +83,8 @@ def joint_offsets(result: IdentificationResult) -> list[JointOffset]:
     C = np.eye(n)
     if nominal.coupling is not None:
         C = nominal.coupling.matrix
-    elif result.coupling:  # a stated J2/J3 factor (--j23-factor) is the controller's coupling
-        C[2, 1] = result.coupling
+    elif result.j23_factor:  # a stated J2/J3 factor (--j23-factor) is the controller's coupling
+        C[2, 1] = result.j23_factor
     Cinv = np.linalg.inv(C)
     delta = Cinv @ d_model
     sig = np.sqrt(np.abs(np.diag(Cinv @ cov @ Cinv.T)))

@@ -42,11 +42,11 @@ class IdentifyOptions:
     compliance : bool
         Also identify the gravity compliance of axes 2 and 3 (rad per N m), multiplied by the
         gravity torque of the nominal link masses (``Joint.mass``, ``Joint.com``).
-    coupling : float, optional
+    j23_factor : float, optional
         J2/J3 coupling factor ``k`` with ``q3_model = J3 + k J2`` (0: none). Held unless
-        ``fit_coupling``. Default: the nominal model's ``j23_factor`` (0 without a coupling).
-    fit_coupling : bool
-        Identify ``k`` too (starting at ``coupling``).
+        ``fit_j23_factor``. Default: the nominal model's ``j23_factor`` (0 without a coupling).
+    fit_j23_factor : bool
+        Identify ``k`` too (starting at ``j23_factor``).
     rank_tol : float
         A scaled Jacobian column closer than this (sine of the angle) to the span of the columns
         kept before it is fixed as not identifiable.
@@ -65,8 +65,8 @@ class IdentifyOptions:
     angle_sigma: float = ANGLE_SIGMA
     scale: bool = False
     compliance: bool = False
-    coupling: float | None = None
-    fit_coupling: bool = False
+    j23_factor: float | None = None
+    fit_j23_factor: bool = False
     rank_tol: float = 1e-6
     max_sigma_length: float = MAX_SIGMA_LENGTH
     max_sigma_angle: float = MAX_SIGMA_ANGLE

@@ -118,7 +118,7 @@ class IdentificationResult:
     labels : list of str
     scale : ndarray, shape (n,)
         Per-axis scale errors (0 when not identified).
-    coupling : float
+    j23_factor : float
         J2/J3 factor ``k`` (``q3_model = J3 + k J2``).
     touch_sigma, angle_sigma : float
         Accuracies used as weights (m, rad).
@@ -151,7 +151,7 @@ class IdentificationResult:
     outliers: list[int]
     labels: list[str]
     scale: NDArray[np.float64]
-    coupling: float
+    j23_factor: float
     touch_sigma: float
     angle_sigma: float
     unexplained: float = float("nan")
@@ -387,7 +387,7 @@ class IdentificationResult:
             "residuals_mm": np.linalg.norm(self.residuals, axis=-1) * 1e3,
             "residuals_before_mm": np.linalg.norm(self.residuals_before, axis=-1) * 1e3,
             "labels": self.labels,
-            "j23_factor": self.coupling,
+            "j23_factor": self.j23_factor,
             "predicted_error": self.error_figures(),
             "sigma_relative_to": SIGMA_RELATIVE_TO,
             "verdict": self.verdict[0],

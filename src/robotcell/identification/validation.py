@@ -73,7 +73,7 @@ def cross_validate(nominal: Robot, measurements: TargetMeasurements, folds: int 
         K >= 2; the rows are shuffled with ``np.random.default_rng(seed)`` and dealt into K folds.
     seed : int
     **options
-        Passed to ``identify`` (accuracies, ``scale``, ``coupling``...).
+        Passed to ``identify`` (accuracies, ``scale``, ``j23_factor``...).
 
     Returns
     -------

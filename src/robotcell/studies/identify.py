@@ -172,7 +172,7 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         (:func:`~robotcell.identification.coupling.coupling_check`).
     **keywords
         Fields of :class:`~robotcell.identification.options.IdentifyOptions` that replace those
-        of ``options`` (``sigma=2e-5, coupling=1.0``).
+        of ``options`` (``sigma=2e-5, j23_factor=1.0``).
 
     Returns
     -------
@@ -196,7 +196,7 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         nominal = load_robot(robot) if robot is not None else Cell.load(cell).nominal_robot
         meas = read_target_measurements(measurements, nominal.prismatic)
     else:
-        nominal, meas = first_estimate(measurements, j23_factor=opts.coupling or 0.0,
+        nominal, meas = first_estimate(measurements, j23_factor=opts.j23_factor or 0.0,
                                        group_tol=opts.group_tol)
     choice, cross = None, None
     if folds:
@@ -205,8 +205,9 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         result, cross = choice.result, choice.cross
     else:
         result = identify(nominal, meas, options=opts)
-    if opts.coupling is not None:
-        result.coupling_check = coupling_check(nominal, meas, opts.coupling, result, options=opts)
+    if opts.j23_factor is not None:
+        result.coupling_check = coupling_check(nominal, meas, opts.j23_factor, result,
+                                               options=opts)
     obs = None
     if report:
         obs = compare_observability(nominal, meas.q, n_targets=meas.n_targets,
