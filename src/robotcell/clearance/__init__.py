@@ -19,4 +19,5 @@ from robotcell.clearance.path import clearance
 from robotcell.clearance.robots import clearance_between
 from robotcell.clearance.skeleton import LinkModel, link_segments
 
-__all__ = ["Body", "Clearance", "LinkModel", "clearance", "clearance_between", "link_segments", "read_bodies"]
+__all__ = ["Body", "Clearance", "LinkModel", "clearance", "clearance_between", "link_segments",
+           "read_bodies"]

@@ -18,10 +18,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.cell.kinematics import (frame_pose, robot_pose, table_batch, table_values,
-                                       tool_pose)
+from robotcell.cell.kinematics import frame_pose, robot_pose, table_batch, table_values, tool_pose
 from robotcell.cell.model import Cell
-from robotcell.clearance.bodies import Body, BodiesFile
+from robotcell.clearance.bodies import BodiesFile, Body
 from robotcell.clearance.distance import Clearance, Shapes, smallest_distances
 from robotcell.clearance.skeleton import link_segments
 from robotcell.errors import InputError

@@ -17,10 +17,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell.kinematics import frame_pose, robot_pose
 from robotcell.cell.model import Cell
-from robotcell.clearance.bodies import Body, BodiesFile
+from robotcell.clearance.bodies import BodiesFile, Body
 from robotcell.clearance.distance import Clearance, Shapes, smallest_distances
-from robotcell.clearance.path import (STEP, ArmMotion, _arm_input, _interpolate, _joined,
-                                      arm_shapes, pairs, samples, shared_table)
+from robotcell.clearance.path import (
+    STEP,
+    ArmMotion,
+    _arm_input,
+    _interpolate,
+    _joined,
+    arm_shapes,
+    pairs,
+    samples,
+    shared_table,
+)
 from robotcell.errors import InputError
 
 __all__ = ["clearance_between"]
