@@ -26,7 +26,8 @@ from robotcell.clearance.skeleton import link_segments
 from robotcell.errors import InputError
 from robotcell.kinematics.transforms import finite_array
 
-__all__ = ["ArmMotion", "arm_shapes", "clearance", "pairs", "samples", "shared_table"]
+__all__ = ["ArmMotion", "arm_input", "arm_shapes", "clearance", "interpolate", "joined", "pairs",
+           "samples", "shared_table"]
 
 #: Default sample spacing: 0.01 rad of a joint (0.57 deg), 10 mm of the track or the TCP.
 STEP = 0.01
@@ -69,7 +70,8 @@ def samples(q: NDArray[np.float64], extra: NDArray[np.float64], tcp: NDArray[np.
     return np.append(starts + within / np.repeat(cuts, cuts), len(q) - 1.0)
 
 
-def _interpolate(values: NDArray[np.float64], pos: NDArray[np.float64]) -> NDArray[np.float64]:
+def interpolate(values: NDArray[np.float64], pos: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``values`` ``(N, k)`` at the places ``pos`` ``(P,)`` along the program, linearly."""
     i = np.minimum(np.floor(pos).astype(int), len(values) - 2) if len(values) > 1 else \
         np.zeros(len(pos), int)
     f = (pos - i)[:, None] if len(values) > 1 else np.zeros((len(pos), 1))
@@ -174,17 +176,17 @@ def clearance(cell: Cell, q: ArrayLike, *, track: ArrayLike = 0.0, table: ArrayL
         pose, a body on a frame the cell lacks, or the collision library missing.
     """
     bodies = bodies or BodiesFile()
-    arm = _arm_input(cell, q, track, tool, motion)
+    arm = arm_input(cell, q, track, tool, motion)
     if not (np.isfinite(step) and step > 0):
         raise InputError(f"step must be > 0, got {step!r}")
     TH = shared_table(cell, table, arm.n)
     pos = samples(arm.q, np.column_stack([arm.E, TH.reshape(arm.n, -1)]), arm.tcp, step)
     robot, Es, T_world_F = arm_shapes(cell, arm, pos, bodies, "")
-    THs = _interpolate(TH.reshape(arm.n, -1), pos).reshape((len(pos),) + TH.shape[1:])
+    THs = interpolate(TH.reshape(arm.n, -1), pos).reshape((len(pos),) + TH.shape[1:])
     held = [b for b in bodies.bodies if b.parent == "flange"]
     parts = [b for b in bodies.bodies if b.parent != "flange"]
     if held:
-        robot = _joined(robot, _body_shapes(cell, held, Es, THs, T_world_F))
+        robot = joined(robot, _body_shapes(cell, held, Es, THs, T_world_F))
     others = _body_shapes(cell, parts, Es, THs, T_world_F)
     return smallest_distances(robot, others, pairs(robot.names, others.names, bodies.ignore), pos)
 
@@ -219,7 +221,7 @@ class ArmMotion:
         return len(self.q)
 
 
-def _arm_input(cell: Cell, q: ArrayLike, track: ArrayLike, tool: str | ArrayLike | None,
+def arm_input(cell: Cell, q: ArrayLike, track: ArrayLike, tool: str | ArrayLike | None,
                motion: str | Sequence[str]) -> ArmMotion:
     """The checked joint values, track values, tool and motions of one robot (``cell`` is the
     cell as that robot sees it)."""
@@ -266,9 +268,9 @@ def arm_shapes(cell: Cell, arm: ArmMotion, pos: NDArray[np.float64], bodies: Bod
         The flange in the world at the samples (m).
     """
     flange_tool = np.eye(4) if arm.T_tool is None else arm.T_tool
-    Q = _interpolate(arm.q, pos)
+    Q = interpolate(arm.q, pos)
     Q = _linear_joints(cell, arm.q, Q, pos, arm.linear, flange_tool)
-    Es = _interpolate(arm.E[:, None], pos)[:, 0]
+    Es = interpolate(arm.E[:, None], pos)[:, 0]
     T_world_R = robot_pose(cell, Es)
     segs, names = link_segments(cell.robot, Q, arm.T_tool)
     kept = np.flatnonzero(np.linalg.norm(segs[..., 1, :] - segs[..., 0, :], axis=-1).max(axis=0)
@@ -293,7 +295,8 @@ def _body_shapes(cell: Cell, bodies: Sequence[Body], E: NDArray[np.float64],
                   tuple(b.size for b in bodies), poses, radii)
 
 
-def _joined(a: Shapes, b: Shapes) -> Shapes:
+def joined(a: Shapes, b: Shapes) -> Shapes:
+    """The shapes of ``a`` and of ``b`` (parts of fixed size) as one group."""
     P = a.poses.shape[0]
     lengths = np.concatenate([a.lengths if a.lengths is not None else np.zeros(a.radii.shape),
                               np.full((P, len(b.names)), np.nan)], axis=1)

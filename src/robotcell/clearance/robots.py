@@ -22,10 +22,10 @@ from robotcell.clearance.distance import Clearance, Shapes, smallest_distances
 from robotcell.clearance.path import (
     STEP,
     ArmMotion,
-    _arm_input,
-    _interpolate,
-    _joined,
+    arm_input,
     arm_shapes,
+    interpolate,
+    joined,
     pairs,
     samples,
     shared_table,
@@ -88,7 +88,7 @@ def clearance_between(cell: Cell, q: Mapping[str, ArrayLike], *,
     arms: dict[str, ArmMotion] = {}
     for name, view in views.items():
         kinds = motion.get(name, "joint") if isinstance(motion, Mapping) else motion
-        arms[name] = _arm_input(view, q[name], track.get(name, 0.0), tools.get(name), kinds)
+        arms[name] = arm_input(view, q[name], track.get(name, 0.0), tools.get(name), kinds)
     lengths = {name: arm.n for name, arm in arms.items()}
     if len(set(lengths.values())) > 1:
         raise InputError("the robots' programs must have as many points each: "
@@ -99,14 +99,14 @@ def clearance_between(cell: Cell, q: Mapping[str, ArrayLike], *,
     extra = TH.reshape(n, -1)
     pos = np.unique(np.concatenate([samples(a.q, np.column_stack([a.E, extra]), a.tcp, step)
                                     for a in arms.values()]))
-    THs = _interpolate(extra, pos).reshape((len(pos),) + TH.shape[1:])
+    THs = interpolate(extra, pos).reshape((len(pos),) + TH.shape[1:])
     groups, tracks, flanges = {}, {}, {}
     for name, arm in arms.items():
         groups[name], tracks[name], flanges[name] = arm_shapes(views[name], arm, pos, bodies,
                                                                f"{name}.")
     held, parts = _sorted_bodies(cell, bodies, tuple(views))
     for name, mine in held.items():
-        groups[name] = _joined(groups[name], _shapes(
+        groups[name] = joined(groups[name], _shapes(
             mine, np.stack([flanges[name] for _ in mine], axis=1), name))
     poses = [_part_pose(cell, views, b, tracks, THs) for b in parts]
     others = _shapes(parts, np.stack(poses, axis=1) if parts else np.zeros((len(pos), 0, 4, 4)),

@@ -25,8 +25,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from robotcell.controllers.abb.program import _declarations, _robtarget, _speed_text, _zone_text
-from robotcell.controllers.abb.reader import _CIRCULAR, _MOTIONS, arguments, statements
+from robotcell.controllers.abb.program import declarations, robtarget_text, speed_text, zone_text
+from robotcell.controllers.abb.reader import MOVE_INSTRUCTIONS, arguments, statements
 from robotcell.controllers.model import Program
 from robotcell.controllers.text import Lines
 from robotcell.errors import InputError
@@ -83,17 +83,17 @@ def write_tasks(programs: list[Program], header: list[str]) -> dict[str, str]:
              "by its \\ID"),
              "    VAR syncident sync1;", "    VAR syncident sync2;",
              f"    TASK PERS tasks all_tasks{{{len(tasks)}}} := [{listed}];",
-             *_declarations(program, tool, wobj),
+             *declarations(program, tool, wobj),
              ("    ! robtarget: x, y, z (mm) and quaternion [q1,q2,q3,q4] of the TCP in the work "
               "object, confdata [cf1,cf4,cf6,cfx], extax (track mm, positioner deg; 9E9: no "
               "axis)")]
-        L += [f"    CONST robtarget {p.name}:={_robtarget(p)};" for p in program.points]
+        L += [f"    CONST robtarget {p.name}:={robtarget_text(p)};" for p in program.points]
         L += ["", f"    PROC {name}()", "        ConfJ \\On;", "        ConfL \\On;",
               "        SyncMoveOn sync1, all_tasks;"]
         for k, p in enumerate(program.points, start=1):
             move = "MoveJ" if p.motion == "ptp" else "MoveL"
-            L.append(f"        {move} {p.name}\\ID:={ID_STEP * k},{_speed_text(p.speed or 0.1)},"
-                     f"{_zone_text(p.zone or 0.0)},{tool}\\WObj:={wobj};")
+            L.append(f"        {move} {p.name}\\ID:={ID_STEP * k},{speed_text(p.speed or 0.1)},"
+                     f"{zone_text(p.zone or 0.0)},{tool}\\WObj:={wobj};")
         L += ["        SyncMoveOff sync2;", "    ENDPROC", "ENDMODULE"]
         out[f"{name}_{task}.mod"] = "\n".join(L) + "\n"
     return out
@@ -141,7 +141,7 @@ def sync_moves(path: str | Path) -> list[SyncMove]:
             synced = True
         elif key == "syncmoveoff":
             synced = False
-        elif key in _MOTIONS or key in _CIRCULAR or key in ("moveextj", "searchl"):
+        elif key in MOVE_INSTRUCTIONS:
             _, optional = arguments(m.group(2))
             moves.append(SyncMove(lineno, m.group(1), optional.get("id"), synced))
     return moves
