@@ -190,3 +190,18 @@ def test_the_command_line_writes_and_checks(tmp_path, capsys):
     code, out, err = run(capsys, "program", "check-coordinated", tmp_path / "only.mod",
                          "--cell", CELL)
     assert code == 2 and "1 program files for 2 robots" in err
+
+
+def test_a_file_robotcell_did_not_write_is_not_replaced(tmp_path):
+    cell = Cell.load(CELL)
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / "seams_T_ROB2.mod").write_text("MODULE mine\nENDMODULE\n")
+    with pytest.raises(InputError, match=r"seams_T_ROB2.mod: it is a file robotcell did not "
+                                         r"write"):
+        write_coordinated(SEAMS, cell, TOOLS, "part", "abb", folder, "seams")
+    assert sorted(p.name for p in folder.iterdir()) == ["seams_T_ROB2.mod"]
+    (folder / "seams_T_ROB2.mod").unlink()
+    first = write_coordinated(SEAMS, cell, TOOLS, "part", "abb", folder, "seams")
+    again = write_coordinated(SEAMS, cell, TOOLS, "part", "abb", folder, "seams")
+    assert first.files == again.files                     # an earlier program is replaced

@@ -249,7 +249,7 @@ def write_coordinated_cmd(paths: tuple[str, ...], cell_path: str, tools: tuple[s
 
     \b
     Example:
-      robotcell program write-coordinated rob1=examples/seam_rob1.csv rob2=examples/seam_rob2.csv --cell examples/cell_two_abb_positioner.yaml --tool torch --frame part --format abb -o prog
+      robotcell program write-coordinated rob1=examples/seam_rob1.csv rob2=examples/seam_rob2.csv --cell examples/cell_two_abb_positioner.yaml --tool torch --frame part --format abb -o prog --name seams
     """
     from robotcell.programs import PathBreaks
     from robotcell.programs.coordinated import write_coordinated
@@ -296,7 +296,7 @@ def check_coordinated_cmd(program_files: tuple[str, ...], cell_path: str, robots
 
     \b
     Example:
-      robotcell program check-coordinated prog/seam_rob1_T_ROB1.mod prog/seam_rob1_T_ROB2.mod --cell examples/cell_two_abb_positioner.yaml
+      robotcell program check-coordinated prog/seams_T_ROB1.mod prog/seams_T_ROB2.mod --cell examples/cell_two_abb_positioner.yaml
     """
     from robotcell.clearance import read_bodies
     from robotcell.programs.coordcheck import check_coordinated

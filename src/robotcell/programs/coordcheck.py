@@ -21,6 +21,7 @@ import numpy as np
 
 from robotcell.cell import Cell
 from robotcell.clearance.bodies import BodiesFile
+from robotcell.clearance.distance import Clearance
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.programs.check import CLEARANCE, CheckReport, check_program
@@ -137,9 +138,10 @@ def _table_problems(reports: dict[str, CheckReport]) -> list[str]:
 def _clearance(cell: Cell, reports: dict[str, CheckReport], bodies: BodiesFile,
                limit: float) -> None:
     """Add the clearance problems of the robots together to their points (where every robot's
-    joints are known at every point and each program keeps one tool)."""
+    joints are known at every point and each program keeps one tool): each robot against the
+    parts, each pair of robots against each other, so that every pair under the limit is
+    named, not only the closest."""
     from robotcell.clearance import clearance_between
-    from robotcell.programs.clearcheck import problem_text
 
     q = {r: np.array([p.q for p in rep.points]) for r, rep in reports.items()}
     if not all(np.isfinite(v).all() for v in q.values()):
@@ -150,27 +152,33 @@ def _clearance(cell: Cell, reports: dict[str, CheckReport], bodies: BodiesFile,
         T_world_F = view.frame_pose("robot", rep.points[0].track) @ view.robot.fk(
             q[r][0], np.eye(4))
         tools[r] = np.linalg.inv(T_world_F) @ rep.points[0].T_world_TCP
-    first = next(iter(reports.values()))
-    got = clearance_between(
-        cell, q, track={r: [p.track for p in rep.points] for r, rep in reports.items()},
-        table=np.array([p.table for p in first.points], dtype=float), tools=tools,
-        bodies=bodies,
-        motion={r: ["linear" if p.motion in ("lin", "circ") else "joint"
-                    for p in rep.points[1:]] for r, rep in reports.items()})
+    names = list(reports)
+    arms = BodiesFile(links=bodies.links, ignore=bodies.ignore)
+    groups = [((r,), bodies) for r in names] + [
+        ((a, b), arms) for i, a in enumerate(names) for b in names[i + 1:]]
+    table = np.array([p.table for p in reports[names[0]].points], dtype=float)
+    for robots, shapes in groups:
+        got = clearance_between(
+            cell, {r: q[r] for r in robots},
+            track={r: [p.track for p in reports[r].points] for r in robots}, table=table,
+            tools={r: tools[r] for r in robots}, bodies=shapes,
+            motion={r: ["linear" if p.motion in ("lin", "circ") else "joint"
+                        for p in reports[r].points[1:]] for r in robots})
+        _report(reports, robots, got, limit)
+
+
+def _report(reports: dict[str, CheckReport], robots: tuple[str, ...], got: Clearance,
+            limit: float) -> None:
+    """The points and motions of ``got`` under ``limit``, given to each robot of ``robots``."""
+    from robotcell.programs.clearcheck import problem_text
+
     at_points = got.per_point()
     along = got.per_segment() if len(at_points) > 1 else np.zeros(0)
-    for k, d in enumerate(at_points):
-        if d < limit:
-            _add(reports, k, problem_text("clearance", got, k, d, limit))
     clear = at_points >= limit
-    for k in np.flatnonzero((along < limit) & clear[1:] & clear[:-1]):
-        _add(reports, k + 1, problem_text("on the way here, clearance", got, k + 0.5, along[k],
-                                          limit))
-
-
-def _add(reports: dict[str, CheckReport], k: int, text: str) -> None:
-    """Give a problem of the pair in ``text`` to the point ``k`` of each robot it names (of the
-    first robot when it names only parts)."""
-    named = [r for r in reports if f" {r}." in f" {text}"]
-    for r in named or list(reports)[:1]:
-        reports[r].points[k].problems.append(text)
+    found = [(k, problem_text("clearance", got, k, d, limit))
+             for k, d in enumerate(at_points) if d < limit]
+    found += [(k + 1, problem_text("on the way here, clearance", got, k + 0.5, along[k], limit))
+              for k in np.flatnonzero((along < limit) & clear[1:] & clear[:-1])]
+    for k, text in found:
+        for r in robots:
+            reports[r].points[k].problems.append(text)

@@ -103,6 +103,21 @@ def shared_table(cell: Cell, targets: Mapping[str, PathTargets], frame: str
     return {r: replace(t, table=values.table, table_given=True) for r, t in targets.items()}
 
 
+#: The start of the header of a coordinated program robotcell writes.
+_HEADER = "robotcell coordinated program of cell"
+
+
+def _refuse_others(folder: Path, texts: dict[str, str]) -> None:
+    """Refuse to replace a file of the folder that is not a coordinated program robotcell
+    wrote (an earlier one is replaced)."""
+    for name in texts:
+        path = folder / name
+        if path.is_file() and _HEADER not in path.read_text(errors="replace"):
+            raise InputError(f"cannot write {path}: it is a file robotcell did not write as a "
+                             "coordinated program; give this program another name or folder, "
+                             "or remove that file first")
+
+
 def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mapping[str, str],
                       frame: str, vendor: str, folder: str | Path, name: str | None = None,
                       inputs: tuple[str | Path, ...] = ()) -> CoordinatedResult:
@@ -153,9 +168,10 @@ def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mappin
         name = ctl.default_name(Path(paths[robots[0]]).stem)
     results = {r: build_programs(cell.for_robot(r), targets[r], ctl.name, name, tools[r], frame)
                for r in robots}
-    header = [f"robotcell coordinated program of cell {cell.name!r}, frame {frame!r}: "
+    header = [f"{_HEADER} {cell.name!r}, frame {frame!r}: "
               + ", ".join(f"{r}: path {Path(paths[r]).name}, tool {tools[r]!r}" for r in robots)]
     texts = ctl.write_coordinated([results[r].programs[0] for r in robots], header)
+    _refuse_others(Path(folder), texts)
     files = write_all(folder, texts, (*paths.values(), *inputs))
     warnings = [w for r in robots for w in targets[r].warnings]
     return CoordinatedResult(files, robots, results, warnings)
