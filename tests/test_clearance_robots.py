@@ -129,3 +129,35 @@ def test_the_example_cell_of_two_robots_on_a_positioner_is_checked():
 def test_bad_calls_name_the_cause(call, match):
     with pytest.raises(InputError, match=match):
         call(_cell())
+
+
+def test_a_part_held_by_a_robots_flange_moves_with_it_and_is_named_by_it():
+    cell = _cell(0.2)
+    q_a, q_b = _pass(cell, n=3)
+    grip = Body("grip", "sphere", (0.03,), "a.flange", np.eye(4))
+    grip.pose[:3, 3] = [0, 0, 0.3]                               # at a's torch tip
+    tip = (cell.for_robot("a").robot.fk(q_a[0], TOOL))[:3, 3]
+    ball = Body("ball", "sphere", (0.05,), "world", np.eye(4))
+    ball.pose[:3, 3] = tip - [0, 0, 0.03 + 0.05 + 0.04]         # 40 mm under the held sphere
+    near = clearance_between(cell, {"a": q_a, "b": q_b}, tools={"a": TOOL, "b": TOOL},
+                             bodies=BodiesFile((grip, ball), LINKS, (("tool", "*"),)))
+    assert near.minimum == pytest.approx(0.04, abs=1e-6)
+    assert near.pair[np.argmin(near.distance)] == ("a.grip", "ball")
+
+
+def test_a_part_on_a_robots_base_moves_with_its_track():
+    cell = Cell.load("examples/cell_two_robots_positioner.yaml")
+    q = np.radians([[0, -90, 90, 0, 45, 0]] * 2)
+    post = Body("post", "sphere", (0.02,), "kuka", np.eye(4))       # 1 m above the carriage
+    post.pose[:3, 3] = [0, 0, 1.0]
+    only = BodiesFile((post,), LINKS, (("*", "post"),))
+    for track in (0.5, 2.0):
+        got = clearance_between(cell, {"kuka": q, "abb": q}, track={"kuka": track},
+                                tools={"kuka": "torch", "abb": "torch"},
+                                bodies=BodiesFile((post,), LINKS))
+        assert np.isfinite(got.minimum)
+        assert np.all(np.isinf(clearance_between(
+            cell, {"kuka": q}, track={"kuka": track}, bodies=only).distance))
+    near = [clearance_between(cell, {"kuka": q}, track={"kuka": t}, tools={"kuka": "torch"},
+                              bodies=BodiesFile((post,), LINKS)).minimum for t in (0.5, 2.0)]
+    assert near[0] == pytest.approx(near[1], abs=1e-9)     # the post rides with the carriage
