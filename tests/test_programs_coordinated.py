@@ -205,3 +205,29 @@ def test_a_file_robotcell_did_not_write_is_not_replaced(tmp_path):
     first = write_coordinated(SEAMS, cell, TOOLS, "part", "abb", folder, "seams")
     again = write_coordinated(SEAMS, cell, TOOLS, "part", "abb", folder, "seams")
     assert first.files == again.files                     # an earlier program is replaced
+
+
+def test_checking_programs_of_a_format_whose_coordinated_form_is_not_read_is_refused(
+        tmp_path, capsys):
+    from robotcell.programs import write_program
+
+    cell = Cell.load(CELL)
+    files = []
+    for robot in ("rob1", "rob2"):
+        seam = read_path(SEAMS[robot], cell.for_robot(robot))
+        path = tmp_path / f"{robot}.csv"          # each robot's seam with the positioner given
+        text = SEAMS[robot].read_text()
+        if "e1" not in text.splitlines()[0]:
+            rows = text.splitlines()
+            given = SEAMS["rob1"].read_text().splitlines()
+            text = "\n".join([rows[0] + ",e1,e2"] + [r + "," + ",".join(g.split(",")[-2:])
+                                                    for r, g in zip(rows[1:], given[1:])]) + "\n"
+        path.write_text(text)
+        assert len(seam) == 6
+        files += write_program(path, cell.for_robot(robot), "torch", "part", "kuka",
+                               tmp_path / robot).files
+    srcs = [f for f in files if f.endswith(".src")]
+    with pytest.raises(InputError, match=r"KUKA coordinated programs .* not written or checked"):
+        check_coordinated(srcs, cell)
+    code, _, err = run(capsys, "program", "check-coordinated", *srcs, "--cell", CELL)
+    assert code == 2 and "RoboTeam" in err
