@@ -231,3 +231,18 @@ def test_checking_programs_of_a_format_whose_coordinated_form_is_not_read_is_ref
         check_coordinated(srcs, cell)
     code, _, err = run(capsys, "program", "check-coordinated", *srcs, "--cell", CELL)
     assert code == 2 and "RoboTeam" in err
+
+
+@pytest.mark.parametrize("args, match", [
+    (["program", "check-coordinated", MULTIMOVE, MULTIMOVE, "--cell", CELL, "--robots",
+      "rob1,rob9"], r"no robot 'rob9'"),
+    (["program", "write-coordinated", f"rob1={SEAMS['rob1']}", f"rob2={SEAMS['rob2']}",
+      "--cell", CELL, "--tool", "rob1=torch", "--tool", "rob2", "--format", "abb", "-o", "x"],
+     r"--tool takes ROBOT=VALUE.*'rob2'"),
+    (["program", "write-coordinated", f"rob1={SEAMS['rob1']}", "--cell", CELL, "--tool",
+      "torch", "--format", "abb", "-o", "x"], r"at least two robots"),
+])
+def test_bad_command_lines_exit_2_naming_the_cause(tmp_path, capsys, monkeypatch, args, match):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, *args)
+    assert code == 2 and re.search(match, err) and not (tmp_path / "x").exists()
