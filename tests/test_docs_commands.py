@@ -215,6 +215,14 @@ def prepare(capsys, argv: list[str]) -> None:
                                       encoding="utf-8")
     if argv[0] == "identify" and "tracker.csv" in argv:
         _tracker()
+    if argv[:2] == ["program", "check-coordinated"]:  # the modules write-coordinated writes
+        mod = Path(argv[2])
+        code, _, err = run(capsys, "program", "write-coordinated", "rob1=examples/seam_rob1.csv",
+                           "rob2=examples/seam_rob2.csv", "--cell",
+                           "examples/cell_two_abb_positioner.yaml", "--tool", "torch", "--frame",
+                           "part", "--format", "abb", "-o", str(mod.parent), "--name",
+                           mod.stem.rsplit("_T_ROB", 1)[0])
+        assert code == 0, err
     if argv[0] == "compensate" or (argv[0] == "program" and (
             argv[1] == "compensate" or any("filtered" in a for a in argv))):
         _tracker()

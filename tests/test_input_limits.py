@@ -182,7 +182,8 @@ def test_a_track_scale_of_1000_is_refused(tmp_path, capsys):
 @pytest.mark.parametrize("path", sorted((ROOT / "examples").glob("cell_*.yaml"))
                          + sorted((ROOT / "tests" / "data").glob("*.saved.yaml")))
 def test_every_example_cell_is_plausible(path):
-    assert all(unit.robot is not None for unit in Cell.load(path).robots.values())
+    cell = Cell.load(path)
+    assert all(cell.for_robot(name).robot is not None for name in cell.robot_names)
 
 
 def test_a_track_without_limits_still_ends_at_100_m(tmp_path, capsys):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import fnmatch
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -25,7 +26,8 @@ from robotcell.clearance.skeleton import link_segments
 from robotcell.errors import InputError
 from robotcell.kinematics.transforms import finite_array
 
-__all__ = ["clearance", "samples"]
+__all__ = ["ArmMotion", "arm_input", "arm_shapes", "clearance", "interpolate", "joined", "pairs",
+           "samples", "shared_table"]
 
 #: Default sample spacing: 0.01 rad of a joint (0.57 deg), 10 mm of the track or the TCP.
 STEP = 0.01
@@ -68,7 +70,8 @@ def samples(q: NDArray[np.float64], extra: NDArray[np.float64], tcp: NDArray[np.
     return np.append(starts + within / np.repeat(cuts, cuts), len(q) - 1.0)
 
 
-def _interpolate(values: NDArray[np.float64], pos: NDArray[np.float64]) -> NDArray[np.float64]:
+def interpolate(values: NDArray[np.float64], pos: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``values`` ``(N, k)`` at the places ``pos`` ``(P,)`` along the program, linearly."""
     i = np.minimum(np.floor(pos).astype(int), len(values) - 2) if len(values) > 1 else \
         np.zeros(len(pos), int)
     f = (pos - i)[:, None] if len(values) > 1 else np.zeros((len(pos), 1))
@@ -116,11 +119,17 @@ def _parent_poses(cell: Cell, body: Body, E: NDArray[np.float64], TH: NDArray[np
     return frame_pose(cell, body.parent, E, TH)
 
 
-def _pairs(a: tuple[str, ...], b: tuple[str, ...], ignore: Sequence[tuple[str, str]]
-           ) -> NDArray[np.intp]:
+def pairs(a: tuple[str, ...], b: tuple[str, ...], ignore: Sequence[tuple[str, str]]
+          ) -> NDArray[np.intp]:
+    """The pairs ``(i, j)`` of shapes of ``a`` and ``b`` that ``ignore`` does not list; a
+    pattern matches a name as written (``kuka.tool``) or without its robot's prefix (``tool``).
+    """
+    def match(name: str, pattern: str) -> bool:
+        return (fnmatch.fnmatchcase(name, pattern)
+                or ("." in name and fnmatch.fnmatchcase(name.partition(".")[2], pattern)))
+
     def ignored(x: str, y: str) -> bool:
-        return any((fnmatch.fnmatchcase(x, p) and fnmatch.fnmatchcase(y, r))
-                   or (fnmatch.fnmatchcase(y, p) and fnmatch.fnmatchcase(x, r))
+        return any((match(x, p) and match(y, r)) or (match(y, p) and match(x, r))
                    for p, r in ignore)
     return np.array([(i, j) for i, x in enumerate(a) for j, y in enumerate(b)
                      if not ignored(x, y)], dtype=np.intp).reshape(-1, 2)
@@ -167,41 +176,112 @@ def clearance(cell: Cell, q: ArrayLike, *, track: ArrayLike = 0.0, table: ArrayL
         pose, a body on a frame the cell lacks, or the collision library missing.
     """
     bodies = bodies or BodiesFile()
-    q = np.atleast_2d(finite_array(q, "q"))
-    if q.ndim != 2 or q.shape[1] != cell.robot.n_joints:
-        raise InputError(f"q must have shape (N, {cell.robot.n_joints}), got {q.shape}")
+    arm = arm_input(cell, q, track, tool, motion)
     if not (np.isfinite(step) and step > 0):
         raise InputError(f"step must be > 0, got {step!r}")
-    n = len(q)
-    E = np.broadcast_to(finite_array(track, "track"), (n,)).astype(float)
-    th = table_values(cell, table)
-    TH = np.broadcast_to(th, (n,) + th.shape[len(table_batch(cell, th)):])
-    T_tool = tool_pose(cell, tool) if tool is not None else None
-    flange_tool = np.eye(4) if T_tool is None else T_tool
-    kinds = _motions(motion, n)
-    tcp = (robot_pose(cell, E) @ cell.robot.fk(q, flange_tool))[:, :3, 3]
-    extra = np.column_stack([E, TH.reshape(n, -1)])
-    pos = samples(q, extra, tcp, step)
-    Q = _interpolate(q, pos)
-    Q = _linear_joints(cell, q, Q, pos, np.array([k == "linear" for k in kinds]), flange_tool)
-    Es = _interpolate(E[:, None], pos)[:, 0]
-    THs = _interpolate(TH.reshape(n, -1), pos).reshape((len(pos),) + TH.shape[1:])
-    T_world_R = robot_pose(cell, Es)
-    segs, names = link_segments(cell.robot, Q, T_tool)
-    kept = np.flatnonzero(np.linalg.norm(segs[..., 1, :] - segs[..., 0, :], axis=-1).max(axis=0)
-                          > 1e-9)
-    segs, names = segs[:, kept], tuple(names[k] for k in kept)
-    segs = np.einsum("pij,pkej->pkei", T_world_R[:, :3, :3], segs) + T_world_R[:, None, None, :3, 3]
-    r = bodies.links.radius_of(cell.robot)
-    radius = np.array([bodies.links.tool_radius if nm == "tool" else r for nm in names])
-    robot = Shapes.capsules(names, segs, radius)
-    T_world_F = T_world_R @ cell.robot.fk(Q, np.eye(4))
+    TH = shared_table(cell, table, arm.n)
+    pos = samples(arm.q, np.column_stack([arm.E, TH.reshape(arm.n, -1)]), arm.tcp, step)
+    robot, Es, T_world_F = arm_shapes(cell, arm, pos, bodies, "")
+    THs = interpolate(TH.reshape(arm.n, -1), pos).reshape((len(pos),) + TH.shape[1:])
     held = [b for b in bodies.bodies if b.parent == "flange"]
     parts = [b for b in bodies.bodies if b.parent != "flange"]
     if held:
-        robot = _joined(robot, _body_shapes(cell, held, Es, THs, T_world_F))
+        robot = joined(robot, _body_shapes(cell, held, Es, THs, T_world_F))
     others = _body_shapes(cell, parts, Es, THs, T_world_F)
-    return smallest_distances(robot, others, _pairs(robot.names, others.names, bodies.ignore), pos)
+    return smallest_distances(robot, others, pairs(robot.names, others.names, bodies.ignore), pos)
+
+
+@dataclass(frozen=True)
+class ArmMotion:
+    """One robot's program as the clearance check takes it.
+
+    Attributes
+    ----------
+    q : ndarray, shape (N, n)
+        Joint values (rad, m).
+    E : ndarray, shape (N,)
+        Track values (m).
+    T_tool : ndarray, shape (4, 4), or None
+        ``T_F_TCP`` (m); None: no tool.
+    linear : ndarray of bool, shape (N - 1,)
+        Each segment is a linear move.
+    tcp : ndarray, shape (N, 3)
+        The TCP (the flange without a tool) in the world (m).
+    """
+
+    q: NDArray[np.float64]
+    E: NDArray[np.float64]
+    T_tool: NDArray[np.float64] | None
+    linear: NDArray[np.bool_]
+    tcp: NDArray[np.float64]
+
+    @property
+    def n(self) -> int:
+        """The number of program points."""
+        return len(self.q)
+
+
+def arm_input(cell: Cell, q: ArrayLike, track: ArrayLike, tool: str | ArrayLike | None,
+               motion: str | Sequence[str]) -> ArmMotion:
+    """The checked joint values, track values, tool and motions of one robot (``cell`` is the
+    cell as that robot sees it)."""
+    q = np.atleast_2d(finite_array(q, "q"))
+    if q.ndim != 2 or q.shape[1] != cell.robot.n_joints:
+        raise InputError(f"q must have shape (N, {cell.robot.n_joints}), got {q.shape}")
+    n = len(q)
+    E = np.broadcast_to(finite_array(track, "track"), (n,)).astype(float)
+    T_tool = tool_pose(cell, tool) if tool is not None else None
+    flange_tool = np.eye(4) if T_tool is None else T_tool
+    linear = np.array([k == "linear" for k in _motions(motion, n)], dtype=bool)
+    tcp = (robot_pose(cell, E) @ cell.robot.fk(q, flange_tool))[:, :3, 3]
+    return ArmMotion(q, E, T_tool, linear, tcp)
+
+
+def shared_table(cell: Cell, table: ArrayLike, n: int) -> NDArray[np.float64]:
+    """The table's values at each of ``n`` points, shape (N,) or (N, k) (rad)."""
+    th = table_values(cell, table)
+    return np.broadcast_to(th, (n,) + th.shape[len(table_batch(cell, th)):])
+
+
+def arm_shapes(cell: Cell, arm: ArmMotion, pos: NDArray[np.float64], bodies: BodiesFile,
+               prefix: str) -> tuple[Shapes, NDArray[np.float64], NDArray[np.float64]]:
+    """One robot's capsules at the samples ``pos``, named ``prefix + link``.
+
+    Parameters
+    ----------
+    cell : Cell
+        The cell as the robot sees it (:meth:`~robotcell.cell.model.Cell.for_robot`).
+    arm : ArmMotion
+    pos : ndarray, shape (P,)
+        The samples' places along the program.
+    bodies : BodiesFile
+        For the capsules' radii.
+    prefix : str
+        Put before each name (``kuka.``), empty for a cell of one robot.
+
+    Returns
+    -------
+    shapes : Shapes
+    track : ndarray, shape (P,)
+        Track values at the samples (m).
+    T_world_F : ndarray, shape (P, 4, 4)
+        The flange in the world at the samples (m).
+    """
+    flange_tool = np.eye(4) if arm.T_tool is None else arm.T_tool
+    Q = interpolate(arm.q, pos)
+    Q = _linear_joints(cell, arm.q, Q, pos, arm.linear, flange_tool)
+    Es = interpolate(arm.E[:, None], pos)[:, 0]
+    T_world_R = robot_pose(cell, Es)
+    segs, names = link_segments(cell.robot, Q, arm.T_tool)
+    kept = np.flatnonzero(np.linalg.norm(segs[..., 1, :] - segs[..., 0, :], axis=-1).max(axis=0)
+                          > 1e-9)
+    segs, names = segs[:, kept], tuple(prefix + names[k] for k in kept)
+    segs = np.einsum("pij,pkej->pkei", T_world_R[:, :3, :3], segs) + T_world_R[:, None, None, :3, 3]
+    r = bodies.links.radius_of(cell.robot)
+    radius = np.array([bodies.links.tool_radius if nm[len(prefix):] == "tool" else r
+                       for nm in names])
+    return (Shapes.capsules(names, segs, radius), Es,
+            T_world_R @ cell.robot.fk(Q, np.eye(4)))
 
 
 def _body_shapes(cell: Cell, bodies: Sequence[Body], E: NDArray[np.float64],
@@ -215,7 +295,8 @@ def _body_shapes(cell: Cell, bodies: Sequence[Body], E: NDArray[np.float64],
                   tuple(b.size for b in bodies), poses, radii)
 
 
-def _joined(a: Shapes, b: Shapes) -> Shapes:
+def joined(a: Shapes, b: Shapes) -> Shapes:
+    """The shapes of ``a`` and of ``b`` (parts of fixed size) as one group."""
     P = a.poses.shape[0]
     lengths = np.concatenate([a.lengths if a.lengths is not None else np.zeros(a.radii.shape),
                               np.full((P, len(b.names)), np.nan)], axis=1)

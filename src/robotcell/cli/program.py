@@ -212,6 +212,115 @@ def check_cmd(program_file: str, cell_path: str, ppd: str | None, singular_margi
     raise BadPoints(f"{program_file}: {bad} of {counted(n, 'point')} {verb} bad")
 
 
+def _by_robot(values: tuple[str, ...], what: str) -> dict[str, str]:
+    """``NAME=VALUE`` items as a mapping (``what`` names the option for messages)."""
+    from robotcell.errors import InputError
+
+    out: dict[str, str] = {}
+    for item in values:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise InputError(f"{what} takes ROBOT=VALUE (a robot of the cell, '='), got {item!r}")
+        out[name.strip()] = value.strip()
+    return out
+
+
+@program.command("write-coordinated")
+@click.argument("paths", nargs=-1, required=True, metavar="ROBOT=PATH...")
+@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file of several robots (YAML, mm/deg).")
+@click.option("--tool", "tools", multiple=True, required=True, metavar="ROBOT=TOOL",
+              help="Each robot's tool (repeat the option), or one TOOL for every robot.")
+@click.option("--frame", default="world", show_default=True,
+              help="Frame of every path: world or a frame of the cell.")
+@click.option("--format", "vendor", required=True, type=LiveChoice(names),
+              help="Program format (coordinated: abb, MultiMove).")
+@click.option("-o", "--output", "folder", required=True, type=OutputPath(file_okay=False),
+              help="Folder for the program files (created; its parent must exist).")
+@click.option("--name", default=None, help="Program name (default: the first path's name).")
+def write_coordinated_cmd(paths: tuple[str, ...], cell_path: str, tools: tuple[str, ...],
+                          frame: str, vendor: str, folder: str, name: str | None) -> None:
+    """Write the paths of several robots of the cell as one coordinated program: point k of
+    every path reached together, the positioner at the values the files give (columns table or
+    e1..en, in at least one file), each robot's track as its file says or following its path
+    (docs/programs.md, "Coordinated programs"). ABB: one MultiMove module per task (T_ROB1,
+    T_ROB2, .. in the order of the cell's robots). A format whose coordinated form robotcell
+    does not write exits with status 2 naming what is missing; nothing is written.
+
+    \b
+    Example:
+      robotcell program write-coordinated rob1=examples/seam_rob1.csv rob2=examples/seam_rob2.csv --cell examples/cell_two_abb_positioner.yaml --tool torch --frame part --format abb -o prog --name seams
+    """
+    from robotcell.programs import PathBreaks
+    from robotcell.programs.coordinated import write_coordinated
+
+    cell = Cell.load(cell_path)
+    by_robot = _by_robot(paths, "ROBOT=PATH")
+    tool_map = (dict.fromkeys(by_robot, tools[0]) if len(tools) == 1 and "=" not in tools[0]
+                else _by_robot(tools, "--tool"))
+    try:
+        result = write_coordinated(by_robot, cell, tool_map, frame, vendor, folder, name,
+                                   inputs=(cell_path,))
+    except PathBreaks as exc:
+        click.echo(format_table(["point", "why", "cause"],
+                                [[b.index + 1, b.kind, b.message] for b in exc.breaks]),
+                   err=True)
+        raise BadPoints(str(exc)) from None
+    for w in result.warnings:
+        click.echo(f"warning: {w}", err=True)
+    for f in result.files:
+        click.echo(f"wrote {f}")
+
+
+@program.command("check-coordinated")
+@click.argument("program_files", nargs=-1, required=True, metavar="PROGRAM...",
+                type=click.Path(dir_okay=False))
+@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+              help="Cell file of several robots (YAML, mm/deg).")
+@click.option("--robots", default=None, metavar="NAME,NAME...",
+              help="The robot of each file, in order (default: the cell's robots in order).")
+@click.option("--bodies", "bodies_path", type=click.Path(dir_okay=False), default=None,
+              help="The cell's parts as shapes (YAML, docs/clearance.md): check the clearance "
+                   "of the robots against each other and the parts.")
+@click.option("--clearance", "clearance_mm", type=float, default=10.0, show_default=True,
+              callback=in_range(0.0, 1000.0, "mm"),
+              help="Smallest good distance, with --bodies (mm).")
+def check_coordinated_cmd(program_files: tuple[str, ...], cell_path: str, robots: str | None,
+                          bodies_path: str | None, clearance_mm: float) -> None:
+    """Check a coordinated program, one file per robot (ABB: a MultiMove module per task):
+    the synchronisation (ABB: the \\ID of every synchronised move has its partner in every
+    other task), as many points each with the positioner at the same values, every robot's
+    points against the cell as 'program check' does, and with --bodies the clearance of the
+    robots against each other and the parts. Exit status 0 when all is good, 3 with a table of
+    the problems, 2 for a file that cannot be read or a format not read.
+
+    \b
+    Example:
+      robotcell program check-coordinated prog/seams_T_ROB1.mod prog/seams_T_ROB2.mod --cell examples/cell_two_abb_positioner.yaml
+    """
+    from robotcell.clearance import read_bodies
+    from robotcell.programs.coordcheck import check_coordinated
+
+    cell = Cell.load(cell_path)
+    bodies = read_bodies(bodies_path) if bodies_path else None
+    order = None if robots is None else [r.strip() for r in robots.split(",")]
+    report = check_coordinated(list(program_files), cell, order, bodies, clearance_mm * 1e-3)
+    for robot, rep in report.reports.items():
+        for s in rep.skipped:
+            click.echo(f"note: {robot}: not checked: {s}", err=True)
+    n = sum(len(r.points) for r in report.reports.values())
+    if report.good:
+        click.echo(f"{len(program_files)} programs, {counted(n, 'point')}, all good")
+        return
+    for s in report.sync:
+        click.echo(f"synchronisation: {s}", err=True)
+    if report.rows():
+        click.echo(format_table(["robot", "point", "line", "problem"], report.rows()), err=True)
+    raise BadPoints(f"{len(report.sync)} synchronisation problem(s), "
+                    f"{sum(len(r.bad) for r in report.reports.values())} of "
+                    f"{counted(n, 'point')} bad")
+
+
 @program.command("retarget")
 @click.argument("program_file", metavar="PROGRAM", type=click.Path(dir_okay=False))
 @click.option("--from", "old_path", required=True, type=click.Path(dir_okay=False),

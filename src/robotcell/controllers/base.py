@@ -199,6 +199,10 @@ class Controller(ABC):
     ik_flags: ClassVar[IkFlags | None] = None
     zero_offsets: ClassVar[ZeroOffsets | None] = None
     sources: ClassVar[tuple[str, ...]] = ()
+    #: What is missing for coordinated programs of several robots (the public sources their
+    #: form would follow); None where :meth:`write_coordinated` writes them.
+    coordinated_missing: ClassVar[str | None] = (
+        "no public manual or real program in the sources robotcell cites shows its form")
 
     def __repr__(self) -> str:
         return f"<controller {self.name}>"
@@ -268,6 +272,37 @@ class Controller(ABC):
     def read_program(self, path: str | Path) -> tuple[Program, list[str]]:
         """Read a program file: the program, and the motions not turned into points (with
         their lines)."""
+
+    def coordinated_refusal(self) -> InputError:
+        """The error that refuses coordinated programs of this controller, naming what is
+        missing."""
+        return InputError(f"{self.label} coordinated programs of several robots are not "
+                          f"written or checked: {self.coordinated_missing}; write each "
+                          "robot's program alone (program write --robot-name NAME)")
+
+    def write_coordinated(self, programs: list[Program], header: list[str]) -> dict[str, str]:
+        """The files of a coordinated program: one program per robot (in the order of the
+        tasks or groups), all of one name and as many points, every point reached together
+        with the same point of the others. File name -> text.
+
+        Raises
+        ------
+        InputError
+            The controller's coordinated form is not written (:attr:`coordinated_missing`).
+        """
+        raise self.coordinated_refusal()
+
+    def coordinated_problems(self, paths: list[str | Path]) -> list[str]:
+        """What breaks the controller's rules for the synchronisation of the coordinated
+        program in ``paths`` (one file per robot, in order), each with its file and line.
+
+        Raises
+        ------
+        InputError
+            The controller's coordinated form is not read (:attr:`coordinated_missing`), or a
+            file cannot be read.
+        """
+        raise self.coordinated_refusal()
 
     def comments(self, text: str) -> list[str]:
         """The comment lines of a program file's ``text``, without the comment marker: where a

@@ -10,7 +10,10 @@
   recalibration;
 - :mod:`robotcell.programs.config`, :mod:`.frames`: configuration flags, tools and frames as a
   controller holds them;
-- :mod:`robotcell.programs.formats`: :func:`read_program`, a program file of any controller.
+- :mod:`robotcell.programs.formats`: :func:`read_program`, a program file of any controller;
+- :mod:`robotcell.programs.coordinated`: :func:`write_coordinated`, several robots' paths as one
+  coordinated program (ABB MultiMove); :mod:`.coordcheck`: :func:`check_coordinated`, read back
+  and checked, all robots together.
 
 What a program holds (:class:`Program`, :class:`ProgramPoint`, :class:`Ref`, :class:`Config`)
 and each controller's reader and writer are in :mod:`robotcell.controllers`. Formats, units and

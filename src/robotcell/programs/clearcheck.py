@@ -18,7 +18,7 @@ from robotcell.cell.model import Cell
 from robotcell.clearance import Clearance, clearance
 from robotcell.clearance.bodies import BodiesFile
 
-__all__ = ["CLEARANCE", "clearance_problems"]
+__all__ = ["CLEARANCE", "clearance_problems", "problem_text"]
 
 #: Default smallest good clearance between the robot and a part (m): 10 mm, a margin for the
 #: capsules' fit of the real links, not a safety distance (docs/clearance.md).
@@ -74,17 +74,17 @@ def clearance_problems(cell: Cell, motions: Sequence[str], q: NDArray[np.float64
         at_points = got.per_point()
         for k, i in enumerate(run):
             if at_points[k] < limit:
-                problems[i].append(_text("clearance", got, k, at_points[k], limit))
+                problems[i].append(problem_text("clearance", got, k, at_points[k], limit))
         if len(run) > 1:
             along = got.per_segment()
             for k in np.flatnonzero((along < limit) & (at_points[1:] >= limit)
                                     & (at_points[:-1] >= limit)):
-                problems[run[k + 1]].append(_text("on the way here, clearance", got, k + 0.5,
-                                                  along[k], limit))
+                problems[run[k + 1]].append(problem_text("on the way here, clearance", got,
+                                                         k + 0.5, along[k], limit))
     return problems
 
 
-def _text(what: str, got: Clearance, where: float, distance: float, limit: float) -> str:
+def problem_text(what: str, got: Clearance, where: float, distance: float, limit: float) -> str:
     """``clearance 8.3 mm between link6 and plate (limit 10 mm)`` for the closest pair within
     half a segment of ``where``."""
     inside = np.flatnonzero(np.abs(got.position - where) <= 0.5 + 1e-9)

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.cell import Cell
 from robotcell.controllers.abb import export as rapid_data
+from robotcell.controllers.abb import multimove
 from robotcell.controllers.abb import program as rapid
 from robotcell.controllers.axes import ExternalAxes, numbered_axes
 from robotcell.controllers.base import Controller, IkFlags, ZeroOffsets
@@ -52,6 +53,7 @@ class Abb(Controller):
     config_fields = ("cf1", "cf4", "cf6", "cfx")
     edits_joints = True
     csv_config = ("cf1", "cf4", "cf6", "cfx")
+    coordinated_missing = None  # MultiMove: controllers.abb.multimove
     ik_flags = IkFlags("confdata", ("cf1", "cf4", "cf6", "cfx"),
                        lambda robot, q: np.atleast_2d(abb_confdata(robot, q)),
                        lambda v: "[" + ",".join(str(x) for x in v) + "]")
@@ -69,6 +71,11 @@ class Abb(Controller):
          "the program's module"),
         ("ABB RobotStudio SDK, RapidDomain Scope enumeration: LOCAL data is available for its "
          "module only"),
+        ("ABB MultiMove application manual 3HAC021272-001, 'Synchronized movements': "
+         "SyncMoveOn/SyncMoveOff, syncident, tasks, \\ID on every synchronised move"),
+        ("ebruun/ECL_robotic_cell, _controller_backups/4600-COMPAS_RRC_BACKUP_2022-04-12_"
+         "3rob_setup/HOME/1/1_T_ROB1.mod and 1_T_ROB2.mod: MultiMove modules an offline tool "
+         "saved on a controller"),
     )
 
     def format_export(self, data: ControllerData, cell_name: str) -> str:
@@ -82,6 +89,12 @@ class Abb(Controller):
 
     def read_program(self, path: str | Path) -> tuple[Program, list[str]]:
         return rapid.read(path)
+
+    def write_coordinated(self, programs: list[Program], header: list[str]) -> dict[str, str]:
+        return multimove.write_tasks(programs, header)
+
+    def coordinated_problems(self, paths: list[str | Path]) -> list[str]:
+        return multimove.id_problems({str(p): multimove.sync_moves(p) for p in paths})
 
     def point_names(self, n: int) -> list[str]:
         return [f"p{i + 1}" for i in range(n)]

@@ -33,7 +33,8 @@ from robotcell.controllers.model import Config, Program, ProgramPoint
 from robotcell.controllers.text import JOINT_DECIMALS, fmt_num
 from robotcell.io.poseformats import pose_to_vendor
 
-__all__ = ["EAX", "config_text", "read", "set_joints", "set_pose", "write"]
+__all__ = ["EAX", "config_text", "declarations", "read", "robtarget_text", "set_joints", "set_pose",
+           "speed_text", "write", "zone_text"]
 
 #: ABB's value of an external axis that is not connected.
 NO_AXIS = "9E9"
@@ -49,7 +50,8 @@ def config_text(values: tuple[int, ...]) -> str:
     return "[" + ",".join(str(x) for x in values) + "]"
 
 
-def _speed_text(v: float) -> str:
+def speed_text(v: float) -> str:
+    """``speeddata`` of a TCP speed ``v`` (m/s): predefined (``v100``) or written out."""
     mm = v * 1e3
     for s in SPEEDS:
         if abs(mm - s) < 1e-9:
@@ -57,7 +59,9 @@ def _speed_text(v: float) -> str:
     return f"[{mm:.6g},500,5000,1000]"
 
 
-def _zone_text(z: float) -> str:
+def zone_text(z: float) -> str:
+    """``zonedata`` of a corner distance ``z`` (m): ``fine``, predefined (``z10``) or written
+    out."""
     mm = z * 1e3
     if mm == 0:
         return "fine"
@@ -69,7 +73,8 @@ def _zone_text(z: float) -> str:
     return "[FALSE," + ",".join(f"{v:.6g}" for v in values) + "]"
 
 
-def _robtarget(p: ProgramPoint) -> str:
+def robtarget_text(p: ProgramPoint) -> str:
+    """The ``robtarget`` value of a Cartesian point (mm, quaternion, confdata, extax)."""
     assert p.pose is not None and p.config is not None
     v = pose_to_vendor(p.pose, "abb")
     trans = ",".join(fmt_num(x, MM_DECIMALS) for x in v[:3])
@@ -84,7 +89,7 @@ def _robtarget(p: ProgramPoint) -> str:
 MODULE_PREFIX = "MOD_"
 
 
-def _declarations(program: Program, tool: str, wobj: str) -> list[str]:
+def declarations(program: Program, tool: str, wobj: str) -> list[str]:
     """``LOCAL PERS`` declarations of the program's tool and work object, with the values of
     ``robotcell export``, so that the module holds what it moves with (empty where the program
     carries no cell data, and for ``wobj0``)."""
@@ -128,15 +133,15 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
     first = program.points[0]
     tool, wobj = first.tool.name, first.frame.name or "wobj0"
     L = [f"MODULE {MODULE_PREFIX}{name}", *(f"    ! {h}" for h in header),
-         *_declarations(program, tool, wobj),
+         *declarations(program, tool, wobj),
          ("    ! robtarget: x, y, z (mm) and quaternion [q1,q2,q3,q4] of the TCP in the work "
           "object, confdata [cf1,cf4,cf6,cfx], extax (track mm, table deg; 9E9: no axis)")]
-    L += [f"    CONST robtarget {p.name}:={_robtarget(p)};" for p in program.points]
+    L += [f"    CONST robtarget {p.name}:={robtarget_text(p)};" for p in program.points]
     L += ["", f"    PROC {name}()", "        ConfJ \\On;", "        ConfL \\On;"]
     for p in program.points:
         move = "MoveJ" if p.motion == "ptp" else "MoveL"
-        L.append(f"        {move} {p.name},{_speed_text(p.speed or 0.1)},"
-                 f"{_zone_text(p.zone or 0.0)},{tool}\\WObj:={wobj};")
+        L.append(f"        {move} {p.name},{speed_text(p.speed or 0.1)},"
+                 f"{zone_text(p.zone or 0.0)},{tool}\\WObj:={wobj};")
     L += ["    ENDPROC", "ENDMODULE"]
     return {f"{name}.mod": "\n".join(L) + "\n"}
 

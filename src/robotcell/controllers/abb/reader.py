@@ -37,7 +37,7 @@ from robotcell.controllers.text import Lines, strip_comment
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 
-__all__ = ["EAX", "read"]
+__all__ = ["EAX", "MOVE_INSTRUCTIONS", "read"]
 
 #: The logical external axes of a robtarget, in order.
 EAX = ("eax_a", "eax_b", "eax_c", "eax_d", "eax_e", "eax_f")
@@ -65,6 +65,9 @@ _CIRCULAR = {n.lower() for n in ("MoveC", "MoveCDO", "MoveCAO", "MoveCGO", "Move
                                  "ArcC", "ArcCStart", "ArcCEnd", "ArcC1", "ArcC2", "SearchC")}
 _OTHER_MOTIONS = {"searchl": "a search motion stops where its signal comes",
                   "moveextj": "a motion of external axes only"}
+#: Every move instruction the reader knows, in lower case (MultiMove's ``\\ID`` rules apply to
+#: them all).
+MOVE_INSTRUCTIONS = frozenset(_MOTIONS) | frozenset(_CIRCULAR) | frozenset(_OTHER_MOTIONS)
 
 
 def statements(lines: Lines) -> list[tuple[int, str]]:

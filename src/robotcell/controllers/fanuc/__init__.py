@@ -71,6 +71,10 @@ class Fanuc(Controller):
     config_fields = ("flip", "down", "back", "turn1", "turn4", "turn6")
     edits_joints = True
     csv_config = ("config",)
+    coordinated_missing = (
+        "a FANUC program of two robot groups (Multi-Arm, Coordinated Motion: the group mask "
+        "with several robots and the points of each group) is shown by no public FANUC manual "
+        "or real .ls file in the sources robotcell cites")
     sources = (
         "Roboception rc_visard documentation, 'Pose formats: FANUC' (W, P, R)",
         ("industrialmonitordirect.com knowledge base, 'FANUC robot frame selection: UFRAME_NUM "

@@ -59,6 +59,10 @@ class Kuka(Controller):
     config_fields = ("S", "T")
     edits_joints = True
     csv_config = ("s", "t")
+    coordinated_missing = (
+        "KUKA's coordinated motion of several robots (RoboTeam) is declared in the "
+        "controllers' configuration and in KRL statements whose form no public KUKA manual or "
+        "real program in the sources robotcell cites shows")
     ik_flags = IkFlags("S/T", ("status", "turn"), _status_turn, lambda v: f"S {v[0]} T {v[1]}")
     zero_offsets = ZeroOffsets(180 / math.pi, 1e3, "deg", "mm",
                                "joint zero corrections for KUKA: add to the current $MAMES[i] in "

@@ -59,6 +59,11 @@ class Yaskawa(Controller):
     frame_slots = SlotRange("UFRAME", 0, 23)
     config_fields = ("l", "m", "n", "o", "p", "q")
     shared_config = True
+    coordinated_missing = (
+        "the sources robotcell cites show jobs of one robot with a base axis and a station "
+        "(///GROUP1 RB1,BS1, ///GROUP2 ST1, +MOVJ EC...), but no public manual page or real "
+        "job of two robots in one job (R1 + R2: its ///GROUP lines and how the points of "
+        "each robot are numbered in //POS)")
     sources = (
         "Roboception documentation, 'Pose formats: Yaskawa' (Rx, Ry, Rz)",
         ("Motoman NX100 manual HW0481924, 4.1 'Job Data Format': //NAME up to 8 characters, "
