@@ -59,7 +59,8 @@ from robotcell.view.cellscene import cell_figure
 from robotcell.view.plot import write_html
 from robotcell.view.program import write_program_view
 
-__all__ = ["DEMO_NOISE", "EXPORT_FILES", "VIEW_TABLE", "Comparison", "export_file", "run_demo"]
+__all__ = ["DEMO_NOISE", "EXPORT_FILES", "VIEW_TABLE", "Comparison", "comparison_table",
+           "export_file", "reported_sigma", "run_demo"]
 
 
 def export_file(fmt: str) -> str:
@@ -100,7 +101,9 @@ class Comparison:
     rotation_sigma: float
 
 
-def _sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
+def reported_sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
+    """Lengths of the 1-sigma position (m) and rotation (rad) vectors a result's JSON reports for
+    pose ``key`` (``T_F_TCP``, ...); NaN where it reports none."""
     s = result.get("sigma") or {}
     p = s.get(key + "_position_mm")
     r = s.get(key + "_rotation_deg")
@@ -188,7 +191,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     calibrated = Cell.load(cell_file)  # as the file holds it (rounded to 1e-10 mm, deg)
     comparisons = _compare(calibrated, truth, results)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
-    echo(_comparison_table(comparisons))
+    echo(comparison_table(comparisons))
     _write_outputs(out, calibrated, results, echo)
     accuracy_step(out, seed, echo)
     acceptance_step(out, truth, nominal, calibrated, seed, echo)
@@ -212,12 +215,14 @@ def _compare(calibrated: Cell, truth: Cell,
     out = []
     for item, est, true, res, key in rows:
         dp, dr = pose_error(est, true)
-        sp, sr = _sigma(res, key)
+        sp, sr = reported_sigma(res, key)
         out.append(Comparison(item, est, true, dp, dr, sp, sr))
     return out
 
 
-def _comparison_table(rows: list[Comparison]) -> str:
+def comparison_table(rows: list[Comparison]) -> str:
+    """The calibrated and the true pose of each row (KUKA X, Y, Z mm, A, B, C deg) and the
+    errors in mm, deg and units of the reported 1-sigma, as a text table."""
     from robotcell.io.poseformats import pose_to_vendor
     from robotcell.io.tables import format_table
 
