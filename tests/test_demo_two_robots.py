@@ -7,6 +7,7 @@ from pathlib import Path
 from cli_helpers import run
 
 from robotcell.cell import Cell
+from robotcell.demo.tworobots import run_two_robot_demo
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,6 +34,19 @@ def test_two_robot_demo_prints_every_result_within_4_sigma_of_the_truth(tmp_path
     assert cell.robots["abb"].tools["torch"].provenance.source == "tcp"
     assert cell.turntable.provenance.source == "positioner"
     assert "3D view of the calibrated cell, both robots" in out
+
+
+def test_the_library_call_returns_every_pose_within_4_sigma_of_the_truth(tmp_path):
+    lines: list[str] = []
+    rows = run_two_robot_demo(tmp_path, seed=5, echo=lines.append)
+    assert [r.item.split(" (")[0] for r in rows] == [
+        "tool torch of kuka", "tool torch of abb", "track KL1500 of kuka", "base of abb in kuka",
+        "positioner DKP_2 root"]
+    for r in rows:
+        assert 0 < r.position_sigma < 1e-3 and 0 < r.rotation_sigma < 1e-2, r.item
+        assert r.position_error <= 4 * r.position_sigma, r.item
+        assert r.rotation_error <= 4 * r.rotation_sigma, r.item
+    assert any("everything is in" in line for line in lines)
 
 
 def test_the_demo_cell_is_the_example_cell():
