@@ -101,9 +101,7 @@ class Comparison:
     rotation_sigma: float
 
 
-def reported_sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
-    """Lengths of the 1-sigma position (m) and rotation (rad) vectors a result's JSON reports for
-    pose ``key`` (``T_F_TCP``, ...); NaN where it reports none."""
+def _sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
     s = result.get("sigma") or {}
     p = s.get(key + "_position_mm")
     r = s.get(key + "_rotation_deg")
@@ -191,7 +189,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     calibrated = Cell.load(cell_file)  # as the file holds it (rounded to 1e-10 mm, deg)
     comparisons = _compare(calibrated, truth, results)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
-    echo(comparison_table(comparisons))
+    echo(_comparison_table(comparisons))
     _write_outputs(out, calibrated, results, echo)
     accuracy_step(out, seed, echo)
     acceptance_step(out, truth, nominal, calibrated, seed, echo)
@@ -215,14 +213,12 @@ def _compare(calibrated: Cell, truth: Cell,
     out = []
     for item, est, true, res, key in rows:
         dp, dr = pose_error(est, true)
-        sp, sr = reported_sigma(res, key)
+        sp, sr = _sigma(res, key)
         out.append(Comparison(item, est, true, dp, dr, sp, sr))
     return out
 
 
-def comparison_table(rows: list[Comparison]) -> str:
-    """The calibrated and the true pose of each row (KUKA X, Y, Z mm, A, B, C deg) and the
-    errors in mm, deg and units of the reported 1-sigma, as a text table."""
+def _comparison_table(rows: list[Comparison]) -> str:
     from robotcell.io.poseformats import pose_to_vendor
     from robotcell.io.tables import format_table
 
@@ -288,6 +284,16 @@ def _write_view(out: Path, cell: Cell) -> Path:
     q = sol.q[sol.valid][0]
     fig = cell_figure(cell, q, float(sol.track), VIEW_TABLE)
     return write_html(fig, out / "cell.html", title=f"{cell.name}: robotcell view")
+
+
+#: ``reported_sigma(result, key)``: lengths of the 1-sigma position (m) and rotation (rad)
+#: vectors a result's JSON reports for pose ``key`` (NaN where it reports none); shared with the
+#: two-robot demo (:mod:`robotcell.demo.tworobots`).
+reported_sigma = _sigma
+
+#: ``comparison_table(rows)``: the calibrated and the true pose of each :class:`Comparison`
+#: (KUKA X, Y, Z mm, A, B, C deg) with the errors in mm, deg and units of the reported 1-sigma.
+comparison_table = _comparison_table
 
 
 def _provenances(cell: Cell) -> list[tuple[str, Provenance]]:
