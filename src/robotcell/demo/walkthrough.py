@@ -60,7 +60,8 @@ from robotcell.view.cellscene import cell_figure
 from robotcell.view.plot import write_html
 from robotcell.view.program import write_program_view
 
-__all__ = ["DEMO_NOISE", "EXPORT_FILES", "VIEW_TABLE", "Comparison", "export_file", "run_demo"]
+__all__ = ["DEMO_NOISE", "EXPORT_FILES", "VIEW_TABLE", "Comparison", "comparison_table",
+           "export_file", "reported_sigma", "run_demo"]
 
 
 def export_file(fmt: str) -> str:
@@ -296,6 +297,16 @@ def _write_view(out: Path, cell: Cell) -> Path:
     q = sol.q[sol.valid][0]
     fig = cell_figure(cell, q, float(sol.track), VIEW_TABLE)
     return write_html(fig, out / "cell.html", title=f"{cell.name}: robotcell view")
+
+
+#: ``reported_sigma(result, key)``: lengths of the 1-sigma position (m) and rotation (rad)
+#: vectors a result's JSON reports for pose ``key`` (NaN where it reports none); shared with the
+#: two-robot demo (:mod:`robotcell.demo.tworobots`).
+reported_sigma = _sigma
+
+#: ``comparison_table(rows)``: the calibrated and the true pose of each :class:`Comparison`
+#: (KUKA X, Y, Z mm, A, B, C deg) with the errors in mm, deg and units of the reported 1-sigma.
+comparison_table = _comparison_table
 
 
 def _provenances(cell: Cell) -> list[tuple[str, Provenance]]:
