@@ -213,7 +213,7 @@ def run_two_robot_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int 
     for stale in (cell_file, truth_file, *(b for _, b in backups(cell_file)),
                   *(b for _, b in backups(truth_file))):  # a run before in the same folder
         stale.unlink(missing_ok=True)
-    truth, nominal = _cells(cell_file)
+    truth, _ = _cells(cell_file)
     truth.save(truth_file)
     echo(f"virtual cell: a KUKA KR 16 on a 3 m track (KL1500) and an ABB IRB 2400 sharing a "
          f"2-axis positioner (DKP_2), each with its tool 'torch'\n"

@@ -106,7 +106,9 @@ class Comparison:
     basis: str = ""
 
 
-def _sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
+def reported_sigma(result: dict[str, Any], key: str) -> tuple[float, float]:
+    """Lengths of the 1-sigma position (m) and rotation (rad) vectors a result's JSON reports
+    for pose ``key`` (NaN where it reports none)."""
     s = result.get("sigma") or {}
     p = s.get(key + "_position_mm")
     r = s.get(key + "_rotation_deg")
@@ -201,7 +203,7 @@ def run_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int = 1,
     calibrated = Cell.load(cell_file)  # as the file holds it (rounded to 1e-10 mm, deg)
     comparisons = _compare(calibrated, truth, results)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
-    echo(_comparison_table(comparisons))
+    echo(comparison_table(comparisons))
     echo("each reported 1-sigma:\n" + "\n".join(f"  {c.item}: {c.basis}" for c in comparisons))
     _write_outputs(out, calibrated, results, echo)
     accuracy_step(out, seed, echo)
@@ -226,12 +228,14 @@ def _compare(calibrated: Cell, truth: Cell,
     out = []
     for item, est, true, res, key in rows:
         dp, dr = pose_error(est, true)
-        sp, sr = _sigma(res, key)
+        sp, sr = reported_sigma(res, key)
         out.append(Comparison(item, est, true, dp, dr, sp, sr, _basis(res, key)))
     return out
 
 
-def _comparison_table(rows: list[Comparison]) -> str:
+def comparison_table(rows: list[Comparison]) -> str:
+    """The calibrated and the true pose of each :class:`Comparison` (KUKA X, Y, Z mm, A, B, C
+    deg) with the errors in mm, deg and units of the reported 1-sigma."""
     from robotcell.io.poseformats import pose_to_vendor
     from robotcell.io.tables import format_table
 
@@ -297,16 +301,6 @@ def _write_view(out: Path, cell: Cell) -> Path:
     q = sol.q[sol.valid][0]
     fig = cell_figure(cell, q, float(sol.track), VIEW_TABLE)
     return write_html(fig, out / "cell.html", title=f"{cell.name}: robotcell view")
-
-
-#: ``reported_sigma(result, key)``: lengths of the 1-sigma position (m) and rotation (rad)
-#: vectors a result's JSON reports for pose ``key`` (NaN where it reports none); shared with the
-#: two-robot demo (:mod:`robotcell.demo.tworobots`).
-reported_sigma = _sigma
-
-#: ``comparison_table(rows)``: the calibrated and the true pose of each :class:`Comparison`
-#: (KUKA X, Y, Z mm, A, B, C deg) with the errors in mm, deg and units of the reported 1-sigma.
-comparison_table = _comparison_table
 
 
 def _provenances(cell: Cell) -> list[tuple[str, Provenance]]:
