@@ -134,3 +134,14 @@ def test_calibrate_cell_says_what_each_items_sigma_is_relative_to(tmp_path, caps
     own = "from its own touches, with the cell's other calibrations, and the errors it inherits"
     assert f"  tools.pointer: relative to the flange, {own}" in out
     assert f"  turntable: relative to frame 'world', {own}" in out
+
+
+def test_an_assumed_part_under_1_percent_of_the_own_part_is_no_reason_of_the_verdict():
+    from robotcell.calibration.verdict import _assumed_parts
+    parts = {"radius": {"unit": "mm", "assumed": {"sigma": [9e-9], "sources": ["track"]},
+                        "own": {"sigma": [0.04]}},
+             "tilt": {"unit": "deg", "assumed": {"sigma": [0.7], "sources": ["track"]},
+                      "own": {"sigma": [0.016]}}}
+    reasons = _assumed_parts({"sigma_parts": parts})
+    assert len(reasons) == 1 and reasons[0].startswith("tilt: up to 0.7 deg of its 1-sigma is "
+                                                        "ASSUMED (track: no recorded uncertainty)")

@@ -309,10 +309,15 @@ def verdict(result: Mapping[str, Any]) -> Verdict:
                    accuracy_source=source, chi2=x2, chi2_bound=bound, touches_needed=needed)
 
 
+#: An assumed part of a 1-sigma below this share of its own part is left out of the reasons.
+NEGLIGIBLE = 0.01
+
+
 def _assumed_parts(result: Mapping[str, Any]) -> list[str]:
     """A reason per quantity whose 1-sigma holds an assumed part (``sigma_parts``: a pose's
     position, else its rotation; a value's ``sigma`` in its ``unit``), with the part its own
-    touches determine: an assumed figure must not read as a measured one."""
+    touches determine: an assumed figure must not read as a measured one. A part under 1 % of
+    what the own touches determine (a scalar the assumed input barely moves) is no reason."""
     out = []
     parts = result.get("sigma_parts")
     for key, p in (parts.items() if isinstance(parts, Mapping) else ()):
@@ -324,6 +329,8 @@ def _assumed_parts(result: Mapping[str, Any]) -> list[str]:
             own = float(np.nanmax(_floats(p["own"][field_])))
             names = ", ".join(str(n) for n in p["assumed"]["sources"])
         except (KeyError, TypeError, ValueError, StopIteration, AttributeError):
+            continue
+        if not assumed > NEGLIGIBLE * own:
             continue
         out.append(f"{key}: up to {assumed:.3g}{unit} of its 1-sigma is ASSUMED ({names}: no "
                    f"recorded uncertainty); its own touches determine it to {own:.3g}{unit} "

@@ -358,6 +358,7 @@ class _System:
             for name, F in errors.items():
                 f = Ninv @ gain[:nu] @ F
                 factors[name] = np.hstack([factors[name], f]) if name in factors else f
+        kept_widths: dict[str, int] = {}
         if self.kept:
             K = -Ninv @ self.N[:nu, nu:]
             for name, F in Sources.stack(list(self.kept.values())).map(K).factors.items():
@@ -365,7 +366,11 @@ class _System:
                     factors[name] = factors[name] + F
                 else:  # the same source reached by another route: its parts side by side
                     factors[name] = np.hstack([factors[name], F]) if name in factors else F
-        return step, Sources(nu, {k: _compact(f) for k, f in factors.items()})
+                kept_widths[name] = F.shape[1]
+        # A source of an item kept out of the fit keeps its columns (the item's parameters),
+        # so that the item's own uncertainty and this fit's share of it stay one error.
+        return step, Sources(nu, {k: f if kept_widths.get(k) == f.shape[1] else _compact(f)
+                                  for k, f in factors.items()})
 
 
 def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
