@@ -127,3 +127,9 @@ def test_plan_help_names_the_robot_to_robot_planner_and_its_help_has_an_example(
     assert code == 0 and "plan robot-to-robot --help" in out
     code, out, _ = run(capsys, "plan", "robot-to-robot", "--help")
     assert code == 0 and "robotcell plan robot-to-robot --cell" in out.split("Example", 1)[1]
+
+
+def test_a_small_common_volume_gives_designs_only_up_to_the_points_found(cell):
+    p = plan_robot_to_robot(cell, "abb", "kuka", noise=1e-4, seed=1, candidates=60)
+    assert p.reachable == 4
+    assert [len(d.points) for d in p.designs] == [3, 4]

@@ -63,7 +63,8 @@ class R2RPlan:
     Attributes
     ----------
     designs : list of R2RDesign
-        One per number of points (:data:`SIZES`), fewest first.
+        One per number of points (:data:`SIZES`, those the common points sampled allow),
+        fewest first.
     best : R2RDesign
         The recommended design: the smallest predicted 1-sigma of a point ``LEVER`` from the
         other robot's base, ``sqrt(position^2 + (LEVER * rotation)^2)``.
@@ -164,7 +165,8 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     seed : int, optional
         Seed of the sampled volume and of the Monte Carlo errors.
     candidates : int
-        Points sampled about the two bases (the common volume is those both reach).
+        Points sampled about the two bases (the common volume is those both reach; a design
+        of K points needs K of them).
 
     Returns
     -------
@@ -174,7 +176,7 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     ------
     InputError
         A cell of one robot, an unknown robot or tool, the same robot twice, a noise that is not
-        positive, or fewer common reachable points than the largest design needs.
+        positive, or fewer than 3 sampled points both robots reach.
     """
     if len(cell.robots) < 2:
         raise InputError("the cell has one robot; a robot-to-robot plan needs a cell of two or "
@@ -189,16 +191,17 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
            _tool(cell.for_robot(names[1]), names[1], tools[1]))
     rng = np.random.default_rng(seed)
     p_w = common_volume(cell, names, use, samples=candidates, rng=rng)
-    if len(p_w) < max(SIZES):
+    sizes = [k for k in SIZES if k <= len(p_w)]
+    if not sizes:
         raise InputError(f"robots {names[0]!r} and {names[1]!r} reach {len(p_w)} of "
                          f"{candidates} sampled points with their tools pointing down, fewer "
-                         f"than {max(SIZES)}: no common reachable volume; move the robots or "
+                         f"than {min(SIZES)}: no common reachable volume; move the robots or "
                          "their tracks closer")
     T_w_ref, T_w_oth = (cell.for_robot(n).frame_pose("robot", track=0.0) for n in names)
     T_true = invert(T_w_ref) @ T_w_oth
     p_ref, p_oth = transform_points(invert(T_w_ref), p_w), transform_points(invert(T_w_oth), p_w)
-    order = _spread(p_w, max(SIZES))
+    order = _spread(p_w, max(sizes))
     designs = [_predict(p_ref[order[:k]], p_oth[order[:k]], noise, runs, rng, T_true)
-               for k in SIZES]
+               for k in sizes]
     best = min(designs, key=lambda d: np.hypot(d.position, LEVER * d.rotation))
     return R2RPlan(designs, best, len(p_w), use)
