@@ -67,7 +67,21 @@ def _designs(procedure: str, max_size: float | None, max_radius: float | None
     return designs
 
 
-@click.command(cls=Command)
+class _Plan(Command):
+    """``plan``, which hands ``plan robot-to-robot ...`` to the common points of two robots of a
+    cell (:func:`robotcell.cli.robottorobot.plan_robot_to_robot_cmd`), a planner of its own."""
+
+    def make_context(self, info_name: str | None, args: list[str],
+                     parent: click.Context | None = None, **extra: Any) -> click.Context:
+        if args[:1] == ["robot-to-robot"]:
+            from robotcell.cli.robottorobot import plan_robot_to_robot_cmd
+
+            return plan_robot_to_robot_cmd.make_context(f"{info_name} robot-to-robot",
+                                                        args[1:], parent, **extra)
+        return super().make_context(info_name, args, parent, **extra)
+
+
+@click.command(cls=_Plan)
 @click.argument("procedure", type=ProcedureChoice(DESIGNS))
 @cell_options
 @click.option("--runs", type=click.IntRange(min=0), default=100, show_default=True,
@@ -90,6 +104,7 @@ def plan(procedure: str, cell_path: str, noise: float, runs: int, output: str | 
     Monte Carlo run (--runs simulated calibrations with errors), with progress shown on stderr.
     The figure of merit is the 1-sigma error of a point 500 mm from the calibrated frame's
     origin: sqrt(sigma_position^2 + (500 mm * sigma_rotation)^2).
+    'robotcell plan robot-to-robot --help': where to put the common points of two robots.
 
     \b
     Examples:

@@ -1,11 +1,13 @@
-"""``robotcell calibrate robot-to-robot`` and ``robotcell simulate robot-to-robot``.
+"""``robotcell calibrate``, ``simulate`` and ``plan robot-to-robot``.
 
 ``calibrate robot-to-robot REF.csv OTHER.csv`` reads the touches of two robots (mm, deg; column
 ``point`` names the common point of every touch) and prints the pose of the other robot's base in
 the reference robot's base (KUKA X,Y,Z,A,B,C in mm and deg) with the report, or ``--json``.
 ``simulate robot-to-robot`` writes such a pair of files for two arms of the robot library at a
-stated pose. Registered in :data:`robotcell.cli.calibrate.REGISTERED` and dispatched by
-:class:`robotcell.cli.simulate` (see ``docs/calibration.md`` and ``docs/simulate.md``).
+stated pose. ``plan robot-to-robot`` proposes where to put the common points in a cell of
+several robots. Registered in :data:`robotcell.cli.calibrate.REGISTERED` and dispatched by
+:class:`robotcell.cli.simulate` and :class:`robotcell.cli.plan` (see ``docs/calibration.md``
+and ``docs/simulate.md``).
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from robotcell.cli.calibrate import (
     robot_and_tool,
     sigma_m,
 )
-from robotcell.cli.common import NOISE_MAX_MM, output_of, parse_numbers, read_csv
+from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of, parse_numbers, read_csv
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write
@@ -48,6 +50,7 @@ from robotcell.studies.robottorobot import (
     simulate_robot_to_robot,
     table_text,
 )
+from robotcell.studies.robottorobot_plan import R2RDesign, plan_robot_to_robot
 
 
 def _table(path: str, robot: str | None, tool: str | None, option: str) -> RobotTable:
@@ -257,3 +260,75 @@ def simulate_robot_to_robot_cmd(points: tuple[str, ...], repeats: int, noise: fl
     click.echo(f"calibrate them:\n  robotcell calibrate robot-to-robot {ref_output} "
                f"{other_output} --robot-ref {robot_ref} --tool-ref {tool_ref} --robot-other "
                f"{robot_other} --tool-other {tool_other} --sigma {max(noise, 0.001):g}", err=True)
+
+
+def _points_csv(points: np.ndarray) -> str:
+    """Common points (K, 3, m) as CSV: ``point`` (P1, P2, ...) and x, y, z (mm, 3 decimals)."""
+    rows = [f"P{i + 1},{p[0]:.3f},{p[1]:.3f},{p[2]:.3f}" for i, p in enumerate(points * 1e3)]
+    return "\n".join(["point,x,y,z", *rows]) + "\n"
+
+
+def _design_row(d: R2RDesign, best: R2RDesign) -> list[object]:
+    mc = ("-", "-") if np.isnan(d.position_rms) else (
+        d.position_rms * 1e3, f"{np.degrees(d.rotation_rms):.4f}")
+    return [len(d.points), d.position * 1e3, f"{np.degrees(d.rotation):.4f}", *mc,
+            "<- best" if d is best else ""]
+
+
+@click.command("robot-to-robot", cls=Command)
+@click.option("--cell", "cell_path", required=True, type=click.Path(dir_okay=False),
+              help="A cell of several robots, taken as the truth.")
+@click.option("--robot", required=True, metavar="NAME",
+              help="The robot whose base is calibrated.")
+@click.option("--reference", "reference_robot", required=True, metavar="NAME",
+              help="The robot whose base the result and the points are in.")
+@click.option("--tool-ref", default=None, metavar="NAME",
+              help="The reference robot's tool that touches (default: its first in the cell).")
+@click.option("--tool-other", default=None, metavar="NAME",
+              help="The other robot's tool that touches (default: its first in the cell).")
+@click.option("--noise", type=float, default=0.1, show_default=True, metavar="MM",
+              help="Touch-up accuracy, 1-sigma per coordinate (mm).")
+@click.option("--runs", type=click.IntRange(0, 10000), default=100, show_default=True,
+              help="Monte Carlo calibrations per design (0: none).")
+@click.option("--seed", type=click.IntRange(min=0), default=None,
+              help="Seed of the sampled volume and the Monte Carlo errors.")
+@click.option("-o", "--output", type=OUTPUT, default=None,
+              callback=output_of("CSV", "the recommended common points"),
+              help="Write the recommended design's points (point, x, y, z mm in the reference "
+                   "robot's base) as CSV, atomically.")
+def plan_robot_to_robot_cmd(cell_path: str, robot: str, reference_robot: str,
+                            tool_ref: str | None, tool_other: str | None, noise: float,
+                            runs: int, seed: int | None, output: str | None) -> None:
+    """Propose where to put the common points of a robot-to-robot calibration.
+
+    \b
+    Samples the volume about the two robots' bases (track position 0), keeps the points both
+    reach with their tools pointing straight down, and proposes designs of 3, 4, 5 and 6 common
+    points spread over that volume. For each, the predicted 1-sigma of the other robot's base
+    in the reference robot's base at the touch-up accuracy --noise, and the RMS error of --runs
+    simulated calibrations. -o writes the recommended design's points.
+
+    \b
+    Example:
+      robotcell plan robot-to-robot --cell examples/cell_two_robots_positioner.yaml --robot abb --reference kuka --seed 1 -o points.csv
+    """
+    if not 0 < noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a positive number of millimetres, at most "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
+    cell = Cell.load(cell_path)
+    p = plan_robot_to_robot(cell, robot, reference_robot, tools=(tool_ref, tool_other),
+                            noise=noise * 1e-3, runs=runs, seed=seed)
+    click.echo(f"robot-to-robot plan: base of {robot!r} in the base of {reference_robot!r}, "
+               f"touch-up error {noise:g} mm (1-sigma per coordinate); {p.reachable} sampled "
+               "points reached by both robots")
+    click.echo(format_table(["points", "position mm", "rotation deg", "MC position mm",
+                             "MC rotation deg", ""], [_design_row(d, p.best) for d in p.designs]))
+    click.echo(f"\nbest: {len(p.best.points)} common points (mm, in the base of "
+               f"{reference_robot!r}):")
+    click.echo(_points_csv(p.best.points), nl=False)
+    if output is not None:
+        atomic_write(output, _points_csv(p.best.points))
+        click.echo(f"wrote the recommended points to {output}; touch each with both robots and "
+                   f"calibrate with:\n  robotcell calibrate robot-to-robot REF.csv OTHER.csv "
+                   f"--cell {cell_path} --robot {robot} --reference {reference_robot} "
+                   f"--tool-ref {p.tools[0]} --tool-other {p.tools[1]}", err=True)
