@@ -22,7 +22,7 @@ from robotcell.cell.kinematics import frame_pose, robot_pose, table_batch, table
 from robotcell.cell.model import Cell
 from robotcell.clearance.bodies import BodiesFile, Body
 from robotcell.clearance.distance import Clearance, Shapes, smallest_distances
-from robotcell.clearance.skeleton import link_segments
+from robotcell.clearance.skeleton import frame_segments
 from robotcell.errors import InputError
 from robotcell.kinematics.transforms import finite_array
 
@@ -272,7 +272,8 @@ def arm_shapes(cell: Cell, arm: ArmMotion, pos: NDArray[np.float64], bodies: Bod
     Q = _linear_joints(cell, arm.q, Q, pos, arm.linear, flange_tool)
     Es = interpolate(arm.E[:, None], pos)[:, 0]
     T_world_R = robot_pose(cell, Es)
-    segs, names = link_segments(cell.robot, Q, arm.T_tool)
+    F = cell.robot.frames(Q)
+    segs, names = frame_segments(cell.robot, F, arm.T_tool)
     kept = np.flatnonzero(np.linalg.norm(segs[..., 1, :] - segs[..., 0, :], axis=-1).max(axis=0)
                           > 1e-9)
     segs, names = segs[:, kept], tuple(prefix + names[k] for k in kept)
@@ -280,8 +281,7 @@ def arm_shapes(cell: Cell, arm: ArmMotion, pos: NDArray[np.float64], bodies: Bod
     r = bodies.links.radius_of(cell.robot)
     radius = np.array([bodies.links.tool_radius if nm[len(prefix):] == "tool" else r
                        for nm in names])
-    return (Shapes.capsules(names, segs, radius), Es,
-            T_world_R @ cell.robot.fk(Q, np.eye(4)))
+    return Shapes.capsules(names, segs, radius), Es, T_world_R @ F[:, -1] @ cell.robot.flange
 
 
 def _body_shapes(cell: Cell, bodies: Sequence[Body], E: NDArray[np.float64],

@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from robotcell.errors import InputError
 from robotcell.kinematics.arm import Arm
 
-__all__ = ["LinkModel", "default_radius", "link_segments"]
+__all__ = ["LinkModel", "default_radius", "frame_segments", "link_segments"]
 
 #: Default link radius as a share of the arm's reach, and its bounds (m).
 RADIUS_SHARE, RADIUS_MIN, RADIUS_MAX = 0.06, 0.03, 0.15
@@ -83,7 +83,14 @@ def link_segments(arm: Arm, q: ArrayLike, tool: ArrayLike | None = None
     names : tuple of str, length S
         The link each segment belongs to: ``base``, ``link1`` .. ``linkN``, ``flange``, ``tool``.
     """
-    F = arm.frames(q)
+    return frame_segments(arm, arm.frames(q), tool)
+
+
+def frame_segments(arm: Arm, F: NDArray[np.float64], tool: ArrayLike | None = None
+                   ) -> tuple[NDArray[np.float64], tuple[str, ...]]:
+    """:func:`link_segments` from the arm's DH frames ``F = arm.frames(q)``, shape
+    ``(..., m + 1, 4, 4)``, for a caller that uses the frames too (the flange is
+    ``F[..., -1, :, :] @ arm.flange``)."""
     O = F[..., :3, 3]
     segs = [(np.zeros_like(O[..., 0, :]), O[..., 0, :])]
     names = ["base"]
