@@ -340,7 +340,7 @@ def fit(
         other = _solve(fun, sol.x, keep, measured, inputs, factor, s)
         if keeps_out(other, worst):
             sol = other
-    return _finish(sol, s, sigma is not None, inputs, factor)
+    return _finish(sol, s, sigma is not None, inputs)
 
 
 def keeps_out(result: Fit | _Solved, worst: int) -> bool:
@@ -389,7 +389,7 @@ def solution_fit(x: ArrayLike, J: ArrayLike, r: ArrayLike, *, used: ArrayLike | 
     factor = inputs.sources.matrix()[0] if inputs is not None else np.zeros((0, 0))
     sol = _analyse(np.asarray(x, dtype=float), J, np.asarray(r, dtype=float),
                    np.broadcast_to(np.eye(3), (n, 3, 3)), used, inputs, factor, s)
-    return _finish(sol, s, sigma is not None, inputs, factor)
+    return _finish(sol, s, sigma is not None, inputs)
 
 
 def _solve(fun, x0, used, measured, inputs, factor, s) -> _Solved:
@@ -450,8 +450,7 @@ def _analyse(x, J, r, P, used, inputs, factor, s) -> _Solved:
                    suspects)
 
 
-def _finish(sol: _Solved, s: float, stated: bool, inputs: Inputs | None,
-            factor: NDArray[np.float64]) -> Fit:
+def _finish(sol: _Solved, s: float, stated: bool, inputs: Inputs | None) -> Fit:
     """The :class:`Fit` of a solution: noise level, covariance with the inputs' share."""
     source = "prior" if stated else "default"
     touch, residual_sigma = s, float("nan")
