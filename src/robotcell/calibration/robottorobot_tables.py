@@ -26,7 +26,8 @@ from robotcell.errors import InputError
 from robotcell.io.tables import empty_rows
 from robotcell.robot.robot import Robot
 
-__all__ = ["NOMINAL_TOOL_SIGMA", "SPEC", "RobotTable", "robot_to_robot_tables"]
+__all__ = ["NOMINAL_TOOL_SIGMA", "SPEC", "RobotTable", "robot_to_robot_tables", "robot_touches",
+           "tool_error"]
 
 #: The measurement table of one robot's touches.
 SPEC = TableSpec(
@@ -79,9 +80,19 @@ def _names(table: RobotTable, n: int) -> tuple[str, ...]:
     return tuple(str(v).strip() for v in values)[:n]
 
 
-def _touches(table: RobotTable, tool_sigma: float | None,
-             on_note: Callable[[str], None] | None) -> RobotTouches:
-    """One robot's touches: TCP positions, or flange poses with the tool and its error."""
+def tool_error(robot: str, tool_sigma: float | None) -> Sources:
+    """The error of a robot's tool as one source named after the robot (``"r1 tool"``, marked
+    assumed when nobody stated it), over its TCP position (3): the same error in every set of
+    touches the robot made with it."""
+    sigma = NOMINAL_TOOL_SIGMA if tool_sigma is None else tool_sigma
+    suffix = ASSUMED_SUFFIX if tool_sigma is None else ""
+    return Sources.of(f"{robot} tool{suffix}", np.eye(3) * sigma**2)
+
+
+def robot_touches(table: RobotTable, tool_sigma: float | None,
+                  on_note: Callable[[str], None] | None) -> RobotTouches:
+    """One robot's touches of common points: TCP positions, or flange poses with the tool and
+    its error (:func:`tool_error`)."""
     m = read_touch_table(SPEC, table.columns, table.source, table.robot, on_note)
     names = _names(table, m.n)
     if m.points is not None:
@@ -91,10 +102,9 @@ def _touches(table: RobotTable, tool_sigma: float | None,
                     "with the robot and the tool to include it")
         return RobotTouches(m.points, names, robot=table.name)
     tool = table.robot.tool if table.tool is None else table.tool
-    sigma = NOMINAL_TOOL_SIGMA if tool_sigma is None else tool_sigma
-    suffix = ASSUMED_SUFFIX if tool_sigma is None else ""
-    src = Sources.of(f"{table.name} tool{suffix}", np.eye(3) * sigma**2)
-    return RobotTouches.from_flange(m.flange(), tool, names, tool_sigma=src, robot=table.name)
+    return RobotTouches.from_flange(m.flange(), tool, names,
+                                    tool_sigma=tool_error(table.name, tool_sigma),
+                                    robot=table.name)
 
 
 def robot_to_robot_tables(reference: RobotTable, other: RobotTable, *, sigma: float | None = None,
@@ -123,6 +133,6 @@ def robot_to_robot_tables(reference: RobotTable, other: RobotTable, *, sigma: fl
     """
     if tool_sigma is not None and not (np.isfinite(tool_sigma) and tool_sigma > 0):
         raise InputError(f"the tools' accuracy must be a positive number, got {tool_sigma}")
-    ref = _touches(reference, tool_sigma, on_note)
-    oth = _touches(other, tool_sigma, on_note)
+    ref = robot_touches(reference, tool_sigma, on_note)
+    oth = robot_touches(other, tool_sigma, on_note)
     return robot_to_robot(ref, oth, sigma=sigma, method=method)

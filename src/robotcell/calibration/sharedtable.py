@@ -42,7 +42,8 @@ from robotcell.calibration.uncertainty import OWN, Sources, estimate
 from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
 
-__all__ = ["Agreement", "compare_shared", "shared_turntable"]
+__all__ = ["Agreement", "carried", "compare_shared", "judge_agreement", "pose_estimate",
+           "prior_warnings", "shared_turntable"]
 
 _AXES = ("position x", "position y", "position z", "rotation about x", "rotation about y",
          "rotation about z")
@@ -69,6 +70,10 @@ class Agreement:
     message : str
         What the comparison says: agreement, or the disagreement with the components beyond
         ``level`` and what to check.
+    components : tuple of str
+        The name of each component (default: a pose's ``position x`` .. ``rotation about z``).
+    lengths : tuple of bool
+        Per component, whether it is a length (m; else an angle, rad).
     """
 
     difference: NDArray[np.float64]
@@ -77,6 +82,8 @@ class Agreement:
     bound: float
     level: float
     message: str
+    components: tuple[str, ...] = _AXES
+    lengths: tuple[bool, ...] = (True,) * 3 + (False,) * 3
 
     @property
     def sigma(self) -> NDArray[np.float64]:
@@ -89,17 +96,20 @@ class Agreement:
         return self.chi2 <= self.bound
 
     def to_json(self) -> dict[str, Any]:
-        """The comparison in mm and deg."""
+        """The comparison in mm and deg: the length components' differences and 1-sigma in mm,
+        the angles' in deg, each in the order of ``components``."""
         z = self.difference / np.where(self.sigma > 0, self.sigma, np.inf)
-        return {"difference_mm": (self.difference[:3] * 1e3).tolist(),
-                "difference_deg": np.degrees(self.difference[3:]).tolist(),
-                "sigma_mm": (self.sigma[:3] * 1e3).tolist(),
-                "sigma_deg": np.degrees(self.sigma[3:]).tolist(), "z": z.tolist(),
+        m = np.array(self.lengths, dtype=bool)
+        return {"components": list(self.components),
+                "difference_mm": (self.difference[m] * 1e3).tolist(),
+                "difference_deg": np.degrees(self.difference[~m]).tolist(),
+                "sigma_mm": (self.sigma[m] * 1e3).tolist(),
+                "sigma_deg": np.degrees(self.sigma[~m]).tolist(), "z": z.tolist(),
                 "chi2": self.chi2, "bound": self.bound, "agree": self.agree,
                 "message": self.message}
 
 
-def _pose_estimate(result: CalibrationResult, name: str) -> tuple[NDArray[np.float64], Sources]:
+def pose_estimate(result: CalibrationResult, name: str) -> tuple[NDArray[np.float64], Sources]:
     """The pose of a result (its first 4x4 value with error sources) and its sources, its own
     touch noise renamed after the calibration so that two results' own noises stay apart."""
     for key, value in result.values.items():
@@ -109,7 +119,7 @@ def _pose_estimate(result: CalibrationResult, name: str) -> tuple[NDArray[np.flo
     raise InputError(f"the {result.procedure} result has no pose with error sources to compare")
 
 
-def _carried(T_ro: NDArray[np.float64], T_oB: NDArray[np.float64]
+def carried(T_ro: NDArray[np.float64], T_oB: NDArray[np.float64]
              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Derivatives of ``T_ro T_oB`` (origin, rotation vector) by those of ``T_ro`` and ``T_oB``."""
     R = T_ro[:3, :3]
@@ -146,34 +156,61 @@ def compare_shared(ref: CalibrationResult, other: CalibrationResult, link: Calib
     Agreement
         ``T_ref_B`` minus ``T_ref_other T_other_B``, its covariance and the verdict.
     """
-    T_a, s_a = _pose_estimate(ref, f"{names[0]} turntable")
-    T_b, s_b = _pose_estimate(other, f"{names[1]} turntable")
-    T_ro, s_ro = _pose_estimate(link, "robot-to-robot")
+    T_a, s_a = pose_estimate(ref, f"{names[0]} turntable")
+    T_b, s_b = pose_estimate(other, f"{names[1]} turntable")
+    T_ro, s_ro = pose_estimate(link, "robot-to-robot")
     T_c = T_ro @ T_b
-    J_ro, J_b = _carried(T_ro, T_b)
+    J_ro, J_b = carried(T_ro, T_b)
     diff = np.concatenate([T_a[:3, 3] - T_c[:3, 3],
                            Rotation.from_matrix(T_a[:3, :3] @ T_c[:3, :3].T).as_rotvec()])
     sources = s_a.select(range(6)) + s_ro.select(range(6)).map(-J_ro) + s_b.select(
         range(6)).map(-J_b)
-    cov = sources.covariance
+    return judge_agreement(diff, sources.covariance, level, names, "turntable")
+
+
+def judge_agreement(diff: NDArray[np.float64], cov: NDArray[np.float64], level: float,
+                    names: Sequence[str], what: str, components: tuple[str, ...] = _AXES,
+                    lengths: tuple[bool, ...] = (True,) * 3 + (False,) * 3) -> Agreement:
+    """Two robots' calibrations of one item compared: the chi-square of their difference.
+
+    Parameters
+    ----------
+    diff : ndarray, shape (k,)
+        First minus second (m and rad).
+    cov : ndarray, shape (k, k)
+        Its covariance, every error source counted once.
+    level : float
+        Sigma level beyond which the two disagree.
+    names : sequence of 2 str
+        The robots' names, for the message.
+    what : str
+        The item, for the message (``"turntable"``, ``"positioner"``).
+    components, lengths : tuple
+        The name of each component and whether it is a length (else an angle).
+
+    Returns
+    -------
+    Agreement
+    """
+    k = len(diff)
     chi2 = float(diff @ np.linalg.pinv(cov) @ diff)
-    bound = float(chdtri(6, 1.0 - erf(level / np.sqrt(2.0))))
+    bound = float(chdtri(k, 1.0 - erf(level / np.sqrt(2.0))))
     sig = np.sqrt(np.abs(np.diag(cov)))
     z = np.abs(diff) / np.where(sig > 0, sig, np.inf)
     if chi2 <= bound:
-        message = (f"{names[0]}'s and {names[1]}'s calibrations of the turntable agree within "
+        message = (f"{names[0]}'s and {names[1]}'s calibrations of the {what} agree within "
                    f"{level:g} sigma (chi-square {chi2:.1f}, bound {bound:.1f})")
     else:
         worst = [i for i in np.argsort(-z) if z[i] > level] or [int(np.argmax(z))]
-        parts = [f"{_AXES[i]} by {diff[i] * 1e3:.2f} mm" if i < 3 else
-                 f"{_AXES[i]} by {np.degrees(diff[i]):.3f} deg" for i in worst]
+        parts = [f"{components[i]} by {diff[i] * 1e3:.2f} mm" if lengths[i] else
+                 f"{components[i]} by {np.degrees(diff[i]):.3f} deg" for i in worst]
         parts = [f"{p} ({z[i]:.1f} sigma)" for p, i in zip(parts, worst, strict=True)]
-        message = (f"{names[0]}'s and {names[1]}'s calibrations of the turntable disagree "
+        message = (f"{names[0]}'s and {names[1]}'s calibrations of the {what} disagree "
                    f"(chi-square {chi2:.1f}, bound {bound:.1f} for {level:g} sigma): "
-                   f"{', '.join(parts)}; one of the tools, the robot-to-robot pose or a turntable "
+                   f"{', '.join(parts)}; one of the tools, the robot-to-robot pose or a {what} "
                    "calibration is wrong: check each robot's tool (touch a fixed tip in two "
                    "orientations) and calibrate again")
-    return Agreement(diff, cov, chi2, bound, level, message)
+    return Agreement(diff, cov, chi2, bound, level, message, components, lengths)
 
 
 def _circle(angles: NDArray[np.float64], f: NDArray[np.float64], height: float
@@ -292,7 +329,7 @@ def shared_turntable(ref_table: RobotTouches, ref_angles: ArrayLike, other_table
     return _shared_result(pf, unpack, sets)
 
 
-def _prior_warnings(pf: PriorFit) -> list[str]:
+def prior_warnings(pf: PriorFit) -> list[str]:
     """A prior (an input's stated accuracy) that the touches contradict, named."""
     res, n = pf.fit, pf.touches
     out = []
@@ -316,7 +353,7 @@ def _shared_result(pf: PriorFit, unpack, sets: list[RobotTouches]) -> Calibratio
     labels = [f"{s.robot or ('ref', 'other')[k % 2]} {kinds[k]} touch {i + 1}"
               + (f" ({s.names[i]})" if kinds[k] == "point" else "")
               for k, s in enumerate(sets) for i in range(len(s.points))]
-    warnings = outlier_warnings(res, labels + pf.blocks) + _prior_warnings(pf)
+    warnings = outlier_warnings(res, labels + pf.blocks) + prior_warnings(pf)
     warnings = [w for w in warnings if not any(f"touch {b} " in w for b in pf.blocks)]
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: "

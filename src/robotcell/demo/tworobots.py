@@ -17,15 +17,14 @@ place, the positioner's root a few millimetres and tenths of a degree off. The d
    :func:`robotcell.cell.calibrate.robottorobot.calibrate_robot_to_robot` and
    :func:`~robotcell.cell.calibrate.robottorobot.place_robot`);
 4. calibrates the shared positioner with the KUKA (``robotcell calibrate positioner
-   --robot-name kuka``);
-5. prints every calibrated value beside the truth, in mm and deg and in units of its reported
-   1-sigma (the :class:`robotcell.demo.walkthrough.Comparison` table of the one-robot demo), and
-   writes an HTML report per calibration and the 3D view of the calibrated cell with both
-   robots (``cell.html``).
-
-The positioner is calibrated by one robot only: the comparison of two robots' calibrations of a
-shared table (:func:`robotcell.calibration.sharedtable.compare_shared`) is made for a turntable
-and is not part of this demo.
+   --robot-name kuka``), at the track position of its common points;
+5. has the ABB touch the positioner too, compares its calibration with the KUKA's through the
+   robot-to-robot pose and fits all touches of both robots at once (``robotcell calibrate
+   shared-positioner``: :func:`robotcell.cell.calibrate.sharedpositioner.shared_positioner`);
+6. prints every calibrated value beside the truth, in mm and deg and in units of its reported
+   1-sigma (the :class:`robotcell.demo.walkthrough.Comparison` table of the one-robot demo), the
+   joint fit's too, and writes an HTML report per calibration and the 3D view of the calibrated
+   cell with both robots (``cell.html``).
 """
 
 from __future__ import annotations
@@ -42,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from robotcell.calibration.result import CalibrationResult
+from robotcell.calibration.sharedtable import Agreement
 from robotcell.cell import Cell, Positioner, Provenance
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate.robottorobot import (
@@ -49,9 +49,11 @@ from robotcell.cell.calibrate.robottorobot import (
     calibrate_robot_to_robot,
     place_robot,
 )
+from robotcell.cell.calibrate.sharedpositioner import SharedPositioner, shared_positioner
 from robotcell.cell.history import backups
 from robotcell.demo.walkthrough import Comparison, comparison_table, reported_sigma
 from robotcell.errors import InputError
+from robotcell.identification.sharedpositioner import PositionerLines, chain_lines
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
@@ -204,7 +206,8 @@ def run_two_robot_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int 
     Returns
     -------
     list of Comparison
-        Both torches, the ABB's base and the positioner's root against the truth.
+        Both torches, the track, the ABB's base and the positioner's root against the truth,
+        then the ABB's base and the positioner's root of the fit of both robots' touches.
     """
     t_start = time.perf_counter()
     out = Path(folder)
@@ -227,9 +230,13 @@ def run_two_robot_demo(folder: str | Path, noise: float = DEMO_NOISE, seed: int 
     results["track_kuka"] = _calibrate(run, REFERENCE, "track", ["--tool", TOOL], {})
     results["robot_to_robot"] = _robot_to_robot(
         run, max(_tool_sigma(results[f"tcp_{r}"]) for r in (REFERENCE, OTHER)))
-    results["positioner_kuka"] = _calibrate(run, REFERENCE, "positioner", ["--tool", TOOL], {})
+    results["positioner_kuka"] = _calibrate(run, REFERENCE, "positioner", ["--tool", TOOL],
+                                            {"track": REFERENCE_TRACK})
+    shared = _shared_positioner(run, max(_tool_sigma(results[f"tcp_{r}"])
+                                         for r in (REFERENCE, OTHER)))
+    results["shared_positioner"] = shared.joint.to_json()
     calibrated = Cell.load(cell_file)
-    comparisons = _compare(calibrated, truth, results)
+    comparisons = _compare(calibrated, truth, results) + _joint_rows(truth, shared)
     echo("\ncalibrated vs true cell (error, and error / reported 1-sigma):")
     echo(comparison_table(comparisons))
     _write_outputs(out, calibrated, results, echo)
@@ -248,14 +255,8 @@ def _compare(calibrated: Cell, truth: Cell,
     assert track is not None and true_track is not None
     rows.append(("track KL1500 of kuka (T_L_R0)", track.T_L_R0, true_track.T_L_R0,
                  results["track_kuka"], "T_L_R"))
-    at = {REFERENCE: REFERENCE_TRACK, OTHER: 0.0}
-
-    def in_reference(cell: Cell) -> np.ndarray:  # T_Rref_Rother at the touches' track positions
-        return (invert(cell.for_robot(REFERENCE).frame_pose("robot", track=at[REFERENCE]))
-                @ cell.for_robot(OTHER).frame_pose("robot", track=at[OTHER]))
-
-    rows.append((f"base of {OTHER} in {REFERENCE} (T_ref_other)", in_reference(calibrated),
-                 in_reference(truth), results["robot_to_robot"], "T_ref_other"))
+    rows.append((f"base of {OTHER} in {REFERENCE} (T_ref_other)", _in_reference(calibrated),
+                 _in_reference(truth), results["robot_to_robot"], "T_ref_other"))
     rows.append(("positioner DKP_2 root (T_world_B)", calibrated.turntable.T_parent_root,
                  _root_as(truth.turntable, calibrated.turntable), results["positioner_kuka"],
                  "T_world_B"))
@@ -263,6 +264,78 @@ def _compare(calibrated: Cell, truth: Cell,
     for item, est, true, res, key in rows:
         dp, dr = pose_error(est, true)
         sp, sr = reported_sigma(res, key)
+        out.append(Comparison(item, est, true, dp, dr, sp, sr))
+    return out
+
+
+def _in_reference(cell: Cell) -> np.ndarray:
+    """``T_Rref_Rother`` at the track positions of the robots' touches (m)."""
+    return (invert(cell.for_robot(REFERENCE).frame_pose("robot", track=REFERENCE_TRACK))
+            @ cell.for_robot(OTHER).frame_pose("robot", track=0.0))
+
+
+def _shared_positioner(run: _Run, tool_sigma: float) -> SharedPositioner:
+    """The ABB touches its own point on the plate; its calibration of the positioner is
+    compared with the KUKA's, and all touches of both robots are fitted at once."""
+    touches = simulate(run.truth.for_robot(OTHER), "positioner", noise=run.noise, seed=run.rng,
+                       tool=TOOL, radius=0.15)
+    plate = (run.out / f"positioner_{REFERENCE}.csv", run.out / f"positioner_{OTHER}.csv")
+    touches.write_csv(plate[1])
+    common = [run.out / f"robot_to_robot_{r}.csv" for r in (REFERENCE, OTHER)]
+    run.echo(f"\nshared positioner ({OTHER}): simulated {len(touches.q)} touches of another "
+             f"point on the plate -> {plate[1].name}; compared with {REFERENCE}'s calibration "
+             "through the robot-to-robot pose, and all touches of both robots in one fit")
+    run.command(["calibrate", "shared-positioner", str(plate[0]), str(plate[1]), "--common",
+                 str(common[0]), str(common[1]), "--cell", str(run.cell_file), "--robot", OTHER,
+                 "--reference", REFERENCE, "--tool-ref", TOOL, "--tool-other", TOOL,
+                 "--track-ref", f"{REFERENCE_TRACK * 1e3:g}", "--sigma",
+                 f"{run.noise * 1e3:g}", "--tool-sigma", f"{tool_sigma * 1e3:.3g}"])
+    shared = shared_positioner(
+        Cell.load(run.cell_file), (RobotTouchFile(REFERENCE, str(common[0]), TOOL,
+                                                  REFERENCE_TRACK),
+                                   RobotTouchFile(OTHER, str(common[1]), TOOL)),
+        (str(plate[0]), str(plate[1])), sigma=run.noise, tool_sigma=tool_sigma)
+    run.echo("  " + shared.agreement.message)
+    run.echo(_agreement_table(shared.agreement))
+    data = shared.joint.to_json()
+    run.echo(f"  all touches in one fit: RMS {data['rms_mm']:.3f} mm, max {data['max_mm']:.3f} "
+             f"mm, condition {data['condition']:.1f}\n  {shared.joint.verdict.line()}")
+    if shared.joint.verdict.level == "poor":
+        raise InputError(f"shared positioner: poor calibration: "
+                         f"{'; '.join(shared.joint.verdict.reasons)}; try a smaller noise")
+    return shared
+
+
+def _agreement_table(agreement: Agreement) -> str:
+    """Each compared component: the difference, its 1-sigma and their ratio."""
+    from robotcell.io.tables import format_table
+
+    rows = []
+    for name, d, s, length in zip(agreement.components, agreement.difference, agreement.sigma,
+                                  agreement.lengths, strict=True):
+        unit, scale = ("mm", 1e3) if length else ("deg", 180.0 / np.pi)
+        rows.append([name, f"{d * scale:.3f} {unit}", f"{s * scale:.3f} {unit}",
+                     f"{d / s:.1f}"])
+    return format_table([f"{REFERENCE} minus {OTHER}", "difference", "1-sigma", "in sigma"], rows)
+
+
+def _joint_rows(truth: Cell, shared: SharedPositioner) -> list[Comparison]:
+    """The fit of all touches beside the truth: the ABB's base and the positioner's root (its
+    axis lines) in the KUKA's base."""
+    assert truth.turntable is not None
+    joint, data = shared.joint, shared.joint.to_json()
+    T_B = np.asarray(joint.values["T_ref_B"], dtype=float)
+    T_w_R = truth.for_robot(REFERENCE).frame_pose("robot", track=REFERENCE_TRACK)
+    chain = truth.turntable.chain
+    true_B = chain_lines(chain.with_base(invert(T_w_R) @ chain.base),
+                         PositionerLines(T_B, 0.0, 0.0)).T_B
+    rows = [(f"base of {OTHER} in {REFERENCE}, all touches (T_ref_other)",
+             joint.values["T_ref_other"], _in_reference(truth), "T_ref_other"),
+            (f"positioner axes in {REFERENCE}, all touches (T_ref_B)", T_B, true_B, "T_ref_B")]
+    out = []
+    for item, est, true, key in rows:
+        dp, dr = pose_error(est, true)
+        sp, sr = reported_sigma(data, key)
         out.append(Comparison(item, est, true, dp, dr, sp, sr))
     return out
 

@@ -25,7 +25,7 @@ from robotcell.errors import InputError
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import invert
 
-__all__ = ["RobotTouchFile", "calibrate_robot_to_robot", "place_robot"]
+__all__ = ["RobotTouchFile", "calibrate_robot_to_robot", "place_robot", "robot_table"]
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,8 @@ class RobotTouchFile:
     track: float = 0.0
 
 
-def _table(cell: Cell, touches: RobotTouchFile) -> RobotTable:
+def robot_table(cell: Cell, touches: RobotTouchFile) -> RobotTable:
+    """One robot's touch file with its model and the named tool of the cell."""
     view = cell.for_robot(touches.robot)
     if touches.tool not in view.tools:
         known = ", ".join(sorted(view.tools)) or "none"
@@ -96,8 +97,9 @@ def calibrate_robot_to_robot(cell: Cell, reference: RobotTouchFile, other: Robot
     if cell.robot_key(reference.robot) == cell.robot_key(other.robot):
         raise InputError(f"the reference and the other robot are both {reference.robot!r}; "
                          "name two robots of the cell")
-    return robot_to_robot_tables(_table(cell, reference), _table(cell, other), sigma=sigma,
-                                 tool_sigma=tool_sigma, method=method, on_note=on_note)
+    return robot_to_robot_tables(robot_table(cell, reference), robot_table(cell, other),
+                                 sigma=sigma, tool_sigma=tool_sigma, method=method,
+                                 on_note=on_note)
 
 
 def place_robot(cell: Cell, result: CalibrationResult, reference: RobotTouchFile,
