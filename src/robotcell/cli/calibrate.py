@@ -623,5 +623,6 @@ REGISTERED: dict[str, str] = {
     "positioner": "robotcell.cli.calibrate_axes:positioner",
     "workpiece": "robotcell.cli.calibrate_axes:workpiece",
     "robot-to-robot": "robotcell.cli.robottorobot:calibrate_robot_to_robot",
+    "shared-positioner": "robotcell.cli.sharedpositioner:calibrate_shared_positioner",
 }
 # ------------------------------------------------------------------------------------------------

@@ -412,5 +412,7 @@ def _joint_result(pf: PriorFit, fitted: tuple, sets: list[RobotTouches]) -> Cali
         + ["axis_offset", "axis_angle"],
         estimates={"T_ref_other": estimate(pf.sources, pf.gain, np.eye(6, p)),
                    "T_ref_B": estimate(pf.sources, pf.gain, np.eye(6, p, 6))},
+        value_sources={"axis_offset": pf.sources.select([12]),
+                       "axis_angle": pf.sources.select([13])},
         **fields,
     )
