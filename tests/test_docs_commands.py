@@ -10,7 +10,8 @@ names are made the way the docs say: ``cell.yaml`` is a copy of the example cell
 positioner cell for positioner commands), touch files come from ``robotcell simulate``,
 ``joints.csv`` from ``identify --propose``, ``poses.csv`` from ``fk --input``, a cell for
 ``calibrate cell`` from a TCP and a turntable calibration into it, ``tracker.csv``
-from the block of docs/identification.md that simulates it; the cell of a command that filters
+from the block of docs/identification.md that simulates it, the files of ``calibrate
+shared-positioner`` from ``robotcell demo --robots 2``; the cell of a command that filters
 (``compensate``, ``program compensate``, ``program check`` of a filtered program) gets the arm
 identified from that ``tracker.csv`` (``identify ... --cell cell.yaml``, docs/accuracy.md). Each
 command must exit 0 without a
@@ -185,6 +186,11 @@ def prepare(capsys, argv: list[str]) -> None:
             _simulate(capsys, proc, f"{proc}.csv", truth, "--tool", "pointer")
             code, _, err = run(capsys, "calibrate", proc, f"{proc}.csv", "--cell", "cell.yaml",
                                "--sigma", "0.1", *extra)
+            assert code == 0, err
+        return
+    if argv[:2] == ["calibrate", "shared-positioner"]:  # the files of the two-robot demo
+        if not Path(argv[2]).exists():
+            code, _, err = run(capsys, "demo", "--robots", "2", "-o", str(Path(argv[2]).parent))
             assert code == 0, err
         return
     if argv[:2] == ["calibrate", "robot-to-robot"]:  # two robots' files, simulated as documented

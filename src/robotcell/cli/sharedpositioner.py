@@ -89,8 +89,8 @@ def calibrate_shared_positioner(reference: str, other: str, as_json: bool, accep
     positioner's axes in the reference robot's base). Writes nothing into the cell.
 
     \b
-    Example:
-      robotcell calibrate shared-positioner pos_kuka.csv pos_abb.csv --common r2r_kuka.csv r2r_abb.csv --cell cell.yaml --reference kuka --robot abb --tool-ref torch --tool-other torch --track-ref 1000 --sigma 0.1 --tool-sigma 0.1
+    Example (on the files of 'robotcell demo --robots 2'):
+      robotcell calibrate shared-positioner robotcell-demo-2/positioner_kuka.csv robotcell-demo-2/positioner_abb.csv --common robotcell-demo-2/robot_to_robot_kuka.csv robotcell-demo-2/robot_to_robot_abb.csv --cell robotcell-demo-2/cell.yaml --reference kuka --robot abb --tool-ref torch --tool-other torch --track-ref 1000 --sigma 0.1 --tool-sigma 0.128
     """
     given = _Given(**options)
     if given.tool_sigma is not None and not 0 < given.tool_sigma <= 1000:
