@@ -148,6 +148,8 @@ def test_the_joint_fit_is_at_least_as_good_as_either_alone() -> None:
         assert alone is not None
         if k == 0:  # the KUKA's calibration is in the reference base, as the joint fit's
             assert np.all(j[6:14] <= alone.sigma * (1 + 1e-6))
+        else:  # the distance and the angle between the axes are the same in every base
+            assert np.all(j[12:14] <= alone.sigma[6:8] * (1 + 1e-6))
     assert np.all(j[:6] <= link * (1 + 1e-6))
     assert np.all(j[:3] < link[:3])  # the positioner touches measure the link too
     assert t["joint"].verdict.level == "good", t["joint"].verdict.reasons
