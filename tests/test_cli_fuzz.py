@@ -981,6 +981,73 @@ CASES.update({"robot-to-robot": (4, 60), "program-bodies": (3, 40)})
 BUILDERS.update({"robot-to-robot": _robot_to_robot, "program-bodies": _program_bodies})
 
 
+@functools.lru_cache(maxsize=1)
+def _shared_positioner_tables() -> tuple[str, str, str, str]:
+    """The two robots of the two-robot example, the KUKA at track 1000 mm: each touching its own
+    point on the positioner's plate at 3 tilt by 4 rotate values, then 5 common points twice
+    (joint values, 0.05 mm touch error)."""
+    import io
+
+    from robotcell.cell import Cell
+    from robotcell.kinematics.transforms import invert
+    from robotcell.studies.robottorobot import (
+        SimulatedRobot,
+        default_points,
+        simulate_robot_to_robot,
+        table_text,
+    )
+    from robotcell.studies.simulate import simulate
+
+    cell = Cell.load(TWO_ROBOTS)
+    rng = np.random.default_rng(SEED)
+    kuka, abb = cell.for_robot("kuka"), cell.for_robot("abb")
+    plates = []
+    for view, track, radius in ((kuka, 1.0, 0.2), (abb, None, 0.15)):
+        buf = io.StringIO()
+        simulate(view, "positioner", noise=5e-5, seed=rng, tool="torch", track=track,
+                 radius=radius).write_csv(buf)
+        plates.append(buf.getvalue())
+    T = invert(kuka.frame_pose("robot", track=1.0)) @ abb.frame_pose("robot")
+    robots = [SimulatedRobot(kuka.robot, np.eye(4), kuka.tools["torch"].T_F_TCP, "kuka"),
+              SimulatedRobot(abb.robot, T, abb.tools["torch"].T_F_TCP, "abb")]
+    tables = simulate_robot_to_robot(robots, default_points(T), noise=5e-5, rng=rng, repeats=2)
+    return plates[0], plates[1], table_text(tables[0]), table_text(tables[1])
+
+
+def _shared_positioner(rng, d, good, out):
+    """calibrate shared-positioner: one of the four touch files mutated (or the cell, in 15 %),
+    and an option sometimes wrong."""
+    texts = _shared_positioner_tables()
+    names = ["pos_kuka.csv", "pos_abb.csv", "r2r_kuka.csv", "r2r_abb.csv"]
+    bad = int(rng.integers(len(names) + 1))
+    files, what = [], []
+    for k, (name, text) in enumerate(zip(names, texts, strict=True)):
+        if k == bad:
+            path, w = _mutated(text, rng, d, name)
+            what.append(w)
+        else:
+            path = _write(d / name, text)
+        files.append(path)
+    cell = _write(d / "cell.yaml", TWO_ROBOTS.read_text(encoding="utf-8"))
+    if rng.random() < 0.15:
+        cell, w = _mutated(TWO_ROBOTS.read_text(encoding="utf-8"), rng, d, "cell.yaml")
+        what.append(w)
+    opts = _maybe(rng, 0.3, {"--robot": ["kuka", "nosuch", ""], "--tool-other": ["nosuch"],
+                             "--track-ref": BAD_FLOATS + ["0", "9000"],
+                             "--sigma": BAD_FLOATS + ["0.05"],
+                             "--tool-sigma": BAD_FLOATS + ["0.2"]})
+    json_out = ["-o", out] if rng.random() < 0.4 else []
+    args = ["calibrate", "shared-positioner", files[0], files[1], "--common", files[2], files[3],
+            "--cell", cell, "--reference", "kuka", "--robot", "abb", "--tool-ref", "torch",
+            "--tool-other", "torch", "--track-ref", "1000", *opts, *json_out]
+    return (args, f"{'; '.join(what) or 'all valid'} {' '.join(opts)}", [*files, cell],
+            [out] if json_out else [])
+
+
+CASES.update({"shared-positioner": (3, 30)})
+BUILDERS.update({"shared-positioner": _shared_positioner})
+
+
 
 def _edit_rows(text: str, edit) -> str:
     return _join(edit(_split(text)))
