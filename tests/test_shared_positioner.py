@@ -198,3 +198,24 @@ def test_comparison_refuses_a_result_that_is_not_a_positioner() -> None:
     with pytest.raises(InputError, match="a robot-to-robot result is not a 2-axis positioner "
                                          "calibration"):
         compare_positioner(t["link"], t["abb positioner"], t["link"])
+
+
+def test_starts_written_with_opposite_normals_give_the_same_fit() -> None:
+    """Without its nominal chain the other robot's calibration writes X_B the other way round;
+    the joint fit turns it and ends where it ends from both nominal chains."""
+    t = _trial(np.random.default_rng(12))
+    j = shared_positioner(t["kuka plate"], VALUES, t["abb plate"], VALUES,
+                          common=(t["kuka points"], t["abb points"]), sigma=NOISE,
+                          nominal=(NOMINAL[0], None))
+    for key in ("T_ref_other", "T_ref_B"):
+        assert np.allclose(j.values[key], t["joint"].values[key], atol=1e-7)
+    assert j.values["axis_angle"] == pytest.approx(t["joint"].values["axis_angle"], abs=1e-7)
+
+
+def test_comparison_refuses_calibrations_written_with_opposite_normals() -> None:
+    t = _trial(np.random.default_rng(13))
+    abb = t["abb plate"]
+    other = calibrate_positioner(VALUES, abb.points, sigma=NOISE, inputs=abb.inputs).result
+    with pytest.raises(InputError, match="opposite X_B \\(common normal\\) directions; calibrate "
+                                         "both with the same nominal positioner"):
+        compare_positioner(t["kuka positioner"], other, t["link"])
