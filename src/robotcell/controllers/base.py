@@ -324,7 +324,7 @@ class Controller(ABC):
             :attr:`name_limit`.
         """
         if not _IDENT.match(name) or len(name) > self.name_limit:
-            raise InputError(f"program name {name!r} is not a {self.name} program name: a "
+            raise InputError(f"program name {name!r} is not valid for {self.label}: a "
                              f"letter, then letters, digits or '_', at most {self.name_limit} "
                              "characters; give another name")
         return name.upper() if self.upper_names else name
