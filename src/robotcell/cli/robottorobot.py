@@ -268,6 +268,23 @@ def _points_csv(points: np.ndarray) -> str:
     return "\n".join(["point,x,y,z", *rows]) + "\n"
 
 
+@dataclass(frozen=True)
+class _Planned:
+    """The options of ``plan robot-to-robot``."""
+
+    cell_path: str
+    robot: str
+    reference_robot: str
+    tool_ref: str | None
+    tool_other: str | None
+    noise: float
+    runs: int
+    seed: int | None
+    track_ref: float
+    track_other: float
+    output: str | None
+
+
 def _design_row(d: R2RDesign, best: R2RDesign) -> list[object]:
     mc = ("-", "-") if np.isnan(d.position_rms) else (
         d.position_rms * 1e3, f"{np.degrees(d.rotation_rms):.4f}")
@@ -300,10 +317,7 @@ def _design_row(d: R2RDesign, best: R2RDesign) -> list[object]:
               callback=output_of("CSV", "the recommended common points"),
               help="Write the recommended design's points (point, x, y, z mm in the reference "
                    "robot's base) as CSV, atomically.")
-def plan_robot_to_robot_cmd(cell_path: str, robot: str, reference_robot: str,
-                            tool_ref: str | None, tool_other: str | None, noise: float,
-                            runs: int, seed: int | None, track_ref: float, track_other: float,
-                            output: str | None) -> None:
+def plan_robot_to_robot_cmd(**options: Any) -> None:
     """Propose where to put the common points of a robot-to-robot calibration.
 
     \b
@@ -318,12 +332,15 @@ def plan_robot_to_robot_cmd(cell_path: str, robot: str, reference_robot: str,
     Example:
       robotcell plan robot-to-robot --cell examples/cell_two_robots_positioner.yaml --robot abb --reference kuka --seed 1 -o points.csv
     """
+    o = _Planned(**options)
+    cell_path, robot, reference_robot, noise = o.cell_path, o.robot, o.reference_robot, o.noise
+    track_ref, track_other, output = o.track_ref, o.track_other, o.output
     if not 0 < noise <= NOISE_MAX_MM:
         raise InputError(f"--noise must be a positive number of millimetres, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
     cell = Cell.load(cell_path)
-    p = plan_robot_to_robot(cell, robot, reference_robot, tools=(tool_ref, tool_other),
-                            noise=noise * 1e-3, runs=runs, seed=seed,
+    p = plan_robot_to_robot(cell, robot, reference_robot, tools=(o.tool_ref, o.tool_other),
+                            noise=noise * 1e-3, runs=o.runs, seed=o.seed,
                             tracks=(track_ref * 1e-3, track_other * 1e-3))
     click.echo(f"robot-to-robot plan: base of {robot!r} in the base of {reference_robot!r}, "
                f"touch-up error {noise:g} mm (1-sigma per coordinate); {p.reachable} sampled "
