@@ -246,3 +246,47 @@ APART = "x,y,z,a,b,c\n0,-1300,0,0,0,180\n20,-1300,0,0,0,180\n"
 ])
 def test_refused_with_nothing_written(tmp_path, capsys, cell, texts, match):
     _refused(tmp_path, capsys, cell, texts, match)
+
+
+TURNTABLE_CELL = """name: two_abb_turntable
+robots:
+  rob1:
+    model: abb_irb2400
+    frame: {x: 1100, y: -1100, z: 0, a: 90, b: 0, c: 0}
+    tools:
+      torch: {number: 1, frame: {x: 300, y: 0, z: 90, a: 0, b: 45, c: 0}}
+  rob2:
+    model: abb_irb2400
+    frame: {x: 1100, y: 1100, z: 0, a: -90, b: 0, c: 0}
+    tools:
+      torch: {number: 1, frame: {x: 300, y: 0, z: 90, a: 0, b: 45, c: 0}}
+turntable:
+  name: STN1
+  parent: world
+  frame: {x: 1100, y: 0, z: 650, a: 0, b: 0, c: 0}
+  min: -360
+  max: 360
+frames:
+  part:
+    number: 1
+    parent: turntable
+    frame: {x: 0, y: 0, z: 30, a: 0, b: 0, c: 0}
+"""
+
+
+def test_a_turntable_is_chosen_once_for_both_robots(tmp_path):
+    """Two fixed robots either side of a turntable, each one's seam 700 mm off the axis on its
+    side: one angle per point, the same for both, the turntable's (N,) values."""
+    (tmp_path / "cell.yaml").write_text(TURNTABLE_CELL)
+    cell = Cell.load(tmp_path / "cell.yaml")
+    rob1 = "x,y,z,a,b,c\n" + "".join(f"{x},-700,0,0,0,180\n" for x in range(-100, 101, 40))
+    rob2 = "x,y,z,a,b,c\n" + "".join(f"{-x},700,0,0,0,180\n" for x in range(-100, 101, 40))
+    paths = _files(tmp_path, rob1=rob1, rob2=rob2)
+    result = write_coordinated(paths, cell, TOOLS, "part", "abb", tmp_path / "prog", "seams")
+    table = result.results["rob1"].table
+    assert table.shape == (6,)
+    np.testing.assert_array_equal(table, result.results["rob2"].table)
+    for robot in ("rob1", "rob2"):
+        seam = read_path(paths[robot], cell.for_robot(robot))
+        got, _ = _assert_reached(cell, result.files, robot, seam.T)
+        np.testing.assert_allclose(got, table, atol=1e-9)

@@ -439,20 +439,41 @@ def _along_z(z: NDArray[np.float64], p: NDArray[np.float64]) -> NDArray[np.float
     return T
 
 
-def _shared_candidates(cell: Cell, frame: str, arrs: list[NDArray[np.float64]], samples: int,
-                       normal_tol: float
+@dataclass(frozen=True)
+class _SharedPaths:
+    """The robots' paths of a shared choice: each robot's view of the cell, targets (N, 4, 4),
+    track (N,) or None and tool, in the order of ``names``."""
+
+    names: list[str]
+    views: dict[str, Cell]
+    T: dict[str, NDArray[np.float64]]
+    tracks: dict[str, NDArray[np.float64] | None]
+    tools: dict[str, str | ArrayLike | None]
+    frame: str
+
+    @property
+    def first(self) -> Cell:
+        return self.views[self.names[0]]
+
+    def mean_normal(self) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Poses (N, 4, 4) whose ``-Z`` is the robots' mean surface normal (the mean of their
+        tools' ``-Z``) at each point, and where that mean is not zero (N,)."""
+        normal = np.mean([-t[:, :3, 2] for t in self.T.values()], axis=0)     # (N, 3)
+        size = np.linalg.norm(normal, axis=1, keepdims=True)
+        up = np.where(size > 1e-6, normal / np.maximum(size, 1e-6), [[0.0, 0.0, 1.0]])
+        return _along_z(-up, self.T[self.names[0]][:, :3, 3]), size[:, 0] > 1e-6
+
+
+def _shared_candidates(paths: _SharedPaths, samples: int, normal_tol: float
                        ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
     """Candidates for every robot at once: a turntable's grid, or a 2-axis positioner in the
     welding position of the robots' mean surface normal (none where the normals cancel)."""
-    ref = arrs[0]
-    if cell.turntable.n_axes == 2:
-        normal = np.mean([-a[:, :3, 2] for a in arrs], axis=0)           # (N, 3)
-        size = np.linalg.norm(normal, axis=1, keepdims=True)
-        up = np.where(size > 1e-6, normal / np.maximum(size, 1e-6), [[0.0, 0.0, 1.0]])
-        ref = _along_z(-up, ref[:, :3, 3])
-        values, ok, dev = _candidates(cell, frame, ref, np.zeros(len(ref)), samples, normal_tol)
-        return values, ok & (size > 1e-6), dev                   # normals that cancel: none
-    return _candidates(cell, frame, ref, np.zeros(len(ref)), samples, normal_tol)
+    ref, ok = paths.mean_normal()
+    if paths.first.turntable.n_axes != 2:
+        ok[:] = True                                          # a grid: the normals do not matter
+    values, keep, dev = _candidates(paths.first, paths.frame, ref, np.zeros(len(ref)), samples,
+                                    normal_tol)
+    return values, keep & ok[:, None], dev
 
 
 def _robot_states(cell: Cell, arr: NDArray[np.float64], frame: str,
@@ -548,25 +569,27 @@ def choose_shared_table(cell: Cell, T: dict[str, ArrayLike], frame: str,
     """
     names = list(T)
     views = {r: cell.for_robot(r) for r in names}
-    first = views[names[0]]
-    if not carried_by_table(first, frame):
+    if not carried_by_table(views[names[0]], frame):
         raise InputError(f"frame {frame!r} is not carried by the turntable: the table values do "
                          "not move its targets; give them")
-    arrs = [validate_pose(T[r], f"path targets of {r}") for r in names]
-    if any(a.ndim != 3 or a.shape != arrs[0].shape or a.shape[0] < 1 for a in arrs):
+    arrs = {r: validate_pose(T[r], f"path targets of {r}") for r in names}
+    shape = arrs[names[0]].shape
+    if any(a.ndim != 3 or a.shape != shape or a.shape[0] < 1 for a in arrs.values()):
         raise InputError("each robot's targets must have shape (N, 4, 4), as many for every "
-                         f"robot; got {', '.join(f'{r} {a.shape}' for r, a in zip(names, arrs))}")
+                         f"robot; got {', '.join(f'{r} {a.shape}' for r, a in arrs.items())}")
     if not max_step > 0 or not samples >= 4:
         raise InputError(f"max_step must be positive (rad) and samples at least 4, got "
                          f"{max_step} and {samples}")
-    n = arrs[0].shape[0]
-    tr = {r: None if (tracks or {}).get(r) is None else
-          np.broadcast_to(finite_array(tracks[r], "track position"), (n,)) for r in names}
-    values, ok, dev = _shared_candidates(first, frame, arrs, samples, normal_tol)
-    turntable = np.ndim(first.turntable.lower) == 0
+    n = shape[0]
+    paths = _SharedPaths(names, views, arrs, {
+        r: None if (tracks or {}).get(r) is None else
+        np.broadcast_to(finite_array(tracks[r], "track position"), (n,)) for r in names},
+        {r: (tools or {}).get(r) for r in names}, frame)
+    values, ok, dev = _shared_candidates(paths, samples, normal_tol)
+    turntable = np.ndim(paths.first.turntable.lower) == 0
     tab = values[..., 0] if turntable else values
-    states = [_robot_states(views[r], a, frame, tr[r], (tools or {}).get(r), tab, ok)
-              for r, a in zip(names, arrs)]
+    states = [_robot_states(views[r], arrs[r], frame, paths.tracks[r], paths.tools[r], tab, ok)
+              for r in names]
     combos, joint = _combinations([s[1] for s in states])
     if not joint.any(axis=(1, 2)).all():
         what = "table" if turntable else "positioner"
@@ -574,23 +597,22 @@ def choose_shared_table(cell: Cell, T: dict[str, ArrayLike], frame: str,
                          + _unserved(names, [s[1] for s in states], joint, ok, what)
                          + f"; give the {what}'s values in a path file, or move the points")
     score = np.min([s[2][..., combos[:, k]] for k, s in enumerate(states)], axis=0)
-    node = (1.0 - score) + _value_costs(first, values, dev, normal_tol)[..., None]
+    node = (1.0 - score) + _value_costs(paths.first, values, dev, normal_tol)[..., None]
     q = np.concatenate([s[0][:, :, combos[:, k]] for k, s in enumerate(states)], axis=-1)
     rev = np.concatenate([~views[r].robot.prismatic for r in names])
     j, c, cut = _viterbi(node, joint, values, np.where(joint[..., None], q, np.nan), rev,
                          max_step)
     rows = np.arange(n)
-    chosen = _shared_smoothed(views, names, arrs, frame, tr, tools or {}, values[rows, j],
-                              combos[c], cut, max_step, normal_tol, turntable, samples)
+    chosen = _shared_smoothed(paths, values[rows, j], combos[c], cut, max_step, normal_tol,
+                              samples)
     return SharedTableChoice(chosen[:, 0] if turntable else chosen,
                              {r: combos[c, k] for k, r in enumerate(names)},
                              score[rows, j, c], int(cut.sum()))
 
 
-def _shared_smoothed(views: dict, names: list[str], arrs: list[NDArray[np.float64]], frame: str,
-                     tracks: dict, tools: dict, chosen: NDArray[np.float64],
+def _shared_smoothed(paths: _SharedPaths, chosen: NDArray[np.float64],
                      branch: NDArray[np.int_], cut: NDArray[np.bool_], max_step: float,
-                     normal_tol: float, turntable: bool, samples: int) -> NDArray[np.float64]:
+                     normal_tol: float, samples: int) -> NDArray[np.float64]:
     """The chosen values (N, n) smoothed as :func:`choose_table` does, piece by piece where
     every robot still reaches every point of the piece in its configuration ``branch`` (N, R)."""
     smooth = _smoothed(chosen, cut, TWO_PI / samples)
@@ -598,18 +620,16 @@ def _shared_smoothed(views: dict, names: list[str], arrs: list[NDArray[np.float6
         return chosen
     n = chosen.shape[0]
     rows = np.arange(n)
+    turntable = np.ndim(paths.first.turntable.lower) == 0
     still = np.ones(n, dtype=bool)
-    for k, r in enumerate(names):
-        again = ik(views[r], arrs[k], frame, tracks[r], smooth[:, 0] if turntable else smooth,
-                   tools.get(r))
+    for k, r in enumerate(paths.names):
+        again = ik(paths.views[r], paths.T[r], paths.frame, paths.tracks[r],
+                   smooth[:, 0] if turntable else smooth, paths.tools[r])
         still &= again.valid[rows, branch[:, k]]
     if n > 1:
         still &= np.max(np.abs(np.diff(smooth, axis=0)), axis=-1).max() <= max_step
-    first = views[names[0]]
-    if first.turntable.n_axes == 2:
-        normal = np.mean([-a[:, :3, 2] for a in arrs], axis=0)
-        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-        ref = _along_z(-normal, arrs[0][:, :3, 3])
-        still &= _normal_deviation(first, frame, ref, np.zeros(n), smooth[:, None])[:, 0] \
-            <= normal_tol
+    if paths.first.turntable.n_axes == 2:
+        ref, _ = paths.mean_normal()
+        still &= _normal_deviation(paths.first, paths.frame, ref, np.zeros(n),
+                                   smooth[:, None])[:, 0] <= normal_tol
     return np.where(_pieces_ok(still, cut)[:, None], smooth, chosen)

@@ -10,7 +10,7 @@ mm and ``table`` or ``e1..en`` deg, ``name``) with the columns of a motion
 | ``motion`` | optional | ``ptp`` or ``lin`` (default: ``ptp`` to the first point, ``lin`` after) |
 | ``speed`` | optional | TCP speed of a linear motion (mm/s; default 100) |
 | ``zone`` | optional | corner distance (mm; default 0, an exact stop) |
-| ``time`` | optional | when the point is reached (s, increasing): coordinated programs match the robots' points by it (:mod:`robotcell.programs.pathtime`) |
+| ``time`` | optional | when the point is reached (s, increasing; ``pathtime``) |
 
 Without ``track`` the track is chosen along the path. Without ``table`` (or ``e1..en``) the
 writer chooses the table's values along a path in a frame the table carries
