@@ -32,6 +32,13 @@ target), kept where every target of the piece stays reached. :func:`robotcell.ce
 solves the path at the chosen values (and :func:`~robotcell.cell.ik.split_path` names the
 breaks that remain). The programme runs over the targets in order (each step depends on the
 one before); each step is vectorised over the candidates and configurations.
+
+:func:`choose_shared_table` chooses the values once for several robots whose point ``k`` is
+reached together (a coordinated program): a 2-axis positioner's candidates put the robots'
+mean surface normal up; a state is a candidate with a configuration of every robot, each
+reaching its point within every limit; its score is the worst robot's (each robot's score as
+above, against its own best at that point); a move keeps every robot's configuration. A point
+no candidate serves for every robot is refused, naming the robot that reaches it at none.
 """
 
 from __future__ import annotations
