@@ -141,9 +141,12 @@ def match_by_time(paths: Mapping[str, PathTargets]) -> dict[str, PathTargets]:
         return dict(paths)
     if len(timed) < len(paths):
         without = [p.source for p in paths.values() if p.time is None]
-        raise InputError(f"{', '.join(p.source for p in timed.values())} give(s) a time column "
-                         f"and {', '.join(without)} not: points are matched by time only when "
-                         "every file gives times; add the column to every file, or remove it")
+        one = len(timed) == 1
+        raise InputError(f"{', '.join(p.source for p in timed.values())} "
+                         f"{'gives' if one else 'give'} a time column and {', '.join(without)} "
+                         f"{'does' if len(without) == 1 else 'do'} not: points are matched by "
+                         "time only when every file gives times; add the column to every file, "
+                         "or remove it")
     for end, what in ((0, "first"), (-1, "last")):
         ends = np.array([p.time[end] for p in timed.values()])
         if np.ptp(ends) > TIME_TOL:
