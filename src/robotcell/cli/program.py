@@ -241,9 +241,11 @@ def _by_robot(values: tuple[str, ...], what: str) -> dict[str, str]:
 def write_coordinated_cmd(paths: tuple[str, ...], cell_path: str, tools: tuple[str, ...],
                           frame: str, vendor: str, folder: str, name: str | None) -> None:
     """Write the paths of several robots of the cell as one coordinated program: point k of
-    every path reached together, the positioner at the values the files give (columns table or
-    e1..en, in at least one file), each robot's track as its file says or following its path
-    (docs/programs.md, "Coordinated programs"). ABB: one MultiMove module per task (T_ROB1,
+    every path reached together (or, when every file has a time column, s, the points matched
+    by time, poses between a file's points interpolated along its linear motions), the
+    positioner at the values the files give (columns table or e1..en) or, where none gives
+    them, chosen once for all robots, each robot's track as its file says or following its
+    path (docs/programs.md, "Coordinated programs"). ABB: one MultiMove module per task (T_ROB1,
     T_ROB2, .. in the order of the cell's robots). A format whose coordinated form robotcell
     does not write exits with status 2 naming what is missing; nothing is written.
 

@@ -3,9 +3,12 @@
 Each robot has a path file (:mod:`robotcell.programs.path`) in one frame, the world or a frame
 of the cell (on the shared positioner: the robots work on the part as the positioner turns
 it). Point ``k`` of every path is reached at the same time, with the positioner at the same
-values: the paths have as many points, and the positioner's values (columns ``table`` or
-``e1..en``) are given in at least one of the files (where several give them, they agree).
-Each robot's track is its own file's ``track`` column, or follows its path. Each robot's path
+values: the paths have as many points, or every file has a ``time`` column and the points are
+matched by time (:func:`robotcell.programs.pathtime.match_by_time`). The positioner's values
+(columns ``table`` or ``e1..en``) are those of the files that give them (where several give
+them, they agree), or, where none does and the frame is on the positioner, chosen once for all
+robots (:func:`robotcell.cell.tablechoice.choose_shared_table`). Each robot's track is its own
+file's ``track`` column, or follows its path. Each robot's path
 is solved through the cell as that robot sees it (:meth:`robotcell.cell.Cell.for_robot`,
 :func:`robotcell.programs.write.build_programs`), and the controller writes the programs as
 one coordinated program (:meth:`robotcell.controllers.base.Controller.write_coordinated`: ABB
@@ -23,11 +26,12 @@ from pathlib import Path
 import numpy as np
 
 from robotcell.cell import Cell
-from robotcell.cell.tablechoice import carried_by_table
+from robotcell.cell.tablechoice import carried_by_table, choose_shared_table
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.programs.files import check_folder, write_all
 from robotcell.programs.path import PathTargets, read_path
+from robotcell.programs.pathtime import match_by_time
 from robotcell.programs.write import WriteResult, build_programs
 
 __all__ = ["CoordinatedResult", "shared_table", "write_coordinated"]
@@ -68,38 +72,58 @@ def _robots(cell: Cell, names: Sequence[str], tools: Mapping[str, str]) -> list[
     return [r for r in cell.robot_names if r in names]
 
 
-def shared_table(cell: Cell, targets: Mapping[str, PathTargets], frame: str
-                 ) -> dict[str, PathTargets]:
-    """The paths with the positioner's values of the files that give them, for every robot.
+def shared_table(cell: Cell, targets: Mapping[str, PathTargets], frame: str,
+                 tools: Mapping[str, str] | None = None) -> dict[str, PathTargets]:
+    """The paths with the positioner's values of the files that give them, for every robot, or
+    chosen once for all robots where no file gives them.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell of several robots.
+    targets : mapping of str to PathTargets
+        Each robot's path, as many points each (:func:`robotcell.programs.pathtime.match_by_time`
+        makes paths with times so).
+    frame : str
+        The paths' frame.
+    tools : mapping of str to str, optional
+        Each robot's tool, for the choice (absent: the robot model's tool).
+
+    Returns
+    -------
+    dict of str to PathTargets
+        Every path with the same ``table`` (rad), given or chosen
+        (:func:`robotcell.cell.tablechoice.choose_shared_table`), ``table_given`` True.
 
     Raises
     ------
     InputError
-        Paths of different lengths; files that give different values for one point; no file
-        giving the values of a positioner that carries the paths' frame.
+        Paths of different lengths; files that give different values for one point; a point
+        at which no positioner values serve every robot (naming the point and the robot).
     """
     lengths = {r: len(t) for r, t in targets.items()}
     if len(set(lengths.values())) > 1:
         raise InputError("the robots' paths must have as many points each (point k of every "
                          "path is reached together): "
-                         + ", ".join(f"{r} {n}" for r, n in lengths.items()))
+                         + ", ".join(f"{r} {n}" for r, n in lengths.items())
+                         + "; give a time column in every file to match the points by time")
     if cell.turntable is None:
         return dict(targets)
     given = {r: t for r, t in targets.items() if t.table_given}
     if not given:
-        if carried_by_table(cell.for_robot(next(iter(targets))), frame):
-            raise InputError(f"frame {frame!r} is on positioner {cell.turntable.name!r}: give "
-                             "its values (columns table or e1..en, deg) in at least one path "
-                             "file; a coordinated program does not choose them")
-        return dict(targets)
+        if not carried_by_table(cell.for_robot(next(iter(targets))), frame):
+            return dict(targets)
+        choice = choose_shared_table(cell, {r: t.T for r, t in targets.items()}, frame,
+                                     {r: t.track for r, t in targets.items()}, dict(tools or {}))
+        return {r: replace(t, table=choice.table, table_given=True) for r, t in targets.items()}
     first, values = next(iter(given.items()))
     want = values.table.reshape(len(values), -1)
     for t in given.values():
         bad = np.flatnonzero(np.abs(t.table.reshape(len(t), -1) - want).max(axis=1) > 1e-9)
         if bad.size:
-            raise InputError(f"{t.source}: line {bad[0] + 2}: the positioner's values differ "
-                             f"from those of {values.source} ({first}); every robot's point k "
-                             "is reached at the same values")
+            raise InputError(f"{t.line(int(bad[0]))}: the positioner's values differ from those "
+                             f"of {values.source} ({first}); every robot's point k is reached "
+                             "at the same values")
     return {r: replace(t, table=values.table, table_given=True) for r, t in targets.items()}
 
 
@@ -151,9 +175,11 @@ def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mappin
     ------
     InputError
         A controller whose coordinated form is not written (the message names what is
-        missing), a robot the cell lacks, a missing tool, paths of different lengths, a value
-        outside the positioner's or a track's limits, positioner values not given or
-        disagreeing, a bad path file, name or folder: nothing is written.
+        missing), a robot the cell lacks, a missing tool, paths of different lengths without
+        times, times in some files only, first or last times that differ, a time on a joint
+        motion, a value outside the positioner's or a track's limits, positioner values that
+        disagree, a point no positioner values serve for every robot, a bad path file, name or
+        folder: nothing is written.
     robotcell.programs.write.PathBreaks
         A robot's path cannot be one program (reach, limits, singularity): nothing is written.
     """
@@ -162,8 +188,8 @@ def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mappin
     if ctl.coordinated_missing is not None:
         raise ctl.coordinated_refusal()
     robots = _robots(cell, list(paths), tools)
-    targets = shared_table(cell, {r: read_path(paths[r], cell.for_robot(r)) for r in robots},
-                           frame)
+    read = {r: read_path(paths[r], cell.for_robot(r)) for r in robots}
+    targets = shared_table(cell, match_by_time(read), frame, tools)
     if name is None:
         name = ctl.default_name(Path(paths[robots[0]]).stem)
     results = {r: build_programs(cell.for_robot(r), targets[r], ctl.name, name, tools[r], frame)
