@@ -126,7 +126,7 @@ def check_coordinated(paths: Sequence[str | Path], cell: Cell,
     if len(set(counts.values())) > 1:
         sync.append("the programs move to different numbers of points: "
                     + ", ".join(f"{r} {n}" for r, n in counts.items()))
-    elif cell.turntable is not None:
+    elif cell.turntable is not None and any(counts.values()):
         sync += _table_problems(reports)
     if bodies is not None and not sync:
         _clearance(cell, reports, bodies, clearance)
