@@ -253,8 +253,12 @@ def test_a_coordinated_job_is_one_file_and_its_check_refuses_more(written, tmp_p
     with pytest.raises(InputError, match=r"2 program files: a YASKAWA coordinated program is "
                                          r"one file for all robots"):
         check_coordinated([_job(result), _job(result)], cell, pulses_per_degree=PPD)
-    with pytest.raises(InputError, match=r"a YASKAWA coordinated job holds two robots .*got 1"):
+    with pytest.raises(InputError, match=r"holds two robots, group 1's and group 2's; got 1: "
+                                         r"name the two robots"):
         check_coordinated([_job(result)], cell, robots=["rob1"], pulses_per_degree=PPD)
+    code, _out, err = run(capsys, "program", "check-coordinated", _job(result), _job(result),
+                          "--cell", CELL, "--pulses-per-degree", "100,100")
+    assert code == 2 and err.startswith("error: 2 program files: a YASKAWA coordinated program")
 
 
 def test_the_command_line_writes_and_checks_the_job(tmp_path, capsys):
@@ -274,3 +278,33 @@ def test_the_command_line_writes_and_checks_the_job(tmp_path, capsys):
                           "--tool", "torch", "--frame", "part", "--format", "yaskawa",
                           "-o", folder, "--name", "seams", "--pulses-per-degree", "100,100")
     assert code == 0, err
+
+
+def test_a_cell_without_a_station_writes_group_1_as_the_first_robot_alone(tmp_path):
+    """The part fixed where the station holds it at 0: ///GROUP1 RB1, ///GROUP2 RB2 (as the
+    job writer run on the DX200 writes them for two robots), no EC, read back through
+    Cell.fk."""
+    text = CELL.read_text()
+    text = text[:text.index("positioner:\n")] + (
+        "frames:\n  part:\n    number: 1\n    parent: world\n"
+        "    frame: {x: 1100, y: 0, z: 830, a: 180, b: 0, c: 0}\n"
+        "    provenance: {source: nominal}\n")
+    (tmp_path / "cell.yaml").write_text(text)
+    cell = Cell.load(tmp_path / "cell.yaml")
+    paths = {}
+    for robot, seam in SEAMS.items():
+        rows = [ln.split(",")[:8] for ln in seam.read_text().splitlines()]
+        paths[robot] = tmp_path / f"{robot}.csv"
+        paths[robot].write_text("\n".join(",".join(r) for r in rows) + "\n")
+    result = write_coordinated(paths, cell, TOOLS, "part", "yaskawa", tmp_path / "out", "seams")
+    lines = _job(result).read_text().splitlines()
+    assert "///GROUP1 RB1" in lines and "///GROUP2 RB2" in lines
+    assert "///NPOS 12,0,0,0,0,0" in lines and not any(ln.startswith("EC") for ln in lines)
+    assert "MOVJ C00000 VJ=20.00  +MOVJ C00001 VJ=20.00" in lines
+    report = check_coordinated(result.files, cell)
+    assert report.good, (report.sync, report.rows())
+    for robot, rep in report.reports.items():
+        q = np.array([p.q for p in rep.points])
+        T = cell.fk(q, tool="torch", frame="part", robot=robot)
+        want = read_path(paths[robot], cell.for_robot(robot)).T
+        assert np.abs(T[:, :3, 3] - want[:, :3, 3]).max() < 1e-6

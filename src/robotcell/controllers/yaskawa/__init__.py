@@ -107,7 +107,9 @@ class Yaskawa(Controller):
         if len(paths) != 1:
             raise InputError(f"a YASKAWA coordinated program is one job for all robots; got "
                              f"{len(paths)} files")
-        multigroup.check_robots(n, [])
+        if n != multigroup.ROBOTS:
+            raise InputError(f"a YASKAWA coordinated job holds two robots, group 1's and group "
+                             f"2's; got {n}: name the two robots, group 1's first")
         return inform.read_groups(paths[0])
 
     def coordinated_problems(self, paths: list[str | Path]) -> list[str]:

@@ -37,7 +37,7 @@ from robotcell.controllers.yaskawa.program import (
 )
 from robotcell.errors import InputError
 
-__all__ = ["GROUPS", "check_robots", "group_problems", "write_job"]
+__all__ = ["GROUPS", "ROBOTS", "check_robots", "group_problems", "write_job"]
 
 #: The groups of a job of two robots, the first with the station (``///GROUP1``,
 #: ``///GROUP2``), as a DX200 saves them; without a station ``RB1``.
