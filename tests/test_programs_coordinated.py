@@ -142,7 +142,7 @@ def _paths_with(tmp_path, robot, text):
      "abb", r"positioner's values differ"),
     (lambda t: SEAMS, "kuka", r"KUKA coordinated programs .* not written.*RoboTeam"),
     (lambda t: SEAMS, "fanuc", r"FANUC coordinated .*two robot groups"),
-    (lambda t: SEAMS, "yaskawa", r"YASKAWA coordinated .*R1 \+ R2"),
+    (lambda t: SEAMS, "yaskawa", r"robot\(s\) rob1 on a track: .*base axis"),
 ])
 def test_bad_input_is_refused_and_nothing_is_written(tmp_path, capsys, make, vendor, match):
     cell = Cell.load(CELL)

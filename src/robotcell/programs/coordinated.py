@@ -12,7 +12,7 @@ file's ``track`` column, or follows its path. Each robot's path
 is solved through the cell as that robot sees it (:meth:`robotcell.cell.Cell.for_robot`,
 :func:`robotcell.programs.write.build_programs`), and the controller writes the programs as
 one coordinated program (:meth:`robotcell.controllers.base.Controller.write_coordinated`: ABB
-MultiMove); a controller whose coordinated form robotcell does not write refuses, naming what
+MultiMove, a YASKAWA job of two robots and a station); a controller whose coordinated form robotcell does not write refuses, naming what
 is missing. :func:`check_coordinated` reads such a program back (docs/programs.md,
 "Coordinated programs").
 """
@@ -24,9 +24,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robotcell.cell import Cell
 from robotcell.cell.tablechoice import carried_by_table, choose_shared_table
+from robotcell.controllers.base import Controller
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.programs.files import check_folder, write_all
@@ -44,9 +46,10 @@ class CoordinatedResult:
     Attributes
     ----------
     files : list of str
-        The files written, one per robot (ABB: one module per task).
+        The files written: one per robot (ABB: one module per task), or one for all
+        (YASKAWA: one job).
     robots : list of str
-        The robots in the order of the tasks (``T_ROB1``, ``T_ROB2``, ..).
+        The robots in the order of the tasks (``T_ROB1``, ``T_ROB2``, ..) or groups.
     results : dict of str to WriteResult
         Each robot's solved path: joints ``q`` (rad), ``track`` (m), ``table`` (rad) per point.
     warnings : list of str
@@ -131,12 +134,14 @@ def shared_table(cell: Cell, targets: Mapping[str, PathTargets], frame: str,
 _HEADER = "robotcell coordinated program of cell"
 
 
-def _refuse_others(folder: Path, texts: dict[str, str]) -> None:
+def _refuse_others(folder: Path, texts: dict[str, str], ctl: Controller) -> None:
     """Refuse to replace a file of the folder that is not a coordinated program robotcell
-    wrote (an earlier one is replaced)."""
+    wrote (an earlier one is replaced; its comments may wrap the header over lines)."""
+    header = "".join(_HEADER.split())
     for name in texts:
         path = folder / name
-        if path.is_file() and _HEADER not in path.read_text(errors="replace"):
+        said = "".join(ctl.comments(path.read_text(errors="replace"))) if path.is_file() else ""
+        if path.is_file() and header not in "".join(said.split()):
             raise InputError(f"cannot write {path}: it is a file robotcell did not write as a "
                              "coordinated program; give this program another name or folder, "
                              "or remove that file first")
@@ -144,7 +149,8 @@ def _refuse_others(folder: Path, texts: dict[str, str]) -> None:
 
 def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mapping[str, str],
                       frame: str, vendor: str, folder: str | Path, name: str | None = None,
-                      inputs: tuple[str | Path, ...] = ()) -> CoordinatedResult:
+                      inputs: tuple[str | Path, ...] = (),
+                      pulses_per_degree: ArrayLike | None = None) -> CoordinatedResult:
     """Write the coordinated program of several robots' paths, all of its files or none.
 
     Parameters
@@ -159,13 +165,16 @@ def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mappin
     frame : str
         ``world`` or a frame of the cell: the frame of every path's poses.
     vendor : str
-        A registered controller whose coordinated form robotcell writes (``abb``: MultiMove).
+        A registered controller whose coordinated form robotcell writes (``abb``: MultiMove;
+        ``yaskawa``: one job of two robots and a station).
     folder : str or Path
         Output folder (created when missing; its parent must exist).
     name : str, optional
         Program name; default: the first robot's path file's name.
     inputs : tuple of str or Path
         Further files the run read (the cell file), which no output may replace.
+    pulses_per_degree : float or array_like, optional
+        YASKAWA: encoder pulses per degree of each station axis.
 
     Returns
     -------
@@ -175,11 +184,12 @@ def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mappin
     ------
     InputError
         A controller whose coordinated form is not written (the message names what is
-        missing), a robot the cell lacks, a missing tool, paths of different lengths without
-        times, times in some files only, first or last times that differ, a time on a joint
-        motion, a value outside the positioner's or a track's limits, positioner values that
-        disagree, a point no positioner values serve for every robot, a bad path file, name or
-        folder: nothing is written.
+        missing) or does not hold these robots (YASKAWA: two, none on a track), a robot the
+        cell lacks, a missing tool, paths of different lengths without times, times in some
+        files only, first or last times that differ, a time on a joint motion, a value outside
+        the positioner's or a track's limits, positioner values that disagree, a point no
+        positioner values serve for every robot, a bad path file, name or folder: nothing is
+        written.
     robotcell.programs.write.PathBreaks
         A robot's path cannot be one program (reach, limits, singularity): nothing is written.
     """
@@ -188,16 +198,17 @@ def write_coordinated(paths: Mapping[str, str | Path], cell: Cell, tools: Mappin
     if ctl.coordinated_missing is not None:
         raise ctl.coordinated_refusal()
     robots = _robots(cell, list(paths), tools)
+    ctl.coordinated_robots(cell, robots)
     read = {r: read_path(paths[r], cell.for_robot(r)) for r in robots}
     targets = shared_table(cell, match_by_time(read), frame, tools)
     if name is None:
         name = ctl.default_name(Path(paths[robots[0]]).stem)
-    results = {r: build_programs(cell.for_robot(r), targets[r], ctl.name, name, tools[r], frame)
-               for r in robots}
+    results = {r: build_programs(cell.for_robot(r), targets[r], ctl.name, name, tools[r], frame,
+                                 pulses_per_degree=pulses_per_degree) for r in robots}
     header = [f"{_HEADER} {cell.name!r}, frame {frame!r}: "
               + ", ".join(f"{r}: path {Path(paths[r]).name}, tool {tools[r]!r}" for r in robots)]
     texts = ctl.write_coordinated([results[r].programs[0] for r in robots], header)
-    _refuse_others(Path(folder), texts)
+    _refuse_others(Path(folder), texts, ctl)
     files = write_all(folder, texts, (*paths.values(), *inputs))
     warnings = [w for r in robots for w in targets[r].warnings]
     return CoordinatedResult(files, robots, results, warnings)
