@@ -189,7 +189,7 @@ def test_the_command_line_writes_and_checks(tmp_path, capsys):
     shutil.copy(files[1], tmp_path / "only.mod")
     code, out, err = run(capsys, "program", "check-coordinated", tmp_path / "only.mod",
                          "--cell", CELL)
-    assert code == 2 and "1 program files for 2 robots" in err
+    assert code == 2 and "1 program file for 2 robots" in err
 
 
 def test_a_file_robotcell_did_not_write_is_not_replaced(tmp_path):

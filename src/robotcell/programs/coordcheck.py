@@ -68,9 +68,9 @@ def _robots(cell: Cell, paths: Sequence[str | Path], robots: Sequence[str] | Non
         raise InputError(f"{len(paths)} program files: a {ctl.label} coordinated program is one "
                          "file for all robots; give that one file")
     if not ctl.coordinated_one_file and len(names) != len(paths):
-        raise InputError(f"{len(paths)} program files for {len(names)} robots "
-                         f"({', '.join(names)}): give one file per robot, in the order of the "
-                         "robots (or name them)")
+        files = "1 program file" if len(paths) == 1 else f"{len(paths)} program files"
+        raise InputError(f"{files} for {len(names)} robots ({', '.join(names)}): give one "
+                         "file per robot, in the order of the robots (or name them)")
     return names
 
 
