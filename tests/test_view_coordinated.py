@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from cli_helpers import run
 from test_view_scenes import assert_triad_line
-from view_helpers import figure_from_page, moving_parts, traces, xyz
+from test_report import _chromium
+from view_helpers import figure_from_page, js_errors, moving_parts, render, traces, xyz
 
 from robotcell import InputError, make_pose
 from robotcell.cell import Cell
@@ -73,6 +74,9 @@ def test_every_robot_and_the_positioner_are_at_their_points_at_every_step(writte
     cell, files = written
     made = write_coordinated_view(cell, files, tmp_path / "v.html", bodies=read_bodies(BODIES))
     assert made.every == 1 and made.size == (tmp_path / "v.html").stat().st_size < 5_000_000
+    # both torches 5 mm above the plate at every point
+    assert {b for _, b in made.closest.pair} == {"plate"}
+    np.testing.assert_allclose(made.closest.distance, 0.005, atol=1e-6)
     data = figure_from_page((tmp_path / "v.html").read_text())
     report = made.report
     n = len(report.reports["rob1"].points)
@@ -236,3 +240,12 @@ def test_the_command_writes_the_view_and_refuses_bad_input(written, tmp_path, ca
         assert lines[0].startswith("error: "), err
     assert not out.exists()
     assert files[1].read_text().startswith("MODULE")
+
+
+def test_the_browser_draws_the_coordinated_view_without_error(written, tmp_path):
+    cell, files = written
+    exe = _chromium()
+    write_coordinated_view(cell, files, tmp_path / "v.html", bodies=read_bodies(BODIES))
+    dom, console, _ = render(exe, tmp_path / "v.html", tmp_path, screenshot=False)
+    assert not js_errors(console), console
+    assert 'data-scene="rendered"' in dom
