@@ -111,8 +111,9 @@ def view(cell_path: str, **options: Any) -> None:
           --track 1500 --table 30 -o cell.html
       robotcell view cell.yaml --reach reach.csv --tool torch -o reach3d.html
       robotcell view cell.yaml --program prog/seam_part.src -o program.html
-      robotcell view cell2.yaml --program prog/seams_T_ROB1.mod \\
-          --program prog/seams_T_ROB2.mod --bodies bodies.yaml -o coordinated.html
+      robotcell view examples/cell_two_abb_positioner.yaml --program prog_cv/seams_T_ROB1.mod \\
+          --program prog_cv/seams_T_ROB2.mod --bodies examples/bodies_two_robots_positioner.yaml \\
+          -o coordinated.html
     """
     o = ViewOptions(**options)
     if o.tool is not None and o.reach_path is None:
