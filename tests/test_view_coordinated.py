@@ -249,3 +249,30 @@ def test_the_browser_draws_the_coordinated_view_without_error(written, tmp_path)
     dom, console, _ = render(exe, tmp_path / "v.html", tmp_path, screenshot=False)
     assert not js_errors(console), console
     assert 'data-scene="rendered"' in dom
+
+
+def test_a_point_a_robot_cannot_reach_is_marked_and_its_arm_stays_at_the_point_before(written):
+    cell, files = written
+    bodies = read_bodies(BODIES)
+    report = check_coordinated(files, cell)
+    lost = report.reports["rob2"].points[3]
+    lost.q = np.full(6, np.nan)
+    lost.problems = ["out of reach by 12.0 mm"]
+    scene = coordinated_scene(cell, report, bodies, clearance=0.003)
+    data = figure_from_page(program_view.page(scene))
+    before, at = moving_parts(data, 2), moving_parts(data, 3)
+    np.testing.assert_array_equal(at["rob2: robot abb_irb2400: links"],
+                                  before["rob2: robot abb_irb2400: links"])
+    assert np.abs(at["rob1: robot abb_irb2400: links"]
+                  - before["rob1: robot abb_irb2400: links"]).max() > 1.0
+    mark = traces(data, "rob2: bad points")[0]
+    assert mark["text"] == [lost.name]
+    assert mark["hovertext"] == [f"<b>rob2 point {lost.name}</b>: out of reach by 12.0 mm"]
+    np.testing.assert_allclose(xyz(mark)[0], lost.T_world_TCP[:3, 3] * 1e3, atol=TOL)
+    # no closest pair where a robot has no joint values
+    got = closest_pairs(cell, report, bodies)
+    assert got.distance[3] == np.inf and got.pair[3] == ("", "")
+    line = next(it for it in scene.steps[3].items if it.name == CLOSEST)
+    label = next(it for it in scene.steps[3].items if it.name == f"{CLOSEST}: distance")
+    assert np.all(np.isnan(line.points)) and len(label.points) == 0
+    np.testing.assert_allclose(got.distance[[0, 1, 2, 4, 5]], 0.005, atol=1e-6)

@@ -90,18 +90,18 @@ class _Robot:
     table: NDArray[np.float64]      # (N,) or (N, k), rad
     T_tcp: NDArray[np.float64]      # (N, 4, 4), the TCP in the world (m; NaN: not placed)
     T_flange: NDArray[np.float64]   # (N, 4, 4), the flange in the world (m; NaN: no joints)
+    shown: NDArray[np.intp]         # (N,), the point whose arm is drawn at each point
 
     @property
     def has_q(self) -> NDArray[np.bool_]:
         return np.all(np.isfinite(self.q), axis=1)
 
-    @property
-    def shown(self) -> NDArray[np.intp]:
-        """At each point, the point whose arm is drawn: the nearest one before it (itself
-        included) with joint values, else the first with them."""
-        has = self.has_q
-        at = np.maximum.accumulate(np.where(has, np.arange(len(has)), -1))
-        return np.where(at < 0, int(np.argmax(has)), at)
+
+def _shown(has_q: NDArray[np.bool_]) -> NDArray[np.intp]:
+    """At each point, the point whose arm is drawn: the nearest one before it (itself included)
+    with joint values, else the first with them."""
+    at = np.maximum.accumulate(np.where(has_q, np.arange(len(has_q)), -1))
+    return np.where(at < 0, int(np.argmax(has_q)), at)
 
 
 def _robots(cell: Cell, report: CoordinatedReport) -> list[_Robot]:
@@ -124,7 +124,7 @@ def _robots(cell: Cell, report: CoordinatedReport) -> list[_Robot]:
         if np.any(has):
             flange[has] = view.fk(q[has], track[has], table[has], tool=np.eye(4))
         T_tcp = np.array([p.T_world_TCP for p in pts], dtype=float)
-        out.append(_Robot(name, view, rep, q, track, table, T_tcp, flange))
+        out.append(_Robot(name, view, rep, q, track, table, T_tcp, flange, _shown(has)))
     if not any(np.any(r.has_q) for r in out):
         raise InputError("no point of the coordinated program can be placed in the cell, so "
                          "there is no arm to draw: " + "; ".join(
