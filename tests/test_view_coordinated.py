@@ -145,13 +145,14 @@ def test_the_closest_pair_at_each_point_is_clearance_betweens_and_changes_along(
                                    got.distance[k], atol=1e-6)
         a, b = got.pair[k]
         assert label.labels == (f"{a} - {b} {got.distance[k] * 1e3:.1f} mm",)
-        assert f"{a} and {b}, {got.distance[k] * 1e3:.3f} mm (limit 10 mm)" in line.hover[0]
+        assert f"{a} and {b}, {got.distance[k] * 1e3:.3f} mm (limit 10 mm)" in label.hover[0]
         assert line.color == CLEAR_COLOR
     # under a limit of 30 mm the two end points are problems: red, and named in the hover
     scene = coordinated_scene(cell, report, bodies, clearance=0.030)
     lines = [next(it for it in s.items if it.name == CLOSEST) for s in scene.steps]
     assert [ln.color == OUTLIER_COLOR for ln in lines] == list(got.distance < 0.030)
-    assert lines[0].color == OUTLIER_COLOR and "under it" in lines[0].hover[0]
+    label = next(it for it in scene.steps[0].items if it.name == f"{CLOSEST}: distance")
+    assert label.color == OUTLIER_COLOR and "(limit 30 mm, under it)" in label.hover[0]
 
 
 def test_every_kth_point_has_the_arms_and_the_closest_pair_of_its_point(written, monkeypatch,

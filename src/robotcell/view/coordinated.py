@@ -243,7 +243,8 @@ def _at_point(robots: list[_Robot], j: int, size: float) -> list[Item]:
 
 def _pair_items(closest: Clearance, j: int, limit: float) -> tuple[Lines, Points]:
     """The closest pair at point ``j``: the line between its nearest points, and its label at
-    the line's middle (the pair and its distance), in red under ``limit`` (m)."""
+    the line's middle (the pair and its distance; its hover text to 0.001 mm with the limit),
+    in red under ``limit`` (m)."""
     d, (a, b) = float(closest.distance[j]), closest.pair[j]
     if not np.isfinite(d):
         return (Lines(CLOSEST, np.full((2, 3), np.nan), color=CLEAR_COLOR),
@@ -254,7 +255,7 @@ def _pair_items(closest: Clearance, j: int, limit: float) -> tuple[Lines, Points
     hover = (f"<b>closest pair</b>: {a} and {b}, {d * 1e3:.3f} mm (limit {limit * 1e3:g} mm"
              f"{', under it' if d < limit else ''})")
     ends = closest.nearest[j]
-    return (Lines(CLOSEST, ends, color=color, width=6.0, hover=[hover, hover]),
+    return (Lines(CLOSEST, ends, color=color, width=6.0),
             Points(f"{CLOSEST}: distance", ends.mean(axis=0)[None], color=color, size=3.0,
                    labels=[label], hover=[hover]))
 
