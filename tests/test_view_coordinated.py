@@ -221,10 +221,15 @@ def test_the_command_writes_the_view_and_refuses_bad_input(written, tmp_path, ca
     on_robot = tmp_path / "on_robot.yaml"
     on_robot.write_text("bodies:\n  carriage: {parent: robot, box: [100, 100, 100]}\n")
     both = ["--program", files[0], "--program", files[1]]
+    short = tmp_path / "seams_T_ROB2.mod"  # its last move left out
+    short.write_text("".join(ln for ln in files[1].read_text().splitlines(True)
+                             if not ln.lstrip().startswith("MoveL p6")))
     cases = [
         (["--program", files[0], "--bodies", BODIES], "--bodies: for a coordinated program, "
                                                       "one --program per robot"),
         ([*both, "--program", files[1]], "3 program files for 2 robots"),
+        (["--program", files[0], "--program", short], "different numbers of points (rob1 6, "
+                                                      "rob2 5)"),
         ([*both, "--robots", "rob1,rob3"], "rob3"),
         ([*both, "--bodies", bad_bodies], "linkz"),
         ([*both, "--bodies", on_robot], "does not say which robot"),

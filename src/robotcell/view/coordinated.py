@@ -110,8 +110,8 @@ def _robots(cell: Cell, report: CoordinatedReport) -> list[_Robot]:
     if len(set(counts.values())) > 1:
         raise InputError("the programs move to different numbers of points ("
                          + ", ".join(f"{r} {n}" for r, n in counts.items())
-                         + "): a coordinated program moves every robot to its point k at once; "
-                         "check it with check_coordinated")
+                         + "): a coordinated program moves every robot to its point k at once, "
+                         "so they cannot be drawn together; draw each robot's program alone")
     out = []
     for name, rep in report.reports.items():
         view = cell.for_robot(name)
