@@ -227,6 +227,7 @@ def test_the_command_writes_the_view_and_refuses_bad_input(written, tmp_path, ca
     cases = [
         (["--program", files[0], "--bodies", BODIES], "--bodies: for a coordinated program, "
                                                       "one --program per robot"),
+        (["--program", files[0]], "has 2 robots (rob1, rob2): give one --program per robot"),
         ([*both, "--program", files[1]], "3 program files for 2 robots"),
         (["--program", files[0], "--program", short], "different numbers of points (rob1 6, "
                                                       "rob2 5)"),

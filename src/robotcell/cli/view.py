@@ -14,7 +14,7 @@ from robotcell.cli.cellargs import cell_tool, table_angles, table_option, track_
 from robotcell.cli.common import in_range, output_of, parse_numbers
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.fk import joints_to_si
-from robotcell.cli.robotname import load_cell, robot_name, robot_name_option, robot_of
+from robotcell.cli.robotname import robot_name, robot_name_option, robot_of
 from robotcell.errors import InputError
 from robotcell.robot.robot import Robot
 from robotcell.view.cellscene import write_cell_view
@@ -84,7 +84,7 @@ def joint_option(robot: Robot, text: str | None) -> np.ndarray | None:
               help="With a coordinated program: the cell's parts as shapes (YAML, "
                    "docs/clearance.md); the clearance is checked and the closest pair drawn "
                    "at each point.")
-@click.option("--clearance", "clearance_mm", type=float, default=None,
+@click.option("--clearance", "clearance_mm", type=float, default=None, metavar="MM",
               callback=in_range(0.0, 1000.0, "mm"),
               help="With --bodies: smallest good distance (mm); default 10.")
 @click.option("-o", "--output", required=True, type=OUTPUT,
@@ -158,7 +158,13 @@ def _arms(every: int) -> str:
 
 def _program(cell_path: str, o: ViewOptions) -> None:
     """One robot's program."""
-    cell = load_cell(cell_path)
+    whole = Cell.load(cell_path)
+    if len(whole.robots) > 1 and robot_name() is None:
+        raise InputError(f"{cell_path} has {len(whole.robots)} robots "
+                         f"({', '.join(whole.robot_names)}): give one --program per robot (a "
+                         "coordinated program), or say whose program this is with "
+                         "--robot-name NAME")
+    cell = whole.for_robot(robot_of(whole, cell_path))
     pulses = None if o.ppd is None else parse_numbers(o.ppd, "--pulses-per-degree")
     try:
         made = write_program_view(cell, o.programs[0], o.output, pulses)
