@@ -173,7 +173,7 @@ def cell_touch_files(cell: Cell) -> list[tuple[str, Path]]:
     out = [(f"{name}: {key}", path) for name in cell.robots
            for key, path in touch_files(cell.for_robot(name), _owned(owners, name))]
     for name, link in _links(cell, f"cell {cell.name!r}", []).items():
-        out += [(f"{name}: base", Path(link.reference.path)), (f"{name}: base", Path(link.other.path))]
+        out += [(f"{name}: base", Path(p)) for p in (link.reference.path, link.other.path)]
     return out
 
 
