@@ -559,7 +559,7 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
     robot = None if robot_name() is None else robot_of(cell, cell_path)
     refuse_overwriting_inputs(click.get_current_context(),
                               read=[(f"the touch file of {key}", _shown(path))
-                                    for key, path in cell_touch_files(cell)])
+                                    for key, path in cell_touch_files(cell, cell_path)])
     nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
 
     def change(cell: Cell) -> tuple[Cell, cellcal.CellRecalibration]:

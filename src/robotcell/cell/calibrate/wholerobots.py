@@ -155,24 +155,33 @@ def _order(names: tuple[str, ...], links: dict[str, RecordedLink]) -> list[str]:
     return order
 
 
-def cell_touch_files(cell: Cell) -> list[tuple[str, Path]]:
+def cell_touch_files(cell: Cell, cell_label: str | None = None) -> list[tuple[str, Path]]:
     """Every touch file :func:`calibrate_cell` reads, each with its item (labelled by its robot
     in a cell of several robots).
 
     Parameters
     ----------
     cell : Cell
+    cell_label : str, optional
+        Name of the cell in messages (its file).
 
     Returns
     -------
     list of (str, Path)
+
+    Raises
+    ------
+    InputError
+        As :func:`calibrate_cell`: a robot named by a provenance that the cell lacks, a shared
+        item whose robot cannot be told, a placement's missing or changed touch file.
     """
     if len(cell.robots) == 1:
         return touch_files(cell)
-    owners = _owners(cell, f"cell {cell.name!r}")
+    label = cell_label or f"cell {cell.name!r}"
+    owners = _owners(cell, label)
     out = [(f"{name}: {key}", path) for name in cell.robots
            for key, path in touch_files(cell.for_robot(name), _owned(owners, name))]
-    for name, link in _links(cell, f"cell {cell.name!r}", []).items():
+    for name, link in _links(cell, label, []).items():
         out += [(f"{name}: base", Path(p)) for p in (link.reference.path, link.other.path)]
     return out
 
