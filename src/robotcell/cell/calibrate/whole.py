@@ -349,8 +349,9 @@ def item_difference(T: NDArray[np.float64], T0: NDArray[np.float64]) -> NDArray[
 def rebased(change: ItemChange, first: ItemChange) -> ItemChange:
     """``change``, made by a second fit of an item, taken relative to the values before the
     first fit (``first``), with the 1-sigma they had."""
-    delta = _difference(change.after, 1.0 + first.change[-1] + change.change[-1], first.before,
-                        1.0, len(change.change))
+    size = len(change.change)
+    scale = 1.0 + first.change[6] + change.change[6] if size == 7 else 1.0
+    delta = _difference(change.after, scale, first.before, 1.0, size)
     return replace(change, before=first.before, change=delta, sigma_before=first.sigma_before)
 
 

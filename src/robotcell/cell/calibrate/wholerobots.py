@@ -293,23 +293,29 @@ class _Fit:
             self.parts.append((name, part))
 
     def _link_change(self, name: str, link: RecordedLink, result: CalibrationResult
-                     ) -> ItemChange:
+                     ) -> tuple[ItemChange, np.ndarray]:
         """How the placement moved robot ``name``'s base (``T_world_R``, or ``T_L_R0`` on a
-        track), with the 1-sigma of the link (in the reference robot's base)."""
-        def base(cell: Cell) -> tuple[np.ndarray, Provenance]:
+        track) and the link's covariance, both along the axes of the base's parent (the world,
+        or the track frame L): the link's 1-sigma is relative to the reference robot's base,
+        and the placement records it along that base's axes."""
+        def base(cell: Cell) -> tuple[np.ndarray, Provenance, np.ndarray]:
             unit = cell.robots[name]
             if unit.track is None:
-                return unit.T_world_R, unit.base_provenance
-            return unit.track.T_L_R0, unit.track.provenance
+                return unit.T_world_R, unit.base_provenance, np.eye(3)
+            return unit.track.T_L_R0, unit.track.provenance, unit.track.T_world_L[:3, :3]
 
-        before, prov = base(self.original)
+        before, prov, R_w_parent = base(self.original)
         after = base(self.current)[0]
+        R = R_w_parent.T @ self.current.for_robot(link.reference.robot).frame_pose(
+            "robot", track=link.reference.track)[:3, :3]  # reference base axes -> parent axes
+        turn = block_diag(R, R)
         est = result.estimates.get("T_ref_other")
-        sigma = np.sqrt(np.diag(est.covariance)) if est is not None else np.zeros(6)
-        sigma_before = (Sources(6, dict(prov.sources)).sigma if prov.sources
-                        else np.asarray(self.nominal.sigma(6)))
-        return ItemChange(f"{name}: base", before, after, item_difference(after, before), sigma,
-                          sigma_before, robot=name)
+        cov = turn @ est.covariance @ turn.T if est is not None else np.zeros((6, 6))
+        old = (Sources(6, dict(prov.sources)).covariance if prov.sources
+               else np.diag(np.asarray(self.nominal.sigma(6)) ** 2))
+        sigma_before = np.sqrt(np.diag(turn @ old @ turn.T if prov.sources else old))
+        return ItemChange(f"{name}: base", before, after, item_difference(after, before),
+                          np.sqrt(np.diag(cov)), sigma_before, robot=name), cov
 
     def combined(self) -> CellRecalibration:
         """The report of every robot's fit and every placement."""
@@ -325,12 +331,12 @@ class _Fit:
             blocks.append(part.covariance)
             iterations = max(iterations, part.iterations)
         for name, link, result in self.links:
-            change = self._link_change(name, link, result)
+            change, cov = self._link_change(name, link, result)
             changes.append(change)
             relative[change.key] = link.reference.robot
             steps.append(CellCalibration(result, key=change.key, value="T_ref_other"))
             items.append(change.key)
-            blocks.append(np.diag(change.sigma ** 2))
+            blocks.append(cov)
         for _, part in self.parts:
             for text in part.notes:
                 self.note(text)
