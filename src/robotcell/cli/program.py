@@ -345,6 +345,7 @@ def check_coordinated_cmd(program_files: tuple[str, ...], cell_path: str, robots
               help="Folder for the retargeted program files (created; its parent must exist).")
 @_ppd_option
 @click.option("--json", "as_json", is_flag=True, help="Print every joint point as JSON.")
+@robot_name_option
 def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, ppd: str | None,
                  as_json: bool) -> None:
     """Move the joint points of PROGRAM (KUKA E6AXIS/AXIS, ABB jointtarget, FANUC joint
@@ -354,7 +355,8 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     Each point keeps its configuration (shoulder, elbow and wrist sides, and its turns). Prints
     the largest axis change per point; a point the new cell cannot reach in its configuration,
     or only with an axis outside its limits, exits with status 3 naming it, and nothing is
-    written. Joint values outside the model's limits in the program are named.
+    written. Joint values outside the model's limits in the program are named. In cell files
+    of several robots --robot-name names the program's robot, in both.
 
     \b
     Example:
@@ -362,7 +364,7 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     """
     from robotcell.programs.retarget import RetargetFailed, retarget_program
 
-    old, new = Cell.load(old_path), Cell.load(new_path)
+    old, new = load_cell(old_path), load_cell(new_path)
     with as_flags(FLAGS):
         try:
             result = retarget_program(program_file, old, new, folder, _ppd(ppd),

@@ -190,7 +190,9 @@ def _into_cell(reference: str, other: str, given: _Given, as_json: bool,
                                on_note=echo_note)
     gate(result, as_json, accept_poor)
     done = update_cell_file(given.cell_path,
-                            lambda c: (place_robot(c, result, ref, oth), None), on_note=echo_note)
+                            lambda c: (place_robot(c, result, ref, oth,
+                                                   tool_sigma=_tool_sigma_m(given)), None),
+                            on_note=echo_note)
     kept = f" (previous version: {done.backup})" if done.backup is not None else ""
     click.echo(f"updated {given.cell_path}: base of robot {given.robot!r} from robot "
                f"{given.reference_robot!r}{kept}", err=True)
