@@ -48,7 +48,7 @@ def test_a_bad_path_file_exits_2_and_writes_nothing(tmp_path, capsys, content, m
 @pytest.mark.parametrize("extra,match", [
     (["--tool", "gripper"], "tool 'gripper' is not in the cell"),
     (["--frame", "wall"], "frame 'wall' is not in the cell"),
-    (["--name", "9lives"], "is not a kuka program name"),
+    (["--name", "9lives"], "is not valid for KUKA: a letter"),
     (["--pulses-per-degree", "abc"], "--pulses-per-degree must be comma-separated numbers"),
 ])
 def test_bad_options_exit_2_naming_the_option(tmp_path, capsys, extra, match):

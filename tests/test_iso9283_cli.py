@@ -279,3 +279,34 @@ def test_the_datasheet_repeatability_survives_a_model_file_round_trip(tmp_path):
     again = load_robot(tmp_path / "again.yaml")
     assert again.repeatability == robot.repeatability
     assert again.repeatability_source == "Datasheet KR 16, example.com/kr16.pdf"
+
+
+@pytest.mark.parametrize("name, mm, page", [
+    ("ur3e", 0.03, "complianceUR3e"), ("ur5e", 0.03, "complianceUR5e"),
+    ("ur10e", 0.05, "complianceUR10e")])
+def test_the_library_ur_arms_carry_their_manual_repeatability(name, mm, page):
+    """The UR e-Series manuals' technical specifications state the pose repeatability per ISO
+    9283; the library's models carry it with the page that states it (docs/models.md)."""
+    from robotcell.robot.models import load_robot
+
+    robot = load_robot(name)
+    assert robot.repeatability == pytest.approx(mm * 1e-3)
+    assert f"+-{mm:.2f} mm" in robot.repeatability_source
+    assert page in robot.repeatability_source and "ISO 9283" in robot.repeatability_source
+
+
+def test_a_ur5e_cell_takes_its_manual_repeatability_as_the_limit_of_rp(tmp_path):
+    """`analyse(..., robot=...)` of a UR5e: the limit of RP_l is the manual's 0.03 mm, named
+    with its source, without a --limit-rp."""
+    from robotcell.iso9283 import analyse, plan, simulate
+    from robotcell.cell.model import cell_from_dict
+    from robotcell.robot.models import load_robot
+
+    cell = cell_from_dict({"name": "ur5e_test", "robot": {"model": "ur5e"}, "tools": {
+        "probe": {"frame": {"x": 0, "y": 0, "z": 100, "a": 0, "b": 0, "c": 0}}}})
+    p = plan(cell, tool="probe", size=0.2)
+    result = analyse(simulate(cell, p, cell, path_cycles=0, cycles=10, noise=2e-6, seed=3), p,
+                     robot=load_robot("ur5e"))
+    assert result.limits.RP == pytest.approx(3e-5)
+    assert any("limit of RP_l 0.03 mm" in n and "complianceUR5e" in n for n in result.notes)
+    assert result.verdict.level == "pass"

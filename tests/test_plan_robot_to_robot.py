@@ -133,3 +133,48 @@ def test_a_small_common_volume_gives_designs_only_up_to_the_points_found(cell):
     p = plan_robot_to_robot(cell, "abb", "kuka", noise=1e-4, seed=1, candidates=60)
     assert p.reachable == 4
     assert [len(d.points) for d in p.designs] == [3, 4]
+
+
+def _down_the_track(tmp_path):
+    """The two-robot cell with the ABB 2.5 m further along the KUKA's track (3 m long)."""
+    text = TWO.read_text().replace("frame: {x: 1100, y: 1100, z: 0, a: -90",
+                                   "frame: {x: 3600, y: 1100, z: 0, a: -90")
+    path = tmp_path / "down.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_a_robot_on_a_track_is_planned_at_the_position_it_touches_from(tmp_path):
+    cell = Cell.load(_down_the_track(tmp_path))
+    with pytest.raises(InputError, match="no common reachable volume"):
+        plan_robot_to_robot(cell, "abb", "kuka", noise=1e-4, seed=0)
+    p = plan_robot_to_robot(cell, "abb", "kuka", noise=1e-4, seed=0, tracks=(2.5, 0.0))
+    assert p.reachable >= 3
+    # the points are in the KUKA's base at track 2.5 m, and both robots reach them there
+    T_w_ref = cell.for_robot("kuka").frame_pose("robot", track=2.5)
+    p_w = transform_points(T_w_ref, p.best.points)
+    T = make_pose(np.broadcast_to(np.diag([1.0, -1.0, -1.0]), (len(p_w), 3, 3)), p_w)
+    for name, tool, track in zip(("kuka", "abb"), p.tools, (2.5, None), strict=True):
+        sol = cell.for_robot(name).ik(T, "world", track=track, tool=tool)
+        assert np.asarray(sol.valid).any(axis=-1).all(), name
+
+
+@pytest.mark.parametrize(("tracks", "match"), [
+    ((3.5, 0.0), "track position 3500 mm of robot 'kuka' is outside its track limits 0 .. 3000"),
+    ((0.0, 0.2), "robot 'abb' has no track"),
+])
+def test_a_track_position_the_robot_cannot_take_is_refused(cell, tracks, match):
+    with pytest.raises(InputError, match=match):
+        plan_robot_to_robot(cell, "abb", "kuka", noise=1e-4, seed=0, tracks=tracks)
+
+
+def test_the_command_takes_the_track_positions_and_names_them_in_the_next_step(capsys, tmp_path):
+    out_csv = tmp_path / "points.csv"
+    code, out, err = run(capsys, "plan", "robot-to-robot", "--cell", _down_the_track(tmp_path),
+                         "--robot", "abb", "--reference", "kuka", "--track-ref", 2500,
+                         "--seed", 0, "--runs", 0, "-o", out_csv)
+    assert code == 0, err
+    assert "at track position 2500 mm" in out and "--track-ref 2500" in err
+    code, _, err = run(capsys, "plan", "robot-to-robot", "--cell", TWO, "--robot", "abb",
+                       "--reference", "kuka", "--track-other", 100, "--seed", 0)
+    assert code == 2 and err.startswith("error:") and "robot 'abb' has no track" in err

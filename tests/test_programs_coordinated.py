@@ -142,7 +142,7 @@ def _paths_with(tmp_path, robot, text):
      "abb", r"positioner's values differ"),
     (lambda t: SEAMS, "kuka", r"KUKA coordinated programs .* not written.*RoboTeam"),
     (lambda t: SEAMS, "fanuc", r"FANUC coordinated .*two robot groups"),
-    (lambda t: SEAMS, "yaskawa", r"YASKAWA coordinated .*R1 \+ R2"),
+    (lambda t: SEAMS, "yaskawa", r"robot\(s\) rob1 on a track: .*base axis"),
 ])
 def test_bad_input_is_refused_and_nothing_is_written(tmp_path, capsys, make, vendor, match):
     cell = Cell.load(CELL)
@@ -159,16 +159,16 @@ def test_bad_input_is_refused_and_nothing_is_written(tmp_path, capsys, make, ven
     assert re.search(match, err.replace("\n", " ")) and not folder.exists()
 
 
-def test_the_positioner_values_must_be_given_in_a_file(tmp_path):
+def test_the_positioner_values_no_file_gives_are_chosen_once_for_both_robots(tmp_path):
+    """tests/test_coordinated_paths.py checks the choice in full."""
     cell = Cell.load(CELL)
     bare = tmp_path / "rob1.csv"
     rows = SEAMS["rob1"].read_text().splitlines()
     bare.write_text("\n".join(",".join(r.split(",")[:-2]) for r in rows) + "\n")
-    with pytest.raises(InputError, match=r"frame 'part' is on positioner 'STN1'.*columns "
-                                         r"table or e1..en"):
-        write_coordinated({"rob1": bare, "rob2": SEAMS["rob2"]}, cell, TOOLS, "part", "abb",
-                          tmp_path / "out")
-    assert not (tmp_path / "out").exists()
+    result = write_coordinated({"rob1": bare, "rob2": SEAMS["rob2"]}, cell, TOOLS, "part", "abb",
+                               tmp_path / "out")
+    np.testing.assert_array_equal(result.results["rob1"].table, result.results["rob2"].table)
+    assert check_coordinated(result.files, cell).good
 
 
 def test_the_command_line_writes_and_checks(tmp_path, capsys):
@@ -189,7 +189,7 @@ def test_the_command_line_writes_and_checks(tmp_path, capsys):
     shutil.copy(files[1], tmp_path / "only.mod")
     code, out, err = run(capsys, "program", "check-coordinated", tmp_path / "only.mod",
                          "--cell", CELL)
-    assert code == 2 and "1 program files for 2 robots" in err
+    assert code == 2 and "1 program file for 2 robots" in err
 
 
 def test_a_file_robotcell_did_not_write_is_not_replaced(tmp_path):

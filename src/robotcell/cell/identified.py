@@ -11,6 +11,7 @@ lock, atomically, with a numbered backup); if that fails the model file is put b
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from robotcell.cell.model import Cell
@@ -23,7 +24,23 @@ from robotcell.identification.validation import CrossValidation
 from robotcell.io.fileio import atomic_write, check_destination, read_text
 from robotcell.robot.models import save_robot
 
-__all__ = ["adopt_identified", "identification_provenance"]
+__all__ = ["CellRobotFile", "adopt_identified", "identification_provenance"]
+
+
+@dataclass(frozen=True)
+class CellRobotFile:
+    """One robot of a cell file: where an identified arm goes.
+
+    Attributes
+    ----------
+    path : str or Path
+        The cell file.
+    robot : str, optional
+        In a cell of several robots, the robot (a key of its ``robots``); None: the only robot.
+    """
+
+    path: str | Path
+    robot: str | None = None
 
 
 def identification_provenance(result: IdentificationResult,
@@ -51,7 +68,8 @@ def identification_provenance(result: IdentificationResult,
 
 
 def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_path: str | Path,
-                     provenance: Provenance, on_note: Callable[[str], None] | None = None) -> Cell:
+                     provenance: Provenance, on_note: Callable[[str], None] | None = None,
+                     robot: str | None = None) -> Cell:
     """Write the identified model file and make it the arm of a cell file, both or neither.
 
     The cell file is changed as one locked step (:func:`robotcell.cell.update.update_cell_file`):
@@ -69,6 +87,9 @@ def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_
         See :func:`identification_provenance`.
     on_note : callable, optional
         Receives the notes of the cell file's update (a wait for another update).
+    robot : str, optional
+        In a cell of several robots, the robot whose arm was identified (a key of its
+        ``robots``); None: the only robot.
 
     Returns
     -------
@@ -78,9 +99,9 @@ def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_
     Raises
     ------
     InputError
-        The cell file cannot be read, the identified model is not of the cell's arm (the
-        nominal the identification started from must be the cell's ``robot.model``), or a file
-        cannot be written: nothing is changed then.
+        The cell file cannot be read, a robot the cell lacks, the identified model is not of
+        the cell's arm (the nominal the identification started from must be the robot's
+        ``model``), or a file cannot be written: nothing is changed then.
     """
     check_destination(model_path)
     check_destination(cell_path)
@@ -89,10 +110,16 @@ def adopt_identified(cell_path: str | Path, result: IdentificationResult, model_
 
     def adopt(cell: Cell) -> tuple[Cell, None]:
         try:
-            cell.set_identified(result.robot, str(Path(model_path).resolve()), provenance)
+            key = cell.robot_key(robot)
         except InputError as exc:
-            raise InputError(f"{cell_path}: {exc} (the cell's robot.model is "
-                             f"{cell.robot_model})") from None
+            raise InputError(f"{cell_path}: {exc}") from None
+        view = cell.for_robot(key)
+        try:
+            view.set_identified(result.robot, str(Path(model_path).resolve()), provenance)
+        except InputError as exc:
+            raise InputError(f"{cell_path}: {exc} (the robot's model is "
+                             f"{view.robot_model})") from None
+        cell = cell.with_view(view, key)
         cell_to_dict(cell, Path(cell_path).resolve().parent)  # every value writable first
         if not written:  # the same model for every version of the cell
             save_robot(result.robot, model_path)

@@ -60,6 +60,15 @@ __all__ = ["IK_CHUNK", "RESERVED_FRAMES", "Cell", "cell_from_dict"]
 IK_CHUNK = 500
 
 
+def _calibrated_by(provenance: Provenance, robot: str) -> Provenance:
+    """A shared item's provenance, calibrated through robot ``robot``'s view, naming that robot
+    in its options (``robot``) when it records a touch file: ``calibrate cell`` repeats it in
+    that robot's view."""
+    if provenance.measurements is None or "robot" in provenance.options:
+        return provenance
+    return replace(provenance, options={**provenance.options, "robot": robot})
+
+
 # -- the cell -------------------------------------------------------------------------------------
 #: A keyword of :class:`Cell` not given (``None`` is a value: ``track=None`` removes the track).
 _KEEP: Any = object()
@@ -275,9 +284,14 @@ class Cell:
                 frames[fname] = replace(fr, parent=key)
             elif not (old is not None and old.parent in self.robots
                       and fr.provenance is old.provenance and fr.number == old.number):
-                frames[fname] = fr  # a frame the view changed (a placed one keeps its provenance)
+                # a frame the view changed (a placed one keeps its provenance)
+                frames[fname] = fr if old is not None and fr.provenance is old.provenance else (
+                    replace(fr, provenance=_calibrated_by(fr.provenance, key)))
+        table = view.turntable
+        if table is not None and table is not self.turntable:
+            table = replace(table, provenance=_calibrated_by(table.provenance, key))
         return Cell(robots={**self.robots, key: view.robots[view.robot_name]},
-                    turntable=view.turntable, frames=frames, name=self.name)
+                    turntable=table, frames=frames, name=self.name)
 
     def _view(self, robot: str | None, frame: str) -> Cell:
         """:meth:`for_robot`, refusing a frame on another robot's track by name."""

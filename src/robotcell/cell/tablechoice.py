@@ -32,6 +32,13 @@ target), kept where every target of the piece stays reached. :func:`robotcell.ce
 solves the path at the chosen values (and :func:`~robotcell.cell.ik.split_path` names the
 breaks that remain). The programme runs over the targets in order (each step depends on the
 one before); each step is vectorised over the candidates and configurations.
+
+:func:`choose_shared_table` chooses the values once for several robots whose point ``k`` is
+reached together (a coordinated program): a 2-axis positioner's candidates put the robots'
+mean surface normal up; a state is a candidate with a configuration of every robot, each
+reaching its point within every limit; its score is the worst robot's (each robot's score as
+above, against its own best at that point); a move keeps every robot's configuration. A point
+no candidate serves for every robot is refused, naming the robot that reaches it at none.
 """
 
 from __future__ import annotations
@@ -53,8 +60,8 @@ from robotcell.ik.trackchoice import arm_manipulability
 from robotcell.kinematics.bounds import within
 from robotcell.kinematics.transforms import finite_array, validate_pose
 
-__all__ = ["LIMIT_MARGIN", "NORMAL_TOL", "TABLE_SAMPLES", "TABLE_WINDOW", "TableChoice",
-           "carried_by_table", "choose_table"]
+__all__ = ["LIMIT_MARGIN", "NORMAL_TOL", "TABLE_SAMPLES", "TABLE_WINDOW", "SharedTableChoice",
+           "TableChoice", "carried_by_table", "choose_shared_table", "choose_table"]
 
 #: Candidate table values per turn (10 deg apart).
 TABLE_SAMPLES = 36
@@ -214,10 +221,11 @@ def _candidates(cell: Cell, frame: str, arr: NDArray[np.float64], track: NDArray
             np.zeros((n, grid.size)))
 
 
-def _node_costs(cell: Cell, q: NDArray[np.float64], valid: NDArray[np.bool_],
-                values: NDArray[np.float64], dev: NDArray[np.float64], normal_tol: float,
-                tool: NDArray[np.float64] | None) -> NDArray[np.float64]:
-    """Cost of each state (N, M, 8): reach, manipulability, limit margin, normal, middle."""
+def _scores(cell: Cell, q: NDArray[np.float64], valid: NDArray[np.bool_],
+            tool: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """Score of each state (N, M, 8) in [0, 1]: ``m / m_best * min(1, margin / LIMIT_MARGIN)``
+    (manipulability against the target's best over all its states, distance to the joint
+    limits); 0 for a state that does not exist."""
     robot = cell.robot
     qz = np.where(valid[..., None], q, 0.0)
     if analytic_solver(robot).method == "opw":
@@ -231,12 +239,24 @@ def _node_costs(cell: Cell, q: NDArray[np.float64], valid: NDArray[np.bool_],
     with np.errstate(invalid="ignore"):
         gap = np.minimum(np.where(np.isfinite(lo), qz - lo, np.inf),
                          np.where(np.isfinite(hi), hi - qz, np.inf)).min(axis=-1)
-    score = rel * np.minimum(1.0, gap / LIMIT_MARGIN)
+    return rel * np.minimum(1.0, gap / LIMIT_MARGIN)
+
+
+def _value_costs(cell: Cell, values: NDArray[np.float64], dev: NDArray[np.float64],
+                 normal_tol: float) -> NDArray[np.float64]:
+    """Cost of each candidate (N, M) itself: the normal's tilt off up, the pull to the middle."""
     tlo, thi = _range(cell)
     mid = np.where(np.isfinite(tlo) & np.isfinite(thi), 0.5 * (tlo + thi), 0.0)
     middle = _MIDDLE * np.sum(((values - mid) / math.pi) ** 2, axis=-1)       # (N, M)
-    extra = (np.where(np.isfinite(dev), dev, 0.0) / normal_tol) ** 2 + middle
-    return (1.0 - score) + extra[..., None]
+    return (np.where(np.isfinite(dev), dev, 0.0) / normal_tol) ** 2 + middle
+
+
+def _node_costs(cell: Cell, q: NDArray[np.float64], valid: NDArray[np.bool_],
+                values: NDArray[np.float64], dev: NDArray[np.float64], normal_tol: float,
+                tool: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """Cost of each state (N, M, 8): reach, manipulability, limit margin, normal, middle."""
+    return (1.0 - _scores(cell, q, valid, tool)) + _value_costs(cell, values, dev,
+                                                               normal_tol)[..., None]
 
 
 def _wrapped(d: NDArray[np.float64], rev: NDArray[np.bool_]) -> NDArray[np.float64]:
@@ -247,37 +267,38 @@ def _wrapped(d: NDArray[np.float64], rev: NDArray[np.bool_]) -> NDArray[np.float
 def _viterbi(node: NDArray[np.float64], ok: NDArray[np.bool_], values: NDArray[np.float64],
              q: NDArray[np.float64], rev: NDArray[np.bool_], max_step: float
              ) -> tuple[NDArray[np.int_], NDArray[np.int_], NDArray[np.bool_]]:
-    """The cheapest sequence of states (``ok`` (N, M, 8) the states that exist): candidate (N,),
-    branch (N,) and where it breaks (N,)."""
-    n, m = ok.shape[:2]
+    """The cheapest sequence of states (``ok`` (N, M, B) the states that exist: B arm
+    configurations per candidate, ``q`` (N, M, B, J) their joints): candidate (N,), configuration
+    (N,) and where it breaks (N,)."""
+    n, m, nb = ok.shape
     big = 10.0 * (n + 1) * 4.0  # more than every move and state of the path together
-    cost = np.where(ok[0], node[0], big)                                        # (M, 8)
-    back = np.zeros((n, m, 8), dtype=np.int64)
-    broke = np.zeros((n, m, 8), dtype=bool)
+    cost = np.where(ok[0], node[0], big)                                       # (M, B)
+    back = np.zeros((n, m, nb), dtype=np.int64)
+    broke = np.zeros((n, m, nb), dtype=bool)
     for i in range(1, n):
         dt = np.max(np.abs(values[i][None, :, :] - values[i - 1][:, None, :]), axis=-1)  # (M, M)
         jp, jn = np.nonzero(dt <= max_step + 1e-12)
-        dq = np.max(np.abs(_wrapped(q[i, jn] - q[i - 1, jp], rev)), axis=-1)  # (P, 8)
+        dq = np.max(np.abs(_wrapped(q[i, jn] - q[i - 1, jp], rev)), axis=-1)  # (P, B)
         with np.errstate(invalid="ignore"):
             move = cost[jp] + ((dt[jp, jn] / max_step) ** 2)[:, None] + (dq / max_step) ** 2
             move = np.where(dq <= max_step, move, np.inf)                    # NaN: not reached
-        dense = np.full((m, m, 8), np.inf)
+        dense = np.full((m, m, nb), np.inf)
         dense[jp, jn] = move
-        prev = np.argmin(dense, axis=0)                                      # (M, 8)
+        prev = np.argmin(dense, axis=0)                                      # (M, B)
         best = np.take_along_axis(dense, prev[None], axis=0)[0]
         flat = int(np.argmin(cost))
         restart = cost.flat[flat] + big
         broke[i] = restart < best
-        back[i] = np.where(broke[i], flat, prev * 8 + np.arange(8))
+        back[i] = np.where(broke[i], flat, prev * nb + np.arange(nb))
         cost = np.minimum(best, restart) + np.where(ok[i], node[i], big)
     state = np.empty(n, dtype=np.int64)
     state[-1] = int(np.argmin(cost))
     cut = np.zeros(n, dtype=bool)
     for i in range(n - 1, 0, -1):
-        j, b = divmod(int(state[i]), 8)
+        j, b = divmod(int(state[i]), nb)
         cut[i] = broke[i, j, b]
         state[i - 1] = back[i, j, b]
-    return state // 8, state % 8, cut
+    return state // nb, state % nb, cut
 
 
 def _smoothed(values: NDArray[np.float64], cut: NDArray[np.bool_], grid: float
@@ -387,3 +408,235 @@ def _pieces_ok(good: NDArray[np.bool_], cut: NDArray[np.bool_]) -> NDArray[np.bo
     piece = np.cumsum(cut)
     bad = np.unique(piece[~good])
     return ~np.isin(piece, bad)
+
+
+@dataclass(frozen=True)
+class SharedTableChoice:
+    """Table values chosen once along the paths of several robots (point ``k`` of every path
+    reached together).
+
+    Attributes
+    ----------
+    table : ndarray, shape (N,) or (N, n)
+        Turntable angles, or a positioner's axis values (rad).
+    branch : dict of str to ndarray of int, shape (N,)
+        Each robot's arm configuration (analytic branch) at each point.
+    score : ndarray, shape (N,)
+        The common score at each point: the worst robot's score there (each robot's
+        manipulability against its best at that point, times its clearance of its joint
+        limits; 1 best, 0 singular or at a limit).
+    breaks : int
+        Places where the chosen values cannot keep one continuous motion.
+    """
+
+    table: NDArray[np.float64]
+    branch: dict[str, NDArray[np.int_]]
+    score: NDArray[np.float64]
+    breaks: int
+
+
+def _along_z(z: NDArray[np.float64], p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Poses (N, 4, 4) at positions ``p`` (N, 3) whose Z axes are the unit vectors ``z``
+    (N, 3)."""
+    a = np.where(np.abs(z[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    x = a - np.sum(a * z, axis=1, keepdims=True) * z
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    T = np.tile(np.eye(4), (z.shape[0], 1, 1))
+    T[:, :3, 0], T[:, :3, 1], T[:, :3, 2], T[:, :3, 3] = x, np.cross(z, x), z, p
+    return T
+
+
+@dataclass(frozen=True)
+class _SharedPaths:
+    """The robots' paths of a shared choice: each robot's view of the cell, targets (N, 4, 4),
+    track (N,) or None and tool, in the order of ``names``."""
+
+    names: list[str]
+    views: dict[str, Cell]
+    T: dict[str, NDArray[np.float64]]
+    tracks: dict[str, NDArray[np.float64] | None]
+    tools: dict[str, str | ArrayLike | None]
+    frame: str
+
+    @property
+    def first(self) -> Cell:
+        return self.views[self.names[0]]
+
+    def mean_normal(self) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Poses (N, 4, 4) whose ``-Z`` is the robots' mean surface normal (the mean of their
+        tools' ``-Z``) at each point, and where that mean is not zero (N,)."""
+        normal = np.mean([-t[:, :3, 2] for t in self.T.values()], axis=0)     # (N, 3)
+        size = np.linalg.norm(normal, axis=1, keepdims=True)
+        up = np.where(size > 1e-6, normal / np.maximum(size, 1e-6), [[0.0, 0.0, 1.0]])
+        return _along_z(-up, self.T[self.names[0]][:, :3, 3]), size[:, 0] > 1e-6
+
+
+def _shared_candidates(paths: _SharedPaths, samples: int, normal_tol: float
+                       ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """Candidates for every robot at once: a turntable's grid, or a 2-axis positioner in the
+    welding position of the robots' mean surface normal (none where the normals cancel)."""
+    ref, ok = paths.mean_normal()
+    if paths.first.turntable.n_axes != 2:
+        ok[:] = True                                          # a grid: the normals do not matter
+    values, keep, dev = _candidates(paths.first, paths.frame, ref, np.zeros(len(ref)), samples,
+                                    normal_tol)
+    return values, keep & ok[:, None], dev
+
+
+def _robot_states(cell: Cell, arr: NDArray[np.float64], frame: str,
+                  track: NDArray[np.float64] | None, tool: str | ArrayLike | None,
+                  tab: NDArray[np.float64], ok: NDArray[np.bool_]
+                  ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """One robot's joints (N, M, 8, J), valid states (N, M, 8) and scores (N, M, 8) at the
+    candidates ``tab`` (N, M) or (N, M, n)."""
+    n, m = ok.shape
+    sol = ik(cell, np.broadcast_to(arr[:, None], (n, m, 4, 4)), frame,
+             None if track is None else np.broadcast_to(track[:, None], (n, m)), tab, tool)
+    valid = sol.valid & ok[..., None]
+    return sol.q, valid, np.where(valid, _scores(cell, sol.q, valid, tool_pose(cell, tool)), 0.0)
+
+
+def _combinations(valid: list[NDArray[np.bool_]]
+                  ) -> tuple[NDArray[np.int_], NDArray[np.bool_]]:
+    """The robots' configurations taken together: each combination (C, R) that serves some
+    point at some candidate, and where it does (N, M, C)."""
+    keep = valid[0].any(axis=(0, 1))
+    combos, joint = np.flatnonzero(keep)[:, None], valid[0][..., keep]
+    for v in valid[1:]:
+        c = np.concatenate([np.repeat(combos, 8, axis=0),
+                            np.tile(np.arange(8), len(combos))[:, None]], axis=1)
+        both = (joint[..., :, None] & v[..., None, :]).reshape(*joint.shape[:2], -1)
+        keep = both.any(axis=(0, 1))
+        combos, joint = c[keep], both[..., keep]
+    return combos, joint
+
+
+def _unserved(names: list[str], valid: list[NDArray[np.bool_]], joint: NDArray[np.bool_],
+              ok: NDArray[np.bool_], what: str) -> str:
+    """Why the points no candidate serves for every robot are not served ("" when all are)."""
+    bad = np.flatnonzero(~joint.any(axis=(1, 2)))
+    why = []
+    for i in bad[:5]:
+        alone = [r for r, v in zip(names, valid) if not v[i].any()]
+        if not ok[i].any():
+            text = "no positioner values within the axis limits turn the robots' mean normal up"
+        elif alone:
+            text = (f"{' and '.join(alone)} reach{'es' if len(alone) == 1 else ''} it at no "
+                    f"{what} values within the limits")
+        else:
+            text = f"{' and '.join(names)} each reach it, but never at the same {what} values"
+        why.append(f"point {i + 1}: {text}")
+    more = f" (and {bad.size - 5} more)" if bad.size > 5 else ""
+    return "; ".join(why) + more
+
+
+def choose_shared_table(cell: Cell, T: dict[str, ArrayLike], frame: str,
+                        tracks: dict[str, ArrayLike | None] | None = None,
+                        tools: dict[str, str | ArrayLike | None] | None = None,
+                        max_step: float = MAX_STEP, samples: int = TABLE_SAMPLES,
+                        normal_tol: float = NORMAL_TOL) -> SharedTableChoice:
+    """Table values chosen once for several robots' paths, point ``k`` of every path together.
+
+    The candidates are those of :func:`choose_table` (a 2-axis positioner in the welding
+    position of the robots' mean surface normal at the point); a state is a candidate and a
+    configuration of every robot at which each reaches its point within every limit; its
+    score is the worst robot's (:attr:`SharedTableChoice.score`); a move keeps every robot's
+    configuration and turns no table axis and no axis of any arm by more than ``max_step``.
+    The dynamic programme and the smoothing are :func:`choose_table`'s.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell of several robots (:meth:`Cell.for_robot <robotcell.cell.Cell.for_robot>`).
+    T : dict of str to array_like, shape (N, 4, 4)
+        Each robot's targets ``T_X_TCP`` in frame ``frame`` (m), as many for every robot.
+    frame : str
+        A frame of the cell carried by the turntable or positioner.
+    tracks : dict of str to array_like of shape (N,) or None, optional
+        A robot's track positions (m); None or absent: chosen per target.
+    tools : dict of str to str or array_like of shape (4, 4), optional
+        Each robot's tool by name or ``T_F_TCP`` (m); absent: the robot model's tool.
+    max_step : float
+        Largest change of a table axis and of an arm axis between consecutive points (rad).
+    samples : int
+        Candidate values per turn of a table axis (>= 4).
+    normal_tol : float
+        A 2-axis positioner: largest angle between the mean normal and straight up (rad).
+
+    Returns
+    -------
+    SharedTableChoice
+
+    Raises
+    ------
+    InputError
+        A point at which no candidate serves every robot (the message names the point and the
+        robot that reaches it at none), paths of different lengths, a frame the table does not
+        carry, a positioner of 3 axes, bad targets, ``max_step`` or ``samples``.
+    """
+    names = list(T)
+    views = {r: cell.for_robot(r) for r in names}
+    if not carried_by_table(views[names[0]], frame):
+        raise InputError(f"frame {frame!r} is not carried by the turntable: the table values do "
+                         "not move its targets; give them")
+    arrs = {r: validate_pose(T[r], f"path targets of {r}") for r in names}
+    shape = arrs[names[0]].shape
+    if any(a.ndim != 3 or a.shape != shape or a.shape[0] < 1 for a in arrs.values()):
+        raise InputError("each robot's targets must have shape (N, 4, 4), as many for every "
+                         f"robot; got {', '.join(f'{r} {a.shape}' for r, a in arrs.items())}")
+    if not max_step > 0 or not samples >= 4:
+        raise InputError(f"max_step must be positive (rad) and samples at least 4, got "
+                         f"{max_step} and {samples}")
+    n = shape[0]
+    paths = _SharedPaths(names, views, arrs, {
+        r: None if (tracks or {}).get(r) is None else
+        np.broadcast_to(finite_array(tracks[r], "track position"), (n,)) for r in names},
+        {r: (tools or {}).get(r) for r in names}, frame)
+    values, ok, dev = _shared_candidates(paths, samples, normal_tol)
+    turntable = np.ndim(paths.first.turntable.lower) == 0
+    tab = values[..., 0] if turntable else values
+    states = [_robot_states(views[r], arrs[r], frame, paths.tracks[r], paths.tools[r], tab, ok)
+              for r in names]
+    combos, joint = _combinations([s[1] for s in states])
+    if not joint.any(axis=(1, 2)).all():
+        what = "table" if turntable else "positioner"
+        raise InputError(f"no {what} values serve every robot: "
+                         + _unserved(names, [s[1] for s in states], joint, ok, what)
+                         + f"; give the {what}'s values in a path file, or move the points")
+    score = np.min([s[2][..., combos[:, k]] for k, s in enumerate(states)], axis=0)
+    node = (1.0 - score) + _value_costs(paths.first, values, dev, normal_tol)[..., None]
+    q = np.concatenate([s[0][:, :, combos[:, k]] for k, s in enumerate(states)], axis=-1)
+    rev = np.concatenate([~views[r].robot.prismatic for r in names])
+    j, c, cut = _viterbi(node, joint, values, np.where(joint[..., None], q, np.nan), rev,
+                         max_step)
+    rows = np.arange(n)
+    chosen = _shared_smoothed(paths, values[rows, j], combos[c], cut, max_step, normal_tol,
+                              samples)
+    return SharedTableChoice(chosen[:, 0] if turntable else chosen,
+                             {r: combos[c, k] for k, r in enumerate(names)},
+                             score[rows, j, c], int(cut.sum()))
+
+
+def _shared_smoothed(paths: _SharedPaths, chosen: NDArray[np.float64],
+                     branch: NDArray[np.int_], cut: NDArray[np.bool_], max_step: float,
+                     normal_tol: float, samples: int) -> NDArray[np.float64]:
+    """The chosen values (N, n) smoothed as :func:`choose_table` does, piece by piece where
+    every robot still reaches every point of the piece in its configuration ``branch`` (N, R)."""
+    smooth = _smoothed(chosen, cut, TWO_PI / samples)
+    if np.array_equal(smooth, chosen):
+        return chosen
+    n = chosen.shape[0]
+    rows = np.arange(n)
+    turntable = np.ndim(paths.first.turntable.lower) == 0
+    still = np.ones(n, dtype=bool)
+    for k, r in enumerate(paths.names):
+        again = ik(paths.views[r], paths.T[r], paths.frame, paths.tracks[r],
+                   smooth[:, 0] if turntable else smooth, paths.tools[r])
+        still &= again.valid[rows, branch[:, k]]
+    if n > 1:
+        still &= np.max(np.abs(np.diff(smooth, axis=0)), axis=-1).max() <= max_step
+    if paths.first.turntable.n_axes == 2:
+        ref, _ = paths.mean_normal()
+        still &= _normal_deviation(paths.first, paths.frame, ref, np.zeros(n),
+                                   smooth[:, None])[:, 0] <= normal_tol
+    return np.where(_pieces_ok(still, cut)[:, None], smooth, chosen)

@@ -31,12 +31,12 @@ from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate import PROCEDURES, CalibrationContext, Procedure
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
-from robotcell.cell.calibrate.whole import touch_files
+from robotcell.cell.calibrate.wholerobots import cell_touch_files
 from robotcell.cell.update import update_cell_file
 from robotcell.cli import load_command
 from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, Group, refuse_overwriting_inputs
-from robotcell.cli.robotname import robot_name_option, robot_of
+from robotcell.cli.robotname import robot_name, robot_name_option, robot_of
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 from robotcell.robot.models import load_robot
@@ -544,6 +544,9 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
     The report says what changed, by how much and in units of its 1-sigma. A missing or changed
     touch file is refused (exit 2), naming it; a poor verdict writes nothing (exit 3).
     -o may name none of the touch files.
+    In a cell of several robots every robot's items are fitted (robot by robot, each labelled
+    by its robot) and every robot-to-robot placement is repeated; --robot-name NAME refits
+    that robot's items and the placement of its base only.
 
     \b
     Example:
@@ -552,20 +555,24 @@ def cell_cmd(cell_path: str | None, as_json: bool, accept_poor: bool) -> None:
     if cell_path is None:
         raise InputError("calibrate cell needs --cell CELL.yaml: the cell whose calibrations "
                          "are fitted together")
-    target = CellTarget.open(cell_path, None)
+    cell = Cell.load(cell_path)
+    robot = None if robot_name() is None else robot_of(cell, cell_path)
     refuse_overwriting_inputs(click.get_current_context(),
                               read=[(f"the touch file of {key}", _shown(path))
-                                    for key, path in touch_files(target.cell)])
+                                    for key, path in cell_touch_files(cell, cell_path)])
     nominal = click.get_current_context().meta.get(NOMINAL_KEY, NOMINAL_ACCURACY)
 
     def change(cell: Cell) -> tuple[Cell, cellcal.CellRecalibration]:
-        out = cellcal.calibrate_cell(cell, cell_label=cell_path, nominal=nominal,
+        out = cellcal.calibrate_cell(cell, robot=robot, cell_label=cell_path, nominal=nominal,
                                      on_note=echo_note)
         gate(out, as_json, accept_poor)
         return out.cell, out
 
-    out = target.update(change, lambda out: ((f"{len(out.items)} item(s) fitted with the whole "
-                                              f"cell ({', '.join(out.items)})"), ()))
+    done = update_cell_file(cell_path, change, on_note=echo_note)
+    out = done.value
+    kept = f" (previous version: {done.backup})" if done.backup is not None else ""
+    click.echo(f"updated {cell_path}: {len(out.items)} item(s) fitted with the whole cell "
+               f"({', '.join(out.items)}){kept}", err=True)
     emit(out, as_json)
 
 

@@ -8,7 +8,6 @@ import sys
 import click
 import numpy as np
 
-from robotcell.cell import Cell
 from robotcell.cli.common import (
     MAX_CORRECTION_MM,
     BadPoints,
@@ -19,6 +18,7 @@ from robotcell.cli.common import (
     output_of,
 )
 from robotcell.cli.files import OUTPUT, Command
+from robotcell.cli.robotname import load_cell, robot_name_option
 
 
 @click.command(cls=Command)
@@ -40,6 +40,7 @@ from robotcell.cli.files import OUTPUT, Command
 @click.option("--json", "as_json", is_flag=True,
               help='Print {"points": [{"x": .., "a1": .., "shoulder": .., "branch": .., "dpos": .., '
                    '"error_mm": .., "sigma_mm": ..}, ...], "configuration": ..}.')
+@robot_name_option
 def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | None,
                max_correction: float, report: str | None, as_json: bool) -> None:
     """Filter POSES (CSV: x, y, z mm and a, b, c deg in --frame; optional track mm, table or
@@ -67,7 +68,7 @@ def compensate(poses: str, cell_path: str, tool: str, frame: str, output: str | 
     from robotcell.accuracy.poses import compensate_poses
     from robotcell.report.accuracy import write_poses_report
 
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     try:
         with as_flags({"max_correction": "--max-correction"}):
             result = compensate_poses(poses, cell, tool, frame, output, max_correction * 1e-3)

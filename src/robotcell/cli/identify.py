@@ -13,6 +13,8 @@ import click
 import numpy as np
 
 from robotcell.calibration.sigmaparts import sigma_basis
+from robotcell.cell import Cell
+from robotcell.cell.identified import CellRobotFile
 from robotcell.cli.common import (
     as_flags,
     check_kind,
@@ -24,6 +26,7 @@ from robotcell.cli.common import (
     warn_unknown_columns,
 )
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command, LiveChoice
+from robotcell.cli.robotname import robot_name, robot_name_option, robot_of
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.identification.result import OWN_MEASUREMENTS, SIGMA_RELATIVE_TO
@@ -61,12 +64,24 @@ ACCURACY_MIN, ACCURACY_MAX = 1e-4, 1e3
 #: Largest ``|--j23-factor|``: a J2/J3 linkage moves axis 3 by about as much as axis 2 (FANUC: 1).
 J23_MAX = 10.0
 
+def _cell_robot(cell_path: str | None) -> str | None:
+    """The robot of ``--cell`` that ``--robot-name`` names (None: no cell, or its only robot)."""
+    if cell_path is None:
+        if robot_name() is not None:
+            raise InputError("--robot-name names a robot of a cell file of several robots: "
+                             "give the cell with --cell CELL.yaml")
+        return None
+    cell = Cell.load(cell_path)
+    return robot_of(cell, cell_path) if len(cell.robots) > 1 or robot_name() else None
+
+
 def _propose(o: SimpleNamespace) -> None:
     """``--propose N``: write the selected configurations (deg, mm) and print O1 against random."""
     box_m = None if o.box is None else np.array(parse_numbers(o.box, "--box", 6)) * 1e-3
     with as_flags({"n": "--propose", "n_targets": "--targets", "pose": "--orientation"}):
         prop = propose_configurations(o.propose, o.robot, o.cell_path, o.targets, o.orientation,
-                                      o.seed, o.sigma * 1e-3, math.radians(o.angle_sigma), box_m)
+                                      o.seed, o.sigma * 1e-3, math.radians(o.angle_sigma), box_m,
+                                      cell_robot=_cell_robot(o.cell_path))
     n, output, as_json = o.propose, o.output, o.as_json
     nominal, sel = prop.robot, prop.selection
     q = np.where(nominal.prismatic, sel.q * 1e3, np.degrees(sel.q))
@@ -145,6 +160,7 @@ def _propose(o: SimpleNamespace) -> None:
                    "(--folds); its robot.model is the nominal when --robot is not given. "
                    "With --propose: its robot.model and its floor.")
 @group_tolerance_option("Joint values")
+@robot_name_option
 def identify(measurements: str | None, **options: Any) -> None:
     """Identify the kinematic parameters of an arm or positioner from measurements.
 
@@ -214,11 +230,13 @@ def _check_numbers(o: SimpleNamespace) -> None:
 def _identify(measurements: str, o: SimpleNamespace) -> None:
     """Identify from ``measurements``, write what the options ask for and print the report."""
     report, output, cell_path, as_json = o.report, o.output, o.cell_path, o.as_json
+    name = _cell_robot(cell_path)
+    where = None if cell_path is None else CellRobotFile(cell_path, name)
     with as_flags({"the nominal model as robot": "the nominal model with --robot",
                    "folds=0": "--folds 0", "folds": "--folds",
                    "state the grouping tolerance": "state it with --group-tolerance"}):
         run = identify_file(
-            measurements, o.robot, cell_path, folds=o.folds, report=report is not None,
+            measurements, o.robot, where, folds=o.folds, report=report is not None,
             offsets_for=o.offsets_for, output=output, force=o.force, sigma=o.sigma * 1e-3,
             angle_sigma=math.radians(o.angle_sigma), scale=o.scale, compliance=o.compliance,
             j23_factor=o.j23,

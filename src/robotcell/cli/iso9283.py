@@ -14,9 +14,9 @@ from typing import Any
 import click
 import numpy as np
 
-from robotcell.cell import Cell
 from robotcell.cli.common import as_flags, in_range, output_of, parse_numbers
 from robotcell.cli.files import OUTPUT, Command, Group, LiveChoice, OutputPath
+from robotcell.cli.robotname import load_cell, robot_name, robot_name_option
 from robotcell.controllers.registry import names
 from robotcell.errors import InputError
 
@@ -81,6 +81,7 @@ def _mm3(text: str | None, what: str) -> np.ndarray | None:
               help="TCP speed along the paths.")
 @click.option("--pulses-per-degree", "ppd", default=None, metavar="N[,N...]",
               help="YASKAWA: encoder pulses per degree of each station axis.")
+@robot_name_option
 def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs: str | None,
              **opts: Any) -> None:
     """Plan the ISO 9283 test of a cell: the largest cube one arm configuration reaches with
@@ -96,6 +97,7 @@ def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs
     Examples:
       robotcell iso9283 plan --cell cell.yaml --tool torch -o plan.csv
       robotcell iso9283 plan --cell cell.yaml --tool torch --size 500 -o plan.csv --programs iso --format kuka
+      robotcell iso9283 plan --cell examples/cell_two_robots_positioner.yaml --robot-name abb --tool torch --size 300 -o plan_abb.csv
     """
     from robotcell.iso9283 import plan, write_plan, write_programs
     from robotcell.iso9283.planfile import table_names
@@ -103,7 +105,7 @@ def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs
 
     a, b, c = np.radians(parse_numbers(opts["orientation"], "--orientation", 3))
     size = None if opts["size"] is None else opts["size"] * 1e-3
-    cell = Cell.load(cell_path)
+    cell = load_cell(cell_path)
     with as_flags(FLAGS):
         p = plan(cell, tool, frame, size, _mm3(opts["centre"], "--centre"),
                  None if opts["track_mm"] is None else opts["track_mm"] * 1e-3,
@@ -153,6 +155,7 @@ def plan_cmd(cell_path: str, tool: str, frame: str, output: str | None, programs
 @click.option("-o", "--output", type=OUTPUT, default=None,
               callback=output_of("HTML", "the test report"),
               help="Write the report (one HTML page) atomically.")
+@robot_name_option
 def analyse_cmd(measurements: str, plan_path: str, cell_path: str | None, device_frame: bool,
                 as_json: bool, output: str | None, **limits: float | None) -> None:
     """Analyse the measurement log MEAS.csv (cycle, pose, x, y, z mm; optional a, b, c deg and
@@ -170,7 +173,9 @@ def analyse_cmd(measurements: str, plan_path: str, cell_path: str | None, device
     """
     from robotcell.iso9283 import Limits, analyse
 
-    cell = None if cell_path is None else Cell.load(cell_path)
+    if cell_path is None and robot_name() is not None:
+        raise InputError("--robot-name names a robot of a cell file; it needs --cell CELL.yaml")
+    cell = None if cell_path is None else load_cell(cell_path)
     # the datasheet belongs to the robot's nominal model (an identified arm's is its nominal)
     robot = None if cell is None else (cell.identified.nominal if cell.identified else cell.robot)
     with as_flags(FLAGS):
@@ -239,6 +244,7 @@ def _text(result: Any) -> str:
 @click.option("--seed", type=click.IntRange(min=0), default=None, help="Seed of the scatter.")
 @click.option("-o", "--output", type=OUTPUT, default=None, callback=output_of("CSV", "the log"),
               help="The log (CSV), atomically (default: standard output).")
+@robot_name_option
 def simulate_iso9283(cell_path: str, plan_path: str, controller_path: str | None,
                      output: str | None, **opts: Any) -> None:
     """Simulate the tracker's log of the ISO 9283 test of --plan in the virtual cell --cell.
@@ -246,6 +252,7 @@ def simulate_iso9283(cell_path: str, plan_path: str, controller_path: str | None
     The controller moves with the joints its cell (--controller) gives; the real TCP is where
     the true cell puts them, measured in the plan's frame with the scatter --noise. Writes the
     log that 'robotcell iso9283 analyse' reads (cycle, pose, x, y, z, a, b, c, time).
+    In cell files of several robots --robot-name names the robot tested, in both.
 
     \b
     Example:
@@ -253,8 +260,8 @@ def simulate_iso9283(cell_path: str, plan_path: str, controller_path: str | None
     """
     from robotcell.iso9283 import read_plan, simulate, write_log
 
-    truth = Cell.load(cell_path)
-    controller = None if controller_path is None else Cell.load(controller_path)
+    truth = load_cell(cell_path)
+    controller = None if controller_path is None else load_cell(controller_path)
     p, warnings = read_plan(plan_path)
     for w in warnings:
         click.echo(f"warning: {w}", err=True)

@@ -234,18 +234,25 @@ def _by_robot(values: tuple[str, ...], what: str) -> dict[str, str]:
 @click.option("--frame", default="world", show_default=True,
               help="Frame of every path: world or a frame of the cell.")
 @click.option("--format", "vendor", required=True, type=LiveChoice(names),
-              help="Program format (coordinated: abb, MultiMove).")
+              help="Program format (coordinated: abb, MultiMove; yaskawa, one job of two "
+                   "robots and a station).")
 @click.option("-o", "--output", "folder", required=True, type=OutputPath(file_okay=False),
               help="Folder for the program files (created; its parent must exist).")
 @click.option("--name", default=None, help="Program name (default: the first path's name).")
+@_ppd_option
 def write_coordinated_cmd(paths: tuple[str, ...], cell_path: str, tools: tuple[str, ...],
-                          frame: str, vendor: str, folder: str, name: str | None) -> None:
+                          frame: str, vendor: str, folder: str, name: str | None,
+                          ppd: str | None) -> None:
     """Write the paths of several robots of the cell as one coordinated program: point k of
-    every path reached together, the positioner at the values the files give (columns table or
-    e1..en, in at least one file), each robot's track as its file says or following its path
-    (docs/programs.md, "Coordinated programs"). ABB: one MultiMove module per task (T_ROB1,
-    T_ROB2, .. in the order of the cell's robots). A format whose coordinated form robotcell
-    does not write exits with status 2 naming what is missing; nothing is written.
+    every path reached together (or, when every file has a time column, s, the points matched
+    by time, poses between a file's points interpolated along its linear motions), the
+    positioner at the values the files give (columns table or e1..en) or, where none gives
+    them, chosen once for all robots, each robot's track as its file says or following its
+    path (docs/programs.md, "Coordinated programs"). ABB: one MultiMove module per task (T_ROB1,
+    T_ROB2, .. in the order of the cell's robots). YASKAWA: one job NAME.jbi, the first robot
+    with the station in group 1, the second in group 2 (--pulses-per-degree for the station).
+    A format whose coordinated form robotcell does not write exits with status 2 naming what
+    is missing; nothing is written.
 
     \b
     Example:
@@ -259,8 +266,9 @@ def write_coordinated_cmd(paths: tuple[str, ...], cell_path: str, tools: tuple[s
     tool_map = (dict.fromkeys(by_robot, tools[0]) if len(tools) == 1 and "=" not in tools[0]
                 else _by_robot(tools, "--tool"))
     try:
-        result = write_coordinated(by_robot, cell, tool_map, frame, vendor, folder, name,
-                                   inputs=(cell_path,))
+        with as_flags(FLAGS):
+            result = write_coordinated(by_robot, cell, tool_map, frame, vendor, folder, name,
+                                       inputs=(cell_path,), pulses_per_degree=_ppd(ppd))
     except PathBreaks as exc:
         click.echo(format_table(["point", "why", "cause"],
                                 [[b.index + 1, b.kind, b.message] for b in exc.breaks]),
@@ -285,11 +293,14 @@ def write_coordinated_cmd(paths: tuple[str, ...], cell_path: str, tools: tuple[s
 @click.option("--clearance", "clearance_mm", type=float, default=10.0, show_default=True,
               callback=in_range(0.0, 1000.0, "mm"),
               help="Smallest good distance, with --bodies (mm).")
+@_ppd_option
 def check_coordinated_cmd(program_files: tuple[str, ...], cell_path: str, robots: str | None,
-                          bodies_path: str | None, clearance_mm: float) -> None:
-    """Check a coordinated program, one file per robot (ABB: a MultiMove module per task):
-    the synchronisation (ABB: the \\ID of every synchronised move has its partner in every
-    other task), as many points each with the positioner at the same values, every robot's
+                          bodies_path: str | None, clearance_mm: float, ppd: str | None) -> None:
+    """Check a coordinated program, one file per robot (ABB: a MultiMove module per task) or
+    one job of two robots (YASKAWA .jbi): the synchronisation (ABB: the \\ID of every
+    synchronised move has its partner in every other task; YASKAWA: the groups, and every
+    motion line moves both robots), as many points each with the positioner at the same
+    values, every robot's
     points against the cell as 'program check' does, and with --bodies the clearance of the
     robots against each other and the parts. Exit status 0 when all is good, 3 with a table of
     the problems, 2 for a file that cannot be read or a format not read.
@@ -304,13 +315,16 @@ def check_coordinated_cmd(program_files: tuple[str, ...], cell_path: str, robots
     cell = Cell.load(cell_path)
     bodies = read_bodies(bodies_path) if bodies_path else None
     order = None if robots is None else [r.strip() for r in robots.split(",")]
-    report = check_coordinated(list(program_files), cell, order, bodies, clearance_mm * 1e-3)
+    with as_flags(FLAGS):
+        report = check_coordinated(list(program_files), cell, order, bodies,
+                                   clearance_mm * 1e-3, _ppd(ppd))
     for robot, rep in report.reports.items():
         for s in rep.skipped:
             click.echo(f"note: {robot}: not checked: {s}", err=True)
     n = sum(len(r.points) for r in report.reports.values())
     if report.good:
-        click.echo(f"{len(program_files)} programs, {counted(n, 'point')}, all good")
+        click.echo(f"{counted(len(report.reports), 'program')}, {counted(n, 'point')}, "
+                   "all good")
         return
     for s in report.sync:
         click.echo(f"synchronisation: {s}", err=True)
@@ -331,6 +345,7 @@ def check_coordinated_cmd(program_files: tuple[str, ...], cell_path: str, robots
               help="Folder for the retargeted program files (created; its parent must exist).")
 @_ppd_option
 @click.option("--json", "as_json", is_flag=True, help="Print every joint point as JSON.")
+@robot_name_option
 def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, ppd: str | None,
                  as_json: bool) -> None:
     """Move the joint points of PROGRAM (KUKA E6AXIS/AXIS, ABB jointtarget, FANUC joint
@@ -340,7 +355,8 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     Each point keeps its configuration (shoulder, elbow and wrist sides, and its turns). Prints
     the largest axis change per point; a point the new cell cannot reach in its configuration,
     or only with an axis outside its limits, exits with status 3 naming it, and nothing is
-    written. Joint values outside the model's limits in the program are named.
+    written. Joint values outside the model's limits in the program are named. In cell files
+    of several robots --robot-name names the program's robot, in both.
 
     \b
     Example:
@@ -348,7 +364,7 @@ def retarget_cmd(program_file: str, old_path: str, new_path: str, folder: str, p
     """
     from robotcell.programs.retarget import RetargetFailed, retarget_program
 
-    old, new = Cell.load(old_path), Cell.load(new_path)
+    old, new = load_cell(old_path), load_cell(new_path)
     with as_flags(FLAGS):
         try:
             result = retarget_program(program_file, old, new, folder, _ppd(ppd),

@@ -190,7 +190,9 @@ def _into_cell(reference: str, other: str, given: _Given, as_json: bool,
                                on_note=echo_note)
     gate(result, as_json, accept_poor)
     done = update_cell_file(given.cell_path,
-                            lambda c: (place_robot(c, result, ref, oth), None), on_note=echo_note)
+                            lambda c: (place_robot(c, result, ref, oth,
+                                                   tool_sigma=_tool_sigma_m(given)), None),
+                            on_note=echo_note)
     kept = f" (previous version: {done.backup})" if done.backup is not None else ""
     click.echo(f"updated {given.cell_path}: base of robot {given.robot!r} from robot "
                f"{given.reference_robot!r}{kept}", err=True)
@@ -268,6 +270,23 @@ def _points_csv(points: np.ndarray) -> str:
     return "\n".join(["point,x,y,z", *rows]) + "\n"
 
 
+@dataclass(frozen=True)
+class _Planned:
+    """The options of ``plan robot-to-robot``."""
+
+    cell_path: str
+    robot: str
+    reference_robot: str
+    tool_ref: str | None
+    tool_other: str | None
+    noise: float
+    runs: int
+    seed: int | None
+    track_ref: float
+    track_other: float
+    output: str | None
+
+
 def _design_row(d: R2RDesign, best: R2RDesign) -> list[object]:
     mc = ("-", "-") if np.isnan(d.position_rms) else (
         d.position_rms * 1e3, f"{np.degrees(d.rotation_rms):.4f}")
@@ -292,17 +311,20 @@ def _design_row(d: R2RDesign, best: R2RDesign) -> list[object]:
               help="Monte Carlo calibrations per design (0: none).")
 @click.option("--seed", type=click.IntRange(min=0), default=None,
               help="Seed of the sampled volume and the Monte Carlo errors.")
+@click.option("--track-ref", type=float, default=0.0, show_default=True, metavar="MM",
+              help="The reference robot's track position during its touches (mm).")
+@click.option("--track-other", type=float, default=0.0, show_default=True, metavar="MM",
+              help="The other robot's track position during its touches (mm).")
 @click.option("-o", "--output", type=OUTPUT, default=None,
               callback=output_of("CSV", "the recommended common points"),
               help="Write the recommended design's points (point, x, y, z mm in the reference "
                    "robot's base) as CSV, atomically.")
-def plan_robot_to_robot_cmd(cell_path: str, robot: str, reference_robot: str,
-                            tool_ref: str | None, tool_other: str | None, noise: float,
-                            runs: int, seed: int | None, output: str | None) -> None:
+def plan_robot_to_robot_cmd(**options: Any) -> None:
     """Propose where to put the common points of a robot-to-robot calibration.
 
     \b
-    Samples the volume about the two robots' bases (track position 0), keeps the points both
+    Samples the volume about the two robots' bases (a robot on a track at the position it
+    touches from, --track-ref / --track-other, default 0), keeps the points both
     reach with their tools pointing straight down, and proposes designs of 3, 4, 5 and 6 common
     points spread over that volume. For each, the predicted 1-sigma of the other robot's base
     in the reference robot's base at the touch-up accuracy --noise, and the RMS error of --runs
@@ -312,23 +334,30 @@ def plan_robot_to_robot_cmd(cell_path: str, robot: str, reference_robot: str,
     Example:
       robotcell plan robot-to-robot --cell examples/cell_two_robots_positioner.yaml --robot abb --reference kuka --seed 1 -o points.csv
     """
+    o = _Planned(**options)
+    cell_path, robot, reference_robot, noise = o.cell_path, o.robot, o.reference_robot, o.noise
+    track_ref, track_other, output = o.track_ref, o.track_other, o.output
     if not 0 < noise <= NOISE_MAX_MM:
         raise InputError(f"--noise must be a positive number of millimetres, at most "
                          f"{NOISE_MAX_MM:g}, got {noise:g}")
     cell = Cell.load(cell_path)
-    p = plan_robot_to_robot(cell, robot, reference_robot, tools=(tool_ref, tool_other),
-                            noise=noise * 1e-3, runs=runs, seed=seed)
+    p = plan_robot_to_robot(cell, robot, reference_robot, tools=(o.tool_ref, o.tool_other),
+                            noise=noise * 1e-3, runs=o.runs, seed=o.seed,
+                            tracks=(track_ref * 1e-3, track_other * 1e-3))
     click.echo(f"robot-to-robot plan: base of {robot!r} in the base of {reference_robot!r}, "
                f"touch-up error {noise:g} mm (1-sigma per coordinate); {p.reachable} sampled "
                "points reached by both robots")
     click.echo(format_table(["points", "position mm", "rotation deg", "MC position mm",
                              "MC rotation deg", ""], [_design_row(d, p.best) for d in p.designs]))
+    at = f" at track position {track_ref:g} mm" if track_ref else ""
     click.echo(f"\nbest: {len(p.best.points)} common points (mm, in the base of "
-               f"{reference_robot!r}):")
+               f"{reference_robot!r}{at}):")
     click.echo(_points_csv(p.best.points), nl=False)
     if output is not None:
         atomic_write(output, _points_csv(p.best.points))
         click.echo(f"wrote the recommended points to {output}; touch each with both robots and "
                    f"calibrate with:\n  robotcell calibrate robot-to-robot REF.csv OTHER.csv "
                    f"--cell {cell_path} --robot {robot} --reference {reference_robot} "
-                   f"--tool-ref {p.tools[0]} --tool-other {p.tools[1]}", err=True)
+                   f"--tool-ref {p.tools[0]} --tool-other {p.tools[1]}"
+                   + (f" --track-ref {track_ref:g}" if track_ref else "")
+                   + (f" --track-other {track_other:g}" if track_other else ""), err=True)

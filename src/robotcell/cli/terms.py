@@ -22,6 +22,7 @@ CLI_TERMS = {
     "tool=flange": "--tool 0,0,0,0,0,0",
     "tool=X,Y,Z,A,B,C": "--tool X,Y,Z,A,B,C",
     "robot=NAME_OR_FILE": "--robot NAME_OR_FILE",
+    "robot=NAME": "with --robot-name NAME",
     "cell": "--cell",
     "cell=FILE": "--cell CELL.yaml",
     "cell=FILE (Cell)": "--cell CELL.yaml (in Python: a Cell)",

@@ -203,6 +203,9 @@ class Controller(ABC):
     #: form would follow); None where :meth:`write_coordinated` writes them.
     coordinated_missing: ClassVar[str | None] = (
         "no public manual or real program in the sources robotcell cites shows its form")
+    #: A coordinated program is one file for all robots (YASKAWA: one job of several groups),
+    #: not one file per robot (ABB: one module per task).
+    coordinated_one_file: ClassVar[bool] = False
 
     def __repr__(self) -> str:
         return f"<controller {self.name}>"
@@ -292,9 +295,35 @@ class Controller(ABC):
         """
         raise self.coordinated_refusal()
 
+    def coordinated_robots(self, cell: Cell, robots: list[str]) -> None:
+        """Refuse robots of the cell whose coordinated program this controller does not write
+        (before their paths are solved); by default none.
+
+        Raises
+        ------
+        InputError
+            Robots the controller's coordinated form does not hold, naming why.
+        """
+
+    def read_coordinated(self, paths: list[str | Path], n: int
+                         ) -> list[tuple[Program, list[str]]]:
+        """Each robot's program of a coordinated program, in order: here each file's
+        (:attr:`coordinated_one_file` False), the program and the motions not turned into
+        points.
+
+        Parameters
+        ----------
+        paths : list of str or Path
+            The program's files (one per robot, or the one file).
+        n : int
+            The number of robots.
+        """
+        return [self.read_program(p) for p in paths]
+
     def coordinated_problems(self, paths: list[str | Path]) -> list[str]:
         """What breaks the controller's rules for the synchronisation of the coordinated
-        program in ``paths`` (one file per robot, in order), each with its file and line.
+        program in ``paths`` (one file per robot in order, or the one file), each with its
+        file and line.
 
         Raises
         ------
@@ -324,7 +353,7 @@ class Controller(ABC):
             :attr:`name_limit`.
         """
         if not _IDENT.match(name) or len(name) > self.name_limit:
-            raise InputError(f"program name {name!r} is not a {self.name} program name: a "
+            raise InputError(f"program name {name!r} is not valid for {self.label}: a "
                              f"letter, then letters, digits or '_', at most {self.name_limit} "
                              "characters; give another name")
         return name.upper() if self.upper_names else name

@@ -179,7 +179,8 @@ def _robot_to_robot(run: _Run, tool_sigma: float) -> dict[str, Any]:
     ref = RobotTouchFile(REFERENCE, str(files[0]), TOOL, REFERENCE_TRACK)
     oth = RobotTouchFile(OTHER, str(files[1]), TOOL)
     result = calibrate_robot_to_robot(cell, ref, oth, sigma=run.noise, tool_sigma=tool_sigma)
-    return run.keep("robot_to_robot", result, place_robot(cell, result, ref, oth))
+    return run.keep("robot_to_robot", result,
+                    place_robot(cell, result, ref, oth, tool_sigma=tool_sigma))
 
 
 def _tool_sigma(result: dict[str, Any]) -> float:

@@ -1,11 +1,12 @@
 """Reading a coordinated program back: every robot's program checked, all robots together.
 
-:func:`check_coordinated` reads one file per robot (ABB: one module per MultiMove task), the
-robots in the order of the files: the cell's robots in its order, or as named. It checks the
-synchronisation by the controller's rules
-(:meth:`robotcell.controllers.base.Controller.coordinated_problems`: ABB's ``\\ID``), that the
-programs move to as many points each with the positioner at the same values at every point,
-each program against the cell as its robot sees it
+:func:`check_coordinated` reads one file per robot (ABB: one module per MultiMove task), or
+the one file of a controller whose coordinated program is one file for all robots (YASKAWA: a
+job of two robot groups), the robots in the order of the files or groups: the cell's robots in
+its order, or as named. It checks the synchronisation by the controller's rules
+(:meth:`robotcell.controllers.base.Controller.coordinated_problems`: ABB's ``\\ID``, YASKAWA's
+groups), that the programs move to as many points each with the positioner at the same values
+at every point, each program against the cell as its robot sees it
 (:func:`robotcell.programs.check.check_program`: reach, limits, configuration, singularities),
 and with ``bodies`` the clearance of the robots against each other and the parts along the
 program they run together (:func:`robotcell.clearance.clearance_between`).
@@ -18,14 +19,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robotcell.cell import Cell
 from robotcell.clearance.bodies import BodiesFile
 from robotcell.clearance.distance import Clearance
+from robotcell.controllers.base import Controller
 from robotcell.controllers.registry import get
 from robotcell.errors import InputError
 from robotcell.programs.check import CLEARANCE, CheckReport, check_program
-from robotcell.programs.formats import read_program
+from robotcell.programs.formats import vendor_of
 
 __all__ = ["CoordinatedReport", "check_coordinated"]
 
@@ -56,37 +59,46 @@ class CoordinatedReport:
         return [[robot, *row] for robot, r in self.reports.items() for row in r.rows()]
 
 
-def _robots(cell: Cell, paths: Sequence[str | Path], robots: Sequence[str] | None
-            ) -> list[str]:
+def _robots(cell: Cell, paths: Sequence[str | Path], robots: Sequence[str] | None,
+            ctl: Controller) -> list[str]:
     names = list(cell.robot_names if robots is None else robots)
     for name in names:
         cell.robot_key(name)
-    if len(names) != len(paths):
-        raise InputError(f"{len(paths)} program files for {len(names)} robots "
-                         f"({', '.join(names)}): give one file per robot, in the order of the "
-                         "robots (or name them)")
+    if ctl.coordinated_one_file and len(paths) != 1:
+        raise InputError(f"{len(paths)} program files: a {ctl.label} coordinated program is one "
+                         "file for all robots; give that one file")
+    if not ctl.coordinated_one_file and len(names) != len(paths):
+        files = "1 program file" if len(paths) == 1 else f"{len(paths)} program files"
+        raise InputError(f"{files} for {len(names)} robots ({', '.join(names)}): give one "
+                         "file per robot, in the order of the robots (or name them)")
     return names
 
 
 def check_coordinated(paths: Sequence[str | Path], cell: Cell,
                       robots: Sequence[str] | None = None, bodies: BodiesFile | None = None,
-                      clearance: float = CLEARANCE) -> CoordinatedReport:
-    """Read a coordinated program (one file per robot) and check it against a cell.
+                      clearance: float = CLEARANCE,
+                      pulses_per_degree: ArrayLike | None = None) -> CoordinatedReport:
+    """Read a coordinated program and check it against a cell.
 
     Parameters
     ----------
     paths : sequence of str or Path
-        One program file per robot (ABB: ``NAME_T_ROB1.mod``, ``NAME_T_ROB2.mod``, ..).
+        One program file per robot (ABB: ``NAME_T_ROB1.mod``, ``NAME_T_ROB2.mod``, ..), or the
+        one file of a controller whose coordinated program is one file (YASKAWA: ``NAME.jbi``,
+        the robots of group 1 and group 2).
     cell : Cell
         A cell of several robots.
     robots : sequence of str, optional
-        The robot of each file, in order; default: the cell's robots in the cell's order (the
-        order of the tasks ``T_ROB1``, ``T_ROB2``, .. that :func:`write_coordinated` writes).
+        The robot of each file (or of each group), in order; default: the cell's robots in the
+        cell's order (the order of the tasks ``T_ROB1``, ``T_ROB2``, .. or of the groups that
+        :func:`write_coordinated` writes).
     bodies : BodiesFile, optional
         The cell's parts: with them the clearance of every robot against the others and the
         parts at every point and along every motion.
     clearance : float
         Smallest good distance (m).
+    pulses_per_degree : float or array_like, optional
+        YASKAWA: encoder pulses per degree of each station axis.
 
     Returns
     -------
@@ -96,24 +108,25 @@ def check_coordinated(paths: Sequence[str | Path], cell: Cell,
     ------
     InputError
         A file that cannot be read, files of different formats or of a controller whose
-        coordinated form is not read, as many files as robots not given, a robot the cell
-        lacks.
+        coordinated form is not read, a number of files the controller's form does not have
+        (one per robot, or one), a robot the cell lacks, a YASKAWA job of a cell with a station
+        and no ``pulses_per_degree``.
     """
-    names = _robots(cell, paths, robots)
-    read = [read_program(p) for p in paths]
-    vendors = sorted({program.vendor for program, _ in read})
+    vendors = sorted({vendor_of(p) for p in paths})
     if len(vendors) > 1:
         raise InputError(f"the files of one coordinated program are of one format; got "
                          f"{', '.join(vendors)}")
     ctl = get(vendors[0], "program format")
+    names = _robots(cell, paths, robots, ctl)
+    read = ctl.read_coordinated(list(paths), len(names))
     sync = ctl.coordinated_problems(list(paths))
-    reports = {r: check_program(program, cell.for_robot(r), skipped=skipped)
+    reports = {r: check_program(program, cell.for_robot(r), pulses_per_degree, skipped=skipped)
                for r, (program, skipped) in zip(names, read)}
     counts = {r: len(rep.points) for r, rep in reports.items()}
     if len(set(counts.values())) > 1:
         sync.append("the programs move to different numbers of points: "
                     + ", ".join(f"{r} {n}" for r, n in counts.items()))
-    elif cell.turntable is not None:
+    elif cell.turntable is not None and any(counts.values()):
         sync += _table_problems(reports)
     if bodies is not None and not sync:
         _clearance(cell, reports, bodies, clearance)

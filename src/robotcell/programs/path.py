@@ -10,6 +10,7 @@ mm and ``table`` or ``e1..en`` deg, ``name``) with the columns of a motion
 | ``motion`` | optional | ``ptp`` or ``lin`` (default: ``ptp`` to the first point, ``lin`` after) |
 | ``speed`` | optional | TCP speed of a linear motion (mm/s; default 100) |
 | ``zone`` | optional | corner distance (mm; default 0, an exact stop) |
+| ``time`` | optional | when the point is reached (s, increasing; ``pathtime``) |
 
 Without ``track`` the track is chosen along the path. Without ``table`` (or ``e1..en``) the
 writer chooses the table's values along a path in a frame the table carries
@@ -32,15 +33,15 @@ from robotcell.cell import Cell, Positioner
 from robotcell.cell.validation import table_columns, table_label
 from robotcell.controllers.model import MOTIONS
 from robotcell.errors import InputError
-from robotcell.io.tables import optional_column
+from robotcell.io.tables import optional_column, require_columns
 from robotcell.io.targets import read_targets
 
-__all__ = ["DEFAULT_SPEED", "PathTargets", "read_path"]
+__all__ = ["DEFAULT_SPEED", "TIME_TOL", "PathTargets", "read_path"]
 
 #: TCP speed of linear motions when the path gives none (m/s).
 DEFAULT_SPEED = 0.1
 
-_MOTION = ("motion", "speed", "zone")
+_MOTION = ("motion", "speed", "zone", "time")
 _MOTION_WORDS = {"ptp": "ptp", "lin": "lin", "j": "ptp", "l": "lin", "joint": "ptp",
                  "linear": "lin", "movej": "ptp", "movel": "lin"}
 
@@ -72,6 +73,11 @@ class PathTargets:
         Columns the reader does not use (misspelt?).
     extra : dict of str to ndarray or list of str
         The caller's further columns (``extra`` of :func:`read_path`) the file has, as read.
+    time : ndarray, shape (N,), or None
+        When each point is reached (s, increasing), from column ``time``; None: no times.
+    lines : ndarray of int, shape (N,), or None
+        The file's line of each point, for messages (0: a point the file does not hold, put
+        between two of its points; None: unknown).
     """
 
     T: NDArray[np.float64]
@@ -84,6 +90,17 @@ class PathTargets:
     source: str = ""
     warnings: list[str] = field(default_factory=list)
     extra: dict = field(default_factory=dict)
+    time: NDArray[np.float64] | None = None
+    lines: NDArray[np.intp] | None = None
+
+    def line(self, i: int) -> str:
+        """Where point ``i`` is, for messages: ``file: line L``, or ``file: at T s`` for a
+        point the file does not hold."""
+        if self.lines is not None and self.lines[i] > 0:
+            return f"{self.source}: line {self.lines[i]}"
+        if self.time is not None:
+            return f"{self.source}: at {self.time[i]:g} s (between two of its points)"
+        return f"{self.source}: line {i + 2}"
 
     def __len__(self) -> int:
         return self.T.shape[0]
@@ -119,8 +136,9 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
     Raises
     ------
     InputError
-        A missing pose column, an empty pose, track or table value, a non-numeric value, an
-        unknown motion, a speed that is not positive, a negative zone, a track or table column
+        A missing pose column, an empty pose, track, table or time value, a non-numeric value,
+        an unknown motion, a speed that is not positive, a negative zone, times that do not
+        increase, a track or table column
         for a cell without one, or a value outside the track's or table's limits; the message
         names the file, line and column.
     """
@@ -145,7 +163,30 @@ def read_path(path: str | Path, cell: Cell, extra: tuple[str, ...] = ()) -> Path
     table = _table(t.table, cell, n, t.lines, p)
     given = cell.turntable is None or t.table is not None
     return PathTargets(t.poses, motion, speed, zone, t.track, table, given, p, t.warnings,
-                       {k: v for k, v in cols.items() if k in extra})
+                       {k: v for k, v in cols.items() if k in extra}, _time(cols, t.lines, p),
+                       t.lines)
+
+
+#: Smallest step between two times of a path (s): closer times are one time.
+TIME_TOL = 1e-6
+
+
+def _time(cols: dict, lines: NDArray[np.intp], path: str) -> NDArray[np.float64] | None:
+    """Column ``time`` (s), each value given, finite and later than the one before by more
+    than :data:`TIME_TOL`; None without the column."""
+    if "time" not in cols:
+        return None
+    t = require_columns(cols, ["time"], path)[:, 0]
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise InputError(f"{path}: line {lines[bad[0]]}: column 'time' must be a finite number "
+                         "(s)")
+    bad = np.flatnonzero(np.diff(t) <= TIME_TOL)
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise InputError(f"{path}: line {lines[i]}: column 'time' has {t[i]:g} s, not later than "
+                         f"{t[i - 1]:g} s of the line before; the times of a path increase")
+    return t
 
 
 def _motion(cols: dict, lines: NDArray[np.intp], path: str) -> list[str]:

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.cell import Cell
-from robotcell.cell.identified import adopt_identified, identification_provenance
+from robotcell.cell.identified import CellRobotFile, adopt_identified, identification_provenance
 from robotcell.controllers.registry import CONTROLLERS, get
 from robotcell.errors import InputError
 from robotcell.identification import identify, read_target_measurements
@@ -133,7 +133,8 @@ class IdentificationRun:
 
 
 def identify_file(measurements: str | Path, robot: str | Path | None = None,
-                  cell: str | Path | None = None, *, folds: int = DEFAULT_FOLDS,
+                  cell: str | Path | CellRobotFile | None = None, *,
+                  folds: int = DEFAULT_FOLDS,
                   report: bool = False, offsets_for: str | None = None,
                   output: str | Path | None = None, force: bool = False,
                   options: IdentifyOptions | None = None, **keywords: Any) -> IdentificationRun:
@@ -146,9 +147,10 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
     robot : str or Path, optional
         Nominal model (library name or model file). Without it and without ``cell`` the circle
         point analysis builds the start model.
-    cell : str or Path, optional
+    cell : str, Path or CellRobotFile, optional
         A cell file: its ``robot.model`` is the nominal when ``robot`` is not given, and the
-        identified model written to ``output`` becomes its ``robot.identified``.
+        identified model written to ``output`` becomes its ``robot.identified``. In a cell of
+        several robots, ``CellRobotFile(path, robot)`` names the robot whose arm was measured.
     folds : int
         Folds of the cross-validation that chooses the constants to free (at most the rows;
         :func:`~robotcell.identification.identify_validated`); 0: none, every identifiable
@@ -192,8 +194,10 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
     if folds < 0 or folds == 1:
         raise InputError(f"folds must be 0 (no cross-validation) or at least 2, got {folds}")
     opts = IdentifyOptions.of(options, **keywords)
+    where = cell if isinstance(cell, CellRobotFile) or cell is None else CellRobotFile(cell)
     if robot is not None or cell is not None:
-        nominal = load_robot(robot) if robot is not None else Cell.load(cell).nominal_robot
+        nominal = (load_robot(robot) if robot is not None
+                   else Cell.load(where.path).for_robot(where.robot).nominal_robot)
         meas = read_target_measurements(measurements, nominal.prismatic)
     else:
         nominal, meas = first_estimate(measurements, j23_factor=opts.j23_factor or 0.0,
@@ -220,6 +224,7 @@ def identify_file(measurements: str | Path, robot: str | Path | None = None,
         if cell is None:
             save_robot(result.robot, output)
         else:
-            adopt_identified(cell, result, output, identification_provenance(result, cross))
+            adopt_identified(where.path, result, output,
+                             identification_provenance(result, cross), robot=where.robot)
     return IdentificationRun(result, cross, folds or None, offsets, written, obs,
                              meas if report else None, choice)

@@ -79,7 +79,7 @@ def work_volume(box: ArrayLike | None = None, cell: Cell | None = None) -> WorkV
 def propose_configurations(n: int, robot: str | Path | None = None, cell: str | Path | None = None,
                            n_targets: int = 1, pose: bool = False, seed: int = 0,
                            sigma: float = 0.05e-3, angle_sigma: float = math.radians(0.02),
-                           box: ArrayLike | None = None) -> Proposal:
+                           box: ArrayLike | None = None, cell_robot: str | None = None) -> Proposal:
     """Propose ``n`` configurations to measure: the most observable inside the work volume.
 
     Parameters
@@ -102,6 +102,9 @@ def propose_configurations(n: int, robot: str | Path | None = None, cell: str | 
         The work volume, ``xmin, ymin, zmin, xmax, ymax, zmax`` in the robot base frame (m)
         (:func:`work_volume`).
 
+    cell_robot : str, optional
+        In a cell of several robots, the robot whose arm is proposed (a key of its
+        ``robots``); None: the only robot.
     Returns
     -------
     Proposal
@@ -121,7 +124,7 @@ def propose_configurations(n: int, robot: str | Path | None = None, cell: str | 
                          f"{CANDIDATES} random candidates)")
     if pose and n_targets != 1:
         raise InputError("pose goes with one target per configuration (n_targets 1)")
-    the_cell = None if cell is None else Cell.load(cell)
+    the_cell = None if cell is None else Cell.load(cell).for_robot(cell_robot)
     nominal = load_robot(robot) if robot is not None else the_cell.nominal_robot
     volume = work_volume(box, the_cell)
     candidates = configurations_within(nominal, volume, CANDIDATES, n_targets, pose, seed)

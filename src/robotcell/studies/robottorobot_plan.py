@@ -2,8 +2,8 @@
 
 For a cell of several robots (its values taken as the truth), :func:`plan_robot_to_robot` samples
 the volume about the two robots' bases, keeps the points both robots reach with their tools
-pointing straight down (each through :meth:`robotcell.cell.Cell.ik` of its own view, at track
-position 0), and builds designs of K common points (:data:`SIZES`) spread over that common
+pointing straight down (each through :meth:`robotcell.cell.Cell.ik` of its own view, a robot on
+a track at the track position it will touch from: 0 unless given), and builds designs of K common points (:data:`SIZES`) spread over that common
 volume by farthest-point selection. For each design the calibration of exact touches with
 ``sigma = noise`` gives the *predicted* 1-sigma of ``T_ref_other`` (first-order propagation, the
 covariance :func:`robotcell.calibration.robottorobot.robot_to_robot` reports), and a Monte Carlo
@@ -93,28 +93,52 @@ def _tool(view: Cell, robot: str, tool: str | None) -> str:
     return tool
 
 
-def _reaches(cell: Cell, robot: str, tool: str, p_world: NDArray[np.float64]
-             ) -> NDArray[np.bool_]:
-    """Which world points (N, 3) ``robot`` reaches with ``tool`` pointing down (track 0)."""
+def _track(cell: Cell, robot: str, track: float) -> float | None:
+    """``track`` (m) for ``robot``: None for a robot without a track (where it must be 0).
+
+    Raises
+    ------
+    InputError
+        A track position for a robot without a track, or outside its track's limits.
+    """
+    t = cell.for_robot(robot).track
+    if t is None:
+        if track != 0.0:
+            raise InputError(f"robot {robot!r} has no track; do not give its track position")
+        return None
+    if not t.within_limits(track):
+        raise InputError(f"track position {track * 1e3:g} mm of robot {robot!r} is outside its "
+                         f"track limits {t.lower * 1e3:g} .. {t.upper * 1e3:g} mm")
+    return track
+
+
+def _reaches(cell: Cell, robot: str, tool: str, p_world: NDArray[np.float64],
+             track: float | None) -> NDArray[np.bool_]:
+    """Which world points (N, 3) ``robot`` reaches with ``tool`` pointing down, at ``track``
+    (m; None without a track)."""
     view = cell.for_robot(robot)
     T = make_pose(np.broadcast_to(_DOWN, (len(p_world), 3, 3)), p_world)
-    sol = view.ik(T, "world", track=None if view.track is None else 0.0, tool=tool)
+    sol = view.ik(T, "world", track=track, tool=tool)
     return np.asarray(sol.valid, dtype=bool).any(axis=-1)
 
 
 def common_volume(cell: Cell, robots: tuple[str, str], tools: tuple[str, str], *,
-                  samples: int = 400, rng: np.random.Generator) -> NDArray[np.float64]:
+                  samples: int = 400, rng: np.random.Generator,
+                  tracks: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.float64]:
     """Points of the world (M, 3, m) both robots reach with their tools pointing down.
 
-    Samples ``samples`` points uniformly in the box spanning the two bases (at track position 0)
-    widened by 1 m in x and y, 0.1 m to 1.2 m above the lower base.
+    Samples ``samples`` points uniformly in the box spanning the two bases (each at its track
+    position ``tracks``, m; 0 for a robot without a track) widened by 1 m in x and y, 0.1 m to
+    1.2 m above the lower base.
     """
-    bases = np.array([cell.for_robot(r).frame_pose("robot", track=0.0)[:3, 3] for r in robots])
+    at = [_track(cell, r, x) for r, x in zip(robots, tracks)]
+    bases = np.array([cell.for_robot(r).frame_pose("robot", track=x or 0.0)[:3, 3]
+                      for r, x in zip(robots, at)])
     lo = np.array([*(bases[:, :2].min(axis=0) - 1.0), bases[:, 2].min() + 0.1])
     hi = np.array([*(bases[:, :2].max(axis=0) + 1.0), bases[:, 2].min() + 1.2])
     p = lo + rng.random((samples, 3)) * (hi - lo)
-    ok = _reaches(cell, robots[0], tools[0], p)
-    ok[ok] = _reaches(cell, robots[1], tools[1], p[ok])
+    ok = _reaches(cell, robots[0], tools[0], p, at[0])
+    ok[ok] = _reaches(cell, robots[1], tools[1], p[ok], at[1])
     return p[ok]
 
 
@@ -145,7 +169,8 @@ def _predict(p_ref: NDArray[np.float64], p_oth: NDArray[np.float64], noise: floa
 
 def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
                         tools: tuple[str | None, str | None] = (None, None), noise: float,
-                        runs: int = 0, seed: int | None = None, candidates: int = 400) -> R2RPlan:
+                        runs: int = 0, seed: int | None = None, candidates: int = 400,
+                        tracks: tuple[float, float] = (0.0, 0.0)) -> R2RPlan:
     """Designs of K common points (:data:`SIZES`) both robots touch, with their predicted 1-sigma.
 
     Parameters
@@ -167,6 +192,10 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     candidates : int
         Points sampled about the two bases (the common volume is those both reach; a design
         of K points needs K of them).
+    tracks : tuple of float
+        The track positions (m) the reference robot and ``robot`` touch from; 0 for a robot
+        without a track. The predicted 1-sigma is that of the two bases at those positions (the
+        tracks' own errors are not counted: a track's calibration adds its stated sigma).
 
     Returns
     -------
@@ -176,7 +205,8 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     ------
     InputError
         A cell of one robot, an unknown robot or tool, the same robot twice, a noise that is not
-        positive, or fewer than 3 sampled points both robots reach.
+        positive, a track position for a robot without a track or outside its limits, or fewer
+        than 3 sampled points both robots reach.
     """
     if len(cell.robots) < 2:
         raise InputError("the cell has one robot; a robot-to-robot plan needs a cell of two or "
@@ -190,14 +220,16 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     use = (_tool(cell.for_robot(names[0]), names[0], tools[0]),
            _tool(cell.for_robot(names[1]), names[1], tools[1]))
     rng = np.random.default_rng(seed)
-    p_w = common_volume(cell, names, use, samples=candidates, rng=rng)
+    p_w = common_volume(cell, names, use, samples=candidates, rng=rng, tracks=tracks)
     sizes = [k for k in SIZES if k <= len(p_w)]
     if not sizes:
         raise InputError(f"robots {names[0]!r} and {names[1]!r} reach {len(p_w)} of "
                          f"{candidates} sampled points with their tools pointing down, fewer "
                          f"than {min(SIZES)}: no common reachable volume; move the robots or "
                          "their tracks closer")
-    T_w_ref, T_w_oth = (cell.for_robot(n).frame_pose("robot", track=0.0) for n in names)
+    # each robot records its touches in its base at the track position it touches from
+    T_w_ref, T_w_oth = (cell.for_robot(n).frame_pose("robot", track=x)
+                        for n, x in zip(names, tracks))
     T_true = invert(T_w_ref) @ T_w_oth
     p_ref, p_oth = transform_points(invert(T_w_ref), p_w), transform_points(invert(T_w_oth), p_w)
     order = _spread(p_w, max(sizes))

@@ -12,6 +12,8 @@
   :func:`write_cell_view`);
   :mod:`robotcell.view.path`: a path with the arm at each point, on a slider;
   :mod:`robotcell.view.program`: a robot program in it, its bad points marked;
+  :mod:`robotcell.view.coordinated`: a coordinated program of several robots, all moving
+  together, with the closest pair of shapes at each point;
   :mod:`robotcell.view.reach`: a reachability map in the cell.
 - :mod:`robotcell.view.pyplot`: matplotlib's pyplot, off screen, for the PNG figures of the
   reports and of the reachability map.
@@ -32,6 +34,7 @@ from robotcell._lazy import module_getattr
 if TYPE_CHECKING:
     from robotcell.view.calibration import calibration_scene
     from robotcell.view.cellscene import cell_figure, cell_scene, write_cell_view
+    from robotcell.view.coordinated import coordinated_scene, write_coordinated_view
     from robotcell.view.identification import identification_scene
     from robotcell.view.path import PathMarks, path_scene
     from robotcell.view.plot import page, scene_figure, write_html
@@ -43,6 +46,8 @@ if TYPE_CHECKING:
 _LAZY = {
     "calibration_scene": "robotcell.view.calibration",
     **dict.fromkeys(["cell_figure", "cell_scene", "write_cell_view"], "robotcell.view.cellscene"),
+    **dict.fromkeys(["coordinated_scene", "write_coordinated_view"],
+                    "robotcell.view.coordinated"),
     "identification_scene": "robotcell.view.identification",
     **dict.fromkeys(["PathMarks", "path_scene"], "robotcell.view.path"),
     **dict.fromkeys(["page", "scene_figure", "write_html"], "robotcell.view.plot"),
@@ -53,9 +58,10 @@ _LAZY = {
 }
 
 __all__ = ["Arrows", "Lines", "Mesh", "PathMarks", "Points", "Scene", "Step", "Triads",
-           "calibration_scene", "cell_figure", "cell_scene", "identification_scene", "page",
-           "path_scene", "program_scene", "read_reach", "scene_figure", "write_cell_view",
-           "write_html", "write_program_view"]
+           "calibration_scene", "cell_figure", "cell_scene", "coordinated_scene",
+           "identification_scene", "page", "path_scene", "program_scene", "read_reach",
+           "scene_figure", "write_cell_view", "write_coordinated_view", "write_html",
+           "write_program_view"]
 
 
 #: Import a public name from its module on first access (PEP 562).

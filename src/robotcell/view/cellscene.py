@@ -48,7 +48,7 @@ if TYPE_CHECKING:
     import plotly.graph_objects as go
 
 __all__ = ["axes_text", "cell_figure", "cell_items", "cell_scene", "degrees", "fixed_items",
-           "frame_size", "joint_values", "robot_items", "robots_scene", "write_cell_view"]
+           "frame_size", "joint_values", "robot_items", "robots_scene", "work_items", "write_cell_view"]
 
 #: Margin of the drawn plate beyond the farthest frame it carries (m).
 PLATE_MARGIN = 0.1
@@ -134,7 +134,7 @@ def cell_items(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLik
         (the track's frame L, the world axes and the fixed geometry are not among them).
     """
     return (robot_items(cell, q, track, size, detail, with_tools, triads)
-            + _work_items(cell, track, table, size, detail, triads))
+            + work_items(cell, track, table, size, detail, triads))
 
 
 def robot_items(cell: Cell, q: NDArray[np.float64], track: float, size: float,
@@ -166,9 +166,10 @@ def robot_items(cell: Cell, q: NDArray[np.float64], track: float, size: float,
     return items
 
 
-def _work_items(cell: Cell, track: float, table: ArrayLike, size: float, detail: bool,
+def work_items(cell: Cell, track: float, table: ArrayLike, size: float, detail: bool,
                 triads: bool, frames: list[str] | None = None) -> list[Item]:
-    """The turntable or positioner and the frames (``frames``: the names drawn, default all)."""
+    """The turntable or positioner and the frames at one configuration (``frames``: the names
+    drawn, default all); see :func:`cell_items` for the parameters."""
     items: list[Item] = []
     T_world_R = robot_pose(cell, track)
     pos = cell.turntable
@@ -327,7 +328,7 @@ def robots_scene(cell: Cell, joints: Mapping[str, ArrayLike] | None = None,
         items += [replace(it, name=f"{name}: {it.name}") for it in fixed_items(view, size)[1:]]
         items += robot_items(view, q, e, size, label=f"{name}: ")
         mine = [f for f, fr in view.frames.items() if fr.parent == "robot"]  # on its base
-        items += [replace(it, name=f"{name}: {it.name}") for it in _work_items(
+        items += [replace(it, name=f"{name}: {it.name}") for it in work_items(
             replace(view, turntable=None, frames={f: view.frames[f] for f in mine}), e, 0.0, size,
             True, True)]
         state.append(f"{name} axes {axes_text(view.robot, q)}"
@@ -337,7 +338,7 @@ def robots_scene(cell: Cell, joints: Mapping[str, ArrayLike] | None = None,
         if outside:
             notes.append(f"{name}: outside their limits: {', '.join(outside)}")
     shared = [f for f, fr in cell.frames.items() if fr.parent in ("world", "turntable")]
-    items += _work_items(views[cell.robot_names[0]], 0.0, th, size, True, True, shared)
+    items += work_items(views[cell.robot_names[0]], 0.0, th, size, True, True, shared)
     if cell.turntable is not None:
         state.append(f"table {degrees(th)} deg")
     return Scene(f"{cell.name}: {'; '.join(state)}", items, notes)

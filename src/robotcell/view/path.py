@@ -41,7 +41,8 @@ from robotcell.view.cellscene import cell_items, fixed_items, frame_size
 from robotcell.view.scene import AXIS_COLORS, Item, Lines, Points, Scene, Step, Triads
 from robotcell.view.shapes import OUTLIER_COLOR
 
-__all__ = ["DECIMALS", "MOVING", "PathMarks", "ordinal", "path_scene", "triad_line"]
+__all__ = ["DECIMALS", "MOVING", "PathMarks", "one_per_frame", "ordinal", "path_scene",
+           "path_steps", "triad_line"]
 
 #: Decimals of the millimetre coordinates of a path's view: 0.01 mm.
 DECIMALS = 2
@@ -144,7 +145,7 @@ def _merge(steps: list[list[Lines | Triads]], width: float) -> list[Lines]:
     return [Lines(MOVING, v[keep], colors=kept, width=width, parts=parts) for v in verts]
 
 
-def _one_per_frame(items: list[Item]) -> list[Item]:
+def one_per_frame(items: list[Item]) -> list[Item]:
     """Triads of several frames split into one item per frame, so that a frame that does not
     move along the path is drawn once, and one that moves at each point."""
     out: list[Item] = []
@@ -308,7 +309,7 @@ def path_scene(cell: Cell, q: ArrayLike, track: ArrayLike = 0.0, table: ArrayLik
     steps = np.arange(0, n, int(every))
     at = [_at_point(cell, qq[j], e[j], th[j], size, T_world_F[j], T_tcp[j])
           for j in shown[steps]]
-    still, frames = _steps(at, [labs[i] for i in steps])
+    still, frames = path_steps(at, [labs[i] for i in steps])
     items += still
     if every > 1:
         notes.append(f"the arm is drawn at every {ordinal(every)} of the {n} points (the path "
@@ -322,7 +323,7 @@ def _at_point(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLike
     (``T_world_F``, m) to the TCP (``T_tcp``, m), the TCP as a triad of ``size`` (m), then the
     rest of the cell (one item per frame), at joints ``q`` (rad), ``track`` (m), ``table``
     (rad)."""
-    parts = _one_per_frame(cell_items(cell, q, track, table, size, detail=False,
+    parts = one_per_frame(cell_items(cell, q, track, table, size, detail=False,
                                       with_tools=False, triads=False))
     arm = parts[0]  # the robot's links; the tool goes on from the flange in their colour
     tool_line = Lines("tool", np.vstack([T_world_F[:3, 3], T_tcp[:3, 3]]),
@@ -330,9 +331,26 @@ def _at_point(cell: Cell, q: NDArray[np.float64], track: float, table: ArrayLike
     return [arm, tool_line, triad_line("TCP", T_tcp, size), *parts[1:]]
 
 
-def _steps(at: list[list[Item]], labels: list[str]) -> tuple[list[Item], list[Step]]:
+def path_steps(at: list[list[Item]], labels: list[str]) -> tuple[list[Item], list[Step]]:
     """What does not move along the path, drawn once, and one step per point drawn with what
-    moves (``at``: the items at each point drawn, ``labels``: its name)."""
+    moves.
+
+    Parameters
+    ----------
+    at : list of list of Item
+        The items of the cell at each point drawn, the same kinds in the same order at each
+        (m); a set of frames as one item per frame (:func:`one_per_frame`).
+    labels : list of str
+        The name of each point drawn, on the slider.
+
+    Returns
+    -------
+    still : list of Item
+        The items that are the same at every point, drawn once.
+    steps : list of Step
+        Per point, what moves: the line-like items as one polyline (:data:`MOVING`), the
+        moving frames' labels, the other items (a plate).
+    """
     still = [all(_same(at[0][k], a[k]) for a in at[1:]) for k in range(len(at[0]))]
     fixed = [it for it, s in zip(at[0], still) if s]
     moving = [[it for it, s in zip(a, still) if not s] for a in at]

@@ -16,6 +16,7 @@ point (the smallest k that fits), with the whole path and every mark, and the pa
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +32,7 @@ from robotcell.view.path import PathMarks, path_scene
 from robotcell.view.plot import MAX_PAGE_BYTES, page
 from robotcell.view.scene import Scene
 
-__all__ = ["ProgramView", "program_scene", "write_program_view"]
+__all__ = ["ProgramView", "fitting_page", "program_scene", "write_program_view"]
 
 
 @dataclass(frozen=True)
@@ -149,17 +150,47 @@ def write_program_view(cell: Cell, program: str | Path, path: str | Path,
     if read is not None:  # a KUKA program's .dat beside its .src
         raise InputError(f"{path} is {read}, which the program is read from: writing the view "
                          "there would replace it; write to another file")
-    n = len(report.points)
+    every, text = fitting_page(lambda k: _page(cell, report, k), len(report.points),
+                               str(program))
+    atomic_write(path, text)
+    return ProgramView(Path(path), report, every, len(text.encode()))
+
+
+def fitting_page(render: Callable[[int], str], n: int, what: str) -> tuple[int, str]:
+    """The page of a path of ``n`` points with the arm at every point, or at every k-th point
+    for the smallest k that keeps it under :data:`~robotcell.view.plot.MAX_PAGE_BYTES`.
+
+    Parameters
+    ----------
+    render : callable
+        ``render(k)``: the page with the arm at every k-th point.
+    n : int
+        The number of points.
+    what : str
+        What the page shows, for the message (the program's file).
+
+    Returns
+    -------
+    every : int
+        k.
+    page : str
+        ``render(k)``.
+
+    Raises
+    ------
+    InputError
+        The page is too large even with the arm at one point.
+    """
     pages: dict[int, str] = {}
 
     def fits(every: int) -> bool:
-        pages.setdefault(every, _page(cell, report, every))
+        pages.setdefault(every, render(every))
         return len(pages[every].encode()) <= MAX_PAGE_BYTES
 
     every = 1
     if not fits(1):
         if not fits(n):
-            raise InputError(f"{program}: its {n} points make a page of "
+            raise InputError(f"{what}: its {n} points make a page of "
                              f"{len(pages[n].encode()) / 1e6:.1f} MB even with the arm at one "
                              f"point, more than {MAX_PAGE_BYTES / 1e6:g} MB; view it in parts")
         # the page grows by about the same number of bytes per step of the slider
@@ -170,5 +201,4 @@ def write_program_view(cell: Cell, program: str | Path, path: str | Path,
             every -= 1
         while not fits(every):
             every += 1
-    atomic_write(path, pages[every])
-    return ProgramView(Path(path), report, every, len(pages[every].encode()))
+    return every, pages[every]

@@ -12,7 +12,8 @@ written into the cell).
 identification engine); ``cellcal.positioner_touches`` gives its input. Each records its touch
 file, options and error sources, so that the next calibration carries its uncertainty
 (:mod:`.chain`) and ``cellcal.calibrate_cell`` re-estimates the whole cell in one fit
-(:mod:`.whole`).
+(:mod:`.whole`; a cell of several robots robot by robot, with the placements between them:
+:mod:`.wholerobots`).
 Each procedure is one module of :mod:`.procedures` and one :class:`Procedure` in the registry
 (:mod:`.registry`: :func:`procedure`, :func:`having`, :func:`register`), from which the command
 line, the simulation, the planner, the whole-cell fit, the reports and the views take it.
@@ -45,7 +46,8 @@ from robotcell.cell.calibrate.touches import (
     robot_in_world,
     track_positions,
 )
-from robotcell.cell.calibrate.whole import CellRecalibration, ItemChange, calibrate_cell
+from robotcell.cell.calibrate.whole import CellRecalibration, ItemChange
+from robotcell.cell.calibrate.wholerobots import calibrate_cell
 
 __all__ = ["NOMINAL_ACCURACY", "PROCEDURES", "SAME_POSE", "CalibrationContext", "CellCalibration",
            "CellRecalibration", "ItemChange", "NominalAccuracy", "Planner", "Procedure",

@@ -11,21 +11,26 @@ writes the other robot's base into the cell through :meth:`robotcell.cell.Cell.s
 from __future__ import annotations
 
 from collections.abc import Callable
+import os
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.robottorobot_tables import RobotTable, robot_to_robot_tables
 from robotcell.calibration.uncertainty import factor_of
+from robotcell.cell.calibrate.common import sha256_of
+from robotcell.cell.calibrate.whole import fitted_note
 from robotcell.cell.model import Cell
 from robotcell.cell.parts import Provenance
 from robotcell.errors import InputError
 from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import invert
 
-__all__ = ["RobotTouchFile", "calibrate_robot_to_robot", "place_robot", "robot_table"]
+__all__ = ["RobotTouchFile", "calibrate_robot_to_robot", "link_options", "place_robot",
+           "repeat_link", "robot_table"]
 
 
 @dataclass(frozen=True)
@@ -103,13 +108,17 @@ def calibrate_robot_to_robot(cell: Cell, reference: RobotTouchFile, other: Robot
 
 
 def place_robot(cell: Cell, result: CalibrationResult, reference: RobotTouchFile,
-                other: RobotTouchFile, time: str | None = None) -> Cell:
+                other: RobotTouchFile, time: str | None = None, *,
+                tool_sigma: float | None = None, note: str = "") -> Cell:
     """``cell`` with ``other.robot``'s base placed from a robot-to-robot result.
 
     The pose at the other robot's track position is taken back to its track position 0 (the
     carriage's travel along the track, which does not depend on the base being placed); its
     1-sigma (``result.estimates["T_ref_other"]``, in the reference base) is recorded as the
-    base's error source, named by the calibration and its file.
+    base's error source, named by the calibration and its file. The provenance records what
+    ``calibrate cell`` needs to repeat it (:func:`link_options`): both touch files with their
+    checksums, the robots, tools and track positions, the touch accuracy, ``tool_sigma`` (m;
+    None: the assumed figure) and the method. ``note`` replaces the note written.
     """
     T_world_R = (cell.for_robot(reference.robot).frame_pose("robot", track=reference.track)
                  @ np.asarray(result.values["T_ref_other"], dtype=float))
@@ -124,10 +133,97 @@ def place_robot(cell: Cell, result: CalibrationResult, reference: RobotTouchFile
     sources = {} if est is None else {ident: factor_of(est.covariance)}
     provenance = Provenance(
         "robot-to-robot", time=stamp, rms_mm=result.rms * 1e3, id=ident,
-        note=(f"{len(result.residuals)} touches from {Path(reference.path).name} and "
-              f"{Path(other.path).name}; base in robot {reference.robot!r}"),
-        measurements=str(Path(other.path).resolve()), inputs=(f"robots.{reference.robot}",),
-        sources=sources)
+        note=note or (f"{len(result.residuals)} touches from {Path(reference.path).name} and "
+                      f"{Path(other.path).name}; base in robot {reference.robot!r}"),
+        measurements=str(Path(other.path).resolve()), sha256=sha256_of(other.path),
+        options=link_options(result, reference, other, tool_sigma),
+        inputs=(f"robots.{reference.robot}",), sources=sources)
     out = replace(cell)
     out.set_robot_base(other.robot, T_world_R, provenance)
     return out
+
+
+def link_options(result: CalibrationResult, reference: RobotTouchFile, other: RobotTouchFile,
+                 tool_sigma: float | None) -> dict[str, Any]:
+    """The options a robot-to-robot placement records, in the units of the command line.
+
+    ``reference`` (the reference robot), ``reference_file`` (its touch file, relative to the
+    folder of the other robot's file, the provenance's ``measurements``), ``reference_sha256``,
+    ``tool_ref`` and ``tool_other``, ``track_ref_mm`` and ``track_other_mm``, ``sigma_mm``,
+    ``tool_sigma_mm`` (when given) and ``method``.
+    """
+    ref_file = os.path.relpath(Path(reference.path).resolve(), Path(other.path).resolve().parent)
+    out: dict[str, Any] = {
+        "reference": reference.robot, "reference_file": ref_file,
+        "reference_sha256": sha256_of(reference.path), "tool_ref": reference.tool,
+        "tool_other": other.tool, "track_ref_mm": float(reference.track * 1e3),
+        "track_other_mm": float(other.track * 1e3), "sigma_mm": float(result.touch_sigma * 1e3),
+        "method": str(result.json_fields.get("method", "common points"))}
+    if tool_sigma is not None:
+        out["tool_sigma_mm"] = float(tool_sigma * 1e3)
+    return out
+
+
+@dataclass(frozen=True)
+class RecordedLink:
+    """A robot-to-robot placement as a cell records it, ready to be repeated.
+
+    Attributes
+    ----------
+    reference, other : RobotTouchFile
+        The two robots' touches (``other.robot`` is the robot placed).
+    provenance : Provenance
+        The provenance of the placed base.
+    """
+
+    reference: RobotTouchFile
+    other: RobotTouchFile
+    provenance: Provenance
+
+    @classmethod
+    def of(cls, robot: str, prov: Provenance) -> RecordedLink | None:
+        """The link that placed ``robot`` (its base's provenance ``prov``); None when the
+        provenance does not record what repeating needs (a placement written before it did)."""
+        o = prov.options
+        if prov.measurements is None or "reference_file" not in o:
+            return None
+        ref_path = Path(prov.measurements).parent / str(o["reference_file"])
+        return cls(RobotTouchFile(str(o["reference"]), str(ref_path), str(o["tool_ref"]),
+                                  float(o.get("track_ref_mm", 0.0)) * 1e-3),
+                   RobotTouchFile(robot, prov.measurements, str(o["tool_other"]),
+                                  float(o.get("track_other_mm", 0.0)) * 1e-3), prov)
+
+    def problems(self) -> list[str]:
+        """Its touch files that are missing or changed since the placement (none: repeatable)."""
+        o = self.provenance.options
+        out = []
+        for path, digest in ((self.reference.path, o.get("reference_sha256")),
+                             (self.other.path, self.provenance.sha256)):
+            if not Path(path).is_file():
+                out.append(f"robots.{self.other.robot}.base: touch file {path} is missing")
+            elif digest is not None and sha256_of(path) != digest:
+                out.append(f"robots.{self.other.robot}.base: touch file {path} has changed since "
+                           "the calibration (checksum differs)")
+        return out
+
+
+def repeat_link(cell: Cell, link: RecordedLink, time: str | None = None
+                ) -> tuple[Cell, CalibrationResult]:
+    """Repeat a recorded robot-to-robot calibration on ``cell`` as it stands (its tools and
+    the reference robot's base as they are now) and place the robot again.
+
+    Returns
+    -------
+    cell : Cell
+        A new cell with the robot placed again; its base's provenance keeps the files and
+        options, with the new time, RMS and error source.
+    result : CalibrationResult
+    """
+    o = link.provenance.options
+    tool_sigma = o["tool_sigma_mm"] * 1e-3 if "tool_sigma_mm" in o else None
+    result = calibrate_robot_to_robot(
+        cell, link.reference, link.other, sigma=float(o["sigma_mm"]) * 1e-3,
+        tool_sigma=tool_sigma, method=str(o.get("method", "common points")))
+    placed = place_robot(cell, result, link.reference, link.other, time, tool_sigma=tool_sigma,
+                         note=fitted_note(link.provenance.note))
+    return placed, result

@@ -1,7 +1,7 @@
 """The whole cell in one fit: every calibrated item re-estimated from all the touches behind it.
 
 Each calibration of a cell records its touch file (with its checksum), its options and the items it
-used (:class:`~robotcell.cell.Provenance`). :func:`calibrate_cell` repeats every recorded
+used (:class:`~robotcell.cell.Provenance`). :func:`calibrate_one_robot` repeats every recorded
 calibration on the cell as it stands and combines them into one maximum-likelihood fit of all the
 items at once: a tool is then estimated from its own touches *and* from the turntable, track and
 frame touches taken with it, and every item measured with it follows it.
@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -54,7 +54,7 @@ from robotcell.errors import InputError, term
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 from robotcell.io.tables import format_table
 
-__all__ = ["CellRecalibration", "ItemChange", "calibrate_cell", "touch_files"]
+__all__ = ["CellRecalibration", "ItemChange", "calibrate_one_robot", "touch_files"]
 
 #: Gauss-Newton steps at most, and the step (in units of each parameter's 1-sigma) below which
 #: the fit has converged.
@@ -85,6 +85,9 @@ class ItemChange:
         1-sigma of ``after`` in the same parameters (the whole-cell fit's).
     sigma_before : ndarray, shape (6,) or (7,)
         1-sigma of ``before`` as the cell recorded it (its sequential calibration).
+    robot : str or None
+        In a cell of several robots, the robot whose calibration the item is (its tool or track,
+        a shared item it touched, a base it placed); None in a one-robot cell.
     """
 
     key: str
@@ -93,6 +96,7 @@ class ItemChange:
     change: NDArray[np.float64]
     sigma: NDArray[np.float64]
     sigma_before: NDArray[np.float64]
+    robot: str | None = None
 
     @property
     def change_sigmas(self) -> NDArray[np.float64]:
@@ -103,7 +107,7 @@ class ItemChange:
 
 @dataclass(frozen=True)
 class CellRecalibration:
-    """Outcome of :func:`calibrate_cell`.
+    """Outcome of :func:`robotcell.cell.calibrate.calibrate_cell`.
 
     Attributes
     ----------
@@ -121,6 +125,9 @@ class CellRecalibration:
         Gauss-Newton steps taken.
     notes : tuple of str
         Items taken at their recorded or nominal accuracy.
+    relative : dict of str to str
+        The frame each item's 1-sigma is relative to, where the cell does not say it by the
+        item's key (the items of a cell of several robots, labelled by their robot).
     """
 
     cell: Cell
@@ -130,6 +137,7 @@ class CellRecalibration:
     covariance: NDArray[np.float64]
     iterations: int
     notes: tuple[str, ...] = ()
+    relative: dict[str, str] = field(default_factory=dict)
 
     @property
     def verdict(self) -> Verdict:
@@ -143,6 +151,8 @@ class CellRecalibration:
         """The frame the 1-sigma of item ``key`` is relative to: its parent (``F`` the flange for
         a tool, ``L`` for the track, ``B`` or ``P`` for a frame on the turntable or positioner,
         ``R`` for the robot base, ``world``)."""
+        if key in self.relative:
+            return self.relative[key]
         if key.startswith("tools."):
             return "F"
         if key == "track":
@@ -166,6 +176,8 @@ class CellRecalibration:
                      "sigma_before_mm_deg": c.sigma_before * to_mm,
                      "change_sigmas": c.change_sigmas,
                      "sigma_relative_to": self.relative_to(c.key)}
+            if c.robot is not None:
+                entry["robot"] = c.robot
             items.append(entry)
         v = self.verdict
         return to_jsonable({"procedure": "cell", "iterations": self.iterations, "items": items,
@@ -186,6 +198,10 @@ class CellRecalibration:
                          float(np.linalg.norm(c.sigma_before[:3]) * 1e3)])
         n = len(self.steps)
         fitted = "1 calibration fitted" if n == 1 else f"{n} calibrations fitted together"
+        robots = list(dict.fromkeys(c.robot for c in self.changes if c.robot is not None))
+        if robots:
+            fitted = (f"{n} calibration(s) of {len(robots)} robot(s) ({', '.join(robots)}), "
+                      "fitted robot by robot, placements repeated")
         lines = [f"calibration: the whole cell, {fitted} ({self.iterations} iterations)", "",
                  ("changes (|position| mm, |rotation| deg; largest change in 1-sigma; 1-sigma "
                   "before):"),
@@ -207,36 +223,42 @@ class CellRecalibration:
         return "\n".join(lines)
 
 
-def _calibrated(cell: Cell) -> list[tuple[str, Provenance]]:
-    """Items whose provenance records a touch file of a procedure :func:`calibrate_cell`
-    repeats, with that provenance."""
+def _calibrated(cell: Cell, owned: Callable[[str], bool] | None = None
+                ) -> list[tuple[str, Provenance]]:
+    """Items whose provenance records a touch file of a procedure :func:`calibrate_one_robot`
+    repeats, with that provenance (of those ``owned(key)`` accepts, when given)."""
     items: list[tuple[str, Any]] = [(f"tools.{n}", t) for n, t in cell.tools.items()]
     items += [(f"frames.{n}", f) for n, f in cell.frames.items()]
     items += [("track", cell.track), ("turntable", cell.turntable)]
     return [(key, owner.provenance) for key, owner in items
             if owner is not None and owner.provenance.measurements is not None
-            and owner.provenance.source in _PROCEDURES]
+            and owner.provenance.source in _PROCEDURES and (owned is None or owned(key))]
 
 
-def touch_files(cell: Cell) -> list[tuple[str, Path]]:
-    """The touch files :func:`calibrate_cell` reads: those the cell's calibrations recorded.
+def touch_files(cell: Cell, owned: Callable[[str], bool] | None = None
+                ) -> list[tuple[str, Path]]:
+    """The touch files :func:`calibrate_one_robot` reads: those the cell's calibrations recorded.
 
     Parameters
     ----------
     cell : Cell
+        A cell of one robot (or one robot's view of a cell of several).
+    owned : callable, optional
+        ``owned(key)``: whether the item is refitted (see :func:`calibrate_one_robot`).
 
     Returns
     -------
     list of (str, Path)
         Item (``tools.torch``, ``track``, ...) and its touch file, in the order of the cell.
     """
-    return [(key, Path(prov.measurements)) for key, prov in _calibrated(cell)]
+    return [(key, Path(prov.measurements)) for key, prov in _calibrated(cell, owned)]
 
 
-def _recorded(cell: Cell, label: str) -> list[tuple[str, Provenance]]:
+def _recorded(cell: Cell, label: str, owned: Callable[[str], bool] | None
+              ) -> list[tuple[str, Provenance]]:
     """Items with a recorded touch file, refusing missing or changed files (all named)."""
     out, problems = [], []
-    for key, prov in _calibrated(cell):
+    for key, prov in _calibrated(cell, owned):
         path = Path(prov.measurements)
         if not path.is_file():
             problems.append(f"{key}: touch file {path} is missing")
@@ -318,6 +340,21 @@ def _moved(cell: Cell, key: str, d: NDArray[np.float64], prov: Provenance) -> No
         cell.update_turntable(prov, T_parent_B=perturbed(cell.turntable.T_parent_B, d))
 
 
+def item_difference(T: NDArray[np.float64], T0: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The 6 parameters of pose ``T`` relative to ``T0``: origin (m) and rotation vector (rad,
+    about the parent's axes), as an item's change."""
+    return _difference(T, 1.0, T0, 1.0, 6)
+
+
+def rebased(change: ItemChange, first: ItemChange) -> ItemChange:
+    """``change``, made by a second fit of an item, taken relative to the values before the
+    first fit (``first``), with the 1-sigma they had."""
+    size = len(change.change)
+    scale = 1.0 + first.change[6] + change.change[6] if size == 7 else 1.0
+    delta = _difference(change.after, scale, first.before, 1.0, size)
+    return replace(change, before=first.before, change=delta, sigma_before=first.sigma_before)
+
+
 class _System:
     """The normal equations of all calibrations over the estimated items and the kept ones."""
 
@@ -373,16 +410,20 @@ class _System:
                                   for k, f in factors.items()})
 
 
-def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
-                   nominal: NominalAccuracy = NOMINAL_ACCURACY, time: str | None = None,
-                   on_note: Callable[[str], None] | None = None) -> CellRecalibration:
-    """Re-estimate every calibrated item of a cell from all the touch files its calibrations used.
+def calibrate_one_robot(cell: Cell, *, cell_label: str | None = None,
+                        nominal: NominalAccuracy = NOMINAL_ACCURACY, time: str | None = None,
+                        on_note: Callable[[str], None] | None = None,
+                        owned: Callable[[str], bool] | None = None) -> CellRecalibration:
+    """Re-estimate every calibrated item of a one-robot cell from all the touch files its
+    calibrations used (:func:`robotcell.cell.calibrate.calibrate_cell` calls it, once per robot
+    in a cell of several).
 
     Parameters
     ----------
     cell : Cell
-        A cell whose items carry the provenance of calibrations into it (touch file, checksum,
-        options: what ``calibrate ... --cell`` records).
+        A cell of one robot (or one robot's view, :meth:`~robotcell.cell.Cell.for_robot`) whose
+        items carry the provenance of calibrations into it (touch file, checksum, options: what
+        ``calibrate ... --cell`` records).
     cell_label : str, optional
         Name of the cell in messages (its file).
     nominal : NominalAccuracy
@@ -391,6 +432,9 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
         ISO 8601 time of the new provenance; default now.
     on_note : callable, optional
         Receives each note as it arises.
+    owned : callable, optional
+        ``owned(key)``: whether the item is refitted here (in a robot's view of a cell of
+        several robots: its own items and the shared ones it calibrated); default every item.
 
     Returns
     -------
@@ -403,7 +447,7 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
         calibration with its file.
     """
     label = cell_label or f"cell {cell.name!r}"
-    recorded = _recorded(cell, label)
+    recorded = _recorded(cell, label, owned)
     notes: list[str] = []
 
     def note(text: str) -> None:
@@ -449,7 +493,8 @@ def calibrate_cell(cell: Cell, *, cell_label: str | None = None,
         T0, scale0 = original[key]
         delta = _difference(T, scale, T0, scale0, _size(key))
         _moved(new, key, delta, replace(prov, time=stamp, sources=item.factors,
-                                        rms_mm=run.result.rms * 1e3, note=_fitted(prov.note)))
+                                        rms_mm=run.result.rms * 1e3,
+                                        note=fitted_note(prov.note)))
         changes.append(ItemChange(key, T0, T, delta, item.sigma, prior[key].sigma))
     return CellRecalibration(new, tuple(changes), tuple(runs), tuple(estimated),
                              sources.covariance, it, tuple(notes))
@@ -463,7 +508,7 @@ RANK_TOL = 1e-5
 FITTED = "; fitted with the whole cell"
 
 
-def _fitted(note: str) -> str:
+def fitted_note(note: str) -> str:
     """The note of an item after a whole-cell fit: said once, however often the cell is fitted."""
     return note if note.endswith(FITTED) else note + FITTED
 

@@ -4,7 +4,8 @@
 - Export (:mod:`.export`): a pendant listing of ``TOOL[n]`` and ``UFRAME[n]`` in the base
   coordinates, at the robot base at base-axis 0; frames on the turntable at station axis 0, and
   the table's root as one more user frame.
-- Programs (:mod:`.program`): jobs ``NAME.jbi``.
+- Programs (:mod:`.program`): jobs ``NAME.jbi``; coordinated jobs of two robots and a station
+  (:mod:`.multigroup`): one job, ``///GROUP1 RB1,ST1`` and ``///GROUP2 RB2``.
 - Flags: ``RCONF l,m,n,o,p,q``: flip, lower arm, rear, and R, T, S at 180 deg or more (24
   values written, the rest 0); one ``RCONF`` holds for the points after it.
 - Slots: tool and user frame numbers 0..23 (NX100 job format); job names of at most 8
@@ -29,6 +30,7 @@ from robotcell.controllers.base import Controller, SlotRange
 from robotcell.controllers.data import ControllerData
 from robotcell.controllers.model import Config, Program, Ref
 from robotcell.controllers.yaskawa import export as listing
+from robotcell.controllers.yaskawa import multigroup
 from robotcell.controllers.yaskawa import program as inform
 from robotcell.errors import InputError
 from robotcell.ik.config import arm_sides
@@ -59,11 +61,8 @@ class Yaskawa(Controller):
     frame_slots = SlotRange("UFRAME", 0, 23)
     config_fields = ("l", "m", "n", "o", "p", "q")
     shared_config = True
-    coordinated_missing = (
-        "the sources robotcell cites show jobs of one robot with a base axis and a station "
-        "(///GROUP1 RB1,BS1, ///GROUP2 ST1, +MOVJ EC...), but no public manual page or real "
-        "job of two robots in one job (R1 + R2: its ///GROUP lines and how the points of "
-        "each robot are numbered in //POS)")
+    coordinated_missing = None  # two robots and a station: controllers.yaskawa.multigroup
+    coordinated_one_file = True
     sources = (
         "Roboception documentation, 'Pose formats: Yaskawa' (Rx, Ry, Rz)",
         ("Motoman NX100 manual HW0481924, 4.1 'Job Data Format': //NAME up to 8 characters, "
@@ -75,6 +74,10 @@ class Yaskawa(Controller):
         ("RoboDK Motoman post 2015-2023 (TetraGenAdmin/TGRoboDKPostProcessors, Motoman.py): "
          "'MOVL C00008 BC00008 V=166.7 +MOVJ EC00008 VJ=100.00', pulses per degree per "
          "external axis"),
+        ("rpiRobotics/dx200_motion_progam_exec, example_inform/R1-R2-S1.JBI and R1-R2-S1-2.JBI "
+         "(c81cb4fb9b8255e8fbfdde596ccabdaa9672d22a): jobs a DX200 saved for two robots and a "
+         "station: ///GROUP1 RB1,ST1, ///GROUP2 RB2, 'MOVL C00004 EC00002 V=11.0  +MOVL C00005 "
+         "V=11.0', ///TOOL before each robot's C position"),
         ("jobs written for DX100 and later (e.g. '////FRAME USER 1', '///GROUP1 RB1' with "
          "'///GROUP2 ST1', '///RCONF 1,0,...' of 24 values): docs/programs.md"),
     )
@@ -90,6 +93,27 @@ class Yaskawa(Controller):
 
     def read_program(self, path: str | Path) -> tuple[Program, list[str]]:
         return inform.read(path)
+
+    def coordinated_robots(self, cell: Cell, robots: list[str]) -> None:
+        multigroup.check_robots(len(robots), [r for r in robots
+                                              if cell.for_robot(r).track is not None])
+
+    def write_coordinated(self, programs: list[Program], header: list[str]) -> dict[str, str]:
+        return multigroup.write_job(programs, header)
+
+    def read_coordinated(self, paths: list[str | Path], n: int
+                         ) -> list[tuple[Program, list[str]]]:
+        """The robots of group 1 and group 2 of the one job (:func:`.program.read`)."""
+        if len(paths) != 1:
+            raise InputError(f"a YASKAWA coordinated program is one job for all robots; got "
+                             f"{len(paths)} files")
+        if n != multigroup.ROBOTS:
+            raise InputError(f"a YASKAWA coordinated job holds two robots, group 1's and group "
+                             f"2's; got {n}: name the two robots, group 1's first")
+        return inform.read_groups(paths[0])
+
+    def coordinated_problems(self, paths: list[str | Path]) -> list[str]:
+        return [p for path in paths for p in multigroup.group_problems(path)]
 
     def point_names(self, n: int) -> list[str]:
         return [f"C{i:05d}" for i in range(n)]

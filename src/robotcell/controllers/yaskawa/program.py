@@ -39,7 +39,8 @@ from robotcell.controllers.text import Lines, fmt_num
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor, pose_to_vendor
 
-__all__ = ["config_text", "read", "set_pose", "write"]
+__all__ = ["config_text", "motion_parts", "move_text", "position_text", "rconf_text", "read",
+           "read_groups", "set_pose", "write", "zone_text"]
 
 #: Decimals written: mm, deg.
 MM_PLACES, DEG_PLACES = 3, 4
@@ -55,9 +56,34 @@ def config_text(values: tuple[int, ...]) -> str:
     return ",".join(str(x) for x in values)
 
 
-def _pl(zone: float) -> str:
+def zone_text(zone: float) -> str:
+    """`` PL=k`` of a corner distance (m; PL 1..8 by its mm), empty for an exact stop."""
     mm = zone * 1e3
     return "" if mm <= 0 else f" PL={min(8, max(1, round(mm)))}"
+
+
+def rconf_text(point: ProgramPoint) -> str:
+    """The ``///RCONF`` values of a Cartesian point: its flags and the unused zeros (24 in
+    all)."""
+    assert point.config is not None
+    values = point.config.values
+    return config_text(values) + ",0" * (RCONF_VALUES - len(values))
+
+
+def position_text(point: ProgramPoint) -> str:
+    """``X,Y,Z,Rx,Ry,Rz`` of a Cartesian point (mm with 3 decimals, deg with 4), the values of
+    its ``Cxxxxx=`` line."""
+    assert point.pose is not None
+    v = pose_to_vendor(point.pose, "yaskawa")
+    return ",".join(fmt_num(x, MM_PLACES if k < 3 else DEG_PLACES) for k, x in enumerate(v))
+
+
+def move_text(point: ProgramPoint, axes: str) -> str:
+    """``MOVJ axes VJ=20.00`` or ``MOVL axes V=100.0`` of a point (``axes``: its positions,
+    ``C00000 BC00000``), without a zone."""
+    if point.motion == "ptp":
+        return f"MOVJ {axes} VJ={PTP_SPEED * 100:.2f}"
+    return f"MOVL {axes} V={(point.speed or 0.1) * 1e3:.1f}"
 
 
 def write(program: Program, header: list[str]) -> dict[str, str]:
@@ -89,14 +115,11 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
             f"///POSTYPE {'USER' if user else 'BASE'}", "///RECTAN"]
     rconf = None
     for i, p in enumerate(pts):
-        assert p.pose is not None and p.config is not None
-        text = config_text(p.config.values) + ",0" * (RCONF_VALUES - len(p.config.values))
+        text = rconf_text(p)
         if text != rconf:
             pos.append(f"///RCONF {text}")
             rconf = text
-        v = pose_to_vendor(p.pose, "yaskawa")
-        pos.append(f"C{i:05d}=" + ",".join(fmt_num(x, MM_PLACES if k < 3 else DEG_PLACES)
-                                            for k, x in enumerate(v)))
+        pos.append(f"C{i:05d}={position_text(p)}")
     pos += [f"BC{i:05d}={fmt_num(b, MM_PLACES)}" for i, b in enumerate(base)]
     if station:
         pos += ["///POSTYPE PULSE", "///PULSE"]
@@ -109,11 +132,7 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
     inst += [f"'{part}" for h in header for part in textwrap.wrap(h, COMMENT_CHARS)]
     for i, p in enumerate(pts):
         axes = f"C{i:05d}" + (f" BC{i:05d}" if base else "")
-        zone = _pl(p.zone or 0.0)
-        if p.motion == "ptp":
-            move = f"MOVJ {axes} VJ={PTP_SPEED * 100:.2f}{zone}"
-        else:
-            move = f"MOVL {axes} V={(p.speed or 0.1) * 1e3:.1f}{zone}"
+        move = move_text(p, axes) + zone_text(p.zone or 0.0)
         inst.append(move + (f" +MOVJ EC{i:05d} VJ={PTP_SPEED * 100:.2f}" if station else ""))
     inst.append("END")
     return {f"{program.name}.jbi": "\n".join(pos + inst) + "\n"}
@@ -132,6 +151,38 @@ _SETE_RE = re.compile(r"^\s*SETE\s+(L?P\d+)\s*\(\s*(\d+)\s*\)\s*(\S+)", re.IGNOR
 _MFRAME_RE = re.compile(r"^\s*MFRAME\s+UF#\(\s*(\d+)\s*\)", re.IGNORECASE)
 #: Characters that end a line without being part of it (whitespace, the Ctrl-Z end of file).
 _BLANK = " \t\r\n\x1a\x00"
+#: Where a motion of another group starts on a motion line (``MOVJ C00000 EC00000 VJ=10.00
+#: +MOVJ C00001 VJ=10.00``: a job of two robots and a station saved by a DX200).
+_PARTNER_SPLIT = re.compile(r"\s+\+(?=(?:MOVJ|MOVL|MOVC|MOVS)\b)", re.IGNORECASE)
+#: A robot's position in a motion: a ``C`` position or a position variable.
+ROBOT_POSITION = re.compile(r"\b(C\d+|L?P\d+)\b", re.IGNORECASE)
+
+
+def motion_parts(text: str) -> list[tuple[str, str]] | None:
+    """The motions of one line of a job: group 1's, then each ``+MOVx`` of another group on
+    the same line.
+
+    Parameters
+    ----------
+    text : str
+        A line of the ``//INST`` section.
+
+    Returns
+    -------
+    list of (str, str) or None
+        ``(instruction, rest)`` per motion, the instruction in capitals
+        (``[("MOVL", "C00004 EC00002 V=11.0"), ("MOVL", "C00005 V=11.0")]``); None for a
+        line that is no motion.
+    """
+    m = _MOVE_RE.match(text)
+    if not m:
+        return None
+    first, *others = _PARTNER_SPLIT.split(m.group(2))
+    parts = [(m.group(1).upper(), first.strip())]
+    for other in others:
+        instr, _, rest = other.partition(" ")
+        parts.append((instr.upper(), rest.strip()))
+    return parts
 
 
 class _Position:
@@ -178,7 +229,10 @@ def _pos_section(lines: Lines, start: int, end: int) -> dict[str, _Position]:
 
 
 def read(path: str | Path) -> tuple[Program, list[str]]:
-    """Read a YASKAWA ``.jbi`` job.
+    """Read a YASKAWA ``.jbi`` job: the points of the robot of group 1 (the motion that starts
+    each line), with the station's values of the line (``EC``); a job of two robots' second
+    robot (group 2, the ``+MOVJ``/``+MOVL`` with a robot position on the same line) is named
+    as not checked (:func:`read_groups` reads both).
 
     Parameters
     ----------
@@ -190,7 +244,8 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         Points in the order the job moves to them; ``line`` is the file's line of the motion;
         external axes as ``BC1`` (mm) and ``EC1``.. (pulses).
     skipped : list of str
-        Motions to robot positions in pulses, circular and spline motions.
+        Motions to robot positions in pulses, circular and spline motions; reading group 1,
+        the second robot's motions of a job of two robots.
 
     Raises
     ------
@@ -198,6 +253,11 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         No ``/JOB``, ``//POS``, ``//INST`` or final ``END``, an unreadable position, a motion to a
         position the job does not hold; the message names the file and line.
     """
+    return _read(path, (1,))[0]
+
+
+def _read(path: str | Path, groups: tuple[int, ...]) -> list[tuple[Program, list[str]]]:
+    """The points of each robot group of ``groups`` (1, 2) and what was not checked."""
     lines = Lines(path, "YASKAWA job")
     marks: dict[str, int] = {}
     sections: list[int] = []  # the lines of every '//' section header: //POS, //ARGINFO, //INST
@@ -218,24 +278,51 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
                  if t.strip().upper().startswith("//NAME") and len(t.split()) > 1),
                 Path(path).stem)
     pos_end = min((n for n in sections if n > marks["//POS"]), default=marks["//INST"])
-    job = _Job(lines, _pos_section(lines, marks["//POS"] + 1, pos_end))
-    for lineno in range(marks["//INST"] + 1, last):
-        job.instruction(lines.lines[lineno - 1].strip(), lineno)
-    job.convert()
-    return Program(name, "yaskawa", job.points, (str(path),)), job.skipped
+    positions = _pos_section(lines, marks["//POS"] + 1, pos_end)
+    out = []
+    for g in groups:
+        job = _Job(lines, positions, g)
+        for lineno in range(marks["//INST"] + 1, last):
+            job.instruction(lines.lines[lineno - 1].strip(), lineno)
+        job.convert()
+        notes = job.skipped + (job.partners if len(groups) == 1 else [])
+        out.append((Program(name, "yaskawa", job.points, (str(path),)), notes))
+    return out
+
+
+def read_groups(path: str | Path) -> list[tuple[Program, list[str]]]:
+    """Read a YASKAWA job of two robots: the points of group 1's robot and of group 2's.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    list of (Program, list of str)
+        Per group, its robot's points and the motions not turned into points (as :func:`read`;
+        neither names the other robot's points).
+
+    Raises
+    ------
+    InputError
+        As :func:`read`.
+    """
+    return _read(path, (1, 2))
 
 
 class _Job:
     """The instructions of a job in order: the motions and what changes tools and frames."""
 
-    def __init__(self, lines: Lines, positions: dict[str, _Position]) -> None:
-        self.lines, self.positions = lines, positions
+    def __init__(self, lines: Lines, positions: dict[str, _Position], group: int) -> None:
+        self.lines, self.positions, self.group = lines, positions, group
         self.changed: dict[tuple[str, int], str] = {}  # (TOOL|USER, n) -> why, set by the job
         self.tools: dict[int, NDArray[np.float64]] = {}  # tools set by SETTOOL from SETE values
         self.elements: dict[str, dict[int, float] | None] = {}  # SETE constants per variable
         self.points: list[ProgramPoint] = []
         self.values: list[list[float]] = []  # each point's position, converted at the end
         self.skipped: list[str] = []
+        self.partners: list[str] = []  # reading group 1: the second robot's motions
 
     def convert(self) -> None:
         """Every point's pose from its position, converted in one batch."""
@@ -259,8 +346,8 @@ class _Job:
                 "variables")
         elif m := _COORD_MOVE_RE.match(text):
             self.coordinated(m.group(2), lineno)
-        elif m := _MOVE_RE.match(text):
-            self.motion(m.group(1).upper(), m.group(2), lineno)
+        elif parts := motion_parts(text):
+            self.motion_line(parts, lineno)
 
     def settool(self, n: int, var: str, lineno: int) -> None:
         """``SETTOOL TL#(n) Pxxx``: tool n from the position variable, when the job sets its six
@@ -299,7 +386,27 @@ class _Job:
         if self.points and self.points[-1].line == lineno - 1:
             self.points[-1].external.update(self.external(refs))
 
-    def motion(self, instr: str, rest: str, lineno: int) -> None:
+    def motion_line(self, parts: list[tuple[str, str]], lineno: int) -> None:
+        """A motion line (:func:`motion_parts`): group 1's motion, and each ``+MOVx`` of the
+        line: one with a robot position is the second robot's (group 2), one without a
+        station's, whose ``EC`` values join the point of either robot."""
+        (instr, rest), partners = parts[0], parts[1:]
+        robots = [(i, m.group(1), r) for i, r in partners if (m := ROBOT_POSITION.search(r))]
+        station = [ref for i, r in partners if not ROBOT_POSITION.search(r)
+                   for ref in self.refs(r, lineno) if ref[0] == "EC"]
+        if self.group == 1:
+            self.motion(instr, rest, lineno, station)
+            self.partners += [f"line {lineno}: +{i} {name} (the second robot's point, group "
+                              "2: checked with the job as a coordinated program)"
+                              for i, name, _ in robots]
+        elif robots:
+            i, _, r = robots[0]
+            shared = [ref for ref in self.refs(rest, lineno) if ref[0] == "EC"]
+            self.motion(i, r, lineno, shared + station)
+
+    def motion(self, instr: str, rest: str, lineno: int,
+               station: tuple[tuple[str, str], ...] | list[tuple[str, str]] = ()) -> None:
+        """One robot's motion; ``station``: the line's station positions moved with it."""
         lines = self.lines
         if instr in ("MOVC", "MOVS"):
             self.skipped.append(f"line {lineno}: {instr} (circular and spline motions are not "
@@ -338,7 +445,7 @@ class _Job:
         self.points.append(ProgramPoint(
             cname, lineno, motion, Ref(number=c.tool, pose=self.tools.get(c.tool)), frame,
             None, None, config,
-            self.external(refs),
+            self.external(refs + [ref for ref in station if ref not in refs]),
             lines.number(speed.group(1), lineno) * 1e-3 if speed and motion == "lin" else None,
             lines.number(zone.group(1), lineno) * 1e-3 if zone else 0.0, c.where))
 
