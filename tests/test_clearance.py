@@ -195,3 +195,47 @@ def test_program_check_refuses_a_bad_bodies_file_with_one_line(capsys, tmp_path)
     code, out, err = run(capsys, "program", "check", program, "--cell", cell, "--bodies", bad)
     assert code == 2 and err.startswith("error:") and "unknown key(s) ['cone']" in err
     assert "Traceback" not in err and out == ""
+
+
+def _kr16_with_link_radius(tmp_path, value):
+    """The library's KR 16 model file with ``link_radius: value`` (mm), in ``tmp_path``."""
+    text = (Path(__file__).resolve().parents[1] / "src" / "robotcell" / "robots"
+            / "kuka_kr16.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "kr16_radius.yaml"
+    path.write_text(text + f"link_radius: {value}\n", encoding="utf-8")
+    return path
+
+
+def test_the_model_files_link_radius_sizes_the_capsules_unless_the_bodies_file_does(tmp_path):
+    """A model file's ``link_radius`` (mm) is the links' radius; the bodies file's wins; without
+    both, 6 % of the reach (136 mm for the KR 16)."""
+    from robotcell.cell import cell_from_dict
+    from robotcell.robot.models import save_robot
+
+    robot = load_robot(_kr16_with_link_radius(tmp_path, 90))
+    assert robot.link_radius == pytest.approx(0.09)
+    assert LinkModel().radius_of(robot) == pytest.approx(0.09)
+    assert LinkModel(radius=0.05).radius_of(robot) == pytest.approx(0.05)
+    assert LinkModel().radius_of(load_robot("kuka_kr16")) == pytest.approx(0.136, abs=1e-3)
+    save_robot(robot, tmp_path / "again.yaml")
+    assert load_robot(tmp_path / "again.yaml").link_radius == pytest.approx(0.09)
+    # the distance of a ball from the arm is measured from capsules of that radius
+    cell = cell_from_dict({"name": "r", "robot": {"model": str(tmp_path / "kr16_radius.yaml")}})
+    q = np.radians([[0.0, -90, 90, 0, 45, 0]])
+    segs, _ = link_segments(cell.robot, q)
+    centre = np.array([0.9, 0.6, 0.9])
+    body = Body("ball", "sphere", (0.1,), "world", np.eye(4))
+    body.pose[:3, 3] = centre
+    got = clearance(cell, q, bodies=BodiesFile((body,), LinkModel(tool_radius=0.0)))
+    want = min(_segment_distance(centre, s[0], s[1]) for s in segs[0][:-1]) - 0.09 - 0.1
+    assert got.distance[0] == pytest.approx(want, abs=1e-6)
+
+
+@pytest.mark.parametrize("value, match", [
+    ("0", "key 'link_radius' must be a radius above 0 and at most 1000"),
+    ("5000", "key 'link_radius' must be a radius above 0 and at most 1000"),
+    ("thick", "key 'link_radius' must be a number"),
+])
+def test_a_bad_link_radius_is_refused_naming_the_key(tmp_path, value, match):
+    with pytest.raises(InputError, match=match):
+        load_robot(_kr16_with_link_radius(tmp_path, value))

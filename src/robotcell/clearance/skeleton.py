@@ -44,7 +44,8 @@ class LinkModel:
     Parameters
     ----------
     radius : float or None
-        Radius of every link's capsule (m); None: :func:`default_radius` of the arm.
+        Radius of every link's capsule (m); None: the arm's model file's ``link_radius``, else
+        :func:`default_radius` of the arm.
     tool_radius : float
         Radius of the tool's capsule from the flange to the TCP (m).
     """
@@ -59,8 +60,11 @@ class LinkModel:
                                  f"got {value!r}")
 
     def radius_of(self, arm: Arm) -> float:
-        """The links' radius for ``arm`` (m)."""
-        return default_radius(arm) if self.radius is None else float(self.radius)
+        """The links' radius for ``arm`` (m): this model's, else the arm's ``link_radius``,
+        else :func:`default_radius`."""
+        if self.radius is not None:
+            return float(self.radius)
+        return default_radius(arm) if arm.link_radius is None else float(arm.link_radius)
 
 
 def link_segments(arm: Arm, q: ArrayLike, tool: ArrayLike | None = None

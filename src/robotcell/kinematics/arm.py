@@ -122,6 +122,10 @@ class Arm:
         (docs/iso9283.md). None when no public datasheet gives it.
     repeatability_source : str
         Where ``repeatability`` is stated (document and address).
+    link_radius : float or None
+        Radius of the capsules around the arm's links for clearance checks (m), e.g. from the
+        datasheet's drawing; None: :func:`robotcell.clearance.skeleton.default_radius` of the
+        arm's size (docs/clearance.md).
     """
 
     name: str
@@ -140,6 +144,7 @@ class Arm:
     covariance: ParameterCovariance | None = None
     repeatability: float | None = None
     repeatability_source: str = ""
+    link_radius: float | None = None
 
     def __post_init__(self) -> None:
         if self.convention not in ("standard", "modified"):

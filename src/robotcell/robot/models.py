@@ -47,7 +47,7 @@ _ANGLE_DECIMALS = 12
 _ANGLE_KEYS = {"alpha", "theta", "beta"}
 _TOP_KEYS = {"name", "title", "convention", "units", "joints", "base", "flange", "tool", "home",
              "source", "verified", "verification", "coupling", "ik_seed", "covariance",
-             "repeatability"}
+             "repeatability", "link_radius"}
 
 
 def _library_dir():
@@ -121,6 +121,21 @@ def _mapping(value: Any, where: str, allowed: set[str], not_mapping: str,
         if key not in value:
             raise InputError(f"{where}: missing key '{key}'")
     return value
+
+
+#: Largest link radius a model file may give (m): no industrial arm's link is thicker.
+LINK_RADIUS_MAX = 1.0
+
+
+def _link_radius(value: Any, origin: str, ls: float) -> float:
+    """Key ``link_radius``: the radius of the arm's capsules for clearance checks, in the file's
+    length unit; returns metres."""
+    where = f"{origin}: key 'link_radius'"
+    r = _number(value, where) * ls
+    if not 0 < r <= LINK_RADIUS_MAX:
+        raise InputError(f"{where} must be a radius above 0 and at most "
+                         f"{LINK_RADIUS_MAX / ls:g} (the file's length unit), got {value!r}")
+    return r
 
 
 def _repeatability(value: Any, origin: str) -> tuple[float, str]:
@@ -262,6 +277,8 @@ def _robot_options(data: dict, joints: list[Joint], origin: str, ls: float, as_:
     if "repeatability" in data:
         kwargs["repeatability"], kwargs["repeatability_source"] = _repeatability(
             data["repeatability"], origin)
+    if "link_radius" in data:
+        kwargs["link_radius"] = _link_radius(data["link_radius"], origin, ls)
     for key in ("base", "flange", "tool"):
         if key in data:
             kwargs[key] = _pose(data[key], f"{origin}: key '{key}'", ls, as_)
@@ -476,6 +493,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     if robot.repeatability is not None:
         data["repeatability"] = {"mm": _clean(robot.repeatability * 1e3),
                                  "source": robot.repeatability_source}
+    if robot.link_radius is not None:
+        data["link_radius"] = _clean(robot.link_radius * 1e3)
     return data
 
 
