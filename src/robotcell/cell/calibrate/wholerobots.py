@@ -10,7 +10,8 @@ robot's items are fitted together, as in a cell of one robot; every robot-to-rob
 cell records (a base whose provenance is ``robot-to-robot``) is repeated at the fitted tools of
 both robots and the reference robot's fitted base, and the robot placed again
 (:func:`~robotcell.cell.calibrate.robottorobot.repeat_link`); a placed robot whose items rest on
-its base (a table or frame it touched in the world) is fitted again on its new base.
+its base (a table or frame it touched in the world) is fitted again on its new base. The positioner and the base a shared-positioner fit wrote (provenance
+``shared-positioner``) are kept as written, with a note.
 
 What is not adjusted jointly: the robots' fits are separate (one robot's calibrations do not
 move another robot's items), and a link's touches do not refine the tools it used, nor is its
@@ -37,6 +38,7 @@ from robotcell.cell.calibrate.chain import (
 )
 from robotcell.cell.calibrate.common import CellCalibration
 from robotcell.cell.calibrate.robottorobot import RecordedLink, repeat_link
+from robotcell.cell.calibrate.sharedpositioner import SOURCE as SHARED_POSITIONER
 from robotcell.cell.calibrate.whole import (
     CellRecalibration,
     ItemChange,
@@ -142,6 +144,23 @@ def _links(cell: Cell, label: str, notes: list[str]) -> dict[str, RecordedLink]:
     return out
 
 
+def _kept_shared(cell: Cell) -> list[str]:
+    """Notes on the items a shared-positioner fit wrote (:func:`~robotcell.cell.calibrate.
+    sharedpositioner.place_shared_positioner`), which the whole-cell fit keeps as they are."""
+    pos = cell.turntable
+    kept = ([f"positioner {pos.name!r}"] if pos is not None
+            and pos.provenance.source == SHARED_POSITIONER else [])
+    for name, unit in cell.robots.items():
+        prov = unit.base_provenance if unit.track is None else unit.track.provenance
+        if prov.source == SHARED_POSITIONER:
+            kept.append(f"the base of robot {name!r}")
+    if not kept:
+        return []
+    return [f"note: {' and '.join(kept)} come from the fit of all touches of calibrate "
+            "shared-positioner, which calibrate cell does not repeat: kept as written "
+            "(calibrate shared-positioner --update-cell again to refit them)"]
+
+
 def _order(names: tuple[str, ...], links: dict[str, RecordedLink]) -> list[str]:
     """The robots, each after the robot its base is placed in (where there is no cycle)."""
     order: list[str] = []
@@ -239,7 +258,7 @@ def calibrate_cell(cell: Cell, *, robot: str | None = None, cell_label: str | No
                          + (f" for robot {robot!r}" if robot is not None else "")
                          + f": calibrate its items {term('cell:into', 'into the cell')} first "
                          "(each calibration then records its file)")
-    for text in [*notes, NOT_JOINT]:
+    for text in [*notes, *_kept_shared(cell), NOT_JOINT]:
         fit.note(text)
     return fit.combined()
 
