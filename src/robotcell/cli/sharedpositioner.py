@@ -148,8 +148,8 @@ def calibrate_shared_positioner(reference: str, other: str, as_json: bool, accep
 
         def change(cell: Cell) -> tuple[Cell, SharedPositioner]:
             d = calibrated(cell)
-            return place_shared_positioner(cell, d, common, plate,
-                                           tool_sigma=given.tool_sigma_m), d
+            return place_shared_positioner(cell, d, common, plate, tool_sigma=given.tool_sigma_m,
+                                           accept_poor=accept_poor), d
 
         written = update_cell_file(given.cell_path, change, on_note=echo_note)
         done = written.value

@@ -231,7 +231,7 @@ def _chain_in_world(cell: Cell, done: SharedPositioner, reference: RobotTouchFil
 def place_shared_positioner(cell: Cell, done: SharedPositioner,
                             common: tuple[RobotTouchFile, RobotTouchFile],
                             plate: tuple[str, str], *, tool_sigma: float | None = None,
-                            time: str | None = None) -> Cell:
+                            time: str | None = None, accept_poor: bool = False) -> Cell:
     """``cell`` with the joint fit of :func:`shared_positioner` written into it (a new cell).
 
     The positioner's chain moves onto the fitted axis lines (root and axes in the world, through
@@ -259,11 +259,26 @@ def place_shared_positioner(cell: Cell, done: SharedPositioner,
         The tools' accuracy the fit was given (m); None: the assumed figure.
     time : str, optional
         ISO 8601 time of the provenance; default now.
+    accept_poor : bool
+        Write a fit whose two calibrations disagree or whose verdict is poor.
 
     Returns
     -------
     Cell
+
+    Raises
+    ------
+    InputError
+        The two calibrations disagree or the verdict is poor (without ``accept_poor``), or a
+        touch file cannot be read; ``cell`` is left as it was.
     """
+    if not accept_poor and not done.agreement.agree:
+        raise InputError(f"{done.agreement.message}; nothing written (accept_poor=True writes "
+                         "the fit anyway)")
+    if not accept_poor and done.joint.verdict.level == "poor":
+        raise InputError(f"poor calibration, nothing written: "
+                         f"{'; '.join(done.joint.verdict.reasons)} (accept_poor=True writes "
+                         "the fit anyway)")
     ref, oth = common
     stamp = time or Provenance.now(SOURCE).time
     sha = sha256_of(plate[0])
