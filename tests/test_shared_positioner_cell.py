@@ -14,6 +14,7 @@ from cli_helpers import run
 from scipy.spatial.transform import Rotation
 
 from robotcell.cell import Cell
+from robotcell.cell.calibrate import calibrate_cell
 from robotcell.cell.calibrate.common import sha256_of
 from robotcell.cell.calibrate.robottorobot import RobotTouchFile
 from robotcell.cell.calibrate.sharedpositioner import (
@@ -140,6 +141,7 @@ def test_the_provenance_records_the_files_checksums_options_and_sigma_parts(cell
         parts = o["sigma_parts"]
         assert set(parts) == {"T_ref_B", "axis_offset", "axis_angle", "T_ref_other"}
         assert set(parts["T_ref_B"]) >= {"own", "recorded"}
+        assert parts["T_ref_B"]["relative_to"] == parts["T_ref_other"]["relative_to"] == "kuka"
         assert parts["T_ref_B"]["recorded"]["sources"] == ["kuka tool", "abb tool"]
         assert "touches from positioner_kuka.csv" in prov.note
     # one fit: the same own touch noise in both, so their correlation is kept
@@ -157,7 +159,7 @@ def test_without_tool_sigma_the_tools_part_is_recorded_as_assumed(cell_dir, caps
     assert "tool_sigma_mm" not in o and "assumed" in o["sigma_parts"]["T_ref_B"]
 
 
-def test_calibrate_cell_keeps_the_fit_with_a_note_and_a_second_run_is_stable(cell_dir, capsys):
+def test_calibrate_cell_repeats_the_fit_and_a_second_run_is_stable(cell_dir, capsys):
     code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
     assert code == 0, err
     written = Cell.load(cell_dir / "cell.yaml")
@@ -165,22 +167,61 @@ def test_calibrate_cell_keeps_the_fit_with_a_note_and_a_second_run_is_stable(cel
     for _ in range(2):
         code, out, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml")
         assert code == 0, err
-        assert ("note: positioner 'DKP_2' and the base of robot 'abb' come from the fit of all "
-                "touches of calibrate shared-positioner, which calibrate cell does not repeat: "
-                "kept as written") in err
+        assert re.search(r"abb: base: RMS [\d.]+ mm over 44 touches, verdict: GOOD", out), out
+        assert "kept as written" not in out + err
         cells.append(Cell.load(cell_dir / "cell.yaml"))
-    for c in cells:
-        assert np.array_equal(c.turntable.chain.base, written.turntable.chain.base)
-        assert c.turntable.chain.joints == written.turntable.chain.joints
-        assert np.array_equal(c.robots["abb"].T_world_R, written.robots["abb"].T_world_R)
-        assert c.turntable.provenance.source == c.robots["abb"].base_provenance.source == SOURCE
     first, second = cells
+    truth = Cell.load(cell_dir / "truth.yaml")
+    for c in cells:
+        assert c.turntable.provenance.source == c.robots["abb"].base_provenance.source == SOURCE
+        o, o0 = c.turntable.provenance.options, written.turntable.provenance.options
+        assert {k: v for k, v in o.items() if k != "sigma_parts"} == {
+            k: v for k, v in o0.items() if k != "sigma_parts"}
+    # repeated at the fitted tools: moved by a fraction of its 1-sigma, still near the truth
+    moved = first.turntable.chain.base[:3, 3] - written.turntable.chain.base[:3, 3]
+    assert 0 < np.linalg.norm(moved) < 1e-4
+    sigma_p = np.full(3, 0.2e-3)  # the fit's 1-sigma of the base is about 0.1-0.2 mm per axis
+    assert np.all(np.abs(_in_kuka(first, first.robots["abb"].T_world_R)[:3, 3] - _in_kuka(
+        truth, truth.robots["abb"].T_world_R)[:3, 3]) <= 4 * sigma_p)
+    # the second run repeats the first
+    assert np.allclose(first.turntable.chain.base, second.turntable.chain.base, atol=1e-9)
+    for j1, j2 in zip(first.turntable.chain.joints, second.turntable.chain.joints, strict=True):
+        assert np.allclose([j1.a, j1.alpha, j1.d, j1.theta], [j2.a, j2.alpha, j2.d, j2.theta],
+                           atol=1e-9)
+    assert np.allclose(first.robots["abb"].T_world_R, second.robots["abb"].T_world_R, atol=1e-9)
     for robot in ("kuka", "abb"):
-        T1 = first.robots[robot].tools["torch"].T_F_TCP
-        T2 = second.robots[robot].tools["torch"].T_F_TCP
-        assert np.linalg.norm(T1[:3, 3] - T2[:3, 3]) < 1e-5, robot  # 0.01 mm
-    assert np.linalg.norm(first.robots["kuka"].track.T_L_R0[:3, 3]
-                          - second.robots["kuka"].track.T_L_R0[:3, 3]) < 1e-5
+        assert np.allclose(first.robots[robot].tools["torch"].T_F_TCP,
+                           second.robots[robot].tools["torch"].T_F_TCP, atol=1e-8), robot
+
+
+def test_calibrate_cell_refuses_a_changed_touch_file_of_the_fit(cell_dir, capsys):
+    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    assert code == 0, err
+    with (cell_dir / "positioner_abb.csv").open("a", encoding="utf-8") as f:
+        f.write("\n")
+    before = (cell_dir / "cell.yaml").read_bytes()
+    code, _, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml")
+    assert code == 2 and err.count("error:") == 1, err
+    assert re.search(r"positioner \(shared-positioner\): touch file .*positioner_abb\.csv has "
+                     r"changed since the calibration \(checksum differs\)", err), err
+    assert (cell_dir / "cell.yaml").read_bytes() == before
+    with pytest.raises(InputError, match=r"positioner_abb\.csv has changed since the calibration"):
+        calibrate_cell(Cell.load(cell_dir / "cell.yaml"))
+
+
+def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys):
+    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    assert code == 0, err
+    written = Cell.load(cell_dir / "cell.yaml")
+    code, out, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml",
+                         "--robot-name", "kuka")
+    assert code == 0, err
+    assert ("note: positioner 'DKP_2' and the base it placed come from the fit of all touches "
+            "of calibrate shared-positioner, not repeated (refitting one robot only): kept as "
+            "written") in err
+    cell = Cell.load(cell_dir / "cell.yaml")
+    assert np.array_equal(cell.turntable.chain.base, written.turntable.chain.base)
+    assert np.array_equal(cell.robots["abb"].T_world_R, written.robots["abb"].T_world_R)
 
 
 def test_without_update_cell_nothing_is_written(cell_dir, capsys):

@@ -10,8 +10,10 @@ robot's items are fitted together, as in a cell of one robot; every robot-to-rob
 cell records (a base whose provenance is ``robot-to-robot``) is repeated at the fitted tools of
 both robots and the reference robot's fitted base, and the robot placed again
 (:func:`~robotcell.cell.calibrate.robottorobot.repeat_link`); a placed robot whose items rest on
-its base (a table or frame it touched in the world) is fitted again on its new base. The positioner and the base a shared-positioner fit wrote (provenance
-``shared-positioner``) are kept as written, with a note.
+its base (a table or frame it touched in the world) is fitted again on its new base. A fit of a shared positioner (provenance ``shared-positioner``: the positioner
+and the other robot's base) is repeated last, at every robot's fitted tools and bases
+(:func:`~robotcell.cell.calibrate.sharedpositioner.repeat_shared`), and the robots whose items
+rest on what it moved are fitted again.
 
 What is not adjusted jointly: the robots' fits are separate (one robot's calibrations do not
 move another robot's items), and a link's touches do not refine the tools it used, nor is its
@@ -39,6 +41,7 @@ from robotcell.cell.calibrate.chain import (
 from robotcell.cell.calibrate.common import CellCalibration
 from robotcell.cell.calibrate.robottorobot import RecordedLink, repeat_link
 from robotcell.cell.calibrate.sharedpositioner import SOURCE as SHARED_POSITIONER
+from robotcell.cell.calibrate.sharedpositioner import RecordedShared, repeat_shared
 from robotcell.cell.calibrate.whole import (
     CellRecalibration,
     ItemChange,
@@ -144,21 +147,30 @@ def _links(cell: Cell, label: str, notes: list[str]) -> dict[str, RecordedLink]:
     return out
 
 
-def _kept_shared(cell: Cell) -> list[str]:
-    """Notes on the items a shared-positioner fit wrote (:func:`~robotcell.cell.calibrate.
-    sharedpositioner.place_shared_positioner`), which the whole-cell fit keeps as they are."""
+def _shared(cell: Cell, label: str, robot: str | None
+            ) -> tuple[RecordedShared | None, list[str]]:
+    """The recorded shared-positioner fit to repeat, and a note when one is kept as written
+    (refitting one robot only, or a provenance without its files); refuses a robot the cell
+    lacks and missing or changed touch files (all named)."""
     pos = cell.turntable
-    kept = ([f"positioner {pos.name!r}"] if pos is not None
-            and pos.provenance.source == SHARED_POSITIONER else [])
-    for name, unit in cell.robots.items():
-        prov = unit.base_provenance if unit.track is None else unit.track.provenance
-        if prov.source == SHARED_POSITIONER:
-            kept.append(f"the base of robot {name!r}")
-    if not kept:
-        return []
-    return [f"note: {' and '.join(kept)} come from the fit of all touches of calibrate "
-            "shared-positioner, which calibrate cell does not repeat: kept as written "
-            "(calibrate shared-positioner --update-cell again to refit them)"]
+    if pos is None or pos.provenance.source != SHARED_POSITIONER:
+        return None, []
+    recorded = RecordedShared.of(cell)
+    why = ("refitting one robot only" if robot is not None else
+           "its provenance does not record its touch files and options"
+           if recorded is None else "")
+    if why:
+        return None, [f"note: positioner {pos.name!r} and the base it placed come from the fit "
+                      f"of all touches of calibrate shared-positioner, not repeated ({why}): "
+                      "kept as written"]
+    assert recorded is not None
+    problems = [f"positioner (shared-positioner) was fitted by robot {t.robot!r}, which the "
+                f"cell lacks (its robots: {', '.join(cell.robots)})"
+                for t in recorded.common if t.robot not in cell.robots] or recorded.problems()
+    if problems:
+        raise InputError(f"{label}: cannot repeat the calibrations: " + "; ".join(problems)
+                         + ". Restore the files, or calibrate those items again")
+    return recorded, []
 
 
 def _order(names: tuple[str, ...], links: dict[str, RecordedLink]) -> list[str]:
@@ -202,6 +214,10 @@ def cell_touch_files(cell: Cell, cell_label: str | None = None) -> list[tuple[st
            for key, path in touch_files(cell.for_robot(name), _owned(owners, name))]
     for name, link in _links(cell, label, []).items():
         out += [(f"{name}: base", Path(p)) for p in (link.reference.path, link.other.path)]
+    shared = _shared(cell, label, None)[0]
+    if shared is not None:
+        out += [(f"{shared.common[1].robot}: base and positioner", Path(p))
+                for p in shared.files]
     return out
 
 
@@ -249,16 +265,19 @@ def calibrate_cell(cell: Cell, *, robot: str | None = None, cell_label: str | No
     notes: list[str] = []
     owners = _owners(cell, label)
     links = {k: v for k, v in _links(cell, label, notes).items() if k in chosen}
+    shared, kept = _shared(cell, label, robot)
     stamp = time or Provenance.now("cell").time
     fit = _Fit(cell, owners, label, nominal, stamp, on_note)
     for name in _order(chosen, links):
         fit.robot(name, links.get(name))
+    if shared is not None:
+        fit.shared(shared)
     if not fit.parts and not fit.links:
         raise InputError(f"{label} records no calibration with its touch file"
                          + (f" for robot {robot!r}" if robot is not None else "")
                          + f": calibrate its items {term('cell:into', 'into the cell')} first "
                          "(each calibration then records its file)")
-    for text in [*notes, *_kept_shared(cell), NOT_JOINT]:
+    for text in [*notes, *kept, NOT_JOINT]:
         fit.note(text)
     return fit.combined()
 
@@ -310,6 +329,32 @@ class _Fit:
                                                     for c in again.changes))
         if part is not None:
             self.parts.append((name, part))
+
+    def shared(self, recorded: RecordedShared) -> None:
+        """Repeat the shared-positioner fit at the fitted tools and bases, then fit again the
+        robots whose items rest on the positioner or on the base it placed."""
+        placed, done = repeat_shared(self.current, recorded, self.stamp)
+        ref, other = recorded.common
+        if placed is None:
+            self.note(f"note: the fit of all touches of the shared positioner, repeated, is not "
+                      f"written ({done.agreement.message}; verdict "
+                      f"{done.joint.verdict.level}): the positioner and the base of robot "
+                      f"{other.robot!r} are kept as written")
+            return
+        self.current = placed
+        self.links.append((other.robot, RecordedLink(ref, other, recorded.provenance),
+                           done.joint))
+        for name in (ref.robot, other.robot):
+            owned = _owned(self.owners, name)
+            if not any(not k.startswith("tools.") for k, _ in
+                       touch_files(self.current.for_robot(name), owned)):
+                continue
+            index = next(i for i, (n, _) in enumerate(self.parts) if n == name)
+            again = self._fit_view(name)
+            assert again is not None
+            firsts = {c.key: c for c in self.parts[index][1].changes}
+            self.parts[index] = (name, replace(again, changes=tuple(
+                rebased(c, firsts[c.key]) for c in again.changes)))
 
     def _link_change(self, name: str, link: RecordedLink, result: CalibrationResult
                      ) -> tuple[ItemChange, np.ndarray]:
