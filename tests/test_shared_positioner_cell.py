@@ -213,8 +213,8 @@ def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys)
     code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
     assert code == 0, err
     written = Cell.load(cell_dir / "cell.yaml")
-    code, out, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml",
-                         "--robot-name", "kuka")
+    code, _, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml",
+                       "--robot-name", "kuka")
     assert code == 0, err
     assert ("note: positioner 'DKP_2' and the base it placed come from the fit of all touches "
             "of calibrate shared-positioner, not repeated (refitting one robot only): kept as "

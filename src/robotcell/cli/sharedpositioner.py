@@ -179,8 +179,8 @@ def _echo_written(given: _Given, cell: Cell, done: SharedPositioner, backup: Pat
             (f"base of robot {given.robot!r} ("
              + ("T_world_R" if unit.track is None else "T_world_R at track 0") + ")", base,
              "T_ref_other")]
-    lines = [f"updated {given.cell_path}: positioner {cell.turntable.name!r} (root, axes) and "
-             f"the base of robot {given.robot!r} from the fit of all touches{kept}"]
+    lines = [(f"updated {given.cell_path}: positioner {cell.turntable.name!r} (root, axes) and "
+              f"the base of robot {given.robot!r} from the fit of all touches{kept}")]
     for what, T, key in rows:
         v = pose_to_vendor(T, "kuka")
         lines.append(f"  {what}, X,Y,Z mm / A,B,C deg: {_numbers(v[:3], 3)} / "

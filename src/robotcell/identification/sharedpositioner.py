@@ -209,8 +209,9 @@ def lines_chain(chain: Robot, lines: PositionerLines
                 ) -> tuple[Robot, NDArray[np.float64]]:
     """The chain nearest ``chain`` whose axis lines at axis values 0 are ``lines``.
 
-    The change of the chain's parameters (:func:`~robotcell.identification.positioner.perturbed_chain`:
-    root origin and rotation, each axis's DH constants) is the smallest that moves its lines
+    The change of the chain's parameters
+    (:func:`~robotcell.identification.positioner.perturbed_chain`: root origin and rotation,
+    each axis's DH constants) is the smallest that moves its lines
     onto ``lines`` (Gauss-Newton with minimum-norm steps): what the lines do not fix (the plate
     frame on the last axis, the writing of the DH table) stays as ``chain`` has it.
 

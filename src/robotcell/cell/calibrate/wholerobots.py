@@ -10,8 +10,9 @@ robot's items are fitted together, as in a cell of one robot; every robot-to-rob
 cell records (a base whose provenance is ``robot-to-robot``) is repeated at the fitted tools of
 both robots and the reference robot's fitted base, and the robot placed again
 (:func:`~robotcell.cell.calibrate.robottorobot.repeat_link`); a placed robot whose items rest on
-its base (a table or frame it touched in the world) is fitted again on its new base. A fit of a shared positioner (provenance ``shared-positioner``: the positioner
-and the other robot's base) is repeated last, at every robot's fitted tools and bases
+its base (a table or frame it touched in the world) is fitted again on its new base. A fit of
+a shared positioner (provenance ``shared-positioner``: the positioner and the other robot's
+base) is repeated last, at every robot's fitted tools and bases
 (:func:`~robotcell.cell.calibrate.sharedpositioner.repeat_shared`), and the robots whose items
 rest on what it moved are fitted again.
 
@@ -160,9 +161,9 @@ def _shared(cell: Cell, label: str, robot: str | None
            "its provenance does not record its touch files and options"
            if recorded is None else "")
     if why:
-        return None, [f"note: positioner {pos.name!r} and the base it placed come from the fit "
-                      f"of all touches of calibrate shared-positioner, not repeated ({why}): "
-                      "kept as written"]
+        return None, [(f"note: positioner {pos.name!r} and the base it placed come from the "
+                       "fit of all touches of calibrate shared-positioner, not repeated "
+                       f"({why}): kept as written")]
     assert recorded is not None
     problems = [f"positioner (shared-positioner) was fitted by robot {t.robot!r}, which the "
                 f"cell lacks (its robots: {', '.join(cell.robots)})"
@@ -346,9 +347,9 @@ class _Fit:
                            done.joint))
         for name in (ref.robot, other.robot):
             owned = _owned(self.owners, name)
-            if not any(not k.startswith("tools.") for k, _ in
+            if not any(not k.startswith(_OWN_KINDS) for k, _ in
                        touch_files(self.current.for_robot(name), owned)):
-                continue
+                continue  # its tools and track rest on neither
             index = next(i for i, (n, _) in enumerate(self.parts) if n == name)
             again = self._fit_view(name)
             assert again is not None
