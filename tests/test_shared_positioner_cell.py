@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import re
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -207,6 +208,23 @@ def test_calibrate_cell_refuses_a_changed_touch_file_of_the_fit(cell_dir, capsys
     assert (cell_dir / "cell.yaml").read_bytes() == before
     with pytest.raises(InputError, match=r"positioner_abb\.csv has changed since the calibration"):
         calibrate_cell(Cell.load(cell_dir / "cell.yaml"))
+
+
+def test_a_repeated_fit_that_is_poor_is_not_written_and_a_note_says_so(cell_dir):
+    cell = Cell.load(cell_dir / "cell.yaml")
+    common, plate = _touches(cell_dir)
+    done = shared_positioner(cell, common, plate, sigma=1e-4, tool_sigma=1.3e-4)
+    new = place_shared_positioner(cell, done, common, plate, tool_sigma=1.3e-4)
+    prov = new.turntable.provenance  # a touch accuracy stated 10 times too small
+    new.turntable = replace(new.turntable, provenance=replace(
+        prov, options={**prov.options, "sigma_mm": 0.01}))
+    notes: list[str] = []
+    out = calibrate_cell(new, on_note=notes.append)
+    assert any(n.startswith("note: the fit of all touches of the shared positioner, repeated, "
+                            "is not written (poor verdict: ") and n.endswith(
+        "the positioner and the base of robot 'abb' are kept as written") for n in notes), notes
+    assert out.cell.turntable.chain is new.turntable.chain
+    assert np.array_equal(out.cell.robots["abb"].T_world_R, new.robots["abb"].T_world_R)
 
 
 def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys):

@@ -337,10 +337,11 @@ class _Fit:
         placed, done = repeat_shared(self.current, recorded, self.stamp)
         ref, other = recorded.common
         if placed is None:
+            why = (done.agreement.message if not done.agreement.agree else
+                   "poor verdict: " + "; ".join(done.joint.verdict.reasons))
             self.note(f"note: the fit of all touches of the shared positioner, repeated, is not "
-                      f"written ({done.agreement.message}; verdict "
-                      f"{done.joint.verdict.level}): the positioner and the base of robot "
-                      f"{other.robot!r} are kept as written")
+                      f"written ({why}): the positioner and the base of robot {other.robot!r} "
+                      "are kept as written")
             return
         self.current = placed
         self.links.append((other.robot, RecordedLink(ref, other, recorded.provenance),
