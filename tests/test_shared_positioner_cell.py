@@ -227,6 +227,26 @@ def test_a_repeated_fit_that_is_poor_is_not_written_and_a_note_says_so(cell_dir)
     assert np.array_equal(out.cell.robots["abb"].T_world_R, new.robots["abb"].T_world_R)
 
 
+def test_a_base_placed_again_since_keeps_the_positioner_with_a_note(cell_dir, capsys):
+    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    assert code == 0, err
+    written = Cell.load(cell_dir / "cell.yaml")
+    code, _, err = run(capsys, "calibrate", "robot-to-robot", cell_dir / "robot_to_robot_kuka.csv",
+                       cell_dir / "robot_to_robot_abb.csv", "--cell", cell_dir / "cell.yaml",
+                       "--reference", "kuka", "--robot", "abb", "--tool-ref", "torch",
+                       "--tool-other", "torch", "--track-ref", "1000", "--sigma", "0.1")
+    assert code == 0, err
+    code, out, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml")
+    assert code == 0, err
+    assert ("note: positioner 'DKP_2' comes from the fit of all touches of calibrate "
+            "shared-positioner, not repeated (the positioner or the base was calibrated "
+            "otherwise since): kept as written") in err
+    cell = Cell.load(cell_dir / "cell.yaml")
+    assert np.array_equal(cell.turntable.chain.base, written.turntable.chain.base)
+    assert cell.robots["abb"].base_provenance.source == "robot-to-robot"
+    assert re.search(r"abb: base: RMS [\d.]+ mm over 20 touches", out), out
+
+
 def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys):
     code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
     assert code == 0, err
@@ -234,9 +254,9 @@ def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys)
     code, _, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml",
                        "--robot-name", "kuka")
     assert code == 0, err
-    assert ("note: positioner 'DKP_2' and the base it placed come from the fit of all touches "
-            "of calibrate shared-positioner, not repeated (refitting one robot only): kept as "
-            "written") in err
+    assert ("note: positioner 'DKP_2' and the base of robot 'abb' come from the fit of all "
+            "touches of calibrate shared-positioner, not repeated (refitting one robot only): "
+            "kept as written") in err
     cell = Cell.load(cell_dir / "cell.yaml")
     assert np.array_equal(cell.turntable.chain.base, written.turntable.chain.base)
     assert np.array_equal(cell.robots["abb"].T_world_R, written.robots["abb"].T_world_R)

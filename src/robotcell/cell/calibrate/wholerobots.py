@@ -125,8 +125,8 @@ def _links(cell: Cell, label: str, notes: list[str]) -> dict[str, RecordedLink]:
     """The recorded robot-to-robot placements, by the robot placed; refuses a reference robot
     the cell lacks and missing or changed touch files (all named)."""
     out, problems = {}, []
-    for name, unit in cell.robots.items():
-        prov = unit.base_provenance if unit.track is None else unit.track.provenance
+    for name in cell.robots:
+        prov = _base_provenance(cell, name)
         if prov.source != "robot-to-robot":
             continue
         link = RecordedLink.of(name, prov)
@@ -148,22 +148,37 @@ def _links(cell: Cell, label: str, notes: list[str]) -> dict[str, RecordedLink]:
     return out
 
 
+def _base_provenance(cell: Cell, name: str) -> Provenance:
+    """The provenance of a robot's base (of its track's placement, for a robot on a track)."""
+    unit = cell.robots[name]
+    return unit.base_provenance if unit.track is None else unit.track.provenance
+
+
 def _shared(cell: Cell, label: str, robot: str | None
             ) -> tuple[RecordedShared | None, list[str]]:
-    """The recorded shared-positioner fit to repeat, and a note when one is kept as written
-    (refitting one robot only, or a provenance without its files); refuses a robot the cell
-    lacks and missing or changed touch files (all named)."""
+    """The recorded shared-positioner fit to repeat, and a note naming what it wrote when that
+    is kept as written instead (refitting one robot only, a provenance without its files, or
+    the positioner or the base calibrated otherwise since); refuses a robot the cell lacks and
+    missing or changed touch files (all named)."""
     pos = cell.turntable
-    if pos is None or pos.provenance.source != SHARED_POSITIONER:
+    on_pos = pos is not None and pos.provenance.source == SHARED_POSITIONER
+    bases = [n for n in cell.robots if _base_provenance(cell, n).source == SHARED_POSITIONER]
+    if not on_pos and not bases:
         return None, []
     recorded = RecordedShared.of(cell)
+    placed = [] if recorded is None else [recorded.common[1].robot]
     why = ("refitting one robot only" if robot is not None else
            "its provenance does not record its touch files and options"
-           if recorded is None else "")
+           if on_pos and recorded is None else
+           "the positioner or the base was calibrated otherwise since"
+           if recorded is None or bases != placed
+           or _base_provenance(cell, placed[0]).id != recorded.provenance.id else "")
     if why:
-        return None, [(f"note: positioner {pos.name!r} and the base it placed come from the "
-                       "fit of all touches of calibrate shared-positioner, not repeated "
-                       f"({why}): kept as written")]
+        items = ([f"positioner {pos.name!r}"] if on_pos and pos is not None else []) + [
+            f"the base of robot {n!r}" for n in bases]
+        verb = "come" if len(items) > 1 else "comes"
+        return None, [(f"note: {' and '.join(items)} {verb} from the fit of all touches of "
+                       f"calibrate shared-positioner, not repeated ({why}): kept as written")]
     assert recorded is not None
     problems = [f"positioner (shared-positioner) was fitted by robot {t.robot!r}, which the "
                 f"cell lacks (its robots: {', '.join(cell.robots)})"
