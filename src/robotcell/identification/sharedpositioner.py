@@ -25,7 +25,8 @@ fixed points. The unknowns are ``T_ref_other``, the positioner's 8 numbers in th
 and each robot's point on the plate (and the common points); each robot's tool error is
 estimated with the rest under its stated accuracy
 (:func:`robotcell.calibration.priors.fit_with_priors`). Two skew axis lines seen by both robots
-fix ``T_ref_other`` without common points. See ``docs/calibration.md``, "Robot to robot".
+fix ``T_ref_other`` without common points. :func:`lines_chain` moves a positioner chain onto
+fitted axis lines, as a cell writes them. See ``docs/calibration.md``, "Robot to robot".
 """
 
 from __future__ import annotations
