@@ -269,7 +269,7 @@ def test_without_update_cell_nothing_is_written(cell_dir, capsys):
     assert (cell_dir / "cell.yaml").read_bytes() == before and "updated" not in err
 
 
-def test_a_disagreement_writes_nothing(cell_dir, capsys):
+def test_a_disagreement_writes_nothing_unless_accept_poor(cell_dir, capsys):
     cell = _tool_off(cell_dir, 2.0)
     before = (cell_dir / cell).read_bytes()
     code, _, err = run(capsys, *_args(cell_dir, cell), "--update-cell")
@@ -278,6 +278,9 @@ def test_a_disagreement_writes_nothing(cell_dir, capsys):
         "error: kuka's and abb's calibrations of the positioner disagree")
     assert (cell_dir / cell).read_bytes() == before
     assert not list(cell_dir.glob("tool_off.yaml.*.bak"))
+    code, out, err = run(capsys, *_args(cell_dir, cell), "--update-cell", "--accept-poor")
+    assert code == 0 and "disagree" in out and "updated" in err, err
+    assert Cell.load(cell_dir / cell).turntable.provenance.source == SOURCE
 
 
 @pytest.mark.parametrize(("change", "message"), [
