@@ -25,7 +25,8 @@ fixed points. The unknowns are ``T_ref_other``, the positioner's 8 numbers in th
 and each robot's point on the plate (and the common points); each robot's tool error is
 estimated with the rest under its stated accuracy
 (:func:`robotcell.calibration.priors.fit_with_priors`). Two skew axis lines seen by both robots
-fix ``T_ref_other`` without common points. See ``docs/calibration.md``, "Robot to robot".
+fix ``T_ref_other`` without common points. :func:`lines_chain` moves a positioner chain onto
+fitted axis lines, as a cell writes them. See ``docs/calibration.md``, "Robot to robot".
 """
 
 from __future__ import annotations
@@ -61,11 +62,16 @@ from robotcell.calibration.sharedtable import (
 )
 from robotcell.calibration.uncertainty import OWN, Sources, estimate
 from robotcell.errors import InputError
-from robotcell.identification.positioner import PositionerCalibration, calibrate_positioner
+from robotcell.identification.positioner import (
+    AXIS_CONSTANTS,
+    PositionerCalibration,
+    calibrate_positioner,
+    perturbed_chain,
+)
 from robotcell.kinematics.transforms import make_pose, rot_z
 from robotcell.robot.robot import Robot
 
-__all__ = ["COMPONENTS", "PositionerLines", "chain_lines", "compare_positioner",
+__all__ = ["COMPONENTS", "PositionerLines", "chain_lines", "compare_positioner", "lines_chain",
            "positioner_lines", "shared_positioner"]
 
 #: The compared numbers of a 2-axis positioner, in order.
@@ -174,6 +180,71 @@ def chain_lines(chain: Robot, like: PositionerLines | None = None) -> Positioner
     origin = c[0] + s * u[0]
     return PositionerLines(make_pose(R, origin), float((c[1] - origin) @ x),
                            math.atan2(-(u[1] @ R[:, 1]), u[1] @ R[:, 2]))
+
+
+def _as_chain_writes(lines: PositionerLines, chain: Robot) -> PositionerLines:
+    """``lines`` written as :func:`chain_lines` writes those of ``chain``: ``Z_B`` and the
+    rotate axis along the directions of positive motion. A reversed direction adds pi to the
+    angle, so the 8 numbers' errors are the same."""
+    u = chain.jacobian(np.zeros(chain.n_joints))[3:].T                   # (2, 3) motion
+    T = lines.T_B.copy()
+    rotate = T[:3, :3] @ np.array([0.0, -math.sin(lines.angle), math.cos(lines.angle)])
+    if u[0] @ T[:3, 2] < 0:
+        T[:3, 1:3] = -T[:3, 1:3]
+    if u[1] @ rotate < 0:
+        rotate = -rotate
+    return PositionerLines(T, lines.offset, math.atan2(-(rotate @ T[:3, 1]), rotate @ T[:3, 2]))
+
+
+def _lines_error(chain: Robot, target: PositionerLines) -> NDArray[np.float64]:
+    """The 8 numbers of ``target`` minus those of ``chain``'s lines (rotation vector about the
+    parent's axes, the angle wrapped)."""
+    got = chain_lines(chain, like=target)
+    turn = Rotation.from_matrix(target.T_B[:3, :3] @ got.T_B[:3, :3].T).as_rotvec()
+    angle = math.remainder(target.angle - got.angle, 2.0 * math.pi)
+    return np.concatenate([target.T_B[:3, 3] - got.T_B[:3, 3], turn,
+                           [target.offset - got.offset, angle]])
+
+
+def lines_chain(chain: Robot, lines: PositionerLines
+                ) -> tuple[Robot, NDArray[np.float64]]:
+    """The chain nearest ``chain`` whose axis lines at axis values 0 are ``lines``.
+
+    The change of the chain's parameters
+    (:func:`~robotcell.identification.positioner.perturbed_chain`: root origin and rotation,
+    each axis's DH constants) is the smallest that moves its lines
+    onto ``lines`` (Gauss-Newton with minimum-norm steps): what the lines do not fix (the plate
+    frame on the last axis, the writing of the DH table) stays as ``chain`` has it.
+
+    Parameters
+    ----------
+    chain : Robot
+        A 2-joint positioner chain, ``base`` its root in the frame of ``lines`` (m), written as
+        the cell holds it (e.g. :func:`~robotcell.identification.calibrate_positioner`'s).
+    lines : PositionerLines
+        The axis lines wanted (``sources`` not used).
+
+    Returns
+    -------
+    chain : Robot
+        The moved chain (its tool as ``chain``'s).
+    gain : ndarray, shape (6 + 4 n, 8)
+        The change of its parameters by a change of the 8 numbers of ``lines``
+        (:data:`COMPONENTS`; rotation vector about the parent's axes): the map of their errors.
+    """
+    target = _as_chain_writes(lines, chain)
+    size = 6 + len(AXIS_CONSTANTS) * chain.n_joints
+    step_h = 1e-7
+    J = np.zeros((8, size))
+    for _ in range(20):
+        err = _lines_error(chain, target)
+        for k in range(size):
+            J[:, k] = (err - _lines_error(perturbed_chain(chain, step_h * np.eye(size)[k]),
+                                          target)) / step_h
+        if np.max(np.abs(err)) < 1e-12:
+            break
+        chain = perturbed_chain(chain, np.linalg.lstsq(J, err, rcond=None)[0])
+    return chain, np.linalg.pinv(J)
 
 
 def compare_positioner(ref: CalibrationResult, other: CalibrationResult,

@@ -30,7 +30,7 @@ from robotcell.io.tables import read_csv
 from robotcell.kinematics.transforms import invert
 
 __all__ = ["RobotTouchFile", "calibrate_robot_to_robot", "link_options", "place_robot",
-           "repeat_link", "robot_table"]
+           "placed_base", "repeat_link", "robot_table"]
 
 
 @dataclass(frozen=True)
@@ -107,6 +107,21 @@ def calibrate_robot_to_robot(cell: Cell, reference: RobotTouchFile, other: Robot
                                  on_note=on_note)
 
 
+def placed_base(cell: Cell, T_ref_other: np.ndarray, reference: RobotTouchFile,
+                other: RobotTouchFile) -> np.ndarray:
+    """The other robot's base in the world as the cell writes it, from ``T_ref_other`` (4x4, m)
+    at the two robots' track positions: ``T_world_R``, for a robot on a track at its track
+    position 0 (the carriage's travel along the track taken back)."""
+    T_world_R = (cell.for_robot(reference.robot).frame_pose("robot", track=reference.track)
+                 @ np.asarray(T_ref_other, dtype=float))
+    view = cell.for_robot(other.robot)
+    if view.track is not None:  # the carriage's travel, in the world, taken back to track 0
+        travel = view.frame_pose("robot", track=other.track) @ invert(
+            view.frame_pose("robot", track=0.0))
+        T_world_R = invert(travel) @ T_world_R
+    return T_world_R
+
+
 def place_robot(cell: Cell, result: CalibrationResult, reference: RobotTouchFile,
                 other: RobotTouchFile, time: str | None = None, *,
                 tool_sigma: float | None = None, note: str = "") -> Cell:
@@ -120,13 +135,7 @@ def place_robot(cell: Cell, result: CalibrationResult, reference: RobotTouchFile
     checksums, the robots, tools and track positions, the touch accuracy, ``tool_sigma`` (m;
     None: the assumed figure) and the method. ``note`` replaces the note written.
     """
-    T_world_R = (cell.for_robot(reference.robot).frame_pose("robot", track=reference.track)
-                 @ np.asarray(result.values["T_ref_other"], dtype=float))
-    view = cell.for_robot(other.robot)
-    if view.track is not None:  # the carriage's travel, in the world, taken back to track 0
-        travel = view.frame_pose("robot", track=other.track) @ invert(
-            view.frame_pose("robot", track=0.0))
-        T_world_R = invert(travel) @ T_world_R
+    T_world_R = placed_base(cell, result.values["T_ref_other"], reference, other)
     stamp = time or Provenance.now("robot-to-robot").time
     ident = f"robots.{other.robot} base {stamp}"
     est = result.estimates.get("T_ref_other")

@@ -10,7 +10,11 @@ robot's items are fitted together, as in a cell of one robot; every robot-to-rob
 cell records (a base whose provenance is ``robot-to-robot``) is repeated at the fitted tools of
 both robots and the reference robot's fitted base, and the robot placed again
 (:func:`~robotcell.cell.calibrate.robottorobot.repeat_link`); a placed robot whose items rest on
-its base (a table or frame it touched in the world) is fitted again on its new base.
+its base (a table or frame it touched in the world) is fitted again on its new base. A fit of
+a shared positioner (provenance ``shared-positioner``: the positioner and the other robot's
+base) is repeated last, at every robot's fitted tools and bases
+(:func:`~robotcell.cell.calibrate.sharedpositioner.repeat_shared`), and the robots whose items
+rest on what it moved are fitted again.
 
 What is not adjusted jointly: the robots' fits are separate (one robot's calibrations do not
 move another robot's items), and a link's touches do not refine the tools it used, nor is its
@@ -37,6 +41,8 @@ from robotcell.cell.calibrate.chain import (
 )
 from robotcell.cell.calibrate.common import CellCalibration
 from robotcell.cell.calibrate.robottorobot import RecordedLink, repeat_link
+from robotcell.cell.calibrate.sharedpositioner import SOURCE as SHARED_POSITIONER
+from robotcell.cell.calibrate.sharedpositioner import RecordedShared, repeat_shared
 from robotcell.cell.calibrate.whole import (
     CellRecalibration,
     ItemChange,
@@ -119,8 +125,8 @@ def _links(cell: Cell, label: str, notes: list[str]) -> dict[str, RecordedLink]:
     """The recorded robot-to-robot placements, by the robot placed; refuses a reference robot
     the cell lacks and missing or changed touch files (all named)."""
     out, problems = {}, []
-    for name, unit in cell.robots.items():
-        prov = unit.base_provenance if unit.track is None else unit.track.provenance
+    for name in cell.robots:
+        prov = _base_provenance(cell, name)
         if prov.source != "robot-to-robot":
             continue
         link = RecordedLink.of(name, prov)
@@ -140,6 +146,47 @@ def _links(cell: Cell, label: str, notes: list[str]) -> dict[str, RecordedLink]:
         raise InputError(f"{label}: cannot repeat the calibrations: " + "; ".join(problems)
                          + ". Restore the files, or calibrate those items again")
     return out
+
+
+def _base_provenance(cell: Cell, name: str) -> Provenance:
+    """The provenance of a robot's base (of its track's placement, for a robot on a track)."""
+    unit = cell.robots[name]
+    return unit.base_provenance if unit.track is None else unit.track.provenance
+
+
+def _shared(cell: Cell, label: str, robot: str | None
+            ) -> tuple[RecordedShared | None, list[str]]:
+    """The recorded shared-positioner fit to repeat, and a note naming what it wrote when that
+    is kept as written instead (refitting one robot only, a provenance without its files, or
+    the positioner or the base calibrated otherwise since); refuses a robot the cell lacks and
+    missing or changed touch files (all named)."""
+    pos = cell.turntable
+    on_pos = pos is not None and pos.provenance.source == SHARED_POSITIONER
+    bases = [n for n in cell.robots if _base_provenance(cell, n).source == SHARED_POSITIONER]
+    if not on_pos and not bases:
+        return None, []
+    recorded = RecordedShared.of(cell)
+    placed = [] if recorded is None else [recorded.common[1].robot]
+    why = ("refitting one robot only" if robot is not None else
+           "its provenance does not record its touch files and options"
+           if on_pos and recorded is None else
+           "the positioner or the base was calibrated otherwise since"
+           if recorded is None or bases != placed
+           or _base_provenance(cell, placed[0]).id != recorded.provenance.id else "")
+    if why:
+        items = ([f"positioner {pos.name!r}"] if on_pos and pos is not None else []) + [
+            f"the base of robot {n!r}" for n in bases]
+        verb = "come" if len(items) > 1 else "comes"
+        return None, [(f"note: {' and '.join(items)} {verb} from the fit of all touches of "
+                       f"calibrate shared-positioner, not repeated ({why}): kept as written")]
+    assert recorded is not None
+    problems = [f"positioner (shared-positioner) was fitted by robot {t.robot!r}, which the "
+                f"cell lacks (its robots: {', '.join(cell.robots)})"
+                for t in recorded.common if t.robot not in cell.robots] or recorded.problems()
+    if problems:
+        raise InputError(f"{label}: cannot repeat the calibrations: " + "; ".join(problems)
+                         + ". Restore the files, or calibrate those items again")
+    return recorded, []
 
 
 def _order(names: tuple[str, ...], links: dict[str, RecordedLink]) -> list[str]:
@@ -183,6 +230,10 @@ def cell_touch_files(cell: Cell, cell_label: str | None = None) -> list[tuple[st
            for key, path in touch_files(cell.for_robot(name), _owned(owners, name))]
     for name, link in _links(cell, label, []).items():
         out += [(f"{name}: base", Path(p)) for p in (link.reference.path, link.other.path)]
+    shared = _shared(cell, label, None)[0]
+    if shared is not None:
+        out += [(f"{shared.common[1].robot}: base and positioner", Path(p))
+                for p in shared.files]
     return out
 
 
@@ -230,16 +281,19 @@ def calibrate_cell(cell: Cell, *, robot: str | None = None, cell_label: str | No
     notes: list[str] = []
     owners = _owners(cell, label)
     links = {k: v for k, v in _links(cell, label, notes).items() if k in chosen}
+    shared, kept = _shared(cell, label, robot)
     stamp = time or Provenance.now("cell").time
     fit = _Fit(cell, owners, label, nominal, stamp, on_note)
     for name in _order(chosen, links):
         fit.robot(name, links.get(name))
+    if shared is not None:
+        fit.shared(shared)
     if not fit.parts and not fit.links:
         raise InputError(f"{label} records no calibration with its touch file"
                          + (f" for robot {robot!r}" if robot is not None else "")
                          + f": calibrate its items {term('cell:into', 'into the cell')} first "
                          "(each calibration then records its file)")
-    for text in [*notes, NOT_JOINT]:
+    for text in [*notes, *kept, NOT_JOINT]:
         fit.note(text)
     return fit.combined()
 
@@ -291,6 +345,33 @@ class _Fit:
                                                     for c in again.changes))
         if part is not None:
             self.parts.append((name, part))
+
+    def shared(self, recorded: RecordedShared) -> None:
+        """Repeat the shared-positioner fit at the fitted tools and bases, then fit again the
+        robots whose items rest on the positioner or on the base it placed."""
+        placed, done = repeat_shared(self.current, recorded, self.stamp)
+        ref, other = recorded.common
+        if placed is None:
+            why = (done.agreement.message if not done.agreement.agree else
+                   "poor verdict: " + "; ".join(done.joint.verdict.reasons))
+            self.note(f"note: the fit of all touches of the shared positioner, repeated, is not "
+                      f"written ({why}): the positioner and the base of robot {other.robot!r} "
+                      "are kept as written")
+            return
+        self.current = placed
+        self.links.append((other.robot, RecordedLink(ref, other, recorded.provenance),
+                           done.joint))
+        for name in (ref.robot, other.robot):
+            owned = _owned(self.owners, name)
+            if not any(not k.startswith(_OWN_KINDS) for k, _ in
+                       touch_files(self.current.for_robot(name), owned)):
+                continue  # its tools and track rest on neither
+            index = next(i for i, (n, _) in enumerate(self.parts) if n == name)
+            again = self._fit_view(name)
+            assert again is not None
+            firsts = {c.key: c for c in self.parts[index][1].changes}
+            self.parts[index] = (name, replace(again, changes=tuple(
+                rebased(c, firsts[c.key]) for c in again.changes)))
 
     def _link_change(self, name: str, link: RecordedLink, result: CalibrationResult
                      ) -> tuple[ItemChange, np.ndarray]:
