@@ -37,7 +37,6 @@ from robotcell.cell import Cell, Provenance
 from robotcell.cell.calibrate.chain import (
     NOMINAL_ACCURACY,
     NominalAccuracy,
-    item_sources,
 )
 from robotcell.cell.calibrate.common import CellCalibration
 from robotcell.cell.calibrate.robottorobot import RecordedLink, repeat_link
