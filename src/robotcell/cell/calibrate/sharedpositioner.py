@@ -38,6 +38,7 @@ from robotcell.calibration.uncertainty import OWN, Estimate, Sources
 from robotcell.cell.calibrate.chain import item_sources, written_sources
 from robotcell.cell.calibrate.common import sha256_of
 from robotcell.cell.calibrate.robottorobot import RobotTouchFile, placed_base, robot_table
+from robotcell.cell.calibrate.sharedrecord import FILES, SOURCE, RecordedShared
 from robotcell.cell.calibrate.touches import read_touches
 from robotcell.cell.model import Cell
 from robotcell.cell.parts import Provenance
@@ -54,9 +55,6 @@ from robotcell.robot.robot import Robot
 
 __all__ = ["FILES", "SOURCE", "RecordedShared", "SharedPositioner", "place_shared_positioner",
            "repeat_shared", "shared_positioner"]
-
-#: The provenance source of the items :func:`place_shared_positioner` writes.
-SOURCE = "shared-positioner"
 
 
 @dataclass(frozen=True)
@@ -301,66 +299,6 @@ def place_shared_positioner(cell: Cell, done: SharedPositioner,
 
 
 # -- repeated by calibrate cell -----------------------------------------------------------------
-#: The touch files a shared-positioner provenance records, by the key of its options.
-FILES = ("reference_plate", "other_plate", "reference_common", "other_common")
-
-
-@dataclass(frozen=True)
-class RecordedShared:
-    """A fit of a shared positioner as a cell records it (:func:`place_shared_positioner`),
-    ready to be repeated.
-
-    Attributes
-    ----------
-    common : (RobotTouchFile, RobotTouchFile)
-        The reference robot's and the other robot's touches of the common points.
-    plate : (str, str)
-        Each robot's touch file of its point on the plate.
-    provenance : Provenance
-        The provenance of the positioner it wrote.
-    """
-
-    common: tuple[RobotTouchFile, RobotTouchFile]
-    plate: tuple[str, str]
-    provenance: Provenance
-
-    @classmethod
-    def of(cls, cell: Cell) -> RecordedShared | None:
-        """The fit that wrote the cell's positioner; None when another calibration did, or its
-        provenance lacks what repeating needs (edited by hand)."""
-        pos = cell.turntable
-        prov = None if pos is None else pos.provenance
-        needed = ("reference", "other", "tool_ref", "tool_other", "sigma_mm",
-                  *(f"{k}_file" for k in FILES))
-        if (prov is None or prov.source != SOURCE or prov.measurements is None
-                or any(k not in prov.options for k in needed)):
-            return None
-        o, folder = prov.options, Path(prov.measurements).parent
-        path = {k: str(folder / str(o[f"{k}_file"])) for k in FILES}
-        return cls((RobotTouchFile(str(o["reference"]), path["reference_common"],
-                                   str(o["tool_ref"]), float(o.get("track_ref_mm", 0.0)) * 1e-3),
-                    RobotTouchFile(str(o["other"]), path["other_common"], str(o["tool_other"]),
-                                   float(o.get("track_other_mm", 0.0)) * 1e-3)),
-                   (path["reference_plate"], path["other_plate"]), prov)
-
-    @property
-    def files(self) -> tuple[str, str, str, str]:
-        """The four touch files, in the order of :data:`FILES`."""
-        return (*self.plate, self.common[0].path, self.common[1].path)
-
-    def problems(self) -> list[str]:
-        """Its touch files that are missing or changed since the fit (none: repeatable)."""
-        out = []
-        for key, path in zip(FILES, self.files, strict=True):
-            digest = self.provenance.options.get(f"{key}_sha256")
-            if not Path(path).is_file():
-                out.append(f"positioner (shared-positioner): touch file {path} is missing")
-            elif digest is not None and sha256_of(path) != digest:
-                out.append(f"positioner (shared-positioner): touch file {path} has changed "
-                           "since the calibration (checksum differs)")
-        return out
-
-
 def repeat_shared(cell: Cell, recorded: RecordedShared, time: str | None = None
                   ) -> tuple[Cell | None, SharedPositioner]:
     """Repeat a recorded shared-positioner fit on ``cell`` as it stands (both robots' tools and

@@ -40,8 +40,8 @@ from robotcell.cell.calibrate.chain import (
 )
 from robotcell.cell.calibrate.common import CellCalibration
 from robotcell.cell.calibrate.robottorobot import RecordedLink, repeat_link
-from robotcell.cell.calibrate.sharedpositioner import SOURCE as SHARED_POSITIONER
-from robotcell.cell.calibrate.sharedpositioner import RecordedShared, repeat_shared
+from robotcell.cell.calibrate.sharedrecord import SOURCE as SHARED_POSITIONER
+from robotcell.cell.calibrate.sharedrecord import RecordedShared
 from robotcell.cell.calibrate.whole import (
     CellRecalibration,
     ItemChange,
@@ -348,6 +348,9 @@ class _Fit:
     def shared(self, recorded: RecordedShared) -> None:
         """Repeat the shared-positioner fit at the fitted tools and bases, then fit again the
         robots whose items rest on the positioner or on the base it placed."""
+        # the fit's machinery (the identification engine) loads only when a fit is repeated
+        from robotcell.cell.calibrate.sharedpositioner import repeat_shared
+
         placed, done = repeat_shared(self.current, recorded, self.stamp)
         ref, other = recorded.common
         if placed is None:
