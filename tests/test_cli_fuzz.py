@@ -20,7 +20,8 @@ Python warning (``RuntimeWarning: ...``) may appear on stdout or stderr; a run t
 or poor changes, creates and deletes no file (an output named like one of the inputs is
 refused), and a run that succeeds changes no input it does not own (the cell file it
 calibrates into) and leaves no temporary file; files written together (an identification's
-model file and the cell it goes into) change all or none.
+model file and the cell it goes into) change all or none, and a page, YASKAWA job or ABB module
+written ends with its last line (:data:`ENDS`).
 
 ``pytest -q`` runs the first cases of each command (:data:`CASES`, first number, 220);
 ``ROBOTCELL_FUZZ=full`` runs the full set (second number, 2,436), as ``.ci/run`` does.
@@ -1477,6 +1478,9 @@ def _problems(case: Case, d: Path, code: int, out: str, err: str, before: dict[s
         problems.append("an output onto an input was not refused")
     if "(never written)" in case.what and code == 0:
         problems.append("a run that can write nothing succeeded")
+    if code == 0 and [name for name in _diff(before, after) & set(after)
+                      if not after[name].rstrip().endswith(ENDS.get(Path(name).suffix, b""))]:
+        problems.append("a file written in part (without its last line)")
     changed = {str(p.relative_to(d)) for p in case.together} & _diff(before, after)
     if changed and len(changed) < len(case.together):
         problems.append(f"only {sorted(changed)} of {[p.name for p in case.together]} changed")
@@ -1485,6 +1489,11 @@ def _problems(case: Case, d: Path, code: int, out: str, err: str, before: dict[s
     if sorted(p.name for p in d.parent.iterdir() if not p.name.startswith("case")):
         problems.append("files written outside the case's folder")
     return problems
+
+
+#: The last line of a file of each kind that a command writes whole (a page, a YASKAWA job, an
+#: ABB module).
+ENDS = {".html": b"</html>", ".jbi": b"END", ".mod": b"ENDMODULE"}
 
 
 #: Cases per command run as another user from a read-only install, without a writable home
