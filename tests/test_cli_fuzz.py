@@ -640,7 +640,7 @@ def _robots_show(rng, d, good, out):
 
 
 def _demo(rng, d, good, out):
-    opts = _maybe(rng, 1.0, {"--noise": ["-1", "0", "nan", "inf", "-inf", "abc", ""],
+    opts = _maybe(rng, 1.0, {"--noise": ["-1", "0", "nan", "inf", "-inf", "abc", "", "1e-300"],
                              "--seed": ["-1", "abc", "1.5", ""]})
     return ["demo", "-o", d / "demo", *opts], " ".join(opts), [], [d / "demo"]
 
