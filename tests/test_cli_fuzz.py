@@ -4,9 +4,13 @@ Every case starts from valid inputs of one command (calibrate tcp, frame, extern
 turntable, workpiece, positioner, also into a cell; fk, ik, also --cell; export, also URDF;
 report; cell show, cell history; identify, also --propose; reach; sweep; simulate; plan; dh
 from-urdf, dh convert; robots show; demo; view, also --reach and --program; iso9283 plan and
-analyse, simulate iso9283, whose logs also get the faults of a tracker's log) and applies one or
+analyse, simulate iso9283, whose logs also get the faults of a tracker's log; the commands of
+two robots: calibrate robot-to-robot and shared-positioner, also --update-cell, program
+write-coordinated and check-coordinated of a YASKAWA job, also with times, view of a
+coordinated program, identify --cell --robot-name, plan robot-to-robot) and applies one or
 two seeded mutations to a file (measurement CSV, cell YAML and its backups, report JSON, URDF,
-robot model YAML, layouts YAML, reach CSV, KUKA, ABB and FANUC programs: truncation, wrong types, huge
+robot model YAML, layouts YAML, reach CSV, KUKA, ABB, FANUC and YASKAWA programs, timed paths,
+bodies YAML: truncation, wrong types, huge
 values, NaN, other encodings, swapped or misspelt columns, empty files, binary junk, European
 CSV, ...) or to an option (negative, zero, NaN, infinite, 1e300, 1e-300, text), or names an
 input as the output. It runs the command in process, in a folder of its own. Each run must end
@@ -15,10 +19,12 @@ poor calibration); 1 means an unexpected failure and fails the test. No ``Traceb
 Python warning (``RuntimeWarning: ...``) may appear on stdout or stderr; a run that is refused
 or poor changes, creates and deletes no file (an output named like one of the inputs is
 refused), and a run that succeeds changes no input it does not own (the cell file it
-calibrates into) and leaves no temporary file.
+calibrates into) and leaves no temporary file; files written together (an identification's
+model file and the cell it goes into) change all or none, and a page, YASKAWA job or ABB module
+written ends with its last line (:data:`ENDS`).
 
-``pytest -q`` runs the first cases of each command (:data:`CASES`, first number, about 170);
-``ROBOTCELL_FUZZ=full`` runs the full set (second number, about 1,700), as ``.ci/run`` does.
+``pytest -q`` runs the first cases of each command (:data:`CASES`, first number, 220);
+``ROBOTCELL_FUZZ=full`` runs the full set (second number, 2,436), as ``.ci/run`` does.
 ``ROBOTCELL_FUZZ_SEED`` changes the seed (default 2026); the cases of a failing seed are printed.
 
 The first cases of every command (:data:`READ_ONLY`) also run as another user, from a read-only
@@ -337,12 +343,16 @@ def _maybe(rng: np.random.Generator, p: float, options: dict[str, list[str]]) ->
 
 # -- the commands ---------------------------------------------------------------------------------
 class Case:
-    """One run: its arguments, what was mutated, the files it may write when it succeeds."""
+    """One run: its arguments, what was mutated, the files it may write when it succeeds, and
+    the files it writes all together or none of (an identification into a cell: the cell and
+    the model file)."""
 
-    def __init__(self, args: list, what: str, writes: tuple[Path, ...] = ()):
+    def __init__(self, args: list, what: str, writes: tuple[Path, ...] = (),
+                 together: tuple[Path, ...] = ()):
         self.args = [str(a) for a in args]
         self.what = what
         self.writes = writes
+        self.together = together
 
 
 def _calibrate(command: str, rng: np.random.Generator, d: Path, good: dict[str, Path]
@@ -409,6 +419,7 @@ def _case(command: str, rng: np.random.Generator, d: Path, good: dict[str, Path]
     """A mutated case of ``command`` in folder ``d``; with probability 0.05 its output file is
     one of its inputs."""
     out = d / f"result{int(rng.integers(0, 3))}.txt"
+    together: list = []
     if command in ("tcp", "frame", "external-tcp", "track", "turntable", "workpiece"):
         args, what, inputs = _calibrate(command, rng, d, good)
         if rng.random() < 0.5:
@@ -416,7 +427,7 @@ def _case(command: str, rng: np.random.Generator, d: Path, good: dict[str, Path]
         else:
             writes = []
     else:
-        args, what, inputs, writes = BUILDERS[command](rng, d, good, out)
+        args, what, inputs, writes, *together = BUILDERS[command](rng, d, good, out)
     writes = list(writes)
     if "--cell" in args and args[0] == "calibrate":
         cell = Path(args[args.index("--cell") + 1])
@@ -427,7 +438,7 @@ def _case(command: str, rng: np.random.Generator, d: Path, good: dict[str, Path]
         args[args.index("-o") + 1] = str(onto)
         what += f"; -o onto the input {Path(onto).name}"
         writes = []
-    return Case(args, what, tuple(writes))
+    return Case(args, what, tuple(writes), tuple(together[0]) if together else ())
 
 
 def _fk(rng, d, good, out):
@@ -629,7 +640,7 @@ def _robots_show(rng, d, good, out):
 
 
 def _demo(rng, d, good, out):
-    opts = _maybe(rng, 1.0, {"--noise": ["-1", "0", "nan", "inf", "-inf", "abc", ""],
+    opts = _maybe(rng, 1.0, {"--noise": ["-1", "0", "nan", "inf", "-inf", "abc", "", "1e-300"],
                              "--seed": ["-1", "abc", "1.5", ""]})
     return ["demo", "-o", d / "demo", *opts], " ".join(opts), [], [d / "demo"]
 
@@ -1048,6 +1059,241 @@ CASES.update({"shared-positioner": (3, 30)})
 BUILDERS.update({"shared-positioner": _shared_positioner})
 
 
+# -- programs and calibrations of two robots: coordinated programs, their view, identify and
+# -- the shared positioner into a cell, planning the common points -----------------------------
+TWO_YASKAWA = EXAMPLES / "cell_two_yaskawa_positioner.yaml"
+TWO_ABB = EXAMPLES / "cell_two_abb_positioner.yaml"
+#: The example paths of the coordinated programs (file names in the case's folder -> examples).
+YASKAWA_SEAMS = {"rob1": "seam_rob1_floor.csv", "rob2": "seam_rob2.csv"}
+TIMED_SEAMS = {"rob1": "seam_rob1_timed.csv", "rob2": "seam_rob2_timed.csv"}
+
+
+@functools.lru_cache(maxsize=2)
+def _coordinated_texts(vendor: str) -> dict[str, str]:
+    """The example's coordinated program (file name -> text): the YASKAWA job of the two-robot
+    YASKAWA cell (100 pulses per degree) or the ABB MultiMove modules of the two-ABB cell."""
+    import tempfile
+
+    from robotcell.cell import Cell
+    from robotcell.programs.coordinated import write_coordinated
+
+    yaskawa = vendor == "yaskawa"
+    seams = YASKAWA_SEAMS if yaskawa else {"rob1": "seam_rob1.csv", "rob2": "seam_rob2.csv"}
+    with tempfile.TemporaryDirectory() as folder:
+        files = write_coordinated({r: EXAMPLES / f for r, f in seams.items()},
+                                  Cell.load(TWO_YASKAWA if yaskawa else TWO_ABB),
+                                  {"rob1": "torch", "rob2": "torch"}, "part", vendor, folder,
+                                  "seams", pulses_per_degree=[100, 100] if yaskawa else None
+                                  ).files
+        return {Path(f).name: Path(f).read_text(encoding="utf-8") for f in files}
+
+
+def _mutate_job(text: str, rng: np.random.Generator) -> tuple[str, str]:
+    """A mutation of a YASKAWA job of two robots: a line dropped, group 2's ``+MOVJ``/``+MOVL``
+    part removed, a group line changed, a station position in group 2's part, a number of a
+    position garbled; else a text mutation."""
+    lines = text.splitlines()
+    moves = [i for i, line in enumerate(lines) if line.startswith("MOV")]
+    kind = str(rng.choice(["drop-line", "drop-plus", "group", "station-in-plus",
+                           "garble-number", "text"]))
+    if kind == "drop-line":
+        i = int(rng.integers(0, len(lines)))
+        what = f"line {i + 1} dropped ({lines.pop(i)[:20]})"
+    elif kind == "drop-plus":
+        i = moves[int(rng.integers(0, len(moves)))]
+        lines[i] = lines[i].split("  +")[0]
+        what = f"line {i + 1} without its +MOV"
+    elif kind == "group":
+        group = str(rng.choice(["///GROUP1", "///GROUP2"]))
+        i = next(k for k, line in enumerate(lines) if line.startswith(group))
+        lines[i] = str(rng.choice(["///GROUP1 RB1", "///GROUP1 RB2,ST1", "///GROUP2 RB1",
+                                   "///GROUP2 RB2,ST1", "///GROUP1 RB1,ST1,ST2", "///GROUP3 RB3",
+                                   "///GROUP1", ""]))
+        what = f"group line {i + 1} -> {lines[i]!r}"
+    elif kind == "station-in-plus":
+        i = moves[int(rng.integers(0, len(moves)))]
+        lines[i] = re.sub(r"(\+MOV\w C\d+)", r"\1 EC00000", lines[i])
+        what = f"line {i + 1}: EC in group 2's part"
+    elif kind == "garble-number":
+        i = [k for k, line in enumerate(lines) if re.match(r"E?C\d+=", line)]
+        i = i[int(rng.integers(0, len(i)))]
+        head, values = lines[i].split("=")
+        values = values.split(",")
+        values[int(rng.integers(0, len(values)))] = str(rng.choice(
+            ["nan", "", "abc", "1e300", "-9999999", "1.2.3", "١٢", "inf"]))
+        lines[i] = head + "=" + ",".join(values)
+        what = f"line {i + 1} garbled: {lines[i]}"
+    else:
+        content, what = mutate_text(text, rng)
+        return content, what
+    return "\n".join(lines) + "\n", what
+
+
+def _copy_seams(d: Path, seams: dict[str, str]) -> dict[str, Path]:
+    return {robot: Path(shutil.copy(EXAMPLES / name, d / name)) for robot, name in seams.items()}
+
+
+def _write_coordinated_args(files: dict[str, Path], cell: Path, d: Path,
+                            ppd: str = "100,100") -> list:
+    return ["program", "write-coordinated", *(f"{r}={f}" for r, f in files.items()), "--cell",
+            cell, "--tool", "torch", "--frame", "part", "--format", "yaskawa",
+            "--pulses-per-degree", ppd, "-o", d / "prog", "--name", "seams"]
+
+
+def _coordinated_yaskawa(rng, d, good, out):
+    """program write-coordinated --format yaskawa (a path file mutated, or --pulses-per-degree
+    wrong), or program check-coordinated of the written job mutated."""
+    ppd = str(rng.choice(BAD_LISTS + ["100", "100,100,100", "0,0", "-100,100", "1e300,100"])
+              ) if rng.random() < 0.2 else "100,100"
+    if rng.random() < 0.5:
+        files = _copy_seams(d, YASKAWA_SEAMS)
+        robot = str(rng.choice(sorted(files)))
+        _, what = _mutated(files[robot].read_text(encoding="utf-8"), rng, d, files[robot].name)
+        if rng.random() < 0.1:  # a robot the cell lacks, or one robot twice
+            files = {"rob1": files["rob1"], str(rng.choice(["rob3", "rob1 ", ""])): files["rob2"]}
+            what += f"; robots {', '.join(map(repr, files))}"
+        return (_write_coordinated_args(files, TWO_YASKAWA, d, ppd), f"{what}; ppd {ppd}",
+                list(files.values()), [d / "prog"])
+    job = d / "SEAMS.jbi"
+    content, what = _mutate_job(_coordinated_texts("yaskawa")["SEAMS.jbi"], rng)
+    _write(job, content)
+    robots = _maybe(rng, 0.1, {"--robots": ["rob2,rob1", "rob1", "rob1,rob3", ""]})
+    return (["program", "check-coordinated", job, "--cell", TWO_YASKAWA,
+             "--pulses-per-degree", ppd, *robots], f"{what}; ppd {ppd} {' '.join(robots)}",
+            [job], [])
+
+
+def _mutate_times(text: str, rng: np.random.Generator) -> tuple[bytes | str, str]:
+    """A mutation of a timed path file: a time not increasing, NaN, empty, negative, huge, the
+    column dropped or misspelt, a ``lin`` made ``ptp``; else a CSV mutation."""
+    rows = _split(text)
+    t = rows[0].index("time")
+    i = int(rng.integers(1, len(rows)))
+    kind = str(rng.choice(["not-increasing", "same-time", "time-value", "no-time",
+                           "misspelt-time", "ptp", "csv"]))
+    if kind == "not-increasing":
+        k = int(rng.integers(1, len(rows)))
+        rows[i][t], rows[k][t] = rows[k][t], rows[i][t]
+        if i == k:
+            rows[i][t] = str(float(rows[i][t]) - 3.0)
+    elif kind == "same-time":
+        k = min(i + 1, len(rows) - 1) if i < len(rows) - 1 else i - 1
+        rows[i][t] = rows[k][t]
+    elif kind == "time-value":
+        rows[i][t] = str(rng.choice(["nan", "NaN", "", "-1", "inf", "1e300", "abc", "1e-7",
+                                     "10.0000001", "1,5"]))
+    elif kind == "no-time":
+        rows = [r[:t] + r[t + 1:] for r in rows]
+    elif kind == "misspelt-time":
+        rows[0][t] = str(rng.choice(["Time", "time_s", "t", "tiem"]))
+    elif kind == "ptp":
+        rows[i][rows[0].index("motion")] = "ptp"
+    else:
+        return mutate_csv(text, rng)
+    return _join(rows), f"{kind} line {i + 1}"
+
+
+def _coordinated_timed(rng, d, good, out):
+    """program write-coordinated of the timed example paths (YASKAWA cell): the times of one
+    file (or both) mutated."""
+    files = _copy_seams(d, TIMED_SEAMS)
+    what = []
+    for robot in sorted(files):
+        if rng.random() < 0.6 or (robot == "rob2" and not what):
+            content, w = _mutate_times(files[robot].read_text(encoding="utf-8"), rng)
+            _write(files[robot], content)
+            what.append(f"{files[robot].name}: {w}")
+    return (_write_coordinated_args(files, TWO_YASKAWA, d), "; ".join(what),
+            list(files.values()), [d / "prog"])
+
+
+def _view_coordinated(rng, d, good, out):
+    """view CELL --program A --program B [--bodies B.yaml]: the ABB MultiMove example, one
+    module or the bodies file mutated, or an option wrong; the page is written whole or not."""
+    modules = {name: _write(d / name, text)
+               for name, text in _coordinated_texts("abb").items()}
+    files = [modules[name] for name in sorted(modules)]
+    bodies_text = (EXAMPLES / "bodies_two_robots_positioner.yaml").read_text(encoding="utf-8")
+    bodies = _write(d / "bodies.yaml", bodies_text)
+    what = "valid"
+    kind = rng.random()
+    if kind < 0.5:
+        target = files[int(rng.integers(0, len(files)))]
+        content, w = mutate_text(target.read_text(encoding="utf-8"), rng)
+        if rng.random() < 0.5:  # the MultiMove structure broken
+            lines = target.read_text(encoding="utf-8").splitlines()
+            sync = [i for i, line in enumerate(lines) if "\\ID:=" in line or "SyncMove" in line]
+            i = sync[int(rng.integers(0, len(sync)))]
+            new = str(rng.choice(["", "\\ID:=15", "\\ID:=abc"]))
+            lines[i] = (re.sub(r"\\ID:=\d+", lambda _: new, lines[i]) if "\\ID:=" in lines[i]
+                        else "")
+            content, w = "\n".join(lines) + "\n", f"line {i + 1} -> {lines[i].strip()!r}"
+        _write(target, content)
+        what = f"{target.name}: {w}"
+    elif kind < 0.8:
+        bodies, what = _mutated(bodies_text, rng, d, "bodies.yaml")
+    opts = ["--bodies", bodies] if rng.random() < 0.7 or "bodies" in what else []
+    opts += _maybe(rng, 0.3, {"--clearance": BAD_FLOATS + ["3"],
+                              "--robots": ["rob2,rob1", "rob1", "rob1,rob3", "", "rob1,rob1"]})
+    programs = [a for f in files for a in ("--program", f)]
+    if rng.random() < 0.1:
+        programs, what = programs[:2], what + "; one --program"
+    html = d / "view.html"
+    return (["view", TWO_ABB, *programs, *opts, "-o", html], f"{what} {' '.join(map(str, opts))}",
+            [*files, bodies], [html])
+
+
+def _identify_robot_name(rng, d, good, out):
+    """identify --cell CELL --robot-name NAME -o ARM.yaml on the two-robot cell: the tracker's
+    rows (of the nominal KR 16) mutated, or the name wrong; the cell and the model file are
+    written together or neither is."""
+    cell = _write(d / "cell.yaml", TWO_ROBOTS.read_text(encoding="utf-8"))
+    content, what = mutate_csv(_tracker_csv(rng), rng) if rng.random() < 0.7 else \
+        (_tracker_csv(rng), "valid")
+    tracker = _write(d / "tracker.csv", content)
+    name = str(rng.choice(["kuka"] * 6 + ["abb", "nope", "", "KUKA", "kuka "]))
+    robot = ["--robot", "kuka_kr16"] if rng.random() < 0.5 else []
+    opts = _maybe(rng, 0.15, {"--folds": ["0", "1", "abc"], "--sigma": BAD_FLOATS})
+    arm = d / "arm.yaml"
+    return (["identify", tracker, *robot, "--cell", cell, "--robot-name", name,
+             *opts, "-o", arm], f"{what}; --robot-name {name!r} {' '.join(robot + opts)}",
+            [cell, tracker], [arm, *_cell_writes(cell)], (cell, arm))
+
+
+def _shared_positioner_cell(rng, d, good, out):
+    """calibrate shared-positioner --update-cell: as the group above, into the cell file, which
+    is byte-identical after any refusal."""
+    args, what, inputs, writes = _shared_positioner(rng, d, good, out)
+    cell = Path(args[args.index("--cell") + 1])
+    if rng.random() < 0.1:
+        args += ["--accept-poor"]
+    return [*args, "--update-cell"], what, inputs, [*writes, *_cell_writes(cell)]
+
+
+def _plan_robot_to_robot(rng, d, good, out):
+    """plan robot-to-robot on the two-robot cell (no Monte Carlo runs): --track-ref or
+    --track-other wrong (the KUKA's track, the ABB has none), either robot the reference."""
+    reference, other = ("kuka", "abb") if rng.random() < 0.6 else ("abb", "kuka")
+    bad = BAD_FLOATS + ["9000", "-5000", "1000", "3000", "3000.0001", "0x10", "1e-320"]
+    opts = _maybe(rng, 0.9, {"--track-ref": bad, "--track-other": bad})
+    opts += _maybe(rng, 0.1, {"--noise": BAD_FLOATS})
+    csv = d / "points.csv"
+    return (["plan", "robot-to-robot", "--cell", TWO_ROBOTS, "--robot", other, "--reference",
+             reference, "--seed", "1", "--runs", "0", *opts, "-o", csv],
+            f"{reference} the reference {' '.join(opts)}", [], [csv])
+
+
+CASES.update({"coordinated-yaskawa": (4, 40), "coordinated-timed": (2, 30),
+              "view-coordinated": (2, 30), "identify-robot-name": (2, 30),
+              "shared-positioner-cell": (2, 30), "plan-robot-to-robot": (2, 30)})
+BUILDERS.update({"coordinated-yaskawa": _coordinated_yaskawa,
+                 "coordinated-timed": _coordinated_timed, "view-coordinated": _view_coordinated,
+                 "identify-robot-name": _identify_robot_name,
+                 "shared-positioner-cell": _shared_positioner_cell,
+                 "plan-robot-to-robot": _plan_robot_to_robot})
+
+
+
 
 def _edit_rows(text: str, edit) -> str:
     return _join(edit(_split(text)))
@@ -1232,11 +1478,22 @@ def _problems(case: Case, d: Path, code: int, out: str, err: str, before: dict[s
         problems.append("an output onto an input was not refused")
     if "(never written)" in case.what and code == 0:
         problems.append("a run that can write nothing succeeded")
+    if code == 0 and [name for name in _diff(before, after) & set(after)
+                      if not after[name].rstrip().endswith(ENDS.get(Path(name).suffix, b""))]:
+        problems.append("a file written in part (without its last line)")
+    changed = {str(p.relative_to(d)) for p in case.together} & _diff(before, after)
+    if changed and len(changed) < len(case.together):
+        problems.append(f"only {sorted(changed)} of {[p.name for p in case.together]} changed")
     if any(name.endswith(".tmp") for name in after):
         problems.append("temporary files left")
     if sorted(p.name for p in d.parent.iterdir() if not p.name.startswith("case")):
         problems.append("files written outside the case's folder")
     return problems
+
+
+#: The last line of a file of each kind that a command writes whole (a page, a YASKAWA job, an
+#: ABB module).
+ENDS = {".html": b"</html>", ".jbi": b"END", ".mod": b"ENDMODULE"}
 
 
 #: Cases per command run as another user from a read-only install, without a writable home

@@ -52,11 +52,15 @@ def test_simulate_noise_changes_the_joints(capsys):
     (["simulate", "track", "--tool", "torch", "--track", "100"],
      "the track procedure moves the track itself"),
     (["plan", "tcp", "--tool", "torch", "--noise", "0"], "--noise must be a positive number"),
+    # a noise whose square underflows made the fit divide by zero (exit 1)
+    (["plan", "tcp", "--tool", "torch", "--noise", "1e-300"],
+     r"--noise must be a positive number of millimetres from 0\.001 \(1 um"),
     (["plan", "turntable", "--tool", "torch", "--max-size", "100"],
      "--max-size does not apply to turntable"),
     (["plan", "frame", "--tool", "torch", "--frame", "fixture", "--max-size", "10"],
      "--max-size 10 mm leaves no design; the smallest is 50 mm"),
     (["demo", "--noise", "0"], "--noise must be a positive number of millimetres"),
+    (["demo", "--noise", "1e-300"], r"--noise must be a positive number of millimetres from 0\.001"),
 ])
 def test_refusals(args, message, capsys):
     extra = [] if args[0] == "demo" else ["--cell", EXAMPLE]

@@ -55,6 +55,8 @@ def test_errors():
         plan(TRUTH, "laser")
     with pytest.raises(InputError, match="noise must be a positive number"):
         plan(TRUTH, "tcp", noise=0.0, tool="torch")
+    with pytest.raises(InputError, match=r"noise must be a positive number \(m\) of at least 1e-06"):
+        plan(TRUTH, "tcp", noise=1e-200, tool="torch")  # its square underflows: a fit divided by 0
     with pytest.raises(InputError, match="runs must be >= 0"):
         plan(TRUTH, "tcp", runs=-1, tool="torch")
     with pytest.raises(InputError, match="no candidate tcp design can be carried out.*reached"):

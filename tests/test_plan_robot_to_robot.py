@@ -83,6 +83,13 @@ def test_unknown_or_repeated_robots_are_refused(cell, robot, reference, match):
         plan_robot_to_robot(cell, robot, reference, noise=1e-4, seed=0)
 
 
+@pytest.mark.parametrize("noise", [1e-303, 9e-7, float("nan"), 0.0])
+def test_a_noise_below_1_um_is_refused(cell, noise):
+    with pytest.raises(InputError, match=r"noise must be a positive distance \(m\) of at least "
+                                         r"1e-06"):
+        plan_robot_to_robot(cell, "abb", "kuka", noise=noise, seed=0)
+
+
 def test_a_cell_of_one_robot_is_refused():
     with pytest.raises(InputError, match="one robot"):
         plan_robot_to_robot(Cell.load(ONE), "a", "b", noise=1e-4, seed=0)
@@ -111,6 +118,9 @@ def test_the_command_prints_the_designs_and_writes_the_best_points(capsys, tmp_p
     (TWO, ["--robot", "abb", "--reference", "abb"], "both 'abb'"),
     (ONE, ["--robot", "abb", "--reference", "kuka"], "one robot"),
     (None, ["--robot", "abb", "--reference", "kuka"], "no common reachable volume"),
+    # a noise whose square underflows made the fit divide by zero (exit 1)
+    (TWO, ["--robot", "abb", "--reference", "kuka", "--noise", "1e-300"],
+     "--noise must be a positive number of millimetres from 0.001 (1 um"),
 ])
 def test_a_refused_plan_exits_2_naming_the_cause_and_writes_nothing(capsys, tmp_path, cell_file,
                                                                      args, match):

@@ -155,6 +155,23 @@ def test_a_group_2_position_missing_from_pos_is_refused(written, tmp_path, capsy
     assert code == 2 and err.startswith("error: ") and "C00003 not in the //POS" in err
 
 
+@pytest.mark.parametrize("old, new", [
+    ("C00003=49.218,", "C00003=٤٩.218,"),      # digits of another script: read as 49 by float
+    ("EC00002=0,-200", "EC00002=0,-2_00"),       # digit grouping: read as -200 by float
+])
+def test_a_number_no_controller_writes_is_refused_naming_the_line(written, tmp_path, capsys,
+                                                                   old, new):
+    cell, result = written
+    path = _broken(tmp_path, result, old, new)
+    bad = new.split("=")[1].split(",")[0 if new.startswith("C") else 1]
+    with pytest.raises(InputError, match=rf"BROKEN\.jbi: line \d+: '{bad}' is not a number"):
+        check_coordinated([path], cell, pulses_per_degree=PPD)
+    code, out, err = run(capsys, "program", "check-coordinated", path, "--cell", CELL,
+                         "--pulses-per-degree", "100,100")
+    assert code == 2 and out == "" and err.startswith("error: ") and err.count("\n") == 1, err
+    assert f"'{bad}' is not a number (digits 0-9" in err
+
+
 def test_the_real_jobs_give_their_structure_and_name_their_pulse_positions():
     first, second = read_groups(EXCERPTS / "R1R2S1.JBI")
     assert group_problems(EXCERPTS / "R1R2S1.JBI") == []

@@ -28,9 +28,11 @@ __all__ = [
     "GROUP_TOLERANCE_DEG",
     "MAX_CORRECTION_MM",
     "NOISE_MAX_MM",
+    "NOISE_MIN_MM",
     "BadPoints",
     "as_flags",
     "check_kind",
+    "check_noise",
     "check_not_folder",
     "check_output",
     "format_table",
@@ -47,6 +49,9 @@ __all__ = [
 
 #: Largest touch-up error (``--noise`` of simulate, plan and demo; mm): 1 m is none.
 NOISE_MAX_MM = 1000.0
+#: Smallest touch-up error of plan and demo (``--noise``, mm; simulate takes 0): 1 um, below any
+#: touch-up accuracy (the fits weigh by ``1 / noise**2``, which 1e-300 mm makes infinite).
+NOISE_MIN_MM = 1e-3
 
 #: Range of ``--max-correction`` (``compensate``, ``program compensate``; mm): a real arm is 0.1
 #: to a few mm off its drawing.
@@ -131,6 +136,15 @@ def counted(n: int, noun: str) -> str:
     str
     """
     return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
+def check_noise(noise: float) -> None:
+    """Refuse a ``--noise`` of plan or demo (mm) outside :data:`NOISE_MIN_MM` ..
+    :data:`NOISE_MAX_MM` (or NaN) with an :class:`InputError` that gives the range."""
+    if not NOISE_MIN_MM <= noise <= NOISE_MAX_MM:
+        raise InputError(f"--noise must be a positive number of millimetres from "
+                         f"{NOISE_MIN_MM:g} (1 um, below any touch-up accuracy) to "
+                         f"{NOISE_MAX_MM:g}, got {noise:g}")
 
 
 def parse_numbers(text: str, what: str, count: int | None = None) -> list[float]:

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import click
 
-from robotcell.cli.common import NOISE_MAX_MM, as_flags
+from robotcell.cli.common import as_flags, check_noise
 from robotcell.cli.files import Command, OutputPath
 from robotcell.demo.tworobots import run_two_robot_demo
 from robotcell.demo.walkthrough import DEMO_NOISE, run_demo
-from robotcell.errors import InputError
 
 
 @click.command(cls=Command)
@@ -44,9 +43,7 @@ def demo(output: str | None, noise: float, seed: int, robots: int) -> None:
       robotcell demo -o /tmp/demo --noise 0.05 --seed 7
       robotcell demo --robots 2
     """
-    if not 0 < noise <= NOISE_MAX_MM:
-        raise InputError(f"--noise must be a positive number of millimetres, at most "
-                         f"{NOISE_MAX_MM:g}, got {noise:g}")
+    check_noise(noise)
     with as_flags({"a smaller noise": "a smaller --noise"}):
         if robots == 2:
             run_two_robot_demo(output or "robotcell-demo-2", noise=noise * 1e-3, seed=seed,

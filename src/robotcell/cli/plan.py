@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from robotcell.calibration.sigmaparts import sigma_basis
-from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of
+from robotcell.cli.common import check_noise, format_table, output_of
 from robotcell.cli.files import OUTPUT, Command
 from robotcell.cli.robotname import load_cell
 from robotcell.cli.simulate import (
@@ -112,9 +112,7 @@ def plan(procedure: str, cell_path: str, noise: float, runs: int, output: str | 
       robotcell plan frame --cell cell.yaml --tool pointer --frame fixture --max-size 300 \\
           -o frame_touches.csv
     """
-    if not 0 < noise <= NOISE_MAX_MM:
-        raise InputError(f"--noise must be a positive number of millimetres, at most "
-                         f"{NOISE_MAX_MM:g}, got {noise:g}")
+    check_noise(noise)
     cell = load_cell(cell_path)
     common = common_keywords(procedure, given["tool"], given["frame"], given["track_mm"])
     common.update(design_keywords(procedure, {"touches": given["touches"],

@@ -38,7 +38,14 @@ from robotcell.cli.calibrate import (
     robot_and_tool,
     sigma_m,
 )
-from robotcell.cli.common import NOISE_MAX_MM, format_table, output_of, parse_numbers, read_csv
+from robotcell.cli.common import (
+    NOISE_MAX_MM,
+    check_noise,
+    format_table,
+    output_of,
+    parse_numbers,
+    read_csv,
+)
 from robotcell.cli.files import NAME_OR_FILE, OUTPUT, Command
 from robotcell.errors import InputError
 from robotcell.io.fileio import atomic_write
@@ -337,9 +344,7 @@ def plan_robot_to_robot_cmd(**options: Any) -> None:
     o = _Planned(**options)
     cell_path, robot, reference_robot, noise = o.cell_path, o.robot, o.reference_robot, o.noise
     track_ref, track_other, output = o.track_ref, o.track_other, o.output
-    if not 0 < noise <= NOISE_MAX_MM:
-        raise InputError(f"--noise must be a positive number of millimetres, at most "
-                         f"{NOISE_MAX_MM:g}, got {noise:g}")
+    check_noise(noise)
     cell = Cell.load(cell_path)
     p = plan_robot_to_robot(cell, robot, reference_robot, tools=(o.tool_ref, o.tool_other),
                             noise=noise * 1e-3, runs=o.runs, seed=o.seed,

@@ -13,7 +13,7 @@ from pathlib import Path
 from robotcell.controllers.data import fmt_num, parse_float
 from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
-from robotcell.io.tables import MAX_ABS_VALUE
+from robotcell.io.tables import MAX_ABS_VALUE, spreadsheet_number
 
 __all__ = ["JOINT_DECIMALS", "NUMBER", "Lines", "fmt_num", "strip_comment"]
 
@@ -63,12 +63,14 @@ class Lines:
         return f"{self.path}:{lineno}"
 
     def number(self, text: str, lineno: int) -> float:
-        """A finite number of at most :data:`~robotcell.io.tables.MAX_ABS_VALUE` in size, or an
-        error naming the line."""
-        try:
-            v = float(text)
-        except ValueError:
-            v = math.nan
+        """A finite number of at most :data:`~robotcell.io.tables.MAX_ABS_VALUE` in size, written
+        as a controller writes one (digits 0-9, a decimal point, an exponent), or an error naming
+        the line. Python's ``float`` also reads ``1_000`` and digits of other scripts (``١٢``),
+        which no controller writes: a typing error, refused rather than read as a position."""
+        v = spreadsheet_number(text)
+        if v is None:
+            raise self.error(lineno, f"{text.strip()!r} is not a number (digits 0-9, a decimal "
+                                     "point, an exponent)")
         if not math.isfinite(v):  # the message of parse_float, naming the line
             v = parse_float(text.strip(), f"{self.path}: line {lineno}")
         if abs(v) > MAX_ABS_VALUE:

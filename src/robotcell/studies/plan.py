@@ -30,7 +30,7 @@ from robotcell.cell.calibrate.registry import Planner, having
 from robotcell.errors import InputError, RobotcellError
 from robotcell.studies.simulate import Touches, check_counts, simulate
 
-__all__ = ["DESIGNS", "LEVER", "PLANNERS", "POSE_KEY", "Candidate", "MonteCarlo", "Plan",
+__all__ = ["DESIGNS", "LEVER", "NOISE_MIN", "PLANNERS", "POSE_KEY", "Candidate", "MonteCarlo", "Plan",
            "calibrate_touches", "plan", "pose_error", "predicted_sigma"]
 
 #: ``progress(items, label)``: wraps a sized iterable (e.g. in a progress bar) and yields its items.
@@ -38,6 +38,10 @@ Progress = Callable[[Sized, str], Iterable[Any]]
 
 #: Distance from the frame origin at which rotation uncertainty is weighed against position (m).
 LEVER = 0.5
+
+#: Smallest touch-up accuracy a plan takes (m): 1 um, below any touch-up accuracy. The fits
+#: weigh by ``1 / noise**2``, which a far smaller noise (1e-200 m) makes infinite.
+NOISE_MIN = 1e-6
 
 #: The procedures that can be planned (those of the registry with a
 #: :class:`~robotcell.cell.calibrate.registry.Planner`), by name.
@@ -204,7 +208,7 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
         A procedure of :data:`PLANNERS`: ``"tcp"``, ``"frame"``, ``"track"``, ``"turntable"``,
         ``"workpiece"``, or one registered with a planner.
     noise : float
-        Touch-up accuracy, 1-sigma per coordinate (m); > 0.
+        Touch-up accuracy, 1-sigma per coordinate (m); at least :data:`NOISE_MIN`.
     runs : int
         Monte Carlo runs at the best design (0: none).
     seed : int, optional
@@ -225,12 +229,13 @@ def plan(cell: Cell, procedure: str, noise: float = 1e-4, runs: int = 100,
     Raises
     ------
     InputError
-        Unknown procedure, non-positive noise, no feasible design.
+        Unknown procedure, a noise below :data:`NOISE_MIN` or not finite, no feasible design.
     """
     if procedure not in DESIGNS:
         raise InputError(f"unknown procedure {procedure!r}; choose from {', '.join(DESIGNS)}")
-    if not (math.isfinite(noise) and noise > 0):
-        raise InputError(f"noise must be a positive number (m), got {noise}")
+    if not (math.isfinite(noise) and noise >= NOISE_MIN):
+        raise InputError(f"noise must be a positive number (m) of at least {NOISE_MIN:g} (1 um, "
+                         f"below any touch-up accuracy), got {noise}")
     if runs < 0:
         raise InputError(f"runs must be >= 0, got {runs}")
     check_counts(common)

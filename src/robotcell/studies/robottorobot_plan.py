@@ -13,6 +13,7 @@ gives the RMS of the actual pose errors. Docs: docs/calibration.md, "Robot to ro
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ from robotcell.calibration.robottorobot import RobotTouches, robot_to_robot
 from robotcell.cell import Cell
 from robotcell.errors import InputError
 from robotcell.kinematics.transforms import invert, make_pose, transform_points
-from robotcell.studies.plan import LEVER, pose_error
+from robotcell.studies.plan import LEVER, NOISE_MIN, pose_error
 
 __all__ = ["SIZES", "R2RDesign", "R2RPlan", "common_volume", "plan_robot_to_robot"]
 
@@ -204,8 +205,8 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     Raises
     ------
     InputError
-        A cell of one robot, an unknown robot or tool, the same robot twice, a noise that is not
-        positive, a track position for a robot without a track or outside its limits, or fewer
+        A cell of one robot, an unknown robot or tool, the same robot twice, a noise below
+        :data:`robotcell.studies.plan.NOISE_MIN` or not finite, a track position for a robot without a track or outside its limits, or fewer
         than 3 sampled points both robots reach.
     """
     if len(cell.robots) < 2:
@@ -215,8 +216,9 @@ def plan_robot_to_robot(cell: Cell, robot: str, reference: str, *,
     if names[0] == names[1]:
         raise InputError(f"the reference and the other robot are both {robot!r}; name two "
                          "robots of the cell")
-    if not noise > 0:
-        raise InputError(f"noise must be a positive distance (m), got {noise!r}")
+    if not (math.isfinite(noise) and noise >= NOISE_MIN):
+        raise InputError(f"noise must be a positive distance (m) of at least {NOISE_MIN:g} (1 um, "
+                         f"below any touch-up accuracy), got {noise!r}")
     use = (_tool(cell.for_robot(names[0]), names[0], tools[0]),
            _tool(cell.for_robot(names[1]), names[1], tools[1]))
     rng = np.random.default_rng(seed)
