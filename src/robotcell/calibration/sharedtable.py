@@ -43,7 +43,7 @@ from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
 
 __all__ = ["Agreement", "carried", "compare_shared", "judge_agreement", "pose_estimate",
-           "prior_warnings", "shared_turntable"]
+           "prior_warnings", "shared_turntable", "two_robot_fit"]
 
 _AXES = ("position x", "position y", "position z", "rotation about x", "rotation about y",
          "rotation about z")
@@ -340,16 +340,21 @@ def prior_warnings(pf: PriorFit) -> list[str]:
     return out
 
 
-def _shared_result(pf: PriorFit, unpack, sets: list[RobotTouches]) -> CalibrationResult:
-    """The result of :func:`shared_turntable`: both poses, the radius, residuals of every touch
-    (the other robot's along the reference base's axes)."""
+def two_robot_fit(pf: PriorFit, T_ref_other: NDArray[np.float64], sets: list[RobotTouches],
+                  kind: str, advice: str) -> tuple[list[str], list[str], dict[str, Any]]:
+    """Labels, warnings and fit fields of a fit of two robots' touches of a shared axis (the
+    first two sets, touches of kind ``kind``) and of their common points (the last two).
+
+    The other robot's residuals are turned along the reference base's axes by ``T_ref_other``
+    (4, 4); the fields hold the touches' rows only (not the tools' prior rows); ``advice`` is
+    what to measure when the condition number exceeds :data:`CONDITION_LIMIT`.
+    """
     res, n = pf.fit, pf.touches
-    T, T_B, r, _ = unpack(pf.x)
     resid = res.residuals[:n].copy()
     rows = np.cumsum([0] + [len(s.points) for s in sets])
     for k in range(1, len(sets), 2):
-        resid[rows[k]:rows[k + 1]] = resid[rows[k]:rows[k + 1]] @ T[:3, :3].T
-    kinds = ["table", "table", "point", "point"]
+        resid[rows[k]:rows[k + 1]] = resid[rows[k]:rows[k + 1]] @ T_ref_other[:3, :3].T
+    kinds = [kind, kind, "point", "point"]
     labels = [f"{s.robot or ('ref', 'other')[k % 2]} {kinds[k]} touch {i + 1}"
               + (f" ({s.names[i]})" if kinds[k] == "point" else "")
               for k, s in enumerate(sets) for i in range(len(s.points))]
@@ -357,12 +362,21 @@ def _shared_result(pf: PriorFit, unpack, sets: list[RobotTouches]) -> Calibratio
     warnings = [w for w in warnings if not any(f"touch {b} " in w for b in pf.blocks)]
     if res.condition > CONDITION_LIMIT:
         warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: "
-                        "touch the table point at more angles around the turn")
-    p = pf.size
+                        + advice)
     fields = fit_fields(res)
     fields["residuals"] = resid
     for key in ("excluded", "unchecked", "outliers", "disagreeing", "gross"):
         fields[key] = [i for i in fields[key] if i < n]
+    return labels, warnings, fields
+
+
+def _shared_result(pf: PriorFit, unpack, sets: list[RobotTouches]) -> CalibrationResult:
+    """The result of :func:`shared_turntable`: both poses, the radius, residuals of every touch
+    (the other robot's along the reference base's axes)."""
+    T, T_B, r, _ = unpack(pf.x)
+    labels, warnings, fields = two_robot_fit(
+        pf, T, sets, "table", "touch the table point at more angles around the turn")
+    p = pf.size
     sigma = pf.sources.sigma
     return CalibrationResult(
         procedure="robot-to-robot", values={"T_ref_other": T, "T_ref_B": T_B, "radius": r},

@@ -39,12 +39,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from robotcell.calibration.fitting import fit, outlier_warnings
+from robotcell.calibration.fitting import fit
 from robotcell.calibration.priors import PriorFit, fit_with_priors
 from robotcell.calibration.result import (
-    CONDITION_LIMIT,
     CalibrationResult,
-    fit_fields,
     pose_fields,
 )
 from robotcell.calibration.robottorobot import (
@@ -58,7 +56,7 @@ from robotcell.calibration.sharedtable import (
     carried,
     judge_agreement,
     pose_estimate,
-    prior_warnings,
+    two_robot_fit,
 )
 from robotcell.calibration.uncertainty import OWN, Sources, estimate
 from robotcell.errors import InputError
@@ -447,25 +445,10 @@ def shared_positioner(ref_table: RobotTouches, ref_values: ArrayLike, other_tabl
 def _joint_result(pf: PriorFit, fitted: tuple, sets: list[RobotTouches]) -> CalibrationResult:
     """The result of :func:`shared_positioner`: both poses, the axes' offset and angle,
     residuals of every touch (the other robot's along the reference base's axes)."""
-    res, n = pf.fit, pf.touches
     T, T_B, off, ang = fitted[:4]
-    resid = res.residuals[:n].copy()
-    rows = np.cumsum([0] + [len(s.points) for s in sets])
-    for k in range(1, len(sets), 2):
-        resid[rows[k]:rows[k + 1]] = resid[rows[k]:rows[k + 1]] @ T[:3, :3].T
-    kinds = ["positioner", "positioner", "point", "point"]
-    labels = [f"{s.robot or ('ref', 'other')[k % 2]} {kinds[k]} touch {i + 1}"
-              + (f" ({s.names[i]})" if kinds[k] == "point" else "")
-              for k, s in enumerate(sets) for i in range(len(s.points))]
-    warnings = outlier_warnings(res, labels + pf.blocks) + prior_warnings(pf)
-    warnings = [w for w in warnings if not any(f"touch {b} " in w for b in pf.blocks)]
-    if res.condition > CONDITION_LIMIT:
-        warnings.append(f"condition number {res.condition:.0f} exceeds {CONDITION_LIMIT:.0f}: "
-                        "touch the plate point at more tilt and rotate values with both robots")
-    fields = fit_fields(res)
-    fields["residuals"] = resid
-    for key in ("excluded", "unchecked", "outliers", "disagreeing", "gross"):
-        fields[key] = [i for i in fields[key] if i < n]
+    labels, warnings, fields = two_robot_fit(
+        pf, T, sets, "positioner",
+        "touch the plate point at more tilt and rotate values with both robots")
     sigma, p = pf.sources.sigma, pf.size
     axes = ("x", "y", "z", "rx", "ry", "rz")
     return CalibrationResult(
