@@ -233,8 +233,8 @@ def test_turntable_cell_command_by_command(tmp_path, capsys):
 def test_a_poor_demo_names_the_noise_parameter_in_python_and_the_option_in_the_cli(
         tmp_path, capsys, monkeypatch):
     """The demo states the accuracy it simulates; touches worse than that (5 mm) are poor."""
-    from robotcell.errors import InputError
     from robotcell.demo import walkthrough as demo
+    from robotcell.errors import InputError
     from robotcell.studies.simulate import simulate
 
     monkeypatch.setattr(demo, "simulate", lambda truth, procedure, noise, **kw: simulate(

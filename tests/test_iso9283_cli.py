@@ -298,8 +298,8 @@ def test_the_library_ur_arms_carry_their_manual_repeatability(name, mm, page):
 def test_a_ur5e_cell_takes_its_manual_repeatability_as_the_limit_of_rp(tmp_path):
     """`analyse(..., robot=...)` of a UR5e: the limit of RP_l is the manual's 0.03 mm, named
     with its source, without a --limit-rp."""
-    from robotcell.iso9283 import analyse, plan, simulate
     from robotcell.cell.model import cell_from_dict
+    from robotcell.iso9283 import analyse, plan, simulate
     from robotcell.robot.models import load_robot
 
     cell = cell_from_dict({"name": "ur5e_test", "robot": {"model": "ur5e"}, "tools": {

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run
-from test_view_scenes import assert_triad_line
 from test_report import _chromium
+from test_view_scenes import assert_triad_line
 from view_helpers import figure_from_page, js_errors, moving_parts, render, traces, xyz
 
 from robotcell import InputError, make_pose

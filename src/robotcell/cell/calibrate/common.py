@@ -116,6 +116,17 @@ def sha256_of(path: str | Path) -> str:
         raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
 
 
+def touch_file_problem(item: str, path: str | Path, digest: str | None) -> str | None:
+    """Why the touch file ``path`` a calibration of ``item`` recorded cannot be repeated: it is
+    missing, or its SHA-256 is no longer ``digest``; None when it can (or no digest was
+    recorded)."""
+    if not Path(path).is_file():
+        return f"{item}: touch file {path} is missing"
+    if digest is not None and sha256_of(path) != digest:
+        return f"{item}: touch file {path} has changed since the calibration (checksum differs)"
+    return None
+
+
 def provenance_of(procedure: str, result: CalibrationResult, n: int, source: str,
                   time: str | None, cell: Cell, item: str, value: str, record: Record,
                   inputs: tuple[str, ...] | None = None) -> Provenance:

@@ -10,8 +10,8 @@ writes the other robot's base into the cell through :meth:`robotcell.cell.Cell.s
 
 from __future__ import annotations
 
-from collections.abc import Callable
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -21,7 +21,7 @@ import numpy as np
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.robottorobot_tables import RobotTable, robot_to_robot_tables
 from robotcell.calibration.uncertainty import factor_of
-from robotcell.cell.calibrate.common import sha256_of
+from robotcell.cell.calibrate.common import sha256_of, touch_file_problem
 from robotcell.cell.calibrate.whole import fitted_note
 from robotcell.cell.model import Cell
 from robotcell.cell.parts import Provenance
@@ -205,15 +205,10 @@ class RecordedLink:
     def problems(self) -> list[str]:
         """Its touch files that are missing or changed since the placement (none: repeatable)."""
         o = self.provenance.options
-        out = []
-        for path, digest in ((self.reference.path, o.get("reference_sha256")),
-                             (self.other.path, self.provenance.sha256)):
-            if not Path(path).is_file():
-                out.append(f"robots.{self.other.robot}.base: touch file {path} is missing")
-            elif digest is not None and sha256_of(path) != digest:
-                out.append(f"robots.{self.other.robot}.base: touch file {path} has changed since "
-                           "the calibration (checksum differs)")
-        return out
+        found = (touch_file_problem(f"robots.{self.other.robot}.base", path, digest)
+                 for path, digest in ((self.reference.path, o.get("reference_sha256")),
+                                      (self.other.path, self.provenance.sha256)))
+        return [p for p in found if p is not None]
 
 
 def repeat_link(cell: Cell, link: RecordedLink, time: str | None = None

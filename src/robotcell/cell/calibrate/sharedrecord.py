@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from robotcell.cell.calibrate.common import sha256_of
+from robotcell.cell.calibrate.common import touch_file_problem
 from robotcell.cell.calibrate.robottorobot import RobotTouchFile
 from robotcell.cell.model import Cell
 from robotcell.cell.parts import Provenance
@@ -72,12 +72,7 @@ class RecordedShared:
 
     def problems(self) -> list[str]:
         """Its touch files that are missing or changed since the fit (none: repeatable)."""
-        out = []
-        for key, path in zip(FILES, self.files, strict=True):
-            digest = self.provenance.options.get(f"{key}_sha256")
-            if not Path(path).is_file():
-                out.append(f"positioner (shared-positioner): touch file {path} is missing")
-            elif digest is not None and sha256_of(path) != digest:
-                out.append(f"positioner (shared-positioner): touch file {path} has changed "
-                           "since the calibration (checksum differs)")
-        return out
+        found = (touch_file_problem("positioner (shared-positioner)", path,
+                                    self.provenance.options.get(f"{key}_sha256"))
+                 for key, path in zip(FILES, self.files, strict=True))
+        return [p for p in found if p is not None]

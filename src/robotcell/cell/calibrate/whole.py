@@ -47,7 +47,7 @@ from robotcell.cell.calibrate.chain import (
     item_sources,
     perturbed,
 )
-from robotcell.cell.calibrate.common import CellCalibration, copied, sha256_of
+from robotcell.cell.calibrate.common import CellCalibration, copied, touch_file_problem
 from robotcell.cell.calibrate.context import CalibrationContext
 from robotcell.cell.calibrate.registry import having, procedure
 from robotcell.errors import InputError, term
@@ -259,14 +259,11 @@ def _recorded(cell: Cell, label: str, owned: Callable[[str], bool] | None
     """Items with a recorded touch file, refusing missing or changed files (all named)."""
     out, problems = [], []
     for key, prov in _calibrated(cell, owned):
-        path = Path(prov.measurements)
-        if not path.is_file():
-            problems.append(f"{key}: touch file {path} is missing")
-        elif prov.sha256 is not None and sha256_of(path) != prov.sha256:
-            problems.append(f"{key}: touch file {path} has changed since the calibration "
-                            "(checksum differs)")
-        else:
+        problem = touch_file_problem(key, Path(prov.measurements), prov.sha256)
+        if problem is None:
             out.append((key, prov))
+        else:
+            problems.append(problem)
     if problems:
         raise InputError(f"{label}: cannot repeat the calibrations: " + "; ".join(problems)
                          + ". Restore the files, or calibrate those items again")
