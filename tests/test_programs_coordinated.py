@@ -141,7 +141,7 @@ def _paths_with(tmp_path, robot, text):
                            .replace(",20\n", ",20,5,0\n")),
      "abb", r"positioner's values differ"),
     (lambda t: SEAMS, "kuka", r"KUKA coordinated programs .* not written.*RoboTeam"),
-    (lambda t: SEAMS, "fanuc", r"FANUC coordinated .*two robot groups"),
+    (lambda t: SEAMS, "fanuc", r"FANUC coordinated .*frame of the follower.s points"),
     (lambda t: SEAMS, "yaskawa", r"robot\(s\) rob1 on a track: .*base axis"),
 ])
 def test_bad_input_is_refused_and_nothing_is_written(tmp_path, capsys, make, vendor, match):

@@ -50,16 +50,15 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     check_kind(output, "URDF" if fmt == URDF else "text", f"the {fmt} export",
                named=other_kinds(fmt), ending=output_ending(fmt))
     cell = Cell.load(cell_path)  # the URDF holds every robot, a controller's export its own
-    if fmt != URDF:
-        cell = cell.for_robot(robot_of(cell, cell_path))
+    robot = None if fmt == URDF else robot_of(cell, cell_path)
     if output is None:
-        write_output(None, export_cell(cell, fmt))
+        write_output(None, export_cell(cell, fmt, robot))
         return
     if fmt == URDF:
         refuse_overwriting_inputs(click.get_current_context(),
                                   [("the UR calibration file written next to -o",
                                     str(ur_kinematics_path(output)))])
-    done = export_files(cell, fmt, output)
+    done = export_files(cell, fmt, output, robot)
     for f in done.files:
         click.echo(f"wrote {f}", err=True)
     for w in done.warnings:

@@ -254,6 +254,12 @@ class Controller(ABC):
             self.check_frame(s)
         return self.format_export(data, cell.name)
 
+    def pair_lines(self, cell: Cell) -> list[str]:
+        """Comment lines that place the robots of a cell of several robots in each other as the
+        controller holds them when it moves them all (FANUC's coordinated pair, YASKAWA's robot
+        calibration; :mod:`robotcell.controllers.robotpairs`); none here."""
+        return []
+
     @abstractmethod
     def format_export(self, data: ControllerData, cell_name: str) -> str:
         """The export text of ``data`` (collected in :attr:`reference`)."""

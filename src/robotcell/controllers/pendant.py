@@ -30,7 +30,7 @@ from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 
 __all__ = ["PendantListing", "format_listing", "listing_line", "parse_listing",
-           "parse_pendant_listing"]
+           "parse_pendant_listing", "pose_text"]
 
 
 @dataclass(frozen=True)
@@ -90,9 +90,13 @@ def listing_line(key: str, number: int, values: NDArray[np.float64], fields: tup
     name : str
         Name written after the comment marker.
     """
-    vals = "  ".join(f"{f} {fmt_num(v, MM_DECIMALS if i < 3 else DEG_DECIMALS)}"
+    return f"{key}[{number}]  {pose_text(values, fields)}  {comment} {name}"
+
+
+def pose_text(values: NDArray[np.float64], fields: tuple[str, ...]) -> str:
+    """``F1 v1  F2 v2 ...``: three lengths (mm, 6 decimals) and three angles (deg, 9 decimals)."""
+    return "  ".join(f"{f} {fmt_num(v, MM_DECIMALS if i < 3 else DEG_DECIMALS)}"
                      for i, (f, v) in enumerate(zip(fields, values)))
-    return f"{key}[{number}]  {vals}  {comment} {name}"
 
 
 def parse_listing(text: str, keys: tuple[str, ...], fields: tuple[str, ...], comment: str

@@ -55,21 +55,33 @@ def other_kinds(fmt: str) -> dict[str, str]:
             for c in CONTROLLERS.values() for s in c.program_suffixes if s != own}
 
 
-def export_cell(cell: Cell, fmt: str) -> str:
+def export_cell(cell: Cell, fmt: str, robot: str | None = None) -> str:
     """Text for ``cell`` in format ``fmt`` (a registered controller, or ``urdf``).
+
+    Parameters
+    ----------
+    cell : Cell
+    fmt : str
+        ``urdf`` (every robot of the cell) or a controller's name.
+    robot : str, optional
+        The robot whose controller export is written, in a cell of several robots (None: the
+        only robot). Its export ends with the controller's placement of the cell's robots in
+        each other where it holds one (:meth:`~robotcell.controllers.base.Controller.pair_lines`).
 
     Raises
     ------
     InputError
-        An unknown format, a tool or frame number the controller does not have, or a cell it
-        cannot hold.
+        An unknown format or robot, a tool or frame number the controller does not have, or a
+        cell it cannot hold.
     """
     if fmt.lower() == URDF:
         return urdf.export(cell)
     if fmt.lower() not in CONTROLLERS:
         raise InputError(f"unknown export format {fmt!r}; choose one of: "
                          f"{', '.join(write_formats())}")
-    return get(fmt).export(cell)
+    controller = get(fmt)
+    text = controller.export(cell.for_robot(robot))
+    return text + "".join(f"{line}\n" for line in controller.pair_lines(cell))
 
 
 def ur_kinematics_path(output: str | Path) -> Path:
@@ -95,7 +107,8 @@ class ExportedFiles:
     warnings: list[str] = field(default_factory=list)
 
 
-def export_files(cell: Cell, fmt: str, output: str | Path) -> ExportedFiles:
+def export_files(cell: Cell, fmt: str, output: str | Path,
+                 robot: str | None = None) -> ExportedFiles:
     """Write the export of ``cell`` to ``output`` (atomically), and what goes with it.
 
     The URDF of a cell whose identified arm is a Universal Robots arm comes with the UR
@@ -104,12 +117,19 @@ def export_files(cell: Cell, fmt: str, output: str | Path) -> ExportedFiles:
     arm as it is. An arm identified with axis scales, which that file cannot hold, gets the file
     of its geometry without them and a warning that says so.
 
+    Parameters
+    ----------
+    cell, fmt, robot
+        As :func:`export_cell`.
+    output : str or Path
+        The file to write.
+
     Returns
     -------
     ExportedFiles
         The files written and the warnings.
     """
-    text = export_cell(cell, fmt)
+    text = export_cell(cell, fmt, robot)
     extra = cell_ur_kinematics(cell) if fmt.lower() == URDF else None
     files = [Path(output)]
     if extra is not None:

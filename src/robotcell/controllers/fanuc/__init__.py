@@ -31,6 +31,7 @@ from robotcell.controllers.data import ControllerData
 from robotcell.controllers.fanuc import export as listing
 from robotcell.controllers.fanuc import program as tp
 from robotcell.controllers.model import Config, Program, Ref
+from robotcell.controllers.robotpairs import robot_pairs
 from robotcell.errors import InputError
 from robotcell.ik.config import arm_sides
 from robotcell.ik.limits import TWO_PI
@@ -72,9 +73,9 @@ class Fanuc(Controller):
     edits_joints = True
     csv_config = ("config",)
     coordinated_missing = (
-        "a FANUC program of two robot groups (Multi-Arm, Coordinated Motion: the group mask "
-        "with several robots and the points of each group) is shown by no public FANUC manual "
-        "or real .ls file in the sources robotcell cites")
+        "no public source states the frame of the follower's points in a COORD motion (the "
+        "leader frame, which moves with the leader), so they can be neither computed nor "
+        "checked")
     sources = (
         "Roboception rc_visard documentation, 'Pose formats: FANUC' (W, P, R)",
         ("industrialmonitordirect.com knowledge base, 'FANUC robot frame selection: UFRAME_NUM "
@@ -89,6 +90,9 @@ class Fanuc(Controller):
          "'X =   -63.679  mm', 'P =      .153 deg', 'J1=     0.000  mm': 3 decimals, 10 "
          "characters"),
     )
+
+    def pair_lines(self, cell: Cell) -> list[str]:
+        return listing.pair_lines(robot_pairs(cell, limit=2))
 
     def format_export(self, data: ControllerData, cell_name: str) -> str:
         return listing.format_data(data, cell_name)

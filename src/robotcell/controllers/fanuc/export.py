@@ -7,15 +7,30 @@ METHOD > Direct Entry, or to load into a position register and assign in a TP pr
 (9 decimals) with ``R = Rz(R) Ry(P) Rx(W)``. Tools are in the faceplate frame; user frames in
 FANUC WORLD, which sits at the robot base (at track position 0 for a robot on a rail). A frame
 on the turntable is written at table axis 0, and the turntable root (Z on the axis) is written as
-one more user frame, the next free number. See ``docs/export.md``.
+one more user frame, the next free number.
+
+In a cell of several robots, :func:`pair_lines` adds the coordinated pair of the first two
+robots (motion groups 1 and 2), as MENU > SETUP > Coord shows it with Leader Group 2 and
+Follower Group 1: X, Y, Z, W, P, R of the leader's WORLD in the follower's WORLD, the values the
+``C_TYP`` Known Direct method takes. Source: rpiRobotics/fanuc_motion_program_exec (Apache-2.0),
+``doc/multi_robot_coord_setup.md``, ``doc/roboguide_base.md`` with its pendant screenshot
+``doc/figures_base/teach_pendant.png`` and ``tools/roboguide_base_adjust.py`` (R2's WORLD is
+R1's WORLD times these values). See ``docs/export.md``.
 """
 
 from __future__ import annotations
 
 from robotcell.controllers.data import ControllerData
-from robotcell.controllers.pendant import PendantListing, format_listing, parse_pendant_listing
+from robotcell.controllers.pendant import (
+    PendantListing,
+    format_listing,
+    parse_pendant_listing,
+    pose_text,
+)
+from robotcell.controllers.robotpairs import RobotPair
+from robotcell.io.poseformats import FORMATS, pose_to_vendor
 
-__all__ = ["LISTING", "format_data", "parse"]
+__all__ = ["LISTING", "format_data", "pair_lines", "parse"]
 
 #: FANUC wording of the pendant listing
 LISTING = PendantListing(
@@ -35,3 +50,33 @@ def format_data(data: ControllerData, cell_name: str) -> str:
 def parse(text: str) -> ControllerData:
     """Read a listing written by :func:`export` back: tools, and frames fixed in WORLD (metres)."""
     return parse_pendant_listing(text, LISTING)
+
+
+def pair_lines(pairs: list[RobotPair]) -> list[str]:
+    """Comment lines of the coordinated pair (``!``), for :func:`format_data`'s listing.
+
+    Parameters
+    ----------
+    pairs : list of RobotPair
+        From :func:`robotcell.controllers.robotpairs.robot_pairs` with ``limit=2``.
+
+    Returns
+    -------
+    list of str
+        A title, then per robot its pair line and the values (mm, deg), or why none is
+        written; empty for a cell of one robot.
+    """
+    if not pairs:
+        return []
+    lines = [("! coordinated pair: MENU > SETUP > Coord, C_TYP Known Direct, SHIFT+EXEC, then "
+             "restart the controller; motion groups in the order of the cell file's robots")]
+    for p in pairs:
+        head = (f"! Coord Pair {p.group - 1}: Leader Group {p.group} = {p.other}, "
+                f"Follower Group 1 = {p.reference}")
+        if p.pose is None:
+            lines.append(f"{head}: not written ({p.why})")
+            continue
+        lines += [(f"{head} ({p.other}'s WORLD in {p.reference}'s WORLD; {p.other}'s base: "
+                  f"{p.provenance})"),
+                  f"!   {pose_text(pose_to_vendor(p.pose, 'fanuc'), FORMATS['fanuc'].fields)}"]
+    return lines

@@ -29,6 +29,7 @@ from robotcell.controllers.axes import DEG, ExternalAxes, table_count
 from robotcell.controllers.base import Controller, SlotRange
 from robotcell.controllers.data import ControllerData
 from robotcell.controllers.model import Config, Program, Ref
+from robotcell.controllers.robotpairs import robot_pairs
 from robotcell.controllers.yaskawa import export as listing
 from robotcell.controllers.yaskawa import multigroup
 from robotcell.controllers.yaskawa import program as inform
@@ -81,6 +82,9 @@ class Yaskawa(Controller):
         ("jobs written for DX100 and later (e.g. '////FRAME USER 1', '///GROUP1 RB1' with "
          "'///GROUP2 ST1', '///RCONF 1,0,...' of 24 values): docs/programs.md"),
     )
+
+    def pair_lines(self, cell: Cell) -> list[str]:
+        return listing.pair_lines(robot_pairs(cell))
 
     def format_export(self, data: ControllerData, cell_name: str) -> str:
         return listing.format_data(data, cell_name)

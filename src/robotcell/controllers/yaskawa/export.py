@@ -8,16 +8,32 @@ the base coordinates, which sit at the robot base (at base-axis position 0 for a
 traveling axis: ``UFRAME.CND`` records that position as ``BASEP``, and these values assume 0). A
 frame on the turntable is written at station axis 0, and the turntable root (Z on the axis) as
 one more user frame, the next free number. ``UFRAME.CND`` itself also stores the three taught
-points in pulses, which only the controller can compute, so it is not written. See
-``docs/export.md``.
+points in pulses, which only the controller can compute, so it is not written.
+
+In a cell of several robots, :func:`pair_lines` adds the robot calibration of every robot to
+R1 (the cell's first robot): X, Y, Z, Rx, Ry, Rz of R2's robot coordinates in R1's, as the
+pendant shows a calibration (DISPLAY > COORDINATE DATA) and ``RBCALIB.DAT`` stores it (its
+``//SRANG`` line). They are written to compare with the controller's own calibration, which the
+pendant measures (ROBOT > ROBOT CALIB) and which ``RBCALIB.DAT`` holds with the calibration
+positions in pulses, so the file is not written. Source: Yaskawa-Global/motoros2 (Apache-2.0),
+``src/Ros_mpGetRobotCalibrationData.c`` (the file's lines), ``src/ControllerStatusIO.c`` and
+``src/PositionMonitor.c`` (the slave robot's frame placed in the master's by these values, ZYX
+Euler angles). See ``docs/export.md``.
 """
 
 from __future__ import annotations
 
 from robotcell.controllers.data import ControllerData
-from robotcell.controllers.pendant import PendantListing, format_listing, parse_pendant_listing
+from robotcell.controllers.pendant import (
+    PendantListing,
+    format_listing,
+    parse_pendant_listing,
+    pose_text,
+)
+from robotcell.controllers.robotpairs import RobotPair
+from robotcell.io.poseformats import FORMATS, pose_to_vendor
 
-__all__ = ["LISTING", "format_data", "parse"]
+__all__ = ["LISTING", "format_data", "pair_lines", "parse"]
 
 #: YASKAWA wording of the pendant listing
 LISTING = PendantListing(
@@ -38,3 +54,33 @@ def format_data(data: ControllerData, cell_name: str) -> str:
 def parse(text: str) -> ControllerData:
     """Read a listing written by :func:`export` back (tools, frames in base coordinates; m)."""
     return parse_pendant_listing(text, LISTING)
+
+
+def pair_lines(pairs: list[RobotPair]) -> list[str]:
+    """Comment lines (``'``) of the robot calibration of every robot to R1.
+
+    Parameters
+    ----------
+    pairs : list of RobotPair
+        From :func:`robotcell.controllers.robotpairs.robot_pairs`.
+
+    Returns
+    -------
+    list of str
+        A title, then per robot its calibration line and the values (mm, deg), or why none
+        is written; empty for a cell of one robot.
+    """
+    if not pairs:
+        return []
+    lines = [(f"' robot calibration to R1 = {pairs[0].reference} (robots numbered in the order of "
+             "the cell file's robots): compare with DISPLAY > COORDINATE DATA after ROBOT > "
+             "ROBOT CALIB")]
+    for p in pairs:
+        head = f"' R1+R{p.group} (R{p.group} = {p.other})"
+        if p.pose is None:
+            lines.append(f"{head}: not written ({p.why})")
+            continue
+        lines += [(f"{head}: R{p.group}'s robot coordinates in R1's ({p.other}'s base: "
+                  f"{p.provenance})"),
+                  f"'   {pose_text(pose_to_vendor(p.pose, 'yaskawa'), FORMATS['yaskawa'].fields)}"]
+    return lines
