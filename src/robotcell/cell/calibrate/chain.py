@@ -19,6 +19,9 @@ item                      parameters
 ``turntable`` (chain)     a positioner of n axes: the root pose ``T_parent_0``, then
                           ``a``, ``alpha``, ``d``, ``theta`` of each axis: 6 + 4 n
 ``track``                 ``T_L_R0`` and ``scale``: 7
+``base``                  ``T_world_R`` of a robot without a track: 6 (an input only,
+                          where the cell records its uncertainty: a base placed by a
+                          robot-to-robot or shared-positioner calibration)
 ========================  ==========================================================
 
 An item with no recorded uncertainty (a nominal or typed-in value, or one calibrated before
@@ -43,8 +46,8 @@ from robotcell.cell.parts import Positioner
 from robotcell.errors import InputError, term
 from robotcell.kinematics.transforms import invert, transform_points
 
-__all__ = ["NOMINAL_ACCURACY", "NominalAccuracy", "item_pose", "item_size", "item_sources",
-           "perturbed", "plate_inputs", "touch_inputs", "written_sources"]
+__all__ = ["NOMINAL_ACCURACY", "NominalAccuracy", "base_inputs", "item_pose", "item_size",
+           "item_sources", "perturbed", "plate_inputs", "touch_inputs", "written_sources"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +101,8 @@ def item_pose(cell: Cell, key: str) -> tuple[NDArray[np.float64], Any]:
         return cell.track.T_L_R0, cell.track
     if key == "turntable" and cell.turntable is not None:
         return cell.turntable.T_parent_root, cell.turntable
+    if key == "base" and len(cell.robots) == 1 and cell.track is None:
+        return cell.T_world_R, cell.robots[cell.robot_name]
     raise InputError(f"the cell has no item {key!r}")
 
 
@@ -115,7 +120,7 @@ def item_sources(cell: Cell, key: str, nominal: NominalAccuracy = NOMINAL_ACCURA
     """
     _, owner = item_pose(cell, key)
     size = item_size(cell, key)
-    prov = owner.provenance
+    prov = owner.base_provenance if key == "base" else owner.provenance
     if prov.sources:
         return Sources(size, dict(prov.sources)), None
     what = "a nominal value" if prov.source in ("nominal", "manual") else (
@@ -201,7 +206,9 @@ def touch_inputs(cell: Cell, points_R: ArrayLike, *, flange: ArrayLike | None = 
         given as a pose ``T_F_TCP``, or None for the robot model's tool, is taken at the
         nominal accuracy.
     track : array_like, shape (N,), optional
-        Track positions (m) when the touches are mapped to the world through the cell's track.
+        Track positions (m) when the touches are mapped to the world: through the cell's track,
+        or (zeros) through the base of a robot without one. The robot base's recorded
+        uncertainty (:func:`base_inputs`) then joins the inputs.
     nominal : NominalAccuracy
         Accuracy of items with none recorded.
 
@@ -242,7 +249,49 @@ def touch_inputs(cell: Cell, points_R: ArrayLike, *, flange: ArrayLike | None = 
         inputs = joined(inputs, sens, sources, [f"track {c}" for c in _POSE_NAMES + ("scale",)])
         keys.append("track")
         notes += [note] if note else []
+    elif track is not None:
+        inputs, base = base_inputs(cell, p, inputs)
+        keys += base
     return Chained(inputs, tuple(keys), tuple(notes))
+
+
+def base_inputs(cell: Cell, points_R: NDArray[np.float64], inputs: Inputs | None
+                ) -> tuple[Inputs | None, list[str]]:
+    """Inputs of touches mapped to the world through the base of a robot without a track.
+
+    The inputs so far (the tool's, in the robot base) are turned into the world, and the
+    base ``T_world_R`` joins them (key ``base``) where the cell records its uncertainty (a base
+    placed by a robot-to-robot or shared-positioner calibration); a base without one is the
+    world's definition, and exact.
+
+    Parameters
+    ----------
+    cell : Cell
+        A cell of one robot without a track (or one robot's view of a cell of several).
+    points_R : ndarray, shape (N, 3)
+        The touched points in the robot base (m).
+    inputs : Inputs or None
+        The inputs in the robot base.
+
+    Returns
+    -------
+    inputs : Inputs or None
+        In the world, with the base's parameters appended.
+    keys : list of str
+        ``["base"]`` when the base joined, else empty.
+    """
+    T_wR = cell.frame_pose("robot")
+    if inputs is not None:
+        inputs = inputs.rotated(T_wR[:3, :3])
+    if not cell.robots[cell.robot_name].base_provenance.sources:
+        return inputs, []
+    sources, _ = item_sources(cell, "base")
+
+    def mapped(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return transform_points(perturbed(T_wR, v), points_R)
+
+    sens = jacobian(mapped, np.zeros(6)).reshape(len(points_R), 3, 6)
+    return joined(inputs, sens, sources, [f"base {c}" for c in _POSE_NAMES]), ["base"]
 
 
 _POSE_NAMES = ("x", "y", "z", "rx", "ry", "rz")

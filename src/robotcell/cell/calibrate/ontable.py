@@ -71,7 +71,8 @@ def on_table(cell: Cell | None, m: TouchTable, context: CalibrationContext, note
 
 
 def world_track(cell: Cell | None, m: TouchTable) -> NDArray[np.float64] | None:
-    """Track positions of touches mapped to the world through the track of a turntable cell."""
+    """Track positions of touches mapped to the world (zeros for a robot without a track) in a
+    cell whose turntable is in the world; None where the touches stay in the robot base."""
     if not _in_world(cell):
         return None
     e = track_positions(cell, m)
@@ -79,10 +80,9 @@ def world_track(cell: Cell | None, m: TouchTable) -> NDArray[np.float64] | None:
 
 
 def _in_world(cell: Cell | None) -> bool:
-    """A cell whose robot is on a track beside a turntable or positioner in the world: its
-    touches of the table are mapped to the world through the track."""
-    return (cell is not None and cell.track is not None and cell.turntable is not None
-            and cell.turntable.parent == "world")
+    """A cell with a turntable or positioner in the world: its robot's touches of the table are
+    mapped to the world, through the track or the robot's base."""
+    return cell is not None and cell.turntable is not None and cell.turntable.parent == "world"
 
 
 def positioner_points(cell: Cell, m: TouchTable, tool: str | ArrayLike | None, label: str

@@ -17,8 +17,10 @@ base) is repeated last, at every robot's fitted tools and bases
 rest on what it moved are fitted again.
 
 What is not adjusted jointly: the robots' fits are separate (one robot's calibrations do not
-move another robot's items), and a link's touches do not refine the tools it used, nor is its
-uncertainty carried into the placed robot's items. The covariance of the result is therefore
+move another robot's items), and a link's touches do not refine the tools it used. A link's
+uncertainty reaches the placed robot's items in the world through its base (or track), an input
+of their calibrations with the link's error sources
+(:func:`robotcell.cell.calibrate.chain.base_inputs`), but the covariance of the result is
 block-diagonal: one block per robot, one per link.
 """
 
