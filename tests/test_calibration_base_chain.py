@@ -4,7 +4,7 @@ adds its own.
 
 The physics of a cell does not change when the world is turned: turning the robot and the
 turntable together by ``G`` must turn the stated covariance of the turntable (and of a frame in
-the world) by ``blkdiag(R_G, R_G)``, touch for touch. Seeded Monte Carlo (200 trials, as in
+the world, and of a positioner's root) by ``blkdiag(R_G, R_G)``, touch for touch. Seeded Monte Carlo (200 trials, as in
 ``tests/test_calibration_chain.py``): with the robot turned 60 deg in the world the spread of
 (error / reported 1-sigma) lies in 0.8-1.25 for every component; and with the robot's base
 placed with a recorded uncertainty and each trial's true base drawn from it, the frame in the
@@ -131,3 +131,25 @@ def test_a_frame_in_the_world_carries_the_recorded_uncertainty_of_the_robots_bas
     else:  # a base without a recorded uncertainty is exact: its error is not stated
         assert np.max(spread) > 2.0, np.round(spread, 3)
         assert "base" not in done.inputs
+
+
+def test_a_positioner_touched_by_a_turned_robot_states_the_turned_uncertainty():
+    plain = Cell.load("examples/cell_kr16_positioner.yaml")
+    G = _turn(90.0)
+    pos = plain.turntable
+    turned = replace(plain, T_world_R=G @ plain.T_world_R,
+                     turntable=replace(pos, chain=pos.chain.with_base(G @ pos.chain.base)))
+    tool = plain.tools["pointer"].T_F_TCP
+    designs = {k: simulate(plain, k, noise=0.0, tool="pointer") for k in ("tcp", "positioner")}
+    covariance = {}
+    for name, cell in (("plain", plain), ("turned", turned)):
+        rng = np.random.default_rng(5)
+        t = cellcal.tcp(cell, retouched(designs["tcp"], plain, tool, rng, NOISE), "pointer",
+                        sigma=NOISE)
+        done = cellcal.positioner(t.cell, retouched(designs["positioner"], plain, tool, rng,
+                                                    NOISE), tool="pointer", sigma=NOISE)
+        covariance[name] = _covariance(done.result, "T_world_B")
+    A = np.kron(np.eye(2), G[:3, :3])
+    expected = A @ covariance["plain"] @ A.T
+    scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)))
+    np.testing.assert_allclose(covariance["turned"] / scale, expected / scale, atol=1e-6)
