@@ -351,3 +351,38 @@ def test_shared_positioner_refuses_a_tool_the_cell_lacks(cell_dir):
     (ref, oth), plate = _touches(cell_dir)
     with pytest.raises(InputError, match="robot 'abb' has no tool 'welder'; its tools: "):
         shared_positioner(cell, (ref, RobotTouchFile("abb", oth.path, "welder")), plate)
+
+
+def test_a_second_robots_positioner_calibration_says_it_replaces_the_first(cell_dir, capsys):
+    """The cell file holds one calibration of the shared positioner: the ABB's replaces the
+    KUKA's, and the command says so and names the joint fit; the same robot again says
+    nothing of it."""
+    args = ["calibrate", "positioner", cell_dir / "positioner_abb.csv", "--cell",
+            cell_dir / "cell.yaml", "--robot-name", "abb", "--tool", "torch", "--sigma", "0.1"]
+    code, _, err = run(capsys, *args)
+    assert code == 0, err
+    assert ("note: positioner 'DKP_2' was calibrated by robot 'kuka' (positioner_kuka.csv); "
+            "this calibration by robot 'abb' replaces it in the cell file; to compare the two "
+            "within their 1-sigma and fit both robots' touches together, use 'robotcell "
+            "calibrate shared-positioner'") in err
+    assert Cell.load(cell_dir / "cell.yaml").turntable.provenance.options["robot"] == "abb"
+    code, _, err = run(capsys, *args)
+    assert code == 0 and "replaces it" not in err
+
+
+def test_a_frame_in_the_world_another_robot_calibrated_is_named_when_replaced():
+    from robotcell.cell import Provenance
+    from robotcell.cell.calibrate.wholerobots import replaced_notes
+
+    before = Cell.load("examples/cell_two_robots_positioner.yaml")
+    by_kuka = replace(Provenance.now("frame"), measurements="frame_kuka.csv",
+                      options={"robot": "kuka"})
+    before.frames["table"] = replace(before.frames["table"], provenance=by_kuka)
+    after = Cell.load("examples/cell_two_robots_positioner.yaml")
+    after.frames["table"] = replace(before.frames["table"], provenance=replace(
+        by_kuka, measurements="frame_abb.csv", options={"robot": "abb"}))
+    assert replaced_notes(before, after, "abb") == [
+        "note: frame 'table' was calibrated by robot 'kuka' (frame_kuka.csv); this calibration "
+        "by robot 'abb' replaces it in the cell file"]
+    assert replaced_notes(before, after, "kuka") == []
+    assert replaced_notes(before, before, "abb") == []

@@ -31,7 +31,7 @@ from robotcell.cell import NAME_RE, Cell
 from robotcell.cell import calibrate as cellcal
 from robotcell.cell.calibrate import PROCEDURES, CalibrationContext, Procedure
 from robotcell.cell.calibrate.chain import NOMINAL_ACCURACY, NominalAccuracy
-from robotcell.cell.calibrate.wholerobots import cell_touch_files
+from robotcell.cell.calibrate.wholerobots import cell_touch_files, replaced_notes
 from robotcell.cell.update import update_cell_file
 from robotcell.cli import load_command
 from robotcell.cli.common import check_kind, check_output, parse_numbers, write_output
@@ -254,12 +254,18 @@ class CellTarget:
 
         def change_robot(cell: Cell) -> tuple[Cell | None, T]:
             new, value = change(cell.for_robot(name))  # this robot's view of the file as it is
-            return (None if new is None else cell.with_view(new, name)), value
+            if new is None:
+                return None, value
+            whole = cell.with_view(new, name)
+            replaced.extend(replaced_notes(cell, whole, name))
+            return whole, value
+
+        replaced: list[str] = []
 
         done = update_cell_file(self.path, change_robot, on_note=echo_note)
         if done.cell is not None:
             what, notes = said(done.value)
-            for note in notes:
+            for note in [*notes, *dict.fromkeys(replaced)]:
                 echo_note(note)
             self.cell = done.cell.for_robot(name)
             kept = f" (previous version: {done.backup})" if done.backup is not None else ""

@@ -32,6 +32,7 @@ CLI_TERMS = {
     "procedure:external-tcp": "'calibrate external-tcp'",
     "procedure:track": "'calibrate track'",
     "procedure:turntable(cell)": "calibrate turntable --cell",
+    "procedure:shared-positioner": "'robotcell calibrate shared-positioner'",
     "parent=world": "--parent world",
     "parent=robot": "--parent robot",
     "axis": "--axis",

@@ -35,7 +35,7 @@ from scipy.linalg import block_diag
 
 from robotcell.calibration.result import CalibrationResult
 from robotcell.calibration.uncertainty import Sources
-from robotcell.cell import Cell, Provenance
+from robotcell.cell import Cell, Positioner, Provenance
 from robotcell.cell.calibrate.chain import (
     NOMINAL_ACCURACY,
     NominalAccuracy,
@@ -54,7 +54,7 @@ from robotcell.cell.calibrate.whole import (
 )
 from robotcell.errors import InputError, term
 
-__all__ = ["NOT_JOINT", "calibrate_cell", "cell_touch_files"]
+__all__ = ["NOT_JOINT", "calibrate_cell", "cell_touch_files", "replaced_notes"]
 
 #: What the fit of a cell of several robots says it does not adjust jointly (a note of its
 #: report).
@@ -63,6 +63,52 @@ NOT_JOINT = ("note: the robots are fitted one by one (each robot's calibrations 
              "reference robot's fitted base. Not adjusted jointly: one robot's touches do not "
              "move another robot's items, and a placement's touches do not refine the tools it "
              "used")
+
+def replaced_notes(before: Cell, after: Cell, robot: str) -> list[str]:
+    """Notes on the shared items another robot calibrated that a calibration by ``robot``
+    replaced (the turntable or positioner, a frame in the world or on the table).
+
+    A cell file holds one calibration of a shared item: the new one replaces the other robot's
+    (the file before it is kept as a backup). The note says so and names how to compare the two
+    and fit both robots' touches together.
+
+    Parameters
+    ----------
+    before, after : Cell
+        The cell of several robots before and after the calibration
+        (:meth:`~robotcell.cell.Cell.with_view`).
+    robot : str
+        The robot that calibrated.
+
+    Returns
+    -------
+    list of str
+        One ``note:`` per replaced item; empty when none was another robot's.
+    """
+    pairs = [("turntable", before.turntable, after.turntable)]
+    pairs += [(f"frame {n!r}", before.frames.get(n), f) for n, f in after.frames.items()]
+    notes = []
+    for what, old, new in pairs:
+        if old is None or new is None or new.provenance is old.provenance:
+            continue
+        by = old.provenance.options.get("robot")
+        if old.provenance.measurements is None or by in (None, robot):
+            continue
+        advice = ""
+        if isinstance(old, Positioner):
+            what = f"positioner {old.name!r}"
+            advice = term("procedure:shared-positioner",
+                          "robotcell.cell.calibrate.sharedpositioner.shared_positioner")
+        elif what == "turntable":
+            what = f"turntable {old.name!r}"
+            advice = "robotcell.calibration.sharedtable.shared_turntable"
+        notes.append(f"note: {what} was calibrated by robot {by!r} "
+                     f"({Path(old.provenance.measurements).name}); this calibration by robot "
+                     f"{robot!r} replaces it in the cell file"
+                     + (f"; to compare the two within their 1-sigma and fit both robots' "
+                        f"touches together, use {advice}" if advice else ""))
+    return notes
+
 
 #: Items of a robot's view that are its own whatever the provenance says.
 _OWN_KINDS = ("tools.", "track")
