@@ -26,11 +26,12 @@ from robotcell.controllers.data import (
     fmt_num,
     parse_float,
 )
+from robotcell.controllers.robotpairs import RobotPair
 from robotcell.errors import InputError
 from robotcell.io.poseformats import FORMATS, pose_from_vendor, pose_to_vendor
 
-__all__ = ["PendantListing", "format_listing", "listing_line", "parse_listing",
-           "parse_pendant_listing", "pose_text"]
+__all__ = ["PairWording", "PendantListing", "format_listing", "listing_line", "pair_listing",
+           "parse_listing", "parse_pendant_listing", "pose_text"]
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,63 @@ class PendantListing:
     at_track_zero: str
     track: str
     table_axis: str
+
+
+@dataclass(frozen=True)
+class PairWording:
+    """How a listing names the placement of a cell's robots in each other.
+
+    Each text is formatted with the pair's fields: ``reference`` and ``other`` (robot names),
+    ``group`` (the other robot's motion group) and ``pair`` (``group - 1``).
+
+    Attributes
+    ----------
+    title : str
+        The first comment line: where the values go on the controller.
+    head : str
+        The line that names one pair (``Coord Pair {pair}: Leader Group {group} = {other}``).
+    meaning : str
+        What the six values are (``{other}'s WORLD in {reference}'s WORLD``).
+    """
+
+    title: str
+    head: str
+    meaning: str
+
+
+def pair_listing(pairs: list[RobotPair], style: PendantListing, wording: PairWording
+                 ) -> list[str]:
+    """Comment lines placing a cell's robots in each other, for the end of a listing.
+
+    Parameters
+    ----------
+    pairs : list of RobotPair
+        From :func:`robotcell.controllers.robotpairs.robot_pairs`.
+    style : PendantListing
+        The vendor's comment marker and pose fields.
+    wording : PairWording
+
+    Returns
+    -------
+    list of str
+        The title, then per pair its line and the values (mm, deg), or why none is written;
+        empty for a cell of one robot.
+    """
+    if not pairs:
+        return []
+    c, fields = style.comment, FORMATS[style.vendor].fields
+    lines = [f"{c} {wording.title.format(reference=pairs[0].reference)}"]
+    for p in pairs:
+        names = {"reference": p.reference, "other": p.other, "group": p.group,
+                 "pair": p.group - 1}
+        head = f"{c} {wording.head.format(**names)}"
+        if p.pose is None:
+            lines.append(f"{head}: not written ({p.why})")
+            continue
+        meaning = wording.meaning.format(**names)
+        lines += [f"{head}: {meaning} ({p.other}'s base: {p.provenance})",
+                  f"{c}   {pose_text(pose_to_vendor(p.pose, style.vendor), fields)}"]
+    return lines
 
 
 def listing_line(key: str, number: int, values: NDArray[np.float64], fields: tuple[str, ...],

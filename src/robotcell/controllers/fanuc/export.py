@@ -22,15 +22,15 @@ from __future__ import annotations
 
 from robotcell.controllers.data import ControllerData
 from robotcell.controllers.pendant import (
+    PairWording,
     PendantListing,
     format_listing,
+    pair_listing,
     parse_pendant_listing,
-    pose_text,
 )
 from robotcell.controllers.robotpairs import RobotPair
-from robotcell.io.poseformats import FORMATS, pose_to_vendor
 
-__all__ = ["LISTING", "format_data", "pair_lines", "parse"]
+__all__ = ["LISTING", "PAIRS", "format_data", "pair_lines", "parse"]
 
 #: FANUC wording of the pendant listing
 LISTING = PendantListing(
@@ -46,37 +46,19 @@ def format_data(data: ControllerData, cell_name: str) -> str:
     return format_listing(data, cell_name, LISTING)
 
 
-
 def parse(text: str) -> ControllerData:
     """Read a listing written by :func:`export` back: tools, and frames fixed in WORLD (metres)."""
     return parse_pendant_listing(text, LISTING)
 
 
+#: How the listing names the placement of the robots in each other.
+PAIRS = PairWording(
+    title=("coordinated pair: MENU > SETUP > Coord, C_TYP Known Direct, SHIFT+EXEC, then "
+           "restart the controller; motion groups in the order of the cell file's robots"),
+    head="Coord Pair {pair}: Leader Group {group} = {other}, Follower Group 1 = {reference}",
+    meaning="{other}'s WORLD in {reference}'s WORLD")
+
+
 def pair_lines(pairs: list[RobotPair]) -> list[str]:
-    """Comment lines of the coordinated pair (``!``), for :func:`format_data`'s listing.
-
-    Parameters
-    ----------
-    pairs : list of RobotPair
-        From :func:`robotcell.controllers.robotpairs.robot_pairs` with ``limit=2``.
-
-    Returns
-    -------
-    list of str
-        A title, then per robot its pair line and the values (mm, deg), or why none is
-        written; empty for a cell of one robot.
-    """
-    if not pairs:
-        return []
-    lines = [("! coordinated pair: MENU > SETUP > Coord, C_TYP Known Direct, SHIFT+EXEC, then "
-             "restart the controller; motion groups in the order of the cell file's robots")]
-    for p in pairs:
-        head = (f"! Coord Pair {p.group - 1}: Leader Group {p.group} = {p.other}, "
-                f"Follower Group 1 = {p.reference}")
-        if p.pose is None:
-            lines.append(f"{head}: not written ({p.why})")
-            continue
-        lines += [(f"{head} ({p.other}'s WORLD in {p.reference}'s WORLD; {p.other}'s base: "
-                  f"{p.provenance})"),
-                  f"!   {pose_text(pose_to_vendor(p.pose, 'fanuc'), FORMATS['fanuc'].fields)}"]
-    return lines
+    """The comment lines placing the cell's robots in each other (:data:`PAIRS`)."""
+    return pair_listing(pairs, LISTING, PAIRS)

@@ -25,15 +25,15 @@ from __future__ import annotations
 
 from robotcell.controllers.data import ControllerData
 from robotcell.controllers.pendant import (
+    PairWording,
     PendantListing,
     format_listing,
+    pair_listing,
     parse_pendant_listing,
-    pose_text,
 )
 from robotcell.controllers.robotpairs import RobotPair
-from robotcell.io.poseformats import FORMATS, pose_to_vendor
 
-__all__ = ["LISTING", "format_data", "pair_lines", "parse"]
+__all__ = ["LISTING", "PAIRS", "format_data", "pair_lines", "parse"]
 
 #: YASKAWA wording of the pendant listing
 LISTING = PendantListing(
@@ -50,37 +50,19 @@ def format_data(data: ControllerData, cell_name: str) -> str:
     return format_listing(data, cell_name, LISTING)
 
 
-
 def parse(text: str) -> ControllerData:
     """Read a listing written by :func:`export` back (tools, frames in base coordinates; m)."""
     return parse_pendant_listing(text, LISTING)
 
 
+#: How the listing names the placement of the robots in each other.
+PAIRS = PairWording(
+    title=("robot calibration to R1 = {reference} (robots numbered in the order of the cell "
+           "file's robots): compare with DISPLAY > COORDINATE DATA after ROBOT > ROBOT CALIB"),
+    head="R1+R{group} (R{group} = {other})",
+    meaning="R{group}'s robot coordinates in R1's")
+
+
 def pair_lines(pairs: list[RobotPair]) -> list[str]:
-    """Comment lines (``'``) of the robot calibration of every robot to R1.
-
-    Parameters
-    ----------
-    pairs : list of RobotPair
-        From :func:`robotcell.controllers.robotpairs.robot_pairs`.
-
-    Returns
-    -------
-    list of str
-        A title, then per robot its calibration line and the values (mm, deg), or why none
-        is written; empty for a cell of one robot.
-    """
-    if not pairs:
-        return []
-    lines = [(f"' robot calibration to R1 = {pairs[0].reference} (robots numbered in the order of "
-             "the cell file's robots): compare with DISPLAY > COORDINATE DATA after ROBOT > "
-             "ROBOT CALIB")]
-    for p in pairs:
-        head = f"' R1+R{p.group} (R{p.group} = {p.other})"
-        if p.pose is None:
-            lines.append(f"{head}: not written ({p.why})")
-            continue
-        lines += [(f"{head}: R{p.group}'s robot coordinates in R1's ({p.other}'s base: "
-                  f"{p.provenance})"),
-                  f"'   {pose_text(pose_to_vendor(p.pose, 'yaskawa'), FORMATS['yaskawa'].fields)}"]
-    return lines
+    """The comment lines placing the cell's robots in each other (:data:`PAIRS`)."""
+    return pair_listing(pairs, LISTING, PAIRS)
