@@ -173,8 +173,8 @@ class _Reader:
         return np.array([self.lines.number(i, lineno) for i in items])
 
     def pose(self, text: str, lineno: int) -> NDArray[np.float64]:
-        """The pose of a literal ``p[x, y, z, rx, ry, rz]`` (m, rad)."""
-        values = self.numbers(text.strip()[1:], lineno)
+        """The pose of a literal ``[x, y, z, rx, ry, rz]`` after its ``p`` (m, rad)."""
+        values = self.numbers(text, lineno)
         if values is None or values.shape != (6,):
             raise self.lines.error(lineno, f"a pose is p[x, y, z, rx, ry, rz], six numbers; "
                                            f"got {text.strip()[:60]!r}")
@@ -263,7 +263,9 @@ class _Reader:
             raise self.lines.error(lineno, f"{func} without a target")
         got = self.target(target, lineno)
         if isinstance(got, str):
-            self.skipped.append(f"line {lineno}: {func}({target.strip()[:40]}) ({got})")
+            t = target.strip()
+            t = t if len(t) <= 50 else t[:47] + "..."
+            self.skipped.append(f"line {lineno}: {func}({t}) ({got})")
             return
         if self.tool is None:
             self.skipped.append(f"line {lineno}: {func} (the TCP set on line {self.tool_line} "
