@@ -310,3 +310,16 @@ def test_a_frame_whose_name_is_a_urscript_word_is_refused():
     cell.frames["end"] = cell.frames.pop("table")
     with pytest.raises(InputError, match=r"frame 'end' is not a URScript name"):
         export_cell(cell, "ur")
+
+
+def test_program_check_of_a_bad_script_exits_2_with_one_error_line(tmp_path, capsys):
+    cell_file = tmp_path / "cell.yaml"
+    cell_file.write_text("name: c\nrobot: {model: ur5e}\n")
+    path = tmp_path / "bad.script"
+    path.write_text(GOOD.replace("0.4, -0.1", "nan, -0.1"), encoding="utf-8")
+    code, out, err = run(capsys, "program", "check", path, "--cell", cell_file)
+    assert code == 2 and out == "" and "Traceback" not in err
+    assert err.count("error:") == 1 and "bad.script: line 4: 'nan' is not finite" in err
+    path.write_text(GOOD, encoding="utf-8")
+    code, out, err = run(capsys, "program", "check", path, "--cell", TRACK_CELL)
+    assert code == 2 and err.count("error:") == 1 and "hold no external axes" in err
