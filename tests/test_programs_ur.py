@@ -18,7 +18,7 @@ from robotcell.controllers.registry import by_suffix, get
 from robotcell.errors import InputError
 from robotcell.export import export_cell, parse_export
 from robotcell.iso9283 import plan, write_programs
-from robotcell.iso9283.cycles import pose_sequence
+from robotcell.iso9283.cycles import path_sequence, pose_sequence
 from robotcell.kinematics.transforms import invert
 from robotcell.programs import read_program
 from robotcell.programs.check import check_program_file
@@ -122,15 +122,16 @@ def test_the_iso9283_plan_of_a_ur5e_is_written_as_urscript_and_passes_program_ch
         code, out, err = run(capsys, "program", "check", f, "--cell", cell_file)
         assert code == 0, f"{f}: {out}{err}"
         assert "all good" in out
-    # every pose of the pose program, read back through the FK, is the plan's to 1e-6 mm
+    # every point of both programs, read back through the FK, is the plan's to 1e-6 mm
     cell = Cell.load(cell_file)
     p = plan(cell, "probe")
-    names, _, _ = pose_sequence(p)
-    report = check_program_file("iso/ur/ISOPOSES.script", cell)
-    assert len(report.points) == len(names) == 1 + 5 * 30
-    want = p.poses[[int(n[1:]) - 1 for n in names]]
-    got = np.stack([pt.T_world_TCP for pt in report.points])
-    assert_same_pose(got, want, tol_m=1e-9)
+    for file, (names, _, _) in (("ISOPOSES", pose_sequence(p)), ("ISOPATHS", path_sequence(p))):
+        report = check_program_file(f"iso/ur/{file}.script", cell)
+        assert len(report.points) == len(names)
+        want = p.T[[p.names.index(n) for n in names]]
+        got = np.stack([pt.T_world_TCP for pt in report.points])
+        assert_same_pose(got, want, tol_m=1e-9, what=file)
+    assert len(pose_sequence(p)[0]) == 1 + 5 * 30
     # without --format the plan is written for the controllers that hold a UR arm: UR alone
     written = write_programs(p, cell, tmp_path / "all")
     assert {Path(f).parent.name for f in written} == {"ur"}
@@ -323,3 +324,28 @@ def test_program_check_of_a_bad_script_exits_2_with_one_error_line(tmp_path, cap
     path.write_text(GOOD, encoding="utf-8")
     code, out, err = run(capsys, "program", "check", path, "--cell", TRACK_CELL)
     assert code == 2 and err.count("error:") == 1 and "hold no external axes" in err
+
+
+def test_joint_points_are_retargeted_to_a_recalibrated_cell(tmp_path, capsys):
+    old, new = tmp_path / "old.yaml", tmp_path / "new.yaml"
+    old.write_text("name: c\nrobot: {model: ur5e}\ntools:\n  probe: {frame: {x: 0, y: 0, "
+                   "z: 100, a: 0, b: 0, c: 0}}\n")
+    new.write_text("name: c\nrobot: {model: ur5e, frame: {x: 0.4, y: -0.3, z: 0.5, a: 0.1, "
+                   "b: 0.05, c: 0}}\ntools:\n  probe: {frame: {x: 0, y: 0, z: 100, a: 0, b: 0, "
+                   "c: 0}}\n")
+    path = tmp_path / "joints.script"
+    path.write_text("def joints():\n  set_tcp(p[0, 0, 0.1, 0, 0, 0])\n"
+                    "  movej([0.1, -1.2, 1.3, -1.6, -1.57, 0.2], r=0)\n"
+                    "  movel([0.3, -1.2, 1.3, -1.6, -1.57, 0.2], v=0.1, r=0)\nend\njoints()\n")
+    code, out, err = run(capsys, "program", "retarget", path, "--from", old, "--to", new, "-o",
+                         tmp_path / "rt")
+    assert code == 0, err
+    back, _ = read_program(tmp_path / "rt" / "joints.script")
+    q_old = np.array([[0.1, -1.2, 1.3, -1.6, -1.57, 0.2], [0.3, -1.2, 1.3, -1.6, -1.57, 0.2]])
+    q_new = np.stack([p.joints for p in back.points])
+    assert 1e-4 < np.max(np.abs(q_new - q_old)) < 0.05      # moved a little, same branch
+    a, b = Cell.load(old), Cell.load(new)
+    tcp = back.points[0].tool.pose
+    T_old = a.T_world_R @ a.robot.fk(q_old) @ tcp
+    T_new = b.T_world_R @ b.robot.fk(q_new) @ tcp
+    np.testing.assert_allclose(T_new[:, :3, 3], T_old[:, :3, 3], atol=1e-9)
