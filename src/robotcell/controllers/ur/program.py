@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.controllers.data import fmt_num
-from robotcell.controllers.model import Config, Program, ProgramPoint
+from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
 from robotcell.controllers.text import NUMBER
 from robotcell.controllers.ur.export import identifier, pose_text
 from robotcell.controllers.ur.reader import read
@@ -43,14 +43,17 @@ Q_DECIMALS = 12
 SPEED_DECIMALS = 9
 
 
-def _frame_line(program: Program, name: str) -> str:
-    """``global NAME=p[..]`` of the program's frame, from the cell's data."""
-    data = program.data
-    slot = None if data is None else next((s for s in data.frames if s.name == name), None)
-    if slot is None:
-        raise InputError(f"frame {name!r}: the program holds no pose of it (write the program "
-                         "from a cell that has it)")
-    return f"  global {identifier(name, 'frame')}={pose_text(slot.pose)}"
+def _frame_line(program: Program, frame: Ref) -> str:
+    """``global NAME=p[..]`` of the program's frame: its pose as the reference holds it, else
+    the cell's frame of that name (in the robot base)."""
+    name = frame.name or ""
+    pose = frame.pose
+    if pose is None and program.data is not None:
+        pose = next((s.pose for s in program.data.frames if s.name == name), None)
+    if pose is None or not name:
+        raise InputError(f"frame {frame.label()}: the program holds no pose and name of it "
+                         "(write the program from a cell that has it)")
+    return f"  global {identifier(name, 'frame')}={pose_text(pose)}"
 
 
 def _tool_line(program: Program, p: ProgramPoint) -> str:
@@ -106,13 +109,14 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
     """
     name = program.name
     first = program.points[0]
-    feature = first.frame.name
+    frame = first.frame
+    feature = frame.name if frame.name or frame.pose is not None else None
     L = [f"def {name}():", *(f"  # {h}" for h in header),
          ("  # poses p[x, y, z, rx, ry, rz]: m and a rotation vector (rad); joints in rad; "
           "v in m/s, r (blend radius) in m"),
          f"  # tool {first.tool.label()}", _tool_line(program, first)]
     if feature is not None:
-        L += [f"  # feature {feature}: its pose in the robot base", _frame_line(program, feature)]
+        L += [f"  # feature {feature}: its pose in the robot base", _frame_line(program, frame)]
     L += [motion_text(p, feature) for p in program.points]
     L += ["end", f"{name}()"]
     return {f"{name}.script": "\n".join(L) + "\n"}
