@@ -63,13 +63,15 @@ def pose_text(T: NDArray[np.float64]) -> str:
 
 
 def format_data(data: ControllerData, cell_name: str) -> str:
-    """URScript lines for :class:`ControllerData` collected with ``reference="robot"``."""
-    names: dict[str, str] = {}
+    """URScript lines for :class:`ControllerData` collected with ``reference="robot"``.
+
+    Raises
+    ------
+    InputError
+        A frame whose name is not a URScript name.
+    """
     for s in data.frames:
         identifier(s.name, "frame")
-        if s.name in names:
-            raise InputError(f"frame name {s.name!r} is written twice; rename one in the cell")
-        names[s.name] = s.name
     L = [f"# robotcell export for Universal Robots (URScript): cell {cell_name!r}",
          "# poses p[x, y, z, rx, ry, rz]: metres and a rotation vector (rad)"]
     if data.tools:

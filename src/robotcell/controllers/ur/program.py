@@ -7,8 +7,8 @@ Written:
 - ``set_tcp(p[x, y, z, rx, ry, rz])``: the program's tool, the TCP in the tool flange frame, as
   ``robotcell export --format ur`` writes it;
 - for a frame of the cell, ``global NAME=p[..]``: the feature's pose in the robot base, and each
-  point as ``pose_trans(NAME, p[..])``, the pose in the feature (PolyScope writes a point taught
-  in a feature so); in the base frame the pose alone;
+  point as ``pose_trans(NAME, p[..])``, the pose in the feature (the manual's ``pose_trans``:
+  ``T_base_to = T_base_feature T_feature_to``); in the base frame the pose alone;
 - a joint motion as ``movej(pose, r=..)`` (the controller finds the joints by inverse
   kinematics, nearest to where the arm is; joint speed and acceleration left at the manual's
   defaults), a joint point as ``movej([q1, .., q6], r=..)`` in rad; a linear motion as

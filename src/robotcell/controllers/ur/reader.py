@@ -12,8 +12,8 @@ The reader follows URScript as Universal Robots' manual describes it (sources in
   joints by inverse kinematics), ``pose`` a pose ``p[x, y, z, rx, ry, rz]`` (m, rotation vector
   in rad; a joint list is moved to by forward kinematics), ``v`` the TCP speed of ``movel`` in
   m/s, ``t`` a time that overrides the speed, ``r`` the blend radius in m;
-- ``pose_trans(Feature, p[..])``: the pose ``p`` in the feature, ``Feature`` a pose (PolyScope
-  writes a feature as ``global Plane_1=p[..]``); ``get_inverse_kin(X, qnear=..)``: the joints of
+- ``pose_trans(Feature, p[..])``: the pose ``p`` in the feature, ``Feature`` a pose the file
+  declares (``global Plane_1=p[..]``, as PolyScope declares its waypoints); ``get_inverse_kin(X, qnear=..)``: the joints of
   the pose ``X`` (the checked point is the pose; the solution is chosen nearest to the previous
   point's, as for every point without flags);
 - ``set_tcp(p[..])``: the TCP in the tool flange frame for the motions after it (before any, the
