@@ -349,3 +349,35 @@ def test_joint_points_are_retargeted_to_a_recalibrated_cell(tmp_path, capsys):
     T_old = a.T_world_R @ a.robot.fk(q_old) @ tcp
     T_new = b.T_world_R @ b.robot.fk(q_new) @ tcp
     np.testing.assert_allclose(T_new[:, :3, 3], T_old[:, :3, 3], atol=1e-9)
+
+
+def test_fuzz_mutated_scripts_end_with_a_documented_status(tmp_path, capsys):
+    """Seeded mutations of the corpus and of a written script, checked and retargeted:
+    exit 0, 2 (one error line) or 3 only, never a traceback, nothing left on refusal."""
+    from programs_helpers import outcome_problems, write_mutation
+    from test_cli_fuzz import mutate_text
+
+    cell_file = tmp_path / "cell.yaml"
+    cell_file.write_text((DATA / "cell.yaml").read_text())
+    sources = [*CORPUS, tmp_path / "written.script"]
+    program, _ = _random_program(ur5e_cell(), np.random.default_rng(5), "table")
+    sources[-1].write_text(UR.write_program(program, ["fuzz"])["random_ur.script"])
+    rng = np.random.default_rng(2026)
+    failures, codes = [], {}
+    for k in range(150):
+        src = sources[k % len(sources)]
+        text = src.read_text(encoding="utf-8")  # the cp1252 mutation needs cp1252 text
+        content, what = mutate_text(text.encode("cp1252", "replace").decode("cp1252"), rng)
+        path = tmp_path / f"case{k}.script"
+        write_mutation(path, content)
+        out = tmp_path / f"out{k}"
+        args = (["program", "check", path, "--cell", cell_file] if k % 2 else
+                ["program", "retarget", path, "--from", cell_file, "--to", cell_file, "-o", out])
+        code, stdout, err = run(capsys, *args)
+        codes[code] = codes.get(code, 0) + 1
+        problems = outcome_problems(code, stdout, err, out.exists() and any(out.iterdir()))
+        if problems:
+            failures.append(f"case {k} ({src.name}, {what}): {', '.join(problems)}\n  "
+                            f"{err.strip()[-300:]}")
+    assert not failures, "\n".join(failures[:6])
+    assert codes.get(2, 0) > 0 and (codes.get(0, 0) + codes.get(3, 0)) > 0, codes
