@@ -381,3 +381,18 @@ def test_fuzz_mutated_scripts_end_with_a_documented_status(tmp_path, capsys):
                             f"{err.strip()[-300:]}")
     assert not failures, "\n".join(failures[:6])
     assert codes.get(2, 0) > 0 and (codes.get(0, 0) + codes.get(3, 0)) > 0, codes
+
+
+def test_an_export_named_as_a_ur_program_is_refused_and_the_ur_export_takes_script(
+        tmp_path, capsys):
+    cell_file = tmp_path / "cell.yaml"
+    cell_file.write_text("name: c\nrobot: {model: ur5e}\n")
+    code, _, err = run(capsys, "export", "--cell", cell_file, "--format", "kuka", "-o",
+                       tmp_path / "x.script")
+    assert code == 2 and "the name says a Universal Robots program" in err
+    code, _, err = run(capsys, "export", "--cell", cell_file, "--format", "ur", "-o",
+                       tmp_path / "x.src")
+    assert code == 2 and "the name says a KUKA program" in err and "name it x.script" in err
+    code, _, err = run(capsys, "export", "--cell", cell_file, "--format", "ur", "-o",
+                       tmp_path / "x.script")
+    assert code == 0 and (tmp_path / "x.script").is_file()
