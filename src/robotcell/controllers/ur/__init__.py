@@ -63,8 +63,11 @@ class UniversalRobots(Controller):
          "movel(p[..], a, v, t, r), .script"),
         ("RoboDK/Industrial-Robots-VSCode examples/Prog1.script and UniveralRobots.script "
          "(MIT): URScript programs as RoboDK writes them for a UR10"),
-        ("PolyScope-saved scripts: global Waypoint_1_p=p[..], movej(get_inverse_kin("
-         "Waypoint_1_p, qnear=Waypoint_1_q), a=.., v=..), set_tcp(p[0.0,..]) first"),
+        ("a script PolyScope saved (ilo21/universal_robots_scripts, record_data_pointURprogram/"
+         "test_holding_force.script): set_tcp(p[0.0,..]) first, waypoints as global "
+         "Start_pos_p=p[..], $ lines of the program tree"),
+        ("forum.universal-robots.com, 'How are the final joint positions chosen in MoveL?': "
+         "movel takes the shortest path to the pose"),
     )
 
     @staticmethod
