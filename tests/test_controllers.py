@@ -1,4 +1,4 @@
-"""The controllers (robotcell.controllers): one object per vendor in one registry; a sixth
+"""The controllers (robotcell.controllers): one object per vendor in one registry; a further
 controller added in this file alone drives the export and the programs; the numbers and names
 each controller holds."""
 
@@ -29,7 +29,7 @@ EXAMPLE = ROOT / "examples" / "cell_kr16_track_turntable.yaml"
 SEAM = ROOT / "examples" / "seam_part.csv"
 
 
-# -- a sixth controller, written here and nowhere else ---------------------------------------------
+# -- a further controller, written here and nowhere else -------------------------------------------
 #: Its pose format: X, Y, Z (mm), then Rx, Ry, Rz (deg) with R = Rx Ry Rz.
 TOY_POSE = PoseFormat("toy", ("X", "Y", "Z", "RX", "RY", "RZ"), "mm, deg", "XYZ")
 
@@ -129,7 +129,7 @@ def toy():
     unregister("toy")
 
 
-def test_a_sixth_controller_registered_here_drives_export_program_write_and_check(
+def test_a_further_controller_registered_here_drives_export_program_write_and_check(
         toy, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     shutil.copy(EXAMPLE, "cell.yaml")
@@ -159,21 +159,21 @@ def test_a_sixth_controller_registered_here_drives_export_program_write_and_chec
     assert code == 2 and "its tools are TOOL[1..4]" in err
 
 
-def test_the_sixth_controller_is_forgotten_when_unregistered(toy):
+def test_the_further_controller_is_forgotten_when_unregistered(toy):
     assert names()[-1] == "toy" and CONTROLLERS["toy"] is toy
     unregister("toy")
     assert "toy" not in names()
     with pytest.raises(InputError, match=r"unknown export format 'toy'; choose one of: kuka, "
-                                         r"abb, fanuc, yaskawa, urdf"):
+                                         r"abb, fanuc, yaskawa, ur, urdf"):
         export_cell(Cell.load(EXAMPLE), "toy")
     register(toy)  # for the fixture's teardown
 
 
-def test_the_registry_holds_the_four_controllers_and_refuses_unknown_names():
-    assert names() == ("kuka", "abb", "fanuc", "yaskawa")
+def test_the_registry_holds_the_five_controllers_and_refuses_unknown_names():
+    assert names() == ("kuka", "abb", "fanuc", "yaskawa", "ur")
     assert get("KUKA") is CONTROLLERS["kuka"]
     with pytest.raises(InputError, match=r"unknown controller 'staubli'; choose one of: kuka, "
-                                         r"abb, fanuc, yaskawa"):
+                                         r"abb, fanuc, yaskawa, ur"):
         get("staubli")
 
 

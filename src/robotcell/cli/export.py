@@ -36,6 +36,8 @@ def export(cell_path: str, fmt: str, output: str | None) -> None:
     abb      RAPID module: tooldata, wobjdata, base frames as pose
     fanuc    UTOOL/UFRAME values for Direct Entry (X Y Z W P R)
     yaskawa  TOOL/UFRAME values for the pendant (X Y Z Rx Ry Rz)
+    ur       URScript: set_tcp of each tool, each frame as a feature pose in the robot
+             base (m, rotation vector in rad); no track or turntable
     urdf     the calibrated cell as a URDF tree for ROS tools (m, rad): robot, track and
              turntable joints, tools and frames as fixed links; the identified arm where the
              cell has one, and for a Universal Robots arm also OUT_kinematics.yaml, the UR

@@ -71,7 +71,8 @@ def _mm3(text: str | None, what: str) -> np.ndarray | None:
 @click.option("--programs", type=OutputPath(file_okay=False), default=None, metavar="DIR",
               help="Also write the pose and path programs, one subfolder per --format.")
 @click.option("--format", "vendors", multiple=True, type=LiveChoice(names),
-              help="Program format(s) for --programs (repeatable; default every controller).")
+              help="Program format(s) for --programs (repeatable; default every controller "
+                   "that holds the cell).")
 @click.option("--cycles", type=int, default=30, show_default=True,
               help="Cycles of the pose program.")
 @click.option("--path-cycles", type=int, default=10, show_default=True,

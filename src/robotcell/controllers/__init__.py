@@ -6,13 +6,14 @@ of that controller.
   configuration flags, slot numbers and name limits, external axes, sources);
 - :mod:`robotcell.controllers.registry`: the registered controllers by name and by program file
   ending (``get``, ``names``, ``register``);
-- one package per controller: :mod:`.kuka`, :mod:`.abb`, :mod:`.fanuc`, :mod:`.yaskawa`, each
-  with its export (``export``) and its programs (``program``);
+- one package per controller: :mod:`.kuka`, :mod:`.abb`, :mod:`.fanuc`, :mod:`.yaskawa`,
+  :mod:`.ur` (Universal Robots, URScript), each with its export (``export``) and its programs
+  (``program``);
 - what they share: :mod:`.model` (the :class:`~robotcell.controllers.model.Program` every
   reader returns and every writer takes), :mod:`.data` (the cell as a controller sees it),
   :mod:`.pendant` (pendant listings), :mod:`.text` (program text), :mod:`.axes` (external axes).
 
-Pose formats that no controller here writes programs for (Staubli, Universal Robots) are pose
-formats only: :mod:`robotcell.io.poseformats`. How to add a controller:
+Pose formats that no controller here writes programs for (Staubli) are pose formats only:
+:mod:`robotcell.io.poseformats`. How to add a controller:
 ``docs/conventions.md``.
 """

@@ -239,6 +239,18 @@ class Controller(ABC):
         """Refuse a program's reference to ``slot`` that says otherwise than the cell whether
         the frame is carried by the table (only a controller that writes it can disagree)."""
 
+    def refusal(self, cell: Cell) -> str | None:
+        """Why the controller holds no program or export of ``cell`` (its arm's flags are not
+        defined, or its external axes are more than the programs hold); None when it holds it.
+        A command that writes for every controller by default skips the ones that refuse."""
+        try:
+            self.data(cell)
+            self.external_axes(cell)
+            self.config_values(cell.robot, np.zeros((1, cell.robot.n_joints)))
+        except InputError as exc:
+            return str(exc)
+        return None
+
     def export(self, cell: Cell) -> str:
         """The text to paste into the controller: tools, frames, placements of ``cell``.
 

@@ -1,6 +1,6 @@
 """The registered controllers, by name and by the file endings of their programs.
 
-KUKA, ABB, FANUC and YASKAWA are registered here; :func:`register` adds another
+KUKA, ABB, FANUC, YASKAWA and Universal Robots are registered here; :func:`register` adds another
 (``docs/conventions.md``, "How to add a controller"). :data:`CONTROLLERS` is a live, read-only
 view (name -> :class:`~robotcell.controllers.base.Controller`, in the order registered) that the
 exports, the programs and the command line's choices read, so a controller registered later is
@@ -16,6 +16,7 @@ from robotcell.controllers.abb import ABB
 from robotcell.controllers.base import Controller
 from robotcell.controllers.fanuc import FANUC
 from robotcell.controllers.kuka import KUKA
+from robotcell.controllers.ur import UR
 from robotcell.controllers.yaskawa import YASKAWA
 from robotcell.errors import InputError
 
@@ -105,5 +106,5 @@ def by_suffix(suffix: str) -> Controller | None:
     return next((c for c in _REGISTERED.values() if suffix.lower() in c.program_suffixes), None)
 
 
-for _builtin in (KUKA, ABB, FANUC, YASKAWA):
+for _builtin in (KUKA, ABB, FANUC, YASKAWA, UR):
     register(_builtin)

@@ -51,7 +51,7 @@ def other_kinds(fmt: str) -> dict[str, str]:
     every controller (``.src``: ``a KUKA program``), but the export's own ending (a KUKA export
     is saved as ``.dat``)."""
     own = output_ending(fmt)
-    return {s: f"{'an' if c.label[:1] in 'AEIOU' else 'a'} {c.label} program"
+    return {s: f"{'an' if c.label[:1] in 'AEIO' else 'a'} {c.label} program"  # a Universal
             for c in CONTROLLERS.values() for s in c.program_suffixes if s != own}
 
 

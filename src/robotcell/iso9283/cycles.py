@@ -108,7 +108,9 @@ def write_programs(plan: TestPlan, cell: Cell, folder: str | Path,
     folder : str or Path
         Output folder (created when missing; its parent must exist); one subfolder per vendor.
     vendors : sequence of str, optional
-        Registered controllers (:func:`robotcell.controllers.registry.names`); default all.
+        Registered controllers (:func:`robotcell.controllers.registry.names`); default every
+        one that holds the cell (:meth:`~robotcell.controllers.base.Controller.refusal`: a
+        UR-type arm has no other controller's flags, a UR program no external axes).
     cycles, path_cycles : int
         Cycles of the pose and of the path program (at least :data:`MIN_CYCLES`).
     speed : float
@@ -129,7 +131,13 @@ def write_programs(plan: TestPlan, cell: Cell, folder: str | Path,
         written then.
     """
     known = registry.names()
-    vendors = known if vendors is None else tuple(vendors)
+    if vendors is None:  # every controller that holds the cell's arm and axes
+        why = {v: registry.get(v).refusal(cell) for v in known}
+        vendors = tuple(v for v in known if why[v] is None)
+        if not vendors:
+            raise InputError("no controller writes programs of this cell: "
+                             + "; ".join(f"{v}: {w}" for v, w in why.items()))
+    vendors = tuple(vendors)
     bad = [v for v in vendors if v not in known]
     if bad or not vendors:
         raise InputError(f"unknown program format(s) {bad}; use {', '.join(known)}")

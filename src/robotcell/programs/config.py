@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from robotcell.controllers.model import Config
 from robotcell.controllers.registry import get
+from robotcell.errors import InputError
 from robotcell.ik.config import ZERO_TOL
 from robotcell.ik.limits import TWO_PI
 from robotcell.kinematics.bounds import within
@@ -211,7 +212,11 @@ _SIDES = ((4, "the wrist centre passes axis 1: the shoulder"),
 
 def side_changes(robot: Robot, q0: ArrayLike, q1: ArrayLike) -> str:
     """Words for the sides of the arm (shoulder, elbow, wrist) that differ between two
-    configurations (shape ``(6,)``, rad); empty when none does."""
-    sides = config_values(robot, np.stack([np.asarray(q0, float), np.asarray(q1, float)]),
-                          "abb")[:, 3]
+    configurations (shape ``(6,)``, rad); empty when none does, or when the arm has no
+    spherical wrist (a UR arm), whose sides these words do not name."""
+    try:
+        sides = config_values(robot, np.stack([np.asarray(q0, float), np.asarray(q1, float)]),
+                              "abb")[:, 3]
+    except InputError:
+        return ""
     return "; ".join(w for bit, w in _SIDES if (sides[0] ^ sides[1]) & bit)

@@ -144,11 +144,14 @@ def _keep(robot: Robot, sol: IKSolutions, q_old: NDArray[np.float64]
     rev = ~robot.prismatic
     cand = sol.q.copy()
     cand[..., rev] += TWO_PI * np.round((q_old[:, None, rev] - cand[..., rev]) / TWO_PI)
-    with np.errstate(invalid="ignore"):
-        sides = config_values(robot, np.nan_to_num(cand), "abb")[..., 3]
-    old_sides = config_values(robot, q_old, "abb")[:, 3]
     dist = np.where(sol.reachable, np.sum((cand - q_old[:, None]) ** 2, axis=-1), np.inf)
-    same = np.where(sides == old_sides[:, None], dist, np.inf)
+    try:
+        with np.errstate(invalid="ignore"):
+            sides = config_values(robot, np.nan_to_num(cand), "abb")[..., 3]
+        old_sides = config_values(robot, q_old, "abb")[:, 3]
+        same = np.where(sides == old_sides[:, None], dist, np.inf)
+    except InputError:  # no spherical wrist (a UR arm): no flags name its sides; the branch
+        same = dist     # nearest to the old joints is theirs (a recalibration moves them little)
     rows = np.arange(len(q_old))
     kept = cand[rows, np.argmin(same, axis=-1)]
     has = np.isfinite(same).any(axis=-1)
