@@ -15,12 +15,32 @@ from robotcell.errors import InputError
 from robotcell.io.fileio import read_text
 from robotcell.io.tables import MAX_ABS_VALUE, spreadsheet_number
 
-__all__ = ["JOINT_DECIMALS", "NUMBER", "Lines", "fmt_num", "strip_comment"]
+__all__ = ["JOINT_DECIMALS", "NUMBER", "Lines", "fmt_num", "split", "strip_comment"]
 
 #: Decimals of the joint values written (deg): 1e-9 deg.
 JOINT_DECIMALS = 9
 #: A number as program files write it (``12``, ``-0.5``, ``1.5e-3``), for editing one in place.
 NUMBER = r"[-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?"
+
+
+def split(text: str) -> list[str]:
+    """Top-level comma-separated parts of ``text`` (brackets, braces, parentheses and double
+    quotes kept): the arguments of a call, the items of a list or record."""
+    parts, depth, cur, quoted = [], 0, [], False
+    for ch in text:
+        if ch == '"':
+            quoted = not quoted
+        elif not quoted and ch in "[({":
+            depth += 1
+        elif not quoted and ch in "])}":
+            depth -= 1
+        if ch == "," and depth == 0 and not quoted:
+            parts.append("".join(cur).strip())
+            cur = []
+        else:
+            cur.append(ch)
+    parts.append("".join(cur).strip())
+    return parts
 
 
 def strip_comment(line: str, marker: str) -> str:

@@ -33,7 +33,7 @@ import numpy as np
 
 from robotcell.controllers.abb import export as export_abb
 from robotcell.controllers.model import Config, Program, ProgramPoint, Ref
-from robotcell.controllers.text import Lines, strip_comment
+from robotcell.controllers.text import Lines, split, strip_comment
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 
@@ -94,25 +94,6 @@ def statements(lines: Lines) -> list[tuple[int, str]]:
         raise lines.error(start, f"the statement {' '.join(cur)[:40]!r} has no ';' (truncated "
                                  "file?)")
     return out
-
-
-def split(text: str) -> list[str]:
-    """Top-level comma-separated parts of ``text`` (brackets, braces, parentheses kept)."""
-    parts, depth, cur, quoted = [], 0, [], False
-    for ch in text:
-        if ch == '"':
-            quoted = not quoted
-        elif not quoted and ch in "[({":
-            depth += 1
-        elif not quoted and ch in "])}":
-            depth -= 1
-        if ch == "," and depth == 0 and not quoted:
-            parts.append("".join(cur).strip())
-            cur = []
-        else:
-            cur.append(ch)
-    parts.append("".join(cur).strip())
-    return parts
 
 
 def arguments(text: str) -> tuple[list[str], dict[str, str]]:

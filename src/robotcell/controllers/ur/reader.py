@@ -38,11 +38,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotcell.controllers.model import Program, ProgramPoint, Ref
-from robotcell.controllers.text import Lines, strip_comment
+from robotcell.controllers.text import Lines, split, strip_comment
 from robotcell.errors import InputError
 from robotcell.io.poseformats import pose_from_vendor
 
-__all__ = ["BASE", "FLANGE", "read", "split"]
+__all__ = ["BASE", "FLANGE", "read"]
 
 #: The frame of a point written in the robot base (no feature).
 BASE = Ref(kind="base")
@@ -62,25 +62,6 @@ _NOT_CHECKED = {"movec": "circular motions are not checked",
                 "speedl": "a speed motion is not checked"}
 #: Arguments of movej and movel by position.
 _ARGS = ("target", "a", "v", "t", "r")
-
-
-def split(text: str) -> list[str]:
-    """Top-level comma-separated parts of ``text`` (brackets, parentheses and quotes kept)."""
-    parts, depth, cur, quoted = [], 0, [], False
-    for ch in text:
-        if ch == '"':
-            quoted = not quoted
-        elif not quoted and ch in "[(":
-            depth += 1
-        elif not quoted and ch in "])":
-            depth -= 1
-        if ch == "," and depth == 0 and not quoted:
-            parts.append("".join(cur).strip())
-            cur = []
-        else:
-            cur.append(ch)
-    parts.append("".join(cur).strip())
-    return parts
 
 
 def _depth(text: str) -> int:
