@@ -17,6 +17,7 @@ from robotcell.controllers.model import Program, ProgramPoint, Ref
 from robotcell.controllers.registry import by_suffix, get
 from robotcell.errors import InputError
 from robotcell.export import export_cell, parse_export
+from robotcell.io.poseformats import pose_to_vendor
 from robotcell.iso9283 import plan, write_programs
 from robotcell.iso9283.cycles import path_sequence, pose_sequence
 from robotcell.kinematics.transforms import invert
@@ -396,3 +397,41 @@ def test_an_export_named_as_a_ur_program_is_refused_and_the_ur_export_takes_scri
     code, _, err = run(capsys, "export", "--cell", cell_file, "--format", "ur", "-o",
                        tmp_path / "x.script")
     assert code == 0 and (tmp_path / "x.script").is_file()
+
+
+def _script(q_a, pose_w, q_w) -> str:
+    def nums(v):
+        return ", ".join(f"{x:.12f}" for x in v)
+    return (f"def qnear_test():\n  set_tcp(p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0])\n"
+            f"  global A_q=[{nums(q_a)}]\n  global W_p=p[{nums(pose_w)}]\n"
+            f"  global W_q=[{nums(q_w)}]\n"
+            "  movej(A_q, a=1.4, v=1.05)\n"
+            "  movej(get_inverse_kin(W_p, qnear=W_q), a=1.4, v=1.05)\n"
+            "  movej(A_q, a=1.4, v=1.05)\n"
+            "  movej(get_inverse_kin(W_p, W_q), a=1.4, v=1.05)\n"
+            "  movej(A_q, a=1.4, v=1.05)\n"
+            "  movej(get_inverse_kin(W_p), a=1.4, v=1.05)\n"
+            "end\nqnear_test()\n")
+
+
+def test_get_inverse_kin_takes_the_solution_nearest_to_qnear(tmp_path):
+    """A waypoint PolyScope saves as get_inverse_kin(pose, qnear=joints) is checked at the
+    solution nearest to its qnear ("the solution closest to qnear", script manual), even where
+    the previous point sits at another solution of the same pose; without a qnear, at the one
+    nearest to the previous point."""
+    cell = ur5e_cell()
+    robot = cell.robot
+    q_w = np.array([0.3, -1.2, 1.4, -1.5, -1.2, 0.4])
+    T = robot.fk(q_w)
+    sol = robot.ik(T)
+    others = [q for q, ok in zip(sol.q, sol.valid) if ok and np.max(np.abs(q - q_w)) > 0.5]
+    q_a = min(others, key=lambda q: np.linalg.norm(q - q_w))   # the same pose, another branch
+    path = tmp_path / "qnear_test.script"
+    path.write_text(_script(q_a, pose_to_vendor(T, "ur"), q_w))
+    report = check_program_file(path, cell)
+    q = np.stack([p.q for p in report.points])
+    np.testing.assert_allclose(q[1], q_w, atol=1e-9)   # qnear, named
+    np.testing.assert_allclose(q[3], q_w, atol=1e-9)   # qnear, second argument
+    np.testing.assert_allclose(q[5], q_a, atol=1e-9)   # none: nearest to the previous point
+    for p in report.points:
+        assert_same_pose(p.T_world_TCP, cell.T_world_R @ T, tol_m=1e-9)

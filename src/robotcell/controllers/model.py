@@ -129,6 +129,10 @@ class ProgramPoint:
         Corner distance (m; 0 for an exact stop) where the file writes one.
     where : str
         The file (and line) that holds the point's values, for messages.
+    near : ndarray, shape (n,), or None
+        Joints (radians) whose nearest inverse-kinematics solution the controller takes for a
+        Cartesian point without flags (URScript ``get_inverse_kin(pose, qnear=q)``); None:
+        the solution nearest to the previous point's.
     """
 
     name: str
@@ -143,6 +147,7 @@ class ProgramPoint:
     speed: float | None = None
     zone: float | None = None
     where: str = ""
+    near: NDArray[np.float64] | None = None
 
 
 @dataclass

@@ -393,7 +393,8 @@ def _outside_any(cell: Cell, branches: NDArray, config: Config) -> str:
 def _sequential(cell: Cell, pts: list[ProgramPoint], cart: NDArray[np.int_],
                 sol: IKSolutions | None, q: NDArray, problems: list[list[str]]) -> None:
     """Cartesian points without flags: the solution nearest to the previous point's, as a
-    controller keeps the configuration (the first: nearest to the robot's home).
+    controller keeps the configuration (the first: nearest to the robot's home), or to the
+    joints the point names (:attr:`ProgramPoint.near`, URScript's ``qnear``).
 
     Each point's choice depends on the one before; all are chosen at once against the previous
     points' choices of the round before, until no choice changes (a few rounds: a choice
@@ -409,8 +410,19 @@ def _sequential(cell: Cell, pts: list[ProgramPoint], cart: NDArray[np.int_],
     part = replace(sol, q=sol.q[free], valid=sol.valid[free], reachable=sol.reachable[free],
                    reach_error=None if sol.reach_error is None else sol.reach_error[free])
     home = robot.home if robot.home is not None else np.zeros(robot.n_joints)
+    near = [(k, pts[i].near) for k, i in enumerate(rows) if pts[i].near is not None]
+
+    def reference(rows_k: NDArray[np.int_], at: int = 0) -> NDArray:
+        """The joints each point's solution is nearest to: its own ``near``, or the previous
+        point's."""
+        ref = _previous(q, rows_k, home)
+        for k, joints in near:
+            if at <= k < at + len(rows_k):
+                ref[k - at] = joints
+        return ref
+
     for _ in range(SEQUENTIAL_ROUNDS):
-        got, found, _ = nearest(robot, part, _previous(q, rows, home))
+        got, found, _ = nearest(robot, part, reference(rows))
         new = np.where(found[:, None], got, np.nan)
         changed = ~np.all((new == q[rows]) | (np.isnan(new) & np.isnan(q[rows])), axis=-1)
         q[rows] = new
@@ -420,7 +432,7 @@ def _sequential(cell: Cell, pts: list[ProgramPoint], cart: NDArray[np.int_],
         for k in range(int(np.argmax(changed)), len(rows)):
             one = replace(part, q=part.q[k], valid=part.valid[k],
                           reachable=part.reachable[k], reach_error=None)
-            got, found, _ = nearest(robot, one, _previous(q, rows[k:k + 1], home)[0])
+            got, found, _ = nearest(robot, one, reference(rows[k:k + 1], k)[0])
             q[rows[k]] = got if found else np.nan
     for i in rows[~np.isfinite(q[rows]).all(axis=-1)]:
         problems[i].append("no solution within the axis limits")

@@ -13,9 +13,10 @@ The reader follows URScript as Universal Robots' manual describes it (sources in
   in rad; a joint list is moved to by forward kinematics), ``v`` the TCP speed of ``movel`` in
   m/s, ``t`` a time that overrides the speed, ``r`` the blend radius in m;
 - ``pose_trans(Feature, p[..])``: the pose ``p`` in the feature, ``Feature`` a pose the file
-  declares (``global Plane_1=p[..]``, as PolyScope declares its waypoints); ``get_inverse_kin(X, qnear=..)``: the joints of
-  the pose ``X`` (the checked point is the pose; the solution is chosen nearest to the previous
-  point's, as for every point without flags);
+  declares (``global Plane_1=p[..]``, as PolyScope declares its waypoints);
+  ``get_inverse_kin(X, qnear=Q)``: the joints of the pose ``X`` nearest to ``Q`` ("the
+  solution closest to qnear", manual); without a ``qnear`` the file gives, the solution nearest
+  to the previous point's, as for every point without flags;
 - ``set_tcp(p[..])``: the TCP in the tool flange frame for the motions after it (before any, the
   flange).
 
@@ -232,6 +233,22 @@ class _Reader:
         elif func in ("movej", "movel"):
             self.motion(func, m.group(2), lineno)
 
+    def near(self, target: str, lineno: int) -> NDArray[np.float64] | None:
+        """The ``qnear`` of a target ``get_inverse_kin(X, qnear)`` (second argument, or named)
+        when the file gives it as six joint values (rad); None otherwise."""
+        m = _CALL_RE.match(target.strip())
+        if not m or m.group(1) != "get_inverse_kin":
+            return None
+        args = split(m.group(2))
+        given = next((n.group(2) for a in args[1:] if (n := _NAMED_RE.match(a))
+                      and n.group(1) == "qnear"), None)
+        if given is None and len(args) > 1 and not _NAMED_RE.match(args[1]):
+            given = args[1]
+        value = None if given is None else self.known(given, lineno)
+        if value is None or value.items is None or value.items.shape != (6,):
+            return None
+        return value.items
+
     def motion(self, func: str, text: str, lineno: int) -> None:
         args: dict[str, str] = {}
         for k, part in enumerate(split(text)):
@@ -260,7 +277,8 @@ class _Reader:
         self.points.append(ProgramPoint(
             name, lineno, "ptp" if func == "movej" else "lin", self.tool,
             BASE if joints is not None else frame, value.pose, joints, None, {}, speed, zone,
-            self.lines.where(value.line if name != f"line {lineno}" else lineno)))
+            self.lines.where(value.line if name != f"line {lineno}" else lineno),
+            None if joints is not None else self.near(target, lineno)))
 
 
 def read(path: str | Path) -> tuple[Program, list[str]]:
