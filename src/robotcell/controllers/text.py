@@ -23,9 +23,10 @@ JOINT_DECIMALS = 9
 NUMBER = r"[-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?"
 
 
-def split(text: str) -> list[str]:
-    """Top-level comma-separated parts of ``text`` (brackets, braces, parentheses and double
-    quotes kept): the arguments of a call, the items of a list or record."""
+def split(text: str, sep: str = ",") -> list[str]:
+    """Top-level parts of ``text`` between the separators ``sep`` (one character) outside
+    brackets, braces, parentheses and double quotes, stripped: the arguments of a call, the
+    items of a list or record (``,``), a RAPID argument and its optional ones (``\\``)."""
     parts, depth, cur, quoted = [], 0, [], False
     for ch in text:
         if ch == '"':
@@ -34,7 +35,7 @@ def split(text: str) -> list[str]:
             depth += 1
         elif not quoted and ch in "])}":
             depth -= 1
-        if ch == "," and depth == 0 and not quoted:
+        if ch == sep and depth == 0 and not quoted:
             parts.append("".join(cur).strip())
             cur = []
         else:

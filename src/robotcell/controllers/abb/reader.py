@@ -102,7 +102,7 @@ def arguments(text: str) -> tuple[list[str], dict[str, str]]:
     required: list[str] = []
     optional: dict[str, str] = {}
     for part in split(text):
-        pieces = _optional_pieces(part)
+        pieces = split(part, "\\")  # the argument, then each optional one
         head = pieces.pop(0).strip()
         if head:
             required.append(head)
@@ -110,26 +110,6 @@ def arguments(text: str) -> tuple[list[str], dict[str, str]]:
             name, _, value = opt.partition(":=")
             optional[name.strip().rstrip("?").lower()] = value.strip()
     return required, optional
-
-
-def _optional_pieces(part: str) -> list[str]:
-    """``p10 \\ID:=10`` -> ``["p10 ", "ID:=10"]``: what precedes the first ``\\`` outside
-    brackets, then each optional argument."""
-    pieces, depth, cur, quoted = [], 0, [], False
-    for ch in part:
-        if ch == '"':
-            quoted = not quoted
-        elif not quoted and ch in "[({":
-            depth += 1
-        elif not quoted and ch in "])}":
-            depth -= 1
-        if ch == "\\" and depth == 0 and not quoted:
-            pieces.append("".join(cur))
-            cur = []
-        else:
-            cur.append(ch)
-    pieces.append("".join(cur))
-    return pieces
 
 
 def _inner(text: str, lines: Lines, lineno: int) -> list[str]:
