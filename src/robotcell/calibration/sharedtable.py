@@ -43,7 +43,7 @@ from robotcell.errors import IllPosedError, InputError
 from robotcell.kinematics.transforms import invert, make_pose, rot_z, transform_points
 
 __all__ = ["Agreement", "carried", "compare_shared", "judge_agreement", "pose_estimate",
-           "prior_warnings", "shared_turntable", "two_robot_fit"]
+           "prior_warnings", "shared_turntable", "through_link", "two_robot_fit"]
 
 _AXES = ("position x", "position y", "position z", "rotation about x", "rotation about y",
          "rotation about z")
@@ -132,6 +132,26 @@ def carried(T_ro: NDArray[np.float64], T_oB: NDArray[np.float64]
     return J_ro, J_oB
 
 
+def through_link(T_a: NDArray[np.float64], T_ro: NDArray[np.float64],
+                 T_b: NDArray[np.float64]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """One item as the reference robot calibrated it (``T_a``) minus the other robot's
+    (``T_b``) carried through the link ``T_ro``.
+
+    Returns
+    -------
+    diff : ndarray, shape (6,)
+        Origin difference (m) and rotation vector ``d`` with ``R_a = exp([d]x) R_ro R_b`` (rad).
+    J_ro, J_b : ndarray, shape (6, 6)
+        How ``T_ro T_b`` follows the link's and ``T_b``'s parameters (:func:`carried`).
+    """
+    T_c = T_ro @ T_b
+    J_ro, J_b = carried(T_ro, T_b)
+    diff = np.concatenate([T_a[:3, 3] - T_c[:3, 3],
+                           Rotation.from_matrix(T_a[:3, :3] @ T_c[:3, :3].T).as_rotvec()])
+    return diff, J_ro, J_b
+
+
 def compare_shared(ref: CalibrationResult, other: CalibrationResult, link: CalibrationResult,
                    *, level: float = 3.0, names: Sequence[str] = ("reference", "other")
                    ) -> Agreement:
@@ -159,10 +179,7 @@ def compare_shared(ref: CalibrationResult, other: CalibrationResult, link: Calib
     T_a, s_a = pose_estimate(ref, f"{names[0]} turntable")
     T_b, s_b = pose_estimate(other, f"{names[1]} turntable")
     T_ro, s_ro = pose_estimate(link, "robot-to-robot")
-    T_c = T_ro @ T_b
-    J_ro, J_b = carried(T_ro, T_b)
-    diff = np.concatenate([T_a[:3, 3] - T_c[:3, 3],
-                           Rotation.from_matrix(T_a[:3, :3] @ T_c[:3, :3].T).as_rotvec()])
+    diff, J_ro, J_b = through_link(T_a, T_ro, T_b)
     sources = s_a.select(range(6)) + s_ro.select(range(6)).map(-J_ro) + s_b.select(
         range(6)).map(-J_b)
     return judge_agreement(diff, sources.covariance, level, names, "turntable")

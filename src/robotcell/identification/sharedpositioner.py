@@ -53,9 +53,9 @@ from robotcell.calibration.robottorobot import (
 )
 from robotcell.calibration.sharedtable import (
     Agreement,
-    carried,
     judge_agreement,
     pose_estimate,
+    through_link,
     two_robot_fit,
 )
 from robotcell.calibration.uncertainty import OWN, Sources, estimate
@@ -66,7 +66,7 @@ from robotcell.identification.positioner import (
     calibrate_positioner,
     perturbed_chain,
 )
-from robotcell.kinematics.transforms import make_pose, rot_z
+from robotcell.kinematics.transforms import make_pose, rot_x, rot_z
 from robotcell.robot.robot import Robot
 
 __all__ = ["COMPONENTS", "PositionerLines", "chain_lines", "compare_positioner", "lines_chain",
@@ -279,11 +279,8 @@ def compare_positioner(ref: CalibrationResult, other: CalibrationResult,
                          "X_B (common normal) directions; calibrate both with the same nominal "
                          "positioner")
     T_ro, s_ro = pose_estimate(link, "robot-to-robot")
-    T_c = T_ro @ b.T_B
-    J_ro, J_b = carried(T_ro, b.T_B)
-    diff = np.concatenate([a.T_B[:3, 3] - T_c[:3, 3],
-                           Rotation.from_matrix(a.T_B[:3, :3] @ T_c[:3, :3].T).as_rotvec(),
-                           [a.offset - b.offset, a.angle - b.angle]])
+    pose_diff, J_ro, J_b = through_link(a.T_B, T_ro, b.T_B)
+    diff = np.concatenate([pose_diff, [a.offset - b.offset, a.angle - b.angle]])
     J_link = np.zeros((8, 6))
     J_link[:6] = J_ro
     J_other = np.eye(8)
@@ -295,17 +292,12 @@ def compare_positioner(ref: CalibrationResult, other: CalibrationResult,
 
 
 # -- the joint fit -----------------------------------------------------------------------------
-def _rot_x(angle: float) -> NDArray[np.float64]:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
 def _moved(T_B: NDArray[np.float64], offset: float, angle: float, signs: NDArray[np.float64],
            values: NDArray[np.float64], point: NDArray[np.float64]) -> NDArray[np.float64]:
     """The point ``point`` of the plate (in the rotate axis's frame at rotate 0) at axis values
     ``values`` (N, 2), in the frame of ``T_B``: ``T_B Rz(s0 e1) Tx(offset) Rx(angle) Rz(s1 e2)``."""
     p2 = np.einsum("nij,j->ni", rot_z(signs[1] * values[:, 1]), point)
-    p1 = p2 @ _rot_x(angle).T + np.array([offset, 0.0, 0.0])
+    p1 = p2 @ rot_x(angle).T + np.array([offset, 0.0, 0.0])
     p0 = np.einsum("nij,nj->ni", rot_z(signs[0] * values[:, 0]), p1)
     return p0 @ T_B[:3, :3].T + T_B[:3, 3]
 
@@ -331,7 +323,7 @@ def _start(values: NDArray[np.float64], touches: RobotTouches, nominal: Robot | 
     signs = np.array([1.0 if u[:, 0] @ T[:3, 2] >= 0 else -1.0,
                       1.0 if u[:, 1] @ rotate >= 0 else -1.0])
     at_zero = cal.robot.fk(np.zeros(2))[:3, 3]
-    point = _rot_x(lines.angle).T @ (T[:3, :3].T @ (at_zero - T[:3, 3])
+    point = rot_x(lines.angle).T @ (T[:3, :3].T @ (at_zero - T[:3, 3])
                                      - np.array([lines.offset, 0.0, 0.0]))
     return _Start(lines, point, signs)
 
