@@ -10,28 +10,18 @@ from pathlib import Path
 
 import pytest
 from cli_helpers import run
+from shared_positioner_helpers import demo_folder, shared_args
 
 from robotcell.cell import Cell
 from robotcell.cell.calibrate.robottorobot import RobotTouchFile
 from robotcell.cell.calibrate.sharedpositioner import shared_positioner
-from robotcell.demo.tworobots import run_two_robot_demo
 from robotcell.errors import InputError
 
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory) -> Path:
     """The two-robot demo's folder: the calibrated cell and every touch file."""
-    folder = tmp_path_factory.mktemp("demo2")
-    run_two_robot_demo(folder, seed=3, echo=lambda line: None)
-    return folder
-
-
-def _args(d: Path, cell: str = "cell.yaml", *extra: str) -> list[str]:
-    return ["calibrate", "shared-positioner", d / "positioner_kuka.csv",
-            d / "positioner_abb.csv", "--common", d / "robot_to_robot_kuka.csv",
-            d / "robot_to_robot_abb.csv", "--cell", d / cell, "--reference", "kuka",
-            "--robot", "abb", "--tool-ref", "torch", "--tool-other", "torch", "--track-ref",
-            "1000", "--sigma", "0.1", "--tool-sigma", "0.13", *extra]
+    return demo_folder(tmp_path_factory.mktemp("demo2"))
 
 
 def _tool_off(d: Path, mm: float) -> str:
@@ -48,14 +38,14 @@ def _tool_off(d: Path, mm: float) -> str:
 
 def test_consistent_calibrations_agree_and_the_joint_fit_is_printed(demo, capsys, tmp_path):
     out_file = tmp_path / "shared.json"
-    code, out, err = run(capsys, *_args(demo), "--json", "-o", out_file)
+    code, out, err = run(capsys, *shared_args(demo), "--json", "-o", out_file)
     assert code == 0, err
     data = json.loads(out_file.read_text(encoding="utf-8"))
     assert data["procedure"] == "robot-to-robot" and data["method"] == "shared positioner"
     assert data["agreement"]["agree"] is True
     assert "positioner agree within 3 sigma" in data["agreement"]["message"]
     assert data["verdict"]["level"] == "good"
-    code, out, err = run(capsys, *_args(demo))
+    code, out, err = run(capsys, *shared_args(demo))
     assert code == 0 and out.startswith("kuka's and abb's calibrations of the positioner agree")
     assert "T_ref_B (KUKA X,Y,Z mm, A,B,C deg)" in out and "axis_angle (deg)" in out
 
@@ -63,13 +53,13 @@ def test_consistent_calibrations_agree_and_the_joint_fit_is_printed(demo, capsys
 def test_a_2mm_error_of_one_robots_tool_is_named_and_nothing_written(demo, capsys, tmp_path):
     cell = _tool_off(demo, 2.0)
     out_file = tmp_path / "shared.txt"
-    code, _, err = run(capsys, *_args(demo, cell), "-o", out_file)
+    code, _, err = run(capsys, *shared_args(demo, cell), "-o", out_file)
     assert code == 3
     lines = err.strip().splitlines()
     assert lines[-1].startswith("error: kuka's and abb's calibrations of the positioner disagree")
     assert re.search(r"by -?\d+\.\d+ mm \(\d+\.\d sigma\)", lines[-1]), lines[-1]
     assert not out_file.exists()
-    code, out, _ = run(capsys, *_args(demo, cell), "--accept-poor")
+    code, out, _ = run(capsys, *shared_args(demo, cell), "--accept-poor")
     assert code == 0 and "disagree" in out
 
 
@@ -83,7 +73,7 @@ def test_a_2mm_error_of_one_robots_tool_is_named_and_nothing_written(demo, capsy
 ])
 def test_bad_input_exits_2_with_one_error_line_and_writes_nothing(demo, capsys, tmp_path,
                                                                   change, message):
-    args = [str(a) for a in _args(demo)]
+    args = [str(a) for a in shared_args(demo)]
     i = args.index(change[0])
     args[i + 1] = change[1]
     out_file = tmp_path / "shared.txt"
@@ -98,7 +88,7 @@ def test_output_onto_an_input_is_refused(demo, capsys):
     common = demo / "robot_to_robot_abb.txt"  # a touch file named as the report would be
     shutil.copy(demo / "robot_to_robot_abb.csv", common)
     before = common.read_bytes()
-    args = [str(a) for a in _args(demo)]
+    args = [str(a) for a in shared_args(demo)]
     args[args.index("--common") + 2] = str(common)
     code, _, err = run(capsys, *args, "-o", common)
     assert code == 2 and err.count("error:") == 1

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from cli_helpers import run
 from scipy.spatial.transform import Rotation
+from shared_positioner_helpers import demo_folder, shared_args
 
 from robotcell.cell import Cell
 from robotcell.cell.calibrate import calibrate_cell
@@ -23,7 +24,6 @@ from robotcell.cell.calibrate.sharedpositioner import (
     place_shared_positioner,
     shared_positioner,
 )
-from robotcell.demo.tworobots import run_two_robot_demo
 from robotcell.errors import InputError
 from robotcell.identification.sharedpositioner import PositionerLines, chain_lines
 from robotcell.kinematics.transforms import invert
@@ -34,9 +34,7 @@ TRACK_REF = 1.0  # the KUKA's track position during its touches in the demo (m)
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory) -> Path:
     """The two-robot demo's folder: the calibrated cell, the true cell and every touch file."""
-    folder = tmp_path_factory.mktemp("demo2")
-    run_two_robot_demo(folder, seed=3, echo=lambda line: None)
-    return folder
+    return demo_folder(tmp_path_factory.mktemp("demo2"))
 
 
 @pytest.fixture()
@@ -45,14 +43,6 @@ def cell_dir(demo, tmp_path) -> Path:
     out = tmp_path / "cell"
     shutil.copytree(demo, out)
     return out
-
-
-def _args(d: Path, cell: str = "cell.yaml", *extra: str) -> list[str]:
-    return ["calibrate", "shared-positioner", d / "positioner_kuka.csv",
-            d / "positioner_abb.csv", "--common", d / "robot_to_robot_kuka.csv",
-            d / "robot_to_robot_abb.csv", "--cell", d / cell, "--reference", "kuka",
-            "--robot", "abb", "--tool-ref", "torch", "--tool-other", "torch", "--track-ref",
-            "1000", "--sigma", "0.1", "--tool-sigma", "0.13", *extra]
 
 
 def _touches(d: Path) -> tuple[tuple[RobotTouchFile, RobotTouchFile], tuple[str, str]]:
@@ -90,7 +80,7 @@ def test_update_cell_writes_the_positioner_and_the_base_within_4_sigma_of_the_tr
     common, plate = _touches(cell_dir)
     fit = shared_positioner(Cell.load(cell_dir / "cell.yaml"), common, plate, sigma=1e-4,
                             tool_sigma=1.3e-4).joint
-    code, out, err = run(capsys, *_args(cell_dir), "--update-cell")
+    code, out, err = run(capsys, *shared_args(cell_dir), "--update-cell")
     assert code == 0, err
     assert "calibrations of the positioner agree" in out
     assert re.search(r"updated .*cell\.yaml: positioner 'DKP_2' \(root, axes\) and the base of "
@@ -121,7 +111,7 @@ def test_update_cell_writes_the_positioner_and_the_base_within_4_sigma_of_the_tr
 
 
 def test_the_provenance_records_the_files_checksums_options_and_sigma_parts(cell_dir, capsys):
-    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    code, _, err = run(capsys, *shared_args(cell_dir), "--update-cell")
     assert code == 0, err
     cell = Cell.load(cell_dir / "cell.yaml")
     pos, base = cell.turntable.provenance, cell.robots["abb"].base_provenance
@@ -152,7 +142,7 @@ def test_the_provenance_records_the_files_checksums_options_and_sigma_parts(cell
 
 
 def test_without_tool_sigma_the_tools_part_is_recorded_as_assumed(cell_dir, capsys):
-    args = [str(a) for a in _args(cell_dir)]
+    args = [str(a) for a in shared_args(cell_dir)]
     del args[args.index("--tool-sigma"):args.index("--tool-sigma") + 2]
     code, _, err = run(capsys, *args, "--update-cell")
     assert code == 0, err
@@ -161,7 +151,7 @@ def test_without_tool_sigma_the_tools_part_is_recorded_as_assumed(cell_dir, caps
 
 
 def test_calibrate_cell_repeats_the_fit_and_a_second_run_is_stable(cell_dir, capsys):
-    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    code, _, err = run(capsys, *shared_args(cell_dir), "--update-cell")
     assert code == 0, err
     written = Cell.load(cell_dir / "cell.yaml")
     cells = []
@@ -196,7 +186,7 @@ def test_calibrate_cell_repeats_the_fit_and_a_second_run_is_stable(cell_dir, cap
 
 
 def test_calibrate_cell_refuses_a_changed_touch_file_of_the_fit(cell_dir, capsys):
-    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    code, _, err = run(capsys, *shared_args(cell_dir), "--update-cell")
     assert code == 0, err
     with (cell_dir / "positioner_abb.csv").open("a", encoding="utf-8") as f:
         f.write("\n")
@@ -228,7 +218,7 @@ def test_a_repeated_fit_that_is_poor_is_not_written_and_a_note_says_so(cell_dir)
 
 
 def test_a_base_placed_again_since_keeps_the_positioner_with_a_note(cell_dir, capsys):
-    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    code, _, err = run(capsys, *shared_args(cell_dir), "--update-cell")
     assert code == 0, err
     written = Cell.load(cell_dir / "cell.yaml")
     code, _, err = run(capsys, "calibrate", "robot-to-robot", cell_dir / "robot_to_robot_kuka.csv",
@@ -248,7 +238,7 @@ def test_a_base_placed_again_since_keeps_the_positioner_with_a_note(cell_dir, ca
 
 
 def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys):
-    code, _, err = run(capsys, *_args(cell_dir), "--update-cell")
+    code, _, err = run(capsys, *shared_args(cell_dir), "--update-cell")
     assert code == 0, err
     written = Cell.load(cell_dir / "cell.yaml")
     code, _, err = run(capsys, "calibrate", "cell", "--cell", cell_dir / "cell.yaml",
@@ -264,7 +254,7 @@ def test_calibrate_cell_of_one_robot_keeps_the_fit_with_a_note(cell_dir, capsys)
 
 def test_without_update_cell_nothing_is_written(cell_dir, capsys):
     before = (cell_dir / "cell.yaml").read_bytes()
-    code, _, err = run(capsys, *_args(cell_dir))
+    code, _, err = run(capsys, *shared_args(cell_dir))
     assert code == 0, err
     assert (cell_dir / "cell.yaml").read_bytes() == before and "updated" not in err
 
@@ -272,13 +262,13 @@ def test_without_update_cell_nothing_is_written(cell_dir, capsys):
 def test_a_disagreement_writes_nothing_unless_accept_poor(cell_dir, capsys):
     cell = _tool_off(cell_dir, 2.0)
     before = (cell_dir / cell).read_bytes()
-    code, _, err = run(capsys, *_args(cell_dir, cell), "--update-cell")
+    code, _, err = run(capsys, *shared_args(cell_dir, cell), "--update-cell")
     assert code == 3
     assert err.strip().splitlines()[-1].startswith(
         "error: kuka's and abb's calibrations of the positioner disagree")
     assert (cell_dir / cell).read_bytes() == before
     assert not list(cell_dir.glob("tool_off.yaml.*.bak"))
-    code, out, err = run(capsys, *_args(cell_dir, cell), "--update-cell", "--accept-poor")
+    code, out, err = run(capsys, *shared_args(cell_dir, cell), "--update-cell", "--accept-poor")
     assert code == 0 and "disagree" in out and "updated" in err, err
     assert Cell.load(cell_dir / cell).turntable.provenance.source == SOURCE
 
@@ -293,7 +283,7 @@ def test_a_disagreement_writes_nothing_unless_accept_poor(cell_dir, capsys):
 ])
 def test_bad_input_exits_2_with_one_error_line_and_writes_nothing(cell_dir, capsys, change,
                                                                   message):
-    args = [str(a) for a in _args(cell_dir)]
+    args = [str(a) for a in shared_args(cell_dir)]
     args[args.index(change[0]) + 1] = change[1]
     before = (cell_dir / "cell.yaml").read_bytes()
     code, _, err = run(capsys, *args, "--update-cell")
@@ -304,7 +294,7 @@ def test_bad_input_exits_2_with_one_error_line_and_writes_nothing(cell_dir, caps
 
 def test_output_onto_the_cell_file_is_refused(cell_dir, capsys):
     before = (cell_dir / "cell.yaml").read_bytes()
-    code, _, err = run(capsys, *_args(cell_dir), "--update-cell", "-o", cell_dir / "cell.yaml")
+    code, _, err = run(capsys, *shared_args(cell_dir), "--update-cell", "-o", cell_dir / "cell.yaml")
     assert code == 2 and err.count("error:") == 1, err
     assert (cell_dir / "cell.yaml").read_bytes() == before
 
