@@ -257,7 +257,7 @@ class CellTarget:
             if new is None:
                 return None, value
             whole = cell.with_view(new, name)
-            replaced.extend(replaced_notes(cell, whole, name))
+            replaced[:] = replaced_notes(cell, whole, name)  # of the version written
             return whole, value
 
         replaced: list[str] = []
@@ -265,7 +265,7 @@ class CellTarget:
         done = update_cell_file(self.path, change_robot, on_note=echo_note)
         if done.cell is not None:
             what, notes = said(done.value)
-            for note in [*notes, *dict.fromkeys(replaced)]:
+            for note in [*notes, *replaced]:
                 echo_note(note)
             self.cell = done.cell.for_robot(name)
             kept = f" (previous version: {done.backup})" if done.backup is not None else ""
