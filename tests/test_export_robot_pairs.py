@@ -129,3 +129,19 @@ def test_the_command_line_writes_the_pairs_and_refuses_without_a_robot_name(caps
     assert code == 2
     assert "say which one with --robot-name NAME" in err
     assert not written.exists()
+
+
+@pytest.mark.parametrize("fmt", ["fanuc", "yaskawa"])
+def test_the_export_written_again_to_a_path_with_spaces_is_the_same_and_reads_back(
+        fmt, capsys, tmp_path):
+    out = tmp_path / "my exports" / "frames abb.txt"
+    out.parent.mkdir()
+    texts = []
+    for _ in range(2):
+        code, _, err = run(capsys, "export", "--cell", "examples/cell_two_robots_positioner.yaml",
+                           "--format", fmt, "--robot-name", "abb", "-o", out)
+        assert code == 0, err
+        texts.append(out.read_text(encoding="utf-8"))
+    assert texts[0] == texts[1]
+    assert ("Coord Pair 1" if fmt == "fanuc" else "R1+R2") in texts[0]
+    assert [s.name for s in parse_export(texts[0], fmt).tools] == ["torch", "pointer"]

@@ -280,6 +280,31 @@ def test_program_write_through_the_cli_in_a_feature_is_checked_good(tmp_path, ca
     assert code == 0 and "3 points, all good" in out, out + err
 
 
+def test_a_script_written_again_into_a_folder_with_spaces_reads_back_the_same(tmp_path, capsys):
+    """Written twice into a folder whose name has spaces, for a frame with a 24-character
+    name: the same file, and program check reads it both times."""
+    folder = tmp_path / "my programs" / "cell A"
+    folder.parent.mkdir()
+    cell_file = tmp_path / "my cell.yaml"
+    name = "fixture_of_the_left_part"
+    cell_file.write_text(
+        "name: ur5e_cell\nrobot: {model: ur5e}\n"
+        "tools:\n  probe: {frame: {x: 0, y: 0, z: 100, a: 0, b: 0, c: 0}}\n"
+        f"frames:\n  {name}: {{frame: {{x: 350, y: -250, z: 20, a: 35, b: 0, c: 0}}}}\n")
+    path = tmp_path / "seam path.csv"
+    path.write_text("x,y,z,a,b,c,motion,speed\n0,0,100,0,180,0,ptp,\n50,20,100,0,180,0,lin,50\n")
+    texts = []
+    for _ in range(2):
+        code, _, err = run(capsys, "program", "write", path, "--cell", cell_file, "--tool",
+                           "probe", "--frame", name, "--format", "ur", "-o", folder)
+        assert code == 0, err
+        script = next(folder.glob("*.script"))
+        texts.append(script.read_text(encoding="utf-8"))
+        code, out, err = run(capsys, "program", "check", script, "--cell", cell_file)
+        assert code == 0 and "2 points, all good" in out, out + err
+    assert texts[0] == texts[1] and f"global {name}=p[" in texts[0]
+
+
 # -- export ----------------------------------------------------------------------------------
 def test_the_export_reads_back_to_the_cells_tools_and_frames():
     cell = ur5e_cell()
