@@ -1536,8 +1536,10 @@ def test_cli_fuzz_read_only_install(good, tmp_path, capsys, monkeypatch):
 def _read_only_cases(folder: Path, n: int, good: dict[str, Path]
                      ) -> list[tuple[str, int, Case, Path, dict[str, bytes]]]:
     """The first ``n`` cases of every command in ``folder/COMMAND/caseK``: the command, ``K``,
-    the case, its folder and its files."""
+    the case, its folder and its files; the example files the cases name, copied to
+    ``folder/examples``."""
     cases = []
+    examples = Path(shutil.copytree(EXAMPLES, folder / "examples"))
     for command in CASES:
         rng = np.random.default_rng([SEED, list(CASES).index(command)])
         (folder / command).mkdir()
@@ -1545,6 +1547,8 @@ def _read_only_cases(folder: Path, n: int, good: dict[str, Path]
             d = folder / command / f"case{k}"
             d.mkdir()
             case = _case(command, rng, d, good)
+            # the user may not read the repository: the example files it names are copied
+            case.args = [a.replace(str(EXAMPLES), str(examples)) for a in case.args]
             cases.append((command, k, case, d, _files(d)))
     return cases
 
