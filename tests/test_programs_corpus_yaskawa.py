@@ -118,6 +118,9 @@ BROKEN = {
         ANGLE, lambda b: b.replace(b"C00002=380.000", b"C00002=3\xe980.000"), r"line 13: "),
     "UTF-16 file": (TEST1, lambda b: "\ufeff".encode("utf-16-le") + b.decode().encode("utf-16-le"),
                     r"UTF-16"),
+    "a position named with 3 digits": (
+        COMM, lambda b: b.replace(b"MOVJ C00000", b"MOVJ C000"),
+        r"line 18: C000 not in the //POS section \(it holds C00000 to C00004\)"),
     "no //INST": (TEST1, lambda b: b.split(b"//INST")[0],
                   r"no //INST line \(/JOB at line 1, //POS at line 3 only\)"),
 }

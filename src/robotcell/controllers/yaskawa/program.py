@@ -400,10 +400,16 @@ class _Job:
         return out
 
     def refs(self, rest: str, lineno: int) -> list[tuple[str, str]]:
+        """The ``C``, ``BC`` and ``EC`` positions a motion names, each in ``//POS``, or an error
+        naming the line and the positions of the kind ``//POS`` holds (a job that names
+        ``C000`` where ``//POS`` holds ``C00000`` is refused, not matched by number)."""
         refs = re.findall(r"\b(C|BC|EC)(\d+)\b", rest)
-        missing = [k + n for k, n in refs if k + n not in self.positions]
+        missing = [(k, k + n) for k, n in refs if k + n not in self.positions]
         if missing:
-            raise self.lines.error(lineno, f"{', '.join(missing)} not in the //POS section")
+            held = [n for n in self.positions if n.rstrip("0123456789") == missing[0][0]]
+            raise self.lines.error(lineno, f"{', '.join(m for _, m in missing)} not in the //POS "
+                                   "section" + (f" (it holds {held[0]} to {held[-1]})" if held
+                                                else ""))
         return refs
 
     def coordinated(self, rest: str, lineno: int) -> None:
