@@ -38,6 +38,14 @@ def test_station_positions_in_degrees_are_never_read_as_pulses():
         assert "in degrees (///POSTYPE ANGLE)" in notes[line]
 
 
+def test_a_station_motion_in_degrees_on_the_next_line_takes_the_point_out(tmp_path):
+    job = tmp_path / "NEXTLINE.JBI"
+    job.write_text(ANGLE.read_text().replace("VJ=50.00  +MOVJ EC00000", "VJ=50.00\n+MOVJ EC00000"))
+    program, notes = read_program(job)
+    assert program.points == []
+    assert notes[0].startswith("line 37: C00000 (the station position EC00000 is in degrees")
+
+
 def test_the_same_job_with_station_pulses_is_read_point_by_point(tmp_path):
     text = ANGLE.read_text().replace("///POSTYPE ANGLE\n///ANGLE", "///POSTYPE PULSE\n///PULSE")
     pulses = tmp_path / "ST2PULSE.JBI"
