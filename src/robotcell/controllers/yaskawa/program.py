@@ -21,8 +21,9 @@ blocks, ``RCONF`` with 6, 8 or 24 values, ``///FRAME`` with three or four slashe
 such as ``//ARGINFO`` between ``//POS`` and ``//INST``, ``+MOVJ`` station motions, tools set by
 ``SETTOOL`` from ``SETE`` values, in program order. Named as not checked, with the reason: pulse
 positions of the robot (their pulses per degree are not in the job), position variables, tools
-and user frames set at run time, station-only motions, ``MOVC``/``MOVS``
-(``docs/programs.md``).
+and user frames set at run time, station-only motions, ``MOVC``/``MOVS``/``SMOVC``, motions
+whose station position is in degrees (``///POSTYPE ANGLE``), ``IMOV`` (incremental) and a
+motion after another word (``COMM MOVJ P000``) (``docs/programs.md``).
 """
 
 from __future__ import annotations
@@ -140,7 +141,13 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
 
 # -- reading -------------------------------------------------------------------------------------
 _DATA_RE = re.compile(r"^(C|BC|EC|P|BP|EX)(\d+)\s*=\s*(.*)$")
-_MOVE_RE = re.compile(r"^\s*(MOVJ|MOVL|MOVC|MOVS|SMOVJ|SMOVL)\s+(.*)$", re.IGNORECASE)
+_MOVE_RE = re.compile(r"^\s*(MOVJ|MOVL|MOVC|MOVS|SMOVJ|SMOVL|SMOVC)\s+(.*)$", re.IGNORECASE)
+#: ``IMOV P000 V=138 PL=1 RF``: a motion by the increment a variable holds, from where the
+#: axes are (INFORM ``IMOV``): its target is not in the job.
+_IMOV_RE = re.compile(r"^\s*IMOV\s+(\S+)", re.IGNORECASE)
+#: A motion after another word (``COMM MOVJ P000``, saved by DX200 and YRC1000 controllers):
+#: no job format robotcell cites describes it, so it is named, never read as a motion.
+_PREFIXED_MOVE_RE = re.compile(r"^\s*([A-Z]\w*)\s+((?:S?MOV[JLCS]|IMOV)\b.*)$", re.IGNORECASE)
 #: A coordinated job's second group moving with the line before (``+MOVJ EC00000 VJ=10.00``).
 _COORD_MOVE_RE = re.compile(r"^\s*\+(MOVJ|MOVL|MOVC|MOVS)\s+(.*)$", re.IGNORECASE)
 #: ``SETTOOL TL#(n) P001``: tool n set from a position variable (INFORM, "SETTOOL").
@@ -192,9 +199,16 @@ class _Position:
         self.user, self.tool, self.rconf, self.where = user, tool, rconf, where
 
 
+#: What the positions after ``///RECTAN``, ``///PULSE`` and ``///ANGLE`` hold: ``C`` positions
+#: are Cartesian, in pulses or (no job shows one) axis angles; station positions after
+#: ``///ANGLE`` are in degrees (jobs DX200 cells saved: ``///POSTYPE ANGLE``, ``///ANGLE``,
+#: ``EC00000=-45.0000``, as job writers write a station's angles in degrees).
+_DATA_KINDS = {"RECTAN": "", "PULSE": "-pulse", "ANGLE": "-angle"}
+
+
 def _pos_section(lines: Lines, start: int, end: int) -> dict[str, _Position]:
     out: dict[str, _Position] = {}
-    postype, user, tool, rconf, rectan = "PULSE", 0, 0, None, False
+    postype, user, tool, rconf, data = "PULSE", 0, 0, None, "PULSE"
     for lineno in range(start, end):
         text = lines.lines[lineno - 1].strip()
         if not text:
@@ -208,8 +222,8 @@ def _pos_section(lines: Lines, start: int, end: int) -> dict[str, _Position]:
                 tool = int(lines.number(value, lineno))
             elif key == "POSTYPE":
                 postype = value.strip().upper()
-            elif key in ("RECTAN", "PULSE"):
-                rectan = key == "RECTAN"
+            elif key in _DATA_KINDS:
+                data = key
             elif key == "RCONF":
                 parts = [p for p in value.split(",") if p.strip()]
                 if len(parts) < 6:
@@ -220,11 +234,12 @@ def _pos_section(lines: Lines, start: int, end: int) -> dict[str, _Position]:
         if not m:
             raise lines.error(lineno, f"expected a position line, got {text[:40]!r}")
         values = [lines.number(v, lineno) for v in m.group(3).split(",")]
-        kind = m.group(1) + ("" if m.group(1) != "C" or rectan else "-pulse")
+        kind = m.group(1) + (_DATA_KINDS[data] if m.group(1) == "C" or data == "ANGLE" else "")
         if kind == "C" and len(values) < 6:
             raise lines.error(lineno, f"C{m.group(2)} needs X, Y, Z, Rx, Ry, Rz")
-        out[m.group(1) + m.group(2)] = _Position(kind, values, postype if rectan else "PULSE",
-                                                 user, tool, rconf, lines.where(lineno))
+        out[m.group(1) + m.group(2)] = _Position(kind, values,
+                                                 postype if data == "RECTAN" else data, user,
+                                                 tool, rconf, lines.where(lineno))
     return out
 
 
@@ -244,8 +259,9 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         Points in the order the job moves to them; ``line`` is the file's line of the motion;
         external axes as ``BC1`` (mm) and ``EC1``.. (pulses).
     skipped : list of str
-        Motions to robot positions in pulses, circular and spline motions; reading group 1,
-        the second robot's motions of a job of two robots.
+        Motions to robot positions in pulses, to station positions in degrees, circular and
+        spline motions, incremental motions, a motion after another word; reading group 1,
+        the second robot's motions of a job of two robots. Each starts with ``line N:``.
 
     Raises
     ------
@@ -269,7 +285,9 @@ def _read(path: str | Path, groups: tuple[int, ...]) -> list[tuple[Program, list
             marks[key] = lineno
     for key in ("/JOB", "//POS", "//INST"):
         if key not in marks:
-            raise InputError(f"{path}: no {key} line: not a YASKAWA job")
+            found = ", ".join(f"{k} at line {n}" for k, n in marks.items())
+            raise InputError(f"{path}: no {key} line" + (f" ({found} only)" if found else "")
+                             + ": not a YASKAWA job, or only a part of one")
     last = next((i for i in range(len(lines.lines), 0, -1)
                  if lines.lines[i - 1].strip(_BLANK)), 0)
     if lines.lines[last - 1].strip(_BLANK).upper() != "END":
@@ -348,6 +366,14 @@ class _Job:
             self.coordinated(m.group(2), lineno)
         elif parts := motion_parts(text):
             self.motion_line(parts, lineno)
+        elif m := _IMOV_RE.match(text):
+            self.skipped.append(f"line {lineno}: IMOV {m.group(1)} (an incremental motion: "
+                                f"by the values of {m.group(1)} from where the axes are, a "
+                                "target the job does not hold)")
+        elif m := _PREFIXED_MOVE_RE.match(text):
+            self.skipped.append(f"line {lineno}: {m.group(1).upper()} {m.group(2).strip()} (a "
+                                f"motion after {m.group(1).upper()}, which the job format does "
+                                "not describe: not read as a motion)")
 
     def settool(self, n: int, var: str, lineno: int) -> None:
         """``SETTOOL TL#(n) Pxxx``: tool n from the position variable, when the job sets its six
@@ -374,17 +400,37 @@ class _Job:
         return out
 
     def refs(self, rest: str, lineno: int) -> list[tuple[str, str]]:
+        """The ``C``, ``BC`` and ``EC`` positions a motion names, each in ``//POS``, or an error
+        naming the line and the positions of the kind ``//POS`` holds (a job that names
+        ``C000`` where ``//POS`` holds ``C00000`` is refused, not matched by number)."""
         refs = re.findall(r"\b(C|BC|EC)(\d+)\b", rest)
-        missing = [k + n for k, n in refs if k + n not in self.positions]
+        missing = [(k, k + n) for k, n in refs if k + n not in self.positions]
         if missing:
-            raise self.lines.error(lineno, f"{', '.join(missing)} not in the //POS section")
+            held = [n for n in self.positions if n.rstrip("0123456789") == missing[0][0]]
+            raise self.lines.error(lineno, f"{', '.join(m for _, m in missing)} not in the //POS "
+                                   "section" + (f" (it holds {held[0]} to {held[-1]})" if held
+                                                else ""))
         return refs
 
     def coordinated(self, rest: str, lineno: int) -> None:
-        """``+MOVJ EC00001 ...``: a station's motion with the robot's on the line before."""
+        """``+MOVJ EC00001 ...``: a station's motion with the robot's on the line before; a
+        station position in degrees takes the robot's point out of the check."""
         refs = self.refs(rest, lineno)
         if self.points and self.points[-1].line == lineno - 1:
+            if why := self.in_degrees(refs):
+                point = self.points.pop()
+                self.values.pop()
+                self.skipped.append(f"line {point.line}: {point.name} ({why})")
+                return
             self.points[-1].external.update(self.external(refs))
+
+    def in_degrees(self, refs: list[tuple[str, str]]) -> str | None:
+        """Why a motion is not checked when one of its station positions is in degrees
+        (``///POSTYPE ANGLE``): robotcell converts station positions from pulses."""
+        deg = [k + n for k, n in refs if k == "EC" and self.positions[k + n].kind == "EC-angle"]
+        return (f"the station position {', '.join(deg)} is in degrees (///POSTYPE ANGLE), not "
+                "in the encoder pulses robotcell converts with --pulses-per-degree") if deg \
+            else None
 
     def motion_line(self, parts: list[tuple[str, str]], lineno: int) -> None:
         """A motion line (:func:`motion_parts`): group 1's motion, and each ``+MOVx`` of the
@@ -408,14 +454,17 @@ class _Job:
                station: tuple[tuple[str, str], ...] | list[tuple[str, str]] = ()) -> None:
         """One robot's motion; ``station``: the line's station positions moved with it."""
         lines = self.lines
-        if instr in ("MOVC", "MOVS"):
-            self.skipped.append(f"line {lineno}: {instr} (circular and spline motions are not "
-                                "checked)")
+        if instr in ("MOVC", "MOVS", "SMOVC"):
+            self.skipped.append(f"line {lineno}: {' '.join([instr, *rest.split()[:1]])} "
+                                "(circular and spline motions are not checked)")
             return
         refs = self.refs(rest, lineno)
+        if why := self.in_degrees(refs + [ref for ref in station if ref not in refs]):
+            self.skipped.append(f"line {lineno}: {instr} {rest.split()[0]} ({why})")
+            return
         cname = next((k + n for k, n in refs if k == "C"), None)
         if cname is None:
-            var = re.search(r"\b(L?P\d+|P\[[^\]]*\])", rest)
+            var = re.search(r"\b(L?(?:P|BP|EX)\d+|L?(?:P|BP|EX)\[[^\]]*\])", rest)
             axes = " ".join(k + n for k, n in refs)
             self.skipped.append(f"line {lineno}: {instr} " + (
                 f"{var.group(1)} (a position variable, set at run time)" if var else
@@ -423,9 +472,11 @@ class _Job:
                 "without a C position"))
             return
         c = self.positions[cname]
-        if c.kind == "C-pulse":
-            self.skipped.append(f"line {lineno}: {instr} {cname} (robot pulses: their pulses "
-                                "per degree are not in the job)")
+        if c.kind != "C":
+            self.skipped.append(f"line {lineno}: {instr} {cname} (" + (
+                "robot pulses: their pulses per degree are not in the job" if c.kind == "C-pulse"
+                else "a robot position as axis angles (///ANGLE), which no job robotcell cites "
+                "holds") + ")")
             return
         why = self.changed.get(("TOOL", c.tool)) or (
             self.changed.get(("USER", c.user)) if c.postype == "USER" else None)
