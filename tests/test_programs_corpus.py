@@ -18,7 +18,7 @@ from robotcell.programs import read_program, write_program
 
 DATA = Path(__file__).resolve().parent / "data" / "programs"
 #: The program files of each vendor's corpus (a KUKA program is its .src).
-MAIN = {"kuka": ".src", "abb": ".mod", "fanuc": ".ls", "yaskawa": ".jbi"}
+MAIN = {"kuka": ".src", "abb": ".mod", "fanuc": ".ls", "yaskawa": ".jbi", "ur": ".script"}
 
 
 def _corpus(vendor: str) -> list[Path]:
@@ -83,7 +83,9 @@ def cell() -> Cell:
     return Cell.load(CELL)
 
 
-@pytest.mark.parametrize("vendor", list(MAIN))
+# UR: a UR arm moves without the example cell's track (refused); test_programs_ur.py reads
+# its written programs back
+@pytest.mark.parametrize("vendor", [v for v in MAIN if v != "ur"])
 def test_a_written_program_reads_back_as_written(cell, tmp_path, vendor):
     result = write_program(SEAM, cell, "torch", "part", vendor, tmp_path / "p",
                            pulses_per_degree=100 if vendor == "yaskawa" else None)

@@ -3,35 +3,49 @@
 The reader follows URScript as Universal Robots' manual describes it (sources in
 ``docs/programs.md``):
 
-- a program is ``def NAME():`` .. ``end`` (then, in a saved file, the call ``NAME()``); a line
-  ending with ``:`` opens a block (``def``, ``if``, ``while``, ``thread``; ``elif``/``else``
-  continue one) that ``end`` closes; ``#`` starts a comment; PolyScope's ``$ 1 "MoveJ"`` lines
-  mark the program tree and are not statements;
+- a program is ``def NAME():`` (or ``sec NAME():``) .. ``end``, then in a saved file the call
+  ``NAME()``; or statements and functions ``def NAME(a, b=1):`` at the top of the file, as
+  PolyScope X saves a program and as Universal Robots' example scripts and URCap snippets are
+  written (a client wraps such a snippet in a ``def`` before it sends it), the program then
+  named after the file; ``def``, ``sec``, ``thread``, ``if``, ``while`` and ``for`` open a block
+  (``elif``/``else`` continue one) that ``end`` closes, their body on the next lines or after
+  the ``:`` (``if (n == 1): x = True``, as PolyScope saves URCap code; ``if (n == 9):
+  movej(q) end`` on one line); ``#`` starts a comment; PolyScope's ``$ 1 "MoveJ"`` lines mark
+  the program tree and are not statements; ``run``, ``join`` and ``kill`` handle threads;
 - ``movej(q, a, v, t, r)`` and ``movel(pose, a, v, t, r)``, their arguments by position or by
   name: ``q`` joint positions ``[..]`` in rad, or a pose (the controller then computes the
   joints by inverse kinematics), ``pose`` a pose ``p[x, y, z, rx, ry, rz]`` (m, rotation vector
   in rad; a joint list is moved to by forward kinematics), ``v`` the TCP speed of ``movel`` in
   m/s, ``t`` a time that overrides the speed, ``r`` the blend radius in m;
 - ``pose_trans(Feature, p[..])``: the pose ``p`` in the feature, ``Feature`` a pose the file
-  declares (``global Plane_1=p[..]``, as PolyScope declares its waypoints);
+  declares (``global Plane_1=p[..]``, as PolyScope declares its waypoints); a variable
+  assigned once ``pose_trans(A, B)`` or ``pose_add(A, B)`` of known poses is known
+  (``pose_add``: "p_3.P = p_1.P + p_2.P, p_3.R = p_1.R * p_2.R", manual);
   ``get_inverse_kin(X, qnear=Q)``: the joints of the pose ``X`` nearest to ``Q`` ("the
   solution closest to qnear", manual); without a ``qnear`` the file gives, the solution nearest
   to the previous point's, as for every point without flags;
 - ``set_tcp(p[..])``: the TCP in the tool flange frame for the motions after it (before any, the
-  flange).
+  flange); PolyScope X adds the TCP's name, ``set_tcp(p[..], "Tool_flange")``;
+- a pose of variables or expressions (``p[x, y, z, rx, ry, rz]``, ``p[v[0], .., 0]``) and a
+  function's parameters (inside the function, where they hide a global of the same name) are
+  values set at run time.
 
 A value is known when the file assigns it once, as a literal (``global Waypoint_1_p=p[..]``,
 ``speed_ms = 0.25``); a variable assigned more than once changes at run time. Points are read in
 the order of the file's lines (a subprogram's motions where it is written, not where it is
 called). Motions whose target is computed at run time or is not known, circular (``movec``),
 process (``movep``), servo and speed motions are named as not checked, never refused; a line
-that cannot be read (a ``p[..]`` without six numbers, a number that is none, a block without
-its ``end``) is refused with the file and line.
+that cannot be read (a ``p[..]`` of numbers that are not six, a number that is none, a block
+without its ``end``, text that is no URScript statement, an assignment without a value, a
+number anywhere that is not finite) is refused with the file and line, and so is a file that
+holds no statement. A file of statements at the top cut between two statements reads as a
+shorter program: no ``end`` is missing.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -50,11 +64,22 @@ BASE = Ref(kind="base")
 #: The tool of motions before any ``set_tcp``: the tool flange.
 FLANGE = Ref(name="flange", pose=np.eye(4))
 
-_DEF_RE = re.compile(r"^def\s+([A-Za-z_]\w*)\s*\(\s*\)\s*:$")
+_DEF_RE = re.compile(r"^(?:def|sec)\s+([A-Za-z_]\w*)\s*\((.*)\)\s*:$", re.DOTALL)
 _ASSIGN_RE = re.compile(r"^(?:global\s+|local\s+)?([A-Za-z_]\w*)\s*=(?!=)\s*(.+)$")
 _CALL_RE = re.compile(r"^([A-Za-z_]\w*)\s*\((.*)\)$", re.DOTALL)
 _NAMED_RE = re.compile(r"^([A-Za-z_]\w*)\s*=(?!=)\s*(.*)$", re.DOTALL)
 _NUMERIC = re.compile(r"^[-+]?(?:[0-9.]|nan\b|inf)", re.IGNORECASE)
+#: What makes an item of a list an expression, not a number: a name (a letter not after a
+#: digit, as ``0.3x`` is a mistyped number), an index, a call or an operator.
+_EXPRESSION = re.compile(r"[()\[\]*/%]|(?<![0-9.])[A-Za-z_]")
+#: A number of a statement (not a digit of a name), and the words ``nan`` and ``inf``.
+_NUMBER_RE = re.compile(r"(?<![\w.])(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?(?![\w.])"
+                        r"|\b(?:nan|inf)\b", re.IGNORECASE)
+#: Words that open a block, which ``end`` closes.
+_BLOCKS = ("def", "thread", "sec", "if", "while", "for")
+#: Words a statement may begin with that are followed by a space and more.
+_STATEMENT_WORDS = frozenset({*_BLOCKS, "elif", "else", "return", "global", "local", "run",
+                              "kill", "join", "halt", "end", "break", "continue", "pass", "not"})
 _NOT_CHECKED = {"movec": "circular motions are not checked",
                 "movep": "process motions are not checked",
                 "servoj": "a servo motion is not checked",
@@ -70,9 +95,32 @@ def _depth(text: str) -> int:
     return text.count("(") + text.count("[") - text.count(")") - text.count("]")
 
 
+def _body(text: str) -> list[str]:
+    """A statement that opens or continues a block (``if``, ``elif``, ``else``, ``while``,
+    ``for``, ``def``, ``thread``), split after its ``:`` outside brackets and quotes: the head,
+    the statement written on the same line, and the ``end`` that closes the block there
+    (``if (n == 9): movej(q, t=2) end``); other statements as they are."""
+    if not re.match(r"^(?:" + "|".join((*_BLOCKS, "elif", "else")) + r")\b", text):
+        return [text]
+    depth, quoted = 0, False
+    for i, ch in enumerate(text):
+        if ch == '"':
+            quoted = not quoted
+        elif not quoted and ch in "([{":
+            depth += 1
+        elif not quoted and ch in ")]}":
+            depth -= 1
+        elif ch == ":" and not quoted and depth == 0:
+            body = text[i + 1:].strip()
+            closed = re.fullmatch(r"(.*\S)\s+end", body, re.DOTALL)
+            return [text[:i + 1], *([closed.group(1), "end"] if closed else [body] * bool(body))]
+    return [text]
+
+
 def statements(lines: Lines) -> list[tuple[int, str]]:
     """The statements of the file with their first line: comments and PolyScope's ``$`` lines
-    dropped, a statement whose brackets are open joined with the lines after it.
+    dropped, a statement whose brackets are open joined with the lines after it, and the
+    statement after a block's ``:`` on the same line a statement of its own.
 
     Raises
     ------
@@ -93,7 +141,7 @@ def statements(lines: Lines) -> list[tuple[int, str]]:
         if depth < 0:
             raise lines.error(lineno, f"a bracket is closed that was not opened: {line[:40]!r}")
         if depth == 0:
-            out.append((start, " ".join(cur)))
+            out.extend((start, part) for part in _body(" ".join(cur)))
             cur = []
     if cur:
         raise lines.error(start, f"the brackets of {' '.join(cur)[:40]!r} are not closed "
@@ -101,22 +149,69 @@ def statements(lines: Lines) -> list[tuple[int, str]]:
     return out
 
 
+def _check_statement(lines: Lines, lineno: int, text: str) -> None:
+    """Refuse text that is no URScript statement: one that does not begin with a name or a
+    word of URScript (a template's ``{{ .. }}``), words not joined by an operator or brackets
+    (``power on``, a dashboard server command), an assignment without its value."""
+    first = re.match(r"^([A-Za-z_]\w*)(\s+[A-Za-z0-9_\"])?", text)
+    if not first or (first.group(2) and first.group(1) not in _STATEMENT_WORDS):
+        raise lines.error(lineno, f"{text[:50]!r} is not a URScript statement (a call, an "
+                                  "assignment, or a statement of a word of URScript such as "
+                                  "'if' or 'global'): not a URScript program")
+    if re.fullmatch(r"(?:global\s+|local\s+)?[A-Za-z_]\w*\s*=", text):
+        raise lines.error(lineno, f"{text!r} assigns no value (a template whose values are "
+                                  "filled in before it is sent?): not a URScript program")
+    for number in _NUMBER_RE.finditer(re.sub(r'"[^"]*"', '""', text)):
+        lines.number(number.group(), lineno)  # every number finite, wherever it is
+
+
 def _check_blocks(lines: Lines, stmts: list[tuple[int, str]]) -> str:
-    """The program's name (its first ``def``), once every block is closed by ``end``."""
-    if not stmts or not (m := _DEF_RE.match(stmts[0][1])):
-        raise InputError(f"{lines.path}: no 'def NAME():' line first: not a URScript program")
+    """The program's name, once every statement is one and every block is closed by ``end``:
+    that of a first ``def NAME():`` without parameters that holds the file (nothing after its
+    ``end`` but the call ``NAME()``), else the file's name (statements at the top of the file,
+    a library of functions)."""
+    if not stmts:
+        raise InputError(f"{lines.path}: no URScript statement, only comments or blank lines: "
+                         "not a URScript program")
+    m = _DEF_RE.match(stmts[0][1])
+    name = m.group(1) if m and not m.group(2).strip() else None
     depth = 0
-    for lineno, text in stmts:
+    for k, (lineno, text) in enumerate(stmts):
+        _check_statement(lines, lineno, text)
+        if name and not depth and k and not re.fullmatch(rf"{name}\s*\(\s*\)", text):
+            name = None  # a statement at the top of the file, outside the first def
         if text == "end":
             depth -= 1
             if depth < 0:
                 raise lines.error(lineno, "'end' closes no block")
-        elif text.endswith(":") and not re.match(r"^(elif|else)\b", text):
+        elif re.match(r"^(?:" + "|".join(_BLOCKS) + r")\b", text):
             depth += 1
+    name = name or Path(lines.path).name.split(".")[0]
     if depth:
-        raise lines.error(len(lines.lines), f"{depth} block(s) not closed by 'end', 'def "
-                                            f"{m.group(1)}():' among them (truncated file?)")
-    return m.group(1)
+        raise lines.error(len(lines.lines), f"{depth} block(s) not closed by 'end' (truncated "
+                                            "file?)")
+    return name
+
+
+def _scoped(stmts: list[tuple[int, str]]) -> Iterator[tuple[int, str, frozenset[str]]]:
+    """The statements with the parameters of the functions they are in (``def NAME(a, b=1):``
+    .. ``end``): names that each call sets, which hide a global of the same name there."""
+    stack: list[frozenset[str]] = []
+    for lineno, text in stmts:
+        yield lineno, text, frozenset().union(*stack)
+        if text == "end" and stack:
+            stack.pop()
+        elif re.match(r"^(?:" + "|".join(_BLOCKS) + r")\b", text):
+            m = _DEF_RE.match(text)
+            params = split(m.group(2)) if m and m.group(2).strip() else []
+            stack.append(frozenset(re.sub(r"\s*=.*", "", a, flags=re.DOTALL) for a in params))
+
+
+def _expression(item: str) -> bool:
+    """Whether an item of a list is a name or an expression (set at run time), not a number
+    (``nan``, ``1e400`` and ``0.3x`` are numbers, refused when they are read)."""
+    return (not _NUMERIC.match(item) or bool(_EXPRESSION.search(item))
+            and not re.fullmatch(r"[-+]?(?:nan|inf)", item, re.IGNORECASE))
 
 
 @dataclass(frozen=True)
@@ -135,11 +230,20 @@ class _Reader:
     def __init__(self, lines: Lines, stmts: list[tuple[int, str]]) -> None:
         self.lines = lines
         self.values: dict[str, _Value | None] = {}
-        for lineno, text in stmts:
+        #: The parameters of the function of the statement read: hidden globals.
+        self.hidden: frozenset[str] = frozenset()
+        once: dict[str, tuple[str, int]] = {}  # assigned once, composed of other values
+        for lineno, text, params in _scoped(stmts):
             if (m := _ASSIGN_RE.match(text)) and not text.endswith(":"):
                 name, value = m.group(1), self.literal(m.group(2), lineno)
                 # assigned twice: a value set at run time
-                self.values[name] = None if name in self.values else value
+                if name not in self.values and not (
+                        params and re.search(rf"\b(?:{'|'.join(params)})\b", m.group(2))):
+                    once[name] = (m.group(2), lineno)
+                else:  # or of the function's parameters: set by each call
+                    once.pop(name, None)
+                self.values[name] = None if name in self.values or name not in once else value
+        self.compose({k: v for k, v in once.items() if self.values[k] is None})
         self.tool: Ref | None = FLANGE
         self.tool_line = 0
         self.points: list[ProgramPoint] = []
@@ -147,15 +251,19 @@ class _Reader:
 
     # -- values ------------------------------------------------------------------------------
     def numbers(self, text: str, lineno: int) -> NDArray[np.float64] | None:
-        """The numbers of a list ``[..]`` (None when an item is not a number, as a list of
-        names); a number that is not finite is refused."""
+        """The numbers of a list ``[..]`` (None when an item is not a number: a name, an
+        expression); a number that is not finite or mistyped is refused."""
         items = split(text.strip()[1:-1]) if text.strip() != "[]" else []
-        if not items or not all(_NUMERIC.match(i) for i in items):
+        if not items or any(_expression(i) for i in items):
             return None
         return np.array([self.lines.number(i, lineno) for i in items])
 
-    def pose(self, text: str, lineno: int) -> NDArray[np.float64]:
-        """The pose of a literal ``[x, y, z, rx, ry, rz]`` after its ``p`` (m, rad)."""
+    def pose(self, text: str, lineno: int) -> NDArray[np.float64] | None:
+        """The pose of a literal ``[x, y, z, rx, ry, rz]`` after its ``p`` (m, rad); None when
+        an item is a name or an expression (a pose computed at run time)."""
+        items = split(text.strip()[1:-1])
+        if all(items) and any(_expression(i) for i in items):
+            return None
         values = self.numbers(text, lineno)
         if values is None or values.shape != (6,):
             raise self.lines.error(lineno, f"a pose is p[x, y, z, rx, ry, rz], six numbers; "
@@ -164,8 +272,9 @@ class _Reader:
 
     def literal(self, text: str, lineno: int) -> _Value | None:
         t = text.strip()
-        if re.match(r"^p\s*\[", t) and t.endswith("]"):
-            return _Value(self.pose(t[t.index("["):], lineno), None, None, lineno)
+        if re.match(r"^p\s*\[", t) and t.endswith("]") and _depth(t[t.index("["):]) == 0:
+            pose = self.pose(t[t.index("["):], lineno)
+            return None if pose is None else _Value(pose, None, None, lineno)
         if t.startswith("[") and t.endswith("]") and _depth(t) == 0:
             items = self.numbers(t, lineno)
             return None if items is None else _Value(None, items, None, lineno)
@@ -173,12 +282,38 @@ class _Reader:
             return _Value(None, None, self.lines.number(t, lineno), lineno)
         return None
 
+    def composed(self, text: str, lineno: int) -> _Value | None:
+        """``pose_trans(p_from, p_from_to)`` or ``pose_add(p_1, p_2)`` of two known poses, as
+        the manual defines them: ``T_from @ T_from_to``; the positions added and the rotations
+        multiplied (``p_3.P = p_1.P + p_2.P``, ``p_3.R = p_1.R * p_2.R``). None otherwise."""
+        m = _CALL_RE.match(text.strip())
+        if not m or m.group(1) not in ("pose_trans", "pose_add"):
+            return None
+        args = split(m.group(2))
+        known = [self.known(a, lineno) for a in args] if len(args) == 2 else [None]
+        if any(v is None or v.pose is None for v in known):
+            return None
+        A, B = (v.pose for v in known)  # type: ignore[union-attr]
+        if m.group(1) == "pose_trans":
+            return _Value(A @ B, None, None, lineno)
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = A[:3, :3] @ B[:3, :3], A[:3, 3] + B[:3, 3]
+        return _Value(T, None, None, lineno)
+
+    def compose(self, assigned: dict[str, tuple[str, int]]) -> None:
+        """Give the variables assigned once a pose composed of known poses (:meth:`composed`)
+        their value, each once the poses it is composed of are known."""
+        while resolved := {name: v for name, (text, lineno) in assigned.items()
+                           if (v := self.composed(text, lineno)) is not None}:
+            self.values.update(resolved)
+            assigned = {k: v for k, v in assigned.items() if k not in resolved}
+
     def known(self, text: str, lineno: int) -> _Value | None:
         """A literal written here, or a variable the file assigns once."""
         t = text.strip()
         if re.fullmatch(r"[A-Za-z_]\w*", t):
-            return self.values.get(t)
-        return self.literal(t, lineno)
+            return None if t in self.hidden else self.values.get(t)
+        return self.literal(t, lineno) or self.composed(t, lineno)
 
     def number(self, text: str | None, lineno: int) -> float | None:
         v = None if text is None else self.known(text, lineno)
@@ -210,8 +345,12 @@ class _Reader:
                                                f"{t[:60]!r}")
             name = t if re.fullmatch(r"[A-Za-z_]\w*", t) else f"line {lineno}"
             return value, BASE, name
+        if t in self.hidden:
+            return f"{t} is a parameter of the function, set by each call"
         if re.fullmatch(r"[A-Za-z_]\w*", t):
             return f"{t} is a variable set at run time or not given a value in this file"
+        if re.match(r"^p\s*\[", t):
+            return "a pose of values computed at run time"
         return "a target computed at run time"
 
     # -- statements --------------------------------------------------------------------------
@@ -221,11 +360,14 @@ class _Reader:
             return
         func = m.group(1)
         if func == "set_tcp":
-            value = self.known(m.group(2), lineno)
+            # set_tcp(pose), PolyScope X: set_tcp(pose, "name"); the pose by position or name
+            args = split(m.group(2))
+            name = next((n.group(2) for a in args if (n := _NAMED_RE.match(a))
+                         and n.group(1) == "pose"), args[0]).strip()
+            value = self.known(name, lineno)
             if value is None or value.pose is None:
                 self.tool, self.tool_line = None, lineno
             else:
-                name = m.group(2).strip()
                 self.tool = Ref(name=name if re.fullmatch(r"[A-Za-z_]\w*", name) else None,
                                 pose=value.pose)
         elif func in _NOT_CHECKED:
@@ -299,13 +441,15 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     Raises
     ------
     InputError
-        No ``def NAME():`` first, a block without ``end``, open brackets, a pose or joint list
-        that is not six numbers, a number that is not one; the message names the file and line.
+        No statement, text that is no URScript statement, a block without ``end``, open
+        brackets, a pose or joint list of numbers that are not six, a number that is not one;
+        the message names the file and line.
     """
     lines = Lines(path, "URScript program")
     stmts = statements(lines)
     name = _check_blocks(lines, stmts)
     reader = _Reader(lines, stmts)
-    for lineno, text in stmts:
+    for lineno, text, params in _scoped(stmts):
+        reader.hidden = params
         reader.statement(text, lineno)
     return Program(name, "ur", reader.points, (str(path),)), reader.skipped
