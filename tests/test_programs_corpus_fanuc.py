@@ -81,6 +81,16 @@ def test_the_cartesian_position_of_a_second_arm_in_group_2_is_no_table_axis():
     assert notes[2].startswith("line 22: L P[1] (COORD:")
 
 
+def test_frames_set_from_registers_with_comments_and_negative_values_in_parentheses():
+    program, notes = read_program(FANUC / "excerpts" / "tooldata.ls")
+    assert not notes and [p.name for p in program.points] == ["P[1]", "P[2]"]
+    tool, frame = program.points[0].tool, program.points[0].frame
+    assert (tool.number, frame.number) == (1, 2)  # UTOOL[1:GUN]=PR[16], UFRAME[2:FIXTURE]=PR[16]
+    assert np.allclose(tool.pose[:3, 3], [-0.0005, 0.0125, 0.21025])  # PR[16,1]=(-.5) ...
+    assert np.allclose(frame.pose[:3, 3], [0.8, -0.3005, -0.02])
+    assert np.allclose(frame.pose[:3, :3], [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], atol=1e-12)
+
+
 def test_a_controller_report_saved_as_ls_is_refused_naming_its_first_line(tmp_path, capsys):
     report = tmp_path / "ERRALL.LS"
     report.write_text("ERRALL.LS      Robot Name ROBOT 27-MAY-25 18:35     \n\n"
@@ -100,7 +110,8 @@ def _variant(tmp_path: Path, name: str, data: bytes) -> Path:
 
 
 @pytest.mark.parametrize("source", ["excerpts/unnumbered.ls", "excerpts/german.ls",
-                                    "excerpts/untaught.ls", "rpi_motion_program_exec/TMPB.LS"])
+                                    "excerpts/untaught.ls", "excerpts/tooldata.ls",
+                                    "rpi_motion_program_exec/TMPB.LS"])
 def test_broken_variants_of_the_new_files_are_refused_in_one_error_line(tmp_path, capsys, source):
     data = (FANUC / source).read_bytes()
     end = data.index(b"/END")

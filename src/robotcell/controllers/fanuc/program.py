@@ -18,13 +18,14 @@ unnumbered ``/MN`` lines (``   5:J P[1] ...``, ``    :J P[1] ...``), joint posit
 (``J1 = .. deg``), comments on positions (``P[3:"approach"]``), other numbers of decimals,
 ``cm/min``, ``sec`` and ``%`` speeds, the words of a listing saved in German (``KONFIG``,
 ``mm/sek``, ``WKZ_Offset``), ``/END`` followed by an end-of-file mark, a tool or user frame set
-in the program from a position register (``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its
-values win over the cell's), in program order; the groups ``DEFAULT_GROUP`` moves. Named as not
-checked, with the reason: motions to position registers, ``Offset``/``Tool_Offset``/
-``VOFFSET``/``INC`` and ``COORD`` motions, positions in frames set from registers set at run
-time, circular motions, positions not recorded (``********``), with no group 1 data or written
-as ``RX..RR``, ``P[...]`` with no number, and the data of groups the program does not move or
-that hold another arm's Cartesian position (``docs/programs.md``).
+in the program from a position register (``PR[9,1]=-30.0 ;`` or ``PR[9,1]=(-30.0) ;`` ..
+``UTOOL[9]=PR[9] ;`` or ``UTOOL[9:comment]=PR[9] ;``: its values win over the cell's), in
+program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked, with the reason:
+motions to position registers, ``Offset``/``Tool_Offset``/``VOFFSET``/``INC`` and ``COORD``
+motions, positions in frames set from registers set at run time, circular motions, positions
+not recorded (``********``), with no group 1 data or written as ``RX..RR``, ``P[...]`` with no
+number, and the data of groups the program does not move or that hold another arm's Cartesian
+position (``docs/programs.md``).
 """
 
 from __future__ import annotations
@@ -161,9 +162,12 @@ _UF_RE = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
 #: ``KONFIG`` in listings saved by a controller set to German (the English and German listings
 #: of the same programs in one backup differ in these words only).
 _CONFIG_RE = re.compile(r"\b(?:CONFIG|KONFIG)\s*:\s*'([^']*)'")
-_PR_SET_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*([-+0-9.eE]+)\s*;")
+#: An element of a position register set to a number, bare or in parentheses as the pendant
+#: writes a negative one (``PR[16,1]=(-.4) ;``, a controller backup's tool data program).
+_PR_SET_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*(\(\s*)?([-+0-9.eE]+)"
+                        r"(?(3)\s*\))\s*;")
 _PR_ANY_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*(?:,\s*\d+\s*)?(?::[^\]]*)?\]\s*=")
-_FRAME_SET_RE = re.compile(_STEP + r"(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*"
+_FRAME_SET_RE = re.compile(_STEP + r"(UTOOL|UFRAME)\[\s*(\d+)\s*(?::[^\]]*)?\]\s*=\s*"
                            r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*;", re.IGNORECASE)
 _SECTION_RE = re.compile(r"^\s*(/[A-Za-z]+)")
 _GROUP_RE = re.compile(r"^\s*DEFAULT_GR\w*\s*=\s*([^;]*);")
@@ -435,7 +439,7 @@ class _Main:
     def line(self, text: str, lineno: int) -> None:
         if m := _PR_SET_RE.match(text):
             self.registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = (
-                self.lines.number(m.group(3), lineno))
+                self.lines.number(m.group(4), lineno))
         elif m := _FRAME_SET_RE.match(text):
             self.frame_set(m.group(1).upper(), int(m.group(2)), int(m.group(3)), lineno)
         elif m := _PR_ANY_RE.match(text):  # a register set at run time (LPOS, another PR)
