@@ -117,6 +117,7 @@ def test_broken_variants_of_the_new_files_are_refused_in_one_error_line(tmp_path
     end = data.index(b"/END")
     cases = {
         "truncated.ls": (data[:end - 12], r"line \d+: (no /END|P\[\d+\] is not closed)"),
+        "half.ls": (data[:data.index(b"/MN")], r"line \d+: no /MN line \(truncated file\?\)"),
         "utf16.ls": (data.decode("latin-1").encode("utf-16"), "UTF-16"),
         "nan.ls": (data.replace(b"=   ", b"=   nan", 1) if b"=   " in data
                    else data.replace(b"= -", b"= nan", 1), r"line \d+: 'nan\S*' is not"),

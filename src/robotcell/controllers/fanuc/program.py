@@ -357,25 +357,24 @@ def _run_time_option(rest: str) -> str | None:
 
 
 def _sections(lines: Lines) -> dict[str, int]:
-    """The line of each section mark (``/PROG``, ``/MN``, ...), the file refused, naming its
-    first line, when it has no ``/PROG`` or ``/MN`` (a controller's report saved as ``.LS``,
-    such as ``ERRALL.LS``, is no program), or no ``/END``."""
+    """The line of each section mark (``/PROG``, ``/MN``, ...); the file refused when it has no
+    ``/PROG`` (naming its first line: a controller's report saved as ``.LS``, such as
+    ``ERRALL.LS``, is no program), or no ``/MN`` or ``/END`` (naming its last line)."""
     marks: dict[str, int] = {}
     for lineno, text in enumerate(lines.lines, start=1):
         m = _SECTION_RE.match(text)  # '/END' and whatever follows it on the line (an EOF mark)
         key = m.group(1).upper() if m else ""
         if key in ("/PROG", "/ATTR", "/MN", "/POS", "/END", "/APPL") and key not in marks:
             marks[key] = lineno
-    for key in ("/PROG", "/MN"):
+    if "/PROG" not in marks:
+        first = next(((i, t.strip()) for i, t in enumerate(lines.lines, 1) if t.strip()), None)
+        if first is None:
+            raise InputError(f"{lines.path}: the file is empty: not a FANUC .ls listing")
+        raise lines.error(first[0], "no /PROG line: not a FANUC TP listing (it starts "
+                                    f"{first[1][:48]!r})")
+    for key in ("/MN", "/END"):
         if key not in marks:
-            first = next(((i, t.strip()) for i, t in enumerate(lines.lines, 1) if t.strip()),
-                         None)
-            if first is None:
-                raise InputError(f"{lines.path}: the file is empty: not a FANUC .ls listing")
-            raise lines.error(first[0], f"no {key} line: not a FANUC TP listing (it starts "
-                                        f"{first[1][:48]!r})")
-    if "/END" not in marks:
-        raise lines.error(len(lines.lines), "no /END (truncated file?)")
+            raise lines.error(len(lines.lines), f"no {key} line (truncated file?)")
     return marks
 
 
