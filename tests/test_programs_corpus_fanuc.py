@@ -91,6 +91,17 @@ def test_frames_set_from_registers_with_comments_and_negative_values_in_parenthe
     assert np.allclose(frame.pose[:3, :3], [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], atol=1e-12)
 
 
+def test_registers_chosen_at_run_time_are_named_with_the_frame_set_from_one():
+    program, notes = read_program(FANUC / "excerpts" / "indirect.ls")
+    assert [(p.name, p.line, p.frame.number) for p in program.points] == [
+        ("P[1]", 30, 0), ("P[1]", 38, 0)]
+    assert notes == [
+        "line 31: L PR[R[98]] (a position register, not held by the program)",
+        "line 35: J PR[R[95]] (a position register, not held by the program)",
+        ("line 36: L P[2] (UFRAME[21] is set at line 33 from PR[R[99]], whose values are set "
+         "at run time)")]
+
+
 def test_a_controller_report_saved_as_ls_is_refused_naming_its_first_line(tmp_path, capsys):
     report = tmp_path / "ERRALL.LS"
     report.write_text("ERRALL.LS      Robot Name ROBOT 27-MAY-25 18:35     \n\n"

@@ -21,8 +21,9 @@ unnumbered ``/MN`` lines (``   5:J P[1] ...``, ``    :J P[1] ...``), joint posit
 in the program from a position register (``PR[9,1]=-30.0 ;`` or ``PR[9,1]=(-30.0) ;`` ..
 ``UTOOL[9]=PR[9] ;`` or ``UTOOL[9:comment]=PR[9] ;``: its values win over the cell's), in
 program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked, with the reason:
-motions to position registers, ``Offset``/``Tool_Offset``/``VOFFSET``/``INC`` and ``COORD``
-motions, positions in frames set from registers set at run time, circular motions, positions
+motions to position registers (``PR[R[n]]`` too), ``Offset``/``Tool_Offset``/``VOFFSET``/
+``INC`` and ``COORD`` motions, positions in frames set from registers set or chosen at run time
+(``UFRAME[21]=PR[R[99]]``), circular motions, positions
 not recorded (``********``), with no group 1 data or written as ``RX..RR``, ``P[...]`` with no
 number, and the data of groups the program does not move or that hold another arm's Cartesian
 position (``docs/programs.md``).
@@ -164,11 +165,13 @@ _UF_RE = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
 _CONFIG_RE = re.compile(r"\b(?:CONFIG|KONFIG)\s*:\s*'([^']*)'")
 #: An element of a position register set to a number, bare or in parentheses as the pendant
 #: writes a negative one (``PR[16,1]=(-.4) ;``, a controller backup's tool data program).
-_PR_SET_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*(\(\s*)?([-+0-9.eE]+)"
-                        r"(?(3)\s*\))\s*;")
+_PR_SET_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*,\s*(\d)\s*(?::[^\]]*)?\]\s*=\s*(\(\s*)?"
+                        r"([-+0-9.eE]+)(?(3)\s*\))\s*;")
 _PR_ANY_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*(?:,\s*\d+\s*)?(?::[^\]]*)?\]\s*=")
+#: A tool or user frame set in the program: from ``PR[m]`` (group 3), or from anything else
+#: (``PR[R[99]]``, a register chosen at run time; group 4).
 _FRAME_SET_RE = re.compile(_STEP + r"(UTOOL|UFRAME)\[\s*(\d+)\s*(?::[^\]]*)?\]\s*=\s*"
-                           r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*;", re.IGNORECASE)
+                           r"(?:PR\[\s*(\d+)\s*(?::[^\]]*)?\]|(.*?))\s*;", re.IGNORECASE)
 _SECTION_RE = re.compile(r"^\s*(/[A-Za-z]+)")
 _GROUP_RE = re.compile(r"^\s*DEFAULT_GR\w*\s*=\s*([^;]*);")
 #: Motion options that move the position by data outside the program (FANUC R-30iB
@@ -440,21 +443,34 @@ class _Main:
             self.registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = (
                 self.lines.number(m.group(4), lineno))
         elif m := _FRAME_SET_RE.match(text):
-            self.frame_set(m.group(1).upper(), int(m.group(2)), int(m.group(3)), lineno)
+            self.frame_set(m.group(1).upper(), int(m.group(2)), m.group(3) or m.group(4), lineno)
         elif m := _PR_ANY_RE.match(text):  # a register set at run time (LPOS, another PR)
             self.registers.pop(int(m.group(1)), None)
         elif m := _MOVE_RE.match(text):
             self.motion(m, lineno)
 
-    def frame_set(self, kind: str, number: int, reg: int, lineno: int) -> None:
-        """``UTOOL[n]=PR[m]``: the register's values if the program sets all six as numbers."""
-        pr = self.registers.get(reg, {})
+    def frame_set(self, kind: str, number: int, source: str, lineno: int) -> None:
+        """``UTOOL[n]=PR[m]``: the register's values if the program sets all six as numbers.
+
+        Parameters
+        ----------
+        kind : str
+            ``UTOOL`` or ``UFRAME``.
+        number : int
+            The frame's number.
+        source : str
+            The register's number (``"9"`` of ``PR[9]``), or what else the frame is set from.
+        lineno : int
+            The line, 1-based.
+        """
+        pr = self.registers.get(int(source), {}) if source.isdigit() else {}
         if sorted(pr) == [1, 2, 3, 4, 5, 6]:
             self.defined[(kind, number)] = pose_from_vendor([pr[i] for i in range(1, 7)],
                                                             "fanuc")
         else:
+            what = f"PR[{source}]" if source.isdigit() else source
             self.defined[(kind, number)] = (f"{kind}[{number}] is set at line {lineno} from "
-                                            f"PR[{reg}], whose values are set at run time")
+                                            f"{what}, whose values are set at run time")
 
     def motion(self, m: re.Match, lineno: int) -> None:
         lines, skipped = self.lines, self.skipped
