@@ -4,12 +4,14 @@ named as not checked with their reason, or refused naming the cause and the line
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 from cli_helpers import run
 
+from robotcell.controllers.fanuc import FANUC as FANUC_CTL
 from robotcell.controllers.model import Config
 from robotcell.errors import InputError
 from robotcell.programs import read_program
@@ -38,6 +40,17 @@ def test_a_listing_saved_in_german_reads_konfig_mm_per_sek_and_wkz_offset():
         None, pytest.approx(1.5), None, pytest.approx(0.2)]  # 1500mm/sek, max_Geschw., 200mm/sek
     assert notes == [("line 29: J P[3] (WKZ_Offset, PR[11]: the position is offset at run time "
                       "by data not in the program)")]
+
+
+def test_a_pose_written_back_into_a_german_listing_rewrites_its_konfig():
+    lines = (FANUC / "excerpts" / "german.ls").read_text(encoding="latin-1").splitlines()
+    idx = lines.index("P[2]{")
+    T = np.eye(4)
+    T[:3, 3] = [1.0, 0.2, 0.4]
+    assert FANUC_CTL.set_pose(lines, idx, T, Config("fanuc", (1, 0, 0, 0, 0, 1)))
+    assert "KONFIG : 'F U T, 0, 0, 1'" in lines[idx + 2]
+    assert [float(v) for v in re.findall(r"[XYZ] =\s*(\S+)\s*mm", lines[idx + 3])] == [
+        1000.0, 200.0, 400.0]
 
 
 def test_a_position_not_recorded_is_named_not_refused():

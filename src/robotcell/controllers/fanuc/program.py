@@ -23,10 +23,9 @@ in the program from a position register (``PR[9,1]=-30.0 ;`` or ``PR[9,1]=(-30.0
 program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked, with the reason:
 motions to position registers (``PR[R[n]]`` too), ``Offset``/``Tool_Offset``/``VOFFSET``/
 ``INC`` and ``COORD`` motions, positions in frames set from registers set or chosen at run time
-(``UFRAME[21]=PR[R[99]]``), circular motions, positions
-not recorded (``********``), with no group 1 data or written as ``RX..RR``, ``P[...]`` with no
-number, and the data of groups the program does not move or that hold another arm's Cartesian
-position (``docs/programs.md``).
+(``UFRAME[21]=PR[R[99]]``), circular motions, positions not recorded (``********``), with no
+group 1 data or written as ``RX..RR``, ``P[...]`` with no number, and the data of groups the
+program does not move or that hold another arm's Cartesian position (``docs/programs.md``).
 """
 
 from __future__ import annotations
