@@ -13,14 +13,19 @@ Positions are the TCP in the user frame, which ``robotcell export`` writes in FA
 robot base at rail position 0); a frame on the turntable is the user frame of its pose at table
 axis 0, with the table at the point's angle in group 2 (no coordinated motion is written).
 
-Read: the same, and what pendants and offline tools write: joint positions (``J1 = .. deg``),
-comments on positions (``P[3:"approach"]``), other numbers of decimals, ``cm/min``, ``sec``
-and ``%`` speeds, ``/END`` followed by an end-of-file mark, a tool or user frame set in the
-program from a position register (``PR[9,1]=-30.0 ;`` .. ``UTOOL[9]=PR[9] ;``: its values win
-over the cell's), in program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked,
-with the reason: motions to position registers, ``Offset``/``Tool_Offset``/``VOFFSET``/``INC``
-and ``COORD`` motions, positions in frames set from registers set at run time, circular
-motions, and the data of groups the program does not move (``docs/programs.md``).
+Read: the same, and what pendants, controller backups and offline tools write: numbered and
+unnumbered ``/MN`` lines (``   5:J P[1] ...``, ``    :J P[1] ...``), joint positions
+(``J1 = .. deg``), comments on positions (``P[3:"approach"]``), other numbers of decimals,
+``cm/min``, ``sec`` and ``%`` speeds, the words of a listing saved in German (``KONFIG``,
+``mm/sek``, ``WKZ_Offset``), ``/END`` followed by an end-of-file mark, a tool or user frame set
+in the program from a position register (``PR[9,1]=-30.0 ;`` or ``PR[9,1]=(-30.0) ;`` ..
+``UTOOL[9]=PR[9] ;`` or ``UTOOL[9:comment]=PR[9] ;``: its values win over the cell's), in
+program order; the groups ``DEFAULT_GROUP`` moves. Named as not checked, with the reason:
+motions to position registers (``PR[R[n]]`` too), ``Offset``/``Tool_Offset``/``VOFFSET``/
+``INC`` and ``COORD`` motions, positions in frames set from registers set or chosen at run time
+(``UFRAME[21]=PR[R[99]]``), circular motions, positions not recorded (``********``), with no
+group 1 data or written as ``RX..RR``, ``P[...]`` with no number, and the data of groups the
+program does not move or that hold another arm's Cartesian position (``docs/programs.md``).
 """
 
 from __future__ import annotations
@@ -139,23 +144,44 @@ def write(program: Program, header: list[str]) -> dict[str, str]:
 
 
 # -- reading -------------------------------------------------------------------------------------
-_MOVE_RE = re.compile(r"^\s*\d+\s*:\s*([JLCA])\s+(P|PR)\[\s*(\d+)\s*(?::[^\]]*)?\]\s*(.*?)\s*;?\s*$")
-_LINE_RE = re.compile(r"^\s*(\d+)\s*:(.*)$")
+#: The start of a ``/MN`` line: its number and ``:``, or ``:`` alone (listings of controller
+#: backups and offline tools number some lines or none: ``   5:J P[1] ...``, ``    :J P[1] ...``).
+_STEP = r"^\s*\d*\s*:\s*"
+#: A motion: type, ``P[n]`` (``P[...]`` while its number is not set) or ``PR[n]`` (``PR[AR[n]]``
+#: by an argument), an optional comment, the rest (speed, termination, options).
+_MOVE_RE = re.compile(_STEP + r"([JLCA])\s+(?:(P)\[\s*(\d+|\.\.\.)|(PR)\[\s*(\d+|[A-Z]+\[\s*\d+\s*\]))"
+                      r"\s*(?::[^\]]*)?\]\s*(.*?)\s*;?\s*$")
 _POS_HEAD_RE = re.compile(r"^\s*P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{")
-_VALUE_RE = re.compile(r"\b([A-Z]+\d*)\s*=\s*([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s*(mm|deg)?")
+#: A value of a position, ``X =   -63.679  mm``: the text up to the unit, read by
+#: ``Lines.number`` (which names a value that is not a number, such as ``nan``).
+_VALUE_RE = re.compile(r"\b([A-Z]+\d*)\s*=\s*([^\s,;*]*)\s*(mm|deg)?")
+#: A value the controller holds no number for (``X = ********  mm``, with ``UF : F``): a
+#: position not recorded, as controllers save it.
+_UNSET_RE = re.compile(r"\b[A-Z]+\d*\s*=\s*\*+")
 _UF_RE = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
-_CONFIG_RE = re.compile(r"CONFIG\s*:\s*'([^']*)'")
-_PR_SET_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*,\s*(\d)\s*\]\s*=\s*([-+0-9.eE]+)\s*;")
-_PR_ANY_RE = re.compile(r"^\s*\d+\s*:\s*PR\[\s*(\d+)\s*(?:,\s*\d+\s*)?(?::[^\]]*)?\]\s*=")
-_FRAME_SET_RE = re.compile(r"^\s*\d+\s*:\s*(UTOOL|UFRAME)\[\s*(\d+)\s*\]\s*=\s*"
-                           r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*;", re.IGNORECASE)
+#: ``KONFIG`` in listings saved by a controller set to German (the English and German listings
+#: of the same programs in one backup differ in these words only).
+_CONFIG_RE = re.compile(r"\b(?:CONFIG|KONFIG)\s*:\s*'([^']*)'")
+#: An element of a position register set to a number, bare or in parentheses as the pendant
+#: writes a negative one (``PR[16,1]=(-.4) ;``, a controller backup's tool data program).
+_PR_SET_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*,\s*(\d)\s*(?::[^\]]*)?\]\s*=\s*(\(\s*)?"
+                        r"([-+0-9.eE]+)(?(3)\s*\))\s*;")
+_PR_ANY_RE = re.compile(_STEP + r"PR\[\s*(\d+)\s*(?:,\s*\d+\s*)?(?::[^\]]*)?\]\s*=")
+#: A tool or user frame set in the program: from ``PR[m]`` (group 3), or from anything else
+#: (``PR[R[99]]``, a register chosen at run time; group 4).
+_FRAME_SET_RE = re.compile(_STEP + r"(UTOOL|UFRAME)\[\s*(\d+)\s*(?::[^\]]*)?\]\s*=\s*"
+                           r"(?:PR\[\s*(\d+)\s*(?::[^\]]*)?\]|(.*?))\s*;", re.IGNORECASE)
 _SECTION_RE = re.compile(r"^\s*(/[A-Za-z]+)")
 _GROUP_RE = re.compile(r"^\s*DEFAULT_GR\w*\s*=\s*([^;]*);")
 #: Motion options that move the position by data outside the program (FANUC R-30iB
-#: Operator's Manual, "Motion instruction options": Offset, Tool_Offset, VOFFSET, INC).
-_OFFSET_RE = re.compile(r"\b(Tool_Offset|Offset|VOFFSET|VTOOL_OFFSET|INC)\b"
+#: Operator's Manual, "Motion instruction options": Offset, Tool_Offset, VOFFSET, INC;
+#: ``WKZ_Offset`` is Tool_Offset in a German listing).
+_OFFSET_RE = re.compile(r"\b(Tool_Offset|WKZ_Offset|Offset|VOFFSET|VTOOL_OFFSET|INC)\b"
                         r"\s*(?:,\s*(PR\[[^\]]*\]))?", re.IGNORECASE)
-_SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|cm/min|inch/min|deg/sec|sec|msec|%)", re.IGNORECASE)
+_SPEED_RE = re.compile(r"^([0-9.]+)\s*(mm/sec|mm/sek|cm/min|inch/min|deg/sec|sec|sek|msec|%)",
+                       re.IGNORECASE)
+#: Linear speeds in m/s per unit (``mm/sek``: mm/sec in a German listing).
+_LINEAR_SPEED = {"mm/sec": 1e-3, "mm/sek": 1e-3, "cm/min": 1e-2 / 60, "inch/min": 0.0254 / 60}
 
 
 def parse_config(text: str) -> Config:
@@ -181,7 +207,7 @@ def parse_config(text: str) -> Config:
                             int(letters[2] == "B"), *t))
 
 
-def _config(text: str, lines: Lines, lineno: int) -> Config:
+def _config(text: str, lineno: int, lines: Lines) -> Config:
     """:func:`parse_config`, the error naming the file and line."""
     try:
         return parse_config(text)
@@ -190,39 +216,79 @@ def _config(text: str, lines: Lines, lineno: int) -> Config:
 
 
 class _Position:
-    """One ``P[n]{...};`` block: group 1 pose or joints, its config, UF/UT, external axes."""
+    """One ``P[n]{...};`` block: group 1 pose or joints, its config, UF/UT, external axes.
+
+    ``missing`` says why a motion to it cannot be checked (None when it can): a position not
+    recorded (``********``), one with no group 1 data (a program moving other groups), or group
+    1 written as ``RX, RY, RZ, RW, RP, RR``, a form no public description gives the frame of.
+    ``arms`` are the other groups that hold a Cartesian position (another arm), not axes.
+    """
 
     def __init__(self, block: list[tuple[int, str]], lines: Lines) -> None:
         start = block[0][0]
         self.where = lines.where(start)
-        group = "GP1"
         self.uf = self.ut = 0
         self.config: Config | None = None
-        values: dict[str, float] = {}
-        self.external: dict[str, float] = {}
+        self.missing: str | None = None
+        values: dict[str, dict[str, float]] = {}
+        config: tuple[str, int] | None = None
+        unset = False
+        group = "GP1"
         for lineno, text in block:
-            if re.match(r"^\s*GP(\d+)\s*:", text):
-                group = re.match(r"^\s*(GP\d+)", text).group(1)
+            if m := re.match(r"^\s*(GP\d+)\s*:", text):
+                group = m.group(1)
+                values.setdefault(group, {})
                 continue
-            if group == "GP1":
-                if m := _UF_RE.search(text):
-                    self.uf, self.ut = int(m.group(1)), int(m.group(2))
-                if m := _CONFIG_RE.search(text):
-                    self.config = _config(m.group(1), lines, lineno)
+            values.setdefault(group, {})
+            if _UNSET_RE.search(text):
+                unset = True
+                continue
+            if group == "GP1" and (m := _UF_RE.search(text)):
+                self.uf, self.ut = int(m.group(1)), int(m.group(2))
+            if group == "GP1" and (m := _CONFIG_RE.search(text)):
+                config = (m.group(1), lineno)
             for m in _VALUE_RE.finditer(text):
-                key, v = m.group(1), lines.number(m.group(2), lineno)
-                if group == "GP1" and re.fullmatch(r"E\d", key):
-                    self.external[key] = v
-                elif group == "GP1":
-                    values[key] = v
-                else:
-                    self.external[f"{group}:{key}"] = v
+                values[group][m.group(1)] = lines.number(m.group(2), lineno)
+        if config is not None and not unset:
+            self.config = _config(*config, lines)
+        gp1 = values.pop("GP1", None)
+        self.arms = sorted(g for g, v in values.items() if all(k in v for k in _POSE_KEYS))
+        self.external = {k: v for k, v in (gp1 or {}).items() if re.fullmatch(r"E\d", k)}
+        self.external.update({f"{g}:{k}": v for g, vals in values.items() if g not in self.arms
+                              for k, v in vals.items()})
         self.pose = self.joints = None
-        if all(k in values for k in _POSE_KEYS):
+        self._group1(gp1 or {}, unset, sorted(values), lines, start)
+
+    def _group1(self, values: dict[str, float], unset: bool, others: list[str], lines: Lines,
+                start: int) -> None:
+        """The pose or joints of group 1, or why there are none (``missing``).
+
+        Parameters
+        ----------
+        values : dict of str to float
+            Group 1's values by key (``X`` mm, ``W`` deg, ``J1`` deg, ...).
+        unset : bool
+            Whether a value of the position is ``********`` (not recorded).
+        others : list of str
+            The other groups the position holds (``GP2``, ...).
+        lines : Lines
+            The file, for the error.
+        start : int
+            The line of ``P[n]{``, 1-based.
+        """
+        if not values and not unset and others:
+            self.missing = (f"holds no group 1 data, only {', '.join(others)}: the motion does "
+                            "not move the arm of group 1")
+        elif unset:
+            self.missing = "is not recorded: its values are ******** in the listing"
+        elif all(k in values for k in _POSE_KEYS):
             self.pose = pose_from_vendor([values[k] for k in _POSE_KEYS], "fanuc")
         elif all(f"J{i}" in values for i in range(1, 7)):
             self.joints = np.radians([values[f"J{i}"] for i in range(1, 7)])
             self.config = None
+        elif all(f"R{k}" in values for k in _POSE_KEYS):
+            self.missing = ("is written as RX, RY, RZ, RW, RP, RR, a form whose frame no public "
+                            "description gives")
         else:
             raise lines.error(start, "the position has neither X, Y, Z, W, P, R nor J1..J6 in "
                                      "group 1")
@@ -256,9 +322,8 @@ def _speed(text: str, motion: str, lines: Lines, lineno: int) -> float | None:
     if not m:
         return None
     v, unit = lines.number(m.group(1), lineno), m.group(2).lower()
-    if motion == "ptp" or unit in ("%", "sec", "msec", "deg/sec"):
-        return None
-    return v * (1e-3 if unit == "mm/sec" else 1e-2 / 60 if unit == "cm/min" else 0.0254 / 60)
+    scale = _LINEAR_SPEED.get(unit)
+    return None if motion == "ptp" or scale is None else v * scale
 
 
 def _zone(text: str, lines: Lines, lineno: int) -> float | None:
@@ -293,6 +358,28 @@ def _run_time_option(rest: str) -> str | None:
     return None
 
 
+def _sections(lines: Lines) -> dict[str, int]:
+    """The line of each section mark (``/PROG``, ``/MN``, ...); the file refused when it has no
+    ``/PROG`` (naming its first line: a controller's report saved as ``.LS``, such as
+    ``ERRALL.LS``, is no program), or no ``/MN`` or ``/END`` (naming its last line)."""
+    marks: dict[str, int] = {}
+    for lineno, text in enumerate(lines.lines, start=1):
+        m = _SECTION_RE.match(text)  # '/END' and whatever follows it on the line (an EOF mark)
+        key = m.group(1).upper() if m else ""
+        if key in ("/PROG", "/ATTR", "/MN", "/POS", "/END", "/APPL") and key not in marks:
+            marks[key] = lineno
+    if "/PROG" not in marks:
+        first = next(((i, t.strip()) for i, t in enumerate(lines.lines, 1) if t.strip()), None)
+        if first is None:
+            raise InputError(f"{lines.path}: the file is empty: not a FANUC .ls listing")
+        raise lines.error(first[0], "no /PROG line: not a FANUC TP listing (it starts "
+                                    f"{first[1][:48]!r})")
+    for key in ("/MN", "/END"):
+        if key not in marks:
+            raise lines.error(len(lines.lines), f"no {key} line (truncated file?)")
+    return marks
+
+
 def read(path: str | Path) -> tuple[Program, list[str]]:
     """Read a FANUC ``.ls`` listing.
 
@@ -306,7 +393,8 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         Points in the order the ``/MN`` section moves to them; ``line`` is the file's line of the
         motion; the frame and tool are the ``UF``/``UT`` of each position.
     skipped : list of str
-        Motions to position registers and circular motions.
+        The motions not checked and the position data not used, each with its reason
+        (``line N: ...``, ``P[n]: ...``).
 
     Raises
     ------
@@ -315,17 +403,7 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
         position the file does not hold; the message names the file and line.
     """
     lines = Lines(path, "FANUC .ls file")
-    marks: dict[str, int] = {}
-    for lineno, text in enumerate(lines.lines, start=1):
-        m = _SECTION_RE.match(text)  # '/END' and whatever follows it on the line (an EOF mark)
-        key = m.group(1).upper() if m else ""
-        if key in ("/PROG", "/ATTR", "/MN", "/POS", "/END", "/APPL") and key not in marks:
-            marks[key] = lineno
-    for key in ("/PROG", "/MN"):
-        if key not in marks:
-            raise InputError(f"{path}: no {key} line: not a FANUC .ls listing")
-    if "/END" not in marks:
-        raise InputError(f"{path}: line {len(lines.lines)}: no /END (truncated file?)")
+    marks = _sections(lines)
     name = lines.lines[marks["/PROG"] - 1].split()[1] if len(
         lines.lines[marks["/PROG"] - 1].split()) > 1 else Path(path).stem
     pos_start = marks.get("/POS", marks["/END"])
@@ -338,6 +416,9 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
             p.external = {k: v for k, v in p.external.items() if not k.startswith(g + ":")}
             skipped.append(f"P[{n}]: its {g} data are not used: the program's DEFAULT_GROUP "
                            f"does not move group {g[2:]}")
+        skipped += [f"P[{n}]: its {g} data are not used: a Cartesian position (X, Y, Z, W, P, R) "
+                    "of another arm, not the axes of a table" for g in p.arms
+                    if g in groups and not p.missing]
     main = _Main(lines, positions, skipped)
     for lineno in range(marks["/MN"] + 1, pos_start):
         main.line(lines.lines[lineno - 1], lineno)
@@ -359,41 +440,61 @@ class _Main:
     def line(self, text: str, lineno: int) -> None:
         if m := _PR_SET_RE.match(text):
             self.registers.setdefault(int(m.group(1)), {})[int(m.group(2))] = (
-                self.lines.number(m.group(3), lineno))
+                self.lines.number(m.group(4), lineno))
         elif m := _FRAME_SET_RE.match(text):
-            self.frame_set(m.group(1).upper(), int(m.group(2)), int(m.group(3)), lineno)
+            self.frame_set(m.group(1).upper(), int(m.group(2)), m.group(3) or m.group(4), lineno)
         elif m := _PR_ANY_RE.match(text):  # a register set at run time (LPOS, another PR)
             self.registers.pop(int(m.group(1)), None)
         elif m := _MOVE_RE.match(text):
             self.motion(m, lineno)
 
-    def frame_set(self, kind: str, number: int, reg: int, lineno: int) -> None:
-        """``UTOOL[n]=PR[m]``: the register's values if the program sets all six as numbers."""
-        pr = self.registers.get(reg, {})
+    def frame_set(self, kind: str, number: int, source: str, lineno: int) -> None:
+        """``UTOOL[n]=PR[m]``: the register's values if the program sets all six as numbers.
+
+        Parameters
+        ----------
+        kind : str
+            ``UTOOL`` or ``UFRAME``.
+        number : int
+            The frame's number.
+        source : str
+            The register's number (``"9"`` of ``PR[9]``), or what else the frame is set from.
+        lineno : int
+            The line, 1-based.
+        """
+        pr = self.registers.get(int(source), {}) if source.isdigit() else {}
         if sorted(pr) == [1, 2, 3, 4, 5, 6]:
             self.defined[(kind, number)] = pose_from_vendor([pr[i] for i in range(1, 7)],
                                                             "fanuc")
         else:
+            what = f"PR[{source}]" if source.isdigit() else source
             self.defined[(kind, number)] = (f"{kind}[{number}] is set at line {lineno} from "
-                                            f"PR[{reg}], whose values are set at run time")
+                                            f"{what}, whose values are set at run time")
 
     def motion(self, m: re.Match, lineno: int) -> None:
         lines, skipped = self.lines, self.skipped
-        kind, reg, n, rest = m.group(1), m.group(2), int(m.group(3)), m.group(4)
-        label = f"{reg}[{n}]"
+        kind, rest = m.group(1), m.group(6)
+        label = f"P[{m.group(3)}]" if m.group(2) else f"PR[{m.group(5)}]"
         if kind in ("C", "A"):
             skipped.append(f"line {lineno}: {kind} {label} (circular motions are not checked)")
             return
-        if reg == "PR":
+        if m.group(4):
             skipped.append(f"line {lineno}: {kind} {label} (a position register, not held by "
                            "the program)")
+            return
+        if m.group(3) == "...":
+            skipped.append(f"line {lineno}: {kind} {label} (the position number is not set)")
             return
         if why := _run_time_option(rest):
             skipped.append(f"line {lineno}: {kind} {label} ({why})")
             return
+        n = int(m.group(3))
         if n not in self.positions:
             raise lines.error(lineno, f"{label} is not in the /POS section")
         p = self.positions[n]
+        if p.missing:
+            skipped.append(f"line {lineno}: {kind} {label} ({label} {p.missing})")
+            return
         tool, frame = self.defined.get(("UTOOL", p.ut)), self.defined.get(("UFRAME", p.uf))
         why = next((w for w in (tool, frame) if isinstance(w, str)), None)
         if why and (p.pose is not None or isinstance(tool, str)):
@@ -446,7 +547,7 @@ def set_pose(lines: list[str], idx: int, T: NDArray[np.float64], config: Config 
                               line, count=1)
             done += n
         if config is not None:
-            line, n = re.subn(r"(CONFIG\s*:\s*)'[^']*'",
+            line, n = re.subn(r"(\b(?:CONFIG|KONFIG)\s*:\s*)'[^']*'",
                               lambda m: m.group(1) + config_text(config.values), line, count=1)
             done += 10 * n
         lines[k] = line

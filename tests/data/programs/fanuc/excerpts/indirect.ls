@@ -1,0 +1,53 @@
+/PROG  INDIRECT
+/ATTR
+OWNER		= MNEDITOR;
+COMMENT		= "excerpt for tests";
+PROG_SIZE	= 1949;
+CREATE		= DATE 24-03-11  TIME 15:33:20;
+MODIFIED	= DATE 24-03-12  TIME 05:20:20;
+FILE_NAME	= ;
+VERSION		= 0;
+LINE_COUNT	= 14;
+MEMORY_SIZE	= 2349;
+PROTECT		= READ_WRITE;
+STORAGE		= SHADOW;
+TCD:  STACK_SIZE	= 0,
+      TASK_PRIORITY	= 50,
+      TIME_SLICE	= 0,
+      BUSY_LAMP_OFF	= 0,
+      ABORT_REQUEST	= 0,
+      PAUSE_REQUEST	= 0;
+DEFAULT_GROUP	= 1,*,*,*,*;
+CONTROL_CODE	= 00000000 00000000;
+LOCAL_REGISTERS	= 0,0,0;
+/APPL
+
+AUTO_SINGULARITY_HEADER;
+  ENABLE_SINGULARITY_AVOIDANCE   : TRUE;
+/MN
+   1:  UFRAME_NUM=0 ;
+   2:  UTOOL_NUM=0 ;
+   3:J P[1:ABOVE INFEED] 100% CNT100    ;
+   4:L PR[R[98]] 100mm/sec FINE    ;
+   5:  UFRAME_NUM=21 ;
+   6:  UFRAME[21:HOLD]=PR[R[99]] ;
+   7:  PR[10,3:LINEAR OFFSET]=200    ;
+   8:J PR[R[95]] 100% CNT100 Offset,PR[10:LINEAR OFFSET]    ;
+   9:L P[2:place] 500mm/sec FINE    ;
+  10:  UFRAME_NUM=0 ;
+  11:J P[1:ABOVE INFEED] 100% FINE    ;
+  12:  END ;
+/POS
+P[1:"ABOVE INFEED"]{
+   GP1:
+	UF : 0, UT : 0,		CONFIG : 'N U T, 0, 0, 0',
+	X =  1000.000  mm,	Y =  -400.000  mm,	Z =   800.000  mm,
+	W =   180.000 deg,	P =      .000 deg,	R =   -90.000 deg
+};
+P[2:"place"]{
+   GP1:
+	UF : 21, UT : 0,		CONFIG : 'N U T, 0, 0, 0',
+	X =    50.000  mm,	Y =    25.000  mm,	Z =   100.000  mm,
+	W =   180.000 deg,	P =      .000 deg,	R =      .000 deg
+};
+/END
