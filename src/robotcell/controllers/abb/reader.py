@@ -367,9 +367,10 @@ class _Motions:
             self.skipped.append(f"line {lineno}: {instr} {target} "
                                 f"({_why_not_held(target, key, data)})")
             return
-        if value.problem is not None:
-            where = "" if value.line == lineno else f" (its value on line {value.line})"
-            raise lines.error(lineno, f"{instr} {target}{where}: {value.problem}")
+        if value.problem is not None:  # an inline target's text is on the motion's line
+            what = instr if target.startswith("[") else (
+                f"{instr} {target} (its value on line {value.line})")
+            raise lines.error(lineno, f"{what}: {value.problem}")
         tname = required[i_tool].strip()
         tref = Ref(name=tname, pose=data.tools.get(tname.lower()))
         wname = optional.get("wobj") or "wobj0"
