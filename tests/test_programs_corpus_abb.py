@@ -81,6 +81,27 @@ def test_a_zone_and_a_speed_declared_by_predefined_names_are_their_values():
     assert np.allclose(np.degrees(point.joints), [0, 0, 0, 0, 30, 0])
 
 
+def test_an_unknown_instruction_with_a_target_of_the_module_is_named_not_checked():
+    program, notes = read_program(EXCERPTS / "torch_service.mod")
+    assert [p.name for p in program.points] == ["rtSprayApp", "rtSpray", "rtSprayApp"]
+    assert notes == [("line 15: MoveSprayJ rtSprayApp (MoveSprayJ is an instruction or routine "
+                      "robotcell does not read: a motion it makes to this target is not checked)")]
+
+
+def test_a_routine_called_with_an_inline_target_is_named_and_a_return_is_not(tmp_path):
+    path = tmp_path / "calls.mod"
+    path.write_text("MODULE calls\n  CONST robtarget p1:=[[900,0,800],[0,0,1,0],[0,0,0,0],"
+                    "[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                    "  FUNC robtarget first()\n    RETURN p1;\n  ENDFUNC\n"
+                    "  PROC main()\n    PickAt [[900,0,700],[0,0,1,0],[0,0,0,0],"
+                    "[9E9,9E9,9E9,9E9,9E9,9E9]], 2;\n    TPWrite \"p1\";\n  ENDPROC\nENDMODULE\n")
+    program, notes = read_program(path)
+    assert not program.points
+    assert notes == [("line 7: PickAt [[900,0,700],[0,0,1,0],[0,0,0,0],[9E9... (PickAt is an "
+                      "instruction or routine robotcell does not read: a motion it makes to "
+                      "this target is not checked)")]
+
+
 def test_a_robotstudio_modx_module_is_read_and_checked_as_a_mod(tmp_path, capsys):
     modx = tmp_path / "screw_plate.modx"
     shutil.copy(EXCERPTS / "screw_plate_arrays.mod", modx)

@@ -23,7 +23,8 @@ The reader follows RAPID as ABB's manuals describe it (sources in ``docs/program
 
 Targets computed at run time (``Offs``, ``RelTool``, ``CRobT``, a variable declared without a
 value, or one of another module of the task) and circular, search and external-axis motions are
-named as not checked, never refused; so is a placeholder. A target declared with a quaternion
+named as not checked, never refused; so are a placeholder and a call of an instruction or
+routine the reader does not know whose first argument is a target. A target declared with a quaternion
 that is no rotation (``[0,0,0,0]``, a position not yet defined) is read; a motion to it is
 refused.
 """
@@ -55,6 +56,8 @@ _KEYWORD_RE = re.compile(r"^(MODULE|ENDMODULE|PROC|ENDPROC|FUNC|ENDFUNC|TRAP|END
                          r"ELSE|ENDIF|FOR|ENDFOR|WHILE|ENDWHILE|TEST|CASE|DEFAULT|ENDTEST|ERROR|"
                          r"BACKWARD|UNDO|RECORD|ENDRECORD)\b", re.IGNORECASE)
 _CALL_RE = re.compile(r"^(\w+)\b\s*(.*)$", re.DOTALL)
+#: Reserved words that start a statement ending with ``;`` (RAPID kernel manual, "Statements").
+_STATEMENT_WORDS = frozenset(("return", "raise", "goto", "connect", "exit", "retry", "trynext"))
 _CONF_RE = re.compile(r"^(ConfJ|ConfL)\s*\\\s*(On|Off)\b", re.IGNORECASE)
 #: RAPID's placeholders for parts of a program not yet written (``<SMT>`` a statement, ``<DDN>``
 #: a data declaration, ..): a placeholder written for a whole statement or declaration has no
@@ -349,6 +352,21 @@ class _Motions:
             self.skipped.append(f"line {lineno}: {instr} ({_OTHER_MOTIONS[key]})")
         elif key in _MOTIONS:
             self.motion(instr, m.group(2), lineno)
+        elif not _KEYWORD_RE.match(text) and key not in _STATEMENT_WORDS:
+            self.unread(instr, m.group(2), lineno)
+
+    def unread(self, instr: str, text: str, lineno: int) -> None:
+        """Name a call of an instruction or routine the reader does not know whose first argument
+        is a target (``ArcRepL p10, ...``, ``PickPart pPick;``): a motion it makes to the target is
+        not checked."""
+        required, _ = arguments(text)
+        first = required[0] if required else ""
+        key = re.sub(r"\s+", "", first).lower()
+        if first.startswith("[[") or (key and self.data.find(key)[0] is not None):
+            shown = first if len(first) <= 40 else first[:37] + "..."
+            self.skipped.append(f"line {lineno}: {instr} {shown} ({instr} is an instruction or "
+                                "routine robotcell does not read: a motion it makes to this "
+                                "target is not checked)")
 
     def motion(self, instr: str, text: str, lineno: int) -> None:
         lines, data = self.lines, self.data
