@@ -3,7 +3,8 @@
 - Poses: x, y, z (mm) and a unit quaternion ``[q1, q2, q3, q4]``, scalar first.
 - Export (:mod:`.export`): a RAPID module of ``tooldata``, ``wobjdata`` (coordinated work
   objects on the turntable's mechanical unit) and base frames as ``CONST pose``, in world.
-- Programs (:mod:`.program`): one module ``NAME.mod`` (``.prg`` read too).
+- Programs (:mod:`.program`): one module ``NAME.mod`` (``.prg`` and RobotStudio's ``.modx``
+  read too).
 - Flags: ``confdata`` ``[cf1, cf4, cf6, cfx]`` (:func:`robotcell.ik.config.abb_confdata`).
 - Slots: none; tools and work objects are RAPID identifiers of at most 32 characters; program
   names of at most 28, so that the module ``MOD_NAME`` is one too.
@@ -45,7 +46,7 @@ class Abb(Controller):
     table_frames = True
     world_ref = Ref(name="wobj0", kind="world")
     world_name = "wobj0"
-    program_suffixes = (".mod", ".prg")
+    program_suffixes = (".mod", ".prg", ".modx")
     comment = "!"
     program_files = "ABB .mod"
     export_name = "cell.mod"
@@ -73,6 +74,8 @@ class Abb(Controller):
          "module only"),
         ("ABB MultiMove application manual 3HAC021272-001, 'Synchronized movements': "
          "SyncMoveOn/SyncMoveOff, syncident, tasks, \\ID on every synchronised move"),
+        ("industrialmonitordirect.com, 'Configuring Shared RAPID System Modules in ABB "
+         "OmniCore': RobotStudio saves program modules as .modx"),
         ("ebruun/ECL_robotic_cell, _controller_backups/4600-COMPAS_RRC_BACKUP_2022-04-12_"
          "3rob_setup/HOME/1/1_T_ROB1.mod and 1_T_ROB2.mod: MultiMove modules an offline tool "
          "saved on a controller"),
