@@ -80,7 +80,8 @@ def decode_text(data: bytes, origin: str) -> str:
     """
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         raise InputError(f"{origin}: not a text file robotcell reads (it starts with a UTF-16 "
-                         "mark, as 'Unicode text' is saved); save it as UTF-8 (\"CSV UTF-8\")")
+                         "mark, as 'Unicode text' is saved); save it as UTF-8 (a spreadsheet's \"CSV UTF-8\", "
+                         "an editor's or a controller tool's encoding UTF-8)")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
