@@ -89,6 +89,8 @@ _CALL_RE = re.compile(r"^(\w+)\s*\(\s*(.*?)\s*\)$")
 _ASSIGN_RE = re.compile(r"^\s*(\w+(?:\s*\[[^\]]*\])?)\s*(?:\.\s*\w+\s*)?=[^=]")
 _APPROX_RE = re.compile(r"\b(C_DIS|C_PTP|C_ORI|C_VEL|C_SPL)\b", re.IGNORECASE)
 _TARGET_RE = re.compile(r"^[\w$]+(?:\s*\[[^\]]*\])?(?:\s*\.\s*\w+)*")
+#: The numbers of a PDAT or LDAT the reader takes: speed (% or m/s) and corner distance (mm).
+_MOTION_NUMBERS = {"VEL", "APO_DIST"}
 #: A tool or base the program sets from data it does not hold: why, in words.
 Unknown = str
 #: The home points KSS declares in $config.dat (XHOME, XHOME1 .. XHOME5).
@@ -254,7 +256,9 @@ def _read_dat(path: Path) -> _Dat:
         elif value is None:
             dat.unset.add(name)
         elif kind in ("FDAT", "PDAT", "LDAT"):
-            dat.data[name] = aggregate_fields(value, lines, lineno)[1]
+            dat.data[name] = fields = aggregate_fields(value, lines, lineno)[1]
+            for key in _MOTION_NUMBERS & fields.keys():  # a corrupt value: refused here
+                lines.number(fields[key], lineno)
         else:
             typ, fields = aggregate_fields(value, lines, lineno)
             dat.points[name] = _Point(_kind_of(typ or kind, fields), fields, lines, lineno, name)
