@@ -36,7 +36,8 @@ def test_spline_inline_forms_move_with_the_tool_and_base_of_their_fdat():
     assert program.points[0].config.values == (2, 2)
     # $APO = SAPO_PTP(PPDAT1), APO_MODE #CDIS, APO_DIST 250 and C_Spl after the WITH clause
     assert [p.zone for p in program.points] == pytest.approx([0.25, 0.0, 0.0])
-    assert notes[0] == "line 17: SPTP XHOME (XHOME is a point of $config.dat, not beside the program)"
+    assert notes[0] == ("line 17: SPTP XHOME (XHOME is a point of $config.dat, not beside the "
+                        "program)")
 
 
 def test_an_external_tcp_is_named_not_checked_until_a_motion_gives_the_base_again():

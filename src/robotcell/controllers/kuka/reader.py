@@ -405,7 +405,7 @@ class _SrcReader:
         if "." not in line[:line.index("=")] and value.startswith("{") and ":" not in (
                 _target(value)[1]):
             typ, fields = aggregate_fields(value, self.lines, lineno)
-            if given := _partial(typ, fields):  # the other components keep their values
+            if given := _partial(typ, fields):  # the others: not in the file
                 self.assigned[key] = (f"{m.group(1).strip()} is given {given} only (line "
                                       f"{lineno}), its other components are set elsewhere")
             else:
@@ -577,7 +577,7 @@ class _SrcReader:
         """The point a motion goes to, or None and why it is not held by the program."""
         if target.startswith("{"):
             typ, fields = aggregate_fields(target, self.lines, lineno)
-            if given := _partial(typ, fields):  # KRL keeps the other components as they are
+            if given := _partial(typ, fields):  # the other components are not in the file
                 return None, (f"the aggregate gives {given} only, not a whole "
                               + ("axis position" if _kind_of(typ, fields) in _JOINT else "pose"))
             return _Point(_kind_of(typ, fields), fields, self.lines, lineno, "the aggregate"), ""
