@@ -49,8 +49,9 @@ def test_an_external_tcp_is_named_not_checked_until_a_motion_gives_the_base_agai
     assert "the tool is fixed in the cell and the robot moves the workpiece" in external[0]
 
 
-def test_a_spline_linear_form_takes_its_speed_and_corner_from_the_with_clause(tmp_path):
-    # the SLIN inline form: $VEL = SVEL_CP(v, , LDAT) is v m/s, $APO = SAPO(LDAT) LDAT's APO_DIST
+def test_a_spline_form_takes_its_speed_and_corner_from_the_with_clause(tmp_path):
+    # the SLIN inline form: $VEL = SVEL_CP(v, , LDAT) is v m/s, $APO = SAPO(LDAT) LDAT's
+    # APO_DIST; SAPO_PTP(PDAT) of a PDAT with APO_MODE #CPTP approximates by a percentage
     (tmp_path / "p.src").write_text(
         "DEF p( )\n"
         "SLIN XP1 WITH $VEL = SVEL_CP(0.3, , LCPDAT1), $TOOL = STOOL2(FP1), $BASE = "
@@ -59,17 +60,21 @@ def test_a_spline_linear_form_takes_its_speed_and_corner_from_the_with_clause(tm
         "$JERK = SJERK(LCPDAT1), $COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0) C_SPL\n"
         "SLIN XP1 WITH $VEL = SVEL_CP(gVel, , LCPDAT1), $TOOL = STOOL2(FP1), $BASE = "
         "SBASE(FP1.BASE_NO)\n"
+        "SPTP XP1 WITH $TOOL = STOOL2(FP1), $BASE = SBASE(FP1.BASE_NO), $APO = "
+        "SAPO_PTP(PPDAT1) C_SPL\n"
         "END\n")
     (tmp_path / "p.dat").write_text(
         "DEFDAT p\n"
         "DECL E6POS XP1={X 800,Y 0,Z 500,A 0,B 90,C 0,S 2,T 2,E1 0.0,E2 0.0}\n"
         "DECL FDAT FP1={TOOL_NO 4,BASE_NO 5,IPO_FRAME #BASE,POINT2[] \" \"}\n"
         "DECL LDAT LCPDAT1={VEL 2.0,ACC 100.0,APO_DIST 12.5,APO_FAC 50.0,AXIS_VEL 100.0}\n"
+        "DECL PDAT PPDAT1={VEL 100.000,ACC 100.000,APO_DIST 50.0000,APO_MODE #CPTP}\n"
         "ENDDAT\n")
     program, notes = read_program(tmp_path / "p.src")
     assert not notes
-    first, second = program.points
+    first, second, third = program.points
     assert (first.tool.number, first.frame.number) == (4, 5)
+    assert third.motion == "ptp" and third.zone is None
     assert first.speed == pytest.approx(0.3) and first.zone == pytest.approx(0.0125)
     assert second.speed is None and second.zone == 0.0  # a variable speed: of run time
 

@@ -10,7 +10,8 @@ inline forms write, which KSS's ``bas.src`` (R1/System, in every controller back
   ``PDAT_ACT.APO_MODE`` is ``#CDIS`` (otherwise ``$APO.CPTP``, a percentage, not a distance);
 - in a spline motion's ``WITH`` clause, ``$VEL = SVEL_CP(v, , LCPDAT1)`` moves at v m/s,
   ``$APO = SAPO(LCPDAT1)`` approximates at ``LCPDAT1.APO_DIST`` and ``$APO =
-  SAPO_PTP(PDAT1)`` at ``PDAT1.APO_DIST`` under ``APO_MODE #CDIS``.
+  SAPO_PTP(PDAT1)`` at ``PDAT1.APO_DIST`` unless its ``APO_MODE`` is ``#CPTP`` (then a
+  percentage of the axis angles: no distance).
 
 A value the program computes (a variable, an expression) is one of run time: not known.
 """
@@ -86,11 +87,12 @@ class MoveData:
         else:
             self.pdat = fields
 
-    def ptp_cdis(self, pdat: dict[str, str], lineno: int) -> float | None:
-        """The ``$APO.CDIS`` (m) a PDAT sets: its ``APO_DIST`` under ``APO_MODE #CDIS``."""
-        if pdat.get("APO_MODE", "").strip().upper() != "#CDIS":
+    def ptp_cdis(self, lineno: int) -> float | None:
+        """``$APO.CDIS`` (m) after ``BAS(#PTP_DAT)``: ``PDAT_ACT.APO_DIST`` under ``APO_MODE
+        #CDIS``, else as it was (the call then sets ``$APO.CPTP``)."""
+        if self.pdat.get("APO_MODE", "").strip().upper() != "#CDIS":
             return self.cdis
-        return self.number(pdat.get("APO_DIST"), lineno, 1e-3)
+        return self.number(self.pdat.get("APO_DIST"), lineno, 1e-3)
 
     def bas(self, command: str, arg: str, lineno: int) -> None:
         """``BAS(#command, arg)``: the speed and approximation distance it sets, if any."""
@@ -101,11 +103,11 @@ class MoveData:
             self.speed = self.number(arg if command == "CP_PARAMS" else self.ldat.get("VEL"),
                                      lineno)
         elif command in ("PTP_DAT", "PTP_PARAMS"):
-            self.cdis = self.ptp_cdis(self.pdat, lineno)
+            self.cdis = self.ptp_cdis(lineno)
 
-    def with_item(self, key: str, value: str, settings: Settings, lineno: int) -> bool:
+    def with_item(self, key: str, value: str, settings: Settings, lineno: int) -> None:
         """Apply ``key = value`` of a ``WITH`` clause to ``settings`` if it sets the speed or
-        the approximation distance; whether it did."""
+        the approximation distance (``$VEL_AXIS[1] = ..``, ``$LOAD = ..``: left as they are)."""
         call = re.match(r"^(\w+)\s*\((.*)\)$", value)
         fn, args = (call.group(1).upper(), split(call.group(2))) if call else ("", [])
         if key == "$VEL.CP":
@@ -116,13 +118,10 @@ class MoveData:
             settings.cdis = self.number(value, lineno, 1e-3)
         elif key == "$APO" and fn in ("SAPO", "SAPO_PTP"):
             fields = self.data.get(args[0].upper(), {})
-            settings.cdis = (self.number(fields.get("APO_DIST"), lineno, 1e-3) if fn == "SAPO"
-                             else self.ptp_cdis(fields, lineno))
+            cptp = fn == "SAPO_PTP" and fields.get("APO_MODE", "").strip().upper() == "#CPTP"
+            settings.cdis = None if cptp else self.number(fields.get("APO_DIST"), lineno, 1e-3)
         elif key == "$APO":
             settings.cdis = None
-        else:
-            return False
-        return True
 
 
 def zone(approx: str | None, cdis: float | None) -> float | None:
