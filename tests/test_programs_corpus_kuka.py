@@ -122,8 +122,7 @@ def test_a_partial_axis_aggregate_and_a_partial_assignment_are_named(tmp_path):
         "P1 = {X 900,Y 0,Z 500,A 0,B 90,C 0}\nPTP P1\nP1 = {Z 400}\nPTP P1\nPTP {A1 45}\nEND\n")
     program, notes = read_program(tmp_path / "p.src")
     assert [p.line for p in program.points] == [6]
-    assert notes == [("line 8: PTP P1 (P1 is given Z only (line 7), its other components "
-                      "are set elsewhere)"),
+    assert notes == ["line 8: PTP P1 (P1 is given Z only (line 7), not a whole point)",
                      ("line 9: PTP {A1 45} (the aggregate gives A1 only, not a whole axis "
                       "position)")]
 

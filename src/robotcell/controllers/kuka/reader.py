@@ -405,9 +405,9 @@ class _SrcReader:
         if "." not in line[:line.index("=")] and value.startswith("{") and ":" not in (
                 _target(value)[1]):
             typ, fields = aggregate_fields(value, self.lines, lineno)
-            if given := _partial(typ, fields):  # the others: not in the file
+            if given := _partial(typ, fields):
                 self.assigned[key] = (f"{m.group(1).strip()} is given {given} only (line "
-                                      f"{lineno}), its other components are set elsewhere")
+                                      f"{lineno}), not a whole point")
             else:
                 self.assigned[key] = _Point(_kind_of(typ, fields), fields, self.lines, lineno,
                                             key)
