@@ -8,14 +8,22 @@ The reader follows KRL as KUKA's manuals describe it (sources in ``docs/programs
   Integrators, "Structure and creation of robot programs");
 - motions ``PTP``/``LIN``/``CIRC`` and the spline ones ``SPTP``/``SLIN``/``SCIRC``/``SPL``, to a
   point named in the ``.dat``, an aggregate written in the line, or an expression; ``C_DIS``,
-  ``C_PTP``, ``C_ORI``, ``C_VEL``, ``C_SPL`` approximate; ``WITH`` gives values for that motion
-  (``$TOOL``/``$BASE`` given there hold for it); ``PTP_REL``/``LIN_REL``/``CIRC_REL`` (and the spline ones) move relative to where the
-  robot is; ``frame1 : frame2`` is the geometric operator;
+  ``C_PTP``, ``C_ORI``, ``C_VEL``, ``C_SPL`` approximate (written last, after a ``WITH`` clause
+  too); ``WITH`` gives values for that motion (``$TOOL``, ``$BASE``, ``$IPO_MODE``, ``$VEL.CP``,
+  ``$APO.CDIS`` given there hold for it, and the spline inline forms' ``STOOL2(FPn)``,
+  ``SBASE(FPn.BASE_NO)``, ``SIPO_MODE(FPn.IPO_FRAME)``, ``SVEL_CP``, ``SAPO``, ``SAPO_PTP`` as
+  KSS's ``bas.src`` defines them); ``PTP_REL``/``LIN_REL``/``CIRC_REL`` (and the spline ones)
+  move relative to where the robot is; ``frame1 : frame2`` is the geometric operator;
 - the tool and the base: ``$TOOL=``/``$BASE=`` a frame, ``TOOL_DATA[n]``, ``BASE_DATA[n]``,
   ``EK(...)`` or ``$NULLFRAME``; ``BAS(#TOOL,n)``/``BAS(#BASE,n)``; the inline forms'
   ``FDAT_ACT=FPn`` with ``DECL FDAT FPn={TOOL_NO n,BASE_NO m,...}``; ``TOOL_DATA[n]={...}`` and
   ``BASE_DATA[n]={...}`` assigned in the program. All of these take effect in program order,
-  as the controller runs them;
+  as the controller runs them; so do the speed and approximation distance
+  (:mod:`robotcell.controllers.kuka.movedata`);
+- ``$IPO_MODE = #TCP`` (or an FDAT's ``IPO_FRAME #TCP``) moves with an external TCP: the tool
+  fixed in the cell, the workpiece on the flange ("$IPO_MODE tells the robot that it is holding
+  the workpiece and the tool is fixed in the workspace", robot-forum.com); its Cartesian points
+  are named as not checked until ``#BASE``;
 - Status and Turn are used by the controller for PTP motions only ("The robot controller only
   takes the programmed Status and Turn values into consideration for PTP motions. They are
   ignored for CP motions", KSS 8 System Integrators manual): a ``LIN``/``SLIN`` point's S and T
@@ -23,10 +31,11 @@ The reader follows KRL as KUKA's manuals describe it (sources in ``docs/programs
   only statement of the configuration the robot starts in.
 
 What the file does not hold is read and named, never refused: points of ``$config.dat``
-(``XHOME``, the tool and base of ``FDAT FHOME``), points declared in another module, variables
-set at run time, ``$AXIS_ACT``/``$POS_ACT``, relative motions, the geometric operator, circular
-and spline-segment motions, and motions in local routines are returned as "not checked" with
-the reason.
+(``XHOME``, the tool and base of ``FDAT FHOME``), points declared in another module (or in no
+``.dat``: a program may have none), variables set at run time, ``$AXIS_ACT``/``$POS_ACT``,
+aggregates that give some components only (``LIN {Z 500}``), relative motions, the geometric
+operator, circular and spline-segment motions, and motions in local routines are returned as
+"not checked" with the reason.
 """
 
 from __future__ import annotations
@@ -37,6 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
+from robotcell.controllers.kuka.movedata import MoveData, Settings, zone
 from robotcell.controllers.model import FLAG_LIMIT, Config, Program, ProgramPoint, Ref
 from robotcell.controllers.text import Lines, strip_comment
 from robotcell.errors import InputError
@@ -65,16 +75,24 @@ _TOOL_RE = re.compile(r"^\s*\$TOOL\s*=\s*(.*)$", re.IGNORECASE)
 _BASE_RE = re.compile(r"^\s*\$BASE\s*=\s*(.*)$", re.IGNORECASE)
 _SLOT_SET_RE = re.compile(r"^\s*(TOOL_DATA|BASE_DATA)\s*\[\s*(\w+)\s*\]\s*(\.\s*\w+)?\s*=\s*(.*)$",
                           re.IGNORECASE)
-_BAS_RE = re.compile(r"^\s*BAS\s*\(\s*#(TOOL|BASE)\s*,\s*(\w+)\s*\)", re.IGNORECASE)
+_BAS_RE = re.compile(r"^\s*BAS\s*\(\s*#(\w+)\s*(?:,\s*([^)]*?))?\s*\)", re.IGNORECASE)
 _EK_RE = re.compile(r"^EK\s*\(.*?,\s*BASE_DATA\s*\[\s*(\d+)\s*\]\s*\)$", re.IGNORECASE)
 _DATA_RE = re.compile(r"^(TOOL_DATA|BASE_DATA)\s*\[\s*(\d+)\s*\]$", re.IGNORECASE)
 _FDAT_ACT_RE = re.compile(r"^\s*FDAT_ACT\s*=\s*(.*)$", re.IGNORECASE)
 _LDAT_ACT_RE = re.compile(r"^\s*(LDAT_ACT|PDAT_ACT)\s*=\s*(\w+)", re.IGNORECASE)
 _VEL_RE = re.compile(r"^\s*\$VEL\.CP\s*=\s*([-+0-9.eE]+)\s*$", re.IGNORECASE)
 _APO_RE = re.compile(r"^\s*\$APO\.CDIS\s*=\s*([-+0-9.eE]+)\s*$", re.IGNORECASE)
+_IPO_RE = re.compile(r"^\s*\$IPO_MODE\s*=\s*#(\w+)\s*$", re.IGNORECASE)
+#: The functions of the spline inline forms' ``WITH`` clause (KSS 8 ``bas.src``): their name and
+#: argument, ``STOOL2(FP1)``, ``SBASE(FP1.BASE_NO)``, ``SVEL_CP(0.5, , LCPDAT1)``.
+_CALL_RE = re.compile(r"^(\w+)\s*\(\s*(.*?)\s*\)$")
 _ASSIGN_RE = re.compile(r"^\s*(\w+(?:\s*\[[^\]]*\])?)\s*(?:\.\s*\w+\s*)?=[^=]")
 _APPROX_RE = re.compile(r"\b(C_DIS|C_PTP|C_ORI|C_VEL|C_SPL)\b", re.IGNORECASE)
 _TARGET_RE = re.compile(r"^[\w$]+(?:\s*\[[^\]]*\])?(?:\s*\.\s*\w+)*")
+#: The numbers of a PDAT or LDAT the reader takes: speed (% or m/s) and corner distance (mm).
+_MOTION_NUMBERS = {"VEL", "APO_DIST"}
+#: A tool or base the program sets from data it does not hold: why, in words.
+Unknown = str
 #: The home points KSS declares in $config.dat (XHOME, XHOME1 .. XHOME5).
 _HOME_RE = re.compile(r"^X?HOME\d*$", re.IGNORECASE)
 
@@ -168,7 +186,25 @@ class _Point:
 def _kind_of(typ: str | None, fields: dict[str, str]) -> str:
     if typ in _CARTESIAN | _JOINT:
         return typ
-    return "E6AXIS" if "A1" in fields else "E6POS"
+    return "E6AXIS" if any(k in fields for k in _AXIS_KEYS) else "E6POS"
+
+
+def _partial(typ: str | None, fields: dict[str, str]) -> str | None:
+    """What an aggregate that is not a whole pose or axis position gives (``Z``), or None."""
+    keys = _AXIS_KEYS if _kind_of(typ, fields) in _JOINT else _POSE_KEYS
+    if all(k in fields for k in keys):
+        return None
+    return ", ".join(fields) or "nothing"
+
+
+def _external(mode: str, lineno: int) -> Unknown | None:
+    """Why Cartesian points are not checked under the interpolation mode ``mode`` from line
+    ``lineno``: ``#TCP`` is an external TCP (the tool fixed in the cell, the workpiece moved by
+    the robot); None for ``#BASE``, the tool on the flange."""
+    if mode.strip().lstrip("#").upper() != "TCP":
+        return None
+    return (f"an external TCP, $IPO_MODE #TCP from line {lineno}: the tool is fixed in the cell "
+            "and the robot moves the workpiece, which robotcell does not check")
 
 
 def _frame_value(text: str, lines: Lines, lineno: int) -> np.ndarray:
@@ -220,12 +256,15 @@ def _read_dat(path: Path) -> _Dat:
         elif value is None:
             dat.unset.add(name)
         elif kind in ("FDAT", "PDAT", "LDAT"):
-            dat.data[name] = aggregate_fields(value, lines, lineno)[1]
+            dat.data[name] = fields = aggregate_fields(value, lines, lineno)[1]
+            for key in _MOTION_NUMBERS & fields.keys():  # a corrupt value: refused here
+                lines.number(fields[key], lineno)
         else:
             typ, fields = aggregate_fields(value, lines, lineno)
             dat.points[name] = _Point(_kind_of(typ or kind, fields), fields, lines, lineno, name)
     if not started:
-        raise InputError(f"{path}: no DEFDAT line: not a KUKA .dat file")
+        what = "the file is empty" if not any(map(str.strip, lines.lines)) else "no DEFDAT line"
+        raise InputError(f"{path}: {what}: not a KUKA .dat file")
     if not ended:
         raise InputError(f"{path}: line {len(lines.lines)}: no ENDDAT (truncated file?)")
     return dat
@@ -263,9 +302,8 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     Raises
     ------
     InputError
-        A missing file, a missing ``DEF``/``END``/``ENDDAT``, an unreadable aggregate or number,
-        a motion to a named point with no ``.dat`` beside the ``.src``; the message names the
-        file and line.
+        A missing or empty file, a missing ``DEF``/``END``/``ENDDAT``, an unreadable aggregate
+        or number; the message names the file and line.
     """
     src = _src_of(Path(path))
     lines = Lines(src, "KUKA .src file")
@@ -274,10 +312,6 @@ def read(path: str | Path) -> tuple[Program, list[str]]:
     name = reader.run()
     files = (str(src),) + ((str(dat_path),) if dat_path is not None else ())
     return Program(name, "kuka", reader.out, files), reader.skipped
-
-
-#: A tool or base the program sets from data it does not hold: why, in words.
-Unknown = str
 
 
 class _SrcReader:
@@ -292,9 +326,8 @@ class _SrcReader:
         self.base: Ref | Unknown = ("the program sets no base before this motion (calls to "
                                      "other routines are not followed)")
         self.slots: dict[tuple[str, int], np.ndarray | Unknown] = {}
-        self.speed: float | None = None
-        self.zone = 0.0
-        self.motion_data: dict[str, str] = {}
+        self.moves = MoveData(lines, dat.data)  # $VEL.CP, $APO.CDIS, LDAT_ACT, PDAT_ACT
+        self.external: Unknown | None = None  # under $IPO_MODE #TCP: why, else None
         self.local: set[str] = set()
         self.assigned: dict[str, _Point | str] = {}  # points given a value in the .src
         self.out: list[ProgramPoint] = []
@@ -325,7 +358,8 @@ class _SrcReader:
                 continue
             self.statement(line, lineno)
         if not started:
-            raise InputError(f"{lines.path}: no DEF line: not a KUKA .src file")
+            what = "the file is empty" if not any(map(str.strip, lines.lines)) else "no DEF line"
+            raise InputError(f"{lines.path}: {what}: not a KUKA .src file")
         if not ended:
             raise InputError(f"{lines.path}: line {len(lines.lines)}: no END (truncated file?)")
         return name
@@ -342,15 +376,19 @@ class _SrcReader:
         elif m := _SLOT_SET_RE.match(line):
             self.set_slot(m, lineno)
         elif m := _BAS_RE.match(line):
-            self.bas(m.group(1).upper(), m.group(2), lineno)
+            self.bas(m.group(1).upper(), (m.group(2) or "").strip(), lineno)
         elif m := _FDAT_ACT_RE.match(line):
-            self.tool, self.base = self.fdat(m.group(1).strip(), lineno)
+            self.tool, self.base, mode = self.fdat(m.group(1).strip(), lineno)
+            if mode is not None:  # BAS(#FRAMES) sets $IPO_MODE to the FDAT's IPO_FRAME
+                self.external = _external(mode, lineno)
         elif m := _LDAT_ACT_RE.match(line):
-            self.motion_data = self.dat.data.get(m.group(2).upper(), {})
+            self.moves.act(m.group(1), m.group(2))
         elif m := _VEL_RE.match(line):
-            self.speed = lines.number(m.group(1), lineno)
+            self.moves.speed = lines.number(m.group(1), lineno)
         elif m := _APO_RE.match(line):
-            self.zone = lines.number(m.group(1), lineno) * 1e-3
+            self.moves.cdis = lines.number(m.group(1), lineno) * 1e-3
+        elif m := _IPO_RE.match(line):
+            self.external = _external(m.group(1), lineno)
         elif m := _LOCAL_RE.match(line):
             for part in re.split(r",(?![^\[]*\])", m.group(1)):
                 self.local.add(re.split(r"[\[=\s]", part.strip(), maxsplit=1)[0].upper())
@@ -367,7 +405,12 @@ class _SrcReader:
         if "." not in line[:line.index("=")] and value.startswith("{") and ":" not in (
                 _target(value)[1]):
             typ, fields = aggregate_fields(value, self.lines, lineno)
-            self.assigned[key] = _Point(_kind_of(typ, fields), fields, self.lines, lineno, key)
+            if given := _partial(typ, fields):
+                self.assigned[key] = (f"{m.group(1).strip()} is given {given} only (line "
+                                      f"{lineno}), not a whole point")
+            else:
+                self.assigned[key] = _Point(_kind_of(typ, fields), fields, self.lines, lineno,
+                                            key)
         else:
             self.assigned[key] = f"{m.group(1).strip()} is set at run time (line {lineno})"
 
@@ -415,7 +458,15 @@ class _SrcReader:
         else:
             self.slots[key] = f"{kind}[{index}] is set at run time (line {lineno})"
 
-    def bas(self, kind: str, number: str, lineno: int) -> None:
+    def bas(self, command: str, arg: str, lineno: int) -> None:
+        """``BAS(#TOOL,n)``, ``BAS(#BASE,n)``; the speed and approximation distance the
+        other commands set (:class:`~robotcell.controllers.kuka.movedata.MoveData`)."""
+        if command in ("TOOL", "BASE"):
+            self.bas_frame(command, arg, lineno)
+        else:
+            self.moves.bas(command, arg, lineno)
+
+    def bas_frame(self, kind: str, number: str, lineno: int) -> None:
         if not number.isdigit():
             why = f"BAS(#{kind},{number}) chooses the {kind.lower()} at run time (line {lineno})"
             if kind == "TOOL":
@@ -431,8 +482,9 @@ class _SrcReader:
             pose, why = self.slot("BASE_DATA", n)
             self.base = why or Ref(number=n, pose=pose, on_table=None)
 
-    def fdat(self, value: str, lineno: int) -> tuple[Ref | Unknown, Ref | Unknown]:
-        """Tool and base of ``FDAT_ACT=FPn`` (or an FDAT aggregate)."""
+    def fdat(self, value: str, lineno: int) -> tuple[Ref | Unknown, Ref | Unknown, str | None]:
+        """Tool, base and ``IPO_FRAME`` (None: not known) of ``FDAT_ACT=FPn`` (or an FDAT
+        aggregate)."""
         if value.startswith("{"):
             fields = aggregate_fields(value, self.lines, lineno)[1]
         else:
@@ -442,31 +494,58 @@ class _SrcReader:
                        + ("KSS declares in $config.dat" if name.upper() == "FHOME" else
                           "is not declared in the program's .dat")
                        + ", not beside the program")
-                return why, why
+                return why, why, None
             fields = self.dat.data[name.upper()]
         tool_no = int_value(fields.get("TOOL_NO", "0"), self.lines, lineno)
         base_no = int_value(fields.get("BASE_NO", "0"), self.lines, lineno)
         tool_pose, tool_why = self.slot("TOOL_DATA", tool_no)
         base_pose, base_why = self.slot("BASE_DATA", base_no)
         return (tool_why or Ref(number=tool_no, pose=tool_pose),
-                base_why or Ref(number=base_no, pose=base_pose, on_table=None))
+                base_why or Ref(number=base_no, pose=base_pose, on_table=None),
+                fields.get("IPO_FRAME"))
 
-    def with_refs(self, clause: str, lineno: int) -> tuple[Ref | Unknown, Ref | Unknown]:
-        """The tool and base of one motion: set in its ``WITH`` clause, else the current ones
-        (a function of the clause, such as a spline inline form's, is a value of run time)."""
-        tool, base = self.tool, self.base
+    def settings(self, clause: str, lineno: int) -> Settings:
+        """The tool, base, interpolation mode, speed and approximation distance of one motion:
+        those its ``WITH`` clause gives, else the current ones.
+
+        The spline inline forms give them through functions KSS's ``bas.src`` defines:
+        ``$TOOL = STOOL2(FP1)`` is ``TOOL_DATA[FP1.TOOL_NO]`` (``STOOL``), ``$BASE =
+        SBASE(FP1.BASE_NO)`` is ``BASE_DATA[FP1.BASE_NO]`` (``$WORLD`` for 0), ``$IPO_MODE =
+        SIPO_MODE(FP1.IPO_FRAME)`` the FDAT's ``IPO_FRAME`` (the tool and base corrections of
+        technology packages, off in ``$config.dat``, are not applied); the speed and distance
+        as :meth:`MoveData.with_item <robotcell.controllers.kuka.movedata.MoveData.with_item>`
+        reads them. Any other function is a value of run time.
+        """
+        s = Settings(self.tool, self.base, self.external, self.moves.speed, self.moves.cdis)
         for item in _top_level(clause):
-            if m := _TOOL_RE.match(item):
-                tool = self.tool_ref(m.group(1).strip(), lineno)
-            elif m := _BASE_RE.match(item):
-                base = self.base_ref(m.group(1).strip(), lineno)
-        return tool, base
+            key, _, value = item.partition("=")
+            key, value = re.sub(r"\s+", "", key).upper(), value.strip()
+            call = _CALL_RE.match(value)
+            fn, arg = (call.group(1).upper(), call.group(2)) if call else ("", "")
+            fdat = arg.split(".")[0]
+            if key == "$TOOL":
+                s.tool = (self.fdat(arg, lineno)[0] if fn == "STOOL2"
+                          else self.tool_ref(value, lineno))
+            elif key == "$BASE" and fn == "SBASE" and arg.upper().endswith(".BASE_NO"):
+                s.base = self.fdat(fdat, lineno)[1]
+            elif key == "$BASE":
+                s.base = self.base_ref(f"BASE_DATA[{arg}]" if fn == "SBASE" and arg.isdigit()
+                                      else value, lineno)
+            elif key == "$IPO_MODE":
+                mode = self.fdat(fdat, lineno)[2] if fn == "SIPO_MODE" else value
+                s.external = s.external if mode is None else _external(mode, lineno)
+            else:
+                self.moves.with_item(key, value, s, lineno)
+        return s
 
     # -- motions -------------------------------------------------------------------------------
     def motion(self, kind: str, rest: str, lineno: int) -> None:
         """A motion instruction: a point, or a note saying why it is not checked."""
         parts = re.split(r"\s+WITH\s+", rest, maxsplit=1, flags=re.IGNORECASE)
         target, after = _target(parts[0].strip())
+        # the approximation keyword ends the instruction, after a WITH clause if there is one
+        clause, approx = _approx(parts[1] if len(parts) > 1 else "")
+        approx = approx or next((m.group(1).upper() for m in _APPROX_RE.finditer(after)), None)
         label = f"line {lineno}: {kind} {target}"
         if kind.endswith("_REL"):
             self.skipped.append(f"{label} (a motion relative to where the robot is at run time)")
@@ -483,22 +562,25 @@ class _SrcReader:
         if value is None:
             self.skipped.append(f"{label} ({why})")
             return
-        tool, base = self.with_refs(parts[1] if len(parts) > 1 else "", lineno)
-        if value.pose is not None and (isinstance(tool, str) or isinstance(base, str)):
-            self.skipped.append(f"{label} ({tool if isinstance(tool, str) else base})")
+        s = self.settings(clause, lineno)
+        if value.pose is not None and (why := next(
+                (w for w in (s.external, s.tool, s.base) if isinstance(w, str)), None)):
+            self.skipped.append(f"{label} ({why})")
             return
-        if isinstance(tool, str):  # joints: checked whatever the tool; the TCP is the flange's
-            tool = Ref(number=0)
-        if isinstance(base, str):
-            base = Ref(number=0, on_table=None)
-        self.out.append(self.program_point(kind, target, value, tool, base,
-                                           bool(_APPROX_RE.search(after)), lineno))
+        if isinstance(s.tool, str):  # joints: checked whatever the tool; the TCP: the flange's
+            s.tool = Ref(number=0)
+        if isinstance(s.base, str):
+            s.base = Ref(number=0, on_table=None)
+        self.out.append(self.program_point(kind, target, value, s, approx, lineno))
 
     def point(self, target: str, lineno: int) -> tuple[_Point | None, str]:
         """The point a motion goes to, or None and why it is not held by the program."""
         if target.startswith("{"):
             typ, fields = aggregate_fields(target, self.lines, lineno)
-            return _Point(_kind_of(typ, fields), fields, self.lines, lineno, f"line {lineno}"), ""
+            if given := _partial(typ, fields):  # the other components are not in the file
+                return None, (f"the aggregate gives {given} only, not a whole "
+                              + ("axis position" if _kind_of(typ, fields) in _JOINT else "pose"))
+            return _Point(_kind_of(typ, fields), fields, self.lines, lineno, "the aggregate"), ""
         key = re.sub(r"\s+", "", target).upper()
         if key.startswith("$"):
             return None, "not held by the program"
@@ -513,29 +595,23 @@ class _SrcReader:
         if _HOME_RE.match(key):
             return None, f"{target} is a point of $config.dat, not beside the program"
         if self.dat_path is None:
-            raise self.lines.error(lineno, f"the .dat is missing: {target} is a point of the "
-                                           f"program's .dat, and there is no "
-                                           f"{Path(self.lines.path).stem}.dat beside the .src; "
-                                           "copy it there with the .src")
+            return None, (f"{target} is declared neither in the .src nor in a .dat beside it: "
+                          f"there is no {Path(self.lines.path).stem}.dat, copy the program's "
+                          ".dat beside the .src if it has one (a global point of another "
+                          "module or of $config.dat is not read)")
         return None, (f"{target} is declared in neither the program's .dat nor its .src (a "
                       "global point of another module is not read)")
 
-    def program_point(self, kind: str, target: str, value: _Point, tool: Ref, base: Ref,
-                      approx: bool, lineno: int) -> ProgramPoint:
-        lines = self.lines
+    def program_point(self, kind: str, target: str, value: _Point, s: Settings,
+                      approx: str | None, lineno: int) -> ProgramPoint:
         motion = "lin" if kind in ("LIN", "SLIN") else "ptp"
-        v = self.speed
-        if motion == "lin" and "VEL" in self.motion_data:
-            v = lines.number(self.motion_data["VEL"], lineno)
-        z = self.zone if approx else 0.0
-        if approx and "APO_DIST" in self.motion_data:
-            z = lines.number(self.motion_data["APO_DIST"], lineno) * 1e-3
         name = f"line {lineno}" if target.startswith("{") else target
         # S and T: PTP only. A linear first motion keeps the configuration the robot is in,
         # which the files do not hold: the point's S and T are the best statement of it.
         config = value.config if motion == "ptp" or not self.out else None
-        return ProgramPoint(name, lineno, motion, tool, base, value.pose, value.joints, config,
-                            dict(value.external), v if motion == "lin" else None, z, value.where)
+        return ProgramPoint(name, lineno, motion, s.tool, s.base, value.pose, value.joints,
+                            config, dict(value.external), s.speed if motion == "lin" else None,
+                            zone(approx, s.cdis), value.where)
 
 
 def _target(text: str) -> tuple[str, str]:
@@ -552,6 +628,15 @@ def _target(text: str) -> tuple[str, str]:
     if not m:
         return text, ""
     return m.group(0), text[m.end():].strip()
+
+
+def _approx(text: str) -> tuple[str, str | None]:
+    """``text`` without the approximation keyword that ends it (``C_DIS``, ``C_SPL``, ..), and
+    the keyword (upper case; None without one)."""
+    m = re.search(rf"(?:^|\s){_APPROX_RE.pattern}\s*$", text, re.IGNORECASE)
+    if not m:
+        return text, None
+    return text[:m.start()].rstrip(), m.group(1).upper()
 
 
 def _top_level(text: str) -> list[str]:
