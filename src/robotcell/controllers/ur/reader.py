@@ -102,19 +102,12 @@ def _body(text: str) -> list[str]:
     (``if (n == 9): movej(q, t=2) end``); other statements as they are."""
     if not re.match(r"^(?:" + "|".join((*_BLOCKS, "elif", "else")) + r")\b", text):
         return [text]
-    depth, quoted = 0, False
-    for i, ch in enumerate(text):
-        if ch == '"':
-            quoted = not quoted
-        elif not quoted and ch in "([{":
-            depth += 1
-        elif not quoted and ch in ")]}":
-            depth -= 1
-        elif ch == ":" and not quoted and depth == 0:
-            body = text[i + 1:].strip()
-            closed = re.fullmatch(r"(.*\S)\s+end", body, re.DOTALL)
-            return [text[:i + 1], *([closed.group(1), "end"] if closed else [body] * bool(body))]
-    return [text]
+    head, *rest = split(text, ":")
+    if not rest:
+        return [text]
+    body = ":".join(rest).strip()
+    closed = re.fullmatch(r"(.*\S)\s+end", body, re.DOTALL)
+    return [head + ":", *([closed.group(1), "end"] if closed else [body] * bool(body))]
 
 
 def statements(lines: Lines) -> list[tuple[int, str]]:
